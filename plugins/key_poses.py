@@ -1,0 +1,189 @@
+"""Timed key poses: the authoring format of movements, and their interpolation into motions.
+
+Buchsbaum & Blumberg 2005, §4.1: source animation is broken into *poses*
+corresponding to key-frames, and *movements* are connected poses played by
+interpolating between them. This module reads that declaration from a motor
+table and samples it; motor systems (``keyframe``, ``posegraph``) build on it.
+
+Declaration (inside a character's ``[motor]`` table)::
+
+    [motor.poses.stand]              # every part, local frame, metres
+    root = [0.0, 0.30, 0.0]
+    ...
+    [motor.poses.crouch]
+    base = "stand"                   # start from another pose
+    shift = [0.0, -0.06, 0.0]        # move every part (optional)
+    offset = { left_knee = [0.0, -0.03, 0.06] }   # move some parts (optional)
+    nose = [0.0, 0.50, 0.12]         # or place a part absolutely
+
+    [motor.movements.jump]
+    keys = [{ pose = "stand", at = 0.0 }, { pose = "crouch", at = 0.25 }, ...]   # at: seconds
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy.interpolate import PchipInterpolator
+
+from toolkit.body import Body
+from toolkit.errors import ConfigError
+from toolkit.motion import Motion
+
+__all__ = ["KeyPoses", "Movement", "parse_poses", "parse_movements", "interpolate"]
+
+POSE_KEYS = ("base", "shift", "offset")
+
+
+@dataclass(frozen=True)
+class Movement:
+    """A movement: named key poses at times (seconds from its start)."""
+
+    name: str
+    poses: tuple[str, ...]
+    times: np.ndarray
+    description: str = ""
+
+    @property
+    def duration(self) -> float:
+        return float(self.times[-1])
+
+
+@dataclass(frozen=True)
+class KeyPoses:
+    """Named poses as one contiguous array: ``array[i]`` is pose ``names[i]``, shape (N, P, 3)."""
+
+    names: tuple[str, ...]
+    array: np.ndarray
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.array[self.names.index(name)]
+
+
+def _vec(value: Any, key: tuple) -> np.ndarray:
+    if (
+        not isinstance(value, list)
+        or len(value) != 3
+        or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
+        or not np.all(np.isfinite(value))
+    ):
+        raise ConfigError(f"invalid value {value!r}", key=key, expected="[x, y, z] finite numbers in metres")
+    return np.asarray(value, dtype=float)
+
+
+def parse_poses(table: Mapping[str, Any], body: Body) -> KeyPoses:
+    """Resolve a ``poses`` table (with ``base`` references) into full poses of ``body``.
+
+    Errors carry key paths relative to the motor table (``("poses", name, part)``).
+    """
+    if not table:
+        raise ConfigError("no poses declared", key=("poses",), expected="at least one [motor.poses.NAME] table")
+    resolved: dict[str, np.ndarray] = {}
+
+    def resolve(name: str, chain: tuple[str, ...]) -> np.ndarray:
+        if name in resolved:
+            return resolved[name]
+        spec = table[name]
+        key = ("poses", name)
+        if not isinstance(spec, Mapping):
+            raise ConfigError("not a table", key=key, expected="a table of part positions")
+        for k in spec:
+            if k not in POSE_KEYS and k not in body.parts:
+                raise ConfigError(
+                    f"unknown key {k!r}", key=(*key, k), expected="a body part or base/shift/offset", available=(*body.parts, *POSE_KEYS)
+                )
+        base = spec.get("base")
+        if base is not None:
+            if not isinstance(base, str) or base not in table:
+                raise ConfigError(f"unknown pose {base!r}", key=(*key, "base"), expected="the name of a declared pose", available=sorted(table))
+            if base in chain:
+                raise ConfigError(f"pose base cycle: {' -> '.join((*chain, name, base))}", key=(*key, "base"), expected="no cycle")
+            pose = resolve(base, (*chain, name)).copy()
+        else:
+            missing = [p for p in body.parts if p not in spec]
+            if missing:
+                raise ConfigError(
+                    f"pose without base misses parts {missing}", key=key, expected="a position for every part, or base = POSE"
+                )
+            pose = np.zeros((body.n_parts, 3))
+        if "shift" in spec:
+            pose += _vec(spec["shift"], (*key, "shift"))
+        offsets = spec.get("offset", {})
+        if not isinstance(offsets, Mapping):
+            raise ConfigError("not a table", key=(*key, "offset"), expected="a table of part = [dx, dy, dz]")
+        for part, value in offsets.items():
+            pose[body.index(part, key=(*key, "offset", part))] += _vec(value, (*key, "offset", part))
+        for part in body.parts:
+            if part in spec:
+                pose[body.index(part)] = _vec(spec[part], (*key, part))
+        resolved[name] = pose
+        return pose
+
+    names = tuple(table)
+    array = np.stack([resolve(n, ()) for n in names])
+    return KeyPoses(names, array)
+
+
+def parse_movements(table: Mapping[str, Any], poses: KeyPoses, hubs: Sequence[str]) -> dict[str, Movement]:
+    """Read a ``movements`` table; every movement must start and end in a hub pose (§5.1)."""
+    if not table:
+        raise ConfigError("no movements declared", key=("movements",), expected="at least one [motor.movements.NAME] table")
+    out: dict[str, Movement] = {}
+    for name, spec in table.items():
+        key = ("movements", name)
+        if not isinstance(spec, Mapping):
+            raise ConfigError("not a table", key=key, expected="a table with keys = [...]")
+        for k in spec:
+            if k not in ("keys", "description"):
+                raise ConfigError(f"unknown key {k!r}", key=(*key, k), expected="a movement key", available=("description", "keys"))
+        keys = spec.get("keys")
+        if not isinstance(keys, list) or len(keys) < 2:
+            raise ConfigError("missing or too short", key=(*key, "keys"), expected='two or more { pose = "...", at = seconds }')
+        names, times = [], []
+        for i, k in enumerate(keys):
+            kk = (*key, "keys", i)
+            if not isinstance(k, Mapping) or set(k) != {"pose", "at"}:
+                raise ConfigError(f"invalid key pose {k!r}", key=kk, expected='{ pose = "NAME", at = SECONDS }')
+            if k["pose"] not in poses.names:
+                raise ConfigError(f"unknown pose {k['pose']!r}", key=(*kk, "pose"), expected="a declared pose", available=poses.names)
+            at = k["at"]
+            if isinstance(at, bool) or not isinstance(at, (int, float)) or not np.isfinite(at):
+                raise ConfigError(f"invalid time {at!r}", key=(*kk, "at"), expected="seconds as a number")
+            names.append(k["pose"])
+            times.append(float(at))
+        t = np.asarray(times)
+        if t[0] != 0.0 or np.any(np.diff(t) <= 0):
+            raise ConfigError(f"key times {times} are not increasing from 0", key=(*key, "keys"), expected="times starting at 0 and strictly increasing")
+        for end, idx in (("start", 0), ("end", -1)):
+            if names[idx] not in hubs:
+                raise ConfigError(
+                    f"movement must {end} in a hub pose, not {names[idx]!r}", key=(*key, "keys"), expected="a hub pose", available=tuple(hubs)
+                )
+        description = spec.get("description", "")
+        out[name] = Movement(name, tuple(names), t, str(description))
+    return out
+
+
+def interpolate(
+    key_poses: np.ndarray, times: np.ndarray, parts: Sequence[str], *, fps: float, speed: float = 1.0
+) -> Motion:
+    """Sample key poses (K, P, 3) at ``times`` (K,) into a motion at ``fps``.
+
+    Shape-preserving cubic (PCHIP) interpolation: no overshoot past a key, zero
+    velocity where the motion turns. ``speed`` > 1 plays faster. The first and
+    last frames are exactly the first and last keys.
+    """
+    if speed <= 0:
+        raise ValueError("speed must be positive")
+    duration = float(times[-1]) / speed
+    n = max(2, int(round(duration * fps)) + 1)
+    t = np.linspace(0.0, float(times[-1]), n)
+    flat = key_poses.reshape(len(times), -1)
+    if len(times) == 2:
+        values = flat[0] + (t / times[-1])[:, None] * (flat[1] - flat[0])
+    else:
+        values = PchipInterpolator(times, flat, axis=0)(t)
+    return Motion(values.reshape(n, len(parts), 3), fps, parts)

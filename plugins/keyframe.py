@@ -1,0 +1,66 @@
+"""Motor system ``keyframe``: movements played from timed key poses.
+
+The demonstrator's motor system in both papers: Moritz "can perform arbitrary
+movements by executing predefined keyframe animations" (Kopp & Graeser 2006,
+§4), and Max and Morris's movements are interpolated key poses (Buchsbaum &
+Blumberg 2005, §4.1). It has no graph and learns nothing; the ``posegraph``
+motor system adds the graph.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from plugins.key_poses import KeyPoses, Movement, interpolate, parse_movements, parse_poses
+from toolkit import ConfigError, MotorSystem, Motion, Parameter, hookimpl
+
+
+class KeyframeMotor(MotorSystem):
+    """Plays movements authored as timed key poses, hub to hub (no learning)."""
+
+    name = "keyframe"
+    parameters = (
+        Parameter("rest", str, "stand", "The hub pose the character stands in when idle."),
+        Parameter("hubs", list, [], "Further hub poses movements may start and end in (the rest pose always is one).", items=str),
+        Parameter("poses", dict, doc="Named key poses, local frame, metres (see the character format)."),
+        Parameter("movements", dict, doc="Named movements: key poses at times in seconds."),
+    )
+
+    def attach(self, owner: Any) -> None:
+        super().attach(owner)
+        body = owner.body
+        self.key_poses: KeyPoses = parse_poses(self.params["poses"], body)
+        self.hubs = (self.params["rest"], *self.params["hubs"])
+        for i, hub in enumerate(self.hubs):
+            if hub not in self.key_poses.names:
+                raise ConfigError(
+                    f"unknown hub pose {hub!r}",
+                    key=("rest",) if i == 0 else ("hubs", i - 1),
+                    expected="a declared pose",
+                    available=self.key_poses.names,
+                )
+        self.repertoire: dict[str, Movement] = parse_movements(self.params["movements"], self.key_poses, self.hubs)
+        self.parts = body.parts
+
+    def movements(self) -> list[str]:
+        return list(self.repertoire)
+
+    def rest_pose(self) -> np.ndarray:
+        return self.key_poses[self.hubs[0]]
+
+    def perform(self, movement: str, *, speed: float = 1.0, fps: float = 30.0) -> Motion:
+        if movement not in self.repertoire:
+            raise ConfigError(f"unknown movement {movement!r}", expected="a movement of this character", available=self.movements())
+        m = self.repertoire[movement]
+        keys = np.stack([self.key_poses[p] for p in m.poses])
+        return interpolate(keys, m.times, self.parts, fps=fps, speed=speed)
+
+    def describe(self) -> dict[str, Any]:
+        return {"movements": len(self.repertoire), "poses": len(self.key_poses.names), "hubs": list(self.hubs)}
+
+
+@hookimpl
+def likeme_register_motor_systems() -> list[type[MotorSystem]]:
+    return [KeyframeMotor]

@@ -1,0 +1,33 @@
+"""Perception ``motion-capture``: every part of the target, exactly, as a tracking suit reports it.
+
+The perfect-input baseline for the perception stage: no field of view, no
+occlusion, no noise. The world positions are converted to root-relative
+coordinates with the facing found from the body's facing parts (Buchsbaum &
+Blumberg 2005, §5.1, see :mod:`plugins.root_frame`), so the result is what the
+``synthetic-vision`` perception gives when nothing is hidden.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from plugins.root_frame import to_root_relative
+from toolkit import Percept, Perception, hookimpl
+
+
+class MotionCapture(Perception):
+    """Sees every part of the target exactly (no occlusion or noise); root-relative by §5.1."""
+
+    name = "motion-capture"
+
+    def perceive(self, observer, target, world) -> Percept:
+        positions = target.world_pose()
+        visible = np.isfinite(positions).all(axis=-1)
+        pose, mask, root, heading = to_root_relative(positions, visible, target.body)
+        objects = {name: obj.position.copy() for name, obj in world.objects.items()}
+        return Percept(world.time, pose, mask, np.where(mask[:, None], positions, np.nan), root, float(heading), objects)
+
+
+@hookimpl
+def likeme_register_perceptions():
+    return [MotionCapture]

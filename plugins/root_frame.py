@@ -1,0 +1,92 @@
+"""Root-relative body-part coordinates and the facing found from the nose and the knees.
+
+Buchsbaum & Blumberg 2005, §5.1: the observer converts the world positions of
+the target's visible parts to positions relative to the target's *root node*,
+with the facing found from a forward marker (the nose, "always somewhat in front
+of the body") against the line through the knees. Only visible parts are used.
+
+All functions are vectorised over leading frame axes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from toolkit.body import Body
+from toolkit.motion import world_to_local
+
+__all__ = ["facing_heading", "to_root_relative"]
+
+_UP = np.array([0.0, 1.0, 0.0])
+
+
+def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body) -> np.ndarray:
+    """Heading (radians about +y) of a body from its visible parts; NaN where it cannot be found.
+
+    Parameters
+    ----------
+    world : array, shape (..., P, 3)
+    visible : array of bool, shape (..., P)
+    body : Body
+
+    Notes
+    -----
+    With both facing parts (knees) visible, the facing is the horizontal
+    perpendicular of the line from right to left; the forward marker (nose),
+    when visible, picks the side of that line it lies on. With a knee hidden,
+    the horizontal direction from the root to the forward marker is used.
+    """
+    world = np.asarray(world, dtype=float)
+    visible = np.asarray(visible, dtype=bool)
+    li, ri, root = body.index(body.facing.left), body.index(body.facing.right), body.root_index
+    across = world[..., li, :] - world[..., ri, :]
+    perp = np.cross(across, _UP)  # +z when left is +x
+    perp[..., 1] = 0.0
+    knees = visible[..., li] & visible[..., ri]
+    heading = np.full(world.shape[:-2], np.nan)
+    if body.facing.forward is not None:
+        fi = body.index(body.facing.forward)
+        mid = 0.5 * (world[..., li, :] + world[..., ri, :])
+        ahead = world[..., fi, :] - mid
+        side = np.sign(np.einsum("...i,...i->...", ahead, perp))
+        perp = perp * np.where((side < 0) & visible[..., fi], -1.0, 1.0)[..., None]
+        fallback = world[..., fi, :] - world[..., root, :]
+        fallback[..., 1] = 0.0
+        use_fb = ~knees & visible[..., fi] & visible[..., root]
+        perp = np.where(use_fb[..., None], fallback, perp)
+        knees = knees | use_fb
+    norm = np.linalg.norm(perp, axis=-1)
+    ok = knees & (norm > 1e-9)
+    heading[ok] = np.arctan2(perp[..., 0], perp[..., 2])[ok]
+    return heading
+
+
+def to_root_relative(world: np.ndarray, visible: np.ndarray, body: Body) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """World positions to root-relative positions in the body's own frame.
+
+    Returns
+    -------
+    pose : array, shape (..., P, 3)
+        Root-relative positions, rotated so the body faces +z.
+    visible : array of bool, shape (..., P)
+        The input mask, cleared where root or heading were not found.
+    root : array, shape (..., 3)
+        The root's world position.
+    heading : array, shape (...)
+    """
+    world = np.asarray(world, dtype=float)
+    visible = np.asarray(visible, dtype=bool) & np.isfinite(world).all(axis=-1)
+    heading = facing_heading(np.where(visible[..., None], world, 0.0), visible, body)
+    root = world[..., body.root_index, :]
+    ok = visible[..., body.root_index] & np.isfinite(heading)
+    safe_world = np.where(visible[..., None], world, 0.0)
+    safe_root = np.where(ok[..., None], root, 0.0)
+    safe_heading = np.where(ok, heading, 0.0)
+    if world.ndim == 2:
+        pose = world_to_local(safe_world, safe_root, float(safe_heading))
+    else:
+        flat = safe_world.reshape(-1, *world.shape[-2:])
+        pose = world_to_local(flat, safe_root.reshape(-1, 3), safe_heading.reshape(-1)).reshape(world.shape)
+    mask = visible & ok[..., None]
+    pose = np.where(mask[..., None], pose, np.nan)
+    return pose, mask, np.where(ok[..., None], root, np.nan), heading

@@ -1,0 +1,173 @@
+"""Bodies: which parts of a character are tracked, which is the root, which give the facing.
+
+Notation used across likeme (the same in every module):
+
+- ``P``: number of tracked body parts; ``F``: number of frames.
+- Positions are metres in a right-handed frame with ``+y`` up. A character's
+  *local* frame has its origin on the ground under the root at rest, ``+z``
+  pointing where the character faces and ``+x`` to the character's left.
+- *Root-relative* coordinates (Buchsbaum & Blumberg 2005, §5.1) are local
+  coordinates with the root position subtracted: rotation by the facing and
+  translation to the root node.
+
+A :class:`Body` is plain data. It is declared in a character's ``[body]`` table
+(see ``docs/character-format.md``) or built in Python.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from toolkit.errors import ConfigError
+
+__all__ = ["Body", "Facing"]
+
+
+@dataclass(frozen=True)
+class Facing:
+    """The parts that tell which way a body faces (§5.1: the nose against the knees).
+
+    ``left`` and ``right`` define a line across the body (the knees); ``forward``,
+    when given, is a part that is always somewhat in front of the body (the nose)
+    and resolves which side of that line is the front.
+    """
+
+    left: str
+    right: str
+    forward: str | None = None
+
+
+@dataclass(frozen=True)
+class Body:
+    """The tracked body parts of a character.
+
+    Parameters
+    ----------
+    parts : sequence of str
+        Names of the tracked parts, in the order of the ``P`` axis of every array.
+    root : str
+        The root node: reference point of root-relative coordinates.
+    facing : Facing
+        Parts that give the facing direction.
+    bones : sequence of (str, str), optional
+        Pairs of parts drawn as bones and used for occlusion between parts.
+    colours : mapping of str to str, optional
+        Colour code of each part (``"#rrggbb"``), used by colour-coded vision and pictures.
+    """
+
+    parts: tuple[str, ...]
+    root: str
+    facing: Facing
+    bones: tuple[tuple[str, str], ...] = ()
+    colours: Mapping[str, str] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "parts", tuple(self.parts))
+        object.__setattr__(self, "bones", tuple(tuple(b) for b in self.bones))
+        object.__setattr__(self, "colours", dict(self.colours))
+        if len(set(self.parts)) != len(self.parts):
+            dupes = sorted({p for p in self.parts if self.parts.count(p) > 1})
+            raise ConfigError(f"duplicate part names {dupes}", key=("parts",), expected="unique names")
+        if not self.parts:
+            raise ConfigError("a body needs at least one part", key=("parts",), expected="a non-empty list")
+        self.index(self.root, key=("root",))
+        self.index(self.facing.left, key=("facing", "left"))
+        self.index(self.facing.right, key=("facing", "right"))
+        if self.facing.forward is not None:
+            self.index(self.facing.forward, key=("facing", "forward"))
+        for i, (a, b) in enumerate(self.bones):
+            self.index(a, key=("bones", i))
+            self.index(b, key=("bones", i))
+        for part in self.colours:
+            self.index(part, key=("colours", part))
+
+    # -- lookups -----------------------------------------------------------------
+
+    @property
+    def n_parts(self) -> int:
+        return len(self.parts)
+
+    @property
+    def root_index(self) -> int:
+        return self.parts.index(self.root)
+
+    def index(self, part: str, *, key: Sequence[str | int] = ()) -> int:
+        """Index of ``part`` on the ``P`` axis; a :class:`ConfigError` listing the parts if unknown."""
+        try:
+            return self.parts.index(part)
+        except ValueError:
+            raise ConfigError(
+                f"unknown body part {part!r}", key=key, expected="a part of this body", available=self.parts
+            ) from None
+
+    def indices(self, parts: Iterable[str]) -> np.ndarray:
+        """Indices of several parts, as an integer array."""
+        return np.array([self.index(p) for p in parts], dtype=np.intp)
+
+    def bone_indices(self) -> np.ndarray:
+        """Bones as an ``(n_bones, 2)`` integer array."""
+        return np.array([[self.index(a), self.index(b)] for a, b in self.bones], dtype=np.intp).reshape(-1, 2)
+
+    # -- declaration -------------------------------------------------------------
+
+    @classmethod
+    def from_config(cls, table: Mapping[str, Any]) -> Body:
+        """Build a body from a character's ``[body]`` table.
+
+        Raises :class:`ConfigError` with a key path relative to the table.
+        """
+        known = {"parts", "root", "facing", "bones", "colours"}
+        for key in table:
+            if key not in known:
+                raise ConfigError(f"unknown key {key!r}", key=(key,), expected="a body key", available=sorted(known))
+        parts = table.get("parts")
+        if not isinstance(parts, list) or not all(isinstance(p, str) for p in parts):
+            raise ConfigError("missing or invalid", key=("parts",), expected="a list of part names")
+        root = table.get("root")
+        if not isinstance(root, str):
+            raise ConfigError("missing or invalid", key=("root",), expected="the name of the root part", available=parts)
+        facing = table.get("facing")
+        if not isinstance(facing, Mapping):
+            raise ConfigError(
+                "missing or invalid", key=("facing",), expected='a table {left = "...", right = "...", forward = "..."}'
+            )
+        for key in facing:
+            if key not in ("left", "right", "forward"):
+                raise ConfigError(
+                    f"unknown key {key!r}", key=("facing", key), expected="a facing key", available=("forward", "left", "right")
+                )
+        for key in ("left", "right"):
+            if not isinstance(facing.get(key), str):
+                raise ConfigError("missing or invalid", key=("facing", key), expected="a part name", available=parts)
+        forward = facing.get("forward")
+        if forward is not None and not isinstance(forward, str):
+            raise ConfigError("invalid", key=("facing", "forward"), expected="a part name", available=parts)
+        bones = table.get("bones", [])
+        if not isinstance(bones, list) or not all(
+            isinstance(b, list) and len(b) == 2 and all(isinstance(p, str) for p in b) for b in bones
+        ):
+            raise ConfigError("invalid", key=("bones",), expected='a list of part pairs like [["root", "head"]]')
+        colours = table.get("colours", {})
+        if not isinstance(colours, Mapping) or not all(_is_hex_colour(c) for c in colours.values()):
+            raise ConfigError("invalid", key=("colours",), expected='a table of part = "#rrggbb"')
+        return cls(
+            parts=tuple(parts),
+            root=root,
+            facing=Facing(facing["left"], facing["right"], forward),
+            bones=tuple((a, b) for a, b in bones),
+            colours=dict(colours),
+        )
+
+
+def _is_hex_colour(value: object) -> bool:
+    if not isinstance(value, str) or len(value) != 7 or value[0] != "#":
+        return False
+    try:
+        int(value[1:], 16)
+    except ValueError:
+        return False
+    return True

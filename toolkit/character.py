@@ -1,0 +1,416 @@
+"""Characters declared in TOML, composed at load time from registered components.
+
+A character file has these tables (``docs/character-format.md`` is the full reference)::
+
+    [character]   name, optional extends and description
+    [body]        tracked parts, root, facing parts, bones, colours
+    [motor]       plugin = NAME and its parameters (the movement repertoire)
+    [perception]  plugin = NAME and its parameters      (optional)
+    [segmenter]   plugin = NAME and its parameters      (optional)
+    [matcher]     plugin = NAME and its parameters      (optional)
+    [action]      plugin = NAME and its parameters      (optional)
+
+``extends`` names another character file; its tables are the defaults, the
+file's own tables are merged over them key by key (a component table whose
+``plugin`` changes replaces the inherited one whole).
+
+Every problem is a :class:`~toolkit.errors.ConfigError` naming the file, the
+key path (and the line where it can be found), what was expected and what is
+available.
+"""
+
+from __future__ import annotations
+
+import re
+import tomllib
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from toolkit.body import Body
+from toolkit.components import ActionSystem, Component, Matcher, MotorSystem, Perception, Segmenter
+from toolkit.errors import ConfigError, LikemeError, PluginError
+from toolkit.manager import PluginManager
+
+__all__ = [
+    "Character",
+    "load_character",
+    "compose_character",
+    "read_toml",
+    "resolve_file",
+    "character_paths",
+    "merge_tables",
+    "COMPONENT_TABLES",
+]
+
+COMPONENT_TABLES: dict[str, bool] = {
+    "motor": True,
+    "perception": False,
+    "segmenter": False,
+    "matcher": False,
+    "action": False,
+}
+"""Component tables of a character file and whether each is required."""
+
+TOP_LEVEL = ("character", "body", *COMPONENT_TABLES)
+CHARACTER_KEYS = ("name", "extends", "description")
+
+
+@dataclass
+class Character:
+    """A composed character: its body and the components of its pipeline.
+
+    Attributes
+    ----------
+    name : str
+    body : Body
+    motor : MotorSystem
+    perception, segmenter, matcher, action : component or None
+    files : tuple of Path
+        The file it was loaded from first, then the files it extends.
+    description : str
+    config : dict
+        The merged declaration.
+    pm : PluginManager or None
+        The plugin manager it was composed with; components announce events through ``pm.hook``.
+    """
+
+    name: str
+    body: Body
+    motor: MotorSystem
+    perception: Perception | None = None
+    segmenter: Segmenter | None = None
+    matcher: Matcher | None = None
+    action: ActionSystem | None = None
+    files: tuple[Path, ...] = ()
+    description: str = ""
+    config: dict[str, Any] = field(default_factory=dict)
+    pm: PluginManager | None = field(default=None, repr=False)
+
+    @property
+    def file(self) -> Path | None:
+        return self.files[0] if self.files else None
+
+    def components(self) -> dict[str, Component]:
+        """The configured components by table name (``motor``, ``perception``...)."""
+        return {k: c for k in COMPONENT_TABLES if (c := getattr(self, k)) is not None}
+
+    def pipeline(self) -> list[tuple[str, Component | None]]:
+        """The stages perceive, segment, match, interpret, respond with the component of each."""
+        return [
+            ("perceive", self.perception),
+            ("segment", self.segmenter),
+            ("match", self.matcher),
+            ("interpret", self.action),
+            ("respond", self.action),
+        ]
+
+    def announce(self, hook: str, **kwargs: Any) -> None:
+        """Call a run-event hook if this character has a plugin manager."""
+        if self.pm is not None:
+            getattr(self.pm.hook, hook)(**kwargs)
+
+
+# -- reading files -------------------------------------------------------------------
+
+
+def read_toml(path: str | Path) -> dict[str, Any]:
+    """Parse a TOML file; syntax errors become a :class:`ConfigError` with line and column."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ConfigError("file not found", file=path, expected="an existing TOML file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ConfigError(f"cannot read file ({exc})", file=path, expected="a readable UTF-8 TOML file") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        msg = str(exc)
+        m = re.search(r"\(at line (\d+), column (\d+)\)", msg)
+        line, col = (int(m.group(1)), int(m.group(2))) if m else (None, None)
+        problem = re.sub(r"\s*\(at (line \d+, column \d+|end of document)\)", "", msg)
+        return _raise(ConfigError(f"TOML syntax error: {problem}", file=path, line=line, column=col))
+
+
+def _raise(err: Exception) -> Any:
+    raise err
+
+
+def character_paths(pm: PluginManager | None = None) -> list[Path]:
+    """Folders searched for character and scenario files named without a path.
+
+    In order: ``$LIKEME_CHARACTERS`` (``os.pathsep``-separated), the project's
+    ``characters/`` folder (source tree or editable install), the installed copy
+    under ``<prefix>/share/likeme/characters``, then folders from the
+    ``likeme_character_paths`` hook.
+    """
+    import os
+    import sys
+
+    paths: list[Path] = []
+    env = os.environ.get("LIKEME_CHARACTERS")
+    if env:
+        paths.extend(Path(p) for p in env.split(os.pathsep) if p)
+    project = Path(__file__).resolve().parent.parent / "characters"
+    paths.append(project)
+    paths.append(Path(sys.prefix) / "share" / "likeme" / "characters")
+    if pm is not None:
+        for result in pm.hook.likeme_character_paths():
+            paths.extend(Path(p) for p in result or ())
+    out: list[Path] = []
+    for p in paths:
+        for candidate in (p, p / "scenarios"):
+            if candidate.is_dir() and candidate not in out:
+                out.append(candidate)
+    return out
+
+
+def resolve_file(ref: str, base: Path | None, pm: PluginManager | None, *, key: tuple = (), file: Path | None = None) -> Path:
+    """Find a referenced file: a path relative to ``base``, else a name on :func:`character_paths`."""
+    candidates: list[Path] = []
+    if base is not None:
+        candidates.append(base / ref)
+    candidates.append(Path(ref))
+    name = ref if ref.endswith(".toml") else ref + ".toml"
+    searched = character_paths(pm)
+    candidates.extend(p / name for p in searched)
+    for c in candidates:
+        if c.is_file():
+            return c.resolve()
+    known = sorted({f.stem for p in searched for f in p.glob("*.toml")})
+    raise ConfigError(
+        f"cannot find {ref!r}",
+        file=file,
+        key=key,
+        expected="a path relative to this file or the name of a character on the search path",
+        available=known,
+    )
+
+
+def merge_tables(base: Mapping[str, Any], over: Mapping[str, Any]) -> dict[str, Any]:
+    """Deep-merge ``over`` onto ``base``: tables merge, anything else is replaced.
+
+    A table whose ``plugin`` key differs from the inherited one replaces it whole,
+    so parameters of one plugin never leak into another.
+    """
+    out = dict(base)
+    for key, value in over.items():
+        old = out.get(key)
+        if isinstance(old, Mapping) and isinstance(value, Mapping):
+            if "plugin" in value and value.get("plugin") != old.get("plugin"):
+                out[key] = dict(value)
+            else:
+                out[key] = merge_tables(old, value)
+        else:
+            out[key] = value
+    return out
+
+
+def _load_chain(path: Path, pm: PluginManager | None, stack: tuple[Path, ...] = ()) -> tuple[dict[str, Any], tuple[Path, ...]]:
+    """The merged table of ``path`` and everything it extends, and the files involved (outermost first)."""
+    path = path.resolve()
+    if path in stack:
+        cycle = " -> ".join(p.name for p in (*stack, path))
+        raise ConfigError(f"extends cycle: {cycle}", file=stack[-1], key=("character", "extends"), expected="no cycle")
+    table = read_toml(path)
+    head = table.get("character", {})
+    if not isinstance(head, Mapping):
+        raise ConfigError("not a table", file=path, key=("character",), expected="a [character] table")
+    ref = head.get("extends")
+    if ref is None:
+        return table, (path,)
+    if not isinstance(ref, str):
+        raise ConfigError(f"wrong type {type(ref).__name__}", file=path, key=("character", "extends"), expected="a file path or character name")
+    parent_path = resolve_file(ref, path.parent, pm, key=("character", "extends"), file=path)
+    parent, files = _load_chain(parent_path, pm, (*stack, path))
+    own = dict(table)
+    own["character"] = {k: v for k, v in head.items() if k != "extends"}
+    parent = dict(parent)
+    parent["character"] = {k: v for k, v in parent.get("character", {}).items() if k != "name"}
+    return merge_tables(parent, own), (path, *files)
+
+
+def load_character(
+    path: str | Path, pm: PluginManager | None = None, *, override: Mapping[str, Any] | None = None
+) -> Character:
+    """Load, merge, validate and compose the character declared in ``path``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The character file, or the name of a character on the search path.
+    pm : PluginManager, optional
+        Where components are looked up; a new one is created if omitted.
+    override : mapping, optional
+        Tables merged over the file's (a scenario's per-actor overrides).
+    """
+    if pm is None:
+        from toolkit.manager import create_plugin_manager
+
+        pm = create_plugin_manager()
+    p = Path(path)
+    if not p.is_file():
+        p = resolve_file(str(path), None, pm)
+    table, files = _load_chain(p, pm)
+    if override:
+        table = merge_tables(table, override)
+    try:
+        return compose_character(table, pm, files=files)
+    except ConfigError as err:
+        raise _locate(err, files) from None
+
+
+def compose_character(table: Mapping[str, Any], pm: PluginManager, *, files: tuple[Path, ...] = ()) -> Character:
+    """Validate a merged character table and build its components.
+
+    Raises :class:`ConfigError` with the key path (file placement is done by
+    :func:`load_character`) or :class:`PluginError` if a component fails to build.
+    """
+    for key in table:
+        if key not in TOP_LEVEL:
+            raise ConfigError(f"unknown table {key!r}", key=(key,), expected="a character table", available=TOP_LEVEL)
+    head = _table(table, "character", required=True)
+    for key in head:
+        if key not in CHARACTER_KEYS:
+            raise ConfigError(f"unknown key {key!r}", key=("character", key), expected="a [character] key", available=CHARACTER_KEYS)
+    name = head.get("name")
+    if not isinstance(name, str) or not name.strip():
+        raise ConfigError("missing or invalid", key=("character", "name"), expected="a non-empty string")
+    description = head.get("description", "")
+    if not isinstance(description, str):
+        raise ConfigError("wrong type", key=("character", "description"), expected="a string")
+    try:
+        body = Body.from_config(_table(table, "body", required=True))
+    except ConfigError as err:
+        raise err.within(prefix=("body",)) from None
+
+    built: dict[str, Component | None] = {}
+    for key, required in COMPONENT_TABLES.items():
+        sub = _table(table, key, required=required)
+        built[key] = None if sub is None else build_component(key, sub, pm)
+    character = Character(
+        name=name,
+        body=body,
+        motor=built["motor"],  # type: ignore[arg-type]
+        perception=built["perception"],  # type: ignore[arg-type]
+        segmenter=built["segmenter"],  # type: ignore[arg-type]
+        matcher=built["matcher"],  # type: ignore[arg-type]
+        action=built["action"],  # type: ignore[arg-type]
+        files=files,
+        description=description,
+        config=dict(table),
+        pm=pm,
+    )
+    for key, component in character.components().items():  # motor first: the others read it
+        _guard(component, key, "attach", lambda c=component: c.attach(character))
+    try:
+        pm.hook.likeme_character_composed(character=character)
+    except LikemeError:
+        raise
+    except Exception as exc:
+        raise PluginError("(a plugin)", "likeme_character_composed", f"{type(exc).__name__}: {exc}") from exc
+    return character
+
+
+def build_component(key: str, table: Mapping[str, Any], pm: PluginManager) -> Component:
+    """Build the component declared by one component table (``plugin = NAME`` plus parameters)."""
+    name = table.get("plugin")
+    registry = pm.registry
+    if not isinstance(name, str):
+        raise ConfigError(
+            "missing or invalid plugin name",
+            key=(key, "plugin"),
+            expected=f"the name of a registered {_label(key)}",
+            available=registry.names(key),
+        )
+    try:
+        cls = registry.get(key, name)
+    except ConfigError as err:
+        raise err.within(prefix=(key, "plugin")) from None
+    params = {k: v for k, v in table.items() if k != "plugin"}
+    return _guard(None, key, f"{cls.__name__}()", lambda: cls(**params), plugin=name)
+
+
+def _guard(component: Component | None, key: str, where: str, call: Any, plugin: str | None = None) -> Any:
+    try:
+        return call()
+    except ConfigError as err:
+        raise err.within(prefix=(key,)) from None
+    except LikemeError:
+        raise
+    except Exception as exc:
+        owner = plugin or (component.name if component is not None else key)
+        raise PluginError(owner, f"{key} {where}", f"{type(exc).__name__}: {exc}") from exc
+
+
+def _label(key: str) -> str:
+    from toolkit.components import KINDS
+
+    return KINDS[key].kind
+
+
+def _table(table: Mapping[str, Any], key: str, *, required: bool) -> Mapping[str, Any] | None:
+    sub = table.get(key)
+    if sub is None:
+        if required:
+            raise ConfigError(f"missing [{key}] table", key=(key,), expected=f"a [{key}] table")
+        return None
+    if not isinstance(sub, Mapping):
+        raise ConfigError(f"wrong type {type(sub).__name__}", key=(key,), expected="a table")
+    return sub
+
+
+# -- placing errors in files -----------------------------------------------------------
+
+
+def _locate(err: ConfigError, files: Iterable[Path]) -> ConfigError:
+    """Attach the file (and line, where it can be found) that declares the failing key."""
+    if err.file is not None or not err.key:
+        return err if err.file is not None else err.within(file=next(iter(files), None))
+    files = list(files)
+    for path in files:
+        line = find_key_line(path, err.key)
+        if line is not None:
+            return ConfigError(
+                err.problem, file=path, key=err.key, line=line, expected=err.expected, available=err.available
+            )
+    return err.within(file=files[0] if files else None)
+
+
+def find_key_line(path: Path, key: tuple) -> int | None:
+    """Best-effort line number of ``key`` in a TOML file (table headers and ``name =`` lines)."""
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except OSError:
+        return None
+    names = [k for k in key if isinstance(k, str)]
+    header = re.compile(r"^\s*\[\[?\s*([^\]]+?)\s*\]\]?\s*(#.*)?$")
+    current: list[str] = []
+    best: tuple[int, int] | None = None  # (matched depth, line)
+    for number, text in enumerate(lines, 1):
+        m = header.match(text)
+        if m:
+            current = [p.strip().strip('"') for p in m.group(1).split(".")]
+            depth = _prefix_depth(current, names)
+            if depth == len(current) and (best is None or depth > best[0]):
+                best = (depth, number)
+            continue
+        m = re.match(r"^\s*([A-Za-z0-9_\-\"\.]+)\s*=", text)
+        if m:
+            dotted = [p.strip().strip('"') for p in m.group(1).split(".")]
+            full = current + dotted
+            depth = _prefix_depth(full, names)
+            if depth == len(full) and (best is None or depth > best[0]):
+                best = (depth, number)
+    return best[1] if best is not None and best[0] > 0 else None
+
+
+def _prefix_depth(path: list[str], key: list[str]) -> int:
+    n = 0
+    for a, b in zip(path, key):
+        if a != b:
+            break
+        n += 1
+    return n

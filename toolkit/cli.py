@@ -1,0 +1,200 @@
+"""The ``likeme`` command.
+
+Sub-commands: ``demo`` (the built-in scenario), ``run SCENARIO``, ``plugins``
+(every registered component by kind, with its distribution) and ``validate
+FILE...``; plugins add more through the ``likeme_register_commands`` hook.
+
+Any error caused by input is printed as one line ``likeme: error: ...`` and the
+command exits with status 1; no traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Sequence
+from typing import Any
+
+from toolkit import __version__
+from toolkit.components import KINDS
+from toolkit.errors import LikemeError
+from toolkit.manager import PluginManager, create_plugin_manager
+
+__all__ = ["main", "build_parser"]
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line and exit status 1, like every other input error."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(1, f"likeme: error: {message} (see '{self.prog} --help')\n")
+
+
+def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
+    parser = _Parser(prog="likeme", description="Characters that understand others by simulating them with their own bodies.")
+    parser.add_argument("--version", action="version", version=f"likeme {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+
+    p = sub.add_parser("demo", help="run the built-in scenario and report what each character did and saw")
+    p.add_argument("--seed", type=int, default=None, help="seed for random choices (default: the scenario's)")
+    p.add_argument("--json", action="store_true", help="print the report as JSON")
+    p.add_argument("--scenario", default="demo", help="built-in scenario name (default: demo)")
+    p.set_defaults(handler=cmd_demo)
+
+    p = sub.add_parser("run", help="run a scenario file")
+    p.add_argument("scenario", help="scenario TOML file, or the name of a built-in scenario")
+    p.add_argument("--seed", type=int, default=None, help="seed for random choices (default: the scenario's)")
+    p.add_argument("--duration", type=float, default=None, help="seconds to run (default: the scenario's)")
+    p.add_argument("--json", action="store_true", help="print the report as JSON")
+    p.set_defaults(handler=cmd_run)
+
+    p = sub.add_parser("plugins", help="list every registered component by kind, with its distribution")
+    p.add_argument("--params", action="store_true", help="also list each component's parameters")
+    p.add_argument("--json", action="store_true", help="print as JSON")
+    p.set_defaults(handler=cmd_plugins)
+
+    p = sub.add_parser("validate", help="check character and scenario files")
+    p.add_argument("files", nargs="+", metavar="FILE", help="character or scenario TOML files")
+    p.set_defaults(handler=cmd_validate)
+
+    pm.hook.likeme_register_commands(subparsers=sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``likeme`` command; returns the exit status."""
+    try:
+        pm = create_plugin_manager()
+        parser = build_parser(pm)
+        args = parser.parse_args(argv)
+        if not getattr(args, "handler", None):
+            parser.print_help()
+            return 1
+        return int(args.handler(args, pm) or 0)
+    except LikemeError as err:
+        print(f"likeme: error: {err}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("likeme: interrupted", file=sys.stderr)
+        return 130
+
+
+# -- commands ----------------------------------------------------------------------------
+
+
+def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> int:
+    from toolkit.report import render_text, summarise
+    from toolkit.scenario import load_scenario
+
+    scenario = load_scenario(path, pm, seed=args.seed)
+    if getattr(args, "duration", None) is not None:
+        scenario.duration = args.duration
+    world = scenario.run()
+    summary = summarise(world, name=scenario.name)
+    summary["seed"] = scenario.seed
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        if scenario.description:
+            print(scenario.description.strip())
+            print()
+        print(render_text(summary))
+    return 0
+
+
+def cmd_demo(args: argparse.Namespace, pm: PluginManager) -> int:
+    """Run a built-in scenario (``characters/scenarios/demo.toml`` by default)."""
+    return _run_scenario(args.scenario, pm, args)
+
+
+def cmd_run(args: argparse.Namespace, pm: PluginManager) -> int:
+    return _run_scenario(args.scenario, pm, args)
+
+
+def plugins_table(pm: PluginManager, *, params: bool = False) -> dict[str, Any]:
+    """Every registered component by kind, and every loaded plugin with its hooks."""
+    registry = pm.registry
+    components: dict[str, list[dict[str, Any]]] = {}
+    for kind in KINDS:
+        rows = []
+        for info in registry.infos(kind):
+            row: dict[str, Any] = {
+                "name": info.name,
+                "summary": info.cls.summary(),
+                "plugin": info.plugin.name,
+                "distribution": info.plugin.distribution,
+                "version": info.plugin.version,
+            }
+            if params:
+                row["parameters"] = [{"name": p.name, "type": p.describe(), "doc": p.doc} for p in info.cls.parameters]
+            rows.append(row)
+        components[kind] = rows
+    plugins = []
+    for name, plugin in pm.list_name_plugin():
+        info = pm.plugin_infos.get(name)
+        hooks = sorted(h.name for h in (pm.get_hookcallers(plugin) or []))
+        plugins.append(
+            {
+                "name": name,
+                "module": info.module if info else repr(plugin),
+                "distribution": info.distribution if info else "(registered in Python)",
+                "version": info.version if info else "",
+                "hooks": hooks,
+            }
+        )
+    skipped = [{"name": i.name, "distribution": i.distribution} for i in pm.skipped]
+    return {"components": components, "plugins": plugins, "skipped": skipped}
+
+
+def cmd_plugins(args: argparse.Namespace, pm: PluginManager) -> int:
+    table = plugins_table(pm, params=args.params)
+    if args.json:
+        print(json.dumps(table, indent=2))
+        return 0
+    for kind, rows in table["components"].items():
+        label = KINDS[kind].kind
+        print(f"{label}s ([{kind}] plugin = NAME):" if kind != "trigger" else "triggers:")
+        if not rows:
+            print("  (none registered)")
+        width = max((len(r["name"]) for r in rows), default=0)
+        for r in rows:
+            dist = f"{r['distribution']} {r['version']}".strip()
+            print(f"  {r['name']:<{width}}  {r['summary']}  [{dist}: {r['plugin']}]")
+            for p in r.get("parameters", []):
+                print(f"      {p['name']}: {p['type']}. {p['doc']}")
+        print()
+    print("plugins:")
+    for p in table["plugins"]:
+        dist = f"{p['distribution']} {p['version']}".strip()
+        print(f"  {p['name']} ({p['module']}, {dist}): {', '.join(p['hooks'])}")
+    for s in table["skipped"]:
+        print(f"  {s['name']} ({s['distribution']}): skipped, LIKEME_DISABLE_PLUGIN_AUTOLOAD is set")
+    return 0
+
+
+def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
+    from toolkit.character import load_character, read_toml
+    from toolkit.report import describe_character
+    from toolkit.scenario import is_scenario, load_scenario
+
+    failed = 0
+    for path in args.files:
+        try:
+            if is_scenario(read_toml(path)):
+                scenario = load_scenario(path, pm)
+                world = scenario.world
+                print(f"ok    {path}: scenario {scenario.name!r}: {len(world.actors)} actor(s) ({', '.join(world.actors)}), {len(world.objects)} object(s)")
+            else:
+                c = describe_character(load_character(path, pm))
+                comps = ", ".join(f"{k} {c[k]['plugin']}" for k in ("motor", "perception", "segmenter", "matcher", "action") if k in c)
+                moves = c["motor"].get("movements")
+                print(f"ok    {path}: character {c['name']!r}: {c['parts']} parts, {moves} movements; {comps}")
+        except LikemeError as err:
+            failed += 1
+            print(f"likeme: error: {err}", file=sys.stderr)
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

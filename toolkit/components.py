@@ -1,0 +1,400 @@
+"""The pluggable component kinds and the values that flow between them.
+
+A character's pipeline is five stages, each a component chosen by name in its
+TOML file and provided by a plugin (see :mod:`toolkit.hookspecs`):
+
+============  ==================  ===============================================
+stage         component kind      turns ...
+============  ==================  ===============================================
+perceive      :class:`Perception`   the world into a :class:`Percept` of the target
+segment       :class:`Segmenter`    the stream of percepts into :class:`Segment` s
+match         :class:`Matcher`      a segment (or its beginning) into a :class:`Match`
+interpret     :class:`ActionSystem` a match into a :class:`Behaviour`
+respond       :class:`ActionSystem` all of it into a :class:`MovementRequest`
+============  ==================  ===============================================
+
+and the :class:`MotorSystem` turns a request into a :class:`~toolkit.motion.Motion`
+the character performs. :class:`Trigger` components are the conditions an action
+system evaluates (can-I, should-I, do-until).
+
+Every component is built from validated parameters (its ``parameters`` tuple)
+and then attached to the character that owns it, so it can reach the owner's
+body and motor system (a segmenter compares with the owner's own hub pose).
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import TYPE_CHECKING, Any, ClassVar
+
+import numpy as np
+
+from toolkit.motion import Motion
+from toolkit.params import Parameter, validate_params
+
+if TYPE_CHECKING:  # pragma: no cover - imports for annotations only
+    from toolkit.character import Character
+    from toolkit.runtime import Actor, World
+
+__all__ = [
+    "Component",
+    "Perception",
+    "Segmenter",
+    "Matcher",
+    "MotorSystem",
+    "ActionSystem",
+    "Trigger",
+    "KINDS",
+    "Percept",
+    "Segment",
+    "Match",
+    "Behaviour",
+    "MovementRequest",
+    "TriggerContext",
+]
+
+
+# -- values ---------------------------------------------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class Percept:
+    """What an observer perceived of a target at one instant.
+
+    Attributes
+    ----------
+    time : float
+        World time in seconds.
+    pose : array, shape (P, 3)
+        Root-relative positions of the target's parts in the target's body frame (§5.1).
+    visible : array of bool, shape (P,)
+        Which parts were seen; ``pose`` rows of hidden parts are meaningless.
+    world : array, shape (P, 3)
+        World positions of the seen parts (NaN for hidden ones).
+    root : array, shape (3,)
+        The target's root in world coordinates as perceived (NaN if not seen).
+    heading : float
+        The target's perceived heading in radians (NaN if it could not be found).
+    objects : mapping of str to array (3,)
+        World positions of the objects the observer can see.
+    """
+
+    time: float
+    pose: np.ndarray
+    visible: np.ndarray
+    world: np.ndarray
+    root: np.ndarray
+    heading: float
+    objects: Mapping[str, np.ndarray] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Segment:
+    """A stretch of the observed stream believed to hold one movement.
+
+    ``start`` is the first frame, ``end`` is one past the last (exclusive), both
+    counted from the first frame the segmenter was given.
+    """
+
+    start: int
+    end: int
+    fps: float
+
+    def __post_init__(self) -> None:
+        if not 0 <= self.start < self.end:
+            raise ValueError(f"a segment needs 0 <= start < end, got {self.start}..{self.end}")
+
+    @property
+    def n_frames(self) -> int:
+        return self.end - self.start
+
+    @property
+    def start_time(self) -> float:
+        return self.start / self.fps
+
+    @property
+    def end_time(self) -> float:
+        return self.end / self.fps
+
+    @property
+    def duration(self) -> float:
+        return self.n_frames / self.fps
+
+
+@dataclass(frozen=True)
+class Match:
+    """A matcher's answer about one segment.
+
+    Attributes
+    ----------
+    movement : str or None
+        The recognised movement of the observer's own repertoire; ``None`` means unknown.
+    confidence : float
+        In [0, 1].
+    decided_at : int or None
+        Frames into the segment at which the matcher committed; ``None`` when it
+        waited for the segment's end.
+    path : tuple
+        The matched path through the observer's motor graph, if the matcher has one.
+    details : mapping
+        Anything else the matcher wants to report (distances, candidates).
+    """
+
+    movement: str | None
+    confidence: float = 0.0
+    decided_at: int | None = None
+    path: tuple = ()
+    details: Mapping[str, Any] = field(default_factory=dict)
+
+    @property
+    def known(self) -> bool:
+        return self.movement is not None
+
+    @classmethod
+    def unknown(cls, **details: Any) -> Match:
+        """The explicit "nothing fits" answer."""
+        return cls(None, 0.0, None, (), dict(details))
+
+
+@dataclass(frozen=True)
+class Behaviour:
+    """What an observer believes the target is doing and why (Buchsbaum & Blumberg §6).
+
+    ``known`` is false for an explicit "I don't know" (the shrug).
+    """
+
+    known: bool
+    movement: str | None = None
+    path: tuple[str, ...] = ()
+    motivation: tuple[str, ...] = ()
+    goal: tuple[str, ...] = ()
+    object: str | None = None
+    prediction: tuple[str, ...] = ()
+    details: Mapping[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class MovementRequest:
+    """An action system's request to its own motor system.
+
+    ``imitating`` names the actor being imitated, if this is an imitation.
+    """
+
+    movement: str
+    speed: float = 1.0
+    reason: str = ""
+    imitating: str | None = None
+    object: str | None = None
+
+
+@dataclass(frozen=True)
+class TriggerContext:
+    """What a trigger is evaluated against.
+
+    ``actor`` is the character the trigger is evaluated for (the observer itself,
+    or the target when the observer simulates it, §6.1); ``world`` the world
+    (or the remembered snapshot of it); ``object`` the current object of attention.
+    """
+
+    actor: Actor
+    world: World
+    object: str | None = None
+    params: Mapping[str, Any] = field(default_factory=dict)
+
+
+# -- components -----------------------------------------------------------------
+
+
+class Component(ABC):
+    """Base of every pluggable component.
+
+    Subclasses set ``name`` (the name TOML uses) and ``parameters``; the class
+    docstring's first line is the summary ``likeme plugins`` prints.
+    Parameters are validated on construction and kept in ``self.params``.
+    """
+
+    kind: ClassVar[str] = "component"
+    name: ClassVar[str] = ""
+    parameters: ClassVar[tuple[Parameter, ...]] = ()
+
+    def __init__(self, **params: Any) -> None:
+        self.params: Mapping[str, Any] = MappingProxyType(
+            validate_params(f"{self.kind} {self.name!r}", self.parameters, params)
+        )
+        self.owner: Character | None = None
+
+    @classmethod
+    def summary(cls) -> str:
+        doc = (cls.__doc__ or "").strip()
+        return doc.splitlines()[0] if doc else ""
+
+    def attach(self, owner: Character) -> None:
+        """Called once the owning character is composed. Override to read the owner's body or motor system."""
+        self.owner = owner
+
+    def __repr__(self) -> str:
+        args = ", ".join(f"{k}={v!r}" for k, v in self.params.items() if not isinstance(v, (dict, list)))
+        return f"{type(self).__name__}({args})"
+
+
+class Perception(Component):
+    """Turns what the observer's eye gets of the world into root-relative percepts of a target."""
+
+    kind = "perception"
+
+    def reset(self) -> None:
+        """Forget buffered state (called when the observer starts watching a new target)."""
+
+    @abstractmethod
+    def perceive(self, observer: Actor, target: Actor, world: World) -> Percept:
+        """What ``observer`` perceives of ``target`` now."""
+
+
+class Segmenter(Component):
+    """Divides a stream of observed poses into segments, one frame at a time or in batch.
+
+    Streaming protocol: :meth:`reset`, then :meth:`push` per frame (each call
+    returns the segments that closed at that frame), then :meth:`flush` at the
+    end of the stream. :attr:`active_since` is the start frame of a segment
+    that has begun but not ended. :meth:`segment` runs the protocol over a whole
+    motion; subclasses may override it with a vectorised equivalent.
+    """
+
+    kind = "segmenter"
+
+    @abstractmethod
+    def reset(self, parts: Sequence[str], fps: float) -> None:
+        """Start a new stream of poses of ``parts`` at ``fps``; frame numbering restarts at 0."""
+
+    @abstractmethod
+    def push(self, pose: np.ndarray, visible: np.ndarray) -> list[Segment]:
+        """One root-relative pose (P, 3) with its mask (P,); returns segments that ended here."""
+
+    @abstractmethod
+    def flush(self) -> list[Segment]:
+        """End of stream: close and return a segment still open, if the segmenter accepts it."""
+
+    @property
+    @abstractmethod
+    def active_since(self) -> int | None:
+        """Start frame of the segment under way, or ``None`` between segments."""
+
+    def segment(self, motion: Motion) -> list[Segment]:
+        """All segments of a root-relative motion."""
+        self.reset(motion.parts, motion.fps)
+        found: list[Segment] = []
+        for f in range(motion.n_frames):
+            found.extend(self.push(motion.positions[f], motion.visible[f]))
+        found.extend(self.flush())
+        return found
+
+
+class Matcher(Component):
+    """Recognises an observed segment as one of the observer's own movements.
+
+    A batch matcher implements :meth:`match`. A streaming matcher (one that can
+    commit before the segment ends: response facilitation) also implements
+    :meth:`begin` and :meth:`observe`; the runtime calls ``begin`` when a
+    segment starts, ``observe`` every frame until it returns a match, and
+    :meth:`conclude` when the segment ends.
+    """
+
+    kind = "matcher"
+
+    @abstractmethod
+    def match(self, motion: Motion) -> Match:
+        """The movement in a whole root-relative motion segment."""
+
+    def begin(self, fps: float) -> None:
+        """A segment has started."""
+
+    def observe(self, pose: np.ndarray, visible: np.ndarray) -> Match | None:
+        """One more frame of the ongoing segment; return a match to commit now."""
+        return None
+
+    def conclude(self, motion: Motion) -> Match:
+        """The segment has ended; ``motion`` holds all of it."""
+        return self.match(motion)
+
+
+class MotorSystem(Component):
+    """Produces a character's own movements (and may learn new ones).
+
+    Motions are in the character's local frame (see :mod:`toolkit.body`): the
+    root may move (a jump lifts it), the runtime places the result in the world.
+    """
+
+    kind = "motor system"
+
+    @abstractmethod
+    def movements(self) -> list[str]:
+        """Names of the movements the character can perform."""
+
+    @abstractmethod
+    def rest_pose(self) -> np.ndarray:
+        """The hub pose the character stands in when idle, local frame, shape (P, 3)."""
+
+    @abstractmethod
+    def perform(self, movement: str, *, speed: float = 1.0, fps: float = 30.0) -> Motion:
+        """The motion of one of :meth:`movements`, sampled at ``fps``, from hub to hub."""
+
+    def describe(self) -> dict[str, Any]:
+        """A summary for reports (counts of movements, nodes, edges...)."""
+        return {"movements": len(self.movements())}
+
+
+class ActionSystem(Component):
+    """Chooses what a character does, and interprets and answers what it sees.
+
+    Every method has a neutral default so that a simple action system overrides
+    only what it needs.
+    """
+
+    kind = "action system"
+
+    def choose(self, actor: Actor, world: World) -> MovementRequest | None:
+        """Called when the actor's motor system is idle: what to do next, if anything."""
+        return None
+
+    def interpret(self, actor: Actor, target: Actor, segment: Segment, match: Match, world: World) -> Behaviour | None:
+        """Identify the behaviour behind a recognised movement (§6.1), or ``None`` if this system does not."""
+        return None
+
+    def respond(
+        self, actor: Actor, target: Actor, match: Match, behaviour: Behaviour | None, world: World
+    ) -> MovementRequest | None:
+        """React to a recognised movement (imitate it, help, ignore)."""
+        return None
+
+    def performed(self, actor: Actor, request: MovementRequest, world: World) -> None:
+        """The actor has started performing ``request`` (to keep correspondence maps)."""
+
+    def describe(self) -> dict[str, Any]:
+        return {}
+
+
+class Trigger(Component):
+    """A condition an action system evaluates: can-I, should-I, do-until, object selection.
+
+    :meth:`evaluate` returns a value in [0, 1]; 0 means the condition does not hold.
+    """
+
+    kind = "trigger"
+
+    @abstractmethod
+    def evaluate(self, context: TriggerContext) -> float:
+        """The trigger's value for ``context``, in [0, 1]."""
+
+
+KINDS: dict[str, type[Component]] = {
+    "perception": Perception,
+    "segmenter": Segmenter,
+    "matcher": Matcher,
+    "motor": MotorSystem,
+    "action": ActionSystem,
+    "trigger": Trigger,
+}
+"""Each component kind by the key it has in a character file and in ``likeme plugins``."""

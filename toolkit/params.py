@@ -1,0 +1,176 @@
+"""Declared parameters of components, and their validation.
+
+A component class lists its parameters as a tuple of :class:`Parameter`. The
+character loader checks a TOML table against that list before the component is
+built: unknown keys (listing the known ones), types, ranges and choices. The
+same check runs when a component is built from Python, so ``HubThreshold(threshold="x")``
+fails the same way as a bad TOML value.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from toolkit.errors import ConfigError
+
+__all__ = ["Parameter", "REQUIRED", "validate_params"]
+
+
+class _Required:
+    def __repr__(self) -> str:
+        return "REQUIRED"
+
+
+REQUIRED: Any = _Required()
+"""Sentinel default of a parameter that must be given."""
+
+_TYPE_NAMES = {
+    bool: "a boolean",
+    int: "an integer",
+    float: "a number",
+    str: "a string",
+    list: "an array",
+    dict: "a table",
+}
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One parameter of a component.
+
+    Parameters
+    ----------
+    name : str
+        Key in the component's TOML table.
+    type : type
+        One of ``bool, int, float, str, list, dict``. ``float`` accepts integers.
+    default : object
+        Value when the key is absent; :data:`REQUIRED` if it must be given.
+    doc : str
+        What the parameter does and its effect (shown by ``likeme plugins --params``).
+    minimum, maximum : float, optional
+        Inclusive bounds for numbers.
+    choices : sequence, optional
+        The allowed values.
+    items : type, optional
+        Element type for ``list`` parameters.
+    check : callable, optional
+        ``check(value) -> str | None``: a further check returning a problem or ``None``.
+    """
+
+    name: str
+    type: type
+    default: Any = REQUIRED
+    doc: str = ""
+    minimum: float | None = None
+    maximum: float | None = None
+    choices: Sequence[Any] | None = None
+    items: type | None = None
+    check: Callable[[Any], str | None] | None = None
+
+    @property
+    def required(self) -> bool:
+        return self.default is REQUIRED
+
+    def describe(self) -> str:
+        """One line: type, default and bounds."""
+        text = _TYPE_NAMES[self.type].split(" ", 1)[1]
+        if self.items is not None:
+            text += f" of {_TYPE_NAMES[self.items].split(' ', 1)[1]}s"
+        if self.minimum is not None or self.maximum is not None:
+            lo = "-inf" if self.minimum is None else f"{self.minimum:g}"
+            hi = "inf" if self.maximum is None else f"{self.maximum:g}"
+            text += f" in [{lo}, {hi}]"
+        if self.choices is not None:
+            text += " (one of " + ", ".join(map(repr, self.choices)) + ")"
+        text += ", required" if self.required else f", default {self.default!r}"
+        return text
+
+    def coerce(self, value: Any) -> Any:
+        """Return the checked value (ints widened to float) or raise :class:`ConfigError`."""
+        value = _check_type(value, self.type, self.name, self._expected())
+        if self.items is not None:
+            value = [_check_type(v, self.items, i, self._expected()) for i, v in enumerate(value)]
+        if self.type in (int, float):
+            if self.minimum is not None and value < self.minimum or self.maximum is not None and value > self.maximum:
+                raise ConfigError(f"value {value!r} out of range", key=(self.name,), expected=self._expected())
+        if self.choices is not None and value not in self.choices:
+            raise ConfigError(
+                f"value {value!r} not allowed",
+                key=(self.name,),
+                expected=self._expected(),
+                available=[str(c) for c in self.choices],
+            )
+        if self.check is not None:
+            problem = self.check(value)
+            if problem:
+                raise ConfigError(problem, key=(self.name,), expected=self._expected())
+        return value
+
+    def _expected(self) -> str:
+        return self.describe().rsplit(", ", 1)[0]
+
+
+def _check_type(value: Any, kind: type, key: str | int, expected: str) -> Any:
+    ok = isinstance(value, kind) and not (kind in (int, float) and isinstance(value, bool))
+    if kind is float and isinstance(value, int) and not isinstance(value, bool):
+        return float(value)
+    if kind is dict:
+        ok = isinstance(value, Mapping)
+    if not ok:
+        raise ConfigError(
+            f"wrong type {type(value).__name__} (value {value!r})",
+            key=(key,) if isinstance(key, str) else ("", key),
+            expected=expected,
+        )
+    return value
+
+
+def validate_params(owner: str, parameters: Sequence[Parameter], values: Mapping[str, Any]) -> dict[str, Any]:
+    """Check ``values`` against ``parameters`` and fill in defaults.
+
+    Parameters
+    ----------
+    owner : str
+        Who the parameters belong to, for messages (``"segmenter 'hub-threshold'"``).
+    parameters : sequence of Parameter
+    values : mapping
+        The given values (a TOML table without the ``plugin`` key).
+
+    Returns
+    -------
+    dict
+        Every parameter name mapped to its checked value.
+
+    Raises
+    ------
+    ConfigError
+        With the key relative to the table.
+    """
+    known = {p.name: p for p in parameters}
+    for key in values:
+        if key not in known:
+            raise ConfigError(
+                f"unknown parameter {key!r} for {owner}",
+                key=(key,),
+                expected=f"a parameter of {owner}",
+                available=sorted(known),
+            )
+    out: dict[str, Any] = {}
+    for p in parameters:
+        if p.name in values:
+            try:
+                out[p.name] = p.coerce(values[p.name])
+            except ConfigError as err:
+                if err.key[:1] == ("",):  # list element: place it under the parameter name
+                    err = ConfigError(
+                        err.problem, key=(p.name, *err.key[1:]), expected=err.expected, available=err.available
+                    )
+                raise err from None
+        elif p.required:
+            raise ConfigError(f"missing required parameter of {owner}", key=(p.name,), expected=p._expected())
+        else:
+            out[p.name] = p.default
+    return out

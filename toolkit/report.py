@@ -1,0 +1,169 @@
+"""What happened in a run, as plain data and as sentences.
+
+:func:`summarise` turns a finished :class:`~toolkit.runtime.World` into a
+JSON-ready dict: for every actor what it did and, if it watched someone, what
+it perceived, segmented, recognised and identified. :func:`render_text` prints
+that summary for people.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from toolkit.runtime import Actor, World
+
+__all__ = ["summarise", "render_text", "describe_character"]
+
+
+def describe_character(character: Any) -> dict[str, Any]:
+    """Components of a character by table, with their plugin names and a short description."""
+    out: dict[str, Any] = {"name": character.name, "parts": len(character.body.parts)}
+    for key, component in character.components().items():
+        entry: dict[str, Any] = {"plugin": component.name}
+        describe = getattr(component, "describe", None)
+        if callable(describe):
+            entry.update(describe())
+        out[key] = entry
+    return out
+
+
+def _did(actor: Actor, world: World) -> list[dict[str, Any]]:
+    return [
+        {"frame": frame, "time": round(frame / world.fps, 3), "movement": r.movement, "reason": r.reason, "imitating": r.imitating}
+        for frame, r in actor.performed
+    ]
+
+
+def _watching(actor: Actor, world: World) -> dict[str, Any]:
+    mem = actor.memory
+    out: dict[str, Any] = {"target": actor.target.id if actor.target else None}
+    out["perceived"] = {
+        "frames": mem.n if mem else 0,
+        "visible_fraction": round(float(mem.visible.mean()), 4) if mem and mem.n else 0.0,
+        "frames_with_root": int(mem.visible[:, actor.target.body.root_index].sum()) if mem and mem.n else 0,
+    }
+    offset = actor.watch_start
+    out["segments"] = [
+        {
+            "start_frame": offset + e.data["segment"].start,
+            "end_frame": offset + e.data["segment"].end,
+            "start": round((offset + e.data["segment"].start) / world.fps, 3),
+            "end": round((offset + e.data["segment"].end) / world.fps, 3),
+        }
+        for e in world.events_of("segment_found", actor.id)
+    ]
+    out["recognised"] = []
+    for e in world.events_of("movement_recognised", actor.id):
+        m = e.data["match"]
+        seg = e.data["segment"]
+        out["recognised"].append(
+            {
+                "time": round(e.time, 3),
+                "movement": m.movement,
+                "confidence": round(float(m.confidence), 3),
+                "decided_at": m.decided_at,
+                "early": seg is None,
+            }
+        )
+    out["behaviours"] = [_behaviour(e.data["behaviour"], e.time) for e in world.events_of("behaviour_identified", actor.id)]
+    return out
+
+
+def _behaviour(b: Any, time: float) -> dict[str, Any]:
+    return {
+        "time": round(time, 3),
+        "known": b.known,
+        "movement": b.movement,
+        "path": list(b.path),
+        "motivation": list(b.motivation),
+        "goal": list(b.goal),
+        "object": b.object,
+        "prediction": list(b.prediction),
+    }
+
+
+def summarise(world: World, *, name: str = "") -> dict[str, Any]:
+    """The run as a JSON-ready dict."""
+    actors = []
+    for actor in world.actors.values():
+        entry: dict[str, Any] = {
+            "id": actor.id,
+            "character": describe_character(actor.character),
+            "file": str(actor.character.file) if actor.character.file else None,
+            "did": _did(actor, world),
+        }
+        if actor.target is not None:
+            entry["watching"] = _watching(actor, world)
+        actors.append(entry)
+    return {
+        "scenario": name,
+        "fps": world.fps,
+        "frames": world.frame,
+        "duration": round(world.time, 3),
+        "objects": [{"name": o.name, "kind": o.kind, "position": [round(float(v), 3) for v in o.position]} for o in world.objects.values()],
+        "actors": actors,
+    }
+
+
+def _components_line(c: dict[str, Any]) -> str:
+    parts = []
+    for key in ("motor", "perception", "segmenter", "matcher", "action"):
+        parts.append(f"{key} {c[key]['plugin']}" if key in c else f"{key} -")
+    return "; ".join(parts)
+
+
+def render_text(summary: dict[str, Any]) -> str:
+    """The summary as lines a person reads: per actor, perceived, segmented, recognised and did."""
+    lines = []
+    title = summary["scenario"] or "run"
+    lines.append(f"{title}: {summary['duration']:.2f} s, {summary['frames']} frames at {summary['fps']:g} fps")
+    for obj in summary["objects"]:
+        lines.append(f"  object {obj['name']} ({obj['kind']}) at {obj['position']}")
+    for a in summary["actors"]:
+        c = a["character"]
+        lines.append("")
+        lines.append(f"{a['id']} ({c['name']}, {c['parts']} parts): {_components_line(c)}")
+        did = a["did"]
+        if did:
+            acts = ", ".join(
+                f"{d['movement']} at {d['time']:.2f}s" + (f" (imitating {d['imitating']})" if d["imitating"] else "") for d in did
+            )
+            lines.append(f"  did: {acts}")
+        else:
+            lines.append("  did: nothing (stood in its hub pose)")
+        w = a.get("watching")
+        if not w:
+            continue
+        p = w["perceived"]
+        lines.append(
+            f"  perceived {w['target']}: {p['frames']} frames, {100 * p['visible_fraction']:.1f}% of parts visible, "
+            f"root seen in {p['frames_with_root']} frames"
+        )
+        if "segmenter" not in c:
+            lines.append("  segmented: no segmenter in this character")
+        else:
+            segs = ", ".join(f"[{s['start']:.2f}-{s['end']:.2f}s]" for s in w["segments"]) or "none"
+            lines.append(f"  segmented: {len(w['segments'])} segment(s) {segs}")
+        if "matcher" not in c:
+            lines.append("  recognised: no matcher in this character")
+        else:
+            recs = ", ".join(
+                (r["movement"] or "unknown") + f" ({r['confidence']:.2f}" + (f", committed {r['decided_at']} frames in" if r["early"] else "") + ")"
+                for r in w["recognised"]
+            )
+            lines.append(f"  recognised: {recs or 'nothing'}")
+        for b in w["behaviours"]:
+            if not b["known"]:
+                lines.append(f"  at {b['time']:.2f}s: does not know why {w['target']} did {b['movement']} (shrugs)")
+                continue
+            text = f"  at {b['time']:.2f}s: believes {w['target']} is doing {' > '.join(b['path'])}"
+            if b["object"]:
+                text += f" with {b['object']}"
+            if b["motivation"]:
+                text += f", because of {', '.join(b['motivation'])}"
+            if b["goal"]:
+                text += f", wanting {', '.join(b['goal'])}"
+            if b["prediction"]:
+                text += f"; next: {', '.join(b['prediction'])}"
+            lines.append(text)
+    return "\n".join(lines)

@@ -1,0 +1,428 @@
+"""The runtime: a world that steps in time, with actors that act and observe.
+
+One :meth:`World.step` advances every actor by one frame:
+
+1. *act*: an actor that is performing moves one frame along its motion; an idle
+   actor asks its action system what to do (:meth:`ActionSystem.choose`) and, if
+   answered, asks its motor system for the motion (:meth:`MotorSystem.perform`).
+2. *observe*: an actor that watches a target runs its pipeline on the new frame:
+   perceive → segment → match → interpret → respond. Percepts are kept in the
+   actor's working memory (:class:`ObservationLog`); a segment that closes is
+   matched on the memory's frames; a streaming matcher may commit earlier.
+3. the world announces the step through the ``likeme_world_stepped`` hook.
+
+Every pipeline result is also recorded as an :class:`Event` in ``world.events``
+and announced through the matching run-event hook, so a plugin can observe or
+extend any run.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from toolkit.character import Character
+from toolkit.components import Behaviour, Match, MovementRequest, Percept, Segment
+from toolkit.errors import ConfigError, LikemeError, PluginError
+from toolkit.motion import Motion, local_to_world
+
+__all__ = ["World", "Actor", "WorldObject", "Event", "ObservationLog"]
+
+
+@dataclass
+class WorldObject:
+    """A thing in the world: cheese, a toy ball, a baton, an ice cream cone.
+
+    Attributes
+    ----------
+    name : str
+        Unique within the world.
+    kind : str
+        What the object really is (``"food"``, ``"toy"``); what a character
+        *believes* it is belongs to that character.
+    position : array, shape (3,)
+        World position of its centre, metres.
+    radius : float
+        Size, for occlusion, reach and pictures.
+    colour : str
+        Colour code ``"#rrggbb"`` for colour-coded vision and pictures.
+    held_by : str or None
+        The actor holding it; its position then follows that actor.
+    properties : dict
+        Anything else plugins need (``{"tasty": true}``).
+    """
+
+    name: str
+    kind: str
+    position: np.ndarray
+    radius: float = 0.05
+    colour: str = "#c0c0c0"
+    held_by: str | None = None
+    properties: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        self.position = np.asarray(self.position, dtype=float).reshape(3)
+
+
+@dataclass(frozen=True)
+class Event:
+    """Something that happened in a run: ``kind`` is the hook's name without ``likeme_``."""
+
+    frame: int
+    time: float
+    kind: str
+    actor: str
+    target: str | None = None
+    data: Mapping[str, Any] = field(default_factory=dict)
+
+
+class ObservationLog:
+    """Working memory of what an actor perceived of its target, as growing arrays.
+
+    ``positions`` (F, P, 3) root-relative, ``visible`` (F, P), one row per frame since watching began.
+    """
+
+    def __init__(self, parts: tuple[str, ...], fps: float, capacity: int = 1024) -> None:
+        self.parts = parts
+        self.fps = fps
+        self._pos = np.full((capacity, len(parts), 3), np.nan)
+        self._vis = np.zeros((capacity, len(parts)), dtype=bool)
+        self.n = 0
+
+    def append(self, pose: np.ndarray, visible: np.ndarray) -> None:
+        if self.n == self._pos.shape[0]:
+            self._pos = np.concatenate([self._pos, np.full_like(self._pos, np.nan)])
+            self._vis = np.concatenate([self._vis, np.zeros_like(self._vis)])
+        self._pos[self.n] = pose
+        self._vis[self.n] = visible
+        self.n += 1
+
+    @property
+    def positions(self) -> np.ndarray:
+        return self._pos[: self.n]
+
+    @property
+    def visible(self) -> np.ndarray:
+        return self._vis[: self.n]
+
+    def motion(self, start: int = 0, stop: int | None = None) -> Motion:
+        """Frames ``start`` to ``stop`` as a root-relative :class:`Motion`."""
+        stop = self.n if stop is None else min(stop, self.n)
+        return Motion(self._pos[start:stop], self.fps, self.parts, self._vis[start:stop])
+
+
+class Actor:
+    """A character placed in a world: where it stands, what it performs, what it watches.
+
+    Attributes
+    ----------
+    id : str
+    character : Character
+    position : array (3,)
+        Ground position of the local frame's origin.
+    heading : float
+        Radians about +y (0 faces +z).
+    target : Actor or None
+        Who it watches.
+    performing : MovementRequest or None
+        The movement under way.
+    memory : ObservationLog or None
+        Working memory of what it perceived of ``target``.
+    performed : list of (frame, MovementRequest)
+        Everything it started performing.
+    """
+
+    def __init__(self, world: World, id: str, character: Character, position: Iterable[float], heading: float) -> None:
+        self.world = world
+        self.id = id
+        self.character = character
+        self.position = np.asarray(list(position), dtype=float).reshape(3)
+        self.heading = float(heading)
+        self.target: Actor | None = None
+        self.watch_start = 0
+        self.performing: MovementRequest | None = None
+        self._motion: Motion | None = None
+        self._frame = 0
+        self._queue: list[MovementRequest] = []
+        self._rest = np.asarray(character.motor.rest_pose(), dtype=float)
+        self.memory: ObservationLog | None = None
+        self.percepts = 0
+        self._committed: Match | None = None
+        self.performed: list[tuple[int, MovementRequest]] = []
+
+    def __repr__(self) -> str:
+        return f"Actor({self.id!r}, {self.character.name!r})"
+
+    @property
+    def body(self):
+        return self.character.body
+
+    # -- acting ----------------------------------------------------------------------
+
+    @property
+    def idle(self) -> bool:
+        return self.performing is None
+
+    def local_pose(self) -> np.ndarray:
+        """Current positions in the actor's local frame, shape (P, 3)."""
+        if self._motion is None:
+            return self._rest
+        return self._motion.positions[min(self._frame, self._motion.n_frames - 1)]
+
+    def world_pose(self) -> np.ndarray:
+        """Current positions in world coordinates, shape (P, 3)."""
+        return local_to_world(self.local_pose(), self.position, self.heading)
+
+    def request(self, request: MovementRequest) -> None:
+        """Perform ``request`` now if idle, else after the current movement."""
+        if self.idle:
+            self._start(request)
+        else:
+            self._queue.append(request)
+
+    def _start(self, request: MovementRequest) -> None:
+        motor = self.character.motor
+        if request.movement not in motor.movements():
+            raise ConfigError(
+                f"{self.id} has no movement {request.movement!r}",
+                expected="a movement of its motor system",
+                available=motor.movements(),
+            )
+        motion = _call(self.character, "motor", "perform", motor.perform, request.movement, speed=request.speed, fps=self.world.fps)
+        self._motion, self._frame, self.performing = motion, 0, request
+        self.performed.append((self.world.frame, request))
+        if self.character.action is not None:
+            _call(self.character, "action", "performed", self.character.action.performed, self, request, self.world)
+        if request.imitating is not None:
+            target = self.world.actors[request.imitating]
+            self.world.emit("imitation_started", self, target, request=request)
+
+    def _advance(self) -> None:
+        if self._motion is not None:
+            self._frame += 1
+            if self._frame >= self._motion.n_frames:
+                done = self.performing
+                self._motion, self.performing = None, None
+                if done is not None and done.imitating is not None:
+                    target = self.world.actors[done.imitating]
+                    self.world.emit("imitation_stopped", self, target, movement=done.movement, reason="completed")
+        if self.idle and self._queue:
+            self._start(self._queue.pop(0))
+        if self.idle and self.character.action is not None:
+            request = _call(self.character, "action", "choose", self.character.action.choose, self, self.world)
+            if request is not None:
+                self._start(request)
+
+    # -- observing -------------------------------------------------------------------
+
+    def watch(self, target: Actor | None) -> None:
+        """Start watching ``target`` (``None`` to stop); working memory and segmenter restart."""
+        self.target = target
+        self.memory = None
+        self._committed = None
+        if target is None:
+            return
+        c = self.character
+        if c.perception is None:
+            raise ConfigError(
+                f"{self.id} cannot watch {target.id}: character {c.name} has no [perception] table",
+                expected="a perception component",
+                available=c.pm.registry.names("perception") if c.pm else None,
+            )
+        self.watch_start = self.world.frame
+        self.memory = ObservationLog(target.body.parts, self.world.fps)
+        c.perception.reset()
+        if c.segmenter is not None:
+            _call(c, "segmenter", "reset", c.segmenter.reset, target.body.parts, self.world.fps)
+
+    def _observe(self) -> None:
+        target, c, world = self.target, self.character, self.world
+        assert target is not None and self.memory is not None and c.perception is not None
+        percept: Percept = _call(c, "perception", "perceive", c.perception.perceive, self, target, world)
+        self.memory.append(percept.pose, percept.visible)
+        self.percepts += 1
+        if c.segmenter is None:
+            return
+        was_open = c.segmenter.active_since is not None
+        closed = _call(c, "segmenter", "push", c.segmenter.push, percept.pose, percept.visible)
+        self._handle_segments(closed, was_open)
+
+    def _handle_segments(self, closed: list[Segment], was_open: bool) -> None:
+        c, target, world = self.character, self.target, self.world
+        assert target is not None and self.memory is not None and c.segmenter is not None
+        for segment in closed:
+            if not isinstance(segment, Segment):
+                raise PluginError(c.segmenter.name, "Segmenter.push", f"returned {segment!r}, expected Segment objects")
+            world.emit("segment_found", self, target, segment=segment)
+            if c.matcher is None:
+                continue
+            if self._committed is None:
+                motion = self.memory.motion(segment.start, segment.end)
+                match = _call(c, "matcher", "conclude", c.matcher.conclude, motion)
+                self._recognised(segment, match)
+            self._committed = None
+        opened = c.segmenter.active_since is not None and (not was_open or closed)
+        if c.matcher is not None and opened:
+            _call(c, "matcher", "begin", c.matcher.begin, world.fps)
+            self._committed = None
+            start = c.segmenter.active_since
+            for f in range(start, self.memory.n):  # catch the matcher up on the frames since onset
+                if self._early(self.memory.positions[f], self.memory.visible[f]):
+                    break
+        elif c.matcher is not None and c.segmenter.active_since is not None and self._committed is None:
+            self._early(self.memory.positions[-1], self.memory.visible[-1])
+
+    def _early(self, pose: np.ndarray, visible: np.ndarray) -> bool:
+        c = self.character
+        match = _call(c, "matcher", "observe", c.matcher.observe, pose, visible)
+        if match is None:
+            return False
+        self._committed = match
+        self._recognised(None, match)
+        return True
+
+    def _recognised(self, segment: Segment | None, match: Match) -> None:
+        c, target, world = self.character, self.target, self.world
+        assert target is not None
+        if not isinstance(match, Match):
+            raise PluginError(c.matcher.name, "Matcher", f"returned {match!r}, expected a Match")
+        world.emit("movement_recognised", self, target, segment=segment, match=match)
+        if c.action is None or not match.known:
+            return
+        behaviour = _call(c, "action", "interpret", c.action.interpret, self, target, segment, match, world)
+        if behaviour is not None:
+            world.emit("behaviour_identified", self, target, behaviour=behaviour)
+        request = _call(c, "action", "respond", c.action.respond, self, target, match, behaviour, world)
+        if request is not None:
+            self.request(request)
+
+    def _finish(self) -> None:
+        c = self.character
+        if self.target is None or c.segmenter is None:
+            return
+        closed = _call(c, "segmenter", "flush", c.segmenter.flush)
+        self._handle_segments(closed, True)
+
+
+def _call(character: Character, key: str, method: str, func: Any, *args: Any, **kwargs: Any) -> Any:
+    """Call a component method; anything but a likeme error is reported with the component's name."""
+    try:
+        return func(*args, **kwargs)
+    except LikemeError:
+        raise
+    except Exception as exc:
+        component = getattr(character, key)
+        name = getattr(component, "name", key)
+        raise PluginError(name, f"{type(component).__name__}.{method}", f"{type(exc).__name__}: {exc}") from exc
+
+
+class World:
+    """Actors and objects stepping together at a fixed frame rate.
+
+    Parameters
+    ----------
+    fps : float
+        Frames per second of the simulation and of every motion in it.
+    pm : PluginManager, optional
+        Whose hooks announce run events; defaults to the plugin manager of the
+        first character added.
+    """
+
+    def __init__(self, fps: float = 30.0, pm: Any = None) -> None:
+        if not fps > 0:
+            raise ValueError("fps must be positive")
+        self.fps = float(fps)
+        self.frame = 0
+        self.actors: dict[str, Actor] = {}
+        self.objects: dict[str, WorldObject] = {}
+        self.events: list[Event] = []
+        self.pm = pm
+
+    @property
+    def time(self) -> float:
+        return self.frame / self.fps
+
+    def add_actor(
+        self, character: Character, id: str | None = None, position: Iterable[float] = (0, 0, 0), heading: float = 0.0
+    ) -> Actor:
+        """Place a character in the world (``heading`` in radians)."""
+        id = id or character.name.lower()
+        if id in self.actors:
+            raise ConfigError(f"duplicate actor id {id!r}", expected="unique actor ids", available=list(self.actors))
+        actor = Actor(self, id, character, position, heading)
+        self.actors[id] = actor
+        if self.pm is None:
+            self.pm = character.pm
+        return actor
+
+    def add_object(self, obj: WorldObject) -> WorldObject:
+        if obj.name in self.objects:
+            raise ConfigError(f"duplicate object name {obj.name!r}", expected="unique object names", available=list(self.objects))
+        self.objects[obj.name] = obj
+        return obj
+
+    def emit(self, kind: str, actor: Actor, target: Actor | None = None, **data: Any) -> None:
+        """Record an event and call the ``likeme_<kind>`` hook."""
+        self.events.append(Event(self.frame, self.time, kind, actor.id, target.id if target else None, data))
+        if self.pm is None:
+            return
+        hook = getattr(self.pm.hook, f"likeme_{kind}")
+        if kind in ("imitation_started", "imitation_stopped"):
+            hook(world=self, actor=actor, target=target, **data)
+        else:
+            hook(world=self, observer=actor, target=target, **data)
+
+    def step(self) -> None:
+        """Advance one frame: every actor acts, then every watching actor observes."""
+        self.frame += 1
+        for actor in self.actors.values():
+            actor._advance()
+        for obj in self.objects.values():
+            if obj.held_by is not None and obj.held_by in self.actors:
+                holder = self.actors[obj.held_by]
+                obj.position = holder.world_pose()[holder.body.index(obj.properties.get("held_in", holder.body.root))]
+        for actor in self.actors.values():
+            if actor.target is not None:
+                actor._observe()
+        if self.pm is not None:
+            self.pm.hook.likeme_world_stepped(world=self)
+
+    def run(
+        self,
+        duration: float | None = None,
+        *,
+        until_idle: bool = False,
+        tail: float = 1.0,
+        max_duration: float = 3600.0,
+    ) -> None:
+        """Step for ``duration`` seconds, or (``until_idle``) until every actor is idle with nothing queued.
+
+        With ``until_idle``, the world steps ``tail`` seconds more once all are
+        idle (so observers see the last movement end), at most ``max_duration``
+        seconds in all. Open segments are closed (segmenters flushed) at the end.
+        """
+        if duration is None and not until_idle:
+            raise ValueError("give a duration or until_idle=True")
+        limit = int(round((duration if duration is not None else max_duration) * self.fps))
+        settle = int(round(tail * self.fps))
+        quiet = 0
+        for _ in range(limit):
+            self.step()
+            if until_idle and duration is None:
+                quiet = quiet + 1 if self.all_idle() else 0
+                if quiet > settle:
+                    break
+        for actor in self.actors.values():
+            actor._finish()
+
+    def all_idle(self) -> bool:
+        return all(a.idle and not a._queue for a in self.actors.values())
+
+    def events_of(self, kind: str, actor: str | None = None) -> list[Event]:
+        return [e for e in self.events if e.kind == kind and (actor is None or e.actor == actor)]
+
+    def behaviours(self, actor: str) -> list[Behaviour]:
+        return [e.data["behaviour"] for e in self.events_of("behaviour_identified", actor)]
