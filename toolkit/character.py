@@ -281,8 +281,9 @@ def compose_character(table: Mapping[str, Any], pm: PluginManager, *, files: tup
     description = head.get("description", "")
     if not isinstance(description, str):
         raise ConfigError("wrong type", key=("character", "description"), expected="a string")
+    body_table = _table(table, "body", required=True)
     try:
-        body = Body.from_config(_table(table, "body", required=True))
+        body = Body.from_config(body_table)
     except ConfigError as err:
         raise err.within(prefix=("body",)) from None
 

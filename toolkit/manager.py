@@ -152,7 +152,10 @@ class PluginManager(pluggy.PluginManager):
         """Register one plugin object under ``info.name`` (used for entry points and by tests)."""
         try:
             self.register(plugin, name=info.name)
+            self.check_pending()  # a hook name that is not a likeme hook (a typo) is an error
         except (pluggy.PluginValidationError, ValueError) as exc:
+            if self.is_registered(plugin):
+                self.unregister(plugin)
             raise PluginError(info.name, "registration", str(exc)) from exc
         self.plugin_infos[info.name] = info
         self._registry = None
@@ -170,7 +173,7 @@ class PluginManager(pluggy.PluginManager):
         found: dict[tuple[str, str], ComponentInfo] = {}
         for kind, hook_name in REGISTER_HOOKS.items():
             caller = getattr(self.hook, hook_name)
-            for impl in reversed(caller.get_hookimpls()):  # registration order
+            for impl in caller.get_hookimpls():  # registration order
                 info = self.plugin_infos.get(impl.plugin_name) or PluginInfo(
                     impl.plugin_name, repr(impl.plugin), "(registered in Python)", ""
                 )
@@ -197,7 +200,7 @@ def _check_registered(classes: Any, kind: str, info: PluginInfo, hook_name: str)
     if classes is None:
         return []
     if not isinstance(classes, (list, tuple)):
-        raise PluginError(info.name, hook_name, f"returned {type(classes).__name__}, expected a list of classes")
+        raise PluginError(info.name, hook_name, f"returned {classes!r}, expected a list of classes")
     for cls in classes:
         if not (isinstance(cls, type) and issubclass(cls, base)):
             raise PluginError(info.name, hook_name, f"returned {cls!r}, expected a subclass of {base.__qualname__}")

@@ -74,9 +74,9 @@ class Parameter:
     def required(self) -> bool:
         return self.default is REQUIRED
 
-    def describe(self) -> str:
-        """One line: type, default and bounds."""
-        text = _TYPE_NAMES[self.type].split(" ", 1)[1]
+    def describe(self, *, article: bool = False) -> str:
+        """One line: type, bounds and default (``article`` starts it with "a"/"an" and leaves the default out)."""
+        text = _TYPE_NAMES[self.type] if article else _TYPE_NAMES[self.type].split(" ", 1)[1]
         if self.items is not None:
             text += f" of {_TYPE_NAMES[self.items].split(' ', 1)[1]}s"
         if self.minimum is not None or self.maximum is not None:
@@ -85,7 +85,8 @@ class Parameter:
             text += f" in [{lo}, {hi}]"
         if self.choices is not None:
             text += " (one of " + ", ".join(map(repr, self.choices)) + ")"
-        text += ", required" if self.required else f", default {self.default!r}"
+        if not article:
+            text += ", required" if self.required else f", default {self.default!r}"
         return text
 
     def coerce(self, value: Any) -> Any:
@@ -110,7 +111,7 @@ class Parameter:
         return value
 
     def _expected(self) -> str:
-        return self.describe().rsplit(", ", 1)[0]
+        return self.describe(article=True)
 
 
 def _check_type(value: Any, kind: type, key: str | int, expected: str) -> Any:
