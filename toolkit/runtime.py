@@ -18,6 +18,8 @@ extend any run.
 
 from __future__ import annotations
 
+import re
+
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -232,7 +234,7 @@ class Actor:
                 expected="a perception component",
                 available=c.pm.registry.names("perception") if c.pm else None,
             )
-        self.watch_start = self.world.frame
+        self.watch_start = self.world.frame + 1  # the world frame of the first percept (memory row 0)
         self.memory = ObservationLog(target.body.parts, self.world.fps)
         c.perception.reset()
         if c.segmenter is not None:
@@ -349,7 +351,7 @@ class World:
         self, character: Character, id: str | None = None, position: Iterable[float] = (0, 0, 0), heading: float = 0.0
     ) -> Actor:
         """Place a character in the world (``heading`` in radians)."""
-        id = id or character.name.lower()
+        id = id or re.sub(r"[^a-z0-9]+", "-", character.name.lower()).strip("-")
         if id in self.actors:
             raise ConfigError(f"duplicate actor id {id!r}", expected="unique actor ids", available=list(self.actors))
         actor = Actor(self, id, character, position, heading)

@@ -28,6 +28,8 @@
 
 from __future__ import annotations
 
+import re
+
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -147,7 +149,7 @@ def _build(table: Mapping[str, Any], path: Path, pm: PluginManager, seed: int | 
         character = load_character(char_path, pm, override=override)
         heading = math.radians(_number(spec.get("heading", 0.0), (*key, "heading"), "degrees"))
         position = _vector(spec.get("position", [0.0, 0.0, 0.0]), (*key, "position"))
-        actor_id = spec.get("id", character.name.lower())
+        actor_id = spec.get("id", re.sub(r"[^a-z0-9]+", "-", character.name.lower()).strip("-"))
         if not isinstance(actor_id, str) or not actor_id:
             raise ConfigError("invalid", key=(*key, "id"), expected="a non-empty string")
         try:

@@ -1,9 +1,9 @@
 """likeme-stillness: a third-party segmenter for likeme.
 
-A segment is a stretch where the mean speed of the target's visible parts,
-root-relative, stays above a threshold; it ends once the body has been still
+A segment is a stretch where the fastest of the target's visible parts,
+root-relative, moves faster than a threshold; it ends once the body has been still
 for ``hold`` seconds. Unlike ``hub-threshold`` it knows nothing of the
-observer's own poses, so it also cuts movements that never pass through a hub.
+observer's own poses, so it also cuts movements that never pass through a hub; but a pose held longer than ``hold`` ends a segment too.
 """
 
 from __future__ import annotations
@@ -18,8 +18,8 @@ class Stillness(Segmenter):
 
     name = "stillness"
     parameters = (
-        Parameter("speed", float, 0.15, "Mean part speed (m/s) above which the body counts as moving.", minimum=0.0),
-        Parameter("hold", float, 0.2, "Seconds of rest that end a segment.", minimum=0.0),
+        Parameter("speed", float, 0.1, "Speed (m/s) of the fastest visible part above which the body counts as moving.", minimum=0.0),
+        Parameter("hold", float, 0.3, "Seconds of rest that end a segment.", minimum=0.0),
         Parameter("min_duration", float, 0.2, "Segments shorter than this (seconds) are dropped.", minimum=0.0),
     )
 
@@ -41,7 +41,7 @@ class Stillness(Segmenter):
         if self._prev is not None:
             step = np.linalg.norm(pose - self._prev, axis=1)
             step = step[np.isfinite(step)]
-            moving = bool(step.size) and float(step.mean()) * self._fps > self.params["speed"]
+            moving = bool(step.size) and float(step.max()) * self._fps > self.params["speed"]
         self._prev = pose
         if moving:
             if self._start is None:

@@ -1,0 +1,121 @@
+"""The likeme command: plugins, validate, demo, run; one-line errors with exit status 1."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import CHARACTERS, ROOT
+
+
+def likeme(*args, env=None, cwd=ROOT):
+    full_env = {**os.environ, "LIKEME_DISABLE_PLUGIN_AUTOLOAD": "1", **(env or {})}
+    return subprocess.run(
+        [sys.executable, "-m", "toolkit.cli", *map(str, args)], capture_output=True, text=True, env=full_env, cwd=cwd, timeout=300
+    )
+
+
+def assert_one_line_error(result, *fragments):
+    assert result.returncode == 1, result.stderr
+    assert "Traceback" not in result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1, result.stderr
+    assert lines[0].startswith("likeme: error: ")
+    for fragment in fragments:
+        assert fragment in lines[0], lines[0]
+
+
+def test_console_script_is_installed():
+    script = Path(sys.executable).parent / "likeme"
+    assert script.exists(), "pip install -e . creates the likeme command"
+    result = subprocess.run([script, "--version"], capture_output=True, text=True)
+    assert result.returncode == 0 and result.stdout.startswith("likeme ")
+
+
+def test_plugins_lists_every_kind_with_distribution():
+    result = likeme("plugins")
+    assert result.returncode == 0, result.stderr
+    out = result.stdout
+    for heading in ("perceptions", "segmenters", "matchers", "motor systems", "action systems", "triggers", "plugins:"):
+        assert heading in out
+    assert "keyframe" in out and "[likeme 0.1.0: keyframe]" in out
+    assert "motion-capture" in out and "imitation" in out and "script" in out
+
+
+def test_plugins_json_and_params():
+    data = json.loads(likeme("plugins", "--json", "--params").stdout)
+    motors = {c["name"]: c for c in data["components"]["motor"]}
+    assert motors["keyframe"]["distribution"] == "likeme"
+    assert {p["name"] for p in motors["keyframe"]["parameters"]} == {"rest", "hubs", "poses", "movements"}
+    plugins = {p["name"]: p for p in data["plugins"]}
+    assert plugins["script"]["hooks"] == ["likeme_register_action_systems"]
+
+
+def test_validate_builtin_characters_and_scenarios():
+    files = sorted(CHARACTERS.glob("*.toml")) + sorted((CHARACTERS / "scenarios").glob("*.toml"))
+    result = likeme("validate", *files)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.count("ok ") == len(files)
+    assert "character 'Max'" in result.stdout and "scenario 'Max watches Morris'" in result.stdout
+
+
+BAD = {
+    "unknown_plugin.toml": ('[segmenter]\nplugin = "hub-treshold"\n', ["unknown_plugin.toml:", "key segmenter.plugin", "unknown segmenter 'hub-treshold'", "available:"]),
+    "wrong_type.toml": ('[action]\nplugin = "script"\nrandom = "ten"\n', ["wrong_type.toml:", "key action.random", "wrong type str", "expected an integer"]),
+    "syntax.toml": ("[action\nplugin = 1\n", ["syntax.toml:4:", "TOML syntax error"]),
+}
+
+
+@pytest.mark.parametrize("name", sorted(BAD))
+def test_validate_bad_character_fails_with_one_clear_line(write, name):
+    text, fragments = BAD[name]
+    path = write(name, f'[character]\nname = "Bad"\nextends = "{CHARACTERS / "max.toml"}"\n{text}')
+    assert_one_line_error(likeme("validate", path), *fragments)
+
+
+def test_validate_reports_each_bad_file_and_still_checks_the_good_ones(write):
+    bad = write("bad.toml", '[character]\nname = 3\n')
+    result = likeme("validate", CHARACTERS / "max.toml", bad)
+    assert result.returncode == 1
+    assert "ok    " in result.stdout and "key character.name" in result.stderr
+
+
+def test_demo_reports_what_each_character_did_and_saw():
+    result = likeme("demo")
+    assert result.returncode == 0, result.stderr
+    out = result.stdout
+    assert "morris (Morris" in out and "max (Max" in out
+    assert "did:" in out and "perceived morris:" in out
+    assert "segmented:" in out and "recognised:" in out
+    data = json.loads(likeme("demo", "--json", "--seed", "3").stdout)
+    morris = next(a for a in data["actors"] if a["id"] == "morris")
+    assert len(morris["did"]) >= 10
+    max_ = next(a for a in data["actors"] if a["id"] == "max")
+    assert max_["watching"]["perceived"]["frames"] == data["frames"]
+
+
+def test_seed_changes_the_random_sequence():
+    a = json.loads(likeme("demo", "--json", "--seed", "1").stdout)
+    b = json.loads(likeme("demo", "--json", "--seed", "2").stdout)
+    seq = lambda d: [x["movement"] for x in next(a for a in d["actors"] if a["id"] == "morris")["did"]]  # noqa: E731
+    assert seq(a) != seq(b)
+    assert seq(a) == seq(json.loads(likeme("demo", "--json", "--seed", "1").stdout))
+
+
+def test_run_scenario_file_and_errors(write):
+    result = likeme("run", CHARACTERS / "scenarios" / "demo.toml", "--duration", "2")
+    assert result.returncode == 0 and "2.00 s" in result.stdout
+    assert_one_line_error(likeme("run", "no-such-scenario"), "cannot find 'no-such-scenario'", "available:")
+    bad = write("scene.toml", f'[scenario]\nname = "x"\n[[actors]]\ncharacter = "{CHARACTERS / "max.toml"}"\nwatch = "ghost"\n')
+    assert_one_line_error(likeme("run", bad), "scene.toml", "key actors[0].watch", "unknown actor 'ghost'")
+
+
+def test_argument_errors_exit_1_with_one_line():
+    assert_one_line_error(likeme("run"), "the following arguments are required: scenario")
+    assert_one_line_error(likeme("frobnicate"), "invalid choice: 'frobnicate'")
+    assert_one_line_error(likeme("demo", "--seed", "x"), "invalid int value")
