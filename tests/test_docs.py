@@ -1,0 +1,47 @@
+"""The documentation stays true: every hook documented with its signature and exercised by a test."""
+
+from __future__ import annotations
+
+import inspect
+import re
+
+import pytest
+
+from tests.conftest import ROOT
+from toolkit import hookspecs
+
+HOOKS = {name: func for name, func in vars(hookspecs).items() if name.startswith("likeme_") and callable(func)}
+PLUGIN_DOC = (ROOT / "docs" / "writing-a-plugin.md").read_text()
+
+
+def _signature(func):
+    return f"{func.__name__}({', '.join(inspect.signature(func).parameters)})"
+
+
+@pytest.mark.parametrize("name", sorted(HOOKS))
+def test_every_hook_is_documented_with_its_signature(name):
+    func = HOOKS[name]
+    assert func.__doc__ and func.__doc__.strip(), f"{name} has no docstring"
+    assert f"`{_signature(func)}`" in PLUGIN_DOC, f"docs/writing-a-plugin.md lacks `{_signature(func)}`"
+
+
+@pytest.mark.parametrize("name", sorted(HOOKS))
+def test_every_hook_is_exercised_by_a_test(name):
+    tests = "\n".join(p.read_text() for p in (ROOT / "tests").rglob("*.py") if p.name != "test_docs.py")
+    assert re.search(rf"\b{name}\b", tests), f"no test implements or calls {name}"
+
+
+def test_docs_exist_and_are_linked_from_the_readme():
+    readme = (ROOT / "README.md").read_text()
+    for doc in ("architecture.md", "character-format.md", "writing-a-plugin.md"):
+        assert (ROOT / "docs" / doc).is_file()
+        assert f"docs/{doc}" in readme
+
+
+def test_readme_commands_are_what_ci_runs():
+    readme = (ROOT / "README.md").read_text()
+    ci = (ROOT / ".ci" / "run").read_text()
+    blocks = re.findall(r"```(?:sh|bash|console)?\n(.*?)```", readme, re.S)
+    test_command = next(b.strip() for b in blocks if "pytest" in b)
+    assert test_command in ci
+    assert any("likeme demo" in b for b in blocks)
