@@ -51,6 +51,57 @@ def scripted(pm):
     return module
 
 
+def make_plugin(**hooks):
+    """A plugin module made of the given functions, each marked as a hook implementation."""
+    import types
+
+    from toolkit import hookimpl
+
+    module = types.ModuleType("fixture_plugin")
+    for name, func in hooks.items():
+        setattr(module, name, hookimpl(func))
+    return module
+
+
+@pytest.fixture
+def watch_scene(write):
+    """watch_scene(moves, watcher_tables="", watcher=max.toml) -> Path of a scenario file.
+
+    Morris (scripted to perform ``moves`` with 0.5 s pauses) stands 1.6 m in front of the
+    watcher, who watches him; ``watcher_tables`` is TOML appended to the watcher's entry
+    (``[actors.override.segmenter]`` tables and the like).
+    """
+
+    def _scene(moves, watcher_tables: str = "", watcher: Path | str = CHARACTERS / "max.toml") -> Path:
+        moves_toml = "[" + ", ".join(f'"{m}"' for m in moves) + "]"
+        return write(
+            "scene.toml",
+            f"""
+            [scenario]
+            name = "test"
+            fps = 30.0
+
+            [[actors]]
+            character = "{CHARACTERS / 'morris.toml'}"
+            position = [0.0, 0.0, 1.6]
+            heading = 180.0
+            [actors.override.action]
+            plugin = "script"
+            movements = {moves_toml}
+            random = 0
+            pause = 0.5
+
+            [[actors]]
+            id = "max"
+            character = "{watcher}"
+            watch = "morris"
+            """
+            + textwrap.dedent(watcher_tables),
+        )
+
+    return _scene
+
+
 def _info(name):
     from toolkit.manager import PluginInfo
 

@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import types
-
-from tests.conftest import CHARACTERS
+from tests.conftest import CHARACTERS, make_plugin
 from toolkit import ActionSystem, Behaviour, Trigger, TriggerContext, World, WorldObject, hookimpl, load_character
 from toolkit.manager import PluginInfo
 
@@ -20,15 +18,10 @@ class Near(Trigger):
         return float(((obj.position - root) ** 2).sum() ** 0.5 <= context.params.get("distance", 0.5))
 
 
-def _module(**hooks):
-    module = types.ModuleType("hooks_fixture")
-    for name, func in hooks.items():
-        setattr(module, name, hookimpl(func))
-    return module
 
 
 def test_trigger_registered_through_the_hook_and_evaluated(pm):
-    pm.register_plugin(_module(likeme_register_triggers=lambda: [Near]), PluginInfo("near", "m", "(tests)", ""))
+    pm.register_plugin(make_plugin(likeme_register_triggers=lambda: [Near]), PluginInfo("near", "m", "(tests)", ""))
     cls = pm.registry.get("trigger", "near")
     world = World()
     max_ = world.add_actor(load_character(CHARACTERS / "max.toml", pm))
@@ -47,7 +40,7 @@ def test_plugin_adds_a_command(pm, monkeypatch, capsys):
     from toolkit import cli
 
     monkeypatch.setattr(cli, "create_plugin_manager", lambda: pm)
-    pm.register_plugin(_module(likeme_register_commands=likeme_register_commands), PluginInfo("hello", "m", "(tests)", ""))
+    pm.register_plugin(make_plugin(likeme_register_commands=likeme_register_commands), PluginInfo("hello", "m", "(tests)", ""))
     assert cli.main(["hello", "Morris"]) == 0
     assert capsys.readouterr().out == "hello Morris\n"
 
@@ -61,24 +54,11 @@ class Explainer(ActionSystem):
         return Behaviour(True, match.movement, path=("play", match.movement), motivation=("playful",))
 
 
-def test_behaviour_identified_is_announced(pm, write, recorder, scripted):
-    pm.register_plugin(_module(likeme_register_action_systems=lambda: [Explainer]), PluginInfo("explainer", "m", "(tests)", ""))
-    scene = write(
-        "s.toml",
-        f"""
-        [scenario]
-        name = "x"
-        [[actors]]
-        character = "{CHARACTERS / 'morris.toml'}"
-        position = [0.0, 0.0, 1.6]
-        heading = 180.0
-        [actors.override.action]
-        plugin = "script"
-        movements = ["wave"]
-        random = 0
-        [[actors]]
-        character = "{CHARACTERS / 'max.toml'}"
-        watch = "morris"
+def test_behaviour_identified_is_announced(pm, watch_scene, recorder, scripted):
+    pm.register_plugin(make_plugin(likeme_register_action_systems=lambda: [Explainer]), PluginInfo("explainer", "m", "(tests)", ""))
+    scene = watch_scene(
+        ["wave"],
+        """
         [actors.override.segmenter]
         plugin = "scripted-cuts"
         cuts = [[15, 60]]
@@ -127,7 +107,7 @@ def test_motor_system_registered_through_the_hook(pm, write):
             n = int(self.params["hold"] * fps / speed)
             return Motion(np.repeat(self.rest_pose()[None], n, axis=0), fps, self.owner.body.parts)
 
-    pm.register_plugin(_module(likeme_register_motor_systems=lambda: [Statue]), PluginInfo("statue", "m", "(tests)", ""))
+    pm.register_plugin(make_plugin(likeme_register_motor_systems=lambda: [Statue]), PluginInfo("statue", "m", "(tests)", ""))
     path = write(
         "statue.toml",
         """

@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-import types
-
 import pytest
 
 from toolkit import ConfigError, MotorSystem, PluginError, Segmenter, create_plugin_manager, hookimpl
+from tests.conftest import make_plugin
 from toolkit.manager import PluginInfo
 
 BUILTINS = {"keyframe", "motion-capture", "script", "imitation"}
@@ -32,11 +31,6 @@ def test_unknown_component_lists_registered_names(pm):
         pm.registry.get("action", "scrip")
 
 
-def _plugin(**hooks):
-    module = types.ModuleType("fake_plugin")
-    for name, func in hooks.items():
-        setattr(module, name, hookimpl(func))
-    return module
 
 
 class Still(Segmenter):
@@ -59,7 +53,7 @@ class Still(Segmenter):
 
 
 def test_plugin_registered_from_python_is_listed(pm):
-    pm.register_plugin(_plugin(likeme_register_segmenters=lambda: [Still]), PluginInfo("still", "m", "(tests)", ""))
+    pm.register_plugin(make_plugin(likeme_register_segmenters=lambda: [Still]), PluginInfo("still", "m", "(tests)", ""))
     assert pm.registry.get("segmenter", "still") is Still
     assert pm.registry.info("segmenter", "still").plugin.distribution == "(tests)"
 
@@ -69,7 +63,7 @@ def test_duplicate_component_names_are_refused(pm):
         """Same name."""
 
     for i, cls in enumerate((Still, Other)):
-        pm.register_plugin(_plugin(likeme_register_segmenters=lambda cls=cls: [cls]), PluginInfo(f"p{i}", "m", "(tests)", ""))
+        pm.register_plugin(make_plugin(likeme_register_segmenters=lambda cls=cls: [cls]), PluginInfo(f"p{i}", "m", "(tests)", ""))
     with pytest.raises(PluginError, match=r"plugin 'p1' failed in likeme_register_segmenters: segmenter name 'still' is already registered by plugin 'p0'"):
         pm.registry
 
@@ -86,7 +80,7 @@ def test_duplicate_component_names_are_refused(pm):
     ],
 )
 def test_invalid_registrations_name_the_plugin_and_hook(pm, returned, message):
-    pm.register_plugin(_plugin(likeme_register_segmenters=returned), PluginInfo("bad", "m", "(tests)", ""))
+    pm.register_plugin(make_plugin(likeme_register_segmenters=returned), PluginInfo("bad", "m", "(tests)", ""))
     with pytest.raises(PluginError, match=message):
         pm.registry
 
@@ -96,7 +90,7 @@ def test_unknown_hook_is_refused_at_registration(pm):
         return []
 
     with pytest.raises(PluginError, match=r"plugin 'typo' failed in registration: .*likeme_register_segmentors"):
-        pm.register_plugin(_plugin(likeme_register_segmentors=likeme_register_segmentors), PluginInfo("typo", "m", "(tests)", ""))
+        pm.register_plugin(make_plugin(likeme_register_segmentors=likeme_register_segmentors), PluginInfo("typo", "m", "(tests)", ""))
 
 
 def test_disabling_autoload_keeps_the_builtins(monkeypatch):
@@ -116,7 +110,7 @@ def test_tracing_writes_hook_calls(monkeypatch, capsys):
 def test_character_paths_hook_adds_folders(pm, tmp_path, write):
     folder = tmp_path / "shipped"
     folder.mkdir()
-    pm.register_plugin(_plugin(likeme_character_paths=lambda: [folder]), PluginInfo("ships", "m", "(tests)", ""))
+    pm.register_plugin(make_plugin(likeme_character_paths=lambda: [folder]), PluginInfo("ships", "m", "(tests)", ""))
     from toolkit.character import character_paths
 
     assert folder in character_paths(pm)

@@ -10,36 +10,11 @@ from toolkit import ConfigError, Percept, Perception, PluginError, World, WorldO
 from toolkit.manager import PluginInfo
 
 
-def _scenario(write, morris_moves, max_override="", extra=""):
-    return write(
-        "scene.toml",
-        f"""
-        [scenario]
-        name = "test"
-        fps = 30.0
-
-        [[actors]]
-        character = "{CHARACTERS / 'morris.toml'}"
-        position = [0.0, 0.0, 1.6]
-        heading = 180.0
-        [actors.override.action]
-        plugin = "script"
-        movements = {morris_moves!r}
-        random = 0
-        pause = 0.5
-
-        [[actors]]
-        character = "{CHARACTERS / 'max.toml'}"
-        watch = "morris"
-        {max_override}
-        {extra}
-        """.replace("'", '"'),
-    )
 
 
-def _performed_frames(pm, write, moves):
+def _performed_frames(pm, watch_scene, moves):
     """Run Morris alone to learn on which world frames each movement starts and ends."""
-    world = load_scenario(_scenario(write, moves), pm).run()
+    world = load_scenario(watch_scene(moves), pm).run()
     morris = world.actors["morris"]
     spans = []
     for frame, request in morris.performed:
@@ -48,8 +23,8 @@ def _performed_frames(pm, write, moves):
     return world, spans
 
 
-def test_script_performs_its_movements_in_order_and_returns_to_rest(pm, write):
-    world, spans = _performed_frames(pm, write, ["jump", "wave"])
+def test_script_performs_its_movements_in_order_and_returns_to_rest(pm, watch_scene):
+    world, spans = _performed_frames(pm, watch_scene, ["jump", "wave"])
     morris = world.actors["morris"]
     assert [r.movement for _, r in morris.performed] == ["jump", "wave"]
     assert spans[1][0] - spans[0][1] == pytest.approx(15, abs=1)  # 0.5 s pause in the hub
@@ -60,14 +35,13 @@ def test_script_performs_its_movements_in_order_and_returns_to_rest(pm, write):
     assert pose[morris.body.index("nose"), 2] < pose[morris.body.root_index, 2]
 
 
-def test_perceive_segment_match_respond(pm, write, recorder, scripted):
-    _, spans = _performed_frames(pm, write, ["jump", "cover_face"])
+def test_perceive_segment_match_respond(pm, watch_scene, recorder, scripted):
+    _, spans = _performed_frames(pm, watch_scene, ["jump", "cover_face"])
     recorder.calls.clear()
     cuts = [[s - 1, e - 1] for s, e in spans]  # memory row 0 is world frame 1: Max watches from the first step
-    path = _scenario(
-        write,
+    path = watch_scene(
         ["jump", "cover_face"],
-        max_override=f'[actors.override.segmenter]\nplugin = "scripted-cuts"\ncuts = {cuts}\n'
+        f'[actors.override.segmenter]\nplugin = "scripted-cuts"\ncuts = {cuts}\n'
         '[actors.override.matcher]\nplugin = "nearest-movement"\n',
     )
     world = load_scenario(path, pm).run()
@@ -90,14 +64,13 @@ def test_perceive_segment_match_respond(pm, write, recorder, scripted):
     assert max_.memory.n == world.frame and max_.memory.visible.all()
 
 
-def test_streaming_matcher_commits_before_the_segment_ends(pm, write, recorder, scripted):
-    _, spans = _performed_frames(pm, write, ["wave"])
+def test_streaming_matcher_commits_before_the_segment_ends(pm, watch_scene, recorder, scripted):
+    _, spans = _performed_frames(pm, watch_scene, ["wave"])
     (s, e), = spans
     recorder.calls.clear()
-    path = _scenario(
-        write,
+    path = watch_scene(
         ["wave"],
-        max_override=f'[actors.override.segmenter]\nplugin = "scripted-cuts"\ncuts = [[{s - 1}, {e - 1}]]\n'
+        f'[actors.override.segmenter]\nplugin = "scripted-cuts"\ncuts = [[{s - 1}, {e - 1}]]\n'
         '[actors.override.matcher]\nplugin = "early-commit"\nmovement = "wave"\nafter = 5\n',
     )
     world = load_scenario(path, pm).run()
@@ -111,8 +84,8 @@ def test_streaming_matcher_commits_before_the_segment_ends(pm, write, recorder, 
     assert imitation[0] < e  # response facilitation: Max starts before Morris ends
 
 
-def test_watching_needs_a_perception(pm, write):
-    path = _scenario(write, ["jump"], max_override='[actors.override.perception]\nplugin = "motion-capture"')
+def test_watching_needs_a_perception(pm, watch_scene):
+    path = watch_scene(["jump"])
     scenario = load_scenario(path, pm)
     max_ = scenario.world.actors["max"]
     max_.character.perception = None
@@ -120,7 +93,7 @@ def test_watching_needs_a_perception(pm, write):
         max_.watch(scenario.world.actors["morris"])
 
 
-def test_a_component_that_raises_is_reported_by_name_and_method(pm, write):
+def test_a_component_that_raises_is_reported_by_name_and_method(pm, watch_scene):
     class Broken(Perception):
         """Always fails."""
 
@@ -135,7 +108,7 @@ def test_a_component_that_raises_is_reported_by_name_and_method(pm, write):
             return [Broken]
 
     pm.register_plugin(Plugin(), PluginInfo("broken-plugin", "m", "(tests)", ""))
-    path = _scenario(write, ["jump"], max_override='[actors.override.perception]\nplugin = "broken"')
+    path = watch_scene(["jump"], '[actors.override.perception]\nplugin = "broken"')
     scenario = load_scenario(path, pm)
     with pytest.raises(PluginError, match=r"plugin 'broken' failed in Broken.perceive: ValueError: lens cap on"):
         scenario.run()
@@ -162,8 +135,8 @@ def test_request_of_unknown_movement_lists_the_repertoire(pm):
         max_.request(MovementRequest("fly"))
 
 
-def test_percept_of_motion_capture_is_root_relative(pm, write):
-    scenario = load_scenario(_scenario(write, ["jump"]), pm)
+def test_percept_of_motion_capture_is_root_relative(pm, watch_scene):
+    scenario = load_scenario(watch_scene(["jump"]), pm)
     world = scenario.world
     world.step()
     max_, morris = world.actors["max"], world.actors["morris"]

@@ -68,27 +68,8 @@ def test_toml_character_selects_the_third_party_segmenter(installed, write):
     assert off.returncode == 1 and "unknown segmenter 'stillness'" in off.stderr
 
 
-def test_run_with_the_third_party_segmenter(installed, write):
-    write("still_max.toml", CHARACTER)
-    scene = write(
-        "scene.toml",
-        f"""
-        [scenario]
-        name = "stillness"
-        [[actors]]
-        character = "{CHARACTERS / 'morris.toml'}"
-        position = [0.0, 0.0, 1.6]
-        heading = 180.0
-        [actors.override.action]
-        plugin = "script"
-        movements = ["jump", "wave", "jump"]
-        random = 0
-        [[actors]]
-        id = "max"
-        character = "still_max.toml"
-        watch = "morris"
-        """,
-    )
+def test_run_with_the_third_party_segmenter(installed, write, watch_scene):
+    scene = watch_scene(["jump", "wave", "jump"], watcher=write("still_max.toml", CHARACTER))
     result = _likeme(installed, "run", scene, "--json")
     assert result.returncode == 0, result.stderr
     data = json.loads(result.stdout)
