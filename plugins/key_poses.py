@@ -33,7 +33,7 @@ from toolkit.body import Body
 from toolkit.errors import ConfigError
 from toolkit.motion import Motion
 
-__all__ = ["KeyPoses", "Movement", "parse_poses", "parse_movements", "interpolate"]
+__all__ = ["KeyPoses", "Movement", "parse_poses", "parse_movements", "read_repertoire", "interpolate"]
 
 POSE_KEYS = ("base", "shift", "offset")
 
@@ -165,6 +165,27 @@ def parse_movements(table: Mapping[str, Any], poses: KeyPoses, hubs: Sequence[st
         description = spec.get("description", "")
         out[name] = Movement(name, tuple(names), t, str(description))
     return out
+
+
+def read_repertoire(params: Mapping[str, Any], body: Body) -> tuple[KeyPoses, tuple[str, ...], dict[str, Movement]]:
+    """Poses, hubs and movements from a motor table's ``poses``, ``rest``, ``hubs`` and ``movements``."""
+    key_poses = parse_poses(params["poses"], body)
+    hubs = (params["rest"], *params["hubs"])
+    for i, hub in enumerate(hubs):
+        if hub not in key_poses.names:
+            raise ConfigError(
+                f"unknown hub pose {hub!r}",
+                key=("rest",) if i == 0 else ("hubs", i - 1),
+                expected="a declared pose",
+                available=key_poses.names,
+            )
+    return key_poses, hubs, parse_movements(params["movements"], key_poses, hubs)
+
+
+def play(key_poses: KeyPoses, movement: Movement, parts: Sequence[str], *, fps: float, speed: float = 1.0) -> Motion:
+    """Sample one authored movement into a motion."""
+    keys = np.stack([key_poses[p] for p in movement.poses])
+    return interpolate(keys, movement.times, parts, fps=fps, speed=speed)
 
 
 def interpolate(

@@ -13,8 +13,8 @@ from typing import Any
 
 import numpy as np
 
-from plugins.key_poses import KeyPoses, Movement, interpolate, parse_movements, parse_poses
-from toolkit import ConfigError, MotorSystem, Motion, Parameter, hookimpl
+from plugins.key_poses import play, read_repertoire
+from toolkit import ConfigError, Motion, MotorSystem, Parameter, hookimpl
 
 
 class KeyframeMotor(MotorSystem):
@@ -30,19 +30,8 @@ class KeyframeMotor(MotorSystem):
 
     def attach(self, owner: Any) -> None:
         super().attach(owner)
-        body = owner.body
-        self.key_poses: KeyPoses = parse_poses(self.params["poses"], body)
-        self.hubs = (self.params["rest"], *self.params["hubs"])
-        for i, hub in enumerate(self.hubs):
-            if hub not in self.key_poses.names:
-                raise ConfigError(
-                    f"unknown hub pose {hub!r}",
-                    key=("rest",) if i == 0 else ("hubs", i - 1),
-                    expected="a declared pose",
-                    available=self.key_poses.names,
-                )
-        self.repertoire: dict[str, Movement] = parse_movements(self.params["movements"], self.key_poses, self.hubs)
-        self.parts = body.parts
+        self.key_poses, self.hubs, self.repertoire = read_repertoire(self.params, owner.body)
+        self.parts = owner.body.parts
 
     def movements(self) -> list[str]:
         return list(self.repertoire)
@@ -53,9 +42,7 @@ class KeyframeMotor(MotorSystem):
     def perform(self, movement: str, *, speed: float = 1.0, fps: float = 30.0) -> Motion:
         if movement not in self.repertoire:
             raise ConfigError(f"unknown movement {movement!r}", expected="a movement of this character", available=self.movements())
-        m = self.repertoire[movement]
-        keys = np.stack([self.key_poses[p] for p in m.poses])
-        return interpolate(keys, m.times, self.parts, fps=fps, speed=speed)
+        return play(self.key_poses, self.repertoire[movement], self.parts, fps=fps, speed=speed)
 
     def describe(self) -> dict[str, Any]:
         return {"movements": len(self.repertoire), "poses": len(self.key_poses.names), "hubs": list(self.hubs)}

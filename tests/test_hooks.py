@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from tests.conftest import CHARACTERS, make_plugin
-from toolkit import ActionSystem, Behaviour, Trigger, TriggerContext, World, WorldObject, hookimpl, load_character
+from toolkit import ActionSystem, Behaviour, Trigger, TriggerContext, World, WorldObject, load_character
 from toolkit.manager import PluginInfo
 
 

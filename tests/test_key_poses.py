@@ -7,8 +7,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from tests.conftest import CHARACTERS
 from plugins.key_poses import interpolate
+from tests.conftest import CHARACTERS
 from toolkit import load_character
 
 

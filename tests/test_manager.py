@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import pytest
 
-from toolkit import ConfigError, MotorSystem, PluginError, Segmenter, create_plugin_manager, hookimpl
 from tests.conftest import make_plugin
+from toolkit import ConfigError, MotorSystem, PluginError, Segmenter, create_plugin_manager
 from toolkit.manager import PluginInfo
 
-BUILTINS = {"keyframe", "motion-capture", "script", "imitation"}
+BUILTINS = {"keyframe", "motion-capture", "script", "imitation", "hub-threshold"}
 
 
 def test_builtins_come_from_the_likeme_entry_points(pm):
@@ -25,7 +25,7 @@ def test_builtins_come_from_the_likeme_entry_points(pm):
 
 
 def test_unknown_component_lists_registered_names(pm):
-    with pytest.raises(ConfigError, match=r"unknown segmenter 'hub-treshold'.*available: \(none\)"):
+    with pytest.raises(ConfigError, match=r"unknown segmenter 'hub-treshold'.*available: hub-threshold"):
         pm.registry.get("segmenter", "hub-treshold")
     with pytest.raises(ConfigError, match=r"unknown action system 'scrip'.*available: imitation, script"):
         pm.registry.get("action", "scrip")

@@ -6,8 +6,8 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tests.conftest import CHARACTERS
 from plugins.root_frame import facing_heading, to_root_relative
+from tests.conftest import CHARACTERS
 from toolkit import load_character
 from toolkit.motion import local_to_world
 

@@ -6,10 +6,18 @@ import numpy as np
 import pytest
 
 from tests.conftest import CHARACTERS
-from toolkit import ConfigError, Percept, Perception, PluginError, World, WorldObject, hookimpl, load_character, load_scenario
+from toolkit import (
+    ConfigError,
+    Percept,
+    Perception,
+    PluginError,
+    World,
+    WorldObject,
+    hookimpl,
+    load_character,
+    load_scenario,
+)
 from toolkit.manager import PluginInfo
-
-
 
 
 def _performed_frames(pm, watch_scene, moves):

@@ -28,9 +28,8 @@
 
 from __future__ import annotations
 
-import re
-
 import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path

@@ -1,0 +1,192 @@
+"""Segmenter ``hub-threshold``: movements begin and end where the observed body leaves and returns to a hub.
+
+Buchsbaum & Blumberg 2005, §5.1. Almost every movement of the observer's own
+repertoire starts and ends in a hub (standing), so the observer compares each
+incoming frame with *its own* hub pose (root-relative, from its motor system)
+by eq. 1 over the visible parts, low-pass filters that distance, and marks a
+segment's beginning where the filtered distance rises above a threshold and its
+end where it falls back below.
+
+Additions a real stream needs, each a parameter:
+
+- hysteresis: the end threshold may be lower than the start threshold, so
+  noise around the threshold does not chatter;
+- frames with no visible part carry no evidence: the filter holds its value
+  (a long dropout neither starts nor ends a movement);
+- ``min_duration`` drops blips, ``max_gap`` joins a dip below the threshold
+  shorter than it to the surrounding segment;
+- the reported start and end are moved back by the filter's delay, so they
+  mark where the raw distance crossed, not where the lagging filter did.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from scipy.signal import butter, lfilter, lfilter_zi
+
+from plugins.pose_distance import pose_distance
+from toolkit import ConfigError, Motion, Parameter, Segment, Segmenter, hookimpl
+
+
+class HubThreshold(Segmenter):
+    """Segments where the distance from the observer's own hub pose crosses a threshold (§5.1)."""
+
+    name = "hub-threshold"
+    parameters = (
+        Parameter("threshold", float, 0.035, "Filtered eq. 1 distance (m) from the hub above which a movement has begun. "
+                  "Lower finds subtler movements and more noise; higher misses small movements.", minimum=0.0),
+        Parameter("release", float, 0.8, "End threshold as a fraction of `threshold` (hysteresis; 1 = none).", minimum=0.0, maximum=1.0),
+        Parameter("cutoff", float, 4.0, "Low-pass cut-off frequency in Hz (second-order Butterworth). "
+                  "Lower smooths more noise but delays and merges boundaries.", minimum=0.1),
+        Parameter("min_duration", float, 0.25, "Segments shorter than this (s) are dropped as noise.", minimum=0.0),
+        Parameter("max_gap", float, 0.0, "Dips below the end threshold shorter than this (s) do not end a segment.", minimum=0.0),
+        Parameter("hub", str, "", "The hub pose to compare with (default: the observer's rest pose)."),
+    )
+
+    def attach(self, owner: Any) -> None:
+        super().attach(owner)
+        motor = owner.motor
+        if self.params["hub"]:
+            poses = getattr(motor, "key_poses", None)
+            if poses is None or self.params["hub"] not in poses.names:
+                raise ConfigError(
+                    f"unknown hub pose {self.params['hub']!r}", key=("hub",), expected="a pose of the observer's motor system",
+                    available=list(poses.names) if poses is not None else [],
+                )
+            hub = poses[self.params["hub"]]
+        else:
+            hub = motor.rest_pose()
+        hub = np.asarray(hub, dtype=float)
+        self.template = hub - hub[owner.body.root_index]
+        self.template_parts = owner.body.parts
+
+    # -- streaming ---------------------------------------------------------------------
+
+    def reset(self, parts: Sequence[str], fps: float) -> None:
+        parts = tuple(parts)
+        missing = [p for p in self.template_parts if p not in parts]
+        if missing and len(missing) == len(self.template_parts):
+            raise ConfigError(f"the observed body shares no part with the hub template {list(self.template_parts)}",
+                              expected="observed parts named like the observer's own", available=list(parts))
+        self._index = np.array([parts.index(p) if p in parts else -1 for p in self.template_parts])
+        self._fps = float(fps)
+        nyquist = 0.5 * self._fps
+        wn = min(self.params["cutoff"] / nyquist, 0.99)
+        self._b, self._a = butter(2, wn)
+        self._zi: np.ndarray | None = None
+        self._delay = int(round(_group_delay(self._b, self._a, self._fps)))
+        self._frame = -1
+        self._last = np.nan
+        self._filtered: list[float] = []
+        self._start: int | None = None
+        self._below = 0
+        self._on = self.params["threshold"]
+        self._off = self.params["threshold"] * self.params["release"]
+
+    @property
+    def active_since(self) -> int | None:
+        return self._start
+
+    def distance(self, pose: np.ndarray, visible: np.ndarray) -> float:
+        """eq. 1 between one observed root-relative pose and the hub template (NaN if nothing visible)."""
+        ok = self._index >= 0
+        obs = np.zeros_like(self.template)
+        vis = np.zeros(len(self.template), dtype=bool)
+        obs[ok] = pose[self._index[ok]]
+        vis[ok] = visible[self._index[ok]]
+        return float(pose_distance(obs, self.template, vis))
+
+    def push(self, pose: np.ndarray, visible: np.ndarray) -> list[Segment]:
+        self._frame += 1
+        raw = self.distance(pose, visible)
+        if np.isnan(raw):  # no evidence: hold
+            raw = self._last if not np.isnan(self._last) else 0.0
+        self._last = raw
+        if self._zi is None:
+            self._zi = lfilter_zi(self._b, self._a) * raw
+        y, self._zi = lfilter(self._b, self._a, [raw], zi=self._zi)
+        value = float(y[0])
+        self._filtered.append(value)
+        return self._step(value)
+
+    def _step(self, value: float) -> list[Segment]:
+        f = self._frame
+        if self._start is None:
+            if value > self._on:
+                self._start = max(0, f - self._delay)
+                self._below = 0
+            return []
+        if value < self._off:
+            self._below += 1
+            gap = int(round(self.params["max_gap"] * self._fps))
+            if self._below > gap:
+                end = max(self._start + 1, f - self._below + 1 - self._delay)
+                return self._close(end)
+        else:
+            self._below = 0
+        return []
+
+    def flush(self) -> list[Segment]:
+        if self._start is None:
+            return []
+        return self._close(self._frame + 1)
+
+    def _close(self, end: int) -> list[Segment]:
+        start, self._start, self._below = self._start, None, 0
+        if (end - start) / self._fps < self.params["min_duration"] or end <= start:
+            return []
+        return [Segment(start, end, self._fps)]
+
+    # -- batch ---------------------------------------------------------------------------
+
+    def signal(self, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
+        """The raw and the low-pass filtered distance-to-hub of a root-relative motion (Fig. 4)."""
+        self.reset(motion.parts, motion.fps)
+        ok = self._index >= 0
+        obs = np.zeros((motion.n_frames, *self.template.shape))
+        vis = np.zeros((motion.n_frames, len(self.template)), dtype=bool)
+        obs[:, ok] = motion.positions[:, self._index[ok]]
+        vis[:, ok] = motion.visible[:, self._index[ok]]
+        raw = pose_distance(obs, self.template, vis)
+        raw = _hold(raw)
+        if raw.size == 0:
+            return raw, raw
+        filtered, _ = lfilter(self._b, self._a, raw, zi=lfilter_zi(self._b, self._a) * raw[0])
+        return raw, filtered
+
+    def segment(self, motion: Motion) -> list[Segment]:
+        _, filtered = self.signal(motion)
+        self.reset(motion.parts, motion.fps)
+        out: list[Segment] = []
+        for value in filtered:
+            self._frame += 1
+            out.extend(self._step(float(value)))
+        out.extend(self.flush())
+        return out
+
+
+def _hold(x: np.ndarray) -> np.ndarray:
+    """Replace NaN by the last valid value (0 before the first), vectorised."""
+    x = np.asarray(x, dtype=float)
+    if x.size == 0:
+        return x
+    valid = ~np.isnan(x)
+    idx = np.where(valid, np.arange(len(x)), -1)
+    np.maximum.accumulate(idx, out=idx)
+    return np.where(idx >= 0, x[np.maximum(idx, 0)], 0.0)
+
+
+def _group_delay(b: np.ndarray, a: np.ndarray, fps: float) -> float:
+    """Delay in frames of the filter at low frequencies (where movements live)."""
+    from scipy.signal import group_delay
+
+    _, gd = group_delay((b, a), w=[0.01])
+    return float(gd[0])
+
+
+@hookimpl
+def likeme_register_segmenters():
+    return [HubThreshold]

@@ -1,0 +1,41 @@
+"""The pose distance of Buchsbaum & Blumberg 2005, §5.1 eq. 1-2 and §5.2 eq. 3.
+
+eq. 2: ``d(a, b)`` is the Euclidean distance between two 3-vectors.
+eq. 1: ``dist(A, B)`` is the mean of ``d(A_i, B_i)`` over the N body parts
+*currently visible*; hidden parts are left out, which is why it is a mean.
+eq. 3: the distance of an observed path O from a graph path P is the sum of
+eq. 1 over the poses considered so far.
+
+All functions broadcast: poses are ``(..., P, 3)`` with masks ``(..., P)``.
+A pose pair with no visible part has distance NaN (there is no evidence).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["pose_distance", "path_distance"]
+
+
+def pose_distance(a: np.ndarray, b: np.ndarray, visible: np.ndarray) -> np.ndarray:
+    """eq. 1: mean distance over visible parts; NaN where nothing is visible.
+
+    Parameters
+    ----------
+    a, b : array, shape (..., P, 3)
+        Root-relative poses (broadcast against each other).
+    visible : array of bool, shape (..., P)
+        Parts that take part in the comparison (broadcast likewise).
+    """
+    diff = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
+    d = np.sqrt(np.einsum("...i,...i->...", diff, diff))  # eq. 2 per part
+    visible = np.broadcast_to(np.asarray(visible, dtype=bool), d.shape)
+    d = np.where(visible, d, 0.0)
+    n = visible.sum(axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(n > 0, d.sum(axis=-1) / np.maximum(n, 1), np.nan)
+
+
+def path_distance(observed: np.ndarray, path: np.ndarray, visible: np.ndarray) -> float:
+    """eq. 3: the sum of eq. 1 over aligned poses ``observed[i]`` and ``path[i]`` (frames without evidence skipped)."""
+    return float(np.nansum(pose_distance(observed, path, visible)))
