@@ -68,8 +68,10 @@ def test_perceive_segment_match_respond(pm, watch_scene, recorder, scripted):
     # events are also kept on the world, in order
     kinds = [e.kind for e in world.events]
     assert kinds.index("segment_found") < kinds.index("movement_recognised") < kinds.index("imitation_started")
-    # working memory holds every perceived frame, all visible with motion capture
-    assert max_.memory.n == world.frame and max_.memory.visible.all()
+    # working memory holds every perceived frame; Max's synthetic vision loses Morris's nose behind his hands
+    assert max_.memory.n == world.frame
+    nose = max_.memory.visible[:, world.actors["morris"].body.index("nose")]
+    assert 0 < (~nose).sum() < 0.5 * len(nose)
 
 
 def test_streaming_matcher_commits_before_the_segment_ends(pm, watch_scene, recorder, scripted):
