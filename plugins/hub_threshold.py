@@ -36,13 +36,13 @@ class HubThreshold(Segmenter):
 
     name = "hub-threshold"
     parameters = (
-        Parameter("threshold", float, 0.035, "Filtered eq. 1 distance (m) from the hub above which a movement has begun. "
+        Parameter("threshold", float, 0.02, "Filtered eq. 1 distance (m) from the hub above which a movement has begun. "
                   "Lower finds subtler movements and more noise; higher misses small movements.", minimum=0.0),
-        Parameter("release", float, 0.8, "End threshold as a fraction of `threshold` (hysteresis; 1 = none).", minimum=0.0, maximum=1.0),
+        Parameter("release", float, 0.75, "End threshold as a fraction of `threshold` (hysteresis; 1 = none).", minimum=0.0, maximum=1.0),
         Parameter("cutoff", float, 4.0, "Low-pass cut-off frequency in Hz (second-order Butterworth). "
                   "Lower smooths more noise but delays and merges boundaries.", minimum=0.1),
         Parameter("min_duration", float, 0.25, "Segments shorter than this (s) are dropped as noise.", minimum=0.0),
-        Parameter("max_gap", float, 0.0, "Dips below the end threshold shorter than this (s) do not end a segment.", minimum=0.0),
+        Parameter("max_gap", float, 0.1, "Dips below the end threshold shorter than this (s) do not end a segment.", minimum=0.0),
         Parameter("hub", str, "", "The hub pose to compare with (default: the observer's rest pose)."),
     )
 

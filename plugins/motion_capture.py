@@ -11,19 +11,29 @@ from __future__ import annotations
 
 import numpy as np
 
-from plugins.root_frame import to_root_relative
-from toolkit import Percept, Perception, hookimpl
+from plugins.root_frame import HeadingFilter, facing_heading, to_root_relative
+from toolkit import Parameter, Percept, Perception, hookimpl
 
 
 class MotionCapture(Perception):
     """Sees every part of the target exactly (no occlusion or noise); root-relative by §5.1."""
 
     name = "motion-capture"
+    parameters = (
+        Parameter("facing_window", float, 1.0, "Seconds over which the target's facing is a running median "
+                  "(steady through kicks and head turns; 0: every frame on its own).", minimum=0.0),
+    )
+
+    def reset(self) -> None:
+        self._facing: HeadingFilter | None = None
 
     def perceive(self, observer, target, world) -> Percept:
         positions = target.world_pose()
         visible = np.isfinite(positions).all(axis=-1)
-        pose, mask, root, heading = to_root_relative(positions, visible, target.body)
+        if getattr(self, "_facing", None) is None:
+            self._facing = HeadingFilter(round(self.params["facing_window"] * world.fps))
+        found = facing_heading(np.where(visible[:, None], positions, 0.0), visible, target.body)
+        pose, mask, root, heading = to_root_relative(positions, visible, target.body, self._facing.update(float(found)))
         objects = {name: obj.position.copy() for name, obj in world.objects.items()}
         return Percept(world.time, pose, mask, np.where(mask[:, None], positions, np.nan), root, float(heading), objects)
 

@@ -15,7 +15,7 @@ import numpy as np
 from toolkit.body import Body
 from toolkit.motion import world_to_local
 
-__all__ = ["facing_heading", "to_root_relative"]
+__all__ = ["facing_heading", "to_root_relative", "HeadingFilter"]
 
 _UP = np.array([0.0, 1.0, 0.0])
 
@@ -33,7 +33,8 @@ def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body) -> np.nda
     -----
     With both facing parts (knees) visible, the facing is the horizontal
     perpendicular of the line from right to left; the forward marker (nose),
-    when visible, picks the side of that line it lies on. With a knee hidden,
+    when visible, picks the side of that line it lies on, as seen from the root
+    (or from the middle of the knees when the root is hidden). With a knee hidden,
     the horizontal direction from the root to the forward marker is used.
     """
     world = np.asarray(world, dtype=float)
@@ -46,8 +47,11 @@ def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body) -> np.nda
     heading = np.full(world.shape[:-2], np.nan)
     if body.facing.forward is not None:
         fi = body.index(body.facing.forward)
+        # the side of the knee line the nose is on; measured from the root when it is seen (a sitting
+        # body has its knees in front of its nose), else from the middle of the knees
         mid = 0.5 * (world[..., li, :] + world[..., ri, :])
-        ahead = world[..., fi, :] - mid
+        base = np.where(visible[..., root, None], world[..., root, :], mid)
+        ahead = world[..., fi, :] - base
         side = np.sign(np.einsum("...i,...i->...", ahead, perp))
         perp = perp * np.where((side < 0) & visible[..., fi], -1.0, 1.0)[..., None]
         fallback = world[..., fi, :] - world[..., root, :]
@@ -61,8 +65,42 @@ def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body) -> np.nda
     return heading
 
 
-def to_root_relative(world: np.ndarray, visible: np.ndarray, body: Body) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+class HeadingFilter:
+    """A running median of recent facing estimates, for a stream of frames.
+
+    The facing found from the knees swings when one knee lifts (a kick, a stomp)
+    and the nose swings when the head turns, while a body standing in place turns
+    slowly. The median over the last ``window`` frames (circular: angles are
+    unwrapped around the newest estimate) keeps the facing steady through such
+    limb movements and still follows a real turn after half a window.
+    A window of 1 returns each estimate unchanged.
+    """
+
+    def __init__(self, window: int) -> None:
+        self.window = max(1, int(window))
+        self._recent: list[float] = []
+
+    def reset(self) -> None:
+        self._recent.clear()
+
+    def update(self, heading: float) -> float:
+        """Add one estimate (NaN when there was none) and return the filtered facing (NaN if none yet)."""
+        if np.isfinite(heading):
+            self._recent.append(float(heading))
+            del self._recent[: -self.window]
+        if not self._recent:
+            return float("nan")
+        ref = self._recent[-1]
+        unwrapped = ref + np.angle(np.exp(1j * (np.asarray(self._recent) - ref)))
+        return float(np.angle(np.exp(1j * np.median(unwrapped))))
+
+
+def to_root_relative(
+    world: np.ndarray, visible: np.ndarray, body: Body, heading: np.ndarray | float | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """World positions to root-relative positions in the body's own frame.
+
+    ``heading`` replaces the facing found from the parts (a filtered value, say).
 
     Returns
     -------
@@ -76,7 +114,9 @@ def to_root_relative(world: np.ndarray, visible: np.ndarray, body: Body) -> tupl
     """
     world = np.asarray(world, dtype=float)
     visible = np.asarray(visible, dtype=bool) & np.isfinite(world).all(axis=-1)
-    heading = facing_heading(np.where(visible[..., None], world, 0.0), visible, body)
+    if heading is None:
+        heading = facing_heading(np.where(visible[..., None], world, 0.0), visible, body)
+    heading = np.asarray(heading, dtype=float)
     root = world[..., body.root_index, :]
     ok = visible[..., body.root_index] & np.isfinite(heading)
     safe_world = np.where(visible[..., None], world, 0.0)

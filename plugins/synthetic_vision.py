@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from plugins.root_frame import to_root_relative
+from plugins.root_frame import HeadingFilter, facing_heading, to_root_relative
 from plugins.sensory_buffer import SensoryBuffer
 from toolkit import ConfigError, Parameter, Percept, Perception, hookimpl
 from toolkit.motion import facing_vector
@@ -79,6 +79,8 @@ class SyntheticVision(Perception):
         Parameter("noise", float, 0.0, "Standard deviation (m) of Gaussian noise on every seen position.", minimum=0.0),
         Parameter("dropout", float, 0.0, "Probability that a visible part is missed in a frame.", minimum=0.0, maximum=1.0),
         Parameter("buffer", float, 0.1, "Seconds the sensory buffer bridges a part's dropout (0: off).", minimum=0.0),
+        Parameter("facing_window", float, 1.0, "Seconds over which the target's facing is a running median "
+                  "(steady through kicks and head turns; 0: every frame on its own).", minimum=0.0),
         Parameter("seed", int, 0, "Seed of noise and dropouts."),
     )
 
@@ -93,6 +95,7 @@ class SyntheticVision(Perception):
     def reset(self) -> None:
         self._rng = np.random.default_rng(self.params["seed"])
         self._buffer: SensoryBuffer | None = None
+        self._facing: HeadingFilter | None = None
 
     def _radii(self, body: Any) -> np.ndarray:
         radii = np.full(body.n_parts, self.params["part_radius"])
@@ -139,7 +142,10 @@ class SyntheticVision(Perception):
         if self._buffer is None or len(self._buffer.last) != len(positions):
             self._buffer = SensoryBuffer(len(positions), int(round(p["buffer"] * world.fps)))
         positions, seen = self._buffer.update(positions, seen)
-        pose, mask, root, heading = to_root_relative(positions, seen, target.body)
+        if self._facing is None:
+            self._facing = HeadingFilter(round(p["facing_window"] * world.fps))
+        found = facing_heading(np.where(seen[:, None], positions, 0.0), seen, target.body)
+        pose, mask, root, heading = to_root_relative(positions, seen, target.body, self._facing.update(float(found)))
         eye = observer.world_pose()[observer.body.index(p["eye"])]
         objects = {}
         for name, obj in world.objects.items():

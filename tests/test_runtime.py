@@ -141,7 +141,7 @@ def test_request_of_unknown_movement_lists_the_repertoire(pm):
 
     world = World(fps=30)
     max_ = world.add_actor(load_character(CHARACTERS / "max.toml", pm))
-    with pytest.raises(ConfigError, match=r"max has no movement 'fly'.*available: jump, cover_face, wave, reach"):
+    with pytest.raises(ConfigError, match=r"max has no movement 'fly'.*available: stand, jump, cover_face, wave, reach, reach_high"):
         max_.request(MovementRequest("fly"))
 
 
