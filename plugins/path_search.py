@@ -43,8 +43,8 @@ class PathSearch(Matcher):
                   "Larger is more robust to noise and occlusion, and slower.", minimum=1),
         Parameter("max_skip", int, 2, "Most nodes a path may advance per observed sample (0 = stay is always "
                   "allowed); 2 tolerates movements up to twice as fast as one's own.", minimum=1, maximum=5),
-        Parameter("max_distance", float, 0.05, "Mean eq. 1 distance (m) per sample above which the answer is "
-                  "'unknown'.", minimum=0.0),
+        Parameter("max_distance", float, 0.03, "Mean eq. 1 distance (m) per sample above which the answer is "
+                  "'unknown'. Must stay above the noise of the input (about 1.8 x its standard deviation).", minimum=0.0),
         Parameter("scale", float, 0.02, "Distance (m) at which confidence falls to 1/e.", minimum=1e-6),
         Parameter("learn", bool, False, "Add an unknown movement's path to the posegraph as a new movement."),
         Parameter("learn_prefix", str, "learned", "Name prefix of learned movements (learned-1, learned-2...)."),
