@@ -16,11 +16,18 @@ Additions a real stream needs, each a parameter:
 - ``min_duration`` drops blips, ``max_gap`` joins a dip below the threshold
   shorter than it to the surrounding segment;
 - the reported start and end are moved back by the filter's delay, so they
-  mark where the raw distance crossed, not where the lagging filter did.
+  mark where the raw distance crossed, not where the lagging filter did;
+- noise floor: noisy observations never reach distance 0 even at rest (eq. 1
+  averages norms, which noise only increases). With ``floor`` > 0 the
+  threshold applies to the filtered distance minus its minimum over the last
+  ``floor`` seconds, so the same threshold works for clean and noisy input.
+  (A stream that starts in the middle of a movement is then not segmented
+  until the body has once been at rest.)
 """
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Sequence
 from typing import Any
 
@@ -43,6 +50,8 @@ class HubThreshold(Segmenter):
                   "Lower smooths more noise but delays and merges boundaries.", minimum=0.1),
         Parameter("min_duration", float, 0.25, "Segments shorter than this (s) are dropped as noise.", minimum=0.0),
         Parameter("max_gap", float, 0.1, "Dips below the end threshold shorter than this (s) do not end a segment.", minimum=0.0),
+        Parameter("floor", float, 10.0, "Seconds over which the running minimum of the filtered distance is "
+                  "taken as the noise floor and subtracted (0: no floor, the paper's plain threshold).", minimum=0.0),
         Parameter("hub", str, "", "The hub pose to compare with (default: the observer's rest pose)."),
     )
 
@@ -80,7 +89,8 @@ class HubThreshold(Segmenter):
         self._delay = int(round(_group_delay(self._b, self._a, self._fps)))
         self._frame = -1
         self._last = np.nan
-        self._filtered: list[float] = []
+        self._window = max(1, int(round(self.params["floor"] * self._fps))) if self.params["floor"] > 0 else 0
+        self._recent: deque[tuple[int, float]] = deque()  # monotonic queue of (frame, value) for the running minimum
         self._start: int | None = None
         self._below = 0
         self._on = self.params["threshold"]
@@ -108,11 +118,21 @@ class HubThreshold(Segmenter):
         if self._zi is None:
             self._zi = lfilter_zi(self._b, self._a) * raw
         y, self._zi = lfilter(self._b, self._a, [raw], zi=self._zi)
-        value = float(y[0])
-        self._filtered.append(value)
-        return self._step(value)
+        return self._step(float(y[0]))
+
+    def _above_floor(self, value: float) -> float:
+        """``value`` minus the running minimum of the last ``floor`` seconds (itself if there is no floor)."""
+        if not self._window:
+            return value
+        while self._recent and self._recent[-1][1] >= value:
+            self._recent.pop()
+        self._recent.append((self._frame, value))
+        while self._recent[0][0] <= self._frame - self._window:
+            self._recent.popleft()
+        return value - self._recent[0][1]
 
     def _step(self, value: float) -> list[Segment]:
+        value = self._above_floor(value)
         f = self._frame
         if self._start is None:
             if value > self._on:
@@ -143,7 +163,10 @@ class HubThreshold(Segmenter):
     # -- batch ---------------------------------------------------------------------------
 
     def signal(self, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
-        """The raw and the low-pass filtered distance-to-hub of a root-relative motion (Fig. 4)."""
+        """The raw and the low-pass filtered distance-to-hub of a root-relative motion (Fig. 4).
+
+        The threshold applies to the filtered signal minus its running minimum (see ``floor``).
+        """
         self.reset(motion.parts, motion.fps)
         ok = self._index >= 0
         obs = np.zeros((motion.n_frames, *self.template.shape))

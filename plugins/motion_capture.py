@@ -20,8 +20,9 @@ class MotionCapture(Perception):
 
     name = "motion-capture"
     parameters = (
-        Parameter("facing_window", float, 1.0, "Seconds over which the target's facing is a running median "
-                  "(steady through kicks and head turns; 0: every frame on its own).", minimum=0.0),
+        Parameter("facing_window", float, 3.0, "Seconds over which the target's facing is a running median "
+                  "(steady through kicks and head turns; a real turn is followed after half of it; 0: every "
+                  "frame on its own).", minimum=0.0),
     )
 
     def reset(self) -> None:

@@ -79,8 +79,9 @@ class SyntheticVision(Perception):
         Parameter("noise", float, 0.0, "Standard deviation (m) of Gaussian noise on every seen position.", minimum=0.0),
         Parameter("dropout", float, 0.0, "Probability that a visible part is missed in a frame.", minimum=0.0, maximum=1.0),
         Parameter("buffer", float, 0.1, "Seconds the sensory buffer bridges a part's dropout (0: off).", minimum=0.0),
-        Parameter("facing_window", float, 1.0, "Seconds over which the target's facing is a running median "
-                  "(steady through kicks and head turns; 0: every frame on its own).", minimum=0.0),
+        Parameter("facing_window", float, 3.0, "Seconds over which the target's facing is a running median "
+                  "(steady through kicks and head turns; a real turn is followed after half of it; 0: every "
+                  "frame on its own).", minimum=0.0),
         Parameter("seed", int, 0, "Seed of noise and dropouts."),
     )
 

@@ -1,0 +1,175 @@
+"""The ``likeme bench`` command: benchmarks that measure the toolkit's figures.
+
+``likeme bench watch`` (Buchsbaum & Blumberg 2005, §5): the observer watches the
+demonstrator perform a long random sequence of movements through its own
+perception (with noise, dropouts and occlusion) and reports
+
+- segmentation precision, recall, F1 and boundary error of its segmenter against
+  what the demonstrator really performed (:mod:`plugins.metrics`);
+- recognition accuracy of its matcher on the *true* segments;
+- the end-to-end movement error rate of what it recognised while watching;
+- frames per second of the whole world (acting, perceiving, segmenting, matching).
+
+Results print as a table and can be written as JSON. Speed is measured here, never in tests.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from plugins.metrics import match_segments, movement_error_rate, segmentation_scores
+from toolkit import World, hookimpl, load_character
+
+
+def watch_benchmark(
+    pm: Any,
+    *,
+    observer: str = "max",
+    demonstrator: str = "morris",
+    movements: int = 200,
+    seed: int = 0,
+    noise: float = 0.005,
+    dropout: float = 0.05,
+    occlusion: bool = True,
+    progress: bool = False,
+) -> dict[str, Any]:
+    """Run the watch benchmark and return its figures (see the module docstring)."""
+    demo = load_character(demonstrator, pm, override={
+        "action": {"plugin": "script", "random": movements, "exclude": ["stand"], "seed": seed, "pause": 0.5}
+    })
+    obs_override = {"perception": {"plugin": "synthetic-vision", "noise": noise, "dropout": dropout,
+                                   "occlusion": occlusion, "seed": seed + 1}}
+    obs = load_character(observer, pm, override=obs_override)
+    obs.action = None  # watch only: the benchmark measures perception, segmentation and recognition
+    world = World(fps=30.0, pm=pm)
+    target = world.add_actor(demo, "demonstrator", (0.0, 0.0, 1.6), np.pi)
+    watcher = world.add_actor(obs, "observer", (0.0, 0.0, 0.0), 0.0)
+    watcher.watch(target)
+
+    limit = int(movements * 4 * world.fps) + 300
+    started = time.perf_counter()
+    steps = range(limit)
+    if progress:
+        from rich.progress import track
+
+        steps = track(steps, description=f"{observer} watches {demonstrator}", transient=True)
+    quiet = 0
+    for _ in steps:
+        world.step()
+        quiet = quiet + 1 if world.all_idle() else 0
+        if quiet > world.fps:
+            break
+    watcher._finish()
+    elapsed = time.perf_counter() - started
+
+    truth, labels = [], []
+    for frame, request in target.performed:
+        n = demo.motor.perform(request.movement, fps=world.fps).n_frames
+        truth.append((frame - watcher.watch_start, frame - watcher.watch_start + n))
+        labels.append(request.movement)
+    found = [(e.data["segment"].start, e.data["segment"].end) for e in world.events_of("segment_found", "observer")]
+    seg = segmentation_scores(found, truth)
+    claimed = {j for _, j in match_segments(found, truth)}
+    missed: dict[str, int] = {}
+    for j, label in enumerate(labels):
+        if j not in claimed:
+            missed[label] = missed.get(label, 0) + 1
+
+    correct = 0
+    confusions: dict[str, int] = {}
+    for (s, e), label in zip(truth, labels):
+        match = obs.matcher.match(watcher.memory.motion(s, e))
+        got = match.movement or "unknown"
+        correct += got == label
+        if got != label:
+            confusions[f"{label} -> {got}"] = confusions.get(f"{label} -> {got}", 0) + 1
+    recognised = [e.data["match"].movement or "unknown" for e in world.events_of("movement_recognised", "observer")]
+
+    return {
+        "benchmark": "watch",
+        "observer": obs.name,
+        "demonstrator": demo.name,
+        "components": {k: c.name for k, c in obs.components().items()},
+        "movements": len(truth),
+        "seed": seed,
+        "noise": noise,
+        "dropout": dropout,
+        "occlusion": occlusion,
+        "visible_fraction": float(watcher.memory.visible.mean()),
+        "segmentation": seg,
+        "recognition_accuracy": correct / max(len(truth), 1),
+        "confusions": dict(sorted(confusions.items(), key=lambda kv: -kv[1])),
+        "unsegmented": dict(sorted(missed.items(), key=lambda kv: -kv[1])),
+        "movement_error_rate": movement_error_rate(recognised, labels),
+        "frames": world.frame,
+        "seconds": elapsed,
+        "frames_per_second": world.frame / elapsed if elapsed > 0 else float("inf"),
+        "real_time_factor": (world.frame / world.fps) / elapsed if elapsed > 0 else float("inf"),
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+    }
+
+
+def render_watch(r: dict[str, Any]) -> str:
+    s = r["segmentation"]
+    rows = [
+        ("movements performed", f"{r['movements']}"),
+        ("parts visible", f"{100 * r['visible_fraction']:.1f}%"),
+        ("segmentation precision / recall", f"{s['precision']:.3f} / {s['recall']:.3f}"),
+        ("segmentation F1", f"{s['f1']:.3f}"),
+        ("boundary error (frames)", f"{s['boundary_error']:.1f}"),
+        ("recognition accuracy (true segments)", f"{r['recognition_accuracy']:.3f}"),
+        ("movement error rate (end to end)", f"{r['movement_error_rate']:.3f}"),
+        ("frames per second (world)", f"{r['frames_per_second']:.0f} ({r['real_time_factor']:.1f}x real time)"),
+    ]
+    head = (f"likeme bench watch: {r['observer']} watches {r['demonstrator']} "
+            f"(seed {r['seed']}, noise {r['noise']} m, dropout {r['dropout']}, occlusion {'on' if r['occlusion'] else 'off'})")
+    comps = ", ".join(f"{k} {v}" for k, v in r["components"].items())
+    width = max(len(a) for a, _ in rows)
+    lines = [head, f"  {comps}"] + [f"  {a:<{width}}  {b}" for a, b in rows]
+    if r["unsegmented"]:
+        lines.append("  movements without a matching segment: " + ", ".join(f"{k} ({v})" for k, v in list(r["unsegmented"].items())[:8]))
+    if r["confusions"]:
+        lines.append("  most frequent confusions: " + ", ".join(f"{k} ({v})" for k, v in list(r["confusions"].items())[:6]))
+    return "\n".join(lines)
+
+
+def cmd_watch(args: argparse.Namespace, pm: Any) -> int:
+    result = watch_benchmark(
+        pm, observer=args.observer, demonstrator=args.demonstrator, movements=args.movements, seed=args.seed,
+        noise=args.noise, dropout=args.dropout, occlusion=not args.no_occlusion, progress=not args.quiet,
+    )
+    print(render_watch(result))
+    if args.json:
+        _write_json(Path(args.json), result)
+    return 0
+
+
+def _write_json(path: Path, data: dict[str, Any]) -> None:
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(json.dumps(data, indent=2, default=float) + "\n", encoding="utf-8")
+    tmp.replace(path)
+
+
+@hookimpl
+def likeme_register_commands(subparsers):
+    bench = subparsers.add_parser("bench", help="measure accuracy and speed (benchmarks)")
+    sub = bench.add_subparsers(dest="benchmark", metavar="BENCHMARK", parser_class=type(bench), required=True)
+    p = sub.add_parser("watch", help="an observer watches a demonstrator's random movements (B&B §5)")
+    p.add_argument("--observer", default="max", help="observer character (default: max)")
+    p.add_argument("--demonstrator", default="morris", help="demonstrator character (default: morris)")
+    p.add_argument("--movements", type=int, default=200, help="number of random movements (default: 200)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--noise", type=float, default=0.005, help="vision noise, metres (default: 0.005)")
+    p.add_argument("--dropout", type=float, default=0.05, help="per-part dropout probability (default: 0.05)")
+    p.add_argument("--no-occlusion", action="store_true", help="switch occlusion off")
+    p.add_argument("--json", metavar="FILE", help="also write the results as JSON")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(handler=cmd_watch)
