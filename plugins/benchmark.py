@@ -25,7 +25,8 @@ from typing import Any
 import numpy as np
 
 from plugins.metrics import match_segments, movement_error_rate, segmentation_scores
-from toolkit import World, hookimpl, load_character
+from toolkit import ConfigError, World, hookimpl, load_character
+from toolkit.character import merge_tables
 
 
 def watch_benchmark(
@@ -39,14 +40,18 @@ def watch_benchmark(
     dropout: float = 0.05,
     occlusion: bool = True,
     progress: bool = False,
+    settings: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
-    """Run the watch benchmark and return its figures (see the module docstring)."""
+    """Run the watch benchmark and return its figures (see the module docstring).
+
+    ``settings`` are tables merged over the observer's character (``{"segmenter": {"floor": 0.0}}``).
+    """
     demo = load_character(demonstrator, pm, override={
         "action": {"plugin": "script", "random": movements, "exclude": ["stand"], "seed": seed, "pause": 0.5}
     })
     obs_override = {"perception": {"plugin": "synthetic-vision", "noise": noise, "dropout": dropout,
                                    "occlusion": occlusion, "seed": seed + 1}}
-    obs = load_character(observer, pm, override=obs_override)
+    obs = load_character(observer, pm, override=merge_tables(obs_override, settings or {}))
     obs.action = None  # watch only: the benchmark measures perception, segmentation and recognition
     world = World(fps=30.0, pm=pm)
     target = world.add_actor(demo, "demonstrator", (0.0, 0.0, 1.6), np.pi)
@@ -102,6 +107,7 @@ def watch_benchmark(
         "noise": noise,
         "dropout": dropout,
         "occlusion": occlusion,
+        "settings": settings or {},
         "visible_fraction": float(watcher.memory.visible.mean()),
         "segmentation": seg,
         "recognition_accuracy": correct / max(len(truth), 1),
@@ -132,6 +138,8 @@ def render_watch(r: dict[str, Any]) -> str:
     head = (f"likeme bench watch: {r['observer']} watches {r['demonstrator']} "
             f"(seed {r['seed']}, noise {r['noise']} m, dropout {r['dropout']}, occlusion {'on' if r['occlusion'] else 'off'})")
     comps = ", ".join(f"{k} {v}" for k, v in r["components"].items())
+    if r["settings"]:
+        comps += "; " + ", ".join(f"{t}.{k} = {v!r}" for t, table in r["settings"].items() for k, v in table.items())
     width = max(len(a) for a, _ in rows)
     lines = [head, f"  {comps}"] + [f"  {a:<{width}}  {b}" for a, b in rows]
     if r["unsegmented"]:
@@ -141,10 +149,28 @@ def render_watch(r: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
+def parse_settings(items: list[str]) -> dict[str, dict[str, Any]]:
+    """``TABLE.KEY=VALUE`` strings (VALUE in TOML syntax) as nested tables."""
+    import tomllib
+
+    out: dict[str, dict[str, Any]] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        table, dot, name = key.strip().partition(".")
+        if not sep or not dot or not table or not name:
+            raise ConfigError(f"invalid setting {item!r}", key=("--set",), expected="TABLE.KEY=VALUE, like segmenter.floor=0")
+        try:
+            out.setdefault(table, {})[name] = tomllib.loads(f"v = {value}")["v"]
+        except tomllib.TOMLDecodeError:
+            out.setdefault(table, {})[name] = value  # a bare word is a string
+    return out
+
+
 def cmd_watch(args: argparse.Namespace, pm: Any) -> int:
     result = watch_benchmark(
         pm, observer=args.observer, demonstrator=args.demonstrator, movements=args.movements, seed=args.seed,
         noise=args.noise, dropout=args.dropout, occlusion=not args.no_occlusion, progress=not args.quiet,
+        settings=parse_settings(args.set),
     )
     print(render_watch(result))
     if args.json:
@@ -170,6 +196,8 @@ def likeme_register_commands(subparsers):
     p.add_argument("--noise", type=float, default=0.005, help="vision noise, metres (default: 0.005)")
     p.add_argument("--dropout", type=float, default=0.05, help="per-part dropout probability (default: 0.05)")
     p.add_argument("--no-occlusion", action="store_true", help="switch occlusion off")
+    p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
+                   help="override an observer parameter, e.g. --set segmenter.floor=0 (repeatable)")
     p.add_argument("--json", metavar="FILE", help="also write the results as JSON")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(handler=cmd_watch)
