@@ -45,3 +45,11 @@ def test_readme_commands_are_what_ci_runs():
     test_command = next(b.strip() for b in blocks if "pytest" in b)
     assert test_command in ci
     assert any("likeme demo" in b for b in blocks)
+
+
+def test_component_reference_is_current(pm):
+    from toolkit.cli import components_markdown
+
+    assert (ROOT / "docs" / "components.md").read_text() == components_markdown(pm), (
+        "regenerate with: LIKEME_DISABLE_PLUGIN_AUTOLOAD=1 likeme plugins --markdown > docs/components.md"
+    )
