@@ -1,0 +1,79 @@
+"""The posegraph motor system (B&B §4.1): nodes, movements as paths, hubs, contiguous poses."""
+
+from __future__ import annotations
+
+import networkx as nx
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from tests.conftest import CHARACTERS
+from toolkit import create_plugin_manager, load_character
+
+
+@pytest.fixture(scope="module")
+def max_():
+    return load_character(CHARACTERS / "max.toml", create_plugin_manager(autoload=False))
+
+
+def test_movements_are_paths_from_the_hub_back_to_the_hub(max_):
+    g, motor = max_.motor.graph, max_.motor
+    assert len(motor.movements()) >= 30
+    for name, path in motor.paths.items():
+        assert path[0] == path[-1] == "stand"
+        assert nx.is_path(g, path)
+        assert all(motor.movement_of(n) == name for n in path[1:-1])
+    # transitions between movements pass through the hub: the only node with edges into several movements
+    for node in g.nodes:
+        successors = {motor.movement_of(s) for s in g.successors(node)} - {None}
+        if len(successors) > 1:
+            assert g.nodes[node]["hub"]
+
+
+def test_node_poses_are_one_contiguous_array_indexed_by_the_graph(max_):
+    motor = max_.motor
+    assert motor.node_poses.flags["C_CONTIGUOUS"]
+    assert motor.node_poses.shape == (motor.graph.number_of_nodes(), len(max_.body.parts), 3)
+    np.testing.assert_allclose(motor.node_poses[motor.node_index("stand")], motor.rest_pose())
+    root = max_.body.root_index
+    np.testing.assert_allclose(motor.node_root_relative[:, root], 0.0)
+
+
+def test_node_rate_sets_the_resolution(max_):
+    motor = max_.motor
+    jump_nodes = len(motor.paths["jump"]) - 2
+    duration = motor.perform("jump").duration
+    assert abs(jump_nodes - duration * motor.params["node_rate"]) <= 2
+
+
+@settings(max_examples=10, deadline=None)
+@given(name=st.sampled_from(["jump", "wave", "sit", "cover_face"]), fps=st.sampled_from([24.0, 30.0, 60.0]))
+def test_playing_a_movement_path_stays_close_to_the_authored_movement(max_, name, fps):
+    motor = max_.motor
+    authored = motor.perform(name, fps=fps)
+    path = motor.play_path(motor.paths[name], fps=fps)
+    n = min(authored.n_frames, path.n_frames)
+    assert abs(authored.n_frames - path.n_frames) <= fps / motor.params["node_rate"] + 1
+    assert np.abs(authored.positions[:n] - path.positions[:n]).max() < 0.05
+
+
+def test_play_path_refuses_a_path_that_is_not_in_the_graph(max_):
+    with pytest.raises(ValueError, match="no edge"):
+        max_.motor.play_path(["stand", "jump/3"])
+
+
+def test_learned_movement_is_a_new_path_through_new_nodes():
+    character = load_character(CHARACTERS / "max.toml", create_plugin_manager(autoload=False))
+    motor = character.motor
+    before = motor.graph.number_of_nodes()
+    poses = motor.node_root_relative[[motor.node_index(n) for n in motor.paths["wave"]]]
+    visible = np.ones(poses.shape[:2], bool)
+    visible[3, 5] = False  # a hidden hand is filled from the nearest known pose
+    path = motor.learn("new-wave", poses, visible)
+    assert path[0] == path[-1] == "stand" and len(path) == len(poses)
+    assert motor.graph.number_of_nodes() == before + len(poses) - 2
+    assert "new-wave" in motor.movements() and motor.describe()["learned"] == ["new-wave"]
+    assert motor.perform("new-wave", fps=30).n_frames > 10
+    with pytest.raises(Exception, match="already exists"):
+        motor.learn("new-wave", poses)
