@@ -79,6 +79,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("likeme: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # the reader went away (likeme plugins | head): not an error of ours
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
 
 
 # -- commands ----------------------------------------------------------------------------
