@@ -43,7 +43,8 @@ def test_builtin_characters_compose(pm):
     assert len(max_.body.parts) >= 10
     assert set(max_.motor.movements()) == set(morris.motor.movements())
     assert morris.files[1] == (CHARACTERS / "max.toml").resolve()
-    assert max_.action.name == "imitation" and morris.action.name == "script"
+    assert max_.action.name == morris.action.name == "hierarchical"
+    assert "ice_cream" in morris.action.beliefs and "ice_cream" not in max_.action.beliefs
     # Morris is Max with some movements changed: his cover face takes longer
     assert morris.motor.perform("cover_face").duration > max_.motor.perform("cover_face").duration + 0.5
     np.testing.assert_allclose(morris.motor.perform("point").positions, max_.motor.perform("point").positions)
@@ -101,7 +102,7 @@ def test_unknown_plugin_lists_registered_names(pm, write):
 
 def test_unknown_action_system_lists_the_builtins(pm, write):
     path = write("c.toml", BODY + '\n[action]\nplugin = "hierarchicl"\n')
-    _fails(pm, path, r"key action.plugin: unknown action system 'hierarchicl'.*available: imitation, script")
+    _fails(pm, path, r"key action.plugin: unknown action system 'hierarchicl'.*available: hierarchical, imitation, script")
 
 
 def test_syntax_error_names_line_and_column(pm, write):

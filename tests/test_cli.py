@@ -92,7 +92,8 @@ def test_demo_reports_what_each_character_did_and_saw():
     assert "morris (Morris" in out and "max (Max" in out
     assert "did:" in out and "perceived morris:" in out
     assert "segmented:" in out and "recognised:" in out
-    data = json.loads(likeme("demo", "--json", "--seed", "3").stdout)
+    assert "Ice cream" in out and "learns that ice_cream is food" in out
+    data = json.loads(likeme("demo", "--json", "--seed", "3", "--scenario", "demo").stdout)
     morris = next(a for a in data["actors"] if a["id"] == "morris")
     assert len(morris["did"]) >= 10
     max_ = next(a for a in data["actors"] if a["id"] == "max")
@@ -100,11 +101,11 @@ def test_demo_reports_what_each_character_did_and_saw():
 
 
 def test_seed_changes_the_random_sequence():
-    a = json.loads(likeme("demo", "--json", "--seed", "1").stdout)
-    b = json.loads(likeme("demo", "--json", "--seed", "2").stdout)
+    a = json.loads(likeme("demo", "--json", "--seed", "1", "--scenario", "demo").stdout)
+    b = json.loads(likeme("demo", "--json", "--seed", "2", "--scenario", "demo").stdout)
     seq = lambda d: [x["movement"] for x in next(a for a in d["actors"] if a["id"] == "morris")["did"]]  # noqa: E731
     assert seq(a) != seq(b)
-    assert seq(a) == seq(json.loads(likeme("demo", "--json", "--seed", "1").stdout))
+    assert seq(a) == seq(json.loads(likeme("demo", "--json", "--seed", "1", "--scenario", "demo").stdout))
 
 
 def test_run_scenario_file_and_errors(write):

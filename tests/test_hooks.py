@@ -75,7 +75,7 @@ def test_behaviour_identified_is_announced(pm, watch_scene, recorder, scripted):
     behaviours = [c["behaviour"] for n, c in recorder.calls if n == "behaviour_identified"]
     assert [b.path for b in behaviours] == [("play", "wave")]
     assert world.behaviours("max")[0].motivation == ("playful",)
-    assert "believes morris is doing play > wave, because of playful" in render_text(summarise(world))
+    assert "Max believes morris did wave (wave > play), because of playful" in render_text(summarise(world))
 
 
 def test_movement_learned_is_announced_through_the_character(pm, recorder):

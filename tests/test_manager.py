@@ -27,7 +27,7 @@ def test_builtins_come_from_the_likeme_entry_points(pm):
 def test_unknown_component_lists_registered_names(pm):
     with pytest.raises(ConfigError, match=r"unknown segmenter 'hub-treshold'.*available: hub-threshold"):
         pm.registry.get("segmenter", "hub-treshold")
-    with pytest.raises(ConfigError, match=r"unknown action system 'scrip'.*available: imitation, script"):
+    with pytest.raises(ConfigError, match=r"unknown action system 'scrip'.*available: hierarchical, imitation, script"):
         pm.registry.get("action", "scrip")
 
 

@@ -199,7 +199,8 @@ def test_segments_are_ordered_disjoint_and_streaming_equals_batch(chars, moves, 
 def test_a_target_that_is_never_visible_gives_no_segment_and_no_recognition(chars):
     pm = create_plugin_manager(autoload=False)
     world = World(fps=30)
-    morris = world.add_actor(load_character(CHARACTERS / "morris.toml", pm), position=(0, 0, -2.0))  # behind Max
+    script = {"action": {"plugin": "script", "movements": ["jump", "wave", "sit"]}}
+    morris = world.add_actor(load_character(CHARACTERS / "morris.toml", pm, override=script), position=(0, 0, -2.0))  # behind Max
     max_ = world.add_actor(load_character(CHARACTERS / "max.toml", pm))
     max_.watch(morris)
     world.run(12.0)

@@ -24,6 +24,10 @@ from toolkit.manager import PluginManager, create_plugin_manager
 __all__ = ["main", "build_parser"]
 
 
+DEMO_SCENARIOS = ("demo", "ice_cream")
+"""What ``likeme demo`` runs: Max imitating Morris's random movements, then Max working out why Morris eats."""
+
+
 class _Parser(argparse.ArgumentParser):
     """An argument parser whose errors are one line and exit status 1, like every other input error."""
 
@@ -39,7 +43,8 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p = sub.add_parser("demo", help="run the built-in scenario and report what each character did and saw")
     p.add_argument("--seed", type=int, default=None, help="seed for random choices (default: the scenario's)")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
-    p.add_argument("--scenario", default="demo", help="built-in scenario name (default: demo)")
+    p.add_argument("--scenario", action="append", metavar="NAME",
+                   help=f"built-in scenario to run, repeatable (default: {' and '.join(DEMO_SCENARIOS)})")
     p.set_defaults(handler=cmd_demo)
 
     p = sub.add_parser("run", help="run a scenario file")
@@ -54,6 +59,11 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print as JSON")
     p.add_argument("--markdown", action="store_true", help="print a Markdown reference of every component and its parameters")
     p.set_defaults(handler=cmd_plugins)
+
+    p = sub.add_parser("show", help="show a character's representations")
+    p.add_argument("character", help="character TOML file or name")
+    p.add_argument("--actions", action="store_true", help="print the action system (hierarchy, drives, beliefs, maps) as text")
+    p.set_defaults(handler=cmd_show)
 
     p = sub.add_parser("validate", help="check character and scenario files")
     p.add_argument("files", nargs="+", metavar="FILE", help="character or scenario TOML files")
@@ -89,9 +99,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 # -- commands ----------------------------------------------------------------------------
 
 
-def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> int:
-    from toolkit.report import render_text, summarise
+def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dict[str, Any]:
     from toolkit.scenario import load_scenario
+    from toolkit.report import summarise
 
     scenario = load_scenario(path, pm, seed=args.seed)
     if getattr(args, "duration", None) is not None:
@@ -99,23 +109,34 @@ def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> int
     world = scenario.run()
     summary = summarise(world, name=scenario.name)
     summary["seed"] = scenario.seed
-    if args.json:
-        print(json.dumps(summary, indent=2))
-    else:
-        if scenario.description:
-            print(scenario.description.strip())
+    summary["description"] = scenario.description.strip()
+    return summary
+
+
+def _print(summaries: list[dict[str, Any]], as_json: bool) -> None:
+    from toolkit.report import render_text
+
+    if as_json:
+        print(json.dumps(summaries[0] if len(summaries) == 1 else summaries, indent=2))
+        return
+    for i, summary in enumerate(summaries):
+        if i:
+            print("\n" + "=" * 100 + "\n")
+        if summary["description"]:
+            print(summary["description"])
             print()
         print(render_text(summary))
-    return 0
 
 
 def cmd_demo(args: argparse.Namespace, pm: PluginManager) -> int:
-    """Run a built-in scenario (``characters/scenarios/demo.toml`` by default)."""
-    return _run_scenario(args.scenario, pm, args)
+    """Run the built-in scenarios (:data:`DEMO_SCENARIOS` unless ``--scenario`` names others)."""
+    _print([_run_scenario(name, pm, args) for name in (args.scenario or DEMO_SCENARIOS)], args.json)
+    return 0
 
 
 def cmd_run(args: argparse.Namespace, pm: PluginManager) -> int:
-    return _run_scenario(args.scenario, pm, args)
+    _print([_run_scenario(args.scenario, pm, args)], args.json)
+    return 0
 
 
 def plugins_table(pm: PluginManager, *, params: bool = False) -> dict[str, Any]:
@@ -201,6 +222,22 @@ def cmd_plugins(args: argparse.Namespace, pm: PluginManager) -> int:
         print(f"  {p['name']} ({p['module']}, {dist}): {', '.join(p['hooks'])}")
     for s in table["skipped"]:
         print(f"  {s['name']} ({s['distribution']}): skipped, LIKEME_DISABLE_PLUGIN_AUTOLOAD is set")
+    return 0
+
+
+def cmd_show(args: argparse.Namespace, pm: PluginManager) -> int:
+    from toolkit.character import load_character
+    from toolkit.report import describe_character
+
+    character = load_character(args.character, pm)
+    if args.actions:
+        if character.action is None:
+            print(f"{character.name} has no action system")
+            return 0
+        print(f"{character.name}: action system {character.action.name}")
+        print(character.action.render())
+        return 0
+    print(json.dumps(describe_character(character), indent=2))
     return 0
 
 

@@ -194,15 +194,39 @@ class MovementRequest:
 class TriggerContext:
     """What a trigger is evaluated against.
 
-    ``actor`` is the character the trigger is evaluated for (the observer itself,
-    or the target when the observer simulates it, §6.1); ``world`` the world
-    (or the remembered snapshot of it); ``object`` the current object of attention.
+    Attributes
+    ----------
+    actor : Actor
+        The character the trigger is evaluated for: the character itself, or the
+        target when an observer simulates it (Buchsbaum & Blumberg §6.1).
+    world : World or a view of it
+        Anything with ``objects`` (name to :class:`~toolkit.runtime.WorldObject`):
+        the live world, or the objects as they were when a movement began.
+    object : str or None
+        The current object of attention.
+    beliefs : mapping of str to str
+        What the *evaluating* character believes each object type affords
+        (``{"cheese": "food"}``); an object type missing here is unknown to it.
+    drives : mapping of str to float
+        Drive levels in [0, 1] (empty when simulating someone else's motivation).
+    params : mapping
+        Anything else an action system passes down.
     """
 
     actor: Actor
-    world: World
+    world: Any
     object: str | None = None
+    beliefs: Mapping[str, str] = field(default_factory=dict)
+    drives: Mapping[str, float] = field(default_factory=dict)
     params: Mapping[str, Any] = field(default_factory=dict)
+
+    def attended(self) -> Any:
+        """The object of attention as a :class:`~toolkit.runtime.WorldObject`, or ``None``."""
+        return self.world.objects.get(self.object) if self.object is not None else None
+
+    def category(self, obj: Any) -> str | None:
+        """What the evaluating character believes ``obj`` affords (``None``: unknown)."""
+        return self.beliefs.get(obj.kind)
 
 
 # -- components -----------------------------------------------------------------
@@ -372,8 +396,15 @@ class ActionSystem(Component):
     def performed(self, actor: Actor, request: MovementRequest, world: World) -> None:
         """The actor has started performing ``request`` (to keep correspondence maps)."""
 
+    def completed(self, actor: Actor, request: MovementRequest, world: World) -> None:
+        """The actor has finished performing ``request`` (to apply its effect on the world: grasp, eat...)."""
+
     def describe(self) -> dict[str, Any]:
         return {}
+
+    def render(self) -> str:
+        """A text view for people (``likeme show --actions``); by default the :meth:`describe` dict."""
+        return "\n".join(f"{k}: {v}" for k, v in self.describe().items()) or f"{self.name} (no state to show)"
 
 
 class Trigger(Component):
@@ -387,6 +418,10 @@ class Trigger(Component):
     @abstractmethod
     def evaluate(self, context: TriggerContext) -> float:
         """The trigger's value for ``context``, in [0, 1]."""
+
+    def describe(self) -> str:
+        """A few words for reports ("hunger", "object within reach"); the name by default."""
+        return self.name
 
 
 KINDS: dict[str, type[Component]] = {

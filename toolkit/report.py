@@ -69,6 +69,26 @@ def _watching(actor: Actor, world: World) -> dict[str, Any]:
     return out
 
 
+def behaviour_sentence(observer: str, target: str, b: dict[str, Any]) -> str:
+    """One identified (or not identified) behaviour as a sentence."""
+    if not b["known"]:
+        return f"{observer} does not know why {target} did {b['movement']} and shrugs"
+    path = " > ".join(reversed(b["path"]))
+    text = f"{observer} believes {target} did {b['movement']}"
+    if b["object"]:
+        text += f" for the {b['object']}"
+    text += f" ({path})"
+    if b["motivation"]:
+        text += f", because of {' and '.join(b['motivation'])}"
+    if b["goal"]:
+        text += f"; {target} wants to be {' and '.join(b['goal'])}"
+    if b["prediction"]:
+        text += f"; next {target} will {b['prediction'][0]}"
+    for kind, category in b.get("learned", {}).items():
+        text += f"; {observer} learns that {kind} is {category}"
+    return text
+
+
 def _behaviour(b: Any, time: float) -> dict[str, Any]:
     return {
         "time": round(time, 3),
@@ -79,6 +99,7 @@ def _behaviour(b: Any, time: float) -> dict[str, Any]:
         "goal": list(b.goal),
         "object": b.object,
         "prediction": list(b.prediction),
+        "learned": dict(b.details.get("learned", {})) if b.details else {},
     }
 
 
@@ -153,17 +174,5 @@ def render_text(summary: dict[str, Any]) -> str:
             )
             lines.append(f"  recognised: {recs or 'nothing'}")
         for b in w["behaviours"]:
-            if not b["known"]:
-                lines.append(f"  at {b['time']:.2f}s: does not know why {w['target']} did {b['movement']} (shrugs)")
-                continue
-            text = f"  at {b['time']:.2f}s: believes {w['target']} is doing {' > '.join(b['path'])}"
-            if b["object"]:
-                text += f" with {b['object']}"
-            if b["motivation"]:
-                text += f", because of {', '.join(b['motivation'])}"
-            if b["goal"]:
-                text += f", wanting {', '.join(b['goal'])}"
-            if b["prediction"]:
-                text += f"; next: {', '.join(b['prediction'])}"
-            lines.append(text)
+            lines.append(f"  at {b['time']:.2f}s: " + behaviour_sentence(c["name"], w["target"], b))
     return "\n".join(lines)

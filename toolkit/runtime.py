@@ -68,6 +68,10 @@ class WorldObject:
         self.position = np.asarray(self.position, dtype=float).reshape(3)
 
 
+def _copy_object(obj: WorldObject) -> WorldObject:
+    return WorldObject(obj.name, obj.kind, obj.position.copy(), obj.radius, obj.colour, obj.held_by, dict(obj.properties))
+
+
 @dataclass(frozen=True)
 class Event:
     """Something that happened in a run: ``kind`` is the hook's name without ``likeme_``."""
@@ -83,23 +87,34 @@ class Event:
 class ObservationLog:
     """Working memory of what an actor perceived of its target, as growing arrays.
 
-    ``positions`` (F, P, 3) root-relative, ``visible`` (F, P), one row per frame since watching began.
+    One row per frame since watching began: ``positions`` (F, P, 3) root-relative,
+    ``visible`` (F, P), and ``world`` (F, P, 3), the world positions that were
+    seen (NaN where hidden), which behaviour identification uses for the
+    target's line of sight.
     """
 
     def __init__(self, parts: tuple[str, ...], fps: float, capacity: int = 1024) -> None:
         self.parts = parts
         self.fps = fps
         self._pos = np.full((capacity, len(parts), 3), np.nan)
+        self._world = np.full((capacity, len(parts), 3), np.nan)
         self._vis = np.zeros((capacity, len(parts)), dtype=bool)
         self.n = 0
 
-    def append(self, pose: np.ndarray, visible: np.ndarray) -> None:
+    def append(self, pose: np.ndarray, visible: np.ndarray, world: np.ndarray | None = None) -> None:
         if self.n == self._pos.shape[0]:
             self._pos = np.concatenate([self._pos, np.full_like(self._pos, np.nan)])
+            self._world = np.concatenate([self._world, np.full_like(self._world, np.nan)])
             self._vis = np.concatenate([self._vis, np.zeros_like(self._vis)])
         self._pos[self.n] = pose
         self._vis[self.n] = visible
+        if world is not None:
+            self._world[self.n] = world
         self.n += 1
+
+    @property
+    def world(self) -> np.ndarray:
+        return self._world[: self.n]
 
     @property
     def positions(self) -> np.ndarray:
@@ -207,6 +222,8 @@ class Actor:
             if self._frame >= self._motion.n_frames:
                 done = self.performing
                 self._motion, self.performing = None, None
+                if done is not None and self.character.action is not None:
+                    _call(self.character, "action", "completed", self.character.action.completed, self, done, self.world)
                 if done is not None and done.imitating is not None:
                     target = self.world.actors[done.imitating]
                     self.world.emit("imitation_stopped", self, target, movement=done.movement, reason="completed")
@@ -243,7 +260,7 @@ class Actor:
         target, c, world = self.target, self.character, self.world
         assert target is not None and self.memory is not None and c.perception is not None
         percept: Percept = _call(c, "perception", "perceive", c.perception.perceive, self, target, world)
-        self.memory.append(percept.pose, percept.visible)
+        self.memory.append(percept.pose, percept.visible, percept.world)
         self.percepts += 1
         if c.segmenter is None:
             return
@@ -341,6 +358,9 @@ class World:
         self.objects: dict[str, WorldObject] = {}
         self.events: list[Event] = []
         self.pm = pm
+        self.history_seconds = 120.0
+        self._removed: dict[str, WorldObject] = {}
+        self._history: dict[int, dict[str, tuple[np.ndarray, str | None]]] = {}
 
     @property
     def time(self) -> float:
@@ -385,11 +405,41 @@ class World:
             if obj.held_by is not None and obj.held_by in self.actors:
                 holder = self.actors[obj.held_by]
                 obj.position = holder.world_pose()[holder.body.index(obj.properties.get("held_in", holder.body.root))]
+        self._remember()
         for actor in self.actors.values():
             if actor.target is not None:
                 actor._observe()
         if self.pm is not None:
             self.pm.hook.likeme_world_stepped(world=self)
+
+    def _remember(self) -> None:
+        self._history[self.frame] = {n: (o.position.copy(), o.held_by) for n, o in self.objects.items()}
+        self._history.pop(self.frame - int(self.history_seconds * self.fps), None)
+
+    def objects_at(self, frame: int) -> dict[str, WorldObject]:
+        """The objects as they were at a past ``frame`` (within ``history_seconds``): copies, for "what was there then".
+
+        Objects that did not exist then are absent; a frame older than the history gives the oldest remembered.
+        """
+        if frame >= self.frame or not self._history:
+            return {n: _copy_object(o) for n, o in self.objects.items()}
+        frame = max(frame, min(self._history))
+        state = self._history.get(frame, {})
+        out = {}
+        for name, (position, held_by) in state.items():
+            source = self.objects.get(name) or self._removed.get(name)
+            if source is None:
+                continue
+            obj = _copy_object(source)
+            obj.position, obj.held_by = position.copy(), held_by
+            out[name] = obj
+        return out
+
+    def remove_object(self, name: str) -> WorldObject:
+        """Take an object out of the world (eaten); its past stays in the history."""
+        obj = self.objects.pop(name)
+        self._removed[name] = obj
+        return obj
 
     def run(
         self,

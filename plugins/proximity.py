@@ -1,0 +1,117 @@
+"""Proximity triggers: where the object of attention is relative to the character (Buchsbaum & Blumberg 2005, §6.1.1).
+
+- ``proximity``: close enough to *get* without walking, and not already held;
+- ``reachable``: within reach of the hands, not too high (reach for it);
+- ``object-high``: near enough but too high to reach (jump for it, Fig. 13);
+- ``holding`` / ``not-holding``: in the character's hands or not (the success
+  context of get, §6.2, and the can-I trigger of eat).
+
+Distances are horizontal from the character's root; heights are above the ground.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from toolkit import Parameter, Trigger, TriggerContext, hookimpl
+
+__all__ = ["Proximity", "Reachable", "ObjectHigh", "Holding", "NotHolding", "horizontal_distance"]
+
+
+def horizontal_distance(context: TriggerContext) -> float:
+    """Horizontal distance from the actor's root to the object of attention (inf without one)."""
+    obj = context.attended()
+    if obj is None:
+        return float("inf")
+    root = context.actor.world_pose()[context.actor.body.root_index]
+    d = obj.position - root
+    return float(np.hypot(d[0], d[2]))
+
+
+class Proximity(Trigger):
+    """The object of attention is within `distance` (m) and not already held by the character."""
+
+    name = "proximity"
+    parameters = (Parameter("distance", float, 0.9, "Farthest horizontal distance (m) at which it can be got without walking.", minimum=0.0),)
+
+    def evaluate(self, context: TriggerContext) -> float:
+        obj = context.attended()
+        if obj is None or obj.held_by == context.actor.id:
+            return 0.0
+        return 1.0 if horizontal_distance(context) <= self.params["distance"] else 0.0
+
+    def describe(self) -> str:
+        return "object close enough to get"
+
+
+class Reachable(Trigger):
+    """The object of attention is within `distance` (m) and no higher than `height` (m): reach for it."""
+
+    name = "reachable"
+    parameters = (
+        Parameter("distance", float, 0.5, "Farthest horizontal distance (m) the hands reach.", minimum=0.0),
+        Parameter("height", float, 0.6, "Highest point (m above the ground) the hands reach standing.", minimum=0.0),
+    )
+
+    def evaluate(self, context: TriggerContext) -> float:
+        obj = context.attended()
+        if obj is None or obj.held_by is not None:
+            return 0.0
+        ok = horizontal_distance(context) <= self.params["distance"] and obj.position[1] <= self.params["height"]
+        return 1.0 if ok else 0.0
+
+    def describe(self) -> str:
+        return "object within reach"
+
+
+class ObjectHigh(Trigger):
+    """The object of attention is higher than `height` (m) but within `distance` (m): jump for it (Fig. 13)."""
+
+    name = "object-high"
+    parameters = (
+        Parameter("distance", float, 0.5, "Farthest horizontal distance (m) below which a jump gets it.", minimum=0.0),
+        Parameter("height", float, 0.6, "Height (m) above which the hands do not reach standing.", minimum=0.0),
+        Parameter("max_height", float, 1.2, "Highest point (m) a jump gets to.", minimum=0.0),
+    )
+
+    def evaluate(self, context: TriggerContext) -> float:
+        obj = context.attended()
+        if obj is None or obj.held_by is not None:
+            return 0.0
+        y = obj.position[1]
+        ok = horizontal_distance(context) <= self.params["distance"] and self.params["height"] < y <= self.params["max_height"]
+        return 1.0 if ok else 0.0
+
+    def describe(self) -> str:
+        return "object high in the air"
+
+
+class Holding(Trigger):
+    """The character holds the object of attention (the success context of get, §6.2)."""
+
+    name = "holding"
+
+    def evaluate(self, context: TriggerContext) -> float:
+        obj = context.attended()
+        return 1.0 if obj is not None and obj.held_by == context.actor.id else 0.0
+
+    def describe(self) -> str:
+        return "holding the object"
+
+
+class NotHolding(Trigger):
+    """The character does not hold the object of attention."""
+
+    name = "not-holding"
+
+    def evaluate(self, context: TriggerContext) -> float:
+        obj = context.attended()
+        return 1.0 if obj is None or obj.held_by != context.actor.id else 0.0
+
+    def describe(self) -> str:
+        return "not holding the object"
+
+
+@hookimpl
+def likeme_register_triggers():
+    return [Proximity, Reachable, ObjectHigh, Holding, NotHolding]
