@@ -1,0 +1,165 @@
+"""Buchsbaum & Blumberg 2005, §6 and §7.4: acting on motivations, identifying behaviour, motivation, goal and object,
+learning affordances, predicting. One scenario test per example of the paper."""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.conftest import CHARACTERS, make_plugin
+from toolkit import ConfigError, Trigger, create_plugin_manager, load_character, load_scenario
+from toolkit.manager import PluginInfo
+
+
+def run(name):
+    pm = create_plugin_manager(autoload=False)
+    world = load_scenario(CHARACTERS / "scenarios" / f"{name}.toml", pm).run()
+    behaviours = world.behaviours("max")
+    return world, behaviours
+
+
+def test_morris_acts_on_his_own_hunger(tmp_path):
+    world, _ = run("hungry_morris")
+    morris = world.actors["morris"]
+    assert [r.movement for _, r in morris.performed] == ["reach", "eat"]
+    assert [r.object for _, r in morris.performed] == ["cheese", "cheese"]
+    assert "cheese" not in world.objects  # eaten
+    system = morris.character.action
+    assert system.drives["hunger"].level < 0.3  # satisfied
+    # the movement-action correspondence map and the transition map grew while he acted
+    assert system.correspondence["reach"][("satisfy_hunger", "get", "reach")] == 3 + 1
+    assert system.transitions[("reach", "eat")] == 1
+
+
+def test_reaching_for_the_cheese_is_reach_get_satisfy_hunger(tmp_path):
+    """§6.1.1, §6.2, §7.4."""
+    world, (reach, eat) = run("hungry_morris")
+    assert reach.known and reach.movement == "reach"
+    assert reach.path == ("satisfy_hunger", "get", "reach")
+    assert reach.object == "cheese"
+    assert reach.motivation == ("hunger",)
+    assert reach.goal == ("holding the cheese",)
+    assert reach.prediction[0] == "eat the cheese"  # §7.4: he will eat it
+    # eat is identified against the world as it was when the movement began: the cheese is gone now
+    assert eat.path == ("satisfy_hunger", "eat") and eat.object == "cheese" and "cheese" not in world.objects
+
+
+def test_line_of_sight_decides_between_cheese_and_ball():
+    """§6.1.2: both food and toy present; Morris looks at the cheese."""
+    _, (reach, _) = run("cheese_or_ball")
+    assert reach.details["line_of_sight"] == "cheese"
+    assert reach.path[0] == "satisfy_hunger" and reach.object == "cheese"
+
+
+def test_without_line_of_sight_max_goes_by_his_own_habits():
+    """§6.1.2: Max reaches to play more often than to eat, so he guesses play, and the ball is within reach."""
+    world, (reach, _) = run("cheese_or_ball_unseen")
+    assert reach.details["line_of_sight"] is None
+    assert reach.path == ("play", "get", "reach") and reach.object == "ball"
+
+
+def test_fall_back_when_the_ball_is_out_of_reach():
+    """§6.1.2: the first guess (play) is impossible, so Max evaluates the alternative path."""
+    _, (reach, _) = run("cheese_or_far_ball_unseen")
+    assert reach.details["tried"][0] == "play > get > reach"
+    assert reach.path == ("satisfy_hunger", "get", "reach") and reach.object == "cheese"
+
+
+def test_reach_or_jump_is_decided_by_where_the_food_is():
+    """Fig. 13: the cheese is high in the air, so it is a jump for food."""
+    world, (jump, eat) = run("high_cheese")
+    assert [r.movement for _, r in world.actors["morris"].performed] == ["jump", "eat"]
+    assert jump.path == ("satisfy_hunger", "get", "jump") and jump.object == "cheese"
+    assert jump.goal == ("holding the cheese",)
+
+
+def test_several_pieces_of_cheese_the_closest():
+    """§6.1.2: without line of sight Max picks the one he would attend to: the closest."""
+    _, (reach, _) = run("several_cheeses")
+    assert reach.object == "near_cheese"
+
+
+def test_ice_cream_shrug_learn_identify():
+    """§6.3: shrug at the unknown ice cream, learn it is food from the eating, then identify reaching for it."""
+    world, behaviours = run("ice_cream")
+    first_reach, first_eat, second_reach, second_eat = behaviours
+    assert not first_reach.known and first_reach.movement == "reach"
+    assert world.actors["max"].performed[0][1].movement == "shrug"
+    assert first_eat.known and first_eat.details["learned"] == {"ice_cream": "food"}
+    assert first_eat.motivation == ("hunger",) and first_eat.object == "ice_cream_1"
+    assert second_reach.known and second_reach.path == ("satisfy_hunger", "get", "reach")
+    assert second_reach.object == "ice_cream_2"
+    assert world.actors["max"].character.action.beliefs["ice_cream"] == "food"
+
+
+def test_failure_objects_close_together_give_the_wrong_motivation():
+    """§7.3.1: a natural mistake: the ball lies next to the cheese and Max goes by his habits."""
+    world, (reach, _) = run("objects_close_together")
+    assert [r.object for _, r in world.actors["morris"].performed][0] == "cheese"
+    assert reach.path[0] == "play" and reach.object == "ball"
+
+
+def test_failure_different_preferences_give_the_wrong_object():
+    """§7.3.1: Morris goes for the biggest piece, Max identifies what he himself would do: the closest."""
+    world, (reach, _) = run("different_preferences")
+    assert world.actors["morris"].performed[0][1].object == "big_cheese"
+    assert reach.known and reach.object == "small_cheese"
+
+
+def test_failure_unknown_object_and_perceptual_failure_shrug():
+    """§7.3.1: none of the behaviours Max uses reach for is possible: he cannot identify it."""
+    _, behaviours = run("ice_cream")
+    assert not behaviours[0].known and behaviours[0].details["tried"] == ["play > get > reach", "satisfy_hunger > get > reach"]
+
+
+def test_action_hierarchy_renders_as_a_tree(pm):
+    text = load_character(CHARACTERS / "max.toml", pm).action.render()
+    assert "satisfy_hunger" in text and "\n      reach  -> movement reach" in text
+    assert "reach: play > get > reach x6, satisfy_hunger > get > reach x3" in text
+
+
+BASE = f"""
+[character]
+name = "Bad"
+extends = "{CHARACTERS / 'max.toml'}"
+"""
+
+
+@pytest.mark.parametrize(
+    "extra, message",
+    [
+        ('[action.tuples.get]\ncan = [{ trigger = "proximty" }]\n',
+         r"key action.tuples.get.can\[0\].trigger: unknown trigger 'proximty'.*available: drive, holding, not-holding, object-high, object-present, proximity, reachable"),
+        ('[action.tuples.reach]\nchildren = ["get"]\n', r"key action.tuples.reach: a tuple needs either a movement"),
+        ('[action.tuples.eat]\nmovement = "munch"\n', r"key action.tuples.eat.movement: unknown movement 'munch'"),
+        ('[action.tuples.get]\nchildren = ["reach", "grab"]\n', r"key action.tuples.get.children\[1\]: unknown tuple 'grab'.*available: eat, get"),
+        ('[action.tuples.loop]\nchildren = ["get"]\n[action.tuples.get]\nchildren = ["reach", "loop"]\n', r"action hierarchy cycle: (get -> loop -> get|loop -> get -> loop)"),
+        ('[action.tuples.idle]\nmovement = "stand"\n', r"key action.tuples.idle.drive: a top-level tuple is a motivational subsystem"),
+        ('[action.tuples.satisfy_hunger]\ndrive = "thirst"\n', r"key action.tuples.satisfy_hunger.drive: unknown drive 'thirst'.*available: hunger, play"),
+        ('[action.tuples.reach]\neffect = "throw"\n', r"unknown effect 'throw'.*available: none, grasp, consume, toss"),
+        ('[action.tuples.get]\nuntil = [{ trigger = "holding", tight = true }]\n', r"key action.tuples.get.until\[0\].tight: unknown parameter 'tight' for trigger 'holding'"),
+        ('[action.drives]\nhunger = { level = 2.0 }\n', r"key action.drives.hunger.level: invalid value 2.0"),
+        ('[action.experience]\nreach = { "play > reach" = 1 }\n', r"key action.experience.reach.\"play > reach\": not a path of the hierarchy"),
+    ],
+)
+def test_action_hierarchy_errors(pm, write, extra, message):
+    path = write("bad.toml", BASE + extra)
+    with pytest.raises(ConfigError, match=message):
+        load_character(path, pm)
+
+
+class Hungry(Trigger):
+    """Third-party should-I trigger: the character's hunger is at least `level`."""
+
+    name = "very-hungry"
+
+    def evaluate(self, context):
+        return 1.0 if context.drives.get("hunger", 0.0) >= 0.9 else 0.0
+
+
+def test_a_third_party_trigger_is_used_by_name_in_a_hierarchy(write):
+    pm = create_plugin_manager(autoload=False)
+    pm.register_plugin(make_plugin(likeme_register_triggers=lambda: [Hungry]), PluginInfo("hungry", "m", "(tests)", ""))
+    path = write("picky.toml", BASE.replace('name = "Bad"', 'name = "Picky"') +
+                 '[action.tuples.satisfy_hunger]\nshould = [{ trigger = "very-hungry" }]\n')
+    picky = load_character(path, pm)
+    assert [t.name for t in picky.action.hierarchy.tuples["satisfy_hunger"].should] == ["very-hungry"]
