@@ -85,6 +85,7 @@ class Hierarchical(ActionSystem):
                                       expected="top > ... > leaf tuple names joined by '>'")
                 self.correspondence.setdefault(movement, Counter())[path] += int(n)
         self.transitions: Counter[tuple[str, str]] = Counter()
+        self.history: list[tuple[int, tuple[str, ...], str | None]] = []  # (frame, path, object) of each behaviour begun
         self._rng = np.random.default_rng(self.params["seed"])
         self._current: tuple[tuple[str, ...], str | None] | None = None
         self._last_leaf: str | None = None
@@ -169,6 +170,7 @@ class Hierarchical(ActionSystem):
         if self.hierarchy.tuples[path[-1]].movement != request.movement:
             return
         self.correspondence.setdefault(request.movement, Counter())[path] += 1
+        self.history.append((world.frame, path, self._current[1]))
         if self._last_leaf is not None:
             self.transitions[(self._last_leaf, path[-1])] += 1
         self._last_leaf = path[-1]

@@ -120,3 +120,20 @@ def test_argument_errors_exit_1_with_one_line():
     assert_one_line_error(likeme("run"), "the following arguments are required: scenario")
     assert_one_line_error(likeme("frobnicate"), "invalid choice: 'frobnicate'")
     assert_one_line_error(likeme("demo", "--seed", "x"), "invalid int value")
+
+
+def test_show_actions_prints_the_hierarchy():
+    result = likeme("show", "--actions", CHARACTERS / "max.toml")
+    assert result.returncode == 0, result.stderr
+    assert "satisfy_hunger" in result.stdout and "movement-action correspondence map:" in result.stdout
+    plain = likeme("show", "--actions", CHARACTERS / "morris.toml")
+    assert "ice_cream is food" in plain.stdout
+
+
+def test_bench_behaviour_runs(tmp_path):
+    out = tmp_path / "b.json"
+    result = likeme("bench", "behaviour", "--episodes", "3", "--quiet", "--json", out)
+    assert result.returncode == 0, result.stderr
+    data = json.loads(out.read_text())
+    assert set(data["conditions"]) == {"line-of-sight", "no-line-of-sight", "close-together"}
+    assert data["conditions"]["line-of-sight"]["path"] >= 2 / 3
