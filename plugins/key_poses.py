@@ -32,10 +32,19 @@ from scipy.interpolate import PchipInterpolator
 from toolkit.body import Body
 from toolkit.errors import ConfigError
 from toolkit.motion import Motion
+from toolkit.params import Parameter
 
-__all__ = ["KeyPoses", "Movement", "parse_poses", "parse_movements", "read_repertoire", "interpolate"]
+__all__ = ["KeyPoses", "Movement", "REPERTOIRE_PARAMETERS", "parse_poses", "parse_movements", "read_repertoire", "interpolate"]
 
 POSE_KEYS = ("base", "shift", "offset")
+
+REPERTOIRE_PARAMETERS = (
+    Parameter("rest", str, "stand", "The hub pose the character stands in when idle."),
+    Parameter("hubs", list, [], "Further hub poses movements may start and end in (the rest pose always is one).", items=str),
+    Parameter("poses", dict, doc="Named key poses, local frame, metres (see the character format)."),
+    Parameter("movements", dict, doc="Named movements: key poses at times in seconds."),
+)
+"""The parameters of every motor system whose repertoire is declared as timed key poses."""
 
 
 @dataclass(frozen=True)

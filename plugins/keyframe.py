@@ -13,20 +13,15 @@ from typing import Any
 
 import numpy as np
 
-from plugins.key_poses import play, read_repertoire
-from toolkit import ConfigError, Motion, MotorSystem, Parameter, hookimpl
+from plugins.key_poses import REPERTOIRE_PARAMETERS, play, read_repertoire
+from toolkit import ConfigError, Motion, MotorSystem, hookimpl
 
 
 class KeyframeMotor(MotorSystem):
     """Plays movements authored as timed key poses, hub to hub (no learning)."""
 
     name = "keyframe"
-    parameters = (
-        Parameter("rest", str, "stand", "The hub pose the character stands in when idle."),
-        Parameter("hubs", list, [], "Further hub poses movements may start and end in (the rest pose always is one).", items=str),
-        Parameter("poses", dict, doc="Named key poses, local frame, metres (see the character format)."),
-        Parameter("movements", dict, doc="Named movements: key poses at times in seconds."),
-    )
+    parameters = REPERTOIRE_PARAMETERS
 
     def attach(self, owner: Any) -> None:
         super().attach(owner)

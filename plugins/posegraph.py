@@ -27,7 +27,7 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
-from plugins.key_poses import interpolate, play, read_repertoire
+from plugins.key_poses import REPERTOIRE_PARAMETERS, interpolate, play, read_repertoire
 from toolkit import ConfigError, Motion, MotorSystem, Parameter, hookimpl
 
 
@@ -36,10 +36,7 @@ class Posegraph(MotorSystem):
 
     name = "posegraph"
     parameters = (
-        Parameter("rest", str, "stand", "The hub pose the character stands in when idle."),
-        Parameter("hubs", list, [], "Further hub poses movements may start and end in.", items=str),
-        Parameter("poses", dict, doc="Named key poses, local frame, metres (as for keyframe)."),
-        Parameter("movements", dict, doc="Named movements: key poses at times in seconds (as for keyframe)."),
+        *REPERTOIRE_PARAMETERS,
         Parameter("node_rate", float, 10.0, "Pose nodes per second of movement: the graph's resolution. Higher "
                   "recognises finer timing at the cost of search time.", minimum=1.0, maximum=120.0),
     )
