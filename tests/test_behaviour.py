@@ -163,3 +163,30 @@ def test_a_third_party_trigger_is_used_by_name_in_a_hierarchy(write):
                  '[action.tuples.satisfy_hunger]\nshould = [{ trigger = "very-hungry" }]\n')
     picky = load_character(path, pm)
     assert [t.name for t in picky.action.hierarchy.tuples["satisfy_hunger"].should] == ["very-hungry"]
+
+
+def test_hunger_rises_until_morris_acts_on_it(write):
+    pm = create_plugin_manager(autoload=False)
+    scene = write(
+        "slow.toml",
+        f"""
+        [scenario]
+        name = "getting hungry"
+        duration = 8.0
+        [[actors]]
+        character = "{CHARACTERS / 'morris.toml'}"
+        position = [0.0, 0.0, 1.6]
+        heading = 180.0
+        [actors.override.action.drives]
+        hunger = {{ level = 0.0, rate = 0.1 }}
+        play = {{ level = 0.0, rate = 0.0 }}
+        [[objects]]
+        name = "cheese"
+        kind = "cheese"
+        position = [0.08, 0.40, 1.26]
+        """,
+    )
+    world = load_scenario(scene, pm).run()
+    first_frame, request = world.actors["morris"].performed[0]
+    assert request.movement == "reach"
+    assert 2.9 <= first_frame / world.fps <= 3.8  # hunger passes 0.3 after 3 s at 0.1 per second
