@@ -234,6 +234,44 @@ class Hierarchical(ActionSystem):
         counts = self.correspondence.get(movement)
         return counts.most_common(1)[0][0] if counts else None
 
+    def get_state(self) -> dict[str, Any]:
+        """Drives, beliefs, the correspondence and transition maps: everything this character learns by acting and watching."""
+        return {
+            "drives": {n: d.level for n, d in self.drives.items()},
+            "beliefs": dict(self.beliefs),
+            "correspondence": {m: {" > ".join(p): n for p, n in c.items()} for m, c in self.correspondence.items()},
+            "transitions": [[a, b, n] for (a, b), n in self.transitions.items()],
+        }
+
+    def set_state(self, state: dict[str, Any]) -> None:
+        known = ("drives", "beliefs", "correspondence", "transitions")
+        for key in state:
+            if key not in known:
+                raise ConfigError(f"unknown key {key!r}", key=(key,), expected="a hierarchical state key", available=known)
+        for name, level in state.get("drives", {}).items():
+            if name not in self.drives:
+                raise ConfigError(f"unknown drive {name!r}", key=("drives", name), expected="a drive of this character", available=list(self.drives))
+            if isinstance(level, bool) or not isinstance(level, (int, float)) or not 0 <= level <= 1:
+                raise ConfigError(f"invalid level {level!r}", key=("drives", name), expected="a number in [0, 1]")
+            self.drives[name].level = float(level)
+        beliefs = state.get("beliefs", {})
+        if not all(isinstance(v, str) for v in beliefs.values()):
+            raise ConfigError("invalid beliefs", key=("beliefs",), expected="object types mapped to categories")
+        self.beliefs = dict(beliefs)
+        self.correspondence = {}
+        for movement, counts in state.get("correspondence", {}).items():
+            for text, n in counts.items():
+                path = tuple(p.strip() for p in text.split(">"))
+                if path[-1] not in self.hierarchy.tuples or path not in self.hierarchy.paths_to(path[-1]):
+                    raise ConfigError(f"not a path of the hierarchy: {text!r}", key=("correspondence", movement, text),
+                                      expected="top > ... > leaf tuple names")
+                self.correspondence.setdefault(movement, Counter())[path] = int(n)
+        self.transitions = Counter()
+        for i, item in enumerate(state.get("transitions", [])):
+            if not (isinstance(item, list) and len(item) == 3 and all(x in self.hierarchy.tuples for x in item[:2])):
+                raise ConfigError(f"invalid transition {item!r}", key=("transitions", i), expected="[from_leaf, to_leaf, count]")
+            self.transitions[(item[0], item[1])] = int(item[2])
+
     def render(self) -> str:
         lines = ["action hierarchy (top level: motivational subsystems; children: the next level's action group):"]
         lines += ["  " + line for line in self.hierarchy.render().splitlines()]

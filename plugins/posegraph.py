@@ -114,7 +114,8 @@ class Posegraph(MotorSystem):
         times = np.arange(len(path)) / self.params["node_rate"]
         return interpolate(keys, times, self.body.parts, fps=fps, speed=speed)
 
-    def learn(self, name: str, poses: np.ndarray, visible: np.ndarray | None = None, *, source: str = "") -> list[str]:
+    def learn(self, name: str, poses: np.ndarray, visible: np.ndarray | None = None, *, source: str = "",
+              announce: bool = True) -> list[str]:
         """Add an observed movement as a new path through new nodes (§5.2.3, §7.3).
 
         Parameters
@@ -152,9 +153,35 @@ class Posegraph(MotorSystem):
         self.node_poses = np.stack(poses_list)
         self.node_root_relative = self.node_poses - self.node_poses[:, root : root + 1]
         self.learned[name] = {"nodes": len(interior), "source": source}
-        if self.owner is not None:
+        if announce and self.owner is not None:
             self.owner.announce("likeme_movement_learned", character=self.owner, movement=name, details=dict(self.learned[name]))
         return self.paths[name]
+
+    def get_state(self) -> dict[str, Any]:
+        """The learned movements: for each, its interior node poses (local frame) and where it came from."""
+        return {
+            "learned": {
+                name: {
+                    "source": info["source"],
+                    "poses": self.node_poses[[self.node_index(n) for n in self.paths[name][1:-1]]].round(6).tolist(),
+                }
+                for name, info in self.learned.items()
+            }
+        }
+
+    def set_state(self, state: dict[str, Any]) -> None:
+        for key in state:
+            if key != "learned":
+                raise ConfigError(f"unknown key {key!r}", key=(key,), expected="a posegraph state key", available=["learned"])
+        root = self.body.root_index
+        for name, entry in state.get("learned", {}).items():
+            poses = np.asarray(entry.get("poses"), dtype=float)
+            if poses.ndim != 3 or poses.shape[1:] != (self.body.n_parts, 3) or not np.isfinite(poses).all():
+                raise ConfigError(f"invalid poses of learned movement {name!r}", key=("learned", name, "poses"),
+                                  expected=f"an array of shape (nodes, {self.body.n_parts}, 3) of finite numbers")
+            hub = self.rest_pose() - self.rest_pose()[root]
+            interior = poses - self.rest_pose()[root]  # learn() stores root-relative poses lifted to the rest root
+            self.learn(name, np.concatenate([[hub], interior, [hub]]), source=str(entry.get("source", "")), announce=False)
 
     def describe(self) -> dict[str, Any]:
         return {

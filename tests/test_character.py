@@ -41,7 +41,7 @@ def test_builtin_characters_compose(pm):
     morris = load_character(CHARACTERS / "morris.toml", pm)
     assert max_.name == "Max" and morris.name == "Morris"
     assert len(max_.body.parts) >= 10
-    assert set(max_.motor.movements()) == set(morris.motor.movements())
+    assert set(morris.motor.movements()) - set(max_.motor.movements()) == {"windmill"}  # a movement Max lacks
     assert morris.files[1] == (CHARACTERS / "max.toml").resolve()
     assert max_.action.name == morris.action.name == "hierarchical"
     assert "ice_cream" in morris.action.beliefs and "ice_cream" not in max_.action.beliefs

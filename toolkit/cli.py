@@ -52,6 +52,9 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=None, help="seed for random choices (default: the scenario's)")
     p.add_argument("--duration", type=float, default=None, help="seconds to run (default: the scenario's)")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
+    p.add_argument("--load", metavar="STATE", help="restore what the characters learned from a state file first")
+    p.add_argument("--save", metavar="STATE", help="save what the characters learn to a state file (atomically, "
+                   "whenever something is learned and at the end)")
     p.set_defaults(handler=cmd_run)
 
     p = sub.add_parser("plugins", help="list every registered component by kind, with its distribution")
@@ -106,7 +109,23 @@ def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dic
     scenario = load_scenario(path, pm, seed=args.seed)
     if getattr(args, "duration", None) is not None:
         scenario.duration = args.duration
-    world = scenario.run()
+    if getattr(args, "load", None):
+        from toolkit.state import load_state
+
+        load_state(scenario.world, args.load)
+    checkpoint = None
+    if getattr(args, "save", None):
+        from toolkit.state import Checkpoint
+
+        checkpoint = Checkpoint(scenario.world, args.save)
+        pm.register(checkpoint, name="checkpoint")
+    try:
+        world = scenario.run()
+    finally:
+        if checkpoint is not None:
+            pm.unregister(checkpoint)
+    if checkpoint is not None:
+        checkpoint.save()
     summary = summarise(world, name=scenario.name)
     summary["seed"] = scenario.seed
     summary["description"] = scenario.description.strip()

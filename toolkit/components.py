@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
+from toolkit.errors import ConfigError
 from toolkit.motion import Motion
 from toolkit.params import Parameter, validate_params
 
@@ -258,6 +259,22 @@ class Component(ABC):
     def attach(self, owner: Character) -> None:
         """Called once the owning character is composed. Override to read the owner's body or motor system."""
         self.owner = owner
+
+    def get_state(self) -> dict[str, Any]:
+        """What this component has learned, as JSON-ready data (empty if it learns nothing).
+
+        Saved by :func:`toolkit.state.save_state`; must round-trip through :meth:`set_state`.
+        """
+        return {}
+
+    def set_state(self, state: dict[str, Any]) -> None:
+        """Restore what :meth:`get_state` returned (on a freshly composed component).
+
+        Raise :class:`~toolkit.errors.ConfigError` (keys relative to ``state``) for data it cannot use.
+        """
+        if state:
+            raise ConfigError(f"{self.kind} {self.name!r} keeps no state, but the file has some", expected="no state",
+                              available=sorted(state))
 
     def __repr__(self) -> str:
         args = ", ".join(f"{k}={v!r}" for k, v in self.params.items() if not isinstance(v, (dict, list)))

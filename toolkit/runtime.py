@@ -207,11 +207,13 @@ class Actor:
                 expected="a movement of its motor system",
                 available=motor.movements(),
             )
-        motion = _call(self.character, "motor", "perform", motor.perform, request.movement, speed=request.speed, fps=self.world.fps)
+        motion = self._call("motor", "perform", request.movement, speed=request.speed, fps=self.world.fps)
+        if motion is None:
+            return
         self._motion, self._frame, self.performing = motion, 0, request
         self.performed.append((self.world.frame, request))
         if self.character.action is not None:
-            _call(self.character, "action", "performed", self.character.action.performed, self, request, self.world)
+            self._call("action", "performed", self, request, self.world)
         if request.imitating is not None:
             target = self.world.actors[request.imitating]
             self.world.emit("imitation_started", self, target, request=request)
@@ -223,16 +225,46 @@ class Actor:
                 done = self.performing
                 self._motion, self.performing = None, None
                 if done is not None and self.character.action is not None:
-                    _call(self.character, "action", "completed", self.character.action.completed, self, done, self.world)
+                    self._call("action", "completed", self, done, self.world)
                 if done is not None and done.imitating is not None:
                     target = self.world.actors[done.imitating]
                     self.world.emit("imitation_stopped", self, target, movement=done.movement, reason="completed")
         if self.idle and self._queue:
             self._start(self._queue.pop(0))
         if self.idle and self.character.action is not None:
-            request = _call(self.character, "action", "choose", self.character.action.choose, self, self.world)
+            request = self._call("action", "choose", self, self.world)
             if request is not None:
                 self._start(request)
+
+    def _call(self, key: str, method: str, *args: Any, **kwargs: Any) -> Any:
+        """Call a method of one of the character's components.
+
+        Anything but a likeme error is a :class:`PluginError` naming the component and the method. With
+        ``world.on_plugin_error == "skip"`` the component is removed from the character instead, the failure
+        is recorded as a ``plugin_failed`` event, and the call returns ``None``.
+        """
+        component = getattr(self.character, key)
+        if component is None:
+            return None
+        try:
+            return getattr(component, method)(*args, **kwargs)
+        except LikemeError as exc:
+            if self.world.on_plugin_error == "skip" and isinstance(exc, PluginError):
+                return self._drop(key, component, method, exc)
+            raise
+        except Exception as exc:
+            error = PluginError(component.name, f"{type(component).__name__}.{method}", f"{type(exc).__name__}: {exc}")
+            if self.world.on_plugin_error == "skip":
+                return self._drop(key, component, method, error)
+            raise error from exc
+
+    def _drop(self, key: str, component: Any, method: str, error: PluginError) -> None:
+        setattr(self.character, key, None)
+        self.world.events.append(
+            Event(self.world.frame, self.world.time, "plugin_failed", self.id, None,
+                  {"plugin": component.name, "where": error.where, "error": str(error)})
+        )
+        return None
 
     # -- observing -------------------------------------------------------------------
 
@@ -254,19 +286,22 @@ class Actor:
         self.memory = ObservationLog(target.body.parts, self.world.fps)
         c.perception.reset()
         if c.segmenter is not None:
-            _call(c, "segmenter", "reset", c.segmenter.reset, target.body.parts, self.world.fps)
+            self._call("segmenter", "reset", target.body.parts, self.world.fps)
 
     def _observe(self) -> None:
         target, c, world = self.target, self.character, self.world
         assert target is not None and self.memory is not None and c.perception is not None
-        percept: Percept = _call(c, "perception", "perceive", c.perception.perceive, self, target, world)
+        percept: Percept | None = self._call("perception", "perceive", self, target, world)
+        if percept is None:
+            return
         self.memory.append(percept.pose, percept.visible, percept.world)
         self.percepts += 1
         if c.segmenter is None:
             return
         was_open = c.segmenter.active_since is not None
-        closed = _call(c, "segmenter", "push", c.segmenter.push, percept.pose, percept.visible)
-        self._handle_segments(closed, was_open)
+        closed = self._call("segmenter", "push", percept.pose, percept.visible)
+        if c.segmenter is not None:
+            self._handle_segments(closed or [], was_open)
 
     def _handle_segments(self, closed: list[Segment], was_open: bool) -> None:
         c, target, world = self.character, self.target, self.world
@@ -279,12 +314,13 @@ class Actor:
                 continue
             if self._committed is None:
                 motion = self.memory.motion(segment.start, segment.end)
-                match = _call(c, "matcher", "conclude", c.matcher.conclude, motion)
-                self._recognised(segment, match)
+                match = self._call("matcher", "conclude", motion)
+                if match is not None:
+                    self._recognised(segment, match)
             self._committed = None
         opened = c.segmenter.active_since is not None and (not was_open or closed)
         if c.matcher is not None and opened:
-            _call(c, "matcher", "begin", c.matcher.begin, world.fps)
+            self._call("matcher", "begin", world.fps)
             self._committed = None
             start = c.segmenter.active_since
             for f in range(start, self.memory.n):  # catch the matcher up on the frames since onset
@@ -294,8 +330,7 @@ class Actor:
             self._early(self.memory.positions[-1], self.memory.visible[-1])
 
     def _early(self, pose: np.ndarray, visible: np.ndarray) -> bool:
-        c = self.character
-        match = _call(c, "matcher", "observe", c.matcher.observe, pose, visible)
+        match = self._call("matcher", "observe", pose, visible)
         if match is None:
             return False
         self._committed = match
@@ -310,10 +345,10 @@ class Actor:
         world.emit("movement_recognised", self, target, segment=segment, match=match)
         if c.action is None or not match.known:
             return
-        behaviour = _call(c, "action", "interpret", c.action.interpret, self, target, segment, match, world)
+        behaviour = self._call("action", "interpret", self, target, segment, match, world)
         if behaviour is not None:
             world.emit("behaviour_identified", self, target, behaviour=behaviour)
-        request = _call(c, "action", "respond", c.action.respond, self, target, match, behaviour, world)
+        request = self._call("action", "respond", self, target, match, behaviour, world)
         if request is not None:
             self.request(request)
 
@@ -321,20 +356,9 @@ class Actor:
         c = self.character
         if self.target is None or c.segmenter is None:
             return
-        closed = _call(c, "segmenter", "flush", c.segmenter.flush)
-        self._handle_segments(closed, True)
-
-
-def _call(character: Character, key: str, method: str, func: Any, *args: Any, **kwargs: Any) -> Any:
-    """Call a component method; anything but a likeme error is reported with the component's name."""
-    try:
-        return func(*args, **kwargs)
-    except LikemeError:
-        raise
-    except Exception as exc:
-        component = getattr(character, key)
-        name = getattr(component, "name", key)
-        raise PluginError(name, f"{type(component).__name__}.{method}", f"{type(exc).__name__}: {exc}") from exc
+        closed = self._call("segmenter", "flush")
+        if c.segmenter is not None:
+            self._handle_segments(closed or [], True)
 
 
 class World:
@@ -347,11 +371,19 @@ class World:
     pm : PluginManager, optional
         Whose hooks announce run events; defaults to the plugin manager of the
         first character added.
+    on_plugin_error : "stop" or "skip"
+        What a failing component or hook implementation does to the run: stop it
+        with a :class:`PluginError` naming the plugin and where it failed, or
+        go on without it (the component is removed from its character, the
+        plugin is unregistered) and record a ``plugin_failed`` event.
     """
 
-    def __init__(self, fps: float = 30.0, pm: Any = None) -> None:
+    def __init__(self, fps: float = 30.0, pm: Any = None, on_plugin_error: str = "stop") -> None:
         if not fps > 0:
             raise ValueError("fps must be positive")
+        if on_plugin_error not in ("stop", "skip"):
+            raise ValueError("on_plugin_error is 'stop' or 'skip'")
+        self.on_plugin_error = on_plugin_error
         self.fps = float(fps)
         self.frame = 0
         self.actors: dict[str, Actor] = {}
@@ -388,13 +420,26 @@ class World:
     def emit(self, kind: str, actor: Actor, target: Actor | None = None, **data: Any) -> None:
         """Record an event and call the ``likeme_<kind>`` hook."""
         self.events.append(Event(self.frame, self.time, kind, actor.id, target.id if target else None, data))
+        if kind in ("imitation_started", "imitation_stopped"):
+            self.announce(f"likeme_{kind}", world=self, actor=actor, target=target, **data)
+        else:
+            self.announce(f"likeme_{kind}", world=self, observer=actor, target=target, **data)
+
+    def announce(self, hook_name: str, **kwargs: Any) -> None:
+        """Call every implementation of a run-event hook; a failing one is named (or dropped, in skip mode)."""
         if self.pm is None:
             return
-        hook = getattr(self.pm.hook, f"likeme_{kind}")
-        if kind in ("imitation_started", "imitation_stopped"):
-            hook(world=self, actor=actor, target=target, **data)
-        else:
-            hook(world=self, observer=actor, target=target, **data)
+        for impl in list(getattr(self.pm.hook, hook_name).get_hookimpls()):
+            try:
+                impl.function(**{k: kwargs[k] for k in impl.argnames})
+            except Exception as exc:
+                error = exc if isinstance(exc, PluginError) else PluginError(
+                    impl.plugin_name, hook_name, f"{type(exc).__name__}: {exc}")
+                if self.on_plugin_error != "skip":
+                    raise error from exc
+                self.pm.unregister(impl.plugin)
+                self.events.append(Event(self.frame, self.time, "plugin_failed", "", None,
+                                         {"plugin": impl.plugin_name, "where": hook_name, "error": str(error)}))
 
     def step(self) -> None:
         """Advance one frame: every actor acts, then every watching actor observes."""
@@ -409,8 +454,7 @@ class World:
         for actor in self.actors.values():
             if actor.target is not None:
                 actor._observe()
-        if self.pm is not None:
-            self.pm.hook.likeme_world_stepped(world=self)
+        self.announce("likeme_world_stepped", world=self)
 
     def _remember(self) -> None:
         self._history[self.frame] = {n: (o.position.copy(), o.held_by) for n, o in self.objects.items()}
