@@ -43,6 +43,7 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p = sub.add_parser("demo", help="run the built-in scenario and report what each character did and saw")
     p.add_argument("--seed", type=int, default=None, help="seed for random choices (default: the scenario's)")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
+    p.add_argument("--keep-going", action="store_true", help="go on without a plugin that fails (default: stop)")
     p.add_argument("--scenario", action="append", metavar="NAME",
                    help=f"built-in scenario to run, repeatable (default: {' and '.join(DEMO_SCENARIOS)})")
     p.set_defaults(handler=cmd_demo)
@@ -52,6 +53,7 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=None, help="seed for random choices (default: the scenario's)")
     p.add_argument("--duration", type=float, default=None, help="seconds to run (default: the scenario's)")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
+    p.add_argument("--keep-going", action="store_true", help="go on without a plugin that fails (default: stop)")
     p.add_argument("--load", metavar="STATE", help="restore what the characters learned from a state file first")
     p.add_argument("--save", metavar="STATE", help="save what the characters learn to a state file (atomically, "
                    "whenever something is learned and at the end)")
@@ -106,7 +108,7 @@ def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dic
     from toolkit.scenario import load_scenario
     from toolkit.report import summarise
 
-    scenario = load_scenario(path, pm, seed=args.seed)
+    scenario = load_scenario(path, pm, seed=args.seed, on_plugin_error="skip" if args.keep_going else "stop")
     if getattr(args, "duration", None) is not None:
         scenario.duration = args.duration
     if getattr(args, "load", None):

@@ -116,8 +116,10 @@ def summarise(world: World, *, name: str = "") -> dict[str, Any]:
         if actor.target is not None:
             entry["watching"] = _watching(actor, world)
         actors.append(entry)
+    failures = [dict(e.data, actor=e.actor, time=round(e.time, 3)) for e in world.events if e.kind == "plugin_failed"]
     return {
         "scenario": name,
+        "plugin_failures": failures,
         "fps": world.fps,
         "frames": world.frame,
         "duration": round(world.time, 3),
@@ -140,6 +142,8 @@ def render_text(summary: dict[str, Any]) -> str:
     lines.append(f"{title}: {summary['duration']:.2f} s, {summary['frames']} frames at {summary['fps']:g} fps")
     for obj in summary["objects"]:
         lines.append(f"  object {obj['name']} ({obj['kind']}) at {obj['position']}")
+    for f in summary.get("plugin_failures", []):
+        lines.append(f"  at {f['time']:.2f}s went on without plugin {f['plugin']!r} ({f['where']}): {f['error']}")
     for a in summary["actors"]:
         c = a["character"]
         lines.append("")

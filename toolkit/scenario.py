@@ -73,18 +73,19 @@ def is_scenario(table: Mapping[str, Any]) -> bool:
     return "scenario" in table
 
 
-def load_scenario(path: str | Path, pm: PluginManager, *, seed: int | None = None) -> Scenario:
+def load_scenario(path: str | Path, pm: PluginManager, *, seed: int | None = None, on_plugin_error: str = "stop") -> Scenario:
     """Load a scenario file, its characters and objects, into a world ready to run.
 
     ``seed`` replaces the file's seed; it is given to every component parameter
-    named ``seed`` that the scenario does not set explicitly.
+    named ``seed`` that the scenario does not set explicitly. ``on_plugin_error``
+    is the world's policy for failing plugins (see :class:`~toolkit.runtime.World`).
     """
     path = Path(path)
     if not path.is_file():
         path = resolve_file(str(path), None, pm)
     table = read_toml(path)
     try:
-        return _build(table, path, pm, seed)
+        return _build(table, path, pm, seed, on_plugin_error)
     except ConfigError as err:
         raise err.within(file=path) from None
 
@@ -107,7 +108,7 @@ def _check_keys(table: Mapping[str, Any], known: tuple[str, ...], key: tuple, wh
             raise ConfigError(f"unknown key {k!r}", key=(*key, k), expected=f"a {what} key", available=known)
 
 
-def _build(table: Mapping[str, Any], path: Path, pm: PluginManager, seed: int | None) -> Scenario:
+def _build(table: Mapping[str, Any], path: Path, pm: PluginManager, seed: int | None, on_plugin_error: str) -> Scenario:
     for k in table:
         if k not in ("scenario", "actors", "objects"):
             raise ConfigError(f"unknown table {k!r}", key=(k,), expected="a scenario table", available=("actors", "objects", "scenario"))
@@ -127,7 +128,7 @@ def _build(table: Mapping[str, Any], path: Path, pm: PluginManager, seed: int | 
         raise ConfigError(f"invalid value {file_seed!r}", key=("scenario", "seed"), expected="an integer")
     seed = file_seed if seed is None else seed
 
-    world = World(fps=fps, pm=pm)
+    world = World(fps=fps, pm=pm, on_plugin_error=on_plugin_error)
     actors = table.get("actors", [])
     if not isinstance(actors, list) or not actors:
         raise ConfigError("missing or invalid", key=("actors",), expected="one or more [[actors]] tables")

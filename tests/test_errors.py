@@ -1,0 +1,202 @@
+"""Every input a user gives fails with one clear line: file, line or key, what was expected, what is available.
+
+``CASES`` is the table of bad inputs; ``docs/errors.md`` is generated from it with the real messages
+(``python -m tests.test_errors > docs/errors.md``) and a test keeps the two equal.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import os
+import re
+import tempfile
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+MAX = (ROOT / "characters" / "max.toml").as_posix()
+
+CHILD = f'[character]\nname = "Bad"\nextends = "{MAX}"\n'
+BODY = """[character]
+name = "Stick"
+[body]
+parts = ["root", "head", "lk", "rk"]
+root = "root"
+facing = { left = "lk", right = "rk", forward = "head" }
+[motor]
+plugin = "keyframe"
+[motor.poses.stand]
+root = [0.0, 1.0, 0.0]
+head = [0.0, 1.6, 0.1]
+lk = [0.1, 0.5, 0.0]
+rk = [-0.1, 0.5, 0.0]
+[motor.poses.bob]
+base = "stand"
+shift = [0.0, -0.2, 0.0]
+[motor.movements.bob]
+keys = [{ pose = "stand", at = 0.0 }, { pose = "bob", at = 0.5 }, { pose = "stand", at = 1.0 }]
+"""
+SCENE = f'[scenario]\nname = "s"\n[[actors]]\nid = "max"\ncharacter = "{MAX}"\n'
+
+
+def state(**changes):
+    import json
+
+    data = {"format": "likeme-state", "version": 1, "actors": {}}
+    data.update(changes)
+    return json.dumps(data)
+
+
+# (case, what is wrong, files {name: text}, command arguments, fragments the one-line message must contain)
+CASES = [
+    # -- character files: syntax and structure
+    ("toml-syntax", "TOML syntax error", {"c.toml": '[character]\nname = "X\n'}, ["validate", "c.toml"], ["c.toml:2:", "TOML syntax error"]),
+    ("unknown-table", "unknown top-level table", {"c.toml": CHILD + "[sensors]\nx = 1\n"}, ["validate", "c.toml"], ["key sensors", "unknown table 'sensors'", "available: character, body, motor"]),
+    ("missing-name", "character without a name", {"c.toml": f'[character]\nextends = "{MAX}"\n'}, ["validate", "c.toml"], ["key character.name", "expected a non-empty string"]),
+    ("name-type", "name of the wrong type", {"c.toml": f'[character]\nname = 3\nextends = "{MAX}"\n'}, ["validate", "c.toml"], ["key character.name", "missing or invalid"]),
+    ("character-key", "unknown key in [character]", {"c.toml": CHILD + 'colour = "grey"\n'}, ["validate", "c.toml"], ["key character.colour", "available: name, extends, description"]),
+    ("extends-missing", "extends a file that does not exist", {"c.toml": '[character]\nname = "A"\nextends = "nobody"\n'}, ["validate", "c.toml"], ["key character.extends", "cannot find 'nobody'", "available:"]),
+    ("extends-cycle", "extends cycle", {"a.toml": '[character]\nname = "A"\nextends = "b.toml"\n', "b.toml": '[character]\nname = "B"\nextends = "a.toml"\n'}, ["validate", "a.toml"], ["extends cycle: a.toml -> b.toml -> a.toml"]),
+    ("missing-body", "no [body] table", {"c.toml": '[character]\nname = "A"\n[motor]\nplugin = "keyframe"\n'}, ["validate", "c.toml"], ["key body", "missing [body] table"]),
+    ("parts-type", "parts is not a list", {"c.toml": BODY.replace('parts = ["root", "head", "lk", "rk"]', 'parts = "root"')}, ["validate", "c.toml"], ["key body.parts", "expected a list of part names"]),
+    ("duplicate-parts", "duplicate part names", {"c.toml": BODY.replace('"lk", "rk"]', '"lk", "lk"]')}, ["validate", "c.toml"], ["key body.parts", "duplicate part names ['lk']"]),
+    ("root-unknown", "root is not a part", {"c.toml": BODY.replace('root = "root"', 'root = "pelvis"')}, ["validate", "c.toml"], ["key body.root", "unknown body part 'pelvis'", "available: root, head, lk, rk"]),
+    ("facing-unknown", "facing names an unknown part", {"c.toml": BODY.replace('left = "lk"', 'left = "knee"')}, ["validate", "c.toml"], ["key body.facing.left", "unknown body part 'knee'"]),
+    ("bones-invalid", "a bone is not a pair", {"c.toml": BODY.replace('facing =', 'bones = [["root"]]\nfacing =')}, ["validate", "c.toml"], ["key body.bones", 'expected a list of part pairs']),
+    ("colour-invalid", "a colour is not #rrggbb", {"c.toml": BODY.replace('[motor]', '[body.colours]\nhead = "red"\n[motor]')}, ["validate", "c.toml"], ["key body.colours", 'expected a table of part = "#rrggbb"']),
+    ("missing-motor", "no [motor] table", {"c.toml": BODY[: BODY.index("[motor]")]}, ["validate", "c.toml"], ["key motor", "missing [motor] table"]),
+    # -- plugin names and parameters
+    ("motor-plugin-missing", "component table without plugin", {"c.toml": BODY.replace('plugin = "keyframe"', "")}, ["validate", "c.toml"], ["key motor.plugin", "missing or invalid plugin name", "available: keyframe, posegraph"]),
+    ("motor-plugin-unknown", "unknown motor system", {"c.toml": BODY.replace('plugin = "keyframe"', 'plugin = "keyfram"')}, ["validate", "c.toml"], ["key motor.plugin", "unknown motor system 'keyfram'", "available: keyframe, posegraph"]),
+    ("segmenter-unknown", "unknown segmenter", {"c.toml": CHILD + '[segmenter]\nplugin = "hub-treshold"\n'}, ["validate", "c.toml"], ["key segmenter.plugin", "unknown segmenter 'hub-treshold'", "available: hub-threshold"]),
+    ("matcher-unknown", "unknown matcher", {"c.toml": CHILD + '[matcher]\nplugin = "dtw"\n'}, ["validate", "c.toml"], ["key matcher.plugin", "unknown matcher 'dtw'", "available: path-search"]),
+    ("perception-unknown", "unknown perception", {"c.toml": CHILD + '[perception]\nplugin = "eyes"\n'}, ["validate", "c.toml"], ["key perception.plugin", "unknown perception 'eyes'", "available: motion-capture, synthetic-vision"]),
+    ("param-unknown", "unknown parameter", {"c.toml": CHILD + '[segmenter]\ntreshold = 0.1\n'}, ["validate", "c.toml"], ["key segmenter.treshold", "unknown parameter 'treshold' for segmenter 'hub-threshold'", "available: cutoff, floor, hub"]),
+    ("param-type", "parameter of the wrong type", {"c.toml": CHILD + '[matcher]\nk = "eight"\n'}, ["validate", "c.toml"], ["key matcher.k", "wrong type str", "expected an integer in [1, inf]"]),
+    ("param-range", "parameter out of range", {"c.toml": CHILD + '[perception]\ndropout = 1.5\n'}, ["validate", "c.toml"], ["key perception.dropout", "value 1.5 out of range", "expected a number in [0, 1]"]),
+    ("param-choice", "parameter not among the choices", {"c.toml": CHILD + '[action.tuples.satisfy_hunger]\nselect = { trigger = "object-present", kind = "food", prefer = "tastiest" }\n'}, ["validate", "c.toml"], ["key action.tuples.satisfy_hunger.select.prefer", "value 'tastiest' not allowed", "available: closest, farthest, largest"]),
+    ("needs-posegraph", "path-search without a posegraph", {"c.toml": BODY + '[matcher]\nplugin = "path-search"\n'}, ["validate", "c.toml"], ["key matcher.plugin", "path-search needs a posegraph motor system, not 'keyframe'"]),
+    ("eye-unknown", "vision eye is not a part", {"c.toml": CHILD + '[perception]\neye = "eyes"\n'}, ["validate", "c.toml"], ["key perception.eye", "unknown body part 'eyes'"]),
+    ("hub-param-unknown", "segmenter hub pose unknown", {"c.toml": CHILD + '[segmenter]\nhub = "sitting"\n'}, ["validate", "c.toml"], ["key segmenter.hub", "unknown hub pose 'sitting'", "available: stand"]),
+    # -- the motor repertoire
+    ("pose-part-unknown", "unknown part in a pose", {"c.toml": BODY.replace("shift = [0.0, -0.2, 0.0]", "shift = [0.0, -0.2, 0.0]\nnoze = [0, 1, 0]")}, ["validate", "c.toml"], ["key motor.poses.bob.noze", "unknown key 'noze'", "available: root, head, lk, rk, base, shift, offset"]),
+    ("pose-incomplete", "pose without base misses parts", {"c.toml": BODY.replace('rk = [-0.1, 0.5, 0.0]\n', "")}, ["validate", "c.toml"], ["key motor.poses.stand", "pose without base misses parts ['rk']"]),
+    ("pose-base-unknown", "pose base unknown", {"c.toml": BODY.replace('base = "stand"', 'base = "stnad"')}, ["validate", "c.toml"], ["key motor.poses.bob.base", "unknown pose 'stnad'", "available: bob, stand"]),
+    ("pose-base-cycle", "pose bases form a cycle", {"c.toml": BODY + '[motor.poses.a]\nbase = "b"\n[motor.poses.b]\nbase = "a"\n'}, ["validate", "c.toml"], ["pose base cycle: a -> b -> a"]),
+    ("pose-vector", "a position is not three numbers", {"c.toml": BODY.replace("shift = [0.0, -0.2, 0.0]", "shift = [0.0, -0.2]")}, ["validate", "c.toml"], ["key motor.poses.bob.shift", "expected [x, y, z] finite numbers in metres"]),
+    ("movement-pose-unknown", "movement uses an unknown pose", {"c.toml": BODY.replace('{ pose = "bob", at = 0.5 }', '{ pose = "bop", at = 0.5 }')}, ["validate", "c.toml"], ["key motor.movements.bob.keys[1].pose", "unknown pose 'bop'", "available: stand, bob"]),
+    ("movement-not-hub", "movement does not end in a hub", {"c.toml": BODY.replace('{ pose = "stand", at = 1.0 }', '{ pose = "bob", at = 1.0 }')}, ["validate", "c.toml"], ["key motor.movements.bob.keys", "movement must end in a hub pose, not 'bob'", "available: stand"]),
+    ("movement-times", "key times not increasing", {"c.toml": BODY.replace("at = 1.0", "at = 0.4")}, ["validate", "c.toml"], ["key motor.movements.bob.keys", "key times [0.0, 0.5, 0.4] are not increasing"]),
+    ("movement-key-form", "a key is not { pose, at }", {"c.toml": BODY.replace('{ pose = "bob", at = 0.5 }', '{ pose = "bob" }')}, ["validate", "c.toml"], ["key motor.movements.bob.keys[1]", 'expected { pose = "NAME", at = SECONDS }']),
+    ("rest-unknown", "rest pose unknown", {"c.toml": BODY.replace('plugin = "keyframe"', 'plugin = "keyframe"\nrest = "sit"')}, ["validate", "c.toml"], ["key motor.rest", "unknown hub pose 'sit'", "available: stand, bob"]),
+    ("script-movement", "script names an unknown movement", {"c.toml": BODY + '[action]\nplugin = "script"\nmovements = ["bob", "jump"]\n'}, ["validate", "c.toml"], ["key action.movements[1]", "unknown movement 'jump'", "available: bob"]),
+    # -- the action hierarchy
+    ("trigger-unknown", "unknown trigger", {"c.toml": CHILD + '[action.tuples.get]\ncan = [{ trigger = "proximty" }]\n'}, ["validate", "c.toml"], ["key action.tuples.get.can[0].trigger", "unknown trigger 'proximty'", "available: drive, holding"]),
+    ("trigger-param", "trigger parameter unknown", {"c.toml": CHILD + '[action.tuples.get]\nuntil = [{ trigger = "holding", tight = true }]\n'}, ["validate", "c.toml"], ["key action.tuples.get.until[0].tight", "unknown parameter 'tight' for trigger 'holding'"]),
+    ("tuple-child-unknown", "unknown child tuple", {"c.toml": CHILD + '[action.tuples.get]\nchildren = ["reach", "grab"]\n'}, ["validate", "c.toml"], ["key action.tuples.get.children[1]", "unknown tuple 'grab'", "available: eat, get"]),
+    ("tuple-cycle", "cycle in the action hierarchy", {"c.toml": CHILD + '[action.tuples.get]\nchildren = ["reach", "loop"]\n[action.tuples.loop]\nchildren = ["get"]\n'}, ["validate", "c.toml"], ["action hierarchy cycle:"]),
+    ("tuple-leaf-and-inner", "tuple with movement and children", {"c.toml": CHILD + '[action.tuples.reach]\nchildren = ["get"]\n'}, ["validate", "c.toml"], ["key action.tuples.reach", "a tuple needs either a movement"]),
+    ("tuple-movement-unknown", "leaf requests an unknown movement", {"c.toml": CHILD + '[action.tuples.eat]\nmovement = "munch"\n'}, ["validate", "c.toml"], ["key action.tuples.eat.movement", "unknown movement 'munch'"]),
+    ("top-without-drive", "top-level tuple without a drive", {"c.toml": CHILD + '[action.tuples.idle]\nmovement = "stand"\n'}, ["validate", "c.toml"], ["key action.tuples.idle.drive", "a top-level tuple is a motivational subsystem"]),
+    ("drive-unknown", "tuple names an unknown drive", {"c.toml": CHILD + '[action.tuples.satisfy_hunger]\ndrive = "thirst"\n'}, ["validate", "c.toml"], ["key action.tuples.satisfy_hunger.drive", "unknown drive 'thirst'", "available: hunger, play"]),
+    ("effect-unknown", "unknown effect", {"c.toml": CHILD + '[action.tuples.reach]\neffect = "throw"\n'}, ["validate", "c.toml"], ["key action.tuples.reach.effect", "unknown effect 'throw'", "available: none, grasp, consume, toss"]),
+    ("drive-level", "drive level out of range", {"c.toml": CHILD + '[action.drives]\nhunger = { level = 2.0 }\n'}, ["validate", "c.toml"], ["key action.drives.hunger.level", "invalid value 2.0"]),
+    ("experience-path", "experience names no path of the hierarchy", {"c.toml": CHILD + '[action.experience]\nreach = { "play > reach" = 1 }\n'}, ["validate", "c.toml"], ["key action.experience.reach", "not a path of the hierarchy: 'play > reach'"]),
+    # -- scenario files
+    ("scenario-missing-table", "scenario without [scenario]", {"s.toml": "[[scenario]]\nname = 1\n"}, ["validate", "s.toml"], ["key scenario", "missing [scenario] table"]),
+    ("scenario-actor-key", "unknown actor key", {"s.toml": SCENE + "speed = 2\n"}, ["validate", "s.toml"], ["key actors[0].speed", "unknown key 'speed'", "available: id, character, position"]),
+    ("scenario-watch", "watching an actor that does not exist", {"s.toml": SCENE + 'watch = "ghost"\n'}, ["validate", "s.toml"], ["key actors[0].watch", "unknown actor 'ghost'", "available:"]),
+    ("scenario-duplicate-id", "two actors with one id", {"s.toml": SCENE + SCENE[SCENE.index("[[actors]]"):]}, ["validate", "s.toml"], ["key actors[1].id", "duplicate actor id 'max'", "available: max"]),
+    ("scenario-position", "position is not [x, y, z]", {"s.toml": SCENE + "position = [0, 1]\n"}, ["validate", "s.toml"], ["key actors[0].position", "expected [x, y, z] in metres"]),
+    ("scenario-character", "character not found", {"s.toml": SCENE.replace(MAX, "nobody")}, ["validate", "s.toml"], ["key actors[0].character", "cannot find 'nobody'", "available:"]),
+    ("scenario-fps", "negative frame rate", {"s.toml": SCENE.replace('name = "s"', 'name = "s"\nfps = -30')}, ["validate", "s.toml"], ["key scenario.fps", "expected a positive number"]),
+    ("scenario-holder", "object held by an unknown actor", {"s.toml": SCENE + '[[objects]]\nname = "cheese"\nkind = "cheese"\nheld_by = "morris"\n'}, ["validate", "s.toml"], ["key objects[0].held_by", "unknown actor 'morris'", "available: max"]),
+    ("scenario-object-kind", "object without a kind", {"s.toml": SCENE + '[[objects]]\nname = "cheese"\n'}, ["validate", "s.toml"], ["key objects[0].kind", "missing or invalid"]),
+    # -- state files
+    ("state-version", "state file of an unknown version", {"st.json": state(version=9)}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["st.json: key version", "unsupported state format version 9", "available: 1"]),
+    ("state-not-json", "state file that is not JSON", {"st.json": "{\n oops\n"}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["st.json:2:", "not JSON"]),
+    ("state-format", "a JSON file that is not a state file", {"st.json": '{"hello": 1}'}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["key format", "not a likeme state file"]),
+    # -- the command line
+    ("cli-command", "unknown command", {}, ["frobnicate"], ["invalid choice: 'frobnicate'"]),
+    ("cli-missing-argument", "missing argument", {}, ["run"], ["the following arguments are required: scenario"]),
+    ("cli-bad-int", "not a number", {}, ["demo", "--seed", "x"], ["argument --seed: invalid int value: 'x'"]),
+    ("cli-bench-set", "bad --set", {}, ["bench", "watch", "--movements", "1", "--set", "floor=0"], ["key --set", "invalid setting 'floor=0'", "expected TABLE.KEY=VALUE"]),
+]
+
+
+def run_case(files, args):
+    """Run the likeme command in-process in a temporary folder; return (exit status, stderr, folder)."""
+    from toolkit.cli import main
+
+    with tempfile.TemporaryDirectory() as folder:
+        for name, text in files.items():
+            Path(folder, name).write_text(text, encoding="utf-8")
+        err = io.StringIO()
+        cwd = os.getcwd()
+        os.chdir(folder)
+        try:
+            with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+                try:
+                    status = main(args)
+                except SystemExit as exc:
+                    status = exc.code
+        finally:
+            os.chdir(cwd)
+        return status, err.getvalue(), os.path.realpath(folder)
+
+
+@pytest.fixture(autouse=True)
+def builtins_only(monkeypatch):
+    monkeypatch.setenv("LIKEME_DISABLE_PLUGIN_AUTOLOAD", "1")
+
+
+def test_there_are_at_least_40_cases():
+    assert len(CASES) >= 40
+    assert len({c[0] for c in CASES}) == len(CASES)
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
+def test_bad_input_fails_with_one_clear_line(case):
+    _, _, files, args, fragments = case
+    status, err, _ = run_case(files, args)
+    assert status == 1, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("likeme: error: "), err
+    assert "Traceback" not in err
+    for fragment in fragments:
+        assert fragment in lines[0], f"{fragment!r} not in {lines[0]!r}"
+
+
+def render() -> str:
+    """docs/errors.md: the table of error cases with their real messages."""
+    out = [
+        "# Errors",
+        "",
+        "Every error a user can cause is one line on standard error, `likeme: error: ...`, with exit status 1, and a",
+        "documented exception in Python: `toolkit.ConfigError` for input (files, keys, values, state files),",
+        "`toolkit.PluginError` for a plugin that fails (named with the hook or method). Both derive from",
+        "`toolkit.LikemeError`. The message names the file (and line where known), the key path, what was expected and",
+        "what is available. The table is generated by `python -m tests.test_errors > docs/errors.md` from the cases",
+        "`tests/test_errors.py` checks; the folder of each case is shown as `DIR`.",
+        "",
+        "| case | command | message |",
+        "| --- | --- | --- |",
+    ]
+    for name, what, files, args, _ in CASES:
+        status, err, folder = run_case(files, args)
+        message = err.strip().replace(folder, "DIR").replace(MAX, "characters/max.toml").replace("|", "\\\\|")
+        message = re.sub(r"/tmp/[^ :;]+/", "DIR/", message)
+        command = "likeme " + " ".join(args)
+        out.append(f"| {what} | `{command}` | `{message}` |")
+    return "\n".join(out) + "\n"
+
+
+def test_docs_errors_table_is_current():
+    assert (ROOT / "docs" / "errors.md").read_text() == render(), "regenerate: python -m tests.test_errors > docs/errors.md"
+
+
+if __name__ == "__main__":
+    os.environ["LIKEME_DISABLE_PLUGIN_AUTOLOAD"] = "1"
+    print(render(), end="")
