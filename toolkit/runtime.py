@@ -210,6 +210,9 @@ class Actor:
         motion = self._call("motor", "perform", request.movement, speed=request.speed, fps=self.world.fps)
         if motion is None:
             return
+        if not isinstance(motion, Motion) or motion.parts != self.body.parts or motion.n_frames == 0:
+            raise PluginError(motor.name, f"{type(motor).__name__}.perform",
+                              f"returned {motion!r}, expected a Motion of at least one frame of the parts {list(self.body.parts)}")
         self._motion, self._frame, self.performing = motion, 0, request
         self.performed.append((self.world.frame, request))
         if self.character.action is not None:
@@ -284,16 +287,28 @@ class Actor:
             )
         self.watch_start = self.world.frame + 1  # the world frame of the first percept (memory row 0)
         self.memory = ObservationLog(target.body.parts, self.world.fps)
-        c.perception.reset()
+        self._call("perception", "reset")
         if c.segmenter is not None:
             self._call("segmenter", "reset", target.body.parts, self.world.fps)
 
     def _observe(self) -> None:
         target, c, world = self.target, self.character, self.world
-        assert target is not None and self.memory is not None and c.perception is not None
+        assert target is not None and self.memory is not None
+        if c.perception is None:  # dropped after failing (skip mode): the observer is blind from now on
+            return
         percept: Percept | None = self._call("perception", "perceive", self, target, world)
         if percept is None:
             return
+        n = len(target.body.parts)
+        if (
+            not isinstance(percept, Percept)
+            or np.shape(percept.pose) != (n, 3)
+            or np.shape(percept.visible) != (n,)
+        ):
+            raise PluginError(c.perception.name, f"{type(c.perception).__name__}.perceive",
+                              f"returned {type(percept).__name__} with pose {np.shape(getattr(percept, 'pose', None))} and "
+                              f"visible {np.shape(getattr(percept, 'visible', None))}, expected a Percept with pose ({n}, 3) "
+                              f"and visible ({n},)")
         self.memory.append(percept.pose, percept.visible, percept.world)
         self.percepts += 1
         if c.segmenter is None:
