@@ -226,3 +226,32 @@ def test_mutated_character_files_raise_only_documented_errors(tmp_path, data):
         load_character(path, pm)
     except LikemeError:
         pass
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    objects=st.lists(
+        st.tuples(st.sampled_from(["cheese", "ball", "baton", "ice_cream", "rock"]),
+                  st.floats(-1.5, 1.5), st.floats(0.0, 1.5), st.floats(-1.5, 1.5)),
+        max_size=5),
+    hunger=st.floats(0, 1), play=st.floats(0, 1),
+)
+def test_action_selection_always_gives_a_possible_path_or_nothing(objects, hunger, play):
+    from toolkit import TriggerContext, WorldObject
+
+    pm = create_plugin_manager(autoload=False)
+    world = World(fps=30, pm=pm)
+    morris = world.add_actor(load_character(CHARACTERS / "morris.toml", pm))
+    for i, (kind, x, y, z) in enumerate(objects):
+        world.add_object(WorldObject(f"{kind}-{i}", kind, (x, y, z)))
+    system = morris.character.action
+    system.drives["hunger"].level, system.drives["play"].level = hunger, play
+    decision = system.decide(morris, world)
+    if decision is None:
+        return
+    path, obj = decision
+    assert path in system.hierarchy.paths_to(path[-1]) and system.hierarchy.tuples[path[-1]].leaf
+    context = TriggerContext(morris, world, obj, system.beliefs, {n: d.level for n, d in system.drives.items()})
+    for name in path:
+        assert all(t.evaluate(context) > 0 for t in system.hierarchy.tuples[name].can)
+    assert obj in world.objects and system.beliefs.get(world.objects[obj].kind) is not None
