@@ -28,6 +28,14 @@ def horizontal_distance(context: TriggerContext) -> float:
     return float(np.hypot(d[0], d[2]))
 
 
+def _free_within(context: TriggerContext, distance: float, low: float, high: float) -> float:
+    """1 if the object of attention is free (held by nobody), within ``distance`` and ``low < height <= high``."""
+    obj = context.attended()
+    if obj is None or obj.held_by is not None:
+        return 0.0
+    return 1.0 if horizontal_distance(context) <= distance and low < obj.position[1] <= high else 0.0
+
+
 class Proximity(Trigger):
     """The object of attention is within `distance` (m) and not already held by the character."""
 
@@ -54,11 +62,7 @@ class Reachable(Trigger):
     )
 
     def evaluate(self, context: TriggerContext) -> float:
-        obj = context.attended()
-        if obj is None or obj.held_by is not None:
-            return 0.0
-        ok = horizontal_distance(context) <= self.params["distance"] and obj.position[1] <= self.params["height"]
-        return 1.0 if ok else 0.0
+        return _free_within(context, self.params["distance"], -np.inf, self.params["height"])
 
     def describe(self) -> str:
         return "object within reach"
@@ -75,12 +79,7 @@ class ObjectHigh(Trigger):
     )
 
     def evaluate(self, context: TriggerContext) -> float:
-        obj = context.attended()
-        if obj is None or obj.held_by is not None:
-            return 0.0
-        y = obj.position[1]
-        ok = horizontal_distance(context) <= self.params["distance"] and self.params["height"] < y <= self.params["max_height"]
-        return 1.0 if ok else 0.0
+        return _free_within(context, self.params["distance"], self.params["height"], self.params["max_height"])
 
     def describe(self) -> str:
         return "object high in the air"

@@ -12,6 +12,33 @@ from toolkit import create_plugin_manager
 ROOT = Path(__file__).resolve().parent.parent
 CHARACTERS = ROOT / "characters"
 
+STICK = """
+[character]
+name = "Stick"
+
+[body]
+parts = ["root", "head", "lk", "rk"]
+root = "root"
+facing = { left = "lk", right = "rk", forward = "head" }
+
+[motor]
+plugin = "keyframe"
+
+[motor.poses.stand]
+root = [0.0, 1.0, 0.0]
+head = [0.0, 1.6, 0.1]
+lk = [0.1, 0.5, 0.0]
+rk = [-0.1, 0.5, 0.0]
+
+[motor.poses.bob]
+base = "stand"
+shift = [0.0, -0.2, 0.0]
+
+[motor.movements.bob]
+keys = [{ pose = "stand", at = 0.0 }, { pose = "bob", at = 0.5 }, { pose = "stand", at = 1.0 }]
+"""
+"""A minimal character: four parts, a keyframe motor with one movement (for tests of the format)."""
+
 
 @pytest.fixture
 def pm():

@@ -5,35 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.conftest import CHARACTERS
+from tests.conftest import CHARACTERS, STICK
 from toolkit import ConfigError, PluginError, load_character
 from toolkit.character import find_key_line, merge_tables
 
-BODY = """
-[character]
-name = "Stick"
-
-[body]
-parts = ["root", "head", "lk", "rk"]
-root = "root"
-facing = { left = "lk", right = "rk", forward = "head" }
-
-[motor]
-plugin = "keyframe"
-
-[motor.poses.stand]
-root = [0.0, 1.0, 0.0]
-head = [0.0, 1.6, 0.1]
-lk = [0.1, 0.5, 0.0]
-rk = [-0.1, 0.5, 0.0]
-
-[motor.poses.bob]
-base = "stand"
-shift = [0.0, -0.2, 0.0]
-
-[motor.movements.bob]
-keys = [{ pose = "stand", at = 0.0 }, { pose = "bob", at = 0.5 }, { pose = "stand", at = 1.0 }]
-"""
+BODY = STICK
 
 
 def test_builtin_characters_compose(pm):

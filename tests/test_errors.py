@@ -15,29 +15,13 @@ from pathlib import Path
 
 import pytest
 
+from tests.conftest import STICK
+
 ROOT = Path(__file__).resolve().parent.parent
 MAX = (ROOT / "characters" / "max.toml").as_posix()
 
 CHILD = f'[character]\nname = "Bad"\nextends = "{MAX}"\n'
-BODY = """[character]
-name = "Stick"
-[body]
-parts = ["root", "head", "lk", "rk"]
-root = "root"
-facing = { left = "lk", right = "rk", forward = "head" }
-[motor]
-plugin = "keyframe"
-[motor.poses.stand]
-root = [0.0, 1.0, 0.0]
-head = [0.0, 1.6, 0.1]
-lk = [0.1, 0.5, 0.0]
-rk = [-0.1, 0.5, 0.0]
-[motor.poses.bob]
-base = "stand"
-shift = [0.0, -0.2, 0.0]
-[motor.movements.bob]
-keys = [{ pose = "stand", at = 0.0 }, { pose = "bob", at = 0.5 }, { pose = "stand", at = 1.0 }]
-"""
+BODY = STICK
 SCENE = f'[scenario]\nname = "s"\n[[actors]]\nid = "max"\ncharacter = "{MAX}"\n'
 
 

@@ -115,15 +115,21 @@ class Character:
 # -- reading files -------------------------------------------------------------------
 
 
+def read_text(path: str | Path, what: str) -> str:
+    """A UTF-8 text file's content; a missing or unreadable file is a :class:`ConfigError` expecting ``what``."""
+    path = Path(path)
+    try:
+        return path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ConfigError("file not found", file=path, expected=f"an existing {what}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ConfigError(f"cannot read file ({exc})", file=path, expected=f"a readable UTF-8 {what}") from None
+
+
 def read_toml(path: str | Path) -> dict[str, Any]:
     """Parse a TOML file; syntax errors become a :class:`ConfigError` with line and column."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ConfigError("file not found", file=path, expected="an existing TOML file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"cannot read file ({exc})", file=path, expected="a readable UTF-8 TOML file") from None
+    text = read_text(path, "TOML file")
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

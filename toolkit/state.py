@@ -30,7 +30,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from toolkit.character import Character
+from toolkit.character import Character, read_text
 from toolkit.errors import ConfigError
 from toolkit.hookspecs import hookimpl
 
@@ -98,12 +98,7 @@ def save_state(target: Any, path: str | Path) -> None:
 def read_state(path: str | Path) -> dict[str, Any]:
     """Read and check a state file's header; :class:`ConfigError` for anything that is not a supported state file."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ConfigError("file not found", file=path, expected="a state file written by --save") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"cannot read file ({exc})", file=path, expected="a UTF-8 JSON state file") from None
+    text = read_text(path, "state file written by --save")
     try:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
