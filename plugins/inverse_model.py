@@ -1,0 +1,119 @@
+"""The inverse model: from an observed segment of a wrist trajectory to the guiding stroke that reproduces it.
+
+Kopp & Graeser 2006, §4.3: "after segmentation, an inverse model is applied to
+each segment in order to calculate the parameters needed to produce it by a
+guiding stroke. To this end, the equations for trajectory formation are applied
+in inverse direction."
+
+1. Start, target and duration are the segment's first and last samples and its length.
+2. The progress along the chord and the perpendicular residual are measured;
+   the residual's principal direction gives the movement plane. A residual
+   smaller than ``straight`` times the chord makes the stroke linear.
+3. A residual that changes sides is an S, otherwise a C. The largest residual is
+   the curvature. The area under the profile gives the roundness (the area
+   of ``1 - |2s - 1|^q`` is ``q / (q + 1)``), and where it peaks gives the skewness.
+4. The speed profile gives the moment of peak velocity and the end gain.
+5. Those closed-form estimates start a bounded least-squares refinement
+   (:func:`scipy.optimize.least_squares`) of the timing and shape parameters
+   against the observed positions, so noise in one estimate is corrected by the
+   trajectory as a whole.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.integrate import trapezoid
+from scipy.optimize import least_squares
+from scipy.signal import savgol_filter
+
+from plugins.guiding_stroke import GuidingStroke
+
+__all__ = ["stroke_from_segment", "trajectory_error"]
+
+
+def trajectory_error(stroke: GuidingStroke, positions: np.ndarray, fps: float) -> float:
+    """Largest distance (m) between the stroke's trajectory and observed ``positions`` sampled at ``fps``."""
+    t = np.arange(len(positions)) / fps
+    return float(np.linalg.norm(stroke.position(t) - positions, axis=1).max())
+
+
+def _closed_form(p: np.ndarray, fps: float, straight: float) -> dict:
+    start, target = p[0], p[-1]
+    chord = target - start
+    length = float(np.linalg.norm(chord))
+    axis = chord / max(length, 1e-12)
+    s = np.clip((p - start) @ axis / max(length, 1e-12), 0.0, 1.0)
+    residual = p - (start + s[:, None] * chord)
+    speed = np.linalg.norm(np.diff(p, axis=0), axis=1) * fps
+    if len(speed) >= 7:
+        speed = savgol_filter(speed, 7 if len(speed) >= 7 else len(speed) | 1, 2, mode="interp")
+    peak = float(np.clip((np.argmax(speed) + 0.5) / max(len(speed), 1), 0.1, 0.9))
+    end_gain = float(np.clip(speed[-1] / max(speed.max(), 1e-12), 0.0, 0.9))
+    est = {"start": start, "target": target, "duration": (len(p) - 1) / fps, "peak": peak, "end_gain": end_gain}
+    size = np.linalg.norm(residual, axis=1)
+    if length < 1e-6 or size.max() < straight * length:
+        return {**est, "shape": "linear"}
+    # movement plane: the residual's principal direction, perpendicular to the chord
+    _, _, vt = np.linalg.svd(residual, full_matrices=False)
+    side = vt[0] - (vt[0] @ axis) * axis
+    side /= max(np.linalg.norm(side), 1e-12)
+    normal = np.cross(axis, side)  # then normal x chord points along side: positive lateral is "left"
+    lateral = residual @ side / (0.5 * length)
+    hi, lo = lateral.max(), lateral.min()
+    if min(hi, -lo) > 0.3 * max(hi, -lo):  # both ways: an S, whose first half bends to the left for "left-s"
+        first = lateral[s < 0.5]
+        left_first = first.size > 0 and first.max() >= -first.min()
+        shape, amplitude = ("left-s" if left_first else "right-s"), 2 * max(hi, -lo)
+        profile = np.abs(lateral) * 2
+    else:
+        sign = 1.0 if hi >= -lo else -1.0
+        shape, amplitude = ("left-c" if sign > 0 else "right-c"), max(hi, -lo)
+        profile = sign * lateral
+    # a normal pointing backwards (towards -z, the body's back) is flipped with the side, for readable parameters
+    if normal[2] < 0 or (abs(normal[2]) < 1e-9 and normal[1] < 0):
+        normal = -normal
+        shape = shape.replace("left", "RIGHT").replace("right", "left").replace("RIGHT", "right")
+    area = float(trapezoid(np.clip(profile / max(profile.max(), 1e-12), 0, 1), s)) if len(s) > 1 else 0.5
+    area = float(np.clip(area, 0.51, 0.93))
+    q = area / (1 - area)
+    roundness = float(np.clip(1 - np.log(q) / np.log(8), 0.0, 1.0))
+    s_peak = float(np.clip(s[np.argmax(profile)], 0.05, 0.95)) if shape.endswith("-c") else 0.5
+    skewness = float(np.clip(np.log2(np.log(0.5) / np.log(s_peak)), -1, 1)) if shape.endswith("-c") else 0.0
+    return {**est, "shape": shape, "normal": normal, "curvature": float(np.clip(amplitude, 0.0, 1.0)),
+            "roundness": roundness, "skewness": skewness}
+
+
+def stroke_from_segment(positions: np.ndarray, fps: float, *, straight: float = 0.03, refine: bool = True) -> GuidingStroke:
+    """The guiding stroke that reproduces a segment of wrist positions (N, 3) sampled at ``fps`` (N >= 2).
+
+    Parameters
+    ----------
+    positions : array, shape (N, 3)
+        Observed positions in the body frame, NaN-free (hidden samples interpolated beforehand).
+    fps : float
+    straight : float
+        Largest sideways deviation, as a share of the chord, still taken as a straight stroke.
+    refine : bool
+        Refine the closed-form estimates by least squares.
+    """
+    p = np.asarray(positions, dtype=float)
+    if p.ndim != 2 or p.shape[1] != 3 or len(p) < 2 or not np.isfinite(p).all():
+        raise ValueError("the inverse model needs two or more finite positions (N, 3)")
+    est = _closed_form(p, fps, straight)
+    stroke = GuidingStroke(**est)
+    if not refine:
+        return stroke
+    t = np.arange(len(p)) / fps
+    curved = stroke.shape != "linear"
+    names = ["peak", "end_gain"] + (["curvature", "roundness", "skewness"] if curved else [])
+    lower = {"peak": 0.05, "end_gain": 0.0, "curvature": 0.0, "roundness": 0.0, "skewness": -1.0}
+    upper = {"peak": 0.95, "end_gain": 0.95, "curvature": 1.0, "roundness": 1.0, "skewness": 1.0}
+    x0 = np.array([np.clip(est.get(n, 0.0), lower[n] + 1e-6, upper[n] - 1e-6) for n in names])
+
+    def residual(x: np.ndarray) -> np.ndarray:
+        candidate = GuidingStroke(**{**est, **dict(zip(names, x))})
+        return (candidate.position(t) - p).ravel()
+
+    fit = least_squares(residual, x0, bounds=([lower[n] for n in names], [upper[n] for n in names]), x_scale="jac", max_nfev=200)
+    refined = GuidingStroke(**{**est, **dict(zip(names, fit.x))})
+    return refined if trajectory_error(refined, p, fps) <= trajectory_error(stroke, p, fps) else stroke

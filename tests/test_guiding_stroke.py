@@ -1,0 +1,89 @@
+"""Guiding strokes (Kopp & Graeser 2006, §3) and the inverse model (§4.3): stroke -> trajectory -> stroke."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from plugins.guiding_stroke import SHAPES, GuidingStroke, progress, velocity_profile
+from plugins.inverse_model import stroke_from_segment, trajectory_error
+
+vec = st.tuples(st.floats(-0.4, 0.4), st.floats(0.6, 1.4), st.floats(0.0, 0.5)).map(np.array)
+
+
+@st.composite
+def strokes(draw):
+    start = draw(vec)
+    target = draw(vec)
+    if np.linalg.norm(target - start) < 0.1:
+        target = start + np.array([0.15, 0.05, 0.05])
+    shape = draw(st.sampled_from(SHAPES))
+    return GuidingStroke(
+        start=start, target=target, duration=draw(st.floats(0.3, 1.5)), peak=draw(st.floats(0.3, 0.7)),
+        end_gain=draw(st.floats(0.0, 0.3)), shape=shape,
+        normal=draw(st.sampled_from([np.array([0.0, 0.0, 1.0]), np.array([0.0, 1.0, 0.0]), np.array([1.0, 0.0, 0.0]),
+                                      np.array([0.3, 0.4, 0.85])])),
+        curvature=0.0 if shape == "linear" else draw(st.floats(0.2, 0.9)),
+        roundness=draw(st.floats(0.1, 0.9)), skewness=draw(st.floats(-0.6, 0.6)),
+    )
+
+
+@settings(max_examples=60, deadline=None)
+@given(stroke=strokes())
+def test_stroke_to_trajectory_to_inverse_model_round_trip(stroke):
+    fps = 60.0
+    observed = stroke.trajectory(fps)
+    recovered = stroke_from_segment(observed, fps)
+    tolerance = 0.03 * stroke.amplitude + 0.002
+    assert trajectory_error(recovered, observed, fps) <= tolerance
+    assert np.allclose(recovered.start, stroke.start) and np.allclose(recovered.target, stroke.target)
+    assert recovered.duration == pytest.approx(stroke.duration, abs=1 / fps)
+
+
+@settings(max_examples=30, deadline=None)
+@given(stroke=strokes(), seed=st.integers(0, 1000))
+def test_inverse_model_under_observation_noise(stroke, seed):
+    fps = 60.0
+    clean = stroke.trajectory(fps)
+    noisy = clean + np.random.default_rng(seed).normal(0, 0.002, clean.shape)
+    recovered = stroke_from_segment(noisy, fps)
+    assert trajectory_error(recovered, clean, fps) <= 0.05 * stroke.amplitude + 0.008
+
+
+def test_bell_shaped_velocity_peaks_where_asked():
+    u = np.linspace(0, 1, 1001)
+    for peak in (0.3, 0.5, 0.7):
+        v = velocity_profile(u, peak, 0.0)
+        assert u[np.argmax(v)] == pytest.approx(peak, abs=0.002)
+        assert v[0] == pytest.approx(0.0) and v[-1] == pytest.approx(0.0)
+    s = progress(u, 0.5, 0.4)
+    assert s[0] == 0.0 and s[-1] == pytest.approx(1.0) and np.all(np.diff(s) >= 0)
+    assert velocity_profile(np.array([1.0]), 0.5, 0.4)[0] == pytest.approx(0.4)  # end gain keeps some speed
+
+
+def test_shapes_bend_the_right_way():
+    start, target = np.zeros(3), np.array([0.3, 0.0, 0.0])
+    normal = np.array([0.0, 0.0, 1.0])  # plane x-y; normal x chord = +y: "left" bends towards +y
+    mid = lambda shape: GuidingStroke(start, target, 1.0, shape=shape, normal=normal, curvature=1.0).position(0.5)  # noqa: E731
+    assert mid("left-c")[1] == pytest.approx(0.15, abs=0.01)  # a semicircle: half the chord sideways
+    assert mid("right-c")[1] == pytest.approx(-0.15, abs=0.01)
+    s_curve = GuidingStroke(start, target, 1.0, shape="left-s", normal=normal, curvature=1.0).trajectory(100)
+    assert s_curve[:, 1].max() > 0.05 and s_curve[:, 1].min() < -0.05
+    assert np.allclose(GuidingStroke(start, target, 1.0).position(np.array([0.0, 1.0, 2.0])), [start, target, target])
+
+
+def test_retimed_stroke_keeps_its_path():
+    stroke = GuidingStroke(np.zeros(3), np.array([0.2, 0.1, 0.0]), 0.8, shape="right-c", curvature=0.5)
+    slow = stroke.retimed(1.6)
+    assert np.allclose(slow.position(1.6 * np.linspace(0, 1, 9)), stroke.position(0.8 * np.linspace(0, 1, 9)))
+
+
+def test_invalid_strokes_are_refused():
+    with pytest.raises(ValueError, match="unknown stroke shape"):
+        GuidingStroke(np.zeros(3), np.ones(3), 1.0, shape="zigzag")
+    with pytest.raises(ValueError, match="positive duration"):
+        GuidingStroke(np.zeros(3), np.ones(3), 0.0)
+    with pytest.raises(ValueError, match="two or more finite positions"):
+        stroke_from_segment(np.zeros((1, 3)), 30)
