@@ -1,0 +1,103 @@
+"""The velocity/direction segmenter (Kopp & Graeser 2006, §4.1, §4.3)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from plugins.guiding_stroke import SHAPES, GuidingStroke
+from plugins.metrics import segmentation_scores
+from plugins.velocity_direction import VelocityDirection, direction_breaks, direction_clusters, speed_breaks
+from tests.conftest import CHARACTERS
+from toolkit import ConfigError, Motion, create_plugin_manager, load_character
+
+FPS = 30.0
+
+
+def stroke_sequence(rng, n_strokes, noise=0.001, end_gain=0.0):
+    p = np.array([0.0, 1.0, 0.3])
+    chunks, truth, t = [np.repeat([p], 12, 0)], [], 12
+    for _ in range(n_strokes):
+        target = p + rng.uniform(-0.3, 0.3, 3)
+        while np.linalg.norm(target - p) < 0.15:
+            target = p + rng.uniform(-0.3, 0.3, 3)
+        shape = SHAPES[rng.integers(0, 5)]
+        stroke = GuidingStroke(p, target, rng.uniform(0.4, 0.9), rng.uniform(0.35, 0.65), end_gain, shape, rng.normal(size=3),
+                               0.0 if shape == "linear" else rng.uniform(0.2, 0.7), rng.uniform(0.2, 0.8), rng.uniform(-0.4, 0.4))
+        path = stroke.trajectory(FPS)[:-1]
+        chunks.append(path)
+        truth.append((t, t + len(path)))
+        t += len(path)
+        p = target
+    chunks.append(np.repeat([p], 12, 0))
+    path = np.concatenate(chunks) + rng.normal(0, noise, (t + 12, 3))
+    return Motion(np.stack([np.zeros_like(path), path], 1), FPS, ("root", "wrist")), truth
+
+
+def test_random_stroke_sequences_are_cut_at_the_strokes():
+    rng = np.random.default_rng(7)
+    scores = []
+    for _ in range(40):
+        motion, truth = stroke_sequence(rng, int(rng.integers(1, 5)))
+        found = [(s.start, s.end) for s in VelocityDirection(parts=["wrist"]).segment(motion)]
+        scores.append(segmentation_scores(found, truth)["f1"])
+    assert np.mean(scores) >= 0.97
+
+
+def test_streaming_equals_batch_and_movement_level():
+    rng = np.random.default_rng(3)
+    motion, truth = stroke_sequence(rng, 3)
+    seg = VelocityDirection(parts=["wrist"])
+    batch = seg.segment(motion)
+    seg.reset(motion.parts, motion.fps)
+    streamed = [s for f in range(motion.n_frames) for s in seg.push(motion.positions[f], motion.visible[f])] + seg.flush()
+    assert streamed == batch
+    flowing, truth = stroke_sequence(rng, 3, end_gain=0.3)  # strokes that flow into each other: one movement
+    whole = VelocityDirection(parts=["wrist"], level="movement").segment(flowing)
+    assert len(whole) == 1 and abs(whole[0].start - truth[0][0]) <= 3 and abs(whole[0].end - truth[-1][1]) <= 4
+
+
+def test_onset_is_known_while_the_movement_goes_on():
+    rng = np.random.default_rng(4)
+    motion, truth = stroke_sequence(rng, 2)
+    seg = VelocityDirection(parts=["wrist"])
+    seg.reset(motion.parts, motion.fps)
+    onset = None
+    for f in range(motion.n_frames):
+        seg.push(motion.positions[f], motion.visible[f])
+        if seg.active_since is not None and onset is None:
+            onset = (f, seg.active_since)
+    detected_at, start = onset
+    assert abs(start - truth[0][0]) <= 3 and detected_at - truth[0][0] <= 0.2 * FPS  # within the sensory memory
+
+
+def test_it_reads_any_body_and_pairs_with_the_mouse():
+    pm = create_plugin_manager(autoload=False)
+    morris = load_character(CHARACTERS / "morris.toml", pm)
+    rest = morris.motor.rest_pose()
+    pos = np.concatenate([np.repeat(rest[None], 15, 0), morris.motor.perform("wave", fps=FPS).positions, np.repeat(rest[None], 15, 0)])
+    motion = Motion(pos - pos[:, :1], FPS, morris.body.parts)
+    whole = VelocityDirection(level="movement").segment(motion)
+    assert len(whole) == 1
+    strokes = VelocityDirection(parts=["right_hand"]).segment(motion)
+    assert len(strokes) >= 4  # raising the arm, the waves, lowering it
+
+
+def test_hidden_parts_do_not_move_and_unknown_parts_are_refused():
+    rng = np.random.default_rng(5)
+    motion, truth = stroke_sequence(rng, 1)
+    visible = np.ones(motion.visible.shape, bool)
+    visible[:, 1] = False
+    assert VelocityDirection(parts=["wrist"]).segment(motion.with_visibility(visible)) == []
+    with pytest.raises(ConfigError, match=r"key parts: parts \['left_wrist'\] are not in the observed body.*available: root, wrist"):
+        VelocityDirection(parts=["left_wrist"]).reset(motion.parts, FPS)
+
+
+def test_building_blocks():
+    speed = np.array([0, 1, 2, 3, 2, 0.5, 2, 3, 2, 1, 0.0])
+    assert speed_breaks(speed, 0.5) == [5]
+    assert speed_breaks(np.array([0, 1, 2, 3, 2.5, 2.4, 2.6, 3, 1, 0.0]), 0.5) == []  # a shallow dip: one curved stroke
+    right, up = np.array([1.0, 0, 0]), np.array([0, 1.0, 0])
+    labels = direction_clusters(np.array([right] * 5 + [up] * 5), 45)
+    assert direction_breaks(labels) == [5]
+    assert len(set(direction_clusters(np.array([right] * 10), 45))) == 1
