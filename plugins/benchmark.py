@@ -48,13 +48,16 @@ def watch_benchmark(
     occlusion: bool = True,
     progress: bool = False,
     settings: dict[str, Any] | None = None,
+    exclude: tuple[str, ...] = ("windmill",),
 ) -> dict[str, Any]:
     """Run the watch benchmark and return its figures (see the module docstring).
+
+    ``exclude``: demonstrator movements never drawn (by default Morris's windmill, which Max does not have).
 
     ``settings`` are tables merged over the observer's character (``{"segmenter": {"floor": 0.0}}``).
     """
     demo = load_character(demonstrator, pm, override={
-        "action": {"plugin": "script", "random": movements, "exclude": ["stand"], "seed": seed, "pause": 0.5}
+        "action": {"plugin": "script", "random": movements, "exclude": ["stand", *exclude], "seed": seed, "pause": 0.5}
     })
     obs_override = {"perception": {"plugin": "synthetic-vision", "noise": noise, "dropout": dropout,
                                    "occlusion": occlusion, "seed": seed + 1}}
