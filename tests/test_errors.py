@@ -52,10 +52,10 @@ CASES = [
     ("colour-invalid", "a colour is not #rrggbb", {"c.toml": BODY.replace('[motor]', '[body.colours]\nhead = "red"\n[motor]')}, ["validate", "c.toml"], ["key body.colours", 'expected a table of part = "#rrggbb"']),
     ("missing-motor", "no [motor] table", {"c.toml": BODY[: BODY.index("[motor]")]}, ["validate", "c.toml"], ["key motor", "missing [motor] table"]),
     # -- plugin names and parameters
-    ("motor-plugin-missing", "component table without plugin", {"c.toml": BODY.replace('plugin = "keyframe"', "")}, ["validate", "c.toml"], ["key motor.plugin", "missing or invalid plugin name", "available: keyframe, posegraph"]),
-    ("motor-plugin-unknown", "unknown motor system", {"c.toml": BODY.replace('plugin = "keyframe"', 'plugin = "keyfram"')}, ["validate", "c.toml"], ["key motor.plugin", "unknown motor system 'keyfram'", "available: keyframe, posegraph"]),
+    ("motor-plugin-missing", "component table without plugin", {"c.toml": BODY.replace('plugin = "keyframe"', "")}, ["validate", "c.toml"], ["key motor.plugin", "missing or invalid plugin name", "available: keyframe, motor-command-graph, posegraph"]),
+    ("motor-plugin-unknown", "unknown motor system", {"c.toml": BODY.replace('plugin = "keyframe"', 'plugin = "keyfram"')}, ["validate", "c.toml"], ["key motor.plugin", "unknown motor system 'keyfram'", "available: keyframe, motor-command-graph, posegraph"]),
     ("segmenter-unknown", "unknown segmenter", {"c.toml": CHILD + '[segmenter]\nplugin = "hub-treshold"\n'}, ["validate", "c.toml"], ["key segmenter.plugin", "unknown segmenter 'hub-treshold'", "available: hub-threshold"]),
-    ("matcher-unknown", "unknown matcher", {"c.toml": CHILD + '[matcher]\nplugin = "dtw"\n'}, ["validate", "c.toml"], ["key matcher.plugin", "unknown matcher 'dtw'", "available: path-search"]),
+    ("matcher-unknown", "unknown matcher", {"c.toml": CHILD + '[matcher]\nplugin = "dtw"\n'}, ["validate", "c.toml"], ["key matcher.plugin", "unknown matcher 'dtw'", "available: forward-model, path-search"]),
     ("perception-unknown", "unknown perception", {"c.toml": CHILD + '[perception]\nplugin = "eyes"\n'}, ["validate", "c.toml"], ["key perception.plugin", "unknown perception 'eyes'", "available: motion-capture, synthetic-vision"]),
     ("param-unknown", "unknown parameter", {"c.toml": CHILD + '[segmenter]\ntreshold = 0.1\n'}, ["validate", "c.toml"], ["key segmenter.treshold", "unknown parameter 'treshold' for segmenter 'hub-threshold'", "available: cutoff, floor, hub"]),
     ("param-type", "parameter of the wrong type", {"c.toml": CHILD + '[matcher]\nk = "eight"\n'}, ["validate", "c.toml"], ["key matcher.k", "wrong type str", "expected an integer in [1, inf]"]),

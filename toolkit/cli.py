@@ -24,8 +24,9 @@ from toolkit.manager import PluginManager, create_plugin_manager
 __all__ = ["main", "build_parser"]
 
 
-DEMO_SCENARIOS = ("demo", "ice_cream")
-"""What ``likeme demo`` runs: Max imitating Morris's random movements, then Max working out why Morris eats."""
+DEMO_SCENARIOS = ("demo", "ice_cream", "imitation_games")
+"""What ``likeme demo`` runs: Max imitating Morris's random movements, Max working out why Morris eats,
+and Max learning Moritz's arm movements in three imitation games."""
 
 
 class _Parser(argparse.ArgumentParser):

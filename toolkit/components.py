@@ -353,11 +353,18 @@ class Matcher(Component):
         """A segment has started."""
 
     def observe(self, pose: np.ndarray, visible: np.ndarray) -> Match | None:
-        """One more frame of the ongoing segment; return a match to commit now."""
+        """One more frame of the ongoing segment; return a match to commit now.
+
+        After committing, a match whose ``details["stop"]`` is true tells the runtime that the
+        demonstration deviates from the committed movement: an imitation of it is stopped.
+        """
         return None
 
-    def conclude(self, motion: Motion) -> Match:
-        """The segment has ended; ``motion`` holds all of it."""
+    def conclude(self, motion: Motion) -> Match | None:
+        """The segment has ended; ``motion`` holds all of it.
+
+        Return the answer, or ``None`` when there is nothing to add to what :meth:`observe` committed to.
+        """
         return self.match(motion)
 
 

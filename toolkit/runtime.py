@@ -327,11 +327,10 @@ class Actor:
             world.emit("segment_found", self, target, segment=segment)
             if c.matcher is None:
                 continue
-            if self._committed is None:
-                motion = self.memory.motion(segment.start, segment.end)
-                match = self._call("matcher", "conclude", motion)
-                if match is not None:
-                    self._recognised(segment, match)
+            motion = self.memory.motion(segment.start, segment.end)
+            match = self._call("matcher", "conclude", motion)  # None: nothing beyond what it committed to
+            if match is not None and not (self._committed is not None and match == self._committed):
+                self._recognised(segment, match)
             self._committed = None
         opened = c.segmenter.active_since is not None and (not was_open or closed)
         if c.matcher is not None and opened:
@@ -341,16 +340,31 @@ class Actor:
             for f in range(start, self.memory.n):  # catch the matcher up on the frames since onset
                 if self._early(self.memory.positions[f], self.memory.visible[f]):
                     break
-        elif c.matcher is not None and c.segmenter.active_since is not None and self._committed is None:
-            self._early(self.memory.positions[-1], self.memory.visible[-1])
+        elif c.matcher is not None and c.segmenter.active_since is not None:
+            self._early(self.memory.positions[-1], self.memory.visible[-1])  # after a commit too: it may deviate
 
     def _early(self, pose: np.ndarray, visible: np.ndarray) -> bool:
         match = self._call("matcher", "observe", pose, visible)
         if match is None:
             return False
+        if match.details.get("stop"):  # the committed movement deviates from the demonstration
+            self.stop_imitation(self.target, str(match.details.get("reason", "deviation")))
+            return False
+        if self._committed is not None:  # one commitment per segment
+            return False
         self._committed = match
         self._recognised(None, match)
         return True
+
+    def stop_imitation(self, target: Actor | None, reason: str) -> None:
+        """Stop imitating ``target`` now (and drop queued imitations of it); announces ``imitation_stopped``."""
+        if target is None:
+            return
+        self._queue = [r for r in self._queue if r.imitating != target.id]
+        if self.performing is not None and self.performing.imitating == target.id:
+            movement = self.performing.movement
+            self._motion, self.performing = None, None
+            self.world.emit("imitation_stopped", self, target, movement=movement, reason=reason)
 
     def _recognised(self, segment: Segment | None, match: Match) -> None:
         c, target, world = self.character, self.target, self.world

@@ -82,6 +82,9 @@ class EarlyCommit(Matcher):
             return Match(self.params["movement"], 1.0, decided_at=self.seen)
         return None
 
+    def conclude(self, motion):
+        return None if self.seen >= self.params["after"] else self.match(motion)
+
     def match(self, motion):
         return Match(self.params["movement"], 0.5)
 

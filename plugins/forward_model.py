@@ -1,0 +1,249 @@
+"""Matcher ``forward-model``: predicting the ongoing demonstration from the active node's edges (Kopp & Graeser 2006, §4.4, Fig. 3).
+
+When a demonstration begins, every edge leaving the active node of the moving
+subsystem's motor command graph predicts, in parallel, where the demonstrator's
+part should be (its forward model, :meth:`GuidingStroke.position`). A candidate
+whose prediction error exceeds ``threshold`` drops out. When exactly one
+prevails (and enough of its path has been seen) it is executed at once, well
+before the demonstration ends: *response facilitation*. While imitating, the
+observation keeps being compared with the chosen edge; if they part by more
+than ``deviation`` the imitation is stopped, the edge is excluded for this
+segment, the subsystem returns to the last correct node and the rest is learned.
+
+Speed: the forward model is evaluated not at the elapsed time but at the time at
+which the edge would have covered the same length of path as has been observed,
+so a familiar movement performed faster or slower still fits; the ratio of the
+two times re-parameterises the command's speed for the imitation.
+
+*True imitation* (§4.3, Fig. 3 top): when no edge predicts the demonstration,
+the working memory of the segment is cut into strokes by the velocity/direction
+segmenter's break points and each stroke is turned into a guiding stroke by the
+inverse model; the strokes become new edges and nodes leading from the active
+node (ending in the hub when the demonstration returns there).
+
+The subsystem "under consideration" is the one whose parts have moved most
+since the onset; subsystems moving at the same time are handled one at a time.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from plugins.inverse_model import stroke_from_segment
+from plugins.velocity_direction import VelocityDirection
+from toolkit import ConfigError, Match, Matcher, Motion, Parameter, hookimpl
+
+__all__ = ["ForwardModel"]
+
+
+def _arc(points: np.ndarray) -> np.ndarray:
+    """Cumulative path length along points (N, 3)."""
+    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+
+
+class ForwardModel(Matcher):
+    """Edges of the active node predict the demonstration in parallel; the last one left is imitated at once (K&G §4.4)."""
+
+    name = "forward-model"
+    parameters = (
+        Parameter("threshold", float, 0.05, "Prediction error (m) above which a candidate edge drops out.", minimum=0.0),
+        Parameter("deviation", float, 0.08, "Error (m) between the imitated edge and the demonstration that stops the "
+                  "imitation.", minimum=0.0),
+        Parameter("min_progress", float, 0.2, "Share of the edge's path that must be seen before committing.", minimum=0.0, maximum=1.0),
+        Parameter("min_move", float, 0.02, "Displacement (m) of a subsystem that makes it the one under consideration.", minimum=0.0),
+        Parameter("learn", bool, True, "Learn new edges by the inverse model when no edge predicts the demonstration."),
+        Parameter("drop", float, 0.5, "Speed-minimum criterion of the stroke segmentation used for learning.", minimum=0.0, maximum=1.0),
+        Parameter("angle", float, 50.0, "Direction criterion (degrees) of the stroke segmentation used for learning.", minimum=1.0, maximum=180.0),
+    )
+
+    def attach(self, owner: Any) -> None:
+        super().attach(owner)
+        motor = owner.motor
+        if not hasattr(motor, "graphs"):
+            raise ConfigError(f"forward-model needs a motor command graph, not {motor.name!r}", key=("plugin",),
+                              expected='[motor] plugin = "motor-command-graph"')
+        self.motor = motor
+        self._root_height = motor.rest_pose()[owner.body.root_index]
+        self._strokes = VelocityDirection(drop=self.params["drop"], angle=self.params["angle"], smooth=0.0)
+
+    # -- streaming ------------------------------------------------------------------------------
+
+    def begin(self, fps: float) -> None:
+        self.fps = fps
+        self.frames: list[np.ndarray] = []
+        self.subsystem: str | None = None
+        self.start_node: str | None = None
+        self.candidates: dict[tuple[str, ...], float] = {}
+        self.excluded: set[str] = set()
+        self.committed: str | None = None
+        self.committed_path: tuple[str, ...] = ()
+        self.deviated = False
+        self.initial: list[str] = []
+
+    def _local(self, pose: np.ndarray) -> np.ndarray:
+        """Root-relative observed positions in the observer's motor frame (root at its own rest height)."""
+        return pose + self._root_height
+
+    def observe(self, pose: np.ndarray, visible: np.ndarray) -> Match | None:
+        points = np.where(visible[:, None], self._local(pose), np.nan)
+        if self.frames:
+            points = np.where(np.isfinite(points), points, self.frames[-1])
+        self.frames.append(points)
+        if self.subsystem is None and not self._choose_subsystem():
+            return None
+        observed = np.array(self.frames)[:, self.motor.subsystems[self.subsystem]]  # (n, k, 3)
+        if self.committed is not None:
+            if not self.deviated and self._error(self.committed_path, observed) > self.params["deviation"]:
+                self.deviated = True
+                self.excluded.add(self.committed_path[0])
+                return Match(self.committed, 0.0, len(self.frames), details={"stop": True, "reason": "deviation"})
+            return None
+        alive: dict[tuple[str, ...], float] = {}
+        for path in self._extended(list(self.candidates), observed):
+            error = self._error(path, observed)
+            if error <= self.params["threshold"]:
+                alive[path] = error
+        self.candidates = alive
+        if len({p[0] for p in alive}) == 1 and alive:  # one first command prevails
+            path = min(alive, key=alive.get)
+            progress = self._progress(path[0], observed)
+            if progress >= self.params["min_progress"] or len(path) > 1:
+                self.committed_path = self._known_continuation(path)
+                self.committed = self.motor.add_sequence(list(self.committed_path))
+                speed = self._speed(path[0], observed)
+                return Match(self.committed, float(np.exp(-alive[path] / self.params["threshold"])), len(self.frames),
+                             path=self.committed_path,
+                             details={"candidates": list(self.initial), "speed": speed, "progress": progress})
+        return None
+
+    def _choose_subsystem(self) -> bool:
+        first, last = self.frames[0], self.frames[-1]
+        best, moved = None, self.params["min_move"]
+        for name, idx in self.motor.subsystems.items():
+            d = float(np.nanmax(np.linalg.norm(last[idx] - first[idx], axis=-1)))
+            if d > moved:
+                best, moved = name, d
+        if best is None:
+            return False
+        self.subsystem = best
+        self.start_node = self.motor.active[best]
+        self.candidates = {(name,): 0.0 for name, _ in self.motor.edges_from(best, self.start_node) if name not in self.excluded}
+        self.initial = sorted(p[0] for p in self.candidates)
+        return True
+
+    def _strokes_of(self, name: str) -> list[Any]:
+        return self.motor.edge(name)[3]["strokes"]
+
+    def _extended(self, paths: list[tuple[str, ...]], observed: np.ndarray) -> list[tuple[str, ...]]:
+        """Paths whose commands have all been covered by the observation continue along every edge of their end node."""
+        out = []
+        seen = _arc(observed[:, 0])[-1]
+        for path in paths:
+            total = sum(_arc(self._strokes_of(e)[0].trajectory(60.0))[-1] for e in path)
+            end = self.motor.edge(path[-1])[2]
+            nxt = [name for name, _ in self.motor.edges_from(self.subsystem, end)] if seen > total + 0.01 else []
+            out.extend([(*path, n) for n in nxt if n not in path] or [path])
+        return out
+
+    def _known_continuation(self, path: tuple[str, ...]) -> tuple[str, ...]:
+        """The whole learned command sequence that ``path`` begins, else ``path`` itself."""
+        for edges in self.motor.sequences.values():
+            if tuple(edges[: len(path)]) == path:
+                return tuple(edges)
+        return path
+
+    def _mapped_time(self, stroke: Any, length: float) -> float:
+        """The stroke time at which it has covered ``length`` metres of path (the speed-free forward model)."""
+        grid = np.linspace(0.0, stroke.duration, 200)
+        arc = _arc(stroke.position(grid))
+        return float(np.interp(min(length, arc[-1]), arc, grid))
+
+    def _predict(self, path: tuple[str, ...], observed: np.ndarray) -> np.ndarray:
+        """Where each part of the subsystem should be after as much path as has been observed."""
+        out = []
+        for j in range(observed.shape[1]):
+            left = _arc(observed[:, j])[-1]
+            strokes = [self._strokes_of(e)[j] for e in path]
+            for i, stroke in enumerate(strokes):
+                length = _arc(stroke.position(np.linspace(0.0, stroke.duration, 200)))[-1]
+                if left <= length or i == len(strokes) - 1:
+                    out.append(stroke.position(self._mapped_time(stroke, left)))
+                    break
+                left -= length
+        return np.array(out)
+
+    def _error(self, path: tuple[str, ...] | str, observed: np.ndarray) -> float:
+        path = (path,) if isinstance(path, str) else path
+        return float(np.linalg.norm(self._predict(path, observed) - observed[-1], axis=-1).max())
+
+    def _progress(self, name: str, observed: np.ndarray) -> float:
+        stroke = self._strokes_of(name)[0]
+        return self._mapped_time(stroke, _arc(observed[:, 0])[-1]) / stroke.duration
+
+    def _speed(self, name: str, observed: np.ndarray) -> float:
+        """How much faster than the command the demonstration goes (1: same speed)."""
+        stroke = self._strokes_of(name)[0]
+        elapsed = (len(observed) - 1) / self.fps
+        return float(np.clip(self._mapped_time(stroke, _arc(observed[:, 0])[-1]) / max(elapsed, 1e-6), 0.25, 4.0))
+
+    # -- the end of the demonstration ------------------------------------------------------------
+
+    def conclude(self, motion: Motion) -> Match | None:
+        if not getattr(self, "frames", None):
+            self.begin(motion.fps)
+            for f in range(motion.n_frames):
+                self.observe(motion.positions[f], motion.visible[f])
+        if self.subsystem is None:
+            return Match.unknown(reason="nothing moved")
+        if self.committed is not None and not self.deviated:
+            self.motor.active[self.subsystem] = self.motor.edge(self.committed_path[-1])[2]
+            return None  # already reported when it committed
+        start = self.start_node
+        if self.deviated:
+            self.motor.reset_to(self.subsystem, start)  # back to the last correct node
+        if not self.params["learn"]:
+            return Match.unknown(reason="no edge predicts the demonstration")
+        observed = np.array(self.frames)[:, self.motor.subsystems[self.subsystem]]
+        names = self._learn(observed, start)
+        movement = self.motor.add_sequence(names)
+        end = self.motor.edge(names[-1])[2]
+        self.motor.active[self.subsystem] = end
+        return Match(movement, 1.0, None, tuple(names),
+                     details={"learned": names, "from": start, "to": end, "candidates": list(self.initial),
+                              "deviated": self.deviated})
+
+    def _learn(self, observed: np.ndarray, start: str) -> list[str]:
+        """Cut the working memory into strokes and add one edge per stroke, chained from ``start``."""
+        n, k, _ = observed.shape
+        flat = observed.reshape(n, k * 3)
+        self._strokes.reset(tuple(f"p{i}" for i in range(k)), self.fps)
+        cuts = self._strokes.breaks(flat)
+        edges = [0, *cuts, n - 1]
+        names, node = [], start
+        hub_state = self.motor.graphs[self.subsystem].nodes["hub"]["state"]
+        for i, (a, b) in enumerate(zip(edges, edges[1:])):
+            if b - a < 2:
+                continue
+            strokes = [stroke_from_segment(observed[a : b + 1, j], self.fps) for j in range(k)]
+            last = i == len(edges) - 2
+            end = "hub" if last and np.linalg.norm(observed[-1] - hub_state, axis=-1).max() <= 0.05 else None
+            name = self.motor.learn(self.subsystem, node, strokes, end=end, source="inverse model")
+            names.append(name)
+            node = self.motor.edge(name)[2]
+        return names
+
+    def match(self, motion: Motion) -> Match:
+        """Batch use: the whole segment at once (no facilitation)."""
+        self.begin(motion.fps)
+        early = None
+        for f in range(motion.n_frames):
+            early = early or self.observe(motion.positions[f], motion.visible[f])
+        late = self.conclude(motion)
+        return late or early or Match.unknown()
+
+
+@hookimpl
+def likeme_register_matchers():
+    return [ForwardModel]

@@ -1,0 +1,226 @@
+"""Motor system ``motor-command-graph``: one graph of motor commands per motor subsystem (Kopp & Graeser 2006, §4.2).
+
+Nodes are motor states of a subsystem (the positions of its parts in the body
+frame, e.g. where the left wrist is); *hub nodes* are the rest states in which
+movements start and end. Edges are motor commands that lead from one state to
+another: for wrist subsystems, guiding strokes (:mod:`plugins.guiding_stroke`),
+one per part of the subsystem. Several edges may join the same two nodes
+(a :class:`networkx.MultiDiGraph`). At every moment each subsystem is in its
+*active node* (or on an edge between two).
+
+A learner starts with the hub nodes only and learns edges and nodes by watching
+(:meth:`MotorCommandGraph.learn`, used by the ``forward-model`` matcher's inverse
+model). Performing an edge (its name is a movement of this motor system) moves
+the subsystem's parts along the edge's strokes from the rest of the body's
+pose; elbows follow by two-link inverse kinematics with the elbow hanging down
+and out (the swivel heuristic of §3, simplified).
+
+Subsystems are configurable (``subsystems = { left_wrist = ["left_wrist"], ... }``),
+including one whole-body subsystem with every part.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import networkx as nx
+import numpy as np
+
+from plugins.guiding_stroke import GuidingStroke
+from plugins.key_poses import parse_poses
+from toolkit import ConfigError, Motion, MotorSystem, Parameter, hookimpl
+
+__all__ = ["MotorCommandGraph", "place_elbows"]
+
+
+def place_elbows(shoulder: np.ndarray, wrist: np.ndarray, upper: float, fore: float, outward: np.ndarray) -> np.ndarray:
+    """Elbow positions (F, 3) for shoulders and wrists (F, 3) by two-link IK, bending towards ``outward`` and down."""
+    d_vec = wrist - shoulder
+    d = np.linalg.norm(d_vec, axis=-1, keepdims=True)
+    d_safe = np.clip(d, 1e-6, upper + fore - 1e-6)
+    u = d_vec / np.maximum(d, 1e-9)
+    along = (upper**2 - fore**2 + d_safe**2) / (2 * d_safe)
+    h = np.sqrt(np.clip(upper**2 - along**2, 0.0, None))
+    pole = outward + np.array([0.0, -1.0, 0.0])
+    v = pole - np.sum(pole * u, axis=-1, keepdims=True) * u
+    v = v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-9)
+    return shoulder + along * u + h * v
+
+
+class MotorCommandGraph(MotorSystem):
+    """Per-subsystem graphs of motor states and guiding-stroke commands; learns edges by watching (K&G §4.2)."""
+
+    name = "motor-command-graph"
+    parameters = (
+        Parameter("rest", str, "rest", "The pose every subsystem's hub node is taken from."),
+        Parameter("poses", dict, doc="Named poses (at least the rest pose), as for keyframe."),
+        Parameter("subsystems", dict, {"left_wrist": ["left_wrist"], "right_wrist": ["right_wrist"]},
+                  "Motor subsystems: name = [parts it moves]."),
+        Parameter("arms", list, [["left_shoulder", "left_elbow", "left_wrist"], ["right_shoulder", "right_elbow", "right_wrist"]],
+                  "Shoulder, elbow, wrist triples whose elbow follows the wrist by inverse kinematics."),
+    )
+
+    def attach(self, owner: Any) -> None:
+        super().attach(owner)
+        body = owner.body
+        poses = parse_poses(self.params["poses"], body)
+        if self.params["rest"] not in poses.names:
+            raise ConfigError(f"unknown pose {self.params['rest']!r}", key=("rest",), expected="a declared pose", available=poses.names)
+        self.body = body
+        self.rest = poses[self.params["rest"]]
+        self.subsystems: dict[str, np.ndarray] = {}
+        for name, parts in self.params["subsystems"].items():
+            if not isinstance(parts, list) or not parts:
+                raise ConfigError("invalid", key=("subsystems", name), expected="a non-empty list of part names")
+            self.subsystems[name] = np.array([body.index(p, key=("subsystems", name)) for p in parts])
+        self.arms = []
+        for i, triple in enumerate(self.params["arms"]):
+            if not isinstance(triple, list) or len(triple) != 3:
+                raise ConfigError("invalid", key=("arms", i), expected="[shoulder, elbow, wrist]")
+            s, e, w = (body.index(p, key=("arms", i)) for p in triple)
+            upper = float(np.linalg.norm(self.rest[e] - self.rest[s]))
+            fore = float(np.linalg.norm(self.rest[w] - self.rest[e]))
+            outward = np.sign(self.rest[s, 0] - self.rest[body.root_index, 0]) * np.array([1.0, 0.0, 0.0])
+            self.arms.append((s, e, w, upper, fore, outward))
+        self.graphs: dict[str, nx.MultiDiGraph] = {}
+        self.active: dict[str, str] = {}
+        for name, idx in self.subsystems.items():
+            g = nx.MultiDiGraph()
+            g.add_node("hub", state=self.rest[idx].copy(), hub=True)
+            self.graphs[name] = g
+            self.active[name] = "hub"
+        self._edges: dict[str, tuple[str, str, str, int]] = {}  # movement name -> (subsystem, from, to, key)
+        self.sequences: dict[str, list[str]] = {}  # a learned path of several edges, performed as one movement
+        self._counter = 0
+        self._state = self.rest.copy()
+
+    # -- the graph ------------------------------------------------------------------------------
+
+    def edges_from(self, subsystem: str, node: str) -> list[tuple[str, dict[str, Any]]]:
+        """(movement name, edge data) of every edge leaving ``node``: the candidates of the forward model."""
+        g = self.graphs[subsystem]
+        return [(data["name"], data) for _, _, data in g.out_edges(node, data=True)]
+
+    def learn(self, subsystem: str, start: str, strokes: list[GuidingStroke], *, end: str | None = None,
+              source: str = "") -> str:
+        """Add an edge of ``strokes`` (one per part of the subsystem) from node ``start``; returns its movement name.
+
+        The edge ends in ``end`` if given (a hub, say), else in a new node at the strokes' targets.
+        """
+        g = self.graphs[subsystem]
+        if end is None:
+            target = np.stack([s.target for s in strokes])
+            end = self._near_node(subsystem, target) or self._new_node(subsystem, target)
+        self._counter += 1
+        name = f"{subsystem}:e{self._counter}"
+        key = g.add_edge(start, end, name=name, strokes=list(strokes), source=source)
+        self._edges[name] = (subsystem, start, end, key)
+        if self.owner is not None:
+            self.owner.announce("likeme_movement_learned", character=self.owner, movement=name,
+                                details={"subsystem": subsystem, "from": start, "to": end, "strokes": len(strokes)})
+        return name
+
+    def _new_node(self, subsystem: str, state: np.ndarray) -> str:
+        g = self.graphs[subsystem]
+        name = f"n{sum(1 for n in g.nodes if n != 'hub') + 1}"
+        g.add_node(name, state=np.asarray(state, dtype=float), hub=False)
+        return name
+
+    def _near_node(self, subsystem: str, state: np.ndarray, tolerance: float = 0.04) -> str | None:
+        """An existing node within ``tolerance`` metres (every part) of ``state``: the same motor state."""
+        for node, data in self.graphs[subsystem].nodes(data=True):
+            if np.linalg.norm(data["state"] - state, axis=-1).max() <= tolerance:
+                return node
+        return None
+
+    def edge(self, movement: str) -> tuple[str, str, str, dict[str, Any]]:
+        """(subsystem, from node, to node, edge data) of a movement (edge) name."""
+        subsystem, a, b, key = self._edges[movement]
+        return subsystem, a, b, self.graphs[subsystem].edges[a, b, key]
+
+    # -- the motor system interface -------------------------------------------------------------
+
+    def add_sequence(self, edges: list[str]) -> str:
+        """Name a path of edges (a movement learned as several strokes) so it can be performed as one movement."""
+        if len(edges) == 1:
+            return edges[0]
+        for name, known in self.sequences.items():
+            if known == list(edges):
+                return name
+        subsystem = self._edges[edges[0]][0]
+        name = f"{subsystem}:m{len(self.sequences) + 1}"
+        self.sequences[name] = list(edges)
+        return name
+
+    def movements(self) -> list[str]:
+        return [*self._edges, *self.sequences]
+
+    def rest_pose(self) -> np.ndarray:
+        return self.rest
+
+    def perform(self, movement: str, *, speed: float = 1.0, fps: float = 30.0) -> Motion:
+        """Execute one edge (or a named path of edges) from the current posture; the active node becomes its end."""
+        if movement in self.sequences:
+            from toolkit.motion import concatenate
+
+            return concatenate([self.perform(e, speed=speed, fps=fps) for e in self.sequences[movement]])
+        if movement not in self._edges:
+            raise ConfigError(f"unknown movement {movement!r}", expected="a learned motor command", available=self.movements())
+        subsystem, _, end, data = self.edge(movement)
+        strokes = [s.retimed(s.duration / speed) for s in data["strokes"]]
+        duration = max(s.duration for s in strokes)
+        t = np.linspace(0.0, duration, max(2, int(round(duration * fps)) + 1))
+        frames = np.repeat(self._state[None], len(t), axis=0)
+        for part, stroke in zip(self.subsystems[subsystem], strokes):
+            frames[:, part] = stroke.position(t)
+        for s, e, w, upper, fore, outward in self.arms:
+            frames[:, e] = place_elbows(frames[:, s], frames[:, w], upper, fore, outward)
+        self._state = frames[-1].copy()
+        self.active[subsystem] = end
+        return Motion(frames, fps, self.body.parts)
+
+    def reset_to(self, subsystem: str, node: str) -> None:
+        """Put a subsystem back in ``node`` (returning to the last correct node after a deviation, §4.4)."""
+        self.active[subsystem] = node
+        self._state[self.subsystems[subsystem]] = self.graphs[subsystem].nodes[node]["state"]
+
+    def describe(self) -> dict[str, Any]:
+        return {
+            "movements": len(self._edges),
+            "subsystems": {n: {"nodes": g.number_of_nodes(), "edges": g.number_of_edges(), "active": self.active[n]}
+                           for n, g in self.graphs.items()},
+        }
+
+    def get_state(self) -> dict[str, Any]:
+        """Learned nodes and edges of every subsystem."""
+        return {
+            name: {
+                "nodes": {n: d["state"].round(6).tolist() for n, d in g.nodes(data=True) if n != "hub"},
+                "edges": [{"from": a, "to": b, "name": d["name"], "strokes": [s.to_dict() for s in d["strokes"]]}
+                          for a, b, d in g.edges(data=True)],
+                "sequences": {m: e for m, e in self.sequences.items() if self._edges[e[0]][0] == name},
+            }
+            for name, g in self.graphs.items()
+        }
+
+    def set_state(self, state: dict[str, Any]) -> None:
+        for name, entry in state.items():
+            if name not in self.graphs:
+                raise ConfigError(f"unknown subsystem {name!r}", key=(name,), expected="a subsystem", available=list(self.graphs))
+            g = self.graphs[name]
+            for node, value in entry.get("nodes", {}).items():
+                g.add_node(node, state=np.asarray(value, dtype=float), hub=False)
+            for i, e in enumerate(entry.get("edges", [])):
+                try:
+                    strokes = [GuidingStroke(**s) for s in e["strokes"]]
+                except (TypeError, ValueError, KeyError) as exc:
+                    raise ConfigError(f"invalid edge ({exc})", key=(name, "edges", i), expected="an edge written by get_state") from None
+                key = g.add_edge(e["from"], e["to"], name=e["name"], strokes=strokes, source="loaded")
+                self._edges[e["name"]] = (name, e["from"], e["to"], key)
+                self._counter = max(self._counter, int(e["name"].rsplit(":e", 1)[-1]))
+            self.sequences.update(entry.get("sequences", {}))
+
+
+@hookimpl
+def likeme_register_motor_systems():
+    return [MotorCommandGraph]
