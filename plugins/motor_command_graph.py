@@ -187,7 +187,8 @@ class MotorCommandGraph(MotorSystem):
     def describe(self) -> dict[str, Any]:
         return {
             "movements": len(self._edges),
-            "subsystems": {n: {"nodes": g.number_of_nodes(), "edges": g.number_of_edges(), "active": self.active[n]}
+            "subsystems": {n: {"nodes": g.number_of_nodes(), "edges": g.number_of_edges(), "active": self.active[n],
+                               "commands": [f"{a} -> {b} ({d['name'].split(':')[-1]})" for a, b, d in g.edges(data=True)]}
                            for n, g in self.graphs.items()},
         }
 

@@ -53,18 +53,31 @@ def _watching(actor: Actor, world: World) -> dict[str, Any]:
         for e in world.events_of("segment_found", actor.id)
     ]
     out["recognised"] = []
+    segments = world.events_of("segment_found", actor.id)
     for e in world.events_of("movement_recognised", actor.id):
         m = e.data["match"]
         seg = e.data["segment"]
-        out["recognised"].append(
-            {
-                "time": round(e.time, 3),
-                "movement": m.movement,
-                "confidence": round(float(m.confidence), 3),
-                "decided_at": m.decided_at,
-                "early": seg is None,
-            }
-        )
+        if seg is None:  # committed early: the segment it belongs to is the next one found
+            seg = next((s.data["segment"] for s in segments if s.frame >= e.frame), None)
+            fraction = round(m.decided_at / seg.n_frames, 3) if seg is not None and m.decided_at else None
+        else:
+            fraction = 1.0
+        entry = {
+            "time": round(e.time, 3),
+            "movement": m.movement,
+            "confidence": round(float(m.confidence), 3),
+            "decided_at": m.decided_at,
+            "early": e.data["segment"] is None,
+            "fraction": fraction,
+        }
+        for key in ("candidates", "learned", "speed", "deviated"):
+            if key in m.details:
+                entry[key] = m.details[key]
+        out["recognised"].append(entry)
+    out["imitations_stopped"] = [
+        {"time": round(e.time, 3), "movement": e.data["movement"], "reason": e.data["reason"]}
+        for e in world.events_of("imitation_stopped", actor.id) if e.data["reason"] != "completed"
+    ]
     out["behaviours"] = [_behaviour(e.data["behaviour"], e.time) for e in world.events_of("behaviour_identified", actor.id)]
     return out
 
@@ -171,12 +184,32 @@ def render_text(summary: dict[str, Any]) -> str:
             lines.append(f"  segmented: {len(w['segments'])} segment(s) {segs}")
         if "matcher" not in c:
             lines.append("  recognised: no matcher in this character")
+        elif any("candidates" in r or "learned" in r for r in w["recognised"]):
+            lines.append("  recognised, one line per demonstration:")
+            for r in w["recognised"]:
+                text = f"    at {r['time']:.2f}s {r['movement'] or 'unknown'}"
+                if "candidates" in r:
+                    text += f"; candidates {', '.join(x.split(':')[-1] for x in r['candidates']) or 'none'}"
+                if r["early"] and r["fraction"] is not None:
+                    text += f"; committed after {100 * r['fraction']:.0f}% of the demonstration"
+                if r.get("learned"):
+                    text += f"; learned {', '.join(x.split(':')[-1] for x in r['learned'])}"
+                    text += " (after a deviation)" if r.get("deviated") else ""
+                if r.get("speed") and abs(r["speed"] - 1) > 0.3:
+                    text += f"; {r['speed']:.1f}x his own speed"
+                lines.append(text)
+            for s_ in w["imitations_stopped"]:
+                lines.append(f"    at {s_['time']:.2f}s stopped imitating {s_['movement']}: {s_['reason']}")
         else:
             recs = ", ".join(
                 (r["movement"] or "unknown") + f" ({r['confidence']:.2f}" + (f", committed {r['decided_at']} frames in" if r["early"] else "") + ")"
                 for r in w["recognised"]
             )
             lines.append(f"  recognised: {recs or 'nothing'}")
+        for name, g in c.get("motor", {}).get("subsystems", {}).items():
+            if g["edges"]:
+                lines.append(f"  motor command graph {name}: {g['nodes']} nodes, {g['edges']} edges, active {g['active']}: "
+                             + "; ".join(g["commands"]))
         for b in w["behaviours"]:
             lines.append(f"  at {b['time']:.2f}s: " + behaviour_sentence(c["name"], w["target"], b))
     return "\n".join(lines)
