@@ -309,9 +309,226 @@ def likeme_register_commands(subparsers):
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(handler=cmd_watch)
 
+    p = sub.add_parser("facilitation", help="Max learns Moritz's arm movements and imitates familiar ones early (K&G §4-5)")
+    p.add_argument("--demonstrations", type=int, default=200, help="demonstrations after the repertoire (default: 200)")
+    p.add_argument("--repertoire", type=int, default=6, help="random movements learned first (default: 6)")
+    p.add_argument("--noise", type=float, default=0.002, help="observation noise, metres (default: 0.002)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--json", metavar="FILE", help="also write the results as JSON")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(handler=cmd_facilitation)
+
     p = sub.add_parser("behaviour", help="an observer identifies the behaviour, motivation and object of a demonstrator (B&B §6)")
     p.add_argument("--episodes", type=int, default=100, help="random episodes per condition (default: 100)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--json", metavar="FILE", help="also write the results (every episode) as JSON")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(handler=cmd_behaviour)
+
+
+# -- Max and Moritz (Kopp & Graeser 2006) -----------------------------------------------------------------
+
+
+class _Replay:
+    """A demonstrator's motor system that plays given motions (random guiding-stroke movements)."""
+
+    def __init__(self, rest: np.ndarray, parts: tuple[str, ...]) -> None:
+        self.name = "replay"
+        self.rest = rest
+        self.parts = parts
+        self.motions: dict[str, Any] = {}
+
+    def movements(self) -> list[str]:
+        return list(self.motions)
+
+    def rest_pose(self) -> np.ndarray:
+        return self.rest
+
+    def perform(self, movement: str, *, speed: float = 1.0, fps: float = 30.0) -> Any:
+        return self.motions[movement]
+
+
+def _random_arm_movement(rng: np.random.Generator, rest: np.ndarray, body: Any, fps: float, *, speed: float = 1.0,
+                         strokes_out: list | None = None) -> tuple[Any, list]:
+    """Out (one or two guiding strokes of the left wrist), hold, back to rest; elbows by IK. Returns (motion, strokes)."""
+    from plugins.guiding_stroke import SHAPES, GuidingStroke
+    from plugins.motor_command_graph import place_elbows
+    from toolkit import Motion
+
+    w, e, s = body.index("left_wrist"), body.index("left_elbow"), body.index("left_shoulder")
+    if strokes_out is None:
+        strokes_out, p = [], rest[w].copy()
+        count = int(rng.integers(1, 3))
+        for k in range(count):
+            target = rest[s] + rng.uniform([-0.05, -0.25, 0.15], [0.35, 0.1, 0.45])
+            shape = SHAPES[int(rng.integers(0, 5))]
+            flow = 0.4 if k < count - 1 else 0.0  # strokes of one movement flow into each other (K&G §3)
+            strokes_out.append(GuidingStroke(p, target, rng.uniform(0.5, 0.9), rng.uniform(0.4, 0.6), flow, shape,
+                                             rng.normal(size=3), 0.0 if shape == "linear" else rng.uniform(0.2, 0.6)))
+            p = target
+    back = GuidingStroke(strokes_out[-1].target, rest[w], 0.8)
+    path = [st.retimed(st.duration / speed).trajectory(fps)[:-1] for st in strokes_out]
+    hold = np.repeat(strokes_out[-1].target[None], int(0.6 * fps), axis=0)
+    wrist = np.concatenate([*path, hold, back.trajectory(fps)])
+    frames = np.repeat(rest[None], len(wrist), axis=0)
+    frames[:, w] = wrist
+    upper = float(np.linalg.norm(rest[e] - rest[s]))
+    fore = float(np.linalg.norm(rest[w] - rest[e]))
+    frames[:, e] = place_elbows(frames[:, s], wrist, upper, fore, np.array([1.0, 0.0, 0.0]))
+    return Motion(frames, fps, body.parts), strokes_out
+
+
+def _shape_error(a: np.ndarray, b: np.ndarray, n: int = 50) -> float:
+    """Mean distance (m) between two paths resampled at ``n`` points equally spaced along each."""
+    def resample(p: np.ndarray) -> np.ndarray:
+        arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
+        u = np.linspace(0.0, arc[-1], n)
+        return np.stack([np.interp(u, arc, p[:, d]) for d in range(3)], axis=1)
+
+    return float(np.linalg.norm(resample(a) - resample(b), axis=1).mean())
+
+
+def facilitation_benchmark(pm: Any, *, demonstrations: int = 200, repertoire: int = 6, seed: int = 0, noise: float = 0.002,
+                           novel: float = 0.3, progress: bool = False) -> dict[str, Any]:
+    """Max learns ``repertoire`` random arm movements by watching, then watches ``demonstrations`` more (known ones,
+    some at other speeds, and novel ones) with observation noise; see ``docs/benchmarks.md``."""
+    rng = np.random.default_rng(seed)
+    moritz = load_character("moritz", pm, override={"action": {"plugin": "script", "movements": []}})
+    learner = load_character("max_learner", pm)
+    world = World(fps=30.0, pm=pm)
+    demo = world.add_actor(moritz, "moritz", (0.0, 0.0, 2.0), np.pi)
+    watcher = world.add_actor(learner, "max", (0.0, 0.0, 0.0), 0.0)
+    replay = _Replay(moritz.motor.rest_pose(), moritz.body.parts)
+    moritz.motor = replay  # type: ignore[assignment]
+    moritz.action = None
+    watcher.watch(demo)
+    fps = world.fps
+    known: list[tuple[str, list]] = []
+
+    def show(name: str, motion: Any) -> list[list[Any]]:
+        """Demonstrate one movement; returns, per segment Max found, the recognitions that belong to it (in order)."""
+        from toolkit import Motion, MovementRequest
+
+        noisy = motion.positions + rng.normal(0.0, noise, motion.positions.shape) if noise else motion.positions
+        replay.motions[name] = Motion(noisy, fps, motion.parts)
+        first = len(world.events)
+        demo.request(MovementRequest(name))
+        limit = world.frame + int(60 * fps)
+        while (not demo.idle or not watcher.idle) and world.frame < limit:
+            world.step()
+        for _ in range(int(0.6 * fps)):
+            world.step()
+        # a recognition made at a segment's end carries its segment; an early one belongs to the next segment found
+        mine = [e for e in world.events[first:] if e.actor == "max"]
+        segments = [e.data["segment"] for e in mine if e.kind == "segment_found"]
+        groups: list[list[Any]] = [[] for _ in segments]
+        for k, e in enumerate(mine):
+            if e.kind != "movement_recognised":
+                continue
+            seg = e.data["segment"]
+            if seg is None:
+                seg = next((x.data["segment"] for x in mine[k:] if x.kind == "segment_found"), None)
+            if seg in segments:
+                groups[segments.index(seg)].append(e)
+        return groups
+
+    for i in range(repertoire):
+        motion, strokes = _random_arm_movement(rng, replay.rest, moritz.body, fps)
+        groups = show(f"teach-{i}", motion)
+        final = groups[0][-1].data["match"] if groups else None
+        if final is not None and final.path:
+            known.append((final.path[0], strokes))
+    rows = []
+    jobs = range(demonstrations)
+    if progress:
+        from rich.progress import track
+
+        jobs = track(jobs, description="demonstrations", transient=True)
+    started = time.perf_counter()
+    frames_before = world.frame
+    for i in jobs:
+        is_novel = bool(rng.random() < novel)
+        speed = float(rng.choice([1.0, 1.0, rng.uniform(0.6, 1.6)]))
+        if is_novel:
+            motion, strokes = _random_arm_movement(rng, replay.rest, moritz.body, fps, speed=speed)
+            truth = None
+        else:
+            truth, strokes = known[int(rng.integers(len(known)))]
+            motion, _ = _random_arm_movement(rng, replay.rest, moritz.body, fps, speed=speed, strokes_out=strokes)
+        edges_before = learner.motor.graphs["left_wrist"].number_of_edges()
+        segments_before = len(world.events_of("segment_found", "max"))
+        groups = show(f"demo-{i}", motion)
+        segs = world.events_of("segment_found", "max")[segments_before:]
+        out = groups[0] if groups else []
+        early = next((e.data["match"] for e in out if e.data["segment"] is None), None)
+        final = out[-1].data["match"] if out else None
+        answer = final.path[0] if final is not None and final.path else (final.movement if final else None)
+        seg = segs[0].data["segment"] if segs else None
+        learned_out = bool(final is not None and final.details.get("learned"))
+        imitation_error = None
+        if final is not None and final.path:
+            executed = np.concatenate([st.trajectory(fps) for e in final.path for st in learner.motor.edge(e)[3]["strokes"]])
+            shown = np.concatenate([st.trajectory(fps) for st in strokes])
+            imitation_error = _shape_error(executed, shown)
+        rows.append({
+            "novel": is_novel,
+            "speed": speed,
+            "truth": truth,
+            "answer": answer,
+            "imitation_error": imitation_error,
+            "committed": early is not None,
+            "fraction": (early.decided_at / seg.n_frames) if early is not None and seg is not None and early.decided_at else None,
+            "correct": (not is_novel) and not learned_out and answer == truth,
+            "false_commit": early is not None and (is_novel or (early.path[0] if early.path else early.movement) != truth),
+            "edges_learned": learner.motor.graphs["left_wrist"].number_of_edges() - edges_before,
+            "strokes": len(strokes),
+        })
+    elapsed = time.perf_counter() - started
+    known_rows = [r for r in rows if not r["novel"]]
+    novel_rows = [r for r in rows if r["novel"]]
+    fractions = [r["fraction"] for r in known_rows if r["committed"] and r["correct"] and r["fraction"] is not None]
+    other_speed = [r for r in known_rows if abs(r["speed"] - 1.0) > 0.15]
+    return {
+        "benchmark": "facilitation", "seed": seed, "demonstrations": demonstrations, "repertoire": repertoire, "noise": noise,
+        "known": len(known_rows), "novel": len(novel_rows),
+        "recognition_accuracy": sum(r["correct"] for r in known_rows) / max(len(known_rows), 1),
+        "accuracy_other_speed": sum(r["correct"] for r in other_speed) / max(len(other_speed), 1),
+        "other_speed": len(other_speed),
+        "committed_share": sum(r["committed"] for r in known_rows) / max(len(known_rows), 1),
+        "decision_fraction_median": float(np.median(fractions)) if fractions else float("nan"),
+        "decision_fraction_p90": float(np.percentile(fractions, 90)) if fractions else float("nan"),
+        "false_commits": sum(r["false_commit"] for r in rows),
+        "edges_per_novel_movement": float(np.mean([r["edges_learned"] for r in novel_rows])) if novel_rows else float("nan"),
+        "strokes_per_novel_movement": float(np.mean([r["strokes"] for r in novel_rows])) if novel_rows else float("nan"),
+        "imitation_error_mean": float(np.mean([r["imitation_error"] for r in rows if r["imitation_error"] is not None])),
+        "imitation_error_p90": float(np.percentile([r["imitation_error"] for r in rows if r["imitation_error"] is not None], 90)),
+        "frames_per_second": (world.frame - frames_before) / elapsed if elapsed > 0 else float("inf"),
+        "rows": rows, "python": platform.python_version(), "numpy": np.__version__,
+    }
+
+
+def render_facilitation(r: dict[str, Any]) -> str:
+    rows = [
+        ("demonstrations (known / novel)", f"{r['known']} / {r['novel']}"),
+        ("recognition accuracy, known movements", f"{r['recognition_accuracy']:.3f}"),
+        (f"  of which at another speed ({r['other_speed']})", f"{r['accuracy_other_speed']:.3f}"),
+        ("committed before the end (known)", f"{r['committed_share']:.3f}"),
+        ("decision fraction, median / 90th percentile", f"{r['decision_fraction_median']:.2f} / {r['decision_fraction_p90']:.2f}"),
+        ("false commits", f"{r['false_commits']}"),
+        ("edges learned per novel movement (its strokes + the return)", f"{r['edges_per_novel_movement']:.2f} ({r['strokes_per_novel_movement'] + 1:.2f})"),
+        ("imitation path error, mean / 90th percentile (m)", f"{r['imitation_error_mean']:.3f} / {r['imitation_error_p90']:.3f}"),
+        ("frames per second (world)", f"{r['frames_per_second']:.0f}"),
+    ]
+    width = max(len(a) for a, _ in rows)
+    head = (f"likeme bench facilitation: Max watches Moritz (seed {r['seed']}, {r['repertoire']} movements learned first, "
+            f"noise {r['noise']} m)")
+    return "\n".join([head] + [f"  {a:<{width}}  {b}" for a, b in rows])
+
+
+def cmd_facilitation(args: argparse.Namespace, pm: Any) -> int:
+    result = facilitation_benchmark(pm, demonstrations=args.demonstrations, repertoire=args.repertoire, seed=args.seed,
+                                    noise=args.noise, progress=not args.quiet)
+    print(render_facilitation(result))
+    if args.json:
+        _write_json(Path(args.json), result)
+    return 0

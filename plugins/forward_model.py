@@ -30,6 +30,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from scipy.ndimage import uniform_filter1d
 
 from plugins.inverse_model import stroke_from_segment
 from plugins.velocity_direction import VelocityDirection
@@ -43,16 +44,27 @@ def _arc(points: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
 
 
+def _observed_length(points: np.ndarray) -> float:
+    """Path length of an observed trajectory (N, 3), robust to observation noise.
+
+    Noise adds length at every frame; the positions are averaged over three frames first.
+    """
+    if len(points) < 3:
+        return float(_arc(points)[-1])
+    return float(_arc(uniform_filter1d(points, size=3, axis=0, mode="nearest"))[-1])
+
+
 class ForwardModel(Matcher):
     """Edges of the active node predict the demonstration in parallel; the last one left is imitated at once (K&G §4.4)."""
 
     name = "forward-model"
     parameters = (
         Parameter("threshold", float, 0.05, "Prediction error (m) above which a candidate edge drops out.", minimum=0.0),
-        Parameter("deviation", float, 0.08, "Error (m) between the imitated edge and the demonstration that stops the "
-                  "imitation.", minimum=0.0),
+        Parameter("deviation", float, 0.05, "Error (m) between the imitated edge and the demonstration that stops the "
+                  "imitation (also checked at the end: the demonstration must end where the edge does).", minimum=0.0),
         Parameter("min_progress", float, 0.2, "Share of the edge's path that must be seen before committing.", minimum=0.0, maximum=1.0),
         Parameter("min_move", float, 0.02, "Displacement (m) of a subsystem that makes it the one under consideration.", minimum=0.0),
+        Parameter("max_candidates", int, 24, "Most candidate command paths followed at once (the best predictions).", minimum=1),
         Parameter("learn", bool, True, "Learn new edges by the inverse model when no edge predicts the demonstration."),
         Parameter("drop", float, 0.5, "Speed-minimum criterion of the stroke segmentation used for learning.", minimum=0.0, maximum=1.0),
         Parameter("angle", float, 50.0, "Direction criterion (degrees) of the stroke segmentation used for learning.", minimum=1.0, maximum=180.0),
@@ -66,7 +78,8 @@ class ForwardModel(Matcher):
                               expected='[motor] plugin = "motor-command-graph"')
         self.motor = motor
         self._root_height = motor.rest_pose()[owner.body.root_index]
-        self._strokes = VelocityDirection(drop=self.params["drop"], angle=self.params["angle"], smooth=0.0)
+        self._strokes = VelocityDirection(drop=self.params["drop"], angle=self.params["angle"])
+        self._tables: dict[int, tuple] = {}
 
     # -- streaming ------------------------------------------------------------------------------
 
@@ -105,6 +118,8 @@ class ForwardModel(Matcher):
             error = self._error(path, observed)
             if error <= self.params["threshold"]:
                 alive[path] = error
+        if len(alive) > self.params["max_candidates"]:  # keep the best predictions
+            alive = dict(sorted(alive.items(), key=lambda kv: kv[1])[: self.params["max_candidates"]])
         self.candidates = alive
         if len({p[0] for p in alive}) == 1 and alive:  # one first command prevails
             path = min(alive, key=alive.get)
@@ -136,12 +151,22 @@ class ForwardModel(Matcher):
     def _strokes_of(self, name: str) -> list[Any]:
         return self.motor.edge(name)[3]["strokes"]
 
+    def _table(self, stroke: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(times, positions, cumulative path length) of a stroke on a fine grid, computed once per stroke."""
+        table = self._tables.get(id(stroke))
+        if table is None or table[0] is not stroke:
+            grid = np.linspace(0.0, stroke.duration, 200)
+            positions = stroke.position(grid)
+            table = (stroke, grid, positions, _arc(positions))
+            self._tables[id(stroke)] = table
+        return table[1], table[2], table[3]
+
     def _extended(self, paths: list[tuple[str, ...]], observed: np.ndarray) -> list[tuple[str, ...]]:
         """Paths whose commands have all been covered by the observation continue along every edge of their end node."""
         out = []
-        seen = _arc(observed[:, 0])[-1]
+        seen = _observed_length(observed[:, 0])
         for path in paths:
-            total = sum(_arc(self._strokes_of(e)[0].trajectory(60.0))[-1] for e in path)
+            total = sum(self._table(self._strokes_of(e)[0])[2][-1] for e in path)
             end = self.motor.edge(path[-1])[2]
             nxt = [name for name, _ in self.motor.edges_from(self.subsystem, end)] if seen > total + 0.01 else []
             out.extend([(*path, n) for n in nxt if n not in path] or [path])
@@ -156,22 +181,22 @@ class ForwardModel(Matcher):
 
     def _mapped_time(self, stroke: Any, length: float) -> float:
         """The stroke time at which it has covered ``length`` metres of path (the speed-free forward model)."""
-        grid = np.linspace(0.0, stroke.duration, 200)
-        arc = _arc(stroke.position(grid))
+        grid, _, arc = self._table(stroke)
         return float(np.interp(min(length, arc[-1]), arc, grid))
 
     def _predict(self, path: tuple[str, ...], observed: np.ndarray) -> np.ndarray:
         """Where each part of the subsystem should be after as much path as has been observed."""
         out = []
         for j in range(observed.shape[1]):
-            left = _arc(observed[:, j])[-1]
+            left = _observed_length(observed[:, j])
             strokes = [self._strokes_of(e)[j] for e in path]
             for i, stroke in enumerate(strokes):
-                length = _arc(stroke.position(np.linspace(0.0, stroke.duration, 200)))[-1]
-                if left <= length or i == len(strokes) - 1:
-                    out.append(stroke.position(self._mapped_time(stroke, left)))
+                _, positions, arc = self._table(stroke)
+                if left <= arc[-1] or i == len(strokes) - 1:
+                    x = min(left, arc[-1])
+                    out.append([np.interp(x, arc, positions[:, d]) for d in range(3)])
                     break
-                left -= length
+                left -= arc[-1]
         return np.array(out)
 
     def _error(self, path: tuple[str, ...] | str, observed: np.ndarray) -> float:
@@ -180,13 +205,13 @@ class ForwardModel(Matcher):
 
     def _progress(self, name: str, observed: np.ndarray) -> float:
         stroke = self._strokes_of(name)[0]
-        return self._mapped_time(stroke, _arc(observed[:, 0])[-1]) / stroke.duration
+        return self._mapped_time(stroke, _observed_length(observed[:, 0])) / stroke.duration
 
     def _speed(self, name: str, observed: np.ndarray) -> float:
         """How much faster than the command the demonstration goes (1: same speed)."""
         stroke = self._strokes_of(name)[0]
         elapsed = (len(observed) - 1) / self.fps
-        return float(np.clip(self._mapped_time(stroke, _arc(observed[:, 0])[-1]) / max(elapsed, 1e-6), 0.25, 4.0))
+        return float(np.clip(self._mapped_time(stroke, _observed_length(observed[:, 0])) / max(elapsed, 1e-6), 0.25, 4.0))
 
     # -- the end of the demonstration ------------------------------------------------------------
 
@@ -198,8 +223,13 @@ class ForwardModel(Matcher):
         if self.subsystem is None:
             return Match.unknown(reason="nothing moved")
         if self.committed is not None and not self.deviated:
-            self.motor.active[self.subsystem] = self.motor.edge(self.committed_path[-1])[2]
-            return None  # already reported when it committed
+            end = self.motor.edge(self.committed_path[-1])[2]
+            state = self.motor.graphs[self.subsystem].nodes[end]["state"]
+            observed_end = np.array(self.frames)[-1, self.motor.subsystems[self.subsystem]]
+            if np.linalg.norm(observed_end - state, axis=-1).max() <= self.params["deviation"]:
+                self.motor.active[self.subsystem] = end
+                return None  # already reported when it committed
+            self.deviated = True  # it ended somewhere else: the committed command was not the right one
         start = self.start_node
         if self.deviated:
             self.motor.reset_to(self.subsystem, start)  # back to the last correct node

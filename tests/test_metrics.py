@@ -61,3 +61,12 @@ def test_bench_watch_runs_and_writes_json(tmp_path):
     assert data["movements"] == 12
     assert data["segmentation"]["f1"] >= 0.8 and data["recognition_accuracy"] >= 0.8
     assert data["frames_per_second"] > 0
+
+
+def test_bench_facilitation_runs(tmp_path):
+    out = tmp_path / "f.json"
+    result = likeme("bench", "facilitation", "--demonstrations", "12", "--repertoire", "3", "--quiet", "--json", out)
+    assert result.returncode == 0, result.stderr
+    data = json.loads(out.read_text())
+    assert data["known"] + data["novel"] == 12
+    assert data["recognition_accuracy"] >= 0.5 and data["imitation_error_mean"] < 0.05
