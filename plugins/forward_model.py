@@ -151,6 +151,10 @@ class ForwardModel(Matcher):
     def _strokes_of(self, name: str) -> list[Any]:
         return self.motor.edge(name)[3]["strokes"]
 
+    def _lead(self, name: str) -> int:
+        """The part of the subsystem that moves farthest along a command: progress and speed are measured on it."""
+        return int(np.argmax([self._table(st)[2][-1] for st in self._strokes_of(name)]))
+
     def _table(self, stroke: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(times, positions, cumulative path length) of a stroke on a fine grid, computed once per stroke."""
         table = self._tables.get(id(stroke))
@@ -164,9 +168,10 @@ class ForwardModel(Matcher):
     def _extended(self, paths: list[tuple[str, ...]], observed: np.ndarray) -> list[tuple[str, ...]]:
         """Paths whose commands have all been covered by the observation continue along every edge of their end node."""
         out = []
-        seen = _observed_length(observed[:, 0])
         for path in paths:
-            total = sum(self._table(self._strokes_of(e)[0])[2][-1] for e in path)
+            lead = self._lead(path[0])
+            seen = _observed_length(observed[:, lead])
+            total = sum(self._table(self._strokes_of(e)[lead])[2][-1] for e in path)
             end = self.motor.edge(path[-1])[2]
             nxt = [name for name, _ in self.motor.edges_from(self.subsystem, end)] if seen > total + 0.01 else []
             out.extend([(*path, n) for n in nxt if n not in path] or [path])
@@ -204,14 +209,16 @@ class ForwardModel(Matcher):
         return float(np.linalg.norm(self._predict(path, observed) - observed[-1], axis=-1).max())
 
     def _progress(self, name: str, observed: np.ndarray) -> float:
-        stroke = self._strokes_of(name)[0]
-        return self._mapped_time(stroke, _observed_length(observed[:, 0])) / stroke.duration
+        lead = self._lead(name)
+        stroke = self._strokes_of(name)[lead]
+        return self._mapped_time(stroke, _observed_length(observed[:, lead])) / stroke.duration
 
     def _speed(self, name: str, observed: np.ndarray) -> float:
         """How much faster than the command the demonstration goes (1: same speed)."""
-        stroke = self._strokes_of(name)[0]
+        lead = self._lead(name)
+        stroke = self._strokes_of(name)[lead]
         elapsed = (len(observed) - 1) / self.fps
-        return float(np.clip(self._mapped_time(stroke, _observed_length(observed[:, 0])) / max(elapsed, 1e-6), 0.25, 4.0))
+        return float(np.clip(self._mapped_time(stroke, _observed_length(observed[:, lead])) / max(elapsed, 1e-6), 0.25, 4.0))
 
     # -- the end of the demonstration ------------------------------------------------------------
 
