@@ -107,22 +107,30 @@ class SyntheticVision(Perception):
 
     def visible_parts(self, observer: Any, target: Any, world: Any) -> tuple[np.ndarray, np.ndarray]:
         """World positions of the target's parts and which of them the eye sees (before noise and dropouts)."""
+        positions, seen, _ = self._look(observer, target, world)
+        return positions, seen
+
+    def _look(self, observer: Any, target: Any, world: Any) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
+        """The target's part positions, which parts the eye sees, and the objects it sees (name to position)."""
         positions = target.world_pose()
         eye = observer.world_pose()[observer.body.index(self.params["eye"])]
         seen = self._in_view(eye, observer.heading, positions)
-        if self.params["occlusion"] and seen.any():
+        names = list(world.objects)
+        centres = np.array([world.objects[n].position for n in names]).reshape(-1, 3)
+        sizes = np.array([world.objects[n].radius for n in names])
+        objects_seen = self._in_view(eye, observer.heading, centres) if names else np.zeros(0, dtype=bool)
+        if self.params["occlusion"]:
             radii = self._radii(target.body)
-            centres, sphere_r = [positions], [radii]
-            for obj in world.objects.values():
-                if obj.held_by == observer.id:
-                    continue
-                centres.append(obj.position[None])
-                sphere_r.append(np.array([obj.radius]))
-            centres_a, radii_a = np.concatenate(centres), np.concatenate(sphere_r)
-            same = np.zeros((len(positions), len(centres_a)), dtype=bool)
-            same[np.arange(len(positions)), np.arange(len(positions))] = True
-            seen &= ~line_of_sight_blocked(eye, positions, radii, centres_a, radii_a, same=same)
-        return positions, seen
+            if seen.any():
+                others = np.array([world.objects[n].held_by != observer.id for n in names], dtype=bool)
+                all_centres = np.concatenate([positions, centres[others]])
+                all_radii = np.concatenate([radii, sizes[others]])
+                same = np.zeros((len(positions), len(all_centres)), dtype=bool)
+                same[np.arange(len(positions)), np.arange(len(positions))] = True
+                seen &= ~line_of_sight_blocked(eye, positions, radii, all_centres, all_radii, same=same)
+            if objects_seen.any():  # objects hidden behind the target's body
+                objects_seen &= ~line_of_sight_blocked(eye, centres, sizes, positions, radii)
+        return positions, seen, {n: centres[i].copy() for i, n in enumerate(names) if objects_seen[i]}
 
     def _in_view(self, eye: np.ndarray, heading: float, points: np.ndarray) -> np.ndarray:
         ray = points - eye
@@ -134,7 +142,7 @@ class SyntheticVision(Perception):
         return inside & (dist <= self.params["range"]) & np.isfinite(points).all(axis=-1)
 
     def perceive(self, observer: Any, target: Any, world: Any) -> Percept:
-        positions, seen = self.visible_parts(observer, target, world)
+        positions, seen, objects = self._look(observer, target, world)
         p = self.params
         if p["noise"] > 0:
             positions = positions + self._rng.normal(0.0, p["noise"], positions.shape)
@@ -147,16 +155,6 @@ class SyntheticVision(Perception):
             self._facing = HeadingFilter(round(p["facing_window"] * world.fps))
         found = facing_heading(np.where(seen[:, None], positions, 0.0), seen, target.body)
         pose, mask, root, heading = to_root_relative(positions, seen, target.body, self._facing.update(float(found)))
-        eye = observer.world_pose()[observer.body.index(p["eye"])]
-        objects = {}
-        for name, obj in world.objects.items():
-            if not self._in_view(eye, observer.heading, obj.position[None])[0]:
-                continue
-            if self.params["occlusion"]:
-                radii = self._radii(target.body)
-                if line_of_sight_blocked(eye, obj.position[None], np.array([obj.radius]), target.world_pose(), radii)[0]:
-                    continue
-            objects[name] = obj.position.copy()
         return Percept(world.time, pose, mask, np.where(seen[:, None], positions, np.nan), root, float(heading), objects)
 
 
