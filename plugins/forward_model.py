@@ -107,15 +107,17 @@ class ForwardModel(Matcher):
         if self.subsystem is None and not self._choose_subsystem():
             return None
         observed = np.array(self.frames)[:, self.motor.subsystems[self.subsystem]]  # (n, k, 3)
+        lengths = np.array([_observed_length(observed[:, j]) for j in range(observed.shape[1])])  # once per frame
+        last = observed[-1]
         if self.committed is not None:
-            if not self.deviated and self._error(self.committed_path, observed) > self.params["deviation"]:
+            if not self.deviated and self._error(self.committed_path, lengths, last) > self.params["deviation"]:
                 self.deviated = True
                 self.excluded.add(self.committed_path[0])
                 return Match(self.committed, 0.0, len(self.frames), details={"stop": True, "reason": "deviation"})
             return None
         alive: dict[tuple[str, ...], float] = {}
-        for path in self._extended(list(self.candidates), observed):
-            error = self._error(path, observed)
+        for path in self._extended(list(self.candidates), lengths):
+            error = self._error(path, lengths, last)
             if error <= self.params["threshold"]:
                 alive[path] = error
         if len(alive) > self.params["max_candidates"]:  # keep the best predictions
@@ -123,11 +125,11 @@ class ForwardModel(Matcher):
         self.candidates = alive
         if len({p[0] for p in alive}) == 1 and alive:  # one first command prevails
             path = min(alive, key=alive.get)
-            progress = self._progress(path[0], observed)
+            progress = self._progress(path[0], lengths)
             if progress >= self.params["min_progress"] or len(path) > 1:
                 self.committed_path = self._known_continuation(path)
                 self.committed = self.motor.add_sequence(list(self.committed_path))
-                speed = self._speed(path[0], observed)
+                speed = self._speed(path[0], lengths, len(observed))
                 return Match(self.committed, float(np.exp(-alive[path] / self.params["threshold"])), len(self.frames),
                              path=self.committed_path,
                              details={"candidates": list(self.initial), "speed": speed, "progress": progress})
@@ -165,12 +167,15 @@ class ForwardModel(Matcher):
             self._tables[id(stroke)] = table
         return table[1], table[2], table[3]
 
-    def _extended(self, paths: list[tuple[str, ...]], observed: np.ndarray) -> list[tuple[str, ...]]:
-        """Paths whose commands have all been covered by the observation continue along every edge of their end node."""
+    def _extended(self, paths: list[tuple[str, ...]], lengths: np.ndarray) -> list[tuple[str, ...]]:
+        """Paths whose commands have all been covered by the observation continue along every edge of their end node.
+
+        ``lengths`` holds the observed path length of each part of the subsystem.
+        """
         out = []
         for path in paths:
             lead = self._lead(path[0])
-            seen = _observed_length(observed[:, lead])
+            seen = lengths[lead]
             total = sum(self._table(self._strokes_of(e)[lead])[2][-1] for e in path)
             end = self.motor.edge(path[-1])[2]
             nxt = [name for name, _ in self.motor.edges_from(self.subsystem, end)] if seen > total + 0.01 else []
@@ -189,11 +194,10 @@ class ForwardModel(Matcher):
         grid, _, arc = self._table(stroke)
         return float(np.interp(min(length, arc[-1]), arc, grid))
 
-    def _predict(self, path: tuple[str, ...], observed: np.ndarray) -> np.ndarray:
-        """Where each part of the subsystem should be after as much path as has been observed."""
+    def _predict(self, path: tuple[str, ...], lengths: np.ndarray) -> np.ndarray:
+        """Where each part of the subsystem should be after as much path as it has been observed to cover."""
         out = []
-        for j in range(observed.shape[1]):
-            left = _observed_length(observed[:, j])
+        for j, left in enumerate(lengths):
             strokes = [self._strokes_of(e)[j] for e in path]
             for i, stroke in enumerate(strokes):
                 _, positions, arc = self._table(stroke)
@@ -204,21 +208,21 @@ class ForwardModel(Matcher):
                 left -= arc[-1]
         return np.array(out)
 
-    def _error(self, path: tuple[str, ...] | str, observed: np.ndarray) -> float:
-        path = (path,) if isinstance(path, str) else path
-        return float(np.linalg.norm(self._predict(path, observed) - observed[-1], axis=-1).max())
+    def _error(self, path: tuple[str, ...], lengths: np.ndarray, last: np.ndarray) -> float:
+        """Largest distance between the path's prediction and the parts' last observed positions ``last`` (k, 3)."""
+        return float(np.linalg.norm(self._predict(path, lengths) - last, axis=-1).max())
 
-    def _progress(self, name: str, observed: np.ndarray) -> float:
+    def _progress(self, name: str, lengths: np.ndarray) -> float:
         lead = self._lead(name)
         stroke = self._strokes_of(name)[lead]
-        return self._mapped_time(stroke, _observed_length(observed[:, lead])) / stroke.duration
+        return self._mapped_time(stroke, lengths[lead]) / stroke.duration
 
-    def _speed(self, name: str, observed: np.ndarray) -> float:
+    def _speed(self, name: str, lengths: np.ndarray, n_frames: int) -> float:
         """How much faster than the command the demonstration goes (1: same speed)."""
         lead = self._lead(name)
         stroke = self._strokes_of(name)[lead]
-        elapsed = (len(observed) - 1) / self.fps
-        return float(np.clip(self._mapped_time(stroke, _observed_length(observed[:, lead])) / max(elapsed, 1e-6), 0.25, 4.0))
+        elapsed = (n_frames - 1) / self.fps
+        return float(np.clip(self._mapped_time(stroke, lengths[lead]) / max(elapsed, 1e-6), 0.25, 4.0))
 
     # -- the end of the demonstration ------------------------------------------------------------
 
