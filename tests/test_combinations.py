@@ -18,32 +18,13 @@ PAIRINGS = {
 
 
 @pytest.mark.parametrize("pairing", list(PAIRINGS), ids=lambda p: " x ".join(p))
-def test_every_pairing_runs_on_the_same_input(write, pairing):
+def test_every_pairing_runs_on_the_same_input(watch_scene, pairing):
     character, override = PAIRINGS[pairing]
-    tables = "".join(
-        f"[actors.override.{table}]\n" + "".join(f"{k} = {v!r}\n".replace("'", '"') for k, v in values.items())
+    tables = '[actors.override.perception]\nplugin = "motion-capture"\n' + "".join(
+        f"[actors.override.{table}]\n" + "".join(f'{k} = "{v}"\n' for k, v in values.items())
         for table, values in override.items()
     )
-    scene = write(
-        "pair.toml",
-        f"""
-        [scenario]
-        name = "pairing"
-        [[actors]]
-        character = "{CHARACTERS / 'morris.toml'}"
-        position = [0.0, 0.0, 1.6]
-        heading = 180.0
-        [actors.override.action]
-        plugin = "script"
-        movements = {MOVES!r}
-        [[actors]]
-        id = "max"
-        character = "{CHARACTERS / character}"
-        watch = "morris"
-        [actors.override.perception]
-        plugin = "motion-capture"
-        """.replace("'", '"') + tables,
-    )
+    scene = watch_scene(MOVES, tables, watcher=CHARACTERS / character)
     world = load_scenario(scene, create_plugin_manager(autoload=False)).run()
     max_ = world.actors["max"].character
     assert (max_.segmenter.name, max_.matcher.name) == pairing
