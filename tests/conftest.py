@@ -11,6 +11,8 @@ from toolkit import create_plugin_manager
 
 ROOT = Path(__file__).resolve().parent.parent
 CHARACTERS = ROOT / "characters"
+BANDAI = ROOT.parent / "shared" / "data" / "bandai-namco-1"
+"""Real motion capture (CC BY-NC, never copied into the repository); tests that read it skip where it is absent."""
 
 STICK = """
 [character]
@@ -44,6 +46,14 @@ keys = [{ pose = "stand", at = 0.0 }, { pose = "bob", at = 0.5 }, { pose = "stan
 def pm():
     """A fresh plugin manager with the built-in plugins only (third-party entry points are not loaded)."""
     return create_plugin_manager(autoload=False, trace=False)
+
+
+@pytest.fixture
+def max_character(pm):
+    """Max the mouse, composed from ``characters/max.toml``."""
+    from toolkit import load_character
+
+    return load_character(CHARACTERS / "max.toml", pm)
 
 
 @pytest.fixture
