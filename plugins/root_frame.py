@@ -36,6 +36,8 @@ def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body) -> np.nda
     when visible, picks the side of that line it lies on, as seen from the root
     (or from the middle of the knees when the root is hidden). With a knee hidden,
     the horizontal direction from the root to the forward marker is used.
+    ``body.facing.behind``, when given, replaces the root as the point the
+    forward marker is seen from (the toes seen from the ankle).
     """
     world = np.asarray(world, dtype=float)
     visible = np.asarray(visible, dtype=bool)
@@ -51,12 +53,16 @@ def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body) -> np.nda
         # body has its knees in front of its nose), else from the middle of the knees
         mid = 0.5 * (world[..., li, :] + world[..., ri, :])
         base = np.where(visible[..., root, None], world[..., root, :], mid)
+        bi = root
+        if body.facing.behind is not None:  # the forward marker is seen from its own behind part (toes from ankle)
+            bi = body.index(body.facing.behind)
+            base = np.where(visible[..., bi, None], world[..., bi, :], base)
         ahead = world[..., fi, :] - base
         side = np.sign(np.einsum("...i,...i->...", ahead, perp))
         perp = perp * np.where((side < 0) & visible[..., fi], -1.0, 1.0)[..., None]
-        fallback = world[..., fi, :] - world[..., root, :]
+        fallback = world[..., fi, :] - world[..., bi, :]
         fallback[..., 1] = 0.0
-        use_fb = ~knees & visible[..., fi] & visible[..., root]
+        use_fb = ~knees & visible[..., fi] & visible[..., bi]
         perp = np.where(use_fb[..., None], fallback, perp)
         knees = knees | use_fb
     norm = np.linalg.norm(perp, axis=-1)

@@ -33,12 +33,16 @@ class Facing:
 
     ``left`` and ``right`` define a line across the body (the knees); ``forward``,
     when given, is a part that is always somewhat in front of the body (the nose)
-    and resolves which side of that line is the front.
+    and resolves which side of that line is the front, as seen from ``behind`` (by
+    default the root). A motion-capture skeleton without a nose can use the toes
+    seen from the ankle: the foot always points forward, while the toes are
+    behind the hips half of every walking step.
     """
 
     left: str
     right: str
     forward: str | None = None
+    behind: str | None = None
 
 
 @dataclass(frozen=True)
@@ -79,6 +83,11 @@ class Body:
         self.index(self.facing.right, key=("facing", "right"))
         if self.facing.forward is not None:
             self.index(self.facing.forward, key=("facing", "forward"))
+        if self.facing.behind is not None:
+            self.index(self.facing.behind, key=("facing", "behind"))
+            if self.facing.forward is None:
+                raise ConfigError("behind without forward", key=("facing", "behind"),
+                                  expected="a forward part to be seen from the behind part")
         for i, (a, b) in enumerate(self.bones):
             self.index(a, key=("bones", i))
             self.index(b, key=("bones", i))
@@ -136,16 +145,18 @@ class Body:
                 "missing or invalid", key=("facing",), expected='a table {left = "...", right = "...", forward = "..."}'
             )
         for key in facing:
-            if key not in ("left", "right", "forward"):
+            if key not in ("left", "right", "forward", "behind"):
                 raise ConfigError(
-                    f"unknown key {key!r}", key=("facing", key), expected="a facing key", available=("forward", "left", "right")
+                    f"unknown key {key!r}", key=("facing", key), expected="a facing key",
+                    available=("behind", "forward", "left", "right")
                 )
         for key in ("left", "right"):
             if not isinstance(facing.get(key), str):
                 raise ConfigError("missing or invalid", key=("facing", key), expected="a part name", available=parts)
-        forward = facing.get("forward")
-        if forward is not None and not isinstance(forward, str):
-            raise ConfigError("invalid", key=("facing", "forward"), expected="a part name", available=parts)
+        forward, behind = facing.get("forward"), facing.get("behind")
+        for key, value in (("forward", forward), ("behind", behind)):
+            if value is not None and not isinstance(value, str):
+                raise ConfigError("invalid", key=("facing", key), expected="a part name", available=parts)
         bones = table.get("bones", [])
         if not isinstance(bones, list) or not all(
             isinstance(b, list) and len(b) == 2 and all(isinstance(p, str) for p in b) for b in bones
@@ -157,7 +168,7 @@ class Body:
         return cls(
             parts=tuple(parts),
             root=root,
-            facing=Facing(facing["left"], facing["right"], forward),
+            facing=Facing(facing["left"], facing["right"], forward, behind),
             bones=tuple((a, b) for a, b in bones),
             colours=dict(colours),
         )
