@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 from scipy.ndimage import uniform_filter1d
 
-from plugins.inverse_model import stroke_from_segment
+from plugins.inverse_model import learn_commands
 from plugins.velocity_direction import VelocityDirection
 from toolkit import ConfigError, Match, Matcher, Motion, Parameter, hookimpl
 
@@ -65,6 +65,11 @@ class ForwardModel(Matcher):
         Parameter("min_progress", float, 0.2, "Share of the edge's path that must be seen before committing.", minimum=0.0, maximum=1.0),
         Parameter("min_move", float, 0.02, "Displacement (m) of a subsystem that makes it the one under consideration.", minimum=0.0),
         Parameter("max_candidates", int, 24, "Most candidate command paths followed at once (the best predictions).", minimum=1),
+        Parameter("error", str, "max", "How the prediction errors of a subsystem's parts combine: the largest "
+                  "(a wrist subsystem, §4.4) or the mean (eq. 1 of B&B 2005, for whole-body subsystems).",
+                  choices=("max", "mean")),
+        Parameter("relative", bool, False, "Compare displacements since the onset instead of positions, so that a "
+                  "demonstrator whose posture differs from the observer's own (another style's stance) still fits."),
         Parameter("learn", bool, True, "Learn new edges by the inverse model when no edge predicts the demonstration."),
         Parameter("drop", float, 0.5, "Speed-minimum criterion of the stroke segmentation used for learning.", minimum=0.0, maximum=1.0),
         Parameter("angle", float, 50.0, "Direction criterion (degrees) of the stroke segmentation used for learning.", minimum=1.0, maximum=180.0),
@@ -123,14 +128,14 @@ class ForwardModel(Matcher):
         if len(alive) > self.params["max_candidates"]:  # keep the best predictions
             alive = dict(sorted(alive.items(), key=lambda kv: kv[1])[: self.params["max_candidates"]])
         self.candidates = alive
-        if len({p[0] for p in alive}) == 1 and alive:  # one first command prevails
+        if alive and len({self._movement_key(p) for p in alive}) == 1:  # one first command (or movement) prevails
             path = min(alive, key=alive.get)
             progress = self._progress(path[0], lengths)
             if progress >= self.params["min_progress"] or len(path) > 1:
                 self.committed_path = self._known_continuation(path)
                 self.committed = self.motor.add_sequence(list(self.committed_path))
                 speed = self._speed(path[0], lengths, len(observed))
-                return Match(self.committed, float(np.exp(-alive[path] / self.params["threshold"])), len(self.frames),
+                return Match(self.motor.label(self.committed), float(np.exp(-alive[path] / self.params["threshold"])), len(self.frames),
                              path=self.committed_path,
                              details={"candidates": list(self.initial), "speed": speed, "progress": progress})
         return None
@@ -182,6 +187,11 @@ class ForwardModel(Matcher):
             out.extend([(*path, n) for n in nxt if n not in path] or [path])
         return out
 
+    def _movement_key(self, path: tuple[str, ...]) -> str:
+        """What a candidate stands for: the labelled movement its sequences are examples of, else its first command."""
+        label = getattr(self.motor, "label_of_path", lambda p: None)(path)
+        return label if label is not None else path[0]
+
     def _known_continuation(self, path: tuple[str, ...]) -> tuple[str, ...]:
         """The whole learned command sequence that ``path`` begins, else ``path`` itself."""
         for edges in self.motor.sequences.values():
@@ -209,8 +219,17 @@ class ForwardModel(Matcher):
         return np.array(out)
 
     def _error(self, path: tuple[str, ...], lengths: np.ndarray, last: np.ndarray) -> float:
-        """Largest distance between the path's prediction and the parts' last observed positions ``last`` (k, 3)."""
-        return float(np.linalg.norm(self._predict(path, lengths) - last, axis=-1).max())
+        """Distance between the path's prediction and the parts' last observed positions ``last`` (k, 3).
+
+        The largest over the parts, or their mean (``error``); with ``relative`` the prediction is moved by
+        the offset between the observed onset posture and the path's start.
+        """
+        predicted = self._predict(path, lengths)
+        if self.params["relative"]:
+            start = np.array([self._table(st)[1][0] for st in self._strokes_of(path[0])])
+            predicted = predicted + (self.frames[0][self.motor.subsystems[self.subsystem]] - start)
+        d = np.linalg.norm(predicted - last, axis=-1)
+        return float(d.max() if self.params["error"] == "max" else d.mean())
 
     def _progress(self, name: str, lengths: np.ndarray) -> float:
         lead = self._lead(name)
@@ -236,8 +255,13 @@ class ForwardModel(Matcher):
         if self.committed is not None and not self.deviated:
             end = self.motor.edge(self.committed_path[-1])[2]
             state = self.motor.graphs[self.subsystem].nodes[end]["state"]
-            observed_end = np.array(self.frames)[-1, self.motor.subsystems[self.subsystem]]
-            if np.linalg.norm(observed_end - state, axis=-1).max() <= self.params["deviation"]:
+            idx = self.motor.subsystems[self.subsystem]
+            observed_end = np.array(self.frames)[-1, idx]
+            if self.params["relative"]:
+                start = np.array([self._table(st)[1][0] for st in self._strokes_of(self.committed_path[0])])
+                state = state + (self.frames[0][idx] - start)
+            d = np.linalg.norm(observed_end - state, axis=-1)
+            if (d.max() if self.params["error"] == "max" else d.mean()) <= self.params["deviation"]:
                 self.motor.active[self.subsystem] = end
                 return None  # already reported when it committed
             self.deviated = True  # it ended somewhere else: the committed command was not the right one
@@ -257,23 +281,9 @@ class ForwardModel(Matcher):
 
     def _learn(self, observed: np.ndarray, start: str) -> list[str]:
         """Cut the working memory into strokes and add one edge per stroke, chained from ``start``."""
-        n, k, _ = observed.shape
-        flat = observed.reshape(n, k * 3)
+        k = observed.shape[1]
         self._strokes.reset(tuple(f"p{i}" for i in range(k)), self.fps)
-        cuts = self._strokes.breaks(flat)
-        edges = [0, *cuts, n - 1]
-        names, node = [], start
-        hub_state = self.motor.graphs[self.subsystem].nodes["hub"]["state"]
-        for i, (a, b) in enumerate(zip(edges, edges[1:])):
-            if b - a < 2:
-                continue
-            strokes = [stroke_from_segment(observed[a : b + 1, j], self.fps) for j in range(k)]
-            last = i == len(edges) - 2
-            end = "hub" if last and np.linalg.norm(observed[-1] - hub_state, axis=-1).max() <= 0.05 else None
-            name = self.motor.learn(self.subsystem, node, strokes, end=end, source="inverse model")
-            names.append(name)
-            node = self.motor.edge(name)[2]
-        return names
+        return learn_commands(self.motor, self.subsystem, observed, self.fps, start, self._strokes.breaks)
 
     def match(self, motion: Motion) -> Match:
         """Batch use: the whole segment at once (no facilitation)."""

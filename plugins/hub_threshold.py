@@ -65,11 +65,13 @@ class HubThreshold(Segmenter):
                     f"unknown hub pose {self.params['hub']!r}", key=("hub",), expected="a pose of the observer's motor system",
                     available=list(poses.names) if poses is not None else [],
                 )
-            hub = poses[self.params["hub"]]
+            hubs = poses[self.params["hub"]][None]
         else:
-            hub = motor.rest_pose()
-        hub = np.asarray(hub, dtype=float)
-        self.template = hub - hub[owner.body.root_index]
+            hubs = motor.hub_poses()
+        hubs = np.asarray(hubs, dtype=float)
+        root = owner.body.root_index
+        self.templates = hubs - hubs[:, root : root + 1]  # every hub: the distance is to the nearest one
+        self.template = self.templates[0]
         self.template_parts = owner.body.parts
 
     # -- streaming ---------------------------------------------------------------------
@@ -107,7 +109,7 @@ class HubThreshold(Segmenter):
         vis = np.zeros(len(self.template), dtype=bool)
         obs[ok] = pose[self._index[ok]]
         vis[ok] = visible[self._index[ok]]
-        return float(pose_distance(obs, self.template, vis))
+        return float(_nearest(pose_distance(obs, self.templates, vis)))
 
     def push(self, pose: np.ndarray, visible: np.ndarray) -> list[Segment]:
         self._frame += 1
@@ -173,7 +175,7 @@ class HubThreshold(Segmenter):
         vis = np.zeros((motion.n_frames, len(self.template)), dtype=bool)
         obs[:, ok] = motion.positions[:, self._index[ok]]
         vis[:, ok] = motion.visible[:, self._index[ok]]
-        raw = pose_distance(obs, self.template, vis)
+        raw = _nearest(pose_distance(obs[:, None], self.templates, vis[:, None]), axis=-1)
         raw = _hold(raw)
         if raw.size == 0:
             return raw, raw
@@ -189,6 +191,14 @@ class HubThreshold(Segmenter):
             out.extend(self._step(float(value)))
         out.extend(self.flush())
         return out
+
+
+def _nearest(distances: np.ndarray, axis: int = -1) -> np.ndarray:
+    """The distance to the nearest hub (NaN where nothing was visible)."""
+    if distances.shape[axis] == 1:
+        return np.take(distances, 0, axis=axis)
+    with np.errstate(all="ignore"):
+        return np.where(np.isnan(distances).all(axis=axis), np.nan, np.nanmin(np.nan_to_num(distances, nan=np.inf), axis=axis))
 
 
 def _hold(x: np.ndarray) -> np.ndarray:

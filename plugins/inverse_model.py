@@ -28,7 +28,7 @@ from scipy.signal import savgol_filter
 
 from plugins.guiding_stroke import GuidingStroke
 
-__all__ = ["stroke_from_segment", "trajectory_error"]
+__all__ = ["stroke_from_segment", "trajectory_error", "learn_commands"]
 
 
 def trajectory_error(stroke: GuidingStroke, positions: np.ndarray, fps: float) -> float:
@@ -117,3 +117,29 @@ def stroke_from_segment(positions: np.ndarray, fps: float, *, straight: float = 
     fit = least_squares(residual, x0, bounds=([lower[n] for n in names], [upper[n] for n in names]), x_scale="jac", max_nfev=200)
     refined = GuidingStroke(**{**est, **dict(zip(names, fit.x))})
     return refined if trajectory_error(refined, p, fps) <= trajectory_error(stroke, p, fps) else stroke
+
+
+def learn_commands(motor, subsystem: str, observed: np.ndarray, fps: float, start: str, breaks, *,
+                   source: str = "inverse model", hub_tolerance: float = 0.05, refine: bool = True) -> list[str]:
+    """Turn an observed segment into new edges of a motor command graph, chained from node ``start`` (§4.3).
+
+    ``observed`` (n, k, 3) holds the positions of the subsystem's k parts; ``breaks``
+    maps the flattened (n, 3k) trajectory to the frames where one stroke ends and
+    the next begins (the velocity/direction segmenter's break points). Each
+    stroke of each part is inverted into a guiding stroke; the last edge ends in
+    the hub when the segment returns there. Returns the new edges' movement names.
+    """
+    n, k, _ = observed.shape
+    cuts = [0, *breaks(observed.reshape(n, k * 3)), n - 1]
+    names, node = [], start
+    hub_state = motor.graphs[subsystem].nodes["hub"]["state"]
+    for i, (a, b) in enumerate(zip(cuts, cuts[1:])):
+        if b - a < 2:
+            continue
+        strokes = [stroke_from_segment(observed[a : b + 1, j], fps, refine=refine) for j in range(k)]
+        last = i == len(cuts) - 2
+        end = "hub" if last and np.linalg.norm(observed[-1] - hub_state, axis=-1).max() <= hub_tolerance else None
+        name = motor.learn(subsystem, node, strokes, end=end, source=source)
+        names.append(name)
+        node = motor.edge(name)[2]
+    return names

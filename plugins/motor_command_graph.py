@@ -17,6 +17,14 @@ and out (the swivel heuristic of §3, simplified).
 
 Subsystems are configurable (``subsystems = { left_wrist = ["left_wrist"], ... }``),
 including one whole-body subsystem with every part.
+
+Clips (:mod:`plugins.clip_repertoire`): with ``clips`` and ``profile`` the graph
+is learned from labelled motion-capture clips by the inverse model, as if the
+character had watched each one: the rest state is the first hub found from the
+clips, the default subsystem is the whole body (every part but the root, no
+arm inverse kinematics), every clip becomes a chain of edges from the hub, and
+the chain is a named movement (the clip's sub-folder name; several clips of one
+movement share it, :meth:`MotorCommandGraph.label`).
 """
 
 from __future__ import annotations
@@ -26,8 +34,11 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
+from plugins.clip_repertoire import CLIP_PARAMETERS, repertoire_for
 from plugins.guiding_stroke import GuidingStroke
+from plugins.inverse_model import learn_commands
 from plugins.key_poses import parse_poses
+from plugins.velocity_direction import VelocityDirection
 from toolkit import ConfigError, Motion, MotorSystem, Parameter, hookimpl
 
 __all__ = ["MotorCommandGraph", "place_elbows"]
@@ -53,21 +64,36 @@ class MotorCommandGraph(MotorSystem):
     name = "motor-command-graph"
     parameters = (
         Parameter("rest", str, "rest", "The pose every subsystem's hub node is taken from."),
-        Parameter("poses", dict, doc="Named poses (at least the rest pose), as for keyframe."),
+        Parameter("poses", dict, {}, "Named poses (at least the rest pose), as for keyframe. Not needed with clips."),
         Parameter("subsystems", dict, {"left_wrist": ["left_wrist"], "right_wrist": ["right_wrist"]},
                   "Motor subsystems: name = [parts it moves]."),
         Parameter("arms", list, [["left_shoulder", "left_elbow", "left_wrist"], ["right_shoulder", "right_elbow", "right_wrist"]],
                   "Shoulder, elbow, wrist triples whose elbow follows the wrist by inverse kinematics."),
+        *CLIP_PARAMETERS,
+        Parameter("drop", float, 0.5, "With clips: speed-minimum criterion of the stroke segmentation.", minimum=0.0,
+                  maximum=1.0),
+        Parameter("angle", float, 50.0, "With clips: direction criterion (degrees) of the stroke segmentation.",
+                  minimum=1.0, maximum=180.0),
     )
 
     def attach(self, owner: Any) -> None:
         super().attach(owner)
         body = owner.body
-        poses = parse_poses(self.params["poses"], body)
-        if self.params["rest"] not in poses.names:
-            raise ConfigError(f"unknown pose {self.params['rest']!r}", key=("rest",), expected="a declared pose", available=poses.names)
         self.body = body
-        self.rest = poses[self.params["rest"]]
+        clips = repertoire_for(self.params, owner)
+        if clips is not None:
+            self.rest = clips.hubs[0].copy()
+            defaults = {p.name: p.default for p in self.parameters}
+            if self.params["subsystems"] == defaults["subsystems"]:  # the whole body unless told otherwise
+                self.params = {**self.params, "subsystems": {"body": [p for p in body.parts if p != body.root]}}
+            if self.params["arms"] == defaults["arms"]:
+                self.params = {**self.params, "arms": []}
+        else:
+            poses = parse_poses(self.params["poses"], body)
+            if self.params["rest"] not in poses.names:
+                raise ConfigError(f"unknown pose {self.params['rest']!r}", key=("rest",), expected="a declared pose",
+                                  available=poses.names)
+            self.rest = poses[self.params["rest"]]
         self.subsystems: dict[str, np.ndarray] = {}
         for name, parts in self.params["subsystems"].items():
             if not isinstance(parts, list) or not parts:
@@ -93,6 +119,28 @@ class MotorCommandGraph(MotorSystem):
         self.sequences: dict[str, list[str]] = {}  # a learned path of several edges, performed as one movement
         self._counter = 0
         self._state = self.rest.copy()
+        self.labels: dict[str, str] = {}  # sequence name -> movement, for sequences learned from labelled clips
+        if clips is not None:
+            self._learn_clips(clips)
+
+    def _learn_clips(self, clips: Any) -> None:
+        """Every clip through the inverse model into a chain of edges from the hub, named by its movement."""
+        (subsystem, idx), = list(self.subsystems.items())[:1]
+        strokes = VelocityDirection(drop=self.params["drop"], angle=self.params["angle"])
+        for clip in clips.clips:
+            m = clip.motion
+            observed = np.where(m.visible[:, idx, None], m.positions[:, idx], np.nan)
+            fill = np.nanmedian(observed, axis=0)
+            observed = np.where(np.isnan(observed), np.where(np.isnan(fill), self.rest[idx], fill), observed)
+            strokes.reset(tuple(f"p{i}" for i in range(len(idx))), m.fps)
+            names = learn_commands(self, subsystem, observed, m.fps, "hub", strokes.breaks, source=str(clip.source),
+                                   hub_tolerance=self.params["hub_radius"], refine=False)
+            if not names:
+                continue
+            n = sum(1 for label in self.labels.values() if label == clip.movement)
+            self.add_sequence(names, name=clip.movement if n == 0 else f"{clip.movement}#{n + 1}", label=clip.movement)
+            self.active[subsystem] = "hub"
+            self._state = self.rest.copy()
 
     # -- the graph ------------------------------------------------------------------------------
 
@@ -140,19 +188,34 @@ class MotorCommandGraph(MotorSystem):
 
     # -- the motor system interface -------------------------------------------------------------
 
-    def add_sequence(self, edges: list[str]) -> str:
-        """Name a path of edges (a movement learned as several strokes) so it can be performed as one movement."""
-        if len(edges) == 1:
+    def add_sequence(self, edges: list[str], *, name: str | None = None, label: str | None = None) -> str:
+        """Name a path of edges (a movement learned as several strokes) so it can be performed as one movement.
+
+        ``label`` is the movement it is an example of (a clip's movement); ``name`` defaults to a new number.
+        """
+        if len(edges) == 1 and name is None:
             return edges[0]
-        for name, known in self.sequences.items():
-            if known == list(edges):
-                return name
+        for known_name, known in self.sequences.items():
+            if known == list(edges) and name is None:
+                return known_name
         subsystem = self._edges[edges[0]][0]
-        name = f"{subsystem}:m{len(self.sequences) + 1}"
+        name = name or f"{subsystem}:m{len(self.sequences) + 1}"
         self.sequences[name] = list(edges)
+        if label is not None:
+            self.labels[name] = label
         return name
 
+    def label(self, movement: str) -> str:
+        return self.labels.get(movement, movement)
+
+    def label_of_path(self, path: tuple[str, ...]) -> str | None:
+        """The movement every labelled sequence beginning with ``path`` is an example of; ``None`` if not one."""
+        labels = {self.labels.get(n) for n, edges in self.sequences.items() if tuple(edges[: len(path)]) == tuple(path)}
+        return labels.pop() if len(labels) == 1 and None not in labels else None
+
     def movements(self) -> list[str]:
+        if self.labels:
+            return list(dict.fromkeys(self.labels.values()))
         return [*self._edges, *self.sequences]
 
     def rest_pose(self) -> np.ndarray:
@@ -160,6 +223,8 @@ class MotorCommandGraph(MotorSystem):
 
     def perform(self, movement: str, *, speed: float = 1.0, fps: float = 30.0) -> Motion:
         """Execute one edge (or a named path of edges) from the current posture; the active node becomes its end."""
+        if movement not in self.sequences and movement in self.labels.values():  # a clip's movement: its first clip
+            movement = next(n for n, label in self.labels.items() if label == movement)
         if movement in self.sequences:
             from toolkit.motion import concatenate
 

@@ -27,8 +27,12 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
-from plugins.key_poses import REPERTOIRE_PARAMETERS, interpolate, play, read_repertoire
+from plugins.clip_repertoire import CLIP_PARAMETERS, repertoire_for
+from plugins.key_poses import REPERTOIRE_PARAMETERS, KeyPoses, interpolate, play, read_repertoire
+from plugins.pose_distance import pose_distance
 from toolkit import ConfigError, Motion, MotorSystem, Parameter, hookimpl
+
+_OPTIONAL = {"poses": {}, "movements": {}}  # with clips, the key-pose repertoire is not needed
 
 
 class Posegraph(MotorSystem):
@@ -36,7 +40,9 @@ class Posegraph(MotorSystem):
 
     name = "posegraph"
     parameters = (
-        *REPERTOIRE_PARAMETERS,
+        *(p if p.name not in _OPTIONAL else Parameter(p.name, p.type, _OPTIONAL[p.name], p.doc + " Not needed with clips.")
+          for p in REPERTOIRE_PARAMETERS),
+        *CLIP_PARAMETERS,
         Parameter("node_rate", float, 10.0, "Pose nodes per second of movement: the graph's resolution. Higher "
                   "recognises finer timing at the cost of search time.", minimum=1.0, maximum=120.0),
     )
@@ -44,7 +50,14 @@ class Posegraph(MotorSystem):
     def attach(self, owner: Any) -> None:
         super().attach(owner)
         self.body = owner.body
-        self.key_poses, self.hubs, self.repertoire = read_repertoire(self.params, self.body)
+        self.clips = repertoire_for(self.params, owner)
+        if self.clips is None:
+            if not self.params["poses"]:
+                raise ConfigError("no repertoire", key=("poses",), expected="poses and movements, or clips and profile")
+            self.key_poses, self.hubs, self.repertoire = read_repertoire(self.params, self.body)
+        else:
+            names = tuple("hub" if i == 0 else f"hub{i + 1}" for i in range(len(self.clips.hubs)))
+            self.key_poses, self.hubs, self.repertoire = KeyPoses(names, self.clips.hubs), names, {}
         self.learned: dict[str, dict[str, Any]] = {}
         self._build()
 
@@ -57,23 +70,44 @@ class Posegraph(MotorSystem):
         for i, hub in enumerate(self.hubs):
             self.graph.add_node(hub, index=i, movement=None, hub=True)
         self.paths: dict[str, list[str]] = {}
+        self.paths_label: dict[str, str] = {}  # path name -> movement (several clips of one movement)
         for name, m in self.repertoire.items():
             sampled = play(self.key_poses, m, self.body.parts, fps=rate).positions
             self._add_path(name, m.poses[0], sampled[1:-1], m.poses[-1], poses)
+        for clip in self.clips.clips if self.clips is not None else ():
+            self._add_clip(clip.movement, clip.motion, poses)
         self.node_poses = np.stack(poses)
         root = self.body.root_index
         self.node_root_relative = self.node_poses - self.node_poses[:, root : root + 1]
 
-    def _add_path(self, name: str, start: str, interior: np.ndarray, end: str, poses: list[np.ndarray]) -> None:
+    def _add_clip(self, movement: str, motion: Motion, poses: list[np.ndarray]) -> None:
+        """One example clip as a path between the hubs nearest its ends, sampled at ``node_rate``."""
+        rate = self.params["node_rate"]
+        t = np.arange(motion.n_frames) / motion.fps
+        keep = np.unique(np.clip(np.round(np.arange(0.0, t[-1] + 1e-9, 1.0 / rate) * motion.fps), 0,
+                                 motion.n_frames - 1).astype(int))
+        sampled = np.where(motion.visible[keep, :, None], motion.positions[keep], np.nan)
+        sampled = np.where(np.isnan(sampled), np.nanmedian(motion.positions, axis=0), sampled)
+        hub_rel = self.key_poses.array - self.key_poses.array[:, self.body.root_index : self.body.root_index + 1]
+        root = self.body.root_index
+        ends = [self.hubs[int(np.argmin(pose_distance(hub_rel, sampled[i] - sampled[i, root], True)))] for i in (0, -1)]
+        n = sum(1 for p in self.paths if self.paths_label.get(p) == movement)
+        self._add_path(movement if n == 0 else f"{movement}#{n + 1}", ends[0], sampled[1:-1], ends[1], poses,
+                       label=movement)
+
+    def _add_path(self, name: str, start: str, interior: np.ndarray, end: str, poses: list[np.ndarray], *,
+                  label: str | None = None) -> None:
+        label = label or name
         path = [start]
         for j, pose in enumerate(interior, 1):
             node = f"{name}/{j}"
-            self.graph.add_node(node, index=len(poses), movement=name, hub=False)
+            self.graph.add_node(node, index=len(poses), movement=label, hub=False)
             poses.append(pose)
             path.append(node)
         path.append(end)
-        nx.add_path(self.graph, path, movement=name)
+        nx.add_path(self.graph, path, movement=label)
         self.paths[name] = path
+        self.paths_label[name] = label
 
     @property
     def nodes(self) -> list[str]:
@@ -91,10 +125,13 @@ class Posegraph(MotorSystem):
     # -- the motor system interface ----------------------------------------------------------
 
     def movements(self) -> list[str]:
-        return list(self.paths)
+        return list(dict.fromkeys(self.paths_label[p] for p in self.paths))
 
     def rest_pose(self) -> np.ndarray:
         return self.key_poses[self.hubs[0]]
+
+    def hub_poses(self) -> np.ndarray:
+        return np.stack([self.key_poses[h] for h in self.hubs])
 
     def perform(self, movement: str, *, speed: float = 1.0, fps: float = 30.0) -> Motion:
         if movement in self.repertoire:
@@ -129,7 +166,7 @@ class Posegraph(MotorSystem):
 
         Returns the new path.
         """
-        if name in self.paths:
+        if name in self.paths or name in self.movements():
             raise ConfigError(f"movement {name!r} already exists", expected="a new movement name", available=self.movements())
         poses = np.asarray(poses, dtype=float)
         if visible is None:
@@ -185,7 +222,8 @@ class Posegraph(MotorSystem):
 
     def describe(self) -> dict[str, Any]:
         return {
-            "movements": len(self.paths),
+            "movements": len(self.movements()),
+            "clips": len(self.clips.clips) if self.clips is not None else 0,
             "nodes": self.graph.number_of_nodes(),
             "edges": self.graph.number_of_edges(),
             "hubs": list(self.hubs),

@@ -15,7 +15,7 @@ import numpy as np
 from toolkit.body import Body
 from toolkit.motion import world_to_local
 
-__all__ = ["facing_heading", "to_root_relative", "HeadingFilter"]
+__all__ = ["facing_heading", "to_root_relative", "HeadingFilter", "smooth_heading"]
 
 _UP = np.array([0.0, 1.0, 0.0])
 
@@ -99,6 +99,32 @@ class HeadingFilter:
         ref = self._recent[-1]
         unwrapped = ref + np.angle(np.exp(1j * (np.asarray(self._recent) - ref)))
         return float(np.angle(np.exp(1j * np.median(unwrapped))))
+
+
+def smooth_heading(heading: np.ndarray, window: int) -> np.ndarray:
+    """A centred running circular median of headings (F,) over ``window`` frames, for whole recordings.
+
+    The batch counterpart of :class:`HeadingFilter` (which, streaming, can only look back).
+    NaN estimates are ignored; frames with no estimate in their window stay NaN.
+    """
+    heading = np.asarray(heading, dtype=float)
+    n, half = len(heading), max(1, int(window)) // 2
+    if n == 0 or window <= 1:
+        return heading.copy()
+    ok = np.isfinite(heading)
+    if not ok.any():
+        return heading.copy()
+    unwrapped = np.full(n, np.nan)
+    unwrapped[ok] = np.unwrap(heading[ok])
+    padded = np.pad(unwrapped, half, constant_values=np.nan)
+    windows = np.lib.stride_tricks.sliding_window_view(padded, 2 * half + 1)[:n]
+    with np.errstate(all="ignore"):
+        import warnings
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            med = np.nanmedian(windows, axis=1)
+    return np.angle(np.exp(1j * med))
 
 
 def to_root_relative(

@@ -385,6 +385,14 @@ class MotorSystem(Component):
     def rest_pose(self) -> np.ndarray:
         """The hub pose the character stands in when idle, local frame, shape (P, 3)."""
 
+    def hub_poses(self) -> np.ndarray:
+        """Every hub pose movements start and end in, local frame, shape (H, P, 3); the rest pose first."""
+        return np.asarray(self.rest_pose(), dtype=float)[None]
+
+    def label(self, movement: str) -> str:
+        """The movement a performable name stands for (several example clips may share one movement)."""
+        return movement
+
     @abstractmethod
     def perform(self, movement: str, *, speed: float = 1.0, fps: float = 30.0) -> Motion:
         """The motion of one of :meth:`movements`, sampled at ``fps``, from hub to hub."""

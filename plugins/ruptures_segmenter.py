@@ -1,0 +1,96 @@
+"""Segmenter ``ruptures``: kernel change-point detection with a penalty (a baseline, via ruptures).
+
+What most users compare against: :class:`ruptures.KernelCPD` on the stream of
+root-relative part positions (an RBF kernel, so changes in any part's
+distribution count), with the number of change points chosen by a penalty
+rather than given. Every stretch between two change points that is at least
+``min_length`` seconds long is a segment.
+
+Change-point detection over a whole recording is offline: pushing frames only
+stores them, and the segments come out when the stream is flushed (so this
+segmenter cannot drive response facilitation).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import ruptures as rpt
+
+from toolkit import Motion, Parameter, Segment, Segmenter, hookimpl
+
+__all__ = ["RupturesSegmenter"]
+
+
+class RupturesSegmenter(Segmenter):
+    """Kernel change points (ruptures KernelCPD, RBF) with a penalty; offline: segments come at the end."""
+
+    name = "ruptures"
+    parameters = (
+        Parameter("penalty", float, 3.0, "Penalty per change point (larger: fewer segments).", minimum=0.0),
+        Parameter("kernel", str, "rbf", "The kernel of the cost.", choices=("rbf", "linear", "cosine")),
+        Parameter("min_length", float, 0.5, "Shortest segment in seconds.", minimum=0.0),
+        Parameter("stride", int, 2, "Use every n-th frame (KernelCPD is quadratic in length).", minimum=1),
+    )
+
+    def reset(self, parts: Sequence[str], fps: float) -> None:
+        self._fps = float(fps)
+        self._frames: list[np.ndarray] = []
+        self._visible: list[np.ndarray] = []
+
+    @property
+    def active_since(self) -> int | None:
+        return None
+
+    def push(self, pose: np.ndarray, visible: np.ndarray) -> list[Segment]:
+        self._frames.append(np.asarray(pose, dtype=float))
+        self._visible.append(np.asarray(visible, dtype=bool))
+        return []
+
+    def flush(self) -> list[Segment]:
+        if not self._frames:
+            return []
+        out = self._detect(np.array(self._frames), np.array(self._visible))
+        self._frames, self._visible = [], []
+        return out
+
+    def segment(self, motion: Motion) -> list[Segment]:
+        self.reset(motion.parts, motion.fps)
+        return self._detect(motion.positions, motion.visible)
+
+    def _detect(self, poses: np.ndarray, visible: np.ndarray) -> list[Segment]:
+        n, stride = len(poses), self.params["stride"]
+        seen = visible.any(axis=1)
+        if seen.sum() < 2:
+            return []
+        x = np.where(visible[..., None], poses, np.nan).reshape(n, -1)
+        x = _hold(x)
+        x = np.nan_to_num(x - np.nanmean(x, axis=0))[::stride]
+        min_size = max(2, int(round(self.params["min_length"] * self._fps / stride)))
+        if len(x) < 2 * min_size:
+            return [Segment(0, n, self._fps)] if n / self._fps >= self.params["min_length"] else []
+        ends = rpt.KernelCPD(kernel=self.params["kernel"], min_size=min_size).fit(x).predict(pen=self.params["penalty"])
+        bounds = [0, *[min(n, e * stride) for e in ends[:-1]], n]
+        return [Segment(a, b, self._fps) for a, b in zip(bounds, bounds[1:])
+                if b > a and (b - a) / self._fps >= self.params["min_length"] and seen[a:b].any()]
+
+
+def _hold(x: np.ndarray) -> np.ndarray:
+    """Carry the last seen value of each column forward (and the first one backward) over NaNs."""
+    x = x.copy()
+    for j in range(x.shape[1]):
+        col = x[:, j]
+        ok = np.flatnonzero(~np.isnan(col))
+        if len(ok) == 0:
+            x[:, j] = 0.0
+            continue
+        idx = np.maximum.accumulate(np.where(~np.isnan(col), np.arange(len(col)), 0))
+        idx[: ok[0]] = ok[0]
+        x[:, j] = col[idx]
+    return x
+
+
+@hookimpl
+def likeme_register_segmenters():
+    return [RupturesSegmenter]
