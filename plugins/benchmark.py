@@ -295,6 +295,9 @@ def _write_json(path: Path, data: dict[str, Any]) -> None:
 def likeme_register_commands(subparsers):
     bench = subparsers.add_parser("bench", help="measure accuracy and speed (benchmarks)")
     sub = bench.add_subparsers(dest="benchmark", metavar="BENCHMARK", parser_class=type(bench), required=True)
+    from plugins.mocap_benchmark import add_commands
+
+    add_commands(sub)  # recognition, segmentation, stream on motion-capture files, and the data they read
     p = sub.add_parser("watch", help="an observer watches a demonstrator's random movements (B&B §5)")
     p.add_argument("--observer", default="max", help="observer character (default: max)")
     p.add_argument("--demonstrator", default="morris", help="demonstrator character (default: morris)")

@@ -82,6 +82,9 @@ def clip_files(folder: Path) -> dict[str, list[Path]]:
         files = sorted(p for p in sub.iterdir() if p.suffix.lower() in CLIP_SUFFIXES)
         if files:
             out[sub.name] = files
+    if not out:  # a flat folder of recordings: each file on its own (its ends still give hubs)
+        for path in sorted(p for p in folder.iterdir() if p.suffix.lower() in CLIP_SUFFIXES):
+            out[path.stem] = [path]
     if not out:
         raise ConfigError("no clips found", file=folder,
                           expected="sub-folders named after movements holding .bvh clips (walk/take1.bvh ...)",

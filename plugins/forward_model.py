@@ -58,6 +58,7 @@ class ForwardModel(Matcher):
     """Edges of the active node predict the demonstration in parallel; the last one left is imitated at once (K&G §4.4)."""
 
     name = "forward-model"
+    motor_systems = ("motor-command-graph",)
     parameters = (
         Parameter("threshold", float, 0.05, "Prediction error (m) above which a candidate edge drops out.", minimum=0.0),
         Parameter("deviation", float, 0.05, "Error (m) between the imitated edge and the demonstration that stops the "
@@ -135,7 +136,8 @@ class ForwardModel(Matcher):
                 self.committed_path = self._known_continuation(path)
                 self.committed = self.motor.add_sequence(list(self.committed_path))
                 speed = self._speed(path[0], lengths, len(observed))
-                return Match(self.motor.label(self.committed), float(np.exp(-alive[path] / self.params["threshold"])), len(self.frames),
+                label = getattr(self.motor, "label_of_path", lambda p: None)(self.committed_path)
+                return Match(label or self.motor.label(self.committed), float(np.exp(-alive[path] / self.params["threshold"])), len(self.frames),
                              path=self.committed_path,
                              details={"candidates": list(self.initial), "speed": speed, "progress": progress})
         return None
@@ -151,9 +153,15 @@ class ForwardModel(Matcher):
             return False
         self.subsystem = best
         self.start_node = self.motor.active[best]
-        self.candidates = {(name,): 0.0 for name, _ in self.motor.edges_from(best, self.start_node) if name not in self.excluded}
+        # a command that moves no part farther than min_move (standing still) cannot be seen to begin
+        self.candidates = {(name,): 0.0 for name, _ in self.motor.edges_from(best, self.start_node)
+                           if name not in self.excluded and self._length(name) > self.params["min_move"]}
         self.initial = sorted(p[0] for p in self.candidates)
         return True
+
+    def _length(self, name: str) -> float:
+        """Path length (m) of a command's lead part."""
+        return float(self._table(self._strokes_of(name)[self._lead(name)])[2][-1])
 
     def _strokes_of(self, name: str) -> list[Any]:
         return self.motor.edge(name)[3]["strokes"]

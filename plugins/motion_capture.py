@@ -29,14 +29,21 @@ class MotionCapture(Perception):
         self._facing: HeadingFilter | None = None
 
     def perceive(self, observer, target, world) -> Percept:
-        positions = target.world_pose()
-        visible = np.isfinite(positions).all(axis=-1)
-        if getattr(self, "_facing", None) is None:
-            self._facing = HeadingFilter(round(self.params["facing_window"] * world.fps))
-        found = facing_heading(np.where(visible[:, None], positions, 0.0), visible, target.body)
-        pose, mask, root, heading = to_root_relative(positions, visible, target.body, self._facing.update(float(found)))
+        self.fps = world.fps
+        percept = self.perceive_pose(target.world_pose(), None, target.body, world.time)
         objects = {name: obj.position.copy() for name, obj in world.objects.items()}
-        return Percept(world.time, pose, mask, np.where(mask[:, None], positions, np.nan), root, float(heading), objects)
+        return Percept(percept.time, percept.pose, percept.visible, percept.world, percept.root, percept.heading, objects)
+
+    def perceive_pose(self, positions, visible, body, time) -> Percept:
+        """Root-relative percept of recorded world positions (P, 3); non-finite or masked parts are not seen."""
+        positions = np.asarray(positions, dtype=float)
+        seen = np.isfinite(positions).all(axis=-1)
+        visible = seen if visible is None else seen & np.asarray(visible, dtype=bool)
+        if getattr(self, "_facing", None) is None:
+            self._facing = HeadingFilter(round(self.params["facing_window"] * getattr(self, "fps", 30.0)))
+        found = facing_heading(np.where(visible[:, None], positions, 0.0), visible, body)
+        pose, mask, root, heading = to_root_relative(positions, visible, body, self._facing.update(float(found)))
+        return Percept(time, pose, mask, np.where(mask[:, None], positions, np.nan), root, float(heading))
 
 
 @hookimpl

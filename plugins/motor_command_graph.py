@@ -210,7 +210,9 @@ class MotorCommandGraph(MotorSystem):
 
     def label_of_path(self, path: tuple[str, ...]) -> str | None:
         """The movement every labelled sequence beginning with ``path`` is an example of; ``None`` if not one."""
-        labels = {self.labels.get(n) for n, edges in self.sequences.items() if tuple(edges[: len(path)]) == tuple(path)}
+        path = tuple(path)
+        labels = {self.labels.get(n) for n, edges in self.sequences.items()
+                  if tuple(edges[: len(path)]) == path or path[: len(edges)] == tuple(edges)}
         return labels.pop() if len(labels) == 1 and None not in labels else None
 
     def movements(self) -> list[str]:

@@ -38,6 +38,7 @@ class PathSearch(Matcher):
     """k-best path search through the observer's posegraph from the middle frame outward (§5.2)."""
 
     name = "path-search"
+    motor_systems = ("posegraph",)
     parameters = (
         Parameter("k", int, 8, "Number of start poses and of paths kept at every step (the beam width). "
                   "Larger is more robust to noise and occlusion, and slower.", minimum=1),

@@ -71,7 +71,7 @@ class RupturesSegmenter(Segmenter):
         if len(x) < 2 * min_size:
             return [Segment(0, n, self._fps)] if n / self._fps >= self.params["min_length"] else []
         ends = rpt.KernelCPD(kernel=self.params["kernel"], min_size=min_size).fit(x).predict(pen=self.params["penalty"])
-        bounds = [0, *[min(n, e * stride) for e in ends[:-1]], n]
+        bounds = [0, *[min(n, int(e) * stride) for e in ends[:-1]], n]
         return [Segment(a, b, self._fps) for a, b in zip(bounds, bounds[1:])
                 if b > a and (b - a) / self._fps >= self.params["min_length"] and seen[a:b].any()]
 

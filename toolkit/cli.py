@@ -71,6 +71,17 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p.add_argument("--actions", action="store_true", help="print the action system (hierarchy, drives, beliefs, maps) as text")
     p.set_defaults(handler=cmd_show)
 
+    p = sub.add_parser("observe", help="watch motion-capture files: segments, recognised movements, decisions")
+    p.add_argument("files", nargs="+", metavar="FILE.bvh")
+    p.add_argument("--body", required=True, metavar="PROFILE", help="body profile TOML of the files")
+    p.add_argument("--repertoire", required=True, metavar="DIR", help="labelled clips: one folder per movement")
+    p.add_argument("--segmenter", default="hub-threshold", metavar="NAME", help="segmenter (default: hub-threshold)")
+    p.add_argument("--matcher", default="path-search", metavar="NAME", help="matcher (default: path-search)")
+    p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
+                   help="override a parameter of the observer, e.g. --set matcher.k=4 (repeatable)")
+    p.add_argument("--json", action="store_true", help="print JSON instead of text")
+    p.set_defaults(handler=cmd_observe)
+
     p = sub.add_parser("validate", help="check character and scenario files")
     p.add_argument("files", nargs="+", metavar="FILE", help="character or scenario TOML files")
     p.set_defaults(handler=cmd_validate)
@@ -260,6 +271,41 @@ def cmd_show(args: argparse.Namespace, pm: PluginManager) -> int:
         print(character.action.render())
         return 0
     print(json.dumps(describe_character(character), indent=2))
+    return 0
+
+
+def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
+    import json
+
+    from plugins.benchmark import parse_settings
+    from toolkit.observe import Observer, compose_observer
+    from toolkit.profile import load_profile
+
+    profile = load_profile(args.body)
+    for name, kind in ((args.segmenter, "segmenter"), (args.matcher, "matcher")):
+        pm.registry.get(kind, name)  # an unknown name fails here, listing the registered ones
+    character = compose_observer(pm, profile, args.repertoire, segmenter=args.segmenter, matcher=args.matcher,
+                                 settings=parse_settings(list(args.set)))
+    report = []
+    for path in args.files:
+        motion = profile.read(path)
+        observer = Observer(character, profile.body, motion.fps)
+        found = observer.watch(motion)
+        report.append({"file": str(path), "frames": motion.n_frames, "fps": round(motion.fps, 3), "segments": [
+            {"start_frame": o.segment.start, "end_frame": o.segment.end, "start_s": round(o.segment.start_time, 3),
+             "end_s": round(o.segment.end_time, 3), "movement": o.movement or "unknown",
+             "confidence": round(o.match.confidence, 3) if o.match else 0.0,
+             "decided_at_frame": o.segment.start + (o.decided_at if o.decided_at is not None else o.segment.n_frames),
+             "decision_fraction": round(o.decision_fraction, 3)} for o in found]})
+    if args.json:
+        print(json.dumps(report, indent=1))
+        return 0
+    for entry in report:
+        print(f"{entry['file']}: {entry['frames']} frames at {entry['fps']:g} fps, {len(entry['segments'])} segments")
+        for seg in entry["segments"]:
+            print(f"  frames {seg['start_frame']:5d}-{seg['end_frame']:<5d} ({seg['start_s']:6.2f}-{seg['end_s']:6.2f} s)  "
+                  f"{seg['movement']:<16} confidence {seg['confidence']:.2f}  decided at frame {seg['decided_at_frame']} "
+                  f"({seg['decision_fraction']:.0%} of the segment)")
     return 0
 
 

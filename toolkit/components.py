@@ -293,6 +293,13 @@ class Perception(Component):
     def perceive(self, observer: Actor, target: Actor, world: World) -> Percept:
         """What ``observer`` perceives of ``target`` now."""
 
+    def perceive_pose(self, positions: np.ndarray, visible: np.ndarray, body: Any, time: float) -> Percept:
+        """A percept of a body from recorded world positions (P, 3) alone, without a world: live or recorded input.
+
+        Perceptions that need the world (an eye, occluders) do not implement it.
+        """
+        raise NotImplementedError(f"perception {self.name!r} needs a world; it cannot watch recorded poses")
+
 
 class Segmenter(Component):
     """Divides a stream of observed poses into segments, one frame at a time or in batch.
@@ -344,6 +351,8 @@ class Matcher(Component):
     """
 
     kind = "matcher"
+    motor_systems: ClassVar[tuple[str, ...]] = ()
+    """Names of the motor systems this matcher works with (empty: any); the first is used when one is composed."""
 
     @abstractmethod
     def match(self, motion: Motion) -> Match:

@@ -1,0 +1,490 @@
+"""Benchmarks on motion-capture files: ``likeme bench recognition|segmentation|stream``, and the data they read.
+
+Every sub-command reads BVH files through a body profile (:mod:`toolkit.profile`)
+and watches them with :class:`toolkit.observe.Observer`, so the toolkit's
+segmenters and matchers and the baselines (``dtw``, ``ruptures``) are measured
+on the same clips in the same loop:
+
+- ``recognition``: each demo clip (a folder per true movement) is one segment;
+  every matcher named classifies it. Accuracy, macro F1, the confusion matrix,
+  the decision fraction (share of the clip seen when the matcher committed; 1.0
+  for matchers that wait for the end) and frames per second.
+- ``segmentation``: each stream ``NAME.bvh`` has ``NAME.segments.csv`` (header
+  ``start_frame,end_frame,movement``, end exclusive). Precision, recall, F1 and
+  boundary error (:mod:`plugins.metrics`) per segmenter.
+- ``stream``: segment and recognise end to end for every pairing; the movement
+  error rate (edit distance over the true count).
+
+``likeme bench make-data DIR`` writes such folders from the project's own
+characters (Max's movements as the repertoire, Morris's as demos and streams),
+``likeme bench bandai SRC DIR`` builds them from the Bandai-Namco clips
+(repertoire from the normal style, demos from the others, streams by
+concatenating clips), without copying anything into the repository.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import platform
+import time
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from plugins.metrics import movement_error_rate, segmentation_scores
+from toolkit import ConfigError
+from toolkit.observe import Observer, compose_observer
+from toolkit.profile import load_profile
+
+__all__ = ["add_commands", "read_segments", "recognition", "segmentation", "stream"]
+
+MATCHERS = ("path-search", "forward-model", "dtw")
+SEGMENTERS = ("hub-threshold", "velocity-direction", "ruptures")
+
+
+# -- inputs --------------------------------------------------------------------------------------------
+
+
+def _labelled(folder: Path) -> list[tuple[str, Path]]:
+    from plugins.clip_repertoire import clip_files
+
+    return [(label, p) for label, files in clip_files(folder).items() for p in files]
+
+
+def read_segments(path: Path) -> list[tuple[int, int, str]]:
+    """A ``NAME.segments.csv`` file: (start, end exclusive, movement) rows, checked, with the line of any error."""
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except OSError as exc:
+        raise ConfigError(f"cannot read ({exc.strerror})", file=path, expected="start_frame,end_frame,movement rows") from None
+    if not lines or [h.strip() for h in lines[0].split(",")] != ["start_frame", "end_frame", "movement"]:
+        raise ConfigError(f"found header {lines[0] if lines else ''!r}", file=path, line=1,
+                          expected="the header start_frame,end_frame,movement")
+    out = []
+    for number, row in enumerate(csv.reader(lines[1:]), 2):
+        if not row:
+            continue
+        try:
+            start, end, label = int(row[0]), int(row[1]), row[2].strip()
+        except (ValueError, IndexError):
+            raise ConfigError(f"found {','.join(row)!r}", file=path, line=number,
+                              expected="two frame numbers and a movement name") from None
+        if not 0 <= start < end:
+            raise ConfigError(f"segment {start}..{end}", file=path, line=number, expected="0 <= start_frame < end_frame")
+        out.append((start, end, label))
+    return out
+
+
+def _streams(folder: Path) -> list[tuple[Path, list[tuple[int, int, str]]]]:
+    files = sorted(Path(folder).glob("*.bvh"))
+    if not files:
+        raise ConfigError("no streams found", file=folder, expected="NAME.bvh files with NAME.segments.csv beside them")
+    out = []
+    for path in files:
+        csv_path = path.with_suffix(".segments.csv")
+        if not csv_path.exists():
+            raise ConfigError("missing segment file", file=csv_path, expected=f"the true segments of {path.name}")
+        out.append((path, read_segments(csv_path)))
+    return out
+
+
+def _settings(values: Sequence[str]) -> dict[str, dict[str, Any]]:
+    from plugins.benchmark import parse_settings
+
+    return parse_settings(list(values))
+
+
+def _versions() -> dict[str, str]:
+    from importlib.metadata import PackageNotFoundError, version
+
+    out = {"python": platform.python_version()}
+    for name in ("likeme", "numpy", "scipy", "networkx", "dtaidistance", "ruptures"):
+        try:
+            out[name] = version(name)
+        except PackageNotFoundError:
+            out[name] = "not installed"
+    return out
+
+
+def _progress(items: list, label: str, quiet: bool):
+    if quiet:
+        return items
+    from rich.progress import track
+
+    return track(items, description=label, transient=True)
+
+
+# -- recognition -----------------------------------------------------------------------------------------
+
+
+def recognition(pm, profile, repertoire: Path, demos: Path, matchers: Sequence[str], *, settings=None,
+                quiet: bool = True) -> dict[str, Any]:
+    """Classify every demo clip with every matcher; per-plugin scores and per-item rows."""
+    items = _labelled(demos)
+    motions = [(label, path, profile.read(path)) for label, path in items]
+    plugins, rows = [], []
+    for name in matchers:
+        character = compose_observer(pm, profile, repertoire, matcher=name, settings=settings)
+        truth, predicted, fractions, frames, seconds = [], [], [], 0, 0.0
+        for label, path, motion in _progress(motions, f"recognition {name}", quiet):
+            observer = Observer(character, profile.body, motion.fps)
+            t0 = time.perf_counter()
+            obs = observer.classify(motion)
+            seconds += time.perf_counter() - t0
+            frames += motion.n_frames
+            truth.append(label)
+            predicted.append(obs.movement or "unknown")
+            fractions.append(obs.decision_fraction)
+            rows.append({"plugin": name, "item": path.name, "truth": label, "recognised": obs.movement or "unknown",
+                         "confidence": round(obs.match.confidence, 4) if obs.match else 0.0,
+                         "decision_fraction": round(obs.decision_fraction, 4), "frames": motion.n_frames})
+        labels = sorted(set(truth) | set(predicted))
+        confusion = np.zeros((len(labels), len(labels)), dtype=int)
+        for t, p in zip(truth, predicted):
+            confusion[labels.index(t), labels.index(p)] += 1
+        plugins.append({"plugin": name, "accuracy": float(np.mean([t == p for t, p in zip(truth, predicted)])),
+                        "macro_f1": _macro_f1(truth, predicted), "decision_median": float(np.median(fractions)),
+                        "decision_p90": float(np.percentile(fractions, 90)), "fps": frames / max(seconds, 1e-9),
+                        "items": len(truth), "labels": labels, "confusion": confusion.tolist()})
+    return {"benchmark": "recognition", "plugins": plugins, "items": rows}
+
+
+def _macro_f1(truth: Sequence[str], predicted: Sequence[str]) -> float:
+    scores = []
+    for label in sorted(set(truth)):
+        tp = sum(t == label and p == label for t, p in zip(truth, predicted))
+        fp = sum(t != label and p == label for t, p in zip(truth, predicted))
+        fn = sum(t == label and p != label for t, p in zip(truth, predicted))
+        scores.append(2 * tp / (2 * tp + fp + fn) if tp else 0.0)
+    return float(np.mean(scores)) if scores else 0.0
+
+
+# -- segmentation and streams ---------------------------------------------------------------------------------
+
+
+def segmentation(pm, profile, streams: Path, segmenters: Sequence[str], *, repertoire: Path | None = None,
+                 settings=None, quiet: bool = True) -> dict[str, Any]:
+    """Segment every stream with every segmenter; precision, recall, F1, boundary error and speed."""
+    data = [(path, truth, profile.read(path)) for path, truth in _streams(streams)]
+    plugins, rows = [], []
+    for name in segmenters:
+        character = compose_observer(pm, profile, repertoire or streams, segmenter=name, matcher=None,
+                                     settings=settings)
+        found_all = true_all = tp = 0
+        errors, frames, seconds = [], 0, 0.0
+        for path, truth, motion in _progress(data, f"segmentation {name}", quiet):
+            observer = Observer(character, profile.body, motion.fps)
+            t0 = time.perf_counter()
+            found = [o.segment for o in observer.watch(motion)]
+            seconds += time.perf_counter() - t0
+            frames += motion.n_frames
+            s = segmentation_scores([(f.start, f.end) for f in found], [(a, b) for a, b, _ in truth])
+            found_all, true_all, tp = found_all + s["found"], true_all + s["true"], tp + s["true_positives"]
+            if s["true_positives"]:
+                errors.append((s["boundary_error"], s["true_positives"]))
+            rows.append({"plugin": name, "item": path.name, "found": s["found"], "true": s["true"],
+                         "f1": round(s["f1"], 4), "boundary_error": round(s["boundary_error"], 2)})
+        precision = tp / found_all if found_all else 0.0
+        recall = tp / true_all if true_all else 0.0
+        f1 = 2 * precision * recall / (precision + recall) if precision + recall else 0.0
+        boundary = sum(e * n for e, n in errors) / max(1, sum(n for _, n in errors))
+        plugins.append({"plugin": name, "precision": precision, "recall": recall, "f1": f1,
+                        "boundary_error": boundary, "fps": frames / max(seconds, 1e-9), "items": len(data)})
+    return {"benchmark": "segmentation", "plugins": plugins, "items": rows}
+
+
+def stream(pm, profile, repertoire: Path, streams: Path, segmenters: Sequence[str], matchers: Sequence[str], *,
+           settings=None, quiet: bool = True) -> dict[str, Any]:
+    """Segment and recognise every stream with every pairing; the movement error rate."""
+    data = [(path, truth, profile.read(path)) for path, truth in _streams(streams)]
+    plugins, rows = [], []
+    for seg in segmenters:
+        for mat in matchers:
+            character = compose_observer(pm, profile, repertoire, segmenter=seg, matcher=mat, settings=settings)
+            errors, true_count, frames, seconds = 0.0, 0, 0, 0.0
+            for path, truth, motion in _progress(data, f"stream {seg} + {mat}", quiet):
+                observer = Observer(character, profile.body, motion.fps)
+                t0 = time.perf_counter()
+                recognised = [o.movement or "unknown" for o in observer.watch(motion)]
+                seconds += time.perf_counter() - t0
+                frames += motion.n_frames
+                labels = [label for _, _, label in truth]
+                rate = movement_error_rate(recognised, labels)
+                errors += rate * len(labels)
+                true_count += len(labels)
+                rows.append({"plugin": f"{seg}+{mat}", "item": path.name, "truth": " ".join(labels),
+                             "recognised": " ".join(recognised), "error_rate": round(rate, 4)})
+            plugins.append({"plugin": f"{seg}+{mat}", "segmenter": seg, "matcher": mat,
+                            "error_rate": errors / max(true_count, 1), "fps": frames / max(seconds, 1e-9),
+                            "items": len(data)})
+    return {"benchmark": "stream", "plugins": plugins, "items": rows}
+
+
+# -- output ----------------------------------------------------------------------------------------------------
+
+COLUMNS = {
+    "recognition": [("accuracy", "{:.3f}"), ("macro_f1", "{:.3f}"), ("decision_median", "{:.2f}"),
+                    ("decision_p90", "{:.2f}"), ("fps", "{:.0f}"), ("items", "{}")],
+    "segmentation": [("precision", "{:.3f}"), ("recall", "{:.3f}"), ("f1", "{:.3f}"), ("boundary_error", "{:.1f}"),
+                     ("fps", "{:.0f}"), ("items", "{}")],
+    "stream": [("error_rate", "{:.3f}"), ("fps", "{:.0f}"), ("items", "{}")],
+}
+
+
+def table(result: dict[str, Any]) -> str:
+    """A markdown table of a result's per-plugin rows."""
+    cols = COLUMNS[result["benchmark"]]
+    lines = ["| plugin | " + " | ".join(c for c, _ in cols) + " |", "|---" * (len(cols) + 1) + "|"]
+    for row in result["plugins"]:
+        lines.append(f"| {row['plugin']} | " + " | ".join(fmt.format(row[c]) for c, fmt in cols) + " |")
+    return "\n".join(lines)
+
+
+def write_outputs(result: dict[str, Any], args: Any) -> None:
+    from toolkit.state import write_atomic as atomic_write_text
+
+    result = {**result, "settings": {"seed": getattr(args, "seed", None), "versions": _versions(),
+                                     "set": list(getattr(args, "set", []))}}
+    if args.json:
+        atomic_write_text(Path(args.json), json.dumps(result, indent=1, default=float) + "\n")
+    if args.csv:
+        keys = ["kind", "plugin", "item"] + sorted({k for r in result["plugins"] + result["items"] for k in r}
+                                                   - {"plugin", "item", "labels", "confusion"})
+        rows = [{"kind": "plugin", **{k: v for k, v in r.items() if k not in ("labels", "confusion")}}
+                for r in result["plugins"]] + [{"kind": "item", **r} for r in result["items"]]
+        import io
+
+        out = io.StringIO()
+        writer = csv.DictWriter(out, fieldnames=keys, extrasaction="ignore", lineterminator="\n")
+        writer.writeheader()
+        for r in rows:
+            writer.writerow({**r, "versions": None})
+        out.write(f"# versions: {json.dumps(result['settings']['versions'])}\n")
+        atomic_write_text(Path(args.csv), out.getvalue())
+    if args.plot:
+        plot(result, Path(args.plot))
+
+
+def plot(result: dict[str, Any], path: Path) -> Path:
+    """Draw a result to PNG: confusion matrices (recognition) or the main score per plugin."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    kind = result["benchmark"]
+    if kind == "recognition":
+        n = len(result["plugins"])
+        fig, axes = plt.subplots(1, n, figsize=(5.5 * n, 5), squeeze=False)
+        for ax, row in zip(axes[0], result["plugins"]):
+            m = np.array(row["confusion"])
+            ax.imshow(m, cmap="Blues")
+            ax.set_xticks(range(len(row["labels"])), row["labels"], rotation=90, fontsize=7)
+            ax.set_yticks(range(len(row["labels"])), row["labels"], fontsize=7)
+            ax.set_title(f"{row['plugin']}: accuracy {row['accuracy']:.2f}")
+            ax.set_xlabel("recognised")
+            ax.set_ylabel("true")
+    else:
+        key = "f1" if kind == "segmentation" else "error_rate"
+        fig, ax = plt.subplots(figsize=(1.2 + 1.1 * len(result["plugins"]), 4))
+        names = [r["plugin"] for r in result["plugins"]]
+        ax.bar(range(len(names)), [r[key] for r in result["plugins"]], color="#4878a8")
+        ax.set_xticks(range(len(names)), names, rotation=30, ha="right", fontsize=8)
+        ax.set_ylabel(key.replace("_", " "))
+        ax.set_title(f"{kind}: {key.replace('_', ' ')} per plugin")
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return path
+
+
+# -- data ----------------------------------------------------------------------------------------------------
+
+
+def make_data(pm, dest: Path, *, seed: int = 0, streams: int = 6, per_stream: int = 6, noise: float = 0.003) -> Path:
+    """Write a benchmark folder from the project's own characters.
+
+    ``repertoire/NAME/max.bvh``: Max's own movements; ``demos/NAME/morris_S.bvh``: Morris's versions of them at
+    speeds 0.8, 1.0 and 1.25 with observation noise; ``streams/stream_K.bvh`` with ``.segments.csv``: Morris's
+    movements one after another from his rest pose; ``profile.toml``: the body profile (metres, +y up).
+    """
+    from toolkit import load_character
+    from toolkit.bvh import from_joint_positions, write_bvh
+    from toolkit.character import resolve_file
+    from toolkit.motion import concatenate
+
+    rng = np.random.default_rng(seed)
+    max_c = load_character(resolve_file("max.toml", None, pm), pm)
+    morris = load_character(resolve_file("morris.toml", None, pm), pm)
+    body = max_c.body
+    root = body.root_index
+    order = [root] + [i for i in range(body.n_parts) if i != root]
+    names = [body.parts[i] for i in order]
+    parents = [-1] + [0] * (len(order) - 1)
+
+    def save(motion, path: Path, jitter: float = 0.0) -> None:
+        positions = motion.positions[:, order] + rng.normal(0.0, jitter, motion.positions.shape) if jitter else \
+            motion.positions[:, order]
+        path.parent.mkdir(parents=True, exist_ok=True)
+        write_bvh(from_joint_positions(names, parents, positions, motion.fps), path)
+
+    dest = Path(dest)
+    movements = [m for m in max_c.motor.movements() if m in morris.motor.movements()]
+    for m in movements:
+        save(max_c.motor.perform(m, fps=30.0), dest / "repertoire" / m / "max.bvh")
+        for speed in (0.8, 1.0, 1.25):
+            save(morris.motor.perform(m, fps=30.0, speed=speed), dest / "demos" / m / f"morris_{speed}.bvh", noise)
+    rest = morris.motor.rest_pose()
+    for k in range(streams):
+        pieces, rows, at = [], [], 0
+        for m in rng.choice(movements, per_stream):
+            still = int(rng.integers(10, 30))
+            from toolkit.motion import Motion
+
+            pieces.append(Motion(np.repeat(rest[None], still, axis=0), 30.0, body.parts))
+            motion = morris.motor.perform(str(m), fps=30.0, speed=float(rng.choice([0.8, 1.0, 1.25])))
+            pieces.append(motion)
+            rows.append((at + still, at + still + motion.n_frames, str(m)))
+            at += still + motion.n_frames
+        pieces.append(Motion(np.repeat(rest[None], 15, axis=0), 30.0, body.parts))
+        save(concatenate(pieces), dest / "streams" / f"stream_{k + 1}.bvh", noise)
+        _write_segments(dest / "streams" / f"stream_{k + 1}.segments.csv", rows)
+    parts = "\n".join(f'{p} = "{p}"' for p in body.parts)
+    f = body.facing
+    facing = f'left = "{f.left}"\nright = "{f.right}"' + (f'\nforward = "{f.forward}"' if f.forward else "")
+    (dest / "profile.toml").write_text(f'[profile]\nname = "max"\nunits = "metre"\nup = "+y"\n\n[parts]\n{parts}\n\n'
+                                       f"[facing]\n{facing}\n", encoding="utf-8")
+    return dest
+
+
+def _write_segments(path: Path, rows: list[tuple[int, int, str]]) -> None:
+    path.write_text("start_frame,end_frame,movement\n" + "".join(f"{a},{b},{m}\n" for a, b, m in rows),
+                    encoding="utf-8")
+
+
+def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams: int = 12, per_stream: int = 5,
+           gestures_only: bool = True) -> Path:
+    """Benchmark folders from the Bandai-Namco clips (links and generated streams; nothing is copied).
+
+    ``repertoire/``: the normal-style clips; ``demos/``: every other style of the movements the repertoire has;
+    ``streams/``: ``per_stream`` random gesture demos (other styles) one after another, with their segments.
+    Locomotion never returns to a standing pose, so streams hold gestures only unless told otherwise.
+    """
+    from toolkit.bvh import BVH, read_bvh, write_bvh
+
+    src, dest = Path(src), Path(dest)
+    files = sorted(src.glob("dataset-1_*.bvh"))
+    if not files:
+        raise ConfigError("no Bandai-Namco clips", file=src, expected="dataset-1_{content}_{style}_{take}.bvh files")
+    clips: dict[tuple[str, str], list[Path]] = {}
+    for f in files:
+        _, content, style, _ = f.stem.split("_")
+        clips.setdefault((content, style), []).append(f)
+    known = {c for c, s in clips if s == "normal"}
+    for (content, style), paths in clips.items():
+        for p in paths:
+            target = dest / ("repertoire" if style == "normal" else "demos") / content / p.name
+            if style != "normal" and content not in known:
+                continue
+            target.parent.mkdir(parents=True, exist_ok=True)
+            if not target.exists():
+                target.symlink_to(p.resolve())
+    locomotion = {"walk", "run", "dash", "walk-back", "walk-left", "walk-right", "dance-short"}
+    pool = [p for (c, s), ps in clips.items() if s != "normal" and c in known and
+            (c not in locomotion or not gestures_only) for p in ps]
+    rng = np.random.default_rng(seed)
+    (dest / "streams").mkdir(parents=True, exist_ok=True)
+    for k in range(streams):
+        chosen = [pool[i] for i in rng.choice(len(pool), per_stream, replace=False)]
+        parts = [read_bvh(p) for p in chosen]
+        rows, at = [], 0
+        for p, b in zip(chosen, parts):
+            rows.append((at, at + b.n_frames, p.stem.split("_")[1]))
+            at += b.n_frames
+        first = parts[0]
+        values = np.concatenate([b.values for b in parts])
+        write_bvh(BVH(first.joints, first.frame_time, values, "stream"), dest / "streams" / f"stream_{k + 1:02d}.bvh")
+        _write_segments(dest / "streams" / f"stream_{k + 1:02d}.segments.csv", rows)
+    (dest / "profile.toml").write_text(Path(profile_path).read_text(encoding="utf-8"), encoding="utf-8")
+    return dest
+
+
+# -- the command line ----------------------------------------------------------------------------------------
+
+
+def _common(p) -> None:
+    p.add_argument("--body", required=True, metavar="PROFILE", help="body profile TOML of the files")
+    p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
+                   help="override a parameter of the observer, e.g. --set matcher.k=4 (repeatable)")
+    p.add_argument("--json", metavar="FILE", help="also write the results as JSON")
+    p.add_argument("--csv", metavar="FILE", help="also write the results as CSV (one row per plugin and per item)")
+    p.add_argument("--plot", metavar="PNG", help="draw the results (confusion matrices, scores per plugin)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def add_commands(sub) -> None:
+    p = sub.add_parser("recognition", help="classify labelled demo clips with every matcher named")
+    _common(p)
+    p.add_argument("--repertoire", required=True, metavar="DIR", help="labelled clips: one folder per movement")
+    p.add_argument("--demos", required=True, metavar="DIR", help="demo clips: one folder per true movement")
+    p.add_argument("--matcher", action="append", metavar="NAME", help=f"matcher (repeatable; default: {', '.join(MATCHERS)})")
+    p.set_defaults(handler=_cmd("recognition"))
+
+    p = sub.add_parser("segmentation", help="segment streams with known segments with every segmenter named")
+    _common(p)
+    p.add_argument("--streams", required=True, metavar="DIR", help="NAME.bvh files with NAME.segments.csv")
+    p.add_argument("--repertoire", metavar="DIR", help="clips the hubs are found from (default: the streams' ends)")
+    p.add_argument("--segmenter", action="append", metavar="NAME", help=f"segmenter (repeatable; default: {', '.join(SEGMENTERS)})")
+    p.set_defaults(handler=_cmd("segmentation"))
+
+    p = sub.add_parser("stream", help="segment and recognise streams end to end with every pairing")
+    _common(p)
+    p.add_argument("--repertoire", required=True, metavar="DIR", help="labelled clips: one folder per movement")
+    p.add_argument("--streams", required=True, metavar="DIR", help="NAME.bvh files with NAME.segments.csv")
+    p.add_argument("--segmenter", action="append", metavar="NAME", help="segmenter (repeatable)")
+    p.add_argument("--matcher", action="append", metavar="NAME", help="matcher (repeatable)")
+    p.set_defaults(handler=_cmd("stream"))
+
+    p = sub.add_parser("make-data", help="write repertoire, demos, streams and a profile from the built-in characters")
+    p.add_argument("dest", metavar="DIR")
+    p.add_argument("--seed", type=int, default=0)
+    p.set_defaults(handler=lambda args, pm: print(make_data(pm, Path(args.dest), seed=args.seed)) or 0)
+
+    p = sub.add_parser("bandai", help="build benchmark folders from the Bandai-Namco clips (links; nothing copied)")
+    p.add_argument("src", metavar="BANDAI_DIR")
+    p.add_argument("dest", metavar="DIR")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--profile", default=str(Path(__file__).resolve().parent.parent / "characters" / "profiles"
+                                            / "bandai-namco.toml"), help="the body profile to put beside the data")
+    p.set_defaults(handler=lambda args, pm: print(bandai(Path(args.src), Path(args.dest), Path(args.profile),
+                                                         seed=args.seed)) or 0)
+
+
+def _cmd(kind: str):
+    def run(args, pm) -> int:
+        profile = load_profile(args.body)
+        settings = _settings(args.set)
+        if kind == "recognition":
+            result = recognition(pm, profile, Path(args.repertoire), Path(args.demos), args.matcher or MATCHERS,
+                                 settings=settings, quiet=args.quiet)
+        elif kind == "segmentation":
+            result = segmentation(pm, profile, Path(args.streams), args.segmenter or SEGMENTERS,
+                                  repertoire=Path(args.repertoire) if args.repertoire else None, settings=settings,
+                                  quiet=args.quiet)
+        else:
+            result = stream(pm, profile, Path(args.repertoire), Path(args.streams), args.segmenter or SEGMENTERS[:2],
+                            args.matcher or MATCHERS, settings=settings, quiet=args.quiet)
+        print(table(result))
+        if kind == "recognition":
+            for row in result["plugins"]:
+                print(f"\n{row['plugin']} confusion (rows true, columns recognised): {', '.join(row['labels'])}")
+                for label, counts in zip(row["labels"], row["confusion"]):
+                    print(f"  {label:>12} " + " ".join(f"{c:3d}" for c in counts))
+        write_outputs(result, args)
+        return 0
+
+    return run

@@ -1,0 +1,197 @@
+"""Watching motion-capture files: clip repertoires, the observe loop, the baselines and the mocap benchmarks.
+
+Everything runs on data the project writes itself (``likeme bench make-data``: Max's movements as the
+repertoire, Morris's as demos and streams, as BVH); the Bandai-Namco tests skip where the data is absent.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from plugins.clip_repertoire import load_clip_repertoire
+from plugins.metrics import segmentation_scores
+from plugins.mocap_benchmark import make_data, read_segments, recognition
+from tests.conftest import BANDAI, CHARACTERS
+from toolkit import ConfigError, create_plugin_manager, load_character
+from toolkit.cli import main
+from toolkit.observe import Observer, compose_observer
+from toolkit.profile import load_profile
+
+
+@pytest.fixture(scope="module")
+def data(tmp_path_factory):
+    pm = create_plugin_manager(autoload=False, trace=False)
+    return make_data(pm, tmp_path_factory.mktemp("generated"), seed=3, streams=3, per_stream=5)
+
+
+@pytest.fixture(scope="module")
+def profile(data):
+    return load_profile(data / "profile.toml")
+
+
+def test_the_hub_is_found_from_the_clips_and_is_maxs_standing_pose(data, profile, pm):
+    repertoire = load_clip_repertoire(data / "repertoire", profile)
+    max_c = load_character(CHARACTERS / "max.toml", pm)
+    stand = max_c.motor.rest_pose()
+    root = max_c.body.root_index
+    assert len(repertoire.hubs) == 1  # every one of Max's movements starts and ends standing
+    hub = repertoire.hubs[0]
+    np.testing.assert_allclose(hub - hub[root], stand - stand[root], atol=1e-3)
+    assert repertoire.movements == sorted(max_c.motor.movements())
+
+
+def test_the_same_clips_become_a_posegraph_and_a_motor_command_graph(data, profile, pm):
+    graph = compose_observer(pm, profile, data / "repertoire", matcher="path-search").motor
+    commands = compose_observer(pm, profile, data / "repertoire", matcher="forward-model").motor
+    assert graph.name == "posegraph" and commands.name == "motor-command-graph"
+    assert sorted(graph.movements()) == sorted(commands.movements()) == load_clip_repertoire(
+        data / "repertoire", profile).movements
+    assert list(commands.subsystems) == ["body"]
+    sequence = commands.sequences["jump"]
+    assert commands.edge(sequence[0])[1] == "hub" and commands.label("jump") == "jump"
+    assert graph.perform("jump", fps=30).n_frames > 10 and commands.perform("jump", fps=30).n_frames > 10
+
+
+def test_observing_a_stream_finds_and_names_its_movements(data, profile, pm):
+    character = compose_observer(pm, profile, data / "repertoire", matcher="path-search")
+    tp = found_n = true_n = right = 0
+    for path in sorted((data / "streams").glob("*.bvh")):
+        truth = read_segments(path.with_suffix(".segments.csv"))
+        motion = profile.read(path)
+        found = Observer(character, profile.body, motion.fps).watch(motion)
+        scores = segmentation_scores([(o.segment.start, o.segment.end) for o in found], [(a, b) for a, b, _ in truth])
+        tp, found_n, true_n = tp + scores["true_positives"], found_n + scores["found"], true_n + scores["true"]
+        right += sum(o.movement == label for o, (_, _, label) in zip(found, truth))
+    assert tp / found_n >= 0.9 and tp / true_n >= 0.75  # movements with a short pause between them may merge
+    assert right >= 0.6 * true_n
+
+
+def test_a_live_loop_gives_what_watching_the_whole_file_gives(data, profile, pm):
+    character = compose_observer(pm, profile, data / "repertoire", segmenter="hub-threshold", matcher="dtw")
+    path = data / "streams" / "stream_1.bvh"
+    motion = profile.read(path)
+    whole = Observer(character, profile.body, motion.fps).watch(motion)
+    live = Observer(character, profile.body, motion.fps)
+    got = []
+    for f in range(motion.n_frames):
+        got.extend(live.push(motion.positions[f]))
+    got.extend(live.flush())
+    assert [(o.segment, o.movement) for o in got] == [(o.segment, o.movement) for o in whole]
+
+
+def test_nan_frames_and_hidden_parts_are_not_seen_rather_than_a_crash(data, profile, pm):
+    character = compose_observer(pm, profile, data / "repertoire", matcher="path-search")
+    motion = profile.read(data / "streams" / "stream_1.bvh")
+    positions = motion.positions.copy()
+    positions[50:80] = np.nan  # everything gone for a second
+    positions[:, 2] = np.inf  # one part never finite
+    observer = Observer(character, profile.body, motion.fps)
+    found = []
+    for f in range(len(positions)):
+        found.extend(observer.push(positions[f]))
+    found.extend(observer.flush())
+    assert all(o.movement is None or o.movement in character.motor.movements() for o in found)
+    assert found and all(a.segment.end <= b.segment.start for a, b in zip(found, found[1:]))
+
+
+def test_the_forward_model_commits_before_a_familiar_demo_ends(data, profile, pm):
+    character = compose_observer(pm, profile, data / "repertoire", matcher="forward-model",
+                                 settings={"matcher": {"error": "mean"}})
+    motion = profile.read(data / "repertoire" / "jump" / "max.bvh")  # his own jump, watched
+    obs = Observer(character, profile.body, motion.fps).classify(motion)
+    assert obs.movement == "jump"
+    assert obs.decision_fraction < 1.0
+
+
+def test_recognition_scores_every_matcher_on_the_same_demos(data, profile, pm):
+    result = recognition(pm, profile, data / "repertoire", data / "demos", ["path-search", "dtw"])
+    rows = {r["plugin"]: r for r in result["plugins"]}
+    assert rows["path-search"]["accuracy"] >= 0.85 and rows["dtw"]["accuracy"] >= 0.85
+    assert rows["dtw"]["decision_median"] == 1.0  # dtw waits for the end
+    assert len(result["items"]) == 2 * rows["dtw"]["items"]
+    m = np.array(rows["dtw"]["confusion"])
+    assert m.sum() == rows["dtw"]["items"] and np.trace(m) == round(rows["dtw"]["accuracy"] * m.sum())
+
+
+def test_the_bench_commands_print_tables_and_write_json_csv_and_png(data, tmp_path, capsys):
+    common = ["--body", str(data / "profile.toml"), "--quiet"]
+    out = tmp_path / "out"
+    assert main(["bench", "segmentation", *common, "--streams", str(data / "streams"), "--json", str(out / "s.json"),
+                 "--csv", str(out / "s.csv"), "--plot", str(out / "s.png")]) == 0 if out.mkdir() is None else False
+    text = capsys.readouterr().out
+    assert "| hub-threshold |" in text and "| ruptures |" in text and "| velocity-direction |" in text
+    result = json.loads((out / "s.json").read_text())
+    hub = next(r for r in result["plugins"] if r["plugin"] == "hub-threshold")
+    assert hub["f1"] >= 0.9
+    assert result["settings"]["versions"]["ruptures"] != "not installed"
+    csv_lines = (out / "s.csv").read_text().splitlines()
+    assert csv_lines[0].startswith("kind,plugin,item") and sum(line.startswith("item,") for line in csv_lines) == 9
+    assert (out / "s.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert main(["bench", "stream", *common, "--repertoire", str(data / "repertoire"), "--streams",
+                 str(data / "streams"), "--segmenter", "hub-threshold", "--matcher", "dtw",
+                 "--json", str(out / "t.json")]) == 0
+    rate = json.loads((out / "t.json").read_text())["plugins"][0]["error_rate"]
+    assert rate <= 0.2
+    assert main(["bench", "recognition", *common, "--repertoire", str(data / "repertoire"), "--demos",
+                 str(data / "demos"), "--matcher", "dtw", "--plot", str(out / "r.png")]) == 0
+    assert "dtw confusion" in capsys.readouterr().out and (out / "r.png").stat().st_size > 1000
+
+
+def test_observe_prints_segments_and_json(data, capsys):
+    args = ["observe", "--body", str(data / "profile.toml"), "--repertoire", str(data / "repertoire"),
+            str(data / "streams" / "stream_2.bvh")]
+    assert main(args) == 0
+    text = capsys.readouterr().out
+    assert "stream_2.bvh: " in text and "decided at frame" in text
+    assert main([*args, "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    truth = [m for _, _, m in read_segments(data / "streams" / "stream_2.segments.csv")]
+    assert [s["movement"] for s in report[0]["segments"]][: len(truth)].count("unknown") <= 1
+    assert {"start_frame", "end_frame", "start_s", "end_s", "confidence", "decision_fraction"} <= set(
+        report[0]["segments"][0])
+
+
+@pytest.mark.parametrize(
+    "args, expected",
+    [
+        (["--matcher", "forward-mode"], "unknown matcher 'forward-mode'; expected the name of a registered matcher; "
+                                        "available: dtw, forward-model, path-search"),
+        (["--segmenter", "rupture"], "unknown segmenter 'rupture'"),
+    ],
+)
+def test_observe_refuses_unknown_plugins_with_the_registered_names(data, capsys, args, expected):
+    assert main(["observe", "--body", str(data / "profile.toml"), "--repertoire", str(data / "repertoire"), *args,
+                 str(data / "streams" / "stream_1.bvh")]) == 1
+    assert expected in capsys.readouterr().err
+
+
+def test_bad_segment_files_and_clip_folders_are_named(tmp_path, profile):
+    bad = tmp_path / "s.segments.csv"
+    bad.write_text("start,end,movement\n0,10,a\n")
+    with pytest.raises(ConfigError, match=r"s.segments.csv:1: found header .*expected the header start_frame"):
+        read_segments(bad)
+    bad.write_text("start_frame,end_frame,movement\n0,10,a\n12,x,b\n")
+    with pytest.raises(ConfigError, match=r"s.segments.csv:3: found '12,x,b'; expected two frame numbers"):
+        read_segments(bad)
+    bad.write_text("start_frame,end_frame,movement\n10,10,a\n")
+    with pytest.raises(ConfigError, match=r":2: segment 10..10; expected 0 <= start_frame < end_frame"):
+        read_segments(bad)
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(ConfigError, match="empty: no clips found"):
+        load_clip_repertoire(tmp_path / "empty", profile)
+
+
+@pytest.mark.skipif(not BANDAI.is_dir(), reason=f"Bandai-Namco motion capture not found at {BANDAI}")
+def test_observing_a_bandai_namco_clip(tmp_path, pm):
+    for style in ("normal", "happy"):
+        for content in ("bow", "bye"):
+            folder = tmp_path / style / content
+            folder.mkdir(parents=True)
+            (folder / "clip.bvh").symlink_to(BANDAI / f"dataset-1_{content}_{style}_001.bvh")
+    profile = load_profile(CHARACTERS / "profiles" / "bandai-namco.toml")
+    rows = {r["plugin"]: r for r in recognition(pm, profile, tmp_path / "normal", tmp_path / "happy",
+                                                 ["path-search", "dtw"])["plugins"]}
+    assert rows["dtw"]["items"] == 2 and rows["dtw"]["accuracy"] == 1.0

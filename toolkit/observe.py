@@ -1,0 +1,211 @@
+"""Watching recorded or live poses without a world: the loop behind ``likeme observe``.
+
+An :class:`Observer` is a character watching a stream of a body's world poses,
+one frame at a time, as it would in a world (perceive, segment, match; see
+:mod:`toolkit.runtime`), but fed by the caller: a motion-capture file, a
+network socket, a tracker. Each segment that closes comes back as an
+:class:`Observation` with the matcher's answer and the moment it decided::
+
+    observer = Observer(character, profile.body, fps=30.0)
+    for positions in live_source():            # (P, 3) world positions, NaN where unseen
+        for obs in observer.push(positions):
+            print(obs.segment.start, obs.match.movement, obs.decided_at)
+    observer.flush()
+
+:func:`compose_observer` builds the observing character from a body profile, a
+folder of labelled clips and plugin names, as ``likeme observe`` does. The
+observer never learns: matchers with a ``learn`` parameter get ``learn = false``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from toolkit.character import Character, compose_character
+from toolkit.components import Match, Segment
+from toolkit.errors import ConfigError, PluginError
+from toolkit.motion import Motion
+from toolkit.profile import BodyProfile
+
+__all__ = ["Observation", "Observer", "compose_observer", "observe_motion"]
+
+
+@dataclass(frozen=True)
+class Observation:
+    """One segment found in the stream and what the matcher made of it.
+
+    ``decided_at`` is the number of frames into the segment at which the matcher
+    committed (``None``: at its end); ``match`` is ``None`` without a matcher.
+    """
+
+    segment: Segment
+    match: Match | None
+    decided_at: int | None
+
+    @property
+    def movement(self) -> str | None:
+        return self.match.movement if self.match is not None else None
+
+    @property
+    def decision_fraction(self) -> float:
+        """Share of the segment seen when the matcher committed (1.0 when it waited for the end)."""
+        if self.decided_at is None:
+            return 1.0
+        return float(min(1.0, self.decided_at / self.segment.n_frames))
+
+
+class Observer:
+    """A character watching a stream of world poses of ``body`` at ``fps``, frame by frame."""
+
+    def __init__(self, character: Character, body: Any, fps: float) -> None:
+        if character.perception is None or character.segmenter is None:
+            raise ConfigError(f"character {character.name} cannot observe", expected="a perception and a segmenter")
+        self.character, self.body, self.fps = character, body, float(fps)
+        self.reset()
+
+    def reset(self) -> None:
+        """Start a new stream: frame numbering, memory, segmenter and matcher restart."""
+        c = self.character
+        c.perception.fps = self.fps
+        c.perception.reset()
+        c.segmenter.reset(self.body.parts, self.fps)
+        self.poses: list[np.ndarray] = []
+        self.visible: list[np.ndarray] = []
+        self._early: Match | None = None
+        self._open: int | None = None
+
+    @property
+    def n_frames(self) -> int:
+        return len(self.poses)
+
+    def push(self, positions: np.ndarray, visible: np.ndarray | None = None) -> list[Observation]:
+        """One frame of world positions (P, 3); returns the observations of segments that closed here."""
+        c = self.character
+        percept = c.perception.perceive_pose(positions, visible, self.body, self.n_frames / self.fps)
+        self.poses.append(percept.pose)
+        self.visible.append(percept.visible)
+        closed = c.segmenter.push(percept.pose, percept.visible)
+        out = self._close(closed)
+        self._follow()
+        return out
+
+    def watch(self, motion: Motion) -> list[Observation]:
+        """Stream a whole motion of world positions (reset first, flushed at the end)."""
+        self.reset()
+        out: list[Observation] = []
+        for f in range(motion.n_frames):
+            out.extend(self.push(motion.positions[f], motion.visible[f]))
+        out.extend(self.flush())
+        return out
+
+    def classify(self, motion: Motion) -> Observation:
+        """Take a whole motion of world positions as one segment: what the matcher makes of it, and when.
+
+        The frames are perceived and fed to the matcher one by one (so a streaming matcher may commit early);
+        the segmenter is not used.
+        """
+        c = self.character
+        if c.matcher is None:
+            raise ConfigError(f"character {c.name} cannot classify", expected="a matcher")
+        self.reset()
+        c.matcher.begin(self.fps)
+        early = None
+        for f in range(motion.n_frames):
+            percept = c.perception.perceive_pose(motion.positions[f], motion.visible[f], self.body, f / self.fps)
+            self.poses.append(percept.pose)
+            self.visible.append(percept.visible)
+            match = c.matcher.observe(percept.pose, percept.visible)
+            if early is None and match is not None and not match.details.get("stop"):
+                early = match
+        segment = Segment(0, max(1, motion.n_frames), self.fps)
+        late = c.matcher.conclude(Motion(np.array(self.poses), self.fps, self.body.parts, np.array(self.visible)))
+        if late is None and early is not None:
+            return Observation(segment, early, early.decided_at)
+        return Observation(segment, late if late is not None else Match.unknown(), None)
+
+    def flush(self) -> list[Observation]:
+        """End of the stream: the segment under way (if the segmenter accepts it)."""
+        return self._close(self.character.segmenter.flush())
+
+    def _follow(self) -> None:
+        """Feed the streaming matcher the frames of the segment under way (from its onset)."""
+        m, since = self.character.matcher, self.character.segmenter.active_since
+        if m is None or since is None:
+            self._open = None
+            return
+        if self._open != since:
+            self._open, self._early = since, None
+            m.begin(self.fps)
+            frames = range(since, self.n_frames)
+        else:
+            frames = range(self.n_frames - 1, self.n_frames)
+        for f in frames:
+            match = m.observe(self.poses[f], self.visible[f])
+            if match is not None and self._early is None and not match.details.get("stop"):
+                self._early = match
+
+    def _close(self, closed: list[Segment]) -> list[Observation]:
+        out = []
+        for segment in closed:
+            if not isinstance(segment, Segment):
+                raise PluginError(self.character.segmenter.name, "Segmenter.push", f"returned {segment!r}")
+            m = self.character.matcher
+            if m is None:
+                out.append(Observation(segment, None, None))
+                continue
+            motion = Motion(np.array(self.poses[segment.start : segment.end]), self.fps, self.body.parts,
+                            np.array(self.visible[segment.start : segment.end]))
+            early = self._early if self._open == segment.start else None
+            if early is None:  # a batch matcher, or a segmenter that only reports segments once they are over
+                m.begin(self.fps)
+            late = m.conclude(motion)
+            if late is None and early is not None:
+                out.append(Observation(segment, early, early.decided_at))
+            else:
+                out.append(Observation(segment, late if late is not None else Match.unknown(), None))
+            self._early, self._open = None, None
+        return out
+
+
+def observe_motion(observer: Observer, motion: Motion) -> list[Observation]:
+    """Stream a whole motion of world positions through ``observer`` (reset first) and flush it."""
+    return observer.watch(motion)
+
+
+def compose_observer(pm: Any, profile: BodyProfile, repertoire: str | Path, *, segmenter: str = "hub-threshold",
+                     matcher: str | None = "path-search", settings: Mapping[str, Mapping[str, Any]] | None = None,
+                     motor: str | None = None) -> Character:
+    """The observing character: ``profile``'s body, a repertoire from the clips in ``repertoire``, named plugins.
+
+    The motor system is the one the matcher works with (its ``motor_systems``), else ``posegraph``.
+    ``settings`` holds extra parameters per table (``{"matcher": {"k": 4}}``).
+    """
+    settings = {k: dict(v) for k, v in (settings or {}).items()}
+    if matcher is not None:
+        cls = pm.registry.get("matcher", matcher)
+        wanted = getattr(cls, "motor_systems", ()) or ("posegraph",)
+        motor = motor or wanted[0]
+        if any(p.name == "learn" for p in cls.parameters):
+            settings.setdefault("matcher", {}).setdefault("learn", False)
+    facing = {"left": profile.body.facing.left, "right": profile.body.facing.right}
+    if profile.body.facing.forward:
+        facing["forward"] = profile.body.facing.forward
+    if profile.body.facing.behind:
+        facing["behind"] = profile.body.facing.behind
+    table: dict[str, Any] = {
+        "character": {"name": "observer", "description": f"watches {profile.name} motion"},
+        "body": {"parts": list(profile.body.parts), "root": profile.body.root, "facing": facing,
+                 "bones": [list(b) for b in profile.body.bones]},
+        "motor": {"plugin": motor or "posegraph", "clips": str(Path(repertoire).resolve()),
+                  "profile": str(profile.file.resolve()) if profile.file else "", **settings.get("motor", {})},
+        "perception": {"plugin": "motion-capture", **settings.get("perception", {})},
+        "segmenter": {"plugin": segmenter, **settings.get("segmenter", {})},
+    }
+    if matcher is not None:
+        table["matcher"] = {"plugin": matcher, **settings.get("matcher", {})}
+    return compose_character(table, pm)
