@@ -23,9 +23,7 @@ column, what was expected and what was found.
 
 from __future__ import annotations
 
-import os
 import re
-import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -357,18 +355,10 @@ def format_bvh(bvh: BVH, *, precision: int = 6) -> str:
 
 def write_bvh(bvh: BVH, path: str | Path, *, precision: int = 6) -> Path:
     """Write ``bvh`` to ``path`` atomically (temporary file, flush, rename); returns the path."""
+    from toolkit.state import write_atomic
+
     path = Path(path)
-    text = format_bvh(bvh, precision=precision)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent or ".")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
-            fh.write(text)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    write_atomic(path, format_bvh(bvh, precision=precision))
     return path
 
 
