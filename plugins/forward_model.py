@@ -136,8 +136,8 @@ class ForwardModel(Matcher):
                 self.committed_path = self._known_continuation(path)
                 self.committed = self.motor.add_sequence(list(self.committed_path))
                 speed = self._speed(path[0], lengths, len(observed))
-                label = getattr(self.motor, "label_of_path", lambda p: None)(self.committed_path)
-                return Match(label or self.motor.label(self.committed), float(np.exp(-alive[path] / self.params["threshold"])), len(self.frames),
+                label = self._path_label(self.committed_path) or self.motor.label(self.committed)
+                return Match(label, float(np.exp(-alive[path] / self.params["threshold"])), len(self.frames),
                              path=self.committed_path,
                              details={"candidates": list(self.initial), "speed": speed, "progress": progress})
         return None
@@ -195,9 +195,14 @@ class ForwardModel(Matcher):
             out.extend([(*path, n) for n in nxt if n not in path] or [path])
         return out
 
+    def _path_label(self, path: tuple[str, ...]) -> str | None:
+        """The labelled movement (clip repertoires) every sequence along ``path`` is an example of, else ``None``."""
+        label_of_path = getattr(self.motor, "label_of_path", None)
+        return label_of_path(path) if label_of_path is not None else None
+
     def _movement_key(self, path: tuple[str, ...]) -> str:
         """What a candidate stands for: the labelled movement its sequences are examples of, else its first command."""
-        label = getattr(self.motor, "label_of_path", lambda p: None)(path)
+        label = self._path_label(path)
         return label if label is not None else path[0]
 
     def _known_continuation(self, path: tuple[str, ...]) -> tuple[str, ...]:
@@ -232,11 +237,18 @@ class ForwardModel(Matcher):
         The largest over the parts, or their mean (``error``); with ``relative`` the prediction is moved by
         the offset between the observed onset posture and the path's start.
         """
-        predicted = self._predict(path, lengths)
-        if self.params["relative"]:
-            start = np.array([self._table(st)[1][0] for st in self._strokes_of(path[0])])
-            predicted = predicted + (self.frames[0][self.motor.subsystems[self.subsystem]] - start)
-        d = np.linalg.norm(predicted - last, axis=-1)
+        return self._distance(self._predict(path, lengths) + self._onset_offset(path[0]), last)
+
+    def _onset_offset(self, name: str) -> np.ndarray | float:
+        """With ``relative``: the observed onset posture minus where command ``name`` starts (k, 3); else 0."""
+        if not self.params["relative"]:
+            return 0.0
+        start = np.array([self._table(st)[1][0] for st in self._strokes_of(name)])
+        return self.frames[0][self.motor.subsystems[self.subsystem]] - start
+
+    def _distance(self, predicted: np.ndarray, observed: np.ndarray) -> float:
+        """Per-part distances (k, 3 each) combined as ``error`` says: the largest or the mean."""
+        d = np.linalg.norm(predicted - observed, axis=-1)
         return float(d.max() if self.params["error"] == "max" else d.mean())
 
     def _progress(self, name: str, lengths: np.ndarray) -> float:
@@ -263,13 +275,9 @@ class ForwardModel(Matcher):
         if self.committed is not None and not self.deviated:
             end = self.motor.edge(self.committed_path[-1])[2]
             state = self.motor.graphs[self.subsystem].nodes[end]["state"]
-            idx = self.motor.subsystems[self.subsystem]
-            observed_end = np.array(self.frames)[-1, idx]
-            if self.params["relative"]:
-                start = np.array([self._table(st)[1][0] for st in self._strokes_of(self.committed_path[0])])
-                state = state + (self.frames[0][idx] - start)
-            d = np.linalg.norm(observed_end - state, axis=-1)
-            if (d.max() if self.params["error"] == "max" else d.mean()) <= self.params["deviation"]:
+            observed_end = self.frames[-1][self.motor.subsystems[self.subsystem]]
+            expected = state + self._onset_offset(self.committed_path[0])
+            if self._distance(expected, observed_end) <= self.params["deviation"]:
                 self.motor.active[self.subsystem] = end
                 return None  # already reported when it committed
             self.deviated = True  # it ended somewhere else: the committed command was not the right one

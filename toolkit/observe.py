@@ -124,9 +124,7 @@ class Observer:
                 early = match
         segment = Segment(0, max(1, motion.n_frames), self.fps)
         late = c.matcher.conclude(Motion(np.array(self.poses), self.fps, self.body.parts, np.array(self.visible)))
-        if late is None and early is not None:
-            return Observation(segment, early, early.decided_at)
-        return Observation(segment, late if late is not None else Match.unknown(), None)
+        return _answer(segment, early, late)
 
     def flush(self) -> list[Observation]:
         """End of the stream: the segment under way (if the segmenter accepts it)."""
@@ -163,13 +161,16 @@ class Observer:
             early = self._early if self._open == segment.start else None
             if early is None:  # a batch matcher, or a segmenter that only reports segments once they are over
                 m.begin(self.fps)
-            late = m.conclude(motion)
-            if late is None and early is not None:
-                out.append(Observation(segment, early, early.decided_at))
-            else:
-                out.append(Observation(segment, late if late is not None else Match.unknown(), None))
+            out.append(_answer(segment, early, m.conclude(motion)))
             self._early, self._open = None, None
         return out
+
+
+def _answer(segment: Segment, early: Match | None, late: Match | None) -> Observation:
+    """The matcher's answer for a segment: what it concluded at the end, else what it committed to early."""
+    if late is None and early is not None:
+        return Observation(segment, early, early.decided_at)
+    return Observation(segment, late if late is not None else Match.unknown(), None)
 
 
 def observe_motion(observer: Observer, motion: Motion) -> list[Observation]:
