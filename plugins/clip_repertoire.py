@@ -32,7 +32,7 @@ from plugins.root_frame import facing_heading, smooth_heading, to_root_relative
 from toolkit import ConfigError, Motion, Parameter
 from toolkit.profile import BodyProfile, load_profile
 
-__all__ = ["Clip", "ClipRepertoire", "load_clip_repertoire", "find_hubs", "root_relative_motion", "clip_files",
+__all__ = ["Clip", "ClipRepertoire", "load_clip_repertoire", "find_hubs", "root_relative_motion", "clip_files", "example_name",
            "CLIP_PARAMETERS", "repertoire_for"]
 
 CLIP_SUFFIXES = (".bvh",)
@@ -70,6 +70,11 @@ def root_relative_motion(world: Motion, profile: BodyProfile, facing_window: flo
     heading = smooth_heading(heading, max(1, int(round(facing_window * world.fps))))
     pose, mask, _, _ = to_root_relative(world.positions, world.visible, profile.body, heading)
     return Motion(pose, world.fps, world.parts, mask)
+
+
+def example_name(movement: str, earlier: int) -> str:
+    """The name of a movement's next example clip, after ``earlier`` ones: ``bow``, ``bow#2``, ``bow#3``..."""
+    return movement if earlier == 0 else f"{movement}#{earlier + 1}"
 
 
 def clip_files(folder: Path) -> dict[str, list[Path]]:
@@ -130,8 +135,7 @@ def load_clip_repertoire(folder: str | Path, profile: str | Path | BodyProfile, 
     hubs_rel = find_hubs(ends, hub_radius, hub_share)
     height = _root_height(rel, profile)
     lift = np.array([0.0, height, 0.0])
-    clips = tuple(Clip(mv, path, Motion(np.where(m.visible[..., None], m.positions, np.nan) + lift, m.fps, m.parts,
-                                        m.visible)) for mv, path, m in rel)
+    clips = tuple(Clip(mv, path, Motion(m.positions + lift, m.fps, m.parts, m.visible)) for mv, path, m in rel)
     return ClipRepertoire(profile, clips, hubs_rel + lift, Path(folder))
 
 

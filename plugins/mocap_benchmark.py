@@ -25,6 +25,7 @@ concatenating clips), without copying anything into the repository.
 from __future__ import annotations
 
 import csv
+import io
 import json
 import platform
 import time
@@ -109,6 +110,26 @@ def _versions() -> dict[str, str]:
     return out
 
 
+class _Clock:
+    """Runs an observer over motions and counts the frames and the seconds spent, for frames per second."""
+
+    def __init__(self, character, profile) -> None:
+        self.character, self.profile, self.frames, self.seconds = character, profile, 0, 0.0
+
+    def run(self, how: str, motion):
+        """``Observer.watch`` or ``Observer.classify`` on ``motion``, timed."""
+        observer = Observer(self.character, self.profile.body, motion.fps)
+        t0 = time.perf_counter()
+        out = getattr(observer, how)(motion)
+        self.seconds += time.perf_counter() - t0
+        self.frames += motion.n_frames
+        return out
+
+    @property
+    def fps(self) -> float:
+        return self.frames / max(self.seconds, 1e-9)
+
+
 def _progress(items: list, label: str, quiet: bool):
     if quiet:
         return items
@@ -127,14 +148,10 @@ def recognition(pm, profile, repertoire: Path, demos: Path, matchers: Sequence[s
     motions = [(label, path, profile.read(path)) for label, path in items]
     plugins, rows = [], []
     for name in matchers:
-        character = compose_observer(pm, profile, repertoire, matcher=name, settings=settings)
-        truth, predicted, fractions, frames, seconds = [], [], [], 0, 0.0
+        clock = _Clock(compose_observer(pm, profile, repertoire, matcher=name, settings=settings), profile)
+        truth, predicted, fractions = [], [], []
         for label, path, motion in _progress(motions, f"recognition {name}", quiet):
-            observer = Observer(character, profile.body, motion.fps)
-            t0 = time.perf_counter()
-            obs = observer.classify(motion)
-            seconds += time.perf_counter() - t0
-            frames += motion.n_frames
+            obs = clock.run("classify", motion)
             truth.append(label)
             predicted.append(obs.movement or "unknown")
             fractions.append(obs.decision_fraction)
@@ -147,7 +164,7 @@ def recognition(pm, profile, repertoire: Path, demos: Path, matchers: Sequence[s
             confusion[labels.index(t), labels.index(p)] += 1
         plugins.append({"plugin": name, "accuracy": float(np.mean([t == p for t, p in zip(truth, predicted)])),
                         "macro_f1": _macro_f1(truth, predicted), "decision_median": float(np.median(fractions)),
-                        "decision_p90": float(np.percentile(fractions, 90)), "fps": frames / max(seconds, 1e-9),
+                        "decision_p90": float(np.percentile(fractions, 90)), "fps": clock.fps,
                         "items": len(truth), "labels": labels, "confusion": confusion.tolist()})
     return {"benchmark": "recognition", "plugins": plugins, "items": rows}
 
@@ -171,16 +188,12 @@ def segmentation(pm, profile, streams: Path, segmenters: Sequence[str], *, reper
     data = [(path, truth, profile.read(path)) for path, truth in _streams(streams)]
     plugins, rows = [], []
     for name in segmenters:
-        character = compose_observer(pm, profile, repertoire or streams, segmenter=name, matcher=None,
-                                     settings=settings)
+        clock = _Clock(compose_observer(pm, profile, repertoire or streams, segmenter=name, matcher=None,
+                                        settings=settings), profile)
         found_all = true_all = tp = 0
-        errors, frames, seconds = [], 0, 0.0
+        errors = []
         for path, truth, motion in _progress(data, f"segmentation {name}", quiet):
-            observer = Observer(character, profile.body, motion.fps)
-            t0 = time.perf_counter()
-            found = [o.segment for o in observer.watch(motion)]
-            seconds += time.perf_counter() - t0
-            frames += motion.n_frames
+            found = [o.segment for o in clock.run("watch", motion)]
             s = segmentation_scores([(f.start, f.end) for f in found], [(a, b) for a, b, _ in truth])
             found_all, true_all, tp = found_all + s["found"], true_all + s["true"], tp + s["true_positives"]
             if s["true_positives"]:
@@ -192,7 +205,7 @@ def segmentation(pm, profile, streams: Path, segmenters: Sequence[str], *, reper
         f1 = 2 * precision * recall / (precision + recall) if precision + recall else 0.0
         boundary = sum(e * n for e, n in errors) / max(1, sum(n for _, n in errors))
         plugins.append({"plugin": name, "precision": precision, "recall": recall, "f1": f1,
-                        "boundary_error": boundary, "fps": frames / max(seconds, 1e-9), "items": len(data)})
+                        "boundary_error": boundary, "fps": clock.fps, "items": len(data)})
     return {"benchmark": "segmentation", "plugins": plugins, "items": rows}
 
 
@@ -203,14 +216,11 @@ def stream(pm, profile, repertoire: Path, streams: Path, segmenters: Sequence[st
     plugins, rows = [], []
     for seg in segmenters:
         for mat in matchers:
-            character = compose_observer(pm, profile, repertoire, segmenter=seg, matcher=mat, settings=settings)
-            errors, true_count, frames, seconds = 0.0, 0, 0, 0.0
+            clock = _Clock(compose_observer(pm, profile, repertoire, segmenter=seg, matcher=mat, settings=settings),
+                           profile)
+            errors, true_count = 0.0, 0
             for path, truth, motion in _progress(data, f"stream {seg} + {mat}", quiet):
-                observer = Observer(character, profile.body, motion.fps)
-                t0 = time.perf_counter()
-                recognised = [o.movement or "unknown" for o in observer.watch(motion)]
-                seconds += time.perf_counter() - t0
-                frames += motion.n_frames
+                recognised = [o.movement or "unknown" for o in clock.run("watch", motion)]
                 labels = [label for _, _, label in truth]
                 rate = movement_error_rate(recognised, labels)
                 errors += rate * len(labels)
@@ -218,7 +228,7 @@ def stream(pm, profile, repertoire: Path, streams: Path, segmenters: Sequence[st
                 rows.append({"plugin": f"{seg}+{mat}", "item": path.name, "truth": " ".join(labels),
                              "recognised": " ".join(recognised), "error_rate": round(rate, 4)})
             plugins.append({"plugin": f"{seg}+{mat}", "segmenter": seg, "matcher": mat,
-                            "error_rate": errors / max(true_count, 1), "fps": frames / max(seconds, 1e-9),
+                            "error_rate": errors / max(true_count, 1), "fps": clock.fps,
                             "items": len(data)})
     return {"benchmark": "stream", "plugins": plugins, "items": rows}
 
@@ -255,13 +265,11 @@ def write_outputs(result: dict[str, Any], args: Any) -> None:
                                                    - {"plugin", "item", "labels", "confusion"})
         rows = [{"kind": "plugin", **{k: v for k, v in r.items() if k not in ("labels", "confusion")}}
                 for r in result["plugins"]] + [{"kind": "item", **r} for r in result["items"]]
-        import io
-
         out = io.StringIO()
         writer = csv.DictWriter(out, fieldnames=keys, extrasaction="ignore", lineterminator="\n")
         writer.writeheader()
         for r in rows:
-            writer.writerow({**r, "versions": None})
+            writer.writerow(r)
         out.write(f"# versions: {json.dumps(result['settings']['versions'])}\n")
         atomic_write_text(Path(args.csv), out.getvalue())
     if args.plot:
@@ -315,7 +323,7 @@ def make_data(pm, dest: Path, *, seed: int = 0, streams: int = 6, per_stream: in
     from toolkit import load_character
     from toolkit.bvh import from_joint_positions, write_bvh
     from toolkit.character import resolve_file
-    from toolkit.motion import concatenate
+    from toolkit.motion import Motion, concatenate
 
     rng = np.random.default_rng(seed)
     max_c = load_character(resolve_file("max.toml", None, pm), pm)
@@ -343,8 +351,6 @@ def make_data(pm, dest: Path, *, seed: int = 0, streams: int = 6, per_stream: in
         pieces, rows, at = [], [], 0
         for m in rng.choice(movements, per_stream):
             still = int(rng.integers(10, 30))
-            from toolkit.motion import Motion
-
             pieces.append(Motion(np.repeat(rest[None], still, axis=0), 30.0, body.parts))
             motion = morris.motor.perform(str(m), fps=30.0, speed=float(rng.choice([0.8, 1.0, 1.25])))
             pieces.append(motion)

@@ -34,7 +34,7 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
-from plugins.clip_repertoire import CLIP_PARAMETERS, repertoire_for
+from plugins.clip_repertoire import CLIP_PARAMETERS, example_name, repertoire_for
 from plugins.guiding_stroke import GuidingStroke
 from plugins.inverse_model import learn_commands
 from plugins.key_poses import parse_poses
@@ -138,7 +138,7 @@ class MotorCommandGraph(MotorSystem):
             if not names:
                 continue
             n = sum(1 for label in self.labels.values() if label == clip.movement)
-            self.add_sequence(names, name=clip.movement if n == 0 else f"{clip.movement}#{n + 1}", label=clip.movement)
+            self.add_sequence(names, name=example_name(clip.movement, n), label=clip.movement)
             self.active[subsystem] = "hub"
             self._state = self.rest.copy()
 

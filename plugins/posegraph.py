@@ -27,7 +27,7 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
-from plugins.clip_repertoire import CLIP_PARAMETERS, repertoire_for
+from plugins.clip_repertoire import CLIP_PARAMETERS, example_name, repertoire_for
 from plugins.key_poses import REPERTOIRE_PARAMETERS, KeyPoses, interpolate, play, read_repertoire
 from plugins.pose_distance import pose_distance
 from toolkit import ConfigError, Motion, MotorSystem, Parameter, hookimpl
@@ -92,7 +92,7 @@ class Posegraph(MotorSystem):
         root = self.body.root_index
         ends = [self.hubs[int(np.argmin(pose_distance(hub_rel, sampled[i] - sampled[i, root], True)))] for i in (0, -1)]
         n = sum(1 for p in self.paths if self.paths_label.get(p) == movement)
-        self._add_path(movement if n == 0 else f"{movement}#{n + 1}", ends[0], sampled[1:-1], ends[1], poses,
+        self._add_path(example_name(movement, n), ends[0], sampled[1:-1], ends[1], poses,
                        label=movement)
 
     def _add_path(self, name: str, start: str, interior: np.ndarray, end: str, poses: list[np.ndarray], *,

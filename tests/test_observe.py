@@ -119,8 +119,9 @@ def test_recognition_scores_every_matcher_on_the_same_demos(data, profile, pm):
 def test_the_bench_commands_print_tables_and_write_json_csv_and_png(data, tmp_path, capsys):
     common = ["--body", str(data / "profile.toml"), "--quiet"]
     out = tmp_path / "out"
+    out.mkdir()
     assert main(["bench", "segmentation", *common, "--streams", str(data / "streams"), "--json", str(out / "s.json"),
-                 "--csv", str(out / "s.csv"), "--plot", str(out / "s.png")]) == 0 if out.mkdir() is None else False
+                 "--csv", str(out / "s.csv"), "--plot", str(out / "s.png")]) == 0
     text = capsys.readouterr().out
     assert "| hub-threshold |" in text and "| ruptures |" in text and "| velocity-direction |" in text
     result = json.loads((out / "s.json").read_text())
