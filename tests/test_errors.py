@@ -25,6 +25,30 @@ BODY = STICK
 SCENE = f'[scenario]\nname = "s"\n[[actors]]\nid = "max"\ncharacter = "{MAX}"\n'
 
 
+BVH = """HIERARCHY
+ROOT hips
+{
+  OFFSET 0 0 0
+  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
+  JOINT head
+  {
+    OFFSET 0 10 0
+    CHANNELS 3 Zrotation Xrotation Yrotation
+    End Site
+    {
+      OFFSET 0 5 0
+    }
+  }
+}
+MOTION
+Frames: 2
+Frame Time: 0.0333333
+0 90 0 0 0 0 0 0 0
+0 91 0 0 0 0 0 0 0
+"""
+PROFILE = '[profile]\nname = "p"\nunits = "cm"\n[parts]\nroot = "hips"\nhead = "head"\nnose = "head_end"\n[facing]\nleft = "head"\nright = "nose"\n'
+
+
 def state(**changes):
     import json
 
@@ -98,6 +122,21 @@ CASES = [
     ("scenario-fps", "negative frame rate", {"s.toml": SCENE.replace('name = "s"', 'name = "s"\nfps = -30')}, ["validate", "s.toml"], ["key scenario.fps", "expected a positive number"]),
     ("scenario-holder", "object held by an unknown actor", {"s.toml": SCENE + '[[objects]]\nname = "cheese"\nkind = "cheese"\nheld_by = "morris"\n'}, ["validate", "s.toml"], ["key objects[0].held_by", "unknown actor 'morris'", "available: max"]),
     ("scenario-object-kind", "object without a kind", {"s.toml": SCENE + '[[objects]]\nname = "cheese"\n'}, ["validate", "s.toml"], ["key objects[0].kind", "missing or invalid"]),
+    # -- motion capture: BVH files and body profiles
+    ("bvh-token", "BVH hierarchy with a wrong word", {"m.bvh": BVH.replace("OFFSET 0 10 0", "OFSET 0 10 0")}, ["validate", "m.bvh"], ["m.bvh:8:5", "found 'OFSET'", "expected 'OFFSET'"]),
+    ("bvh-channel", "unknown BVH channel", {"m.bvh": BVH.replace("Zrotation Xrotation Yrotation\n    End", "Zrotation Wrotation Yrotation\n    End")}, ["validate", "m.bvh"], ["m.bvh:9:", "found 'Wrotation'", "expected a channel name (Xposition"]),
+    ("bvh-frame-values", "a frame with too few values", {"m.bvh": BVH.replace("0 91 0 0 0 0 0 0 0", "0 91 0 0 0 0 0 0")}, ["validate", "m.bvh"], ["m.bvh:20:1", "frame 2 has 8 values", "expected 9 channel values per frame line"]),
+    ("bvh-frame-value", "a frame value that is not a number", {"m.bvh": BVH.replace("0 91 0 0", "0 nine 0 0")}, ["validate", "m.bvh"], ["m.bvh:20:3", "found 'nine'", "expected a number (a channel value)"]),
+    ("bvh-frame-time", "zero frame time", {"m.bvh": BVH.replace("Frame Time: 0.0333333", "Frame Time: 0")}, ["validate", "m.bvh"], ["m.bvh:18:13", "frame time 0.0", "expected a positive number of seconds"]),
+    ("bvh-frame-count", "fewer frame lines than announced", {"m.bvh": BVH.replace("Frames: 2", "Frames: 3")}, ["validate", "m.bvh"], ["m.bvh:", "2 frame lines after 'Frames: 3'", "expected 3 frame lines"]),
+    ("bvh-missing", "BVH file that does not exist", {}, ["validate", "gone.bvh"], ["gone.bvh", "cannot read", "expected a readable BVH file"]),
+    ("profile-table", "unknown table in a profile", {"p.toml": PROFILE + "[joints]\nx = 1\n"}, ["validate", "p.toml"], ["p.toml:11: key joints", "unknown table 'joints'", "available: profile, parts, facing, bones, colours"]),
+    ("profile-units", "unknown units", {"p.toml": PROFILE.replace('"cm"', '"furlong"')}, ["validate", "p.toml"], ["key profile.units", "unknown units 'furlong'", "available: metre, meter, m, centimetre"]),
+    ("profile-up", "unknown up axis", {"p.toml": PROFILE.replace('units = "cm"', 'units = "cm"\nup = "north"')}, ["validate", "p.toml"], ["key profile.up", "unknown up axis 'north'", "available: +y, -y, +z, -z, +x, -x"]),
+    ("profile-no-root", "profile without a root part", {"p.toml": PROFILE.replace('root = "hips"', 'pelvis = "hips"')}, ["validate", "p.toml"], ["key parts", "no part named 'root'", "available: pelvis, head, nose"]),
+    ("profile-facing", "facing names an unknown part", {"p.toml": PROFILE.replace('right = "nose"', 'right = "chin"')}, ["validate", "p.toml"], ["key facing.right", "unknown body part 'chin'", "available: root, head, nose"]),
+    ("profile-joint", "a mapped joint the BVH file lacks", {"p.toml": PROFILE.replace('"head_end"', '"Nose"'), "m.bvh": BVH}, ["validate", "--body", "p.toml", "m.bvh"], ["key parts.nose", "joint 'Nose' of part 'nose' is not in", "available: hips, head, head_end"]),
+    ("observe-matcher", "observe with an unknown matcher", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--matcher", "dtwx", "m.bvh"], ["unknown matcher 'dtwx'", "available: dtw, forward-model, path-search"]),
     # -- state files
     ("state-version", "state file of an unknown version", {"st.json": state(version=9)}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["st.json: key version", "unsupported state format version 9", "available: 1"]),
     ("state-not-json", "state file that is not JSON", {"st.json": "{\n oops\n"}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["st.json:2:", "not JSON"]),

@@ -111,3 +111,16 @@ def test_the_facing_of_every_bandai_namco_clip_is_steady():
         flips += int((np.abs(np.angle(np.exp(1j * np.diff(heading)))) > 2).sum())
         frames += motion.n_frames
     assert flips / frames < 1e-3
+
+
+def test_validate_checks_a_profile_and_bvh_files_against_it(tmp_path, write, max_character, capsys):
+    from toolkit.cli import main
+
+    _write_max_clip(max_character, tmp_path / "jump.bvh")
+    profile = write("max.toml", PROFILE.format(units="cm", up="+y", parts=_max_parts(max_character)))
+    assert main(["validate", str(profile)]) == 0
+    assert main(["validate", "--body", str(profile), str(tmp_path / "jump.bvh")]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].endswith(f"body profile 'max-cm': {len(max_character.body.parts)} parts, units 0.01 m, up +y")
+    n = len(max_character.body.parts)
+    assert f"BVH: {n} joints" in out[1] and f"maps {n}, leaves 0 unmapped" in out[1]

@@ -255,3 +255,105 @@ def test_action_selection_always_gives_a_possible_path_or_nothing(objects, hunge
     for name in path:
         assert all(t.evaluate(context) > 0 for t in system.hierarchy.tuples[name].can)
     assert obj in world.objects and system.beliefs.get(world.objects[obj].kind) is not None
+
+
+# -- fuzzed motion-capture input: BVH files and body profiles fail only with a ConfigError
+
+def _small_bvh_text() -> str:
+    from toolkit.bvh import format_bvh, from_joint_positions
+
+    rng = np.random.default_rng(0)
+    positions = np.cumsum(rng.normal(0, 1, (3, 4, 3)), axis=0) + np.array([[0, 90, 0], [0, 100, 0], [5, 100, 0], [0, 80, 5]])
+    return format_bvh(from_joint_positions(["hips", "chest", "arm", "leg"], [-1, 0, 1, 0], positions, 30.0))
+
+
+BVH_TEXT = _small_bvh_text()
+BVH_TOKENS = ["{", "}", "ROOT", "JOINT", "End", "Site", "OFFSET", "CHANNELS", "0", "3", "6", "7", "-1", "1e999", "nan",
+              "inf", "Xrotation", "Wrotation", "Frames:", "Frame", "Time:", "0.0", "-0.5", "MOTION", "HIERARCHY", "hips",
+              "", "\t", "\r\n"]
+
+
+def _read_all(text: str, profile=None):
+    from toolkit.bvh import parse_bvh
+
+    bvh = parse_bvh(text, "fuzz.bvh")
+    positions = bvh.positions()
+    assert positions.shape == (bvh.n_frames, len(bvh.names), 3)
+    if profile is not None:
+        profile.motion(bvh)
+
+
+@settings(max_examples=150, deadline=None)
+@given(data=st.data())
+def test_mutated_bvh_files_raise_only_config_errors(data):
+    """Drop, replace, insert or truncate tokens of a valid file: it reads or fails with a ConfigError, nothing else."""
+    from toolkit import ConfigError
+
+    tokens = BVH_TEXT.replace("\n", " \n ").split(" ")
+    for _ in range(data.draw(st.integers(1, 5))):
+        i = data.draw(st.integers(0, len(tokens) - 1))
+        action = data.draw(st.sampled_from(["drop", "replace", "insert", "truncate"]))
+        if action == "drop":
+            tokens.pop(i)
+        elif action == "replace":
+            tokens[i] = data.draw(st.sampled_from(BVH_TOKENS))
+        elif action == "insert":
+            tokens.insert(i, data.draw(st.sampled_from(BVH_TOKENS)))
+        else:
+            tokens = tokens[:i]
+        if not tokens:
+            tokens = [""]
+    try:
+        _read_all(" ".join(tokens))
+    except ConfigError as err:
+        assert "fuzz.bvh" in str(err)
+
+
+@settings(max_examples=80, deadline=None)
+@given(text=st.text(max_size=200))
+def test_arbitrary_text_as_bvh_raises_only_config_errors(text):
+    from toolkit import ConfigError
+
+    try:
+        _read_all(text)
+    except ConfigError as err:
+        assert "fuzz.bvh" in str(err)
+
+
+@settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(data=st.data())
+def test_mutated_profiles_raise_only_config_errors(tmp_path, data):
+    """Take the Bandai-Namco profile, drop or rewrite lines: it loads (and reads a file) or fails with a ConfigError."""
+    from toolkit import ConfigError
+    from toolkit.profile import load_profile
+
+    lines = (CHARACTERS / "profiles" / "bandai-namco.toml").read_text().splitlines()
+    for _ in range(data.draw(st.integers(1, 4))):
+        i = data.draw(st.integers(0, len(lines) - 1))
+        action = data.draw(st.sampled_from(["drop", "value", "key", "table"]))
+        if action == "drop":
+            lines.pop(i)
+        elif action == "table":
+            lines.insert(i, data.draw(st.sampled_from(["[facing]", "[parts]", "[profile]", "[bones]", "[extra]", "[[parts]]"])))
+        elif "=" in lines[i]:
+            key, _, _ = lines[i].partition("=")
+            value = data.draw(st.sampled_from(['"x"', '"Hips"', "1", "-3.5", "0", "true", "[]", "{}", '["a", "b"]', "nan",
+                                               '"+q"', '"furlong"', '"root"']))
+            lines[i] = f"{key}= {value}" if action == "value" else \
+                f"{data.draw(st.sampled_from(['zzz', 'root', 'left', 'units', 'up', 'forward']))} = {value}"
+    path = tmp_path / "mutant.toml"
+    path.write_text("\n".join(lines), encoding="utf-8")
+    try:
+        profile = load_profile(path)
+    except ConfigError as err:
+        assert "mutant.toml" in str(err)
+        return
+    from toolkit.bvh import format_bvh, from_joint_positions
+
+    rng = np.random.default_rng(1)
+    names = list(dict.fromkeys(profile.joints))
+    text = format_bvh(from_joint_positions(names, [-1] + [0] * (len(names) - 1), rng.normal(0, 50, (2, len(names), 3)), 30.0))
+    try:
+        _read_all(text, profile)
+    except ConfigError:
+        pass

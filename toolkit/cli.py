@@ -82,8 +82,9 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print JSON instead of text")
     p.set_defaults(handler=cmd_observe)
 
-    p = sub.add_parser("validate", help="check character and scenario files")
-    p.add_argument("files", nargs="+", metavar="FILE", help="character or scenario TOML files")
+    p = sub.add_parser("validate", help="check character, scenario and body-profile files and BVH motion files")
+    p.add_argument("files", nargs="+", metavar="FILE", help="character, scenario or profile TOML files, or BVH files")
+    p.add_argument("--body", metavar="PROFILE", help="also check that each BVH file has the joints this profile maps")
     p.set_defaults(handler=cmd_validate)
 
     pm.hook.likeme_register_commands(subparsers=sub)
@@ -310,17 +311,36 @@ def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
 
 
 def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
+    from toolkit.bvh import read_bvh
     from toolkit.character import load_character, read_toml
+    from toolkit.profile import is_profile, load_profile
     from toolkit.report import describe_character
     from toolkit.scenario import is_scenario, load_scenario
 
     failed = 0
+    try:
+        profile = load_profile(args.body) if args.body else None
+    except LikemeError as err:
+        print(f"likeme: error: {err}", file=sys.stderr)
+        return 1
     for path in args.files:
         try:
-            if is_scenario(read_toml(path)):
+            if str(path).lower().endswith(".bvh"):
+                bvh = read_bvh(path)
+                line = f"ok    {path}: BVH: {len(bvh.names)} joints, {bvh.n_frames} frames at {bvh.fps:g} fps"
+                if profile is not None:
+                    unmapped = profile.check(bvh)
+                    line += f"; profile {profile.name!r} maps {len(profile.joints)}, leaves {len(unmapped)} unmapped"
+                print(line)
+                continue
+            table = read_toml(path)
+            if is_scenario(table):
                 scenario = load_scenario(path, pm)
                 world = scenario.world
                 print(f"ok    {path}: scenario {scenario.name!r}: {len(world.actors)} actor(s) ({', '.join(world.actors)}), {len(world.objects)} object(s)")
+            elif is_profile(table):
+                prof = load_profile(path)
+                print(f"ok    {path}: body profile {prof.name!r}: {len(prof.joints)} parts, units {prof.scale:g} m, up {prof.up}")
             else:
                 c = describe_character(load_character(path, pm))
                 comps = ", ".join(f"{k} {c[k]['plugin']}" for k in ("motor", "perception", "segmenter", "matcher", "action") if k in c)

@@ -40,7 +40,7 @@ from toolkit.bvh import BVH, read_bvh
 from toolkit.errors import ConfigError
 from toolkit.motion import Motion
 
-__all__ = ["BodyProfile", "load_profile", "UNITS", "UP_AXES"]
+__all__ = ["BodyProfile", "is_profile", "load_profile", "UNITS", "UP_AXES"]
 
 UNITS: dict[str, float] = {"metre": 1.0, "meter": 1.0, "m": 1.0, "centimetre": 0.01, "centimeter": 0.01, "cm": 0.01,
                            "millimetre": 0.001, "millimeter": 0.001, "mm": 0.001, "inch": 0.0254, "in": 0.0254,
@@ -118,6 +118,11 @@ class BodyProfile:
         return self.motion(read_bvh(path))
 
 
+def is_profile(table: Mapping[str, Any]) -> bool:
+    """Whether a parsed TOML table is a body profile (it has a ``[profile]`` or ``[parts]`` table, no ``[character]``)."""
+    return "character" not in table and ("profile" in table or "parts" in table)
+
+
 def load_profile(path: str | Path) -> BodyProfile:
     """Read a body profile TOML file; every problem is a :class:`ConfigError` naming the file, key and line."""
     from toolkit.character import find_key_line, read_toml
@@ -156,10 +161,13 @@ def load_profile(path: str | Path) -> BodyProfile:
     for part, joint in parts.items():
         if not isinstance(joint, str) or not joint:
             raise fail(f"invalid joint {joint!r}", ("parts", part), expected="the name of a source joint")
-    if "root" not in table.get("facing", {}) and "root" not in parts:
+    facing = table.get("facing", {})
+    if not isinstance(facing, Mapping):
+        raise fail(f"invalid facing {facing!r}", ("facing",), expected='a table with left, right and optional forward, behind')
+    facing = dict(facing)
+    if "root" not in facing and "root" not in parts:
         raise fail("no part named 'root'", ("parts",), expected="a part named root (or facing.root naming it)",
                    available=list(parts))
-    facing = dict(table.get("facing", {}))
     root = facing.pop("root", "root")
     body_table = {"parts": list(parts), "root": root, "facing": facing,
                   "bones": table.get("bones", []), "colours": table.get("colours", {})}
