@@ -260,16 +260,18 @@ class MotorCommandGraph(MotorSystem):
         }
 
     def get_state(self) -> dict[str, Any]:
-        """Learned nodes and edges of every subsystem."""
-        return {
-            name: {
+        """Learned nodes, edges, sequences and the movement labels of clip sequences, per subsystem."""
+        state = {}
+        for name, g in self.graphs.items():
+            sequences = {m: e for m, e in self.sequences.items() if self._edges[e[0]][0] == name}
+            state[name] = {
                 "nodes": {n: d["state"].round(6).tolist() for n, d in g.nodes(data=True) if n != "hub"},
                 "edges": [{"from": a, "to": b, "name": d["name"], "strokes": [s.to_dict() for s in d["strokes"]]}
                           for a, b, d in g.edges(data=True)],
-                "sequences": {m: e for m, e in self.sequences.items() if self._edges[e[0]][0] == name},
+                "sequences": sequences,
+                "labels": {m: label for m, label in self.labels.items() if m in sequences},
             }
-            for name, g in self.graphs.items()
-        }
+        return state
 
     def set_state(self, state: dict[str, Any]) -> None:
         for name, entry in state.items():
@@ -283,10 +285,14 @@ class MotorCommandGraph(MotorSystem):
                     strokes = [GuidingStroke(**s) for s in e["strokes"]]
                 except (TypeError, ValueError, KeyError) as exc:
                     raise ConfigError(f"invalid edge ({exc})", key=(name, "edges", i), expected="an edge written by get_state") from None
+                if e["name"] in self._edges:  # the same command built already (from clips, say): the saved one replaces it
+                    _, a, b, old = self._edges[e["name"]]
+                    g.remove_edge(a, b, old)
                 key = g.add_edge(e["from"], e["to"], name=e["name"], strokes=strokes, source="loaded")
                 self._edges[e["name"]] = (name, e["from"], e["to"], key)
                 self._counter = max(self._counter, int(e["name"].rsplit(":e", 1)[-1]))
             self.sequences.update(entry.get("sequences", {}))
+            self.labels.update(entry.get("labels", {}))
 
 
 @hookimpl

@@ -196,3 +196,27 @@ def test_observing_a_bandai_namco_clip(tmp_path, pm):
     rows = {r["plugin"]: r for r in recognition(pm, profile, tmp_path / "normal", tmp_path / "happy",
                                                  ["path-search", "dtw"])["plugins"]}
     assert rows["dtw"]["items"] == 2 and rows["dtw"]["accuracy"] == 1.0
+
+
+def test_a_clip_built_motor_command_graph_saves_and_loads_its_labels_without_doubling_edges(data, profile, pm):
+    import json as _json
+
+    commands = compose_observer(pm, profile, data / "repertoire", matcher="forward-model").motor
+    state = _json.loads(_json.dumps(commands.get_state()))
+    again = compose_observer(pm, profile, data / "repertoire", matcher="forward-model").motor
+
+    def by_name(s):  # edges in name order, stroke numbers to 5 decimals (a stroke's normal is normalised on load)
+        body = dict(s["body"])
+        body["edges"] = [{**e, "strokes": [{k: np.round(v, 5).tolist() if isinstance(v, list | float) else v
+                                           for k, v in stroke.items()} for stroke in e["strokes"]]}
+                         for e in sorted(body["edges"], key=lambda e: e["name"])]
+        return body
+
+    again.set_state(state)  # onto a graph the same clips built: the same commands, not twice as many
+    assert by_name(again.get_state()) == by_name(state)
+    assert again.graphs["body"].number_of_edges() == commands.graphs["body"].number_of_edges()
+    unlabelled = compose_observer(pm, profile, data / "repertoire", matcher="forward-model").motor
+    unlabelled.labels.clear()
+    assert sorted(unlabelled.movements()) != sorted(commands.movements())  # example names, not movements
+    unlabelled.set_state(state)  # the labels come back with the state
+    assert unlabelled.labels == commands.labels and sorted(unlabelled.movements()) == sorted(commands.movements())
