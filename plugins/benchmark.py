@@ -32,8 +32,9 @@ from typing import Any
 import numpy as np
 
 from plugins.metrics import match_segments, movement_error_rate, segmentation_scores
-from toolkit import ConfigError, World, hookimpl, load_character
+from toolkit import World, hookimpl, load_character
 from toolkit.character import merge_tables
+from toolkit.params import parse_settings
 
 
 def watch_benchmark(
@@ -254,23 +255,6 @@ def render_watch(r: dict[str, Any]) -> str:
     if r["confusions"]:
         lines.append("  most frequent confusions: " + ", ".join(f"{k} ({v})" for k, v in list(r["confusions"].items())[:6]))
     return "\n".join(lines)
-
-
-def parse_settings(items: list[str]) -> dict[str, dict[str, Any]]:
-    """``TABLE.KEY=VALUE`` strings (VALUE in TOML syntax) as nested tables."""
-    import tomllib
-
-    out: dict[str, dict[str, Any]] = {}
-    for item in items:
-        key, sep, value = item.partition("=")
-        table, dot, name = key.strip().partition(".")
-        if not sep or not dot or not table or not name:
-            raise ConfigError(f"invalid setting {item!r}", key=("--set",), expected="TABLE.KEY=VALUE, like segmenter.floor=0")
-        try:
-            out.setdefault(table, {})[name] = tomllib.loads(f"v = {value}")["v"]
-        except tomllib.TOMLDecodeError:
-            out.setdefault(table, {})[name] = value  # a bare word is a string
-    return out
 
 
 def cmd_watch(args: argparse.Namespace, pm: Any) -> int:

@@ -32,6 +32,7 @@ from toolkit.components import (
     Segmenter,
     Trigger,
     TriggerContext,
+    View,
 )
 from toolkit.errors import ConfigError, LikemeError, PluginError
 from toolkit.hookspecs import hookimpl
@@ -70,6 +71,7 @@ __all__ = [
     "Segmenter",
     "Trigger",
     "TriggerContext",
+    "View",
     "World",
     "WorldObject",
     "create_plugin_manager",

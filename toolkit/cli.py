@@ -12,13 +12,15 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import sys
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any
 
 from toolkit import __version__
 from toolkit.components import KINDS
-from toolkit.errors import LikemeError
+from toolkit.errors import ConfigError, LikemeError
 from toolkit.manager import PluginManager, create_plugin_manager
 
 __all__ = ["main", "build_parser"]
@@ -66,9 +68,14 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p.add_argument("--markdown", action="store_true", help="print a Markdown reference of every component and its parameters")
     p.set_defaults(handler=cmd_plugins)
 
-    p = sub.add_parser("show", help="show a character's representations")
+    p = sub.add_parser("show", help="show a character's representations: as text, or drawn by a view to PNG")
     p.add_argument("character", help="character TOML file or name")
     p.add_argument("--actions", action="store_true", help="print the action system (hierarchy, drives, beliefs, maps) as text")
+    p.add_argument("--view", metavar="NAME", help="draw the character with this view (see 'likeme plugins'), "
+                   "e.g. body, posegraph, motor-command-graph")
+    p.add_argument("--out", metavar="FILE.png", help="where the view writes its picture (default: CHARACTER-VIEW.png)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="a parameter of the view, e.g. --set keys=4 (repeatable)")
     p.set_defaults(handler=cmd_show)
 
     p = sub.add_parser("observe", help="watch motion-capture files: segments, recognised movements, decisions")
@@ -264,6 +271,19 @@ def cmd_show(args: argparse.Namespace, pm: PluginManager) -> int:
     from toolkit.report import describe_character
 
     character = load_character(args.character, pm)
+    if args.view:
+        from toolkit.params import parse_settings
+
+        cls = pm.registry.get("view", args.view)
+        if cls.subject != "character":
+            raise ConfigError(f"view {args.view!r} draws a {cls.subject}, not a character", key=("--view",),
+                              expected="a view of characters", available=[n for n in pm.registry.names("view")
+                                                                          if pm.registry.get("view", n).subject == "character"])
+        view = cls(**parse_settings(args.set, tables=False))
+        out = Path(args.out or f"{re.sub(r'[^a-z0-9]+', '-', character.name.lower()).strip('-')}-{args.view}.png")
+        for path in view.draw(character, out):
+            print(f"wrote {path}")
+        return 0
     if args.actions:
         if character.action is None:
             print(f"{character.name} has no action system")
@@ -278,8 +298,8 @@ def cmd_show(args: argparse.Namespace, pm: PluginManager) -> int:
 def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
     import json
 
-    from plugins.benchmark import parse_settings
     from toolkit.observe import Observer, compose_observer
+    from toolkit.params import parse_settings
     from toolkit.profile import load_profile
 
     profile = load_profile(args.body)

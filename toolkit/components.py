@@ -37,6 +37,8 @@ from toolkit.motion import Motion
 from toolkit.params import Parameter, validate_params
 
 if TYPE_CHECKING:  # pragma: no cover - imports for annotations only
+    from pathlib import Path
+
     from toolkit.character import Character
     from toolkit.runtime import Actor, World
 
@@ -48,6 +50,7 @@ __all__ = [
     "MotorSystem",
     "ActionSystem",
     "Trigger",
+    "View",
     "KINDS",
     "Percept",
     "Segment",
@@ -465,6 +468,23 @@ class Trigger(Component):
         return self.name
 
 
+class View(Component):
+    """A picture of one of the toolkit's representations: ``likeme show --view NAME`` or ``likeme run --render``.
+
+    ``subject`` says what it draws: ``"character"`` (a composed
+    :class:`~toolkit.character.Character`) or ``"scenario"`` (a
+    :class:`~toolkit.scenario.Scenario`, run while it is drawn). Views render
+    off screen; the core never imports a drawing library.
+    """
+
+    kind = "view"
+    subject: ClassVar[str] = "character"
+
+    @abstractmethod
+    def draw(self, subject: Any, out: Path) -> list[Path]:
+        """Draw ``subject`` to ``out`` (an image file, or a folder for an animation); return the files written."""
+
+
 KINDS: dict[str, type[Component]] = {
     "perception": Perception,
     "segmenter": Segmenter,
@@ -472,5 +492,6 @@ KINDS: dict[str, type[Component]] = {
     "motor": MotorSystem,
     "action": ActionSystem,
     "trigger": Trigger,
+    "view": View,
 }
 """Each component kind by the key it has in a character file and in ``likeme plugins``."""

@@ -40,6 +40,7 @@ if TYPE_CHECKING:  # pragma: no cover
         Segment,
         Segmenter,
         Trigger,
+        View,
     )
     from toolkit.runtime import Actor, World
 
@@ -104,6 +105,15 @@ def likeme_register_triggers() -> list[type[Trigger]]:
 
     A trigger is a condition (can-I, should-I, do-until, object selection)
     evaluated to a value in [0, 1].
+    """
+
+
+@hookspec
+def likeme_register_views() -> list[type[View]]:
+    """Return view component classes (``likeme show --view NAME``, ``likeme run --render``).
+
+    A view draws a character's representations or a running scenario to image
+    files, off screen.
     """
 
 

@@ -54,6 +54,7 @@ REGISTER_HOOKS: dict[str, str] = {
     "motor": "likeme_register_motor_systems",
     "action": "likeme_register_action_systems",
     "trigger": "likeme_register_triggers",
+    "view": "likeme_register_views",
 }
 """The registration hook of each component kind (keys as in :data:`toolkit.components.KINDS`)."""
 

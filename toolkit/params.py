@@ -175,3 +175,27 @@ def validate_params(owner: str, parameters: Sequence[Parameter], values: Mapping
         else:
             out[p.name] = p.default
     return out
+
+
+def parse_settings(items: list[str], *, tables: bool = True) -> dict[str, Any]:
+    """Command-line ``--set`` strings as nested tables: ``TABLE.KEY=VALUE`` (or ``KEY=VALUE`` without ``tables``).
+
+    VALUE is read as TOML (``4``, ``0.5``, ``true``, ``["a", "b"]``); a bare word is a string.
+    """
+    import tomllib
+
+    out: dict[str, Any] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        table, dot, name = key.strip().partition(".")
+        if not tables:
+            table, dot, name = "", ".", key.strip()
+        if not sep or not dot or (tables and not table) or not name:
+            raise ConfigError(f"invalid setting {item!r}", key=("--set",), expected="TABLE.KEY=VALUE, like segmenter.floor=0"
+                              if tables else "KEY=VALUE, like keys=4")
+        try:
+            parsed = tomllib.loads(f"v = {value}")["v"]
+        except tomllib.TOMLDecodeError:
+            parsed = value  # a bare word is a string
+        (out.setdefault(table, {}) if tables else out)[name] = parsed
+    return out

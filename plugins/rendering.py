@@ -1,0 +1,253 @@
+"""Off-screen pyvista scaffolding shared by the views and ``rendered-vision``: plotters, bodies, frames, movies.
+
+Everything renders off screen (no display needed): :func:`plotter` picks VTK's
+EGL or OSMesa window when there is no X display. A :class:`BodyFigure` draws a
+body as one sphere per tracked part in the part's colour (the paper's
+colour-coded body, Buchsbaum & Blumberg 2005, Fig. 2-3), bones as lines between
+them and the root as a ring; :meth:`BodyFigure.update` moves it to a new pose
+in place, so an animation reuses one plotter and one set of actors. A
+:class:`Movie` writes the frames of one plotter as numbered PNG files, a GIF
+and an MP4 at the motion's own frame rate (imageio, imageio-ffmpeg).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from toolkit.body import Body
+
+__all__ = ["plotter", "BodyFigure", "Movie", "part_colours", "hex_to_rgb", "GREY", "save_png", "draw_bodies", "frame_2d", "add_labels"]
+
+GREY = "#b0b0b0"
+"""The colour of a part the observer does not see."""
+
+_PALETTE = ("#e6194b", "#3cb44b", "#4363d8", "#f58231", "#911eb4", "#42d4f4", "#f032e6", "#bfef45", "#fabed4",
+            "#469990", "#dcbeff", "#9a6324", "#800000", "#aaffc3", "#808000", "#000075", "#ffe119", "#a9a9a9")
+
+
+def hex_to_rgb(colour: str) -> tuple[int, int, int]:
+    """``"#rrggbb"`` to (r, g, b) in 0..255."""
+    c = colour.lstrip("#")
+    return int(c[0:2], 16), int(c[2:4], 16), int(c[4:6], 16)
+
+
+def part_colours(body: Body) -> list[str]:
+    """Each part's colour: the body's own (``[body.colours]``), else a distinct palette colour."""
+    return [body.colours.get(p, _PALETTE[i % len(_PALETTE)]) for i, p in enumerate(body.parts)]
+
+
+def _headless() -> None:
+    """Without an X display, ask VTK for an EGL window (falling back to OSMesa) before it opens one."""
+    if not os.environ.get("DISPLAY") and "VTK_DEFAULT_OPENGL_WINDOW" not in os.environ:
+        os.environ["VTK_DEFAULT_OPENGL_WINDOW"] = "vtkEGLRenderWindow"
+
+
+def plotter(size: tuple[int, int] = (800, 600), *, background: str = "white", flat: bool = False) -> Any:
+    """An off-screen :class:`pyvista.Plotter` of ``size`` (width, height) pixels.
+
+    ``flat``: no anti-aliasing and no lights, so every pixel of a mesh has exactly its colour (for colour scanning).
+    Close it (``plotter.close()``) when done; :class:`Movie` and the views do.
+    """
+    _headless()
+    import pyvista as pv
+
+    pl = pv.Plotter(off_screen=True, window_size=list(size), lighting="none" if flat else "light kit")
+    pl.set_background(background)
+    if flat:
+        pl.disable_anti_aliasing()
+    return pl
+
+
+def save_png(pl: Any, path: str | Path) -> Path:
+    """Render ``pl`` and write it to ``path`` as PNG (creating the folder)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    pl.screenshot(str(path))
+    return path
+
+
+def draw_bodies(pl: Any, body: Body, poses: np.ndarray, *, radius: float = 0.03, colours: Sequence[str] | None = None,
+                bone_colour: str = "#404040", root_ring: bool = True, opacity: float = 1.0) -> None:
+    """Draw many still poses (N, P, 3) of one body at once: one sphere mesh, one bone mesh, one ring mesh.
+
+    For pictures (strips of key poses, graph nodes); animations move a :class:`BodyFigure` instead.
+    """
+    import pyvista as pv
+
+    poses = np.asarray(poses, dtype=float).reshape(-1, body.n_parts, 3)
+    finite = np.isfinite(poses).all(axis=2)
+    rgb = np.array([hex_to_rgb(c) for c in (colours if colours is not None else part_colours(body))], dtype=np.uint8)
+    points = pv.PolyData(poses[finite])
+    points["rgb"] = np.broadcast_to(rgb, (*poses.shape[:2], 3))[finite]
+    sphere = pv.Sphere(radius=radius, theta_resolution=12, phi_resolution=8)
+    if points.n_points:
+        pl.add_mesh(points.glyph(geom=sphere, scale=False, orient=False), scalars="rgb", rgb=True, smooth_shading=True,
+                    opacity=opacity)
+    pairs = body.bone_indices()
+    if len(pairs):
+        ok = finite[:, pairs[:, 0]] & finite[:, pairs[:, 1]]  # (N, B)
+        base = (np.arange(len(poses)) * body.n_parts)[:, None]
+        segments = np.stack([base + pairs[:, 0], base + pairs[:, 1]], axis=-1)[ok]
+        if len(segments):
+            lines = pv.PolyData(np.nan_to_num(poses.reshape(-1, 3)), lines=np.column_stack(
+                [np.full(len(segments), 2), segments]).ravel())
+            pl.add_mesh(lines, color=bone_colour, line_width=2, opacity=opacity)
+    if root_ring:
+        roots = poses[:, body.root_index][finite[:, body.root_index]]
+        if len(roots):
+            ring = pv.Disc(inner=radius * 1.6, outer=radius * 2.2, normal=(0, 1, 0), c_res=24)
+            pl.add_mesh(pv.PolyData(roots).glyph(geom=ring, scale=False, orient=False), color="black", opacity=opacity)
+
+
+def add_labels(pl: Any, points: np.ndarray, texts: Sequence[str], *, font_size: int = 14, align: str = "left",
+               colour: str = "black") -> Any:
+    """Text at 3D points, every one of them drawn (no culling of overlapping labels); ``align`` left, centre or right."""
+    actor = pl.add_point_labels(np.asarray(points, dtype=float).reshape(-1, 3), list(texts), font_size=font_size,
+                                shape=None, show_points=False, always_visible=True, text_color=colour,
+                                justification_horizontal={"centre": "center"}.get(align, align))
+    actor.GetMapper().SetPlaceAllLabels(True)
+    return actor
+
+
+def frame_2d(pl: Any, lower: Sequence[float], upper: Sequence[float], *, margin: float = 0.04) -> None:
+    """Look along -z with a parallel projection at the rectangle ``lower``..``upper`` (x, y), filling the window."""
+    (x0, y0), (x1, y1) = lower, upper
+    w, h = pl.window_size
+    cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
+    half_h = max((y1 - y0) / 2, (x1 - x0) / 2 * h / w) * (1 + margin)
+    pl.enable_parallel_projection()
+    pl.camera.focal_point = (cx, cy, 0.0)
+    pl.camera.position = (cx, cy, 100.0)
+    pl.camera.up = (0.0, 1.0, 0.0)
+    pl.camera.parallel_scale = half_h
+    pl.camera.clipping_range = (1.0, 1000.0)
+
+
+class BodyFigure:
+    """A body drawn in a plotter: a sphere per part, bones, the root marked; moved in place by :meth:`update`.
+
+    Parameters
+    ----------
+    pl : pyvista.Plotter
+    body : Body
+    pose : array (P, 3)
+        World positions of the parts (NaN: not drawn).
+    radius : float
+        Sphere radius in metres.
+    colours : sequence of str, optional
+        One colour per part; default :func:`part_colours`.
+    bones : bool
+        Draw the bones (``body.bones``) as lines.
+    flat : bool
+        Unlit flat colours (for colour-coded rendering).
+    label : str, optional
+        Text shown above the head.
+    """
+
+    def __init__(self, pl: Any, body: Body, pose: np.ndarray, *, radius: float = 0.03,
+                 colours: Sequence[str] | None = None, bones: bool = True, flat: bool = False,
+                 label: str | None = None, opacity: float = 1.0) -> None:
+        import pyvista as pv
+
+        self.pl, self.body = pl, body
+        self.colours = list(colours) if colours is not None else part_colours(body)
+        self.spheres = []
+        for i in range(body.n_parts):
+            mesh = pv.Sphere(radius=radius, theta_resolution=16, phi_resolution=12)
+            self.spheres.append(pl.add_mesh(mesh, color=self.colours[i], lighting=not flat, smooth_shading=not flat,
+                                            opacity=opacity))
+        self.ring = None
+        if not flat:
+            ring = pv.Disc(inner=radius * 1.6, outer=radius * 2.2, normal=(0, 1, 0), c_res=32)
+            self.ring = pl.add_mesh(ring, color="black", opacity=opacity)
+        self.bones = None
+        pairs = body.bone_indices()
+        if bones and len(pairs):
+            self._lines = pv.PolyData(np.zeros((body.n_parts, 3)), lines=np.column_stack(
+                [np.full(len(pairs), 2), pairs]).ravel())
+            self.bones = pl.add_mesh(self._lines, color="#404040", line_width=3, opacity=opacity)
+        self.label = None
+        self._label_text = label
+        self.update(pose)
+
+    def update(self, pose: np.ndarray, visible: np.ndarray | None = None) -> None:
+        """Move to ``pose`` (P, 3); parts not ``visible`` are greyed, NaN parts hidden."""
+        pose = np.asarray(pose, dtype=float)
+        finite = np.isfinite(pose).all(axis=1)
+        for i, actor in enumerate(self.spheres):
+            actor.SetVisibility(bool(finite[i]))
+            if finite[i]:
+                actor.SetPosition(*pose[i])
+            actor.prop.color = self.colours[i] if visible is None or visible[i] else GREY
+        root = pose[self.body.root_index]
+        if self.ring is not None:
+            self.ring.SetVisibility(bool(finite[self.body.root_index]))
+            if finite[self.body.root_index]:
+                self.ring.SetPosition(*root)
+        if self.bones is not None:
+            self._lines.points = np.where(finite[:, None], pose, np.nanmean(pose[finite], axis=0) if finite.any() else 0.0)
+        if self._label_text is not None and finite.any():
+            top = pose[finite][np.argmax(pose[finite, 1])] + np.array([0.0, 0.12, 0.0])
+            if self.label is not None:
+                self.pl.remove_actor(self.label)
+            self.label = add_labels(self.pl, top, [self._label_text], align="centre")
+
+
+class Movie:
+    """Frames of one plotter written as PNG files, a GIF and an MP4 at ``fps``.
+
+    Call :meth:`frame` after each update of the scene, then :meth:`close`.
+    ``formats`` is any of ``png`` (numbered frames ``frame_00000.png``...),
+    ``gif`` and ``mp4``.
+    """
+
+    def __init__(self, pl: Any, folder: str | Path, fps: float, *, formats: Iterable[str] = ("png", "gif", "mp4"),
+                 name: str = "scenario") -> None:
+        self.pl, self.folder, self.fps = pl, Path(folder), float(fps)
+        self.formats = tuple(formats)
+        self.folder.mkdir(parents=True, exist_ok=True)
+        self.files: list[Path] = []
+        self.n = 0
+        self._gif = self._mp4 = None
+        if "gif" in self.formats:
+            import imageio.v2 as imageio
+
+            path = self.folder / f"{name}.gif"
+            self._gif = imageio.get_writer(path, mode="I", duration=1.0 / self.fps, loop=0)
+            self.files.append(path)
+        if "mp4" in self.formats:
+            import imageio.v2 as imageio
+
+            path = self.folder / f"{name}.mp4"
+            self._mp4 = imageio.get_writer(path, fps=self.fps, codec="libx264", quality=7, macro_block_size=8)
+            self.files.append(path)
+
+    def frame(self) -> np.ndarray:
+        """Render the plotter's current scene and write it to every format; returns the image (H, W, 3)."""
+        self.pl.render()
+        image = np.asarray(self.pl.screenshot(return_img=True))
+        if "png" in self.formats:
+            import imageio.v2 as imageio
+
+            path = self.folder / f"frame_{self.n:05d}.png"
+            imageio.imwrite(path, image)
+            self.files.append(path)
+        if self._gif is not None:
+            self._gif.append_data(image)
+        if self._mp4 is not None:
+            self._mp4.append_data(image)
+        self.n += 1
+        return image
+
+    def close(self) -> list[Path]:
+        """Finish the GIF and MP4 and close the plotter; returns every file written."""
+        for writer in (self._gif, self._mp4):
+            if writer is not None:
+                writer.close()
+        self.pl.close()
+        return self.files
