@@ -69,7 +69,9 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p.set_defaults(handler=cmd_plugins)
 
     p = sub.add_parser("show", help="show a character's representations: as text, or drawn by a view to PNG")
-    p.add_argument("character", help="character TOML file or name")
+    p.add_argument("character", help="character TOML file or name (with --after: the id of an actor of the scenario)")
+    p.add_argument("--after", metavar="SCENARIO", help="run this scenario first and show the actor as it is then "
+                   "(what it learned included)")
     p.add_argument("--actions", action="store_true", help="print the action system (hierarchy, drives, beliefs, maps) as text")
     p.add_argument("--view", metavar="NAME", help="draw the character with this view (see 'likeme plugins'), "
                    "e.g. body, posegraph, motor-command-graph")
@@ -270,7 +272,16 @@ def cmd_show(args: argparse.Namespace, pm: PluginManager) -> int:
     from toolkit.character import load_character
     from toolkit.report import describe_character
 
-    character = load_character(args.character, pm)
+    if args.after:
+        from toolkit.scenario import load_scenario
+
+        world = load_scenario(args.after, pm).run()
+        if args.character not in world.actors:
+            raise ConfigError(f"no actor {args.character!r} in scenario {args.after!r}", key=("character",),
+                              expected="the id of an actor of the scenario", available=list(world.actors))
+        character = world.actors[args.character].character
+    else:
+        character = load_character(args.character, pm)
     if args.view:
         from toolkit.params import parse_settings
 
