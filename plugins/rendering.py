@@ -106,8 +106,11 @@ def draw_bodies(pl: Any, body: Body, poses: np.ndarray, *, radius: float = 0.03,
 
 def add_labels(pl: Any, points: np.ndarray, texts: Sequence[str], *, font_size: int = 14, align: str = "left",
                colour: str = "black") -> Any:
-    """Text at 3D points, every one of them drawn (no culling of overlapping labels); ``align`` left, centre or right."""
-    actor = pl.add_point_labels(np.asarray(points, dtype=float).reshape(-1, 3), list(texts), font_size=font_size,
+    """Text at 3D points (an array, or a PolyData whose points can move later), every one drawn; ``align`` left,
+    centre or right."""
+    if not hasattr(points, "points"):  # a PolyData is kept: moving its points moves the labels
+        points = np.asarray(points, dtype=float).reshape(-1, 3)
+    actor = pl.add_point_labels(points, list(texts), font_size=font_size,
                                 shape=None, show_points=False, always_visible=True, text_color=colour,
                                 justification_horizontal={"centre": "center"}.get(align, align))
     actor.GetMapper().SetPlaceAllLabels(True)
@@ -171,8 +174,10 @@ class BodyFigure:
             self._lines = pv.PolyData(np.zeros((body.n_parts, 3)), lines=np.column_stack(
                 [np.full(len(pairs), 2), pairs]).ravel())
             self.bones = pl.add_mesh(self._lines, color="#404040", line_width=3, opacity=opacity)
-        self.label = None
-        self._label_text = label
+        self._label_point = None
+        if label is not None:
+            self._label_point = pv.PolyData(np.zeros((1, 3)))
+            add_labels(pl, self._label_point, [label], align="centre")
         self.update(pose)
 
     def update(self, pose: np.ndarray, visible: np.ndarray | None = None) -> None:
@@ -191,11 +196,8 @@ class BodyFigure:
                 self.ring.SetPosition(*root)
         if self.bones is not None:
             self._lines.points = np.where(finite[:, None], pose, np.nanmean(pose[finite], axis=0) if finite.any() else 0.0)
-        if self._label_text is not None and finite.any():
-            top = pose[finite][np.argmax(pose[finite, 1])] + np.array([0.0, 0.12, 0.0])
-            if self.label is not None:
-                self.pl.remove_actor(self.label)
-            self.label = add_labels(self.pl, top, [self._label_text], align="centre")
+        if self._label_point is not None and finite.any():
+            self._label_point.points = pose[finite][np.argmax(pose[finite, 1])][None] + np.array([[0.0, 0.12, 0.0]])
 
 
 class Movie:

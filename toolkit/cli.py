@@ -60,6 +60,10 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p.add_argument("--load", metavar="STATE", help="restore what the characters learned from a state file first")
     p.add_argument("--save", metavar="STATE", help="save what the characters learn to a state file (atomically, "
                    "whenever something is learned and at the end)")
+    p.add_argument("--render", metavar="DIR", help="draw the run into DIR (PNG frames, GIF and MP4 by default)")
+    p.add_argument("--view", default="scenario", metavar="NAME", help="the view that draws it (default: scenario)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="a parameter of the view, e.g. --set every=2 --set 'formats=[\"gif\"]' (repeatable)")
     p.set_defaults(handler=cmd_run)
 
     p = sub.add_parser("plugins", help="list every registered component by kind, with its distribution")
@@ -143,13 +147,30 @@ def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dic
 
         checkpoint = Checkpoint(scenario.world, args.save)
         pm.register(checkpoint, name="checkpoint")
+    view = recorder = None
+    if getattr(args, "render", None):
+        from toolkit.params import parse_settings
+
+        cls = pm.registry.get("view", args.view)
+        if cls.subject != "scenario":
+            raise ConfigError(f"view {args.view!r} draws a {cls.subject}, not a scenario", key=("--view",),
+                              expected="a view of scenarios", available=[n for n in pm.registry.names("view")
+                                                                         if pm.registry.get("view", n).subject == "scenario"])
+        view = cls(**parse_settings(args.set, tables=False))
+        recorder = view.start(scenario.world)
     try:
         world = scenario.run()
     finally:
         if checkpoint is not None:
             pm.unregister(checkpoint)
+        if recorder is not None and pm.is_registered(recorder):
+            pm.unregister(recorder)
     if checkpoint is not None:
         checkpoint.save()
+    if view is not None:
+        files = view.render(recorder, world, Path(args.render))
+        print(f"wrote {len(files)} file(s) to {args.render}: " + ", ".join(
+            sorted({f.suffix.lstrip('.') for f in files})), file=sys.stderr)
     summary = summarise(world, name=scenario.name)
     summary["seed"] = scenario.seed
     summary["description"] = scenario.description.strip()
