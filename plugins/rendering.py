@@ -58,6 +58,7 @@ def plotter(size: tuple[int, int] = (800, 600), *, background: str = "white", fl
 
     pl = pv.Plotter(off_screen=True, window_size=list(size), lighting="none" if flat else "light kit")
     pl.set_background(background)
+    pl.renderer.GetCullers().RemoveAllItems()  # VTK culls props covering < 1e-4 of the view: far small parts vanish
     if flat:
         pl.disable_anti_aliasing()
     return pl
