@@ -312,6 +312,75 @@ def likeme_register_commands(subparsers):
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(handler=cmd_behaviour)
 
+    p = sub.add_parser("vision", help="rendered-vision against synthetic-vision on the same frames: agreement, "
+                       "position difference, milliseconds per frame")
+    p.add_argument("--scenario", default="jump_then_cover_face", help="scenario to watch (default: jump_then_cover_face)")
+    p.add_argument("--observer", default="max", help="the watching actor (default: max)")
+    p.add_argument("--resolution", type=int, action="append", help="rendered-vision resolution, repeatable "
+                   "(default: 240, 480, 960)")
+    p.add_argument("--frames", type=int, default=240, help="frames to compare (default: 240)")
+    p.set_defaults(handler=cmd_vision)
+
+
+def vision_benchmark(pm: Any, scenario: str, observer: str, resolutions: list[int], frames: int) -> list[dict[str, Any]]:
+    """Step the scenario; on every frame both perceptions look at the watched actor; compare and time them."""
+    from plugins.rendered_vision import RenderedVision
+    from plugins.synthetic_vision import SyntheticVision
+    from toolkit.scenario import load_scenario
+
+    world = load_scenario(scenario, pm).world
+    actor = world.actors[observer]
+    target = actor.target
+    if target is None:
+        raise ConfigError(f"actor {observer!r} watches nobody in {scenario!r}", key=("--observer",),
+                          expected="an actor that watches another", available=[a.id for a in world.actors.values()
+                                                                               if a.target is not None])
+    params = dict(actor.character.perception.params) if actor.character.perception is not None else {}
+    params = {k: v for k, v in params.items() if k in {q.name for q in SyntheticVision.parameters}}
+    geometric = SyntheticVision(**params)
+    geometric.attach(actor.character)
+    rendered = {r: RenderedVision(**params, resolution=r) for r in resolutions}
+    for v in rendered.values():
+        v.attach(actor.character)
+    rows = {"synthetic-vision": {"time": 0.0}} | {f"rendered-vision {r} px": {"time": 0.0, "agree": 0, "n": 0,
+                                                                          "errors": []} for r in resolutions}
+    try:
+        for _ in range(frames):
+            world.step()
+            t0 = time.perf_counter()
+            truth_p, truth_s, _ = geometric._look(actor, target, world)
+            rows["synthetic-vision"]["time"] += time.perf_counter() - t0
+            for r, v in rendered.items():
+                row = rows[f"rendered-vision {r} px"]
+                t0 = time.perf_counter()
+                p, s, _ = v._look(actor, target, world)
+                row["time"] += time.perf_counter() - t0
+                row["agree"] += int((s == truth_s).sum())
+                row["n"] += len(s)
+                both = s & truth_s
+                row["errors"] += list(np.linalg.norm(p[both] - truth_p[both], axis=1))
+    finally:
+        for v in rendered.values():
+            v.close()
+    out = []
+    for name, row in rows.items():
+        errors = np.array(row.get("errors", [0.0]) or [np.nan])
+        out.append({"perception": name, "ms_per_frame": 1000 * row["time"] / frames,
+                    "agreement": row["agree"] / row["n"] if "n" in row else 1.0,
+                    "median_mm": 1000 * float(np.median(errors)) if "n" in row else 0.0,
+                    "p95_mm": 1000 * float(np.percentile(errors, 95)) if "n" in row else 0.0})
+    return out
+
+
+def cmd_vision(args: argparse.Namespace, pm: Any) -> int:
+    rows = vision_benchmark(pm, args.scenario, args.observer, args.resolution or [240, 480, 960], args.frames)
+    print(f"{args.observer} watching in {args.scenario}, {args.frames} frames")
+    print(f"{'perception':<26} {'ms/frame':>9} {'seen-agreement':>15} {'median mm':>10} {'p95 mm':>8}")
+    for r in rows:
+        print(f"{r['perception']:<26} {r['ms_per_frame']:9.2f} {r['agreement']:15.3f} {r['median_mm']:10.1f} "
+              f"{r['p95_mm']:8.1f}")
+    return 0
+
 
 # -- Max and Moritz (Kopp & Graeser 2006) -----------------------------------------------------------------
 

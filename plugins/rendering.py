@@ -109,9 +109,13 @@ def add_labels(pl: Any, points: np.ndarray, texts: Sequence[str], *, font_size: 
                colour: str = "black") -> Any:
     """Text at 3D points (an array, or a PolyData whose points can move later), every one drawn; ``align`` left,
     centre or right."""
-    if not hasattr(points, "points"):  # a PolyData is kept: moving its points moves the labels
+    if hasattr(points, "points"):  # a PolyData is kept (texts as its array): moving its points moves the labels
+        points["labels"] = np.array(list(texts))
+        texts = "labels"
+    else:
         points = np.asarray(points, dtype=float).reshape(-1, 3)
-    actor = pl.add_point_labels(points, list(texts), font_size=font_size,
+        texts = list(texts)
+    actor = pl.add_point_labels(points, texts, font_size=font_size,
                                 shape=None, show_points=False, always_visible=True, text_color=colour,
                                 justification_horizontal={"centre": "center"}.get(align, align))
     actor.GetMapper().SetPlaceAllLabels(True)
