@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from plugins.metrics import match_segments, movement_error_rate, segmentation_scores
-from toolkit import World, hookimpl, load_character
+from toolkit import ConfigError, World, hookimpl, load_character
 from toolkit.character import merge_tables
 from toolkit.params import parse_settings
 

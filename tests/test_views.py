@@ -209,3 +209,27 @@ def test_a_character_can_watch_with_rendered_vision(write):
     recognised = [e.data["match"].movement for e in world.events_of("movement_recognised", "max")]
     max_.perception.close()
     assert recognised == ["jump", "cover_face"]
+
+
+def test_a_third_party_view_registers_through_the_hook_and_draws(tmp_path):
+    from tests.conftest import make_plugin
+    from toolkit import View
+    from toolkit.manager import PluginInfo
+
+    class Outline(View):
+        """The hub pose's parts as a text file (a view needs no drawing library)."""
+
+        name = "outline"
+
+        def draw(self, subject, out):
+            out = Path(out)
+            out.write_text("\n".join(f"{p} {x:.2f} {y:.2f} {z:.2f}" for p, (x, y, z) in
+                                     zip(subject.body.parts, subject.motor.rest_pose())))
+            return [out]
+
+    pm = create_plugin_manager(autoload=False)
+    pm.register_plugin(make_plugin(likeme_register_views=lambda: [Outline]), PluginInfo("outline", "m", "(tests)", ""))
+    assert "outline" in pm.registry.names("view") and "body" in pm.registry.names("view")
+    max_ = load_character("max", pm)
+    files = pm.registry.get("view", "outline")().draw(max_, tmp_path / "max.txt")
+    assert files[0].read_text().splitlines()[0].startswith(max_.body.parts[0])
