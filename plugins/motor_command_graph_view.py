@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from plugins.rendering import add_labels, draw_bodies, part_colours, plotter, save_png
+from plugins.rendering import add_labels, demonstration, draw_bodies, part_colours, plotter, save_png
 from toolkit import ConfigError, Parameter, View, hookimpl
 
 __all__ = ["MotorCommandGraphView", "edge_trajectories"]
@@ -110,16 +110,7 @@ class MotorCommandGraphView(View):
         if matcher is None or matcher.name != "forward-model":
             raise ConfigError(f"{character.name} has no forward-model matcher to predict with", key=("predict",),
                               expected="a character whose [matcher] plugin is forward-model")
-        demonstrator = character
-        if self.params["demonstrator"]:
-            from toolkit import load_character
-
-            demonstrator = load_character(self.params["demonstrator"], character.pm)
-        movement = self.params["predict"]
-        if movement not in demonstrator.motor.movements():
-            raise ConfigError(f"unknown movement {movement!r}", key=("predict",), expected=f"a movement of "
-                              f"{demonstrator.name}", available=sorted(demonstrator.motor.movements()))
-        motion = demonstrator.motor.perform(movement).root_relative(demonstrator.body.root)
+        who, motion = demonstration(character, self.params["demonstrator"], self.params["predict"], "predict")
         parts = [motion.parts.index(p) if p in motion.parts else -1 for p in character.body.parts]
         n = max(1, int(round(self.params["at"] * motion.n_frames)))
         matcher.begin(motion.fps)
@@ -132,7 +123,7 @@ class MotorCommandGraphView(View):
                 committed = answer.movement
         observed = np.array(matcher.frames)
         subsystem = matcher.subsystem or next(iter(character.motor.graphs))
-        return {"who": demonstrator.name, "subsystem": subsystem, "active": matcher.start_node or "hub",
+        return {"who": who, "subsystem": subsystem, "active": matcher.start_node or "hub",
                 "candidates": sorted({p[0] for p in matcher.candidates}), "initial": list(matcher.initial),
                 "committed": committed, "observed": observed[:, character.motor.subsystems[subsystem]]}
 

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from plugins.rendering import _PALETTE, add_labels, plotter, save_png
+from plugins.rendering import _PALETTE, add_labels, demonstration, plotter, save_png
 from toolkit import ConfigError, Parameter, View, hookimpl
 
 __all__ = ["PosegraphView", "pose_layout"]
@@ -108,17 +108,9 @@ class PosegraphView(View):
         if matcher is None or matcher.name != "path-search":
             raise ConfigError(f"{character.name} has no path-search matcher to find the path", key=("match",),
                               expected="a character whose [matcher] plugin is path-search")
-        demonstrator = character
-        if self.params["demonstrator"]:
-            from toolkit import load_character
-
-            demonstrator = load_character(self.params["demonstrator"], character.pm)
-        movement = self.params["match"]
-        if movement not in demonstrator.motor.movements():
-            raise ConfigError(f"unknown movement {movement!r}", key=("match",), expected=f"a movement of "
-                              f"{demonstrator.name}", available=sorted(demonstrator.motor.movements()))
-        motion = demonstrator.motor.perform(movement, speed=self.params["speed"])
-        return matcher.match(motion.root_relative(demonstrator.body.root))
+        _, motion = demonstration(character, self.params["demonstrator"], self.params["match"], "match",
+                                  speed=self.params["speed"])
+        return matcher.match(motion)
 
 
 @hookimpl
