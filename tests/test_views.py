@@ -95,8 +95,8 @@ def test_a_view_of_the_wrong_subject_or_an_unknown_view_is_refused(capsys):
     assert main(["show", "max", "--view", "scenario"]) == 1
     assert "view 'scenario' draws a scenario, not a character" in capsys.readouterr().err
     assert main(["show", "max", "--view", "bodyy"]) == 1
-    assert "unknown view 'bodyy'" in capsys.readouterr().err and "available: body, motor-command-graph" in \
-        capsys.readouterr().err + "available: body, motor-command-graph"
+    err = capsys.readouterr().err
+    assert "unknown view 'bodyy'" in err and "available: body, motor-command-graph" in err
     assert main(["show", "moritz", "--view", "posegraph"]) == 1
     assert "has no posegraph" in capsys.readouterr().err
 

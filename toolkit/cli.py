@@ -130,6 +130,18 @@ def main(argv: Sequence[str] | None = None) -> int:
 # -- commands ----------------------------------------------------------------------------
 
 
+def _view(pm: PluginManager, name: str, subject: str, settings: list[str]) -> Any:
+    """The view ``name`` made with ``--set KEY=VALUE`` settings; it must draw ``subject`` (character or scenario)."""
+    from toolkit.params import parse_settings
+
+    cls = pm.registry.get("view", name)
+    if cls.subject != subject:
+        raise ConfigError(f"view {name!r} draws a {cls.subject}, not a {subject}", key=("--view",),
+                          expected=f"a view of {subject}s", available=[n for n in pm.registry.names("view")
+                                                                      if pm.registry.get("view", n).subject == subject])
+    return cls(**parse_settings(settings, tables=False))
+
+
 def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dict[str, Any]:
     from toolkit.report import summarise
     from toolkit.scenario import load_scenario
@@ -149,14 +161,7 @@ def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dic
         pm.register(checkpoint, name="checkpoint")
     view = recorder = None
     if getattr(args, "render", None):
-        from toolkit.params import parse_settings
-
-        cls = pm.registry.get("view", args.view)
-        if cls.subject != "scenario":
-            raise ConfigError(f"view {args.view!r} draws a {cls.subject}, not a scenario", key=("--view",),
-                              expected="a view of scenarios", available=[n for n in pm.registry.names("view")
-                                                                         if pm.registry.get("view", n).subject == "scenario"])
-        view = cls(**parse_settings(args.set, tables=False))
+        view = _view(pm, args.view, "scenario", args.set)
         recorder = view.start(scenario.world)
     try:
         world = scenario.run()
@@ -304,14 +309,7 @@ def cmd_show(args: argparse.Namespace, pm: PluginManager) -> int:
     else:
         character = load_character(args.character, pm)
     if args.view:
-        from toolkit.params import parse_settings
-
-        cls = pm.registry.get("view", args.view)
-        if cls.subject != "character":
-            raise ConfigError(f"view {args.view!r} draws a {cls.subject}, not a character", key=("--view",),
-                              expected="a view of characters", available=[n for n in pm.registry.names("view")
-                                                                          if pm.registry.get("view", n).subject == "character"])
-        view = cls(**parse_settings(args.set, tables=False))
+        view = _view(pm, args.view, "character", args.set)
         out = Path(args.out or f"{re.sub(r'[^a-z0-9]+', '-', character.name.lower()).strip('-')}-{args.view}.png")
         for path in view.draw(character, out):
             print(f"wrote {path}")
