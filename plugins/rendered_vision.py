@@ -150,27 +150,26 @@ class RenderedVision(SyntheticVision):
         image = np.asarray(self._pl.screenshot(return_img=True))[..., :3].astype(np.int16)
         depth = -np.asarray(self._pl.get_image_depth(fill_value=np.nan, reset_camera_clipping_range=False))
         size = (image.shape[1], image.shape[0])
-        positions = np.full((len(points), 3), np.nan)
-        seen = np.zeros(len(points), dtype=bool)
+        n = len(points)
         # every pixel's code index: the nearest code within half a step on every channel
         index = np.rint((image - 15) / _STEP).astype(int)
         exact = (np.abs(image - (index * _STEP + 15)) <= _STEP // 2 - 1).all(axis=-1)
         pixel_code = index[..., 0] + 6 * index[..., 1] + 36 * index[..., 2] - 1
-        pixel_code[~exact | (image.sum(axis=-1) == 0)] = -1
-        for i in np.flatnonzero(finite):
-            mask = pixel_code == i
-            count = int(mask.sum())
-            if count < self.params["min_pixels"]:
-                continue
-            rows, cols = np.nonzero(mask)
-            d = depth[rows, cols]
-            d = d[np.isfinite(d)]
-            if not len(d):
-                continue
-            z = float(d.min()) + float(radii[i])
-            local = unproject(cols.mean(), rows.mean(), np.array(z), size, view_angle)
-            positions[i] = eye + right * local[0] + up * local[1] + forward * local[2]
-            seen[i] = True
+        rows, cols = np.nonzero(exact & (image.sum(axis=-1) > 0) & (pixel_code >= 0) & (pixel_code < n))
+        code = pixel_code[rows, cols]
+        # per code in one pass: pixel count, centroid, nearest finite depth
+        count = np.bincount(code, minlength=n)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            u = np.bincount(code, weights=cols, minlength=n) / count
+            v = np.bincount(code, weights=rows, minlength=n) / count
+        d = depth[rows, cols]
+        near = np.full(n, np.inf)
+        np.minimum.at(near, code[np.isfinite(d)], d[np.isfinite(d)])
+        seen = finite & (count >= self.params["min_pixels"]) & np.isfinite(near)
+        local = unproject(np.where(seen, u, 0.0), np.where(seen, v, 0.0), np.where(seen, near + radii, 1.0), size,
+                          view_angle)  # (n, 3): right, up, forward
+        positions = eye + local[:, :1] * right + local[:, 1:2] * up + local[:, 2:] * forward
+        positions[~seen] = np.nan
         return positions, seen & (np.linalg.norm(np.nan_to_num(positions) - eye, axis=1) <= self.params["range"])
 
 
