@@ -342,16 +342,16 @@ def vision_benchmark(pm: Any, scenario: str, observer: str, resolutions: list[in
     rendered = {r: RenderedVision(**params, resolution=r) for r in resolutions}
     for v in rendered.values():
         v.attach(actor.character)
-    rows = {"synthetic-vision": {"time": 0.0}} | {f"rendered-vision {r} px": {"time": 0.0, "agree": 0, "n": 0,
-                                                                          "errors": []} for r in resolutions}
+    geometric_time = 0.0
+    stats = {r: {"time": 0.0, "agree": 0, "n": 0, "errors": []} for r in resolutions}
     try:
         for _ in range(frames):
             world.step()
             t0 = time.perf_counter()
             truth_p, truth_s, _ = geometric._look(actor, target, world)
-            rows["synthetic-vision"]["time"] += time.perf_counter() - t0
+            geometric_time += time.perf_counter() - t0
             for r, v in rendered.items():
-                row = rows[f"rendered-vision {r} px"]
+                row = stats[r]
                 t0 = time.perf_counter()
                 p, s, _ = v._look(actor, target, world)
                 row["time"] += time.perf_counter() - t0
@@ -362,13 +362,13 @@ def vision_benchmark(pm: Any, scenario: str, observer: str, resolutions: list[in
     finally:
         for v in rendered.values():
             v.close()
-    out = []
-    for name, row in rows.items():
-        errors = np.array(row.get("errors", [0.0]) or [np.nan])
-        out.append({"perception": name, "ms_per_frame": 1000 * row["time"] / frames,
-                    "agreement": row["agree"] / row["n"] if "n" in row else 1.0,
-                    "median_mm": 1000 * float(np.median(errors)) if "n" in row else 0.0,
-                    "p95_mm": 1000 * float(np.percentile(errors, 95)) if "n" in row else 0.0})
+    out = [{"perception": "synthetic-vision", "ms_per_frame": 1000 * geometric_time / frames, "agreement": 1.0,
+            "median_mm": 0.0, "p95_mm": 0.0}]
+    for r, row in stats.items():
+        errors = np.array(row["errors"] or [np.nan])
+        out.append({"perception": f"rendered-vision {r} px", "ms_per_frame": 1000 * row["time"] / frames,
+                    "agreement": row["agree"] / row["n"], "median_mm": 1000 * float(np.median(errors)),
+                    "p95_mm": 1000 * float(np.percentile(errors, 95))})
     return out
 
 

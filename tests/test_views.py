@@ -233,3 +233,11 @@ def test_a_third_party_view_registers_through_the_hook_and_draws(tmp_path):
     max_ = load_character("max", pm)
     files = pm.registry.get("view", "outline")().draw(max_, tmp_path / "max.txt")
     assert files[0].read_text().splitlines()[0].startswith(max_.body.parts[0])
+
+
+def test_the_vision_benchmark_compares_both_perceptions_on_the_same_frames():
+    from plugins.benchmark import vision_benchmark
+
+    rows = vision_benchmark(create_plugin_manager(autoload=False), "jump_then_cover_face", "max", [240], 20)
+    assert [r["perception"] for r in rows] == ["synthetic-vision", "rendered-vision 240 px"]
+    assert rows[1]["agreement"] > 0.9 and 0 < rows[1]["median_mm"] < 30 and rows[1]["ms_per_frame"] > 0
