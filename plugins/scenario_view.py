@@ -34,6 +34,7 @@ __all__ = ["ScenarioView", "Recorder"]
 class Recorder:
     """What a run showed, frame by frame; registered as a plugin while the world runs."""
 
+    world: Any = field(repr=False)
     every: int = 1
     poses: dict[str, list[np.ndarray]] = field(default_factory=dict)
     headings: dict[str, list[float]] = field(default_factory=dict)
@@ -45,7 +46,6 @@ class Recorder:
 
     @hookimpl
     def likeme_world_stepped(self, world: Any) -> None:
-        self.fps = world.fps
         if world.frame % self.every:
             return
         self.frames.append(world.frame)
@@ -105,28 +105,34 @@ class ScenarioView(View):
 
             raise ConfigError(f"unknown format {unknown[0]!r}", key=("formats",), expected="image formats",
                               available=["png", "gif", "mp4"])
-        recorder = Recorder(every=self.params["every"], fps=world.fps)
+        recorder = Recorder(world, every=self.params["every"], fps=world.fps)
         world.pm.register(recorder, name="scenario-view-recorder")
-        self._world = world
         return recorder
+
+    @staticmethod
+    def stop(recorder: Recorder) -> None:
+        """Stop recording (whether the run ended or failed); calling it again does nothing."""
+        if recorder.world.pm.is_registered(recorder):
+            recorder.world.pm.unregister(recorder)
 
     def finish(self, recorder: Recorder, out: Path) -> list[Path]:
         """Stop recording and draw every recorded frame into the folder ``out``."""
-        world = self._world
-        world.pm.unregister(recorder)
-        return self.render(recorder, world, Path(out))
+        self.stop(recorder)
+        return self.render(recorder, Path(out))
 
     def draw(self, subject: Any, out: Path) -> list[Path]:
         recorder = self.start(subject.world)
         try:
             subject.run()
-        except BaseException:
-            subject.world.pm.unregister(recorder)
-            raise
-        return self.finish(recorder, Path(out))
+        finally:
+            self.stop(recorder)
+        return self.render(recorder, Path(out))
 
-    def render(self, recorder: Recorder, world: Any, out: Path) -> list[Path]:
+    def render(self, recorder: Recorder, out: Path) -> list[Path]:
+        """Draw every recorded frame into the folder ``out``; returns the files written."""
         import pyvista as pv
+
+        world = recorder.world
 
         if not recorder.frames:
             return []

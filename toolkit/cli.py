@@ -159,21 +159,20 @@ def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dic
 
         checkpoint = Checkpoint(scenario.world, args.save)
         pm.register(checkpoint, name="checkpoint")
-    view = recorder = None
-    if getattr(args, "render", None):
-        view = _view(pm, args.view, "scenario", args.set)
-        recorder = view.start(scenario.world)
+    view = _view(pm, args.view, "scenario", args.set) if getattr(args, "render", None) else None
+    files = []
     try:
-        world = scenario.run()
+        if view is not None:  # a scenario view runs the scenario while it records it, then draws it
+            files = view.draw(scenario, Path(args.render))
+        else:
+            scenario.run()
     finally:
         if checkpoint is not None:
             pm.unregister(checkpoint)
-        if recorder is not None and pm.is_registered(recorder):
-            pm.unregister(recorder)
+    world = scenario.world
     if checkpoint is not None:
         checkpoint.save()
     if view is not None:
-        files = view.render(recorder, world, Path(args.render))
         print(f"wrote {len(files)} file(s) to {args.render}: " + ", ".join(
             sorted({f.suffix.lstrip('.') for f in files})), file=sys.stderr)
     summary = summarise(world, name=scenario.name)
