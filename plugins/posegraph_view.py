@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from plugins.rendering import _PALETTE, add_labels, demonstration, plotter, save_png
+from plugins.rendering import _PALETTE, add_labels, demonstration, hex_to_rgb, plotter, save_png
 from toolkit import ConfigError, Parameter, View, hookimpl
 
 __all__ = ["PosegraphView", "pose_layout"]
@@ -72,8 +72,6 @@ class PosegraphView(View):
                 pl.add_mesh(lines, color="#9a9a9a", line_width=1)
             nodes = pv.PolyData(coords[~hub])
             if nodes.n_points:
-                from plugins.rendering import hex_to_rgb
-
                 nodes["rgb"] = np.array([hex_to_rgb(colour[motor.movement_of(n)]) for n, h in zip(names, hub) if not h],
                                         dtype=np.uint8)
                 pl.add_mesh(nodes.glyph(geom=pv.Sphere(radius=0.012), scale=False, orient=False), scalars="rgb", rgb=True)

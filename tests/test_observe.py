@@ -199,10 +199,8 @@ def test_observing_a_bandai_namco_clip(tmp_path, pm):
 
 
 def test_a_clip_built_motor_command_graph_saves_and_loads_its_labels_without_doubling_edges(data, profile, pm):
-    import json as _json
-
     commands = compose_observer(pm, profile, data / "repertoire", matcher="forward-model").motor
-    state = _json.loads(_json.dumps(commands.get_state()))
+    state = json.loads(json.dumps(commands.get_state()))
     again = compose_observer(pm, profile, data / "repertoire", matcher="forward-model").motor
 
     def by_name(s):  # edges in name order, stroke numbers to 5 decimals (a stroke's normal is normalised on load)
