@@ -161,6 +161,9 @@ def test_observe_prints_segments_and_json(data, capsys):
         (["--matcher", "forward-mode"], "unknown matcher 'forward-mode'; expected the name of a registered matcher; "
                                         "available: dtw, forward-model, path-search"),
         (["--segmenter", "rupture"], "unknown segmenter 'rupture'"),
+        (["--set", "perception.plugin=synthetic-vision"], "perception 'synthetic-vision' cannot watch recorded poses; "
+                                                          "expected a perception that implements perceive_pose; "
+                                                          "available: motion-capture"),
     ],
 )
 def test_observe_refuses_unknown_plugins_with_the_registered_names(data, capsys, args, expected):

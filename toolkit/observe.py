@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from toolkit.character import Character, compose_character
-from toolkit.components import Match, Segment
+from toolkit.components import Match, Perception, Segment
 from toolkit.errors import ConfigError, PluginError
 from toolkit.motion import Motion
 from toolkit.profile import BodyProfile
@@ -65,6 +65,13 @@ class Observer:
     def __init__(self, character: Character, body: Any, fps: float) -> None:
         if character.perception is None or character.segmenter is None:
             raise ConfigError(f"character {character.name} cannot observe", expected="a perception and a segmenter")
+        if type(character.perception).perceive_pose is Perception.perceive_pose:  # it needs a world to look at
+            pm = character.pm
+            able = [n for n in pm.registry.names("perception") if pm.registry.get("perception", n).perceive_pose
+                    is not Perception.perceive_pose] if pm is not None else []
+            raise ConfigError(f"perception {character.perception.name!r} cannot watch recorded poses",
+                              key=("perception", "plugin"), expected="a perception that implements perceive_pose",
+                              available=able)
         self.character, self.body, self.fps = character, body, float(fps)
         self.reset()
 
