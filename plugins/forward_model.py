@@ -100,6 +100,11 @@ class ForwardModel(Matcher):
         self.committed_path: tuple[str, ...] = ()
         self.deviated = False
         self.initial: list[str] = []
+        # per frame of the segment (once a subsystem moves): the prediction error of every candidate path evaluated,
+        # dropped ones included at the frame they drop; while imitating, the committed path's error
+        self.trace: list[tuple[int, dict[tuple[str, ...], float]]] = []
+        self.committed_at: int | None = None  # frames of the segment seen when it committed, and when it deviated
+        self.deviated_at: int | None = None
 
     def _local(self, pose: np.ndarray) -> np.ndarray:
         """Root-relative observed positions in the observer's motor frame (root at its own rest height)."""
@@ -115,17 +120,21 @@ class ForwardModel(Matcher):
         observed = np.array(self.frames)[:, self.motor.subsystems[self.subsystem]]  # (n, k, 3)
         lengths = np.array([_observed_length(observed[:, j]) for j in range(observed.shape[1])])  # once per frame
         last = observed[-1]
+        frame = len(self.frames) - 1
         if self.committed is not None:
-            if not self.deviated and self._error(self.committed_path, lengths, last) > self.params["deviation"]:
+            if self.deviated:
+                return None
+            error = self._error(self.committed_path, lengths, last)
+            self.trace.append((frame, {self.committed_path: error}))
+            if error > self.params["deviation"]:
                 self.deviated = True
+                self.deviated_at = len(self.frames)
                 self.excluded.add(self.committed_path[0])
                 return Match(self.committed, 0.0, len(self.frames), details={"stop": True, "reason": "deviation"})
             return None
-        alive: dict[tuple[str, ...], float] = {}
-        for path in self._extended(list(self.candidates), lengths):
-            error = self._error(path, lengths, last)
-            if error <= self.params["threshold"]:
-                alive[path] = error
+        errors = {path: self._error(path, lengths, last) for path in self._extended(list(self.candidates), lengths)}
+        self.trace.append((frame, errors))
+        alive = {path: error for path, error in errors.items() if error <= self.params["threshold"]}
         if len(alive) > self.params["max_candidates"]:  # keep the best predictions
             alive = dict(sorted(alive.items(), key=lambda kv: kv[1])[: self.params["max_candidates"]])
         self.candidates = alive
@@ -135,6 +144,7 @@ class ForwardModel(Matcher):
             if progress >= self.params["min_progress"] or len(path) > 1:
                 self.committed_path = self._known_continuation(path)
                 self.committed = self.motor.add_sequence(list(self.committed_path))
+                self.committed_at = len(self.frames)
                 speed = self._speed(path[0], lengths, len(observed))
                 label = self._path_label(self.committed_path) or self.motor.label(self.committed)
                 return Match(label, float(np.exp(-alive[path] / self.params["threshold"])), len(self.frames),

@@ -32,6 +32,7 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
+from scipy.ndimage import minimum_filter1d
 from scipy.signal import butter, lfilter, lfilter_zi
 
 from plugins.pose_distance import pose_distance
@@ -95,8 +96,7 @@ class HubThreshold(Segmenter):
         self._recent: deque[tuple[int, float]] = deque()  # monotonic queue of (frame, value) for the running minimum
         self._start: int | None = None
         self._below = 0
-        self._on = self.params["threshold"]
-        self._off = self.params["threshold"] * self.params["release"]
+        self._on, self._off = self.thresholds
 
     @property
     def active_since(self) -> int | None:
@@ -164,10 +164,10 @@ class HubThreshold(Segmenter):
 
     # -- batch ---------------------------------------------------------------------------
 
-    def signal(self, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
-        """The raw and the low-pass filtered distance-to-hub of a root-relative motion (Fig. 4).
-
-        The threshold applies to the filtered signal minus its running minimum (see ``floor``).
+    def signal(self, motion: Motion) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The distance-to-hub of a root-relative motion (Fig. 4): raw, low-pass filtered, and the level the
+        thresholds apply to (the filtered distance minus its running minimum over ``floor`` seconds; the filtered
+        distance itself without a floor). Frames with nothing visible hold the last value.
         """
         self.reset(motion.parts, motion.fps)
         ok = self._index >= 0
@@ -178,12 +178,20 @@ class HubThreshold(Segmenter):
         raw = _nearest(pose_distance(obs[:, None], self.templates, vis[:, None]), axis=-1)
         raw = _hold(raw)
         if raw.size == 0:
-            return raw, raw
+            return raw, raw, raw
         filtered, _ = lfilter(self._b, self._a, raw, zi=lfilter_zi(self._b, self._a) * raw[0])
-        return raw, filtered
+        if not self._window:
+            return raw, filtered, filtered
+        w = self._window  # the running minimum of the last w frames, this one included (trailing window)
+        return raw, filtered, filtered - minimum_filter1d(filtered, w, mode="nearest", origin=(w - 1) // 2)
+
+    @property
+    def thresholds(self) -> tuple[float, float]:
+        """The level at which a movement begins and the level below which it ends (hysteresis)."""
+        return self.params["threshold"], self.params["threshold"] * self.params["release"]
 
     def segment(self, motion: Motion) -> list[Segment]:
-        _, filtered = self.signal(motion)
+        _, filtered, _ = self.signal(motion)
         self.reset(motion.parts, motion.fps)
         out: list[Segment] = []
         for value in filtered:

@@ -23,7 +23,8 @@ from typing import Any
 
 import numpy as np
 
-from plugins.rendering import add_labels, demonstration, draw_bodies, part_colours, plotter, save_png
+from plugins.demonstration import demonstration, onto
+from plugins.rendering import add_labels, draw_bodies, part_colours, plotter, save_png
 from toolkit import ConfigError, Parameter, View, hookimpl
 
 __all__ = ["MotorCommandGraphView", "edge_trajectories"]
@@ -111,14 +112,12 @@ class MotorCommandGraphView(View):
             raise ConfigError(f"{character.name} has no forward-model matcher to predict with", key=("predict",),
                               expected="a character whose [matcher] plugin is forward-model")
         who, motion = demonstration(character, self.params["demonstrator"], self.params["predict"], "predict")
-        parts = [motion.parts.index(p) if p in motion.parts else -1 for p in character.body.parts]
+        motion = onto(motion, character.body.parts)
         n = max(1, int(round(self.params["at"] * motion.n_frames)))
         matcher.begin(motion.fps)
         committed = None
         for f in range(n):
-            pose = np.where(np.array(parts)[:, None] >= 0, motion.positions[f, parts], np.nan)
-            visible = np.isfinite(pose).all(axis=1)
-            answer = matcher.observe(np.nan_to_num(pose), visible)
+            answer = matcher.observe(np.nan_to_num(motion.positions[f]), motion.visible[f])
             if answer is not None and answer.movement and committed is None:
                 committed = answer.movement
         observed = np.array(matcher.frames)

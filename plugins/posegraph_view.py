@@ -18,7 +18,8 @@ from typing import Any
 
 import numpy as np
 
-from plugins.rendering import _PALETTE, add_labels, demonstration, hex_to_rgb, plotter, save_png
+from plugins.demonstration import demonstration
+from plugins.rendering import _PALETTE, add_labels, hex_to_rgb, plotter, save_png
 from toolkit import ConfigError, Parameter, View, hookimpl
 
 __all__ = ["PosegraphView", "pose_layout"]

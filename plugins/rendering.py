@@ -21,8 +21,7 @@ import numpy as np
 
 from toolkit.body import Body
 
-__all__ = ["plotter", "BodyFigure", "Movie", "part_colours", "hex_to_rgb", "GREY", "save_png", "draw_bodies", "frame_2d", "add_labels",
-           "demonstration"]
+__all__ = ["plotter", "BodyFigure", "Movie", "part_colours", "hex_to_rgb", "GREY", "save_png", "draw_bodies", "frame_2d", "add_labels"]
 
 GREY = "#b0b0b0"
 """The colour of a part the observer does not see."""
@@ -259,18 +258,3 @@ class Movie:
                 writer.close()
         self.pl.close()
         return self.files
-
-
-def demonstration(character: Any, demonstrator: str, movement: str, key: str, *, speed: float = 1.0) -> tuple[str, Any]:
-    """A movement performed by ``demonstrator`` (a character file or name; empty: ``character``), root-relative,
-    as an observer would see it with perfect tracking: (the demonstrator's name, the motion).
-
-    ``key`` names the view parameter in the error for an unknown movement.
-    """
-    from toolkit import ConfigError, load_character
-
-    who = load_character(demonstrator, character.pm) if demonstrator else character
-    if movement not in who.motor.movements():
-        raise ConfigError(f"unknown movement {movement!r}", key=(key,), expected=f"a movement of {who.name}",
-                          available=sorted(who.motor.movements()))
-    return who.name, who.motor.perform(movement, speed=speed).root_relative(who.body.root)

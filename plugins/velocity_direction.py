@@ -33,13 +33,14 @@ from __future__ import annotations
 
 from collections import deque
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.signal import argrelextrema, savgol_filter
 
 from toolkit import ConfigError, Parameter, Segment, Segmenter, hookimpl
 
-__all__ = ["VelocityDirection", "speed_breaks", "direction_clusters", "direction_breaks"]
+__all__ = ["VelocityDirection", "StrokeAnalysis", "speed_breaks", "direction_clusters", "direction_breaks"]
 
 
 def speed_breaks(speed: np.ndarray, drop: float) -> list[int]:
@@ -90,6 +91,23 @@ def direction_breaks(labels: np.ndarray) -> list[int]:
     return [int(i) for i in np.flatnonzero(np.diff(labels) != 0) + 1]
 
 
+@dataclass(frozen=True)
+class StrokeAnalysis:
+    """How one movement's working memory was cut into strokes (indices are frames into the movement).
+
+    ``window``: the (smoothed) positions (N, 3k); ``speed``: the speed of the fastest chosen part between
+    successive frames (N - 1,); ``clusters``: the direction cluster of each movement vector (-1: none, at rest);
+    ``speed_breaks`` and ``direction_breaks``: the candidates each criterion found; ``breaks``: the ones kept.
+    """
+
+    window: np.ndarray
+    speed: np.ndarray
+    clusters: np.ndarray
+    speed_breaks: list[int]
+    direction_breaks: list[int]
+    breaks: list[int]
+
+
 def _unit(v: np.ndarray) -> np.ndarray:
     n = np.linalg.norm(v)
     return v / n if n > 1e-12 else v
@@ -116,6 +134,9 @@ class VelocityDirection(Segmenter):
         Parameter("level", str, "stroke", "Report strokes (break points) or whole movements (onset to end).",
                   choices=("stroke", "movement")),
     )
+
+    record: list[tuple[int, int, StrokeAnalysis]] | None = None
+    """Set to a list to keep ``(start, end, analysis)`` of every movement the working memory closes (for plots)."""
 
     def reset(self, parts: Sequence[str], fps: float) -> None:
         parts = tuple(parts)
@@ -182,27 +203,43 @@ class VelocityDirection(Segmenter):
         self._buffer = []
         if end - start < 2:
             return []
+        if self.params["level"] == "movement" and self.record is None:
+            return [Segment(start, end, self._fps)]
+        analysis = self.analyse(window)
+        if self.record is not None:
+            self.record.append((start, end, analysis))
         if self.params["level"] == "movement":
             return [Segment(start, end, self._fps)]
-        cuts = self.breaks(window)
+        cuts = analysis.breaks
         edges = [0, *cuts, end - start]
         return [Segment(start + a, start + b, self._fps) for a, b in zip(edges, edges[1:]) if b > a]
 
     def breaks(self, window: np.ndarray) -> list[int]:
         """Break points (indices into ``window``, positions (N, 3k) of the chosen parts) by speed and direction."""
+        return self.analyse(window).breaks
+
+    def analyse(self, window: np.ndarray) -> StrokeAnalysis:
+        """The working memory of one movement (positions (N, 3k) of the chosen parts) analysed for break points.
+
+        Speed minima below ``drop`` of their neighbouring maxima cut; direction-cluster changes cut where the
+        direction turns sharply at a dip of the speed (see the module). Pieces shorter than ``min_stroke`` merge.
+        """
         n = len(window)
+        empty = np.zeros(max(0, n - 1))
         if n < 4:
-            return []
+            return StrokeAnalysis(np.asarray(window, dtype=float), empty, np.full(len(empty), -1), [], [], [])
         smooth = int(round(self.params["smooth"] * self._fps)) | 1
         if smooth >= 5 and n > smooth:
             window = savgol_filter(window, smooth, 2, axis=0, mode="interp")
         vectors = np.diff(window, axis=0)
         speed = np.linalg.norm(vectors.reshape(len(vectors), -1, 3), axis=2).max(axis=1) * self._fps
         moving = speed > self.params["rest_speed"]
-        cuts = set(b + 1 for b in speed_breaks(speed, self.params["drop"]))
+        by_speed = sorted(b + 1 for b in speed_breaks(speed, self.params["drop"]))
+        cuts = set(by_speed)
+        by_direction: list[int] = []
         units = np.array([_unit(v) for v in vectors])
+        labels = np.full(len(units), -1)
         if moving.any():
-            labels = np.full(len(units), -1)
             labels[moving] = direction_clusters(units[moving], self.params["angle"])
             for i in range(1, len(labels)):  # slow vectors take the cluster of the one before
                 if labels[i] < 0:
@@ -216,13 +253,14 @@ class VelocityDirection(Segmenter):
                 sharp = np.degrees(np.arccos(np.clip(before @ after, -1.0, 1.0))) >= 0.5 * self.params["angle"]
                 near = dips[np.abs(dips - b) <= k]
                 if sharp and near.size:
-                    cuts.add(int(near[np.argmin(np.abs(near - b))]))
+                    by_direction.append(int(near[np.argmin(np.abs(near - b))]))
+        cuts.update(by_direction)
         shortest = max(1, int(round(self.params["min_stroke"] * self._fps)))
         kept: list[int] = []
         for c in sorted(cuts):
             if c - (kept[-1] if kept else 0) >= shortest and n - c >= shortest:
                 kept.append(c)
-        return kept
+        return StrokeAnalysis(window, speed, labels, by_speed, sorted(set(by_direction)), kept)
 
 
 @hookimpl

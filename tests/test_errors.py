@@ -146,6 +146,10 @@ CASES = [
     ("cli-missing-argument", "missing argument", {}, ["run"], ["the following arguments are required: scenario"]),
     ("cli-bad-int", "not a number", {}, ["demo", "--seed", "x"], ["argument --seed: invalid int value: 'x'"]),
     ("cli-bench-set", "bad --set", {}, ["bench", "watch", "--movements", "1", "--set", "floor=0"], ["key --set", "invalid setting 'floor=0'", "expected TABLE.KEY=VALUE"]),
+    # -- views
+    ("view-unknown", "unknown view", {}, ["show", MAX, "--view", "graph"], ["unknown view 'graph'", "available:", "hub-signal"]),
+    ("view-segmenter", "a signal view of a segmenter the character does not have", {}, ["show", MAX, "--view", "speed-profile"], ["key --view", "does not segment by velocity and direction", "velocity-direction"]),
+    ("view-movement", "a view asked to perform an unknown movement", {}, ["show", MAX, "--view", "hub-signal", "--set", 'movements=["fly"]'], ["key movements", "unknown movement 'fly'", "available:", "wave"]),
 ]
 
 

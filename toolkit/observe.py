@@ -60,26 +60,32 @@ class Observation:
 
 
 class Observer:
-    """A character watching a stream of world poses of ``body`` at ``fps``, frame by frame."""
+    """A character watching a stream of world poses of ``body`` at ``fps``, frame by frame.
 
-    def __init__(self, character: Character, body: Any, fps: float) -> None:
-        if character.perception is None or character.segmenter is None:
+    ``perception`` replaces the character's own for this stream (a character that
+    looks at a world through ``synthetic-vision`` can watch recordings through
+    ``motion-capture``); its segmenter and matcher are the character's.
+    """
+
+    def __init__(self, character: Character, body: Any, fps: float, *, perception: Perception | None = None) -> None:
+        perception = perception if perception is not None else character.perception
+        if perception is None or character.segmenter is None:
             raise ConfigError(f"character {character.name} cannot observe", expected="a perception and a segmenter")
-        if type(character.perception).perceive_pose is Perception.perceive_pose:  # it needs a world to look at
+        if type(perception).perceive_pose is Perception.perceive_pose:  # it needs a world to look at
             pm = character.pm
             able = [n for n in pm.registry.names("perception") if pm.registry.get("perception", n).perceive_pose
                     is not Perception.perceive_pose] if pm is not None else []
-            raise ConfigError(f"perception {character.perception.name!r} cannot watch recorded poses",
+            raise ConfigError(f"perception {perception.name!r} cannot watch recorded poses",
                               key=("perception", "plugin"), expected="a perception that implements perceive_pose",
                               available=able)
-        self.character, self.body, self.fps = character, body, float(fps)
+        self.character, self.body, self.fps, self.perception = character, body, float(fps), perception
         self.reset()
 
     def reset(self) -> None:
         """Start a new stream: frame numbering, memory, segmenter and matcher restart."""
         c = self.character
-        c.perception.fps = self.fps
-        c.perception.reset()
+        self.perception.fps = self.fps
+        self.perception.reset()
         c.segmenter.reset(self.body.parts, self.fps)
         self.poses: list[np.ndarray] = []
         self.visible: list[np.ndarray] = []
@@ -93,7 +99,7 @@ class Observer:
     def push(self, positions: np.ndarray, visible: np.ndarray | None = None) -> list[Observation]:
         """One frame of world positions (P, 3); returns the observations of segments that closed here."""
         c = self.character
-        percept = c.perception.perceive_pose(positions, visible, self.body, self.n_frames / self.fps)
+        percept = self.perception.perceive_pose(positions, visible, self.body, self.n_frames / self.fps)
         self.poses.append(percept.pose)
         self.visible.append(percept.visible)
         closed = c.segmenter.push(percept.pose, percept.visible)
@@ -123,7 +129,7 @@ class Observer:
         c.matcher.begin(self.fps)
         early = None
         for f in range(motion.n_frames):
-            percept = c.perception.perceive_pose(motion.positions[f], motion.visible[f], self.body, f / self.fps)
+            percept = self.perception.perceive_pose(motion.positions[f], motion.visible[f], self.body, f / self.fps)
             self.poses.append(percept.pose)
             self.visible.append(percept.visible)
             match = c.matcher.observe(percept.pose, percept.visible)

@@ -1,0 +1,117 @@
+"""Demonstrations for the views: a character performs movements, and another watches them as recorded poses.
+
+Not a component: the helpers the views share to make a demonstration (one
+movement, or several with rests between them, optionally with observation
+noise) and to let a character watch it outside a world, through the
+``motion-capture`` perception (perfect tracking, root-relative by Buchsbaum &
+Blumberg 2005, §5.1), with its own segmenter and matcher, frame by frame as
+:class:`toolkit.observe.Observer` streams any recording.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from toolkit import ConfigError, Motion, load_character
+from toolkit.motion import concatenate
+
+__all__ = ["Demonstration", "demonstration", "onto", "perform_sequence", "watch"]
+
+
+@dataclass(frozen=True)
+class Demonstration:
+    """Movements performed one after another: who performed them, the motion (body frame), and where each lies.
+
+    ``truth`` holds ``(start_frame, end_frame, movement)`` per movement, end exclusive.
+    """
+
+    who: str
+    motion: Motion
+    truth: tuple[tuple[int, int, str], ...]
+
+
+def _performer(character: Any, demonstrator: str, movements: Sequence[str], key: str) -> Any:
+    who = load_character(demonstrator, character.pm) if demonstrator else character
+    known = who.motor.movements()
+    for movement in movements:
+        if movement not in known:
+            raise ConfigError(f"unknown movement {movement!r}", key=(key,), expected=f"a movement of {who.name}",
+                              available=sorted(known))
+    return who
+
+
+def demonstration(character: Any, demonstrator: str, movement: str, key: str, *, speed: float = 1.0) -> tuple[str, Motion]:
+    """A movement performed by ``demonstrator`` (a character file or name; empty: ``character``), root-relative,
+    as an observer would see it with perfect tracking: (the demonstrator's name, the motion).
+
+    ``key`` names the view parameter in the error for an unknown movement.
+    """
+    who = _performer(character, demonstrator, [movement], key)
+    return who.name, who.motor.perform(movement, speed=speed).root_relative(who.body.root)
+
+
+def perform_sequence(character: Any, demonstrator: str, movements: Sequence[str], key: str, *, speed: float = 1.0,
+                     rest: float = 0.5, noise: float = 0.0, seed: int = 0, fps: float = 30.0) -> Demonstration:
+    """``movements`` performed one after another by ``demonstrator`` (empty: ``character``), holding still for
+    ``rest`` seconds before, between and after them, with Gaussian observation noise of ``noise`` metres.
+
+    The motion is in the demonstrator's body frame, which serves as the world a recording would be in.
+    """
+    if not movements:
+        raise ConfigError("no movements to perform", key=(key,), expected="a list of one or more movements")
+    who = _performer(character, demonstrator, movements, key)
+    hold = max(1, int(round(rest * fps)))
+    parts = who.body.parts
+
+    def still(pose: np.ndarray) -> Motion:
+        return Motion(np.repeat(pose[None], hold, axis=0), fps, parts)
+
+    pieces = [still(np.asarray(who.motor.rest_pose(), dtype=float))]
+    truth, frame = [], hold
+    for movement in movements:
+        motion = who.motor.perform(movement, speed=speed, fps=fps)
+        truth.append((frame, frame + motion.n_frames, movement))
+        pieces += [motion, still(motion.positions[-1])]
+        frame += motion.n_frames + hold
+    motion = concatenate(pieces)
+    if noise > 0:
+        rng = np.random.default_rng(seed)
+        motion = Motion(motion.positions + rng.normal(0.0, noise, motion.positions.shape), fps, parts)
+    return Demonstration(who.name, motion, tuple(truth))
+
+
+def watch(character: Any, demo: Demonstration, each: Callable[[Any], None] | None = None) -> tuple[Any, list[Any]]:
+    """``character`` watches ``demo`` through ``motion-capture`` with its own segmenter and matcher, frame by frame.
+
+    The demonstrator's parts are taken by name onto the watcher's own body (a part the demonstrator lacks is
+    never seen). ``each`` is called with every observation the moment its segment closes (while the matcher
+    still holds what it made of that segment). Returns the :class:`~toolkit.observe.Observer` (its ``poses``
+    and ``visible`` hold what was perceived, in the watcher's parts) and the observations.
+    """
+    from toolkit.observe import Observer
+
+    perception = character.pm.registry.get("perception", "motion-capture")()
+    observer = Observer(character, character.body, demo.motion.fps, perception=perception)
+    motion = onto(demo.motion, character.body.parts)
+    found: list[Any] = []
+    for f in range(motion.n_frames + 1):
+        closed = observer.push(motion.positions[f], motion.visible[f]) if f < motion.n_frames else observer.flush()
+        for observation in closed:
+            if each is not None:
+                each(observation)
+            found.append(observation)
+    return observer, found
+
+
+def onto(motion: Motion, parts: Sequence[str]) -> Motion:
+    """``motion`` with its parts taken by name onto ``parts``; a part it lacks is NaN and not visible."""
+    index = np.array([motion.parts.index(p) if p in motion.parts else -1 for p in parts], dtype=int)
+    positions = np.full((motion.n_frames, len(parts), 3), np.nan)
+    visible = np.zeros((motion.n_frames, len(parts)), dtype=bool)
+    positions[:, index >= 0] = motion.positions[:, index[index >= 0]]
+    visible[:, index >= 0] = motion.visible[:, index[index >= 0]]
+    return Motion(positions, motion.fps, parts, visible)
