@@ -19,7 +19,7 @@ import numpy as np
 from toolkit import ConfigError, Motion, load_character
 from toolkit.motion import concatenate
 
-__all__ = ["Demonstration", "demonstration", "onto", "perform_sequence", "watch"]
+__all__ = ["Demonstration", "demonstration", "onto", "perform_sequence", "require", "watch"]
 
 
 @dataclass(frozen=True)
@@ -32,6 +32,17 @@ class Demonstration:
     who: str
     motion: Motion
     truth: tuple[tuple[int, int, str], ...]
+
+
+def require(character: Any, kind: str, plugin: str, key: str = "--view") -> Any:
+    """The character's component of ``kind`` (``"segmenter"``, ``"matcher"``, ``"motor"``) if it is ``plugin``;
+    else a :class:`ConfigError` naming what it has (``key``: the option or parameter that asked for it)."""
+    component = getattr(character, kind, None)
+    if component is None or getattr(component, "name", None) != plugin:
+        have = repr(component.name) if component is not None else "none"
+        raise ConfigError(f"{character.name} has no {plugin} {kind} (its {kind} is {have})", key=(key,),
+                          expected=f"a character whose [{kind}] plugin is {plugin}")
+    return component
 
 
 def _performer(character: Any, demonstrator: str, movements: Sequence[str], key: str) -> Any:

@@ -21,9 +21,9 @@ from typing import Any
 
 import numpy as np
 
-from plugins.demonstration import watch
+from plugins.demonstration import require, watch
 from plugins.plotting import DEMONSTRATION, demonstrate, figure, save_figure, timeline
-from toolkit import ConfigError, Motion, View, hookimpl
+from toolkit import Motion, View, hookimpl
 
 __all__ = ["HubSignalView"]
 
@@ -36,10 +36,7 @@ class HubSignalView(View):
 
     def draw(self, subject: Any, out: Path) -> list[Path]:
         character = subject
-        segmenter = character.segmenter
-        if segmenter is None or segmenter.name != "hub-threshold":
-            raise ConfigError(f"{character.name} does not segment by distance to a hub", key=("--view",),
-                              expected="a character whose [segmenter] plugin is hub-threshold")
+        segmenter = require(character, "segmenter", "hub-threshold")
         demo = demonstrate(self, character)
         observer, found = watch(character, demo)
         fps = observer.fps

@@ -23,9 +23,9 @@ from typing import Any
 
 import numpy as np
 
-from plugins.demonstration import demonstration, onto
+from plugins.demonstration import demonstration, onto, require
 from plugins.rendering import add_labels, draw_bodies, part_colours, plotter, save_png
-from toolkit import ConfigError, Parameter, View, hookimpl
+from toolkit import Parameter, View, hookimpl
 
 __all__ = ["MotorCommandGraphView", "edge_trajectories"]
 
@@ -53,10 +53,7 @@ class MotorCommandGraphView(View):
         import pyvista as pv
 
         character = subject
-        motor = character.motor
-        if getattr(motor, "name", "") != "motor-command-graph":
-            raise ConfigError(f"{character.name} has no motor command graph (its motor system is {motor.name!r})",
-                              key=("--view",), expected="a character whose [motor] plugin is motor-command-graph")
+        motor = require(character, "motor", "motor-command-graph")
         body = character.body
         colours = part_colours(body)
         prediction = self._predict(character) if self.params["predict"] else None
@@ -107,10 +104,7 @@ class MotorCommandGraphView(View):
 
     def _predict(self, character: Any) -> dict[str, Any]:
         """Feed the first ``at`` of the demonstration to the character's forward model; what it holds then."""
-        matcher = character.matcher
-        if matcher is None or matcher.name != "forward-model":
-            raise ConfigError(f"{character.name} has no forward-model matcher to predict with", key=("predict",),
-                              expected="a character whose [matcher] plugin is forward-model")
+        matcher = require(character, "matcher", "forward-model", "predict")
         who, motion = demonstration(character, self.params["demonstrator"], self.params["predict"], "predict")
         motion = onto(motion, character.body.parts)
         n = max(1, int(round(self.params["at"] * motion.n_frames)))

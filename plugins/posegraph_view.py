@@ -18,9 +18,9 @@ from typing import Any
 
 import numpy as np
 
-from plugins.demonstration import demonstration
+from plugins.demonstration import demonstration, require
 from plugins.rendering import _PALETTE, add_labels, hex_to_rgb, plotter, save_png
-from toolkit import ConfigError, Parameter, View, hookimpl
+from toolkit import Parameter, View, hookimpl
 
 __all__ = ["PosegraphView", "pose_layout"]
 
@@ -55,10 +55,7 @@ class PosegraphView(View):
         import pyvista as pv
 
         character = subject
-        motor = character.motor
-        if getattr(motor, "name", "") != "posegraph":
-            raise ConfigError(f"{character.name} has no posegraph (its motor system is {motor.name!r})",
-                              key=("--view",), expected="a character whose [motor] plugin is posegraph")
+        motor = require(character, "motor", "posegraph")
         names = motor.nodes
         coords = pose_layout(motor.node_root_relative)
         index = {n: i for i, n in enumerate(names)}
@@ -103,10 +100,7 @@ class PosegraphView(View):
             pl.close()
 
     def _match(self, character: Any) -> Any:
-        matcher = character.matcher
-        if matcher is None or matcher.name != "path-search":
-            raise ConfigError(f"{character.name} has no path-search matcher to find the path", key=("match",),
-                              expected="a character whose [matcher] plugin is path-search")
+        matcher = require(character, "matcher", "path-search", "match")
         _, motion = demonstration(character, self.params["demonstrator"], self.params["match"], "match",
                                   speed=self.params["speed"])
         return matcher.match(motion)

@@ -26,9 +26,9 @@ from typing import Any
 
 import numpy as np
 
-from plugins.demonstration import watch
+from plugins.demonstration import require, watch
 from plugins.plotting import DEMONSTRATION, PALETTE, demonstrate, figure, save_figure, timeline
-from toolkit import ConfigError, View, hookimpl
+from toolkit import View, hookimpl
 
 __all__ = ["PredictionErrorView"]
 
@@ -41,10 +41,7 @@ class PredictionErrorView(View):
 
     def draw(self, subject: Any, out: Path) -> list[Path]:
         character = subject
-        matcher = character.matcher
-        if matcher is None or matcher.name != "forward-model":
-            raise ConfigError(f"{character.name} has no forward-model matcher to predict with", key=("--view",),
-                              expected="a character whose [matcher] plugin is forward-model")
+        matcher = require(character, "matcher", "forward-model")
         demo = demonstrate(self, character)
         segments: list[dict[str, Any]] = []
         observer, found = watch(character, demo, each=lambda o: segments.append({

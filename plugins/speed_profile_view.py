@@ -26,9 +26,9 @@ from typing import Any
 
 import numpy as np
 
-from plugins.demonstration import watch
+from plugins.demonstration import require, watch
 from plugins.plotting import DEMONSTRATION, PALETTE, blank, demonstrate, save_figure, timeline
-from toolkit import ConfigError, View, hookimpl
+from toolkit import View, hookimpl
 
 __all__ = ["SpeedProfileView"]
 
@@ -41,10 +41,7 @@ class SpeedProfileView(View):
 
     def draw(self, subject: Any, out: Path) -> list[Path]:
         character = subject
-        segmenter = character.segmenter
-        if segmenter is None or segmenter.name != "velocity-direction":
-            raise ConfigError(f"{character.name} does not segment by velocity and direction", key=("--view",),
-                              expected="a character whose [segmenter] plugin is velocity-direction")
+        segmenter = require(character, "segmenter", "velocity-direction")
         demo = demonstrate(self, character)
         segmenter.record = []
         try:

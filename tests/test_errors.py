@@ -147,9 +147,9 @@ CASES = [
     ("cli-bad-int", "not a number", {}, ["demo", "--seed", "x"], ["argument --seed: invalid int value: 'x'"]),
     ("cli-bench-set", "bad --set", {}, ["bench", "watch", "--movements", "1", "--set", "floor=0"], ["key --set", "invalid setting 'floor=0'", "expected TABLE.KEY=VALUE"]),
     # -- views
-    ("view-unknown", "unknown view", {}, ["show", MAX, "--view", "graph"], ["unknown view 'graph'", "available:", "hub-signal"]),
-    ("view-segmenter", "a signal view of a segmenter the character does not have", {}, ["show", MAX, "--view", "speed-profile"], ["key --view", "does not segment by velocity and direction", "velocity-direction"]),
-    ("view-movement", "a view asked to perform an unknown movement", {}, ["show", MAX, "--view", "hub-signal", "--set", 'movements=["fly"]'], ["key movements", "unknown movement 'fly'", "available:", "wave"]),
+    ("view-unknown", "unknown view", {}, ["show", "max", "--view", "graph"], ["unknown view 'graph'", "available:", "hub-signal"]),
+    ("view-segmenter", "a signal view of a segmenter the character does not have", {}, ["show", "max", "--view", "speed-profile"], ["key --view", "Max has no velocity-direction segmenter (its segmenter is 'hub-threshold')", "expected a character whose [segmenter] plugin is velocity-direction"]),
+    ("view-movement", "a view asked to perform an unknown movement", {}, ["show", "max", "--view", "hub-signal", "--set", 'movements=["fly"]'], ["key movements", "unknown movement 'fly'", "available:", "wave"]),
 ]
 
 
@@ -215,7 +215,7 @@ def render() -> str:
         status, err, folder = run_case(files, args)
         message = err.strip().replace(folder, "DIR").replace(MAX, "characters/max.toml").replace("|", "\\\\|")
         message = re.sub(r"/tmp/[^ :;]+/", "DIR/", message)
-        command = "likeme " + " ".join(args)
+        command = ("likeme " + " ".join(args)).replace(MAX, "characters/max.toml")
         out.append(f"| {what} | `{command}` | `{message}` |")
     return "\n".join(out) + "\n"
 
