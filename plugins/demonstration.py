@@ -67,14 +67,16 @@ def demonstration(character: Any, demonstrator: str, movement: str, key: str, *,
 
 def perform_sequence(character: Any, demonstrator: str, movements: Sequence[str], key: str, *, speed: float = 1.0,
                      rest: float = 0.5, noise: float = 0.0, seed: int = 0, fps: float = 30.0) -> Demonstration:
-    """``movements`` performed one after another by ``demonstrator`` (empty: ``character``), holding still for
-    ``rest`` seconds before, between and after them, with Gaussian observation noise of ``noise`` metres.
+    """``movements`` (empty: the whole repertoire) performed one after another by ``demonstrator`` (empty:
+    ``character``), holding still for ``rest`` seconds before, between and after them, with Gaussian observation
+    noise of ``noise`` metres.
 
     The motion is in the demonstrator's body frame, which serves as the world a recording would be in.
     """
-    if not movements:
-        raise ConfigError("no movements to perform", key=(key,), expected="a list of one or more movements")
     who = _performer(character, demonstrator, movements, key)
+    movements = list(movements) or who.motor.movements()
+    if not movements:
+        raise ConfigError(f"{who.name} has no movements to perform", key=(key,), expected="a list of one or more movements")
     hold = max(1, int(round(rest * fps)))
     parts = who.body.parts
 

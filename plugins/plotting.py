@@ -40,15 +40,10 @@ DEMONSTRATION = (
 def demonstrate(view: Any, character: Any) -> Any:
     """The :class:`~plugins.demonstration.Demonstration` a signal view's parameters ask for."""
     from plugins.demonstration import perform_sequence
-    from toolkit import load_character
 
     p = view.params
-    movements = list(p["movements"])
-    if not movements:
-        who = load_character(p["demonstrator"], character.pm) if p["demonstrator"] else character
-        movements = who.motor.movements()
-    return perform_sequence(character, p["demonstrator"], movements, "movements", speed=p["speed"], rest=p["rest"],
-                            noise=p["noise"], seed=p["seed"])
+    return perform_sequence(character, p["demonstrator"], p["movements"], "movements", speed=p["speed"],
+                            rest=p["rest"], noise=p["noise"], seed=p["seed"])
 
 
 def blank(width: int, height: int) -> Any:
