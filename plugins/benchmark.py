@@ -459,13 +459,16 @@ def facilitation_benchmark(pm: Any, *, demonstrations: int = 200, repertoire: in
     moritz.action = None
     watcher.watch(demo)
     fps = world.fps
+    points = ~moritz.body.angle_mask
     known: list[tuple[str, list]] = []
 
     def show(name: str, motion: Any) -> list[list[Any]]:
         """Demonstrate one movement; returns, per segment Max found, the recognitions that belong to it (in order)."""
         from toolkit import Motion, MovementRequest
 
-        noisy = motion.positions + rng.normal(0.0, noise, motion.positions.shape) if noise else motion.positions
+        noisy = motion.positions.copy()
+        if noise:  # metres of noise on the positions (the fingers' joint angles are not part of this benchmark)
+            noisy[:, points] += rng.normal(0.0, noise, noisy[:, points].shape)
         replay.motions[name] = Motion(noisy, fps, motion.parts)
         first = len(world.events)
         demo.request(MovementRequest(name))
@@ -523,7 +526,7 @@ def facilitation_benchmark(pm: Any, *, demonstrations: int = 200, repertoire: in
         learned_out = bool(final is not None and final.details.get("learned"))
         imitation_error = None
         if final is not None and final.path:
-            executed = np.concatenate([st.trajectory(fps) for e in final.path for st in learner.motor.edge(e)[3]["strokes"]])
+            executed = np.concatenate([st.trajectory(fps) for e in final.path for st in learner.motor.edge(e)[3]["commands"]])
             shown = np.concatenate([st.trajectory(fps) for st in strokes])
             imitation_error = _shape_error(executed, shown)
         rows.append({

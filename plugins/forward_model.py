@@ -23,6 +23,13 @@ node (ending in the hub when the demonstration returns there).
 
 The subsystem "under consideration" is the one whose parts have moved most
 since the onset; subsystems moving at the same time are handled one at a time.
+
+Hands: a hand subsystem's edges are hand transitions over the fingers' joint
+angles (:mod:`plugins.hand_transition`); they predict the observed finger
+configuration just as guiding strokes predict the wrist. Angles are compared
+with the same thresholds through ``angle_scale`` (metres one radian counts as),
+and a new hand movement is learned as one edge whose key postures are the
+angular-velocity minima and direction changes (§4.3).
 """
 
 from __future__ import annotations
@@ -65,6 +72,9 @@ class ForwardModel(Matcher):
                   "imitation (also checked at the end: the demonstration must end where the edge does).", minimum=0.0),
         Parameter("min_progress", float, 0.2, "Share of the edge's path that must be seen before committing.", minimum=0.0, maximum=1.0),
         Parameter("min_move", float, 0.02, "Displacement (m) of a subsystem that makes it the one under consideration.", minimum=0.0),
+        Parameter("angle_scale", float, 0.25, "Metres one radian of finger joint angle counts as when a hand "
+                  "subsystem's errors and movement are compared with threshold, deviation and min_move "
+                  "(0.25: the 0.05 m threshold is 0.2 rad, 11 degrees).", minimum=1e-6),
         Parameter("max_candidates", int, 24, "Most candidate command paths followed at once (the best predictions).", minimum=1),
         Parameter("error", str, "max", "How the prediction errors of a subsystem's parts combine: the largest "
                   "(a wrist subsystem, §4.4) or the mean (eq. 1 of B&B 2005, for whole-body subsystems).",
@@ -83,7 +93,9 @@ class ForwardModel(Matcher):
             raise ConfigError(f"forward-model needs a motor command graph, not {motor.name!r}", key=("plugin",),
                               expected='[motor] plugin = "motor-command-graph"')
         self.motor = motor
-        self._root_height = motor.rest_pose()[owner.body.root_index]
+        # observed root-relative positions are placed at the observer's own root height; finger angles stay as they are
+        self._root_height = np.where(owner.body.angle_mask[:, None], 0.0, motor.rest_pose()[owner.body.root_index])
+        self._scales = {name: self.params["angle_scale"] if motor.is_hand(name) else 1.0 for name in motor.subsystems}
         self._strokes = VelocityDirection(drop=self.params["drop"], angle=self.params["angle"])
         self._tables: dict[int, tuple] = {}
 
@@ -93,6 +105,7 @@ class ForwardModel(Matcher):
         self.fps = fps
         self.frames: list[np.ndarray] = []
         self.subsystem: str | None = None
+        self._scale, self._hand = 1.0, False
         self.start_node: str | None = None
         self.candidates: dict[tuple[str, ...], float] = {}
         self.excluded: set[str] = set()
@@ -107,7 +120,7 @@ class ForwardModel(Matcher):
         self.deviated_at: int | None = None
 
     def _local(self, pose: np.ndarray) -> np.ndarray:
-        """Root-relative observed positions in the observer's motor frame (root at its own rest height)."""
+        """Root-relative observed positions in the observer's motor frame (root at its own rest height; angles as seen)."""
         return pose + self._root_height
 
     def observe(self, pose: np.ndarray, visible: np.ndarray) -> Match | None:
@@ -156,25 +169,27 @@ class ForwardModel(Matcher):
         first, last = self.frames[0], self.frames[-1]
         best, moved = None, self.params["min_move"]
         for name, idx in self.motor.subsystems.items():
-            d = float(np.nanmax(np.linalg.norm(last[idx] - first[idx], axis=-1)))
+            d = float(np.nanmax(np.linalg.norm(last[idx] - first[idx], axis=-1))) * self._scales[name]
             if d > moved:
                 best, moved = name, d
         if best is None:
             return False
         self.subsystem = best
+        self._scale = self._scales[best]
+        self._hand = self.motor.is_hand(best)
         self.start_node = self.motor.active[best]
         # a command that moves no part farther than min_move (standing still) cannot be seen to begin
         self.candidates = {(name,): 0.0 for name, _ in self.motor.edges_from(best, self.start_node)
-                           if name not in self.excluded and self._length(name) > self.params["min_move"]}
+                           if name not in self.excluded and self._length(name) * self._scale > self.params["min_move"]}
         self.initial = sorted(p[0] for p in self.candidates)
         return True
 
     def _length(self, name: str) -> float:
-        """Path length (m) of a command's lead part."""
+        """Path length (m, or radians for a hand) of a command's lead part."""
         return float(self._table(self._strokes_of(name)[self._lead(name)])[2][-1])
 
     def _strokes_of(self, name: str) -> list[Any]:
-        return self.motor.edge(name)[3]["strokes"]
+        return self.motor.edge(name)[3]["commands"]
 
     def _lead(self, name: str) -> int:
         """The part of the subsystem that moves farthest along a command: progress and speed are measured on it."""
@@ -201,7 +216,7 @@ class ForwardModel(Matcher):
             seen = lengths[lead]
             total = sum(self._table(self._strokes_of(e)[lead])[2][-1] for e in path)
             end = self.motor.edge(path[-1])[2]
-            nxt = [name for name, _ in self.motor.edges_from(self.subsystem, end)] if seen > total + 0.01 else []
+            nxt = [name for name, _ in self.motor.edges_from(self.subsystem, end)] if seen > total + 0.01 / self._scale else []
             out.extend([(*path, n) for n in nxt if n not in path] or [path])
         return out
 
@@ -228,7 +243,22 @@ class ForwardModel(Matcher):
         return float(np.interp(min(length, arc[-1]), arc, grid))
 
     def _predict(self, path: tuple[str, ...], lengths: np.ndarray) -> np.ndarray:
-        """Where each part of the subsystem should be after as much path as it has been observed to cover."""
+        """Where each part of the subsystem should be after as much path as it has been observed to cover.
+
+        The fingers of a hand share their timing (one transition function, §4.2): they are all predicted at the
+        time at which the lead finger has covered its observed path, so fingers that move in another order than
+        the command's do not fit it.
+        """
+        if self._hand:
+            lead = self._lead(path[0])
+            left = lengths[lead]
+            for i, name in enumerate(path):
+                commands = self._strokes_of(name)
+                arc = self._table(commands[lead])[2]
+                if left <= arc[-1] or i == len(path) - 1:
+                    t = self._mapped_time(commands[lead], left)
+                    return np.array([c.position(t) for c in commands])
+                left -= arc[-1]
         out = []
         for j, left in enumerate(lengths):
             strokes = [self._strokes_of(e)[j] for e in path]
@@ -257,8 +287,8 @@ class ForwardModel(Matcher):
         return self.frames[0][self.motor.subsystems[self.subsystem]] - start
 
     def _distance(self, predicted: np.ndarray, observed: np.ndarray) -> float:
-        """Per-part distances (k, 3 each) combined as ``error`` says: the largest or the mean."""
-        d = np.linalg.norm(predicted - observed, axis=-1)
+        """Per-part distances (k, 3 each) combined as ``error`` says: the largest or the mean (radians of a hand scaled)."""
+        d = np.linalg.norm(predicted - observed, axis=-1) * self._scale
         return float(d.max() if self.params["error"] == "max" else d.mean())
 
     def _progress(self, name: str, lengths: np.ndarray) -> float:

@@ -1,4 +1,4 @@
-"""The inverse model: from an observed segment of a wrist trajectory to the guiding stroke that reproduces it.
+"""The inverse model: from an observed segment to the motor command that reproduces it (guiding stroke or hand transition).
 
 Kopp & Graeser 2006, §4.3: "after segmentation, an inverse model is applied to
 each segment in order to calculate the parameters needed to produce it by a
@@ -17,22 +17,33 @@ in inverse direction."
    (:func:`scipy.optimize.least_squares`) of the timing and shape parameters
    against the observed positions, so noise in one estimate is corrected by the
    trajectory as a whole.
+
+Hands (§4.3): "if Max observes a completed, unknown finger movement by the
+demonstrator, the movement will be segmented both, at angular velocity minima
+and according to a clustering of movement directions, to detect the start, end,
+and via postures of the sighted hand movements. These configurations are used
+as key postures to create a new edge in the hand motor command graph".
+:func:`transitions_from_segment` takes those break points as key postures and
+fits the one remaining parameter, the moment of peak angular velocity, by a
+bounded scalar search; :func:`learn_commands` makes one edge of them.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from scipy.integrate import trapezoid
-from scipy.optimize import least_squares
+from scipy.optimize import least_squares, minimize_scalar
 from scipy.signal import savgol_filter
 
 from plugins.guiding_stroke import GuidingStroke
+from plugins.hand_transition import HandTransition
 
-__all__ = ["stroke_from_segment", "trajectory_error", "learn_commands"]
+__all__ = ["stroke_from_segment", "transitions_from_segment", "trajectory_error", "learn_commands"]
 
 
-def trajectory_error(stroke: GuidingStroke, positions: np.ndarray, fps: float) -> float:
-    """Largest distance (m) between the stroke's trajectory and observed ``positions`` sampled at ``fps``."""
+def trajectory_error(stroke: GuidingStroke | HandTransition, positions: np.ndarray, fps: float) -> float:
+    """Largest distance (m, or radians for a hand transition) between the command's trajectory and observed
+    ``positions`` sampled at ``fps``."""
     t = np.arange(len(positions)) / fps
     return float(np.linalg.norm(stroke.position(t) - positions, axis=1).max())
 
@@ -119,6 +130,34 @@ def stroke_from_segment(positions: np.ndarray, fps: float, *, straight: float = 
     return refined if trajectory_error(refined, p, fps) <= trajectory_error(stroke, p, fps) else stroke
 
 
+def transitions_from_segment(angles: np.ndarray, fps: float, breaks: list[int] | tuple[int, ...] = ()) -> list[HandTransition]:
+    """The hand transitions (one per finger, shared timing) that reproduce a segment of finger joint angles.
+
+    Parameters
+    ----------
+    angles : array, shape (N, k, 3)
+        Observed joint angles (radians) of the hand's k fingers, NaN-free, N >= 2.
+    fps : float
+    breaks : list of int
+        Frames of the via postures (the angular-velocity minima and direction changes found by the segmenter).
+    """
+    a = np.asarray(angles, dtype=float)
+    if a.ndim != 3 or a.shape[2] != 3 or len(a) < 2 or not np.isfinite(a).all():
+        raise ValueError("the hand inverse model needs two or more finite configurations (N, k, 3)")
+    frames = np.array(sorted({0, *(int(b) for b in breaks if 0 < b < len(a) - 1), len(a) - 1}))
+    times = frames / fps
+    t = np.arange(len(a)) / fps
+
+    def build(peak: float) -> list[HandTransition]:
+        return [HandTransition(a[frames, j], times, peak) for j in range(a.shape[1])]
+
+    def error(peak: float) -> float:
+        return float(sum(np.sum((tr.position(t) - a[:, j]) ** 2) for j, tr in enumerate(build(peak))))
+
+    fit = minimize_scalar(error, bounds=(0.05, 0.95), method="bounded", options={"xatol": 1e-3})
+    return build(float(fit.x) if error(float(fit.x)) <= error(0.5) else 0.5)
+
+
 def learn_commands(motor, subsystem: str, observed: np.ndarray, fps: float, start: str, breaks, *,
                    source: str = "inverse model", hub_tolerance: float = 0.05, refine: bool = True) -> list[str]:
     """Turn an observed segment into new edges of a motor command graph, chained from node ``start`` (§4.3).
@@ -128,11 +167,20 @@ def learn_commands(motor, subsystem: str, observed: np.ndarray, fps: float, star
     the next begins (the velocity/direction segmenter's break points). Each
     stroke of each part is inverted into a guiding stroke; the last edge ends in
     the hub when the segment returns there. Returns the new edges' movement names.
+
+    A hand subsystem (its parts are fingers, ``observed`` holds joint angles) gets
+    one edge whose key postures are the break points, by
+    :func:`transitions_from_segment`; it ends in the hub when within the motor
+    system's hand tolerance (radians) of it.
     """
     n, k, _ = observed.shape
+    hub_state = motor.graphs[subsystem].nodes["hub"]["state"]
+    if motor.is_hand(subsystem):
+        transitions = transitions_from_segment(observed, fps, breaks(observed.reshape(n, k * 3)))
+        home = np.linalg.norm(observed[-1] - hub_state, axis=-1).max() <= motor.tolerance(subsystem)
+        return [motor.learn(subsystem, start, transitions, end="hub" if home else None, source=source)]
     cuts = [0, *breaks(observed.reshape(n, k * 3)), n - 1]
     names, node = [], start
-    hub_state = motor.graphs[subsystem].nodes["hub"]["state"]
     for i, (a, b) in enumerate(zip(cuts, cuts[1:])):
         if b - a < 2:
             continue

@@ -18,6 +18,10 @@ Declaration (inside a character's ``[motor]`` table)::
 
     [motor.movements.jump]
     keys = [{ pose = "stand", at = 0.0 }, { pose = "crouch", at = 0.25 }, ...]   # at: seconds
+
+A body with hands (:class:`toolkit.body.Hand`) gives each finger as three joint
+angles in *degrees* (``left_index = [70, 80, 0]``: base flexion, middle
+flexion, spread); they are held in radians. ``shift`` moves positions only.
 """
 
 from __future__ import annotations
@@ -72,15 +76,16 @@ class KeyPoses:
         return self.array[self.names.index(name)]
 
 
-def _vec(value: Any, key: tuple) -> np.ndarray:
+def _vec(value: Any, key: tuple, *, angles: bool = False) -> np.ndarray:
     if (
         not isinstance(value, list)
         or len(value) != 3
         or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
         or not np.all(np.isfinite(value))
     ):
-        raise ConfigError(f"invalid value {value!r}", key=key, expected="[x, y, z] finite numbers in metres")
-    return np.asarray(value, dtype=float)
+        expected = "[base, middle, spread] finger joint angles in degrees" if angles else "[x, y, z] finite numbers in metres"
+        raise ConfigError(f"invalid value {value!r}", key=key, expected=expected)
+    return np.radians(np.asarray(value, dtype=float)) if angles else np.asarray(value, dtype=float)
 
 
 def parse_poses(table: Mapping[str, Any], body: Body) -> KeyPoses:
@@ -118,16 +123,18 @@ def parse_poses(table: Mapping[str, Any], body: Body) -> KeyPoses:
                     f"pose without base misses parts {missing}", key=key, expected="a position for every part, or base = POSE"
                 )
             pose = np.zeros((body.n_parts, 3))
+        angles = body.angle_mask
         if "shift" in spec:
-            pose += _vec(spec["shift"], (*key, "shift"))
+            pose[~angles] += _vec(spec["shift"], (*key, "shift"))
         offsets = spec.get("offset", {})
         if not isinstance(offsets, Mapping):
             raise ConfigError("not a table", key=(*key, "offset"), expected="a table of part = [dx, dy, dz]")
         for part, value in offsets.items():
-            pose[body.index(part, key=(*key, "offset", part))] += _vec(value, (*key, "offset", part))
-        for part in body.parts:
+            i = body.index(part, key=(*key, "offset", part))
+            pose[i] += _vec(value, (*key, "offset", part), angles=angles[i])
+        for i, part in enumerate(body.parts):
             if part in spec:
-                pose[body.index(part)] = _vec(spec[part], (*key, part))
+                pose[i] = _vec(spec[part], (*key, part), angles=angles[i])
         resolved[name] = pose
         return pose
 

@@ -4,7 +4,12 @@ Nodes are motor states of a subsystem (the positions of its parts in the body
 frame, e.g. where the left wrist is); *hub nodes* are the rest states in which
 movements start and end. Edges are motor commands that lead from one state to
 another: for wrist subsystems, guiding strokes (:mod:`plugins.guiding_stroke`),
-one per part of the subsystem. Several edges may join the same two nodes
+one per part of the subsystem; for hand subsystems, whose parts are the
+fingers of a hand and whose states are their joint angles, hand transitions
+through key postures (:mod:`plugins.hand_transition`), one per finger with
+shared timing. Every hand of the body gets a subsystem of its own (``hands``),
+so Max and Moritz have the paper's four graphs: left and right wrist, left and
+right hand. Several edges may join the same two nodes
 (a :class:`networkx.MultiDiGraph`). At every moment each subsystem is in its
 *active node* (or on an edge between two).
 
@@ -16,7 +21,8 @@ pose; elbows follow by two-link inverse kinematics with the elbow hanging down
 and out (the swivel heuristic of §3, simplified).
 
 Subsystems are configurable (``subsystems = { left_wrist = ["left_wrist"], ... }``),
-including one whole-body subsystem with every part.
+including one whole-body subsystem with every part; a subsystem moves either
+positions or finger joint angles, never both.
 
 Clips (:mod:`plugins.clip_repertoire`): with ``clips`` and ``profile`` the graph
 is learned from labelled motion-capture clips by the inverse model, as if the
@@ -36,12 +42,18 @@ import numpy as np
 
 from plugins.clip_repertoire import CLIP_PARAMETERS, example_name, repertoire_for
 from plugins.guiding_stroke import GuidingStroke
+from plugins.hand_transition import HandTransition
 from plugins.inverse_model import learn_commands
 from plugins.key_poses import parse_poses
 from plugins.velocity_direction import VelocityDirection
 from toolkit import ConfigError, Motion, MotorSystem, Parameter, hookimpl
 
-__all__ = ["MotorCommandGraph", "place_elbows"]
+__all__ = ["MotorCommandGraph", "place_elbows", "command_from_dict"]
+
+
+def command_from_dict(entry: dict[str, Any]) -> GuidingStroke | HandTransition:
+    """A motor command from its ``to_dict()``: a hand transition (it has key postures) or a guiding stroke."""
+    return HandTransition(**entry) if "keys" in entry else GuidingStroke(**entry)
 
 
 def place_elbows(shoulder: np.ndarray, wrist: np.ndarray, upper: float, fore: float, outward: np.ndarray) -> np.ndarray:
@@ -67,6 +79,11 @@ class MotorCommandGraph(MotorSystem):
         Parameter("poses", dict, {}, "Named poses (at least the rest pose), as for keyframe. Not needed with clips."),
         Parameter("subsystems", dict, {"left_wrist": ["left_wrist"], "right_wrist": ["right_wrist"]},
                   "Motor subsystems: name = [parts it moves]."),
+        Parameter("hands", bool, True, "Give every hand of the body a subsystem of its own, named as the hand, that "
+                  "moves its fingers (the paper's hand motor command graphs)."),
+        Parameter("tolerance", float, 0.04, "Metres within which two wrist states are the same node.", minimum=0.0),
+        Parameter("hand_tolerance", float, 0.15, "Radians of finger joint angle within which two hand configurations "
+                  "are the same node (and a hand movement has come back to its hub).", minimum=0.0),
         Parameter("arms", list, [["left_shoulder", "left_elbow", "left_wrist"], ["right_shoulder", "right_elbow", "right_wrist"]],
                   "Shoulder, elbow, wrist triples whose elbow follows the wrist by inverse kinematics."),
         *CLIP_PARAMETERS,
@@ -95,10 +112,18 @@ class MotorCommandGraph(MotorSystem):
                                   available=poses.names)
             self.rest = poses[self.params["rest"]]
         self.subsystems: dict[str, np.ndarray] = {}
-        for name, parts in self.params["subsystems"].items():
+        declared = dict(self.params["subsystems"])
+        if self.params["hands"]:
+            declared.update({name: list(hand.fingers) for name, hand in body.hands.items() if name not in declared})
+        angles = body.angle_mask
+        for name, parts in declared.items():
             if not isinstance(parts, list) or not parts:
                 raise ConfigError("invalid", key=("subsystems", name), expected="a non-empty list of part names")
             self.subsystems[name] = np.array([body.index(p, key=("subsystems", name)) for p in parts])
+            if 0 < angles[self.subsystems[name]].sum() < len(parts):
+                raise ConfigError("a subsystem mixes fingers and position parts", key=("subsystems", name),
+                                  expected="only fingers (a hand) or only position parts",
+                                  available=[f"fingers: {', '.join(body.angle_parts)}"])
         self.arms = []
         for i, triple in enumerate(self.params["arms"]):
             if not isinstance(triple, list) or len(triple) != 3:
@@ -149,23 +174,32 @@ class MotorCommandGraph(MotorSystem):
         g = self.graphs[subsystem]
         return [(data["name"], data) for _, _, data in g.out_edges(node, data=True)]
 
-    def learn(self, subsystem: str, start: str, strokes: list[GuidingStroke], *, end: str | None = None,
-              source: str = "") -> str:
-        """Add an edge of ``strokes`` (one per part of the subsystem) from node ``start``; returns its movement name.
+    def is_hand(self, subsystem: str) -> bool:
+        """Whether the subsystem moves fingers (its states are joint angles) rather than positions."""
+        return bool(self.body.angle_mask[self.subsystems[subsystem]].all())
 
-        The edge ends in ``end`` if given (a hub, say), else in a new node at the strokes' targets.
+    def tolerance(self, subsystem: str) -> float:
+        """How close (metres, or radians for a hand) two states of the subsystem must be to be the same node."""
+        return self.params["hand_tolerance"] if self.is_hand(subsystem) else self.params["tolerance"]
+
+    def learn(self, subsystem: str, start: str, commands: list[GuidingStroke | HandTransition], *,
+              end: str | None = None, source: str = "") -> str:
+        """Add an edge of ``commands`` (one per part of the subsystem) from node ``start``; returns its movement name.
+
+        Guiding strokes for a wrist subsystem, hand transitions for a hand. The edge ends in ``end`` if given
+        (a hub, say), else in the node at the commands' targets (an existing one within :meth:`tolerance`, or a new one).
         """
         g = self.graphs[subsystem]
         if end is None:
-            target = np.stack([s.target for s in strokes])
+            target = np.stack([c.target for c in commands])
             end = self._near_node(subsystem, target) or self._new_node(subsystem, target)
         self._counter += 1
         name = f"{subsystem}:e{self._counter}"
-        key = g.add_edge(start, end, name=name, strokes=list(strokes), source=source)
+        key = g.add_edge(start, end, name=name, commands=list(commands), source=source)
         self._edges[name] = (subsystem, start, end, key)
         if self.owner is not None:
             self.owner.announce("likeme_movement_learned", character=self.owner, movement=name,
-                                details={"subsystem": subsystem, "from": start, "to": end, "strokes": len(strokes)})
+                                details={"subsystem": subsystem, "from": start, "to": end, "commands": len(commands)})
         return name
 
     def _new_node(self, subsystem: str, state: np.ndarray) -> str:
@@ -174,8 +208,9 @@ class MotorCommandGraph(MotorSystem):
         g.add_node(name, state=np.asarray(state, dtype=float), hub=False)
         return name
 
-    def _near_node(self, subsystem: str, state: np.ndarray, tolerance: float = 0.04) -> str | None:
-        """An existing node within ``tolerance`` metres (every part) of ``state``: the same motor state."""
+    def _near_node(self, subsystem: str, state: np.ndarray) -> str | None:
+        """An existing node within :meth:`tolerance` (every part) of ``state``: the same motor state."""
+        tolerance = self.tolerance(subsystem)
         for node, data in self.graphs[subsystem].nodes(data=True):
             if np.linalg.norm(data["state"] - state, axis=-1).max() <= tolerance:
                 return node
@@ -234,12 +269,12 @@ class MotorCommandGraph(MotorSystem):
         if movement not in self._edges:
             raise ConfigError(f"unknown movement {movement!r}", expected="a learned motor command", available=self.movements())
         subsystem, _, end, data = self.edge(movement)
-        strokes = [s.retimed(s.duration / speed) for s in data["strokes"]]
-        duration = max(s.duration for s in strokes)
+        commands = [c.retimed(c.duration / speed) for c in data["commands"]]
+        duration = max(c.duration for c in commands)
         t = np.linspace(0.0, duration, max(2, int(round(duration * fps)) + 1))
         frames = np.repeat(self._state[None], len(t), axis=0)
-        for part, stroke in zip(self.subsystems[subsystem], strokes):
-            frames[:, part] = stroke.position(t)
+        for part, command in zip(self.subsystems[subsystem], commands):
+            frames[:, part] = command.position(t)
         for s, e, w, upper, fore, outward in self.arms:
             frames[:, e] = place_elbows(frames[:, s], frames[:, w], upper, fore, outward)
         self._state = frames[-1].copy()
@@ -266,7 +301,7 @@ class MotorCommandGraph(MotorSystem):
             sequences = {m: e for m, e in self.sequences.items() if self._edges[e[0]][0] == name}
             state[name] = {
                 "nodes": {n: d["state"].round(6).tolist() for n, d in g.nodes(data=True) if n != "hub"},
-                "edges": [{"from": a, "to": b, "name": d["name"], "strokes": [s.to_dict() for s in d["strokes"]]}
+                "edges": [{"from": a, "to": b, "name": d["name"], "commands": [c.to_dict() for c in d["commands"]]}
                           for a, b, d in g.edges(data=True)],
                 "sequences": sequences,
                 "labels": {m: label for m, label in self.labels.items() if m in sequences},
@@ -282,13 +317,13 @@ class MotorCommandGraph(MotorSystem):
                 g.add_node(node, state=np.asarray(value, dtype=float), hub=False)
             for i, e in enumerate(entry.get("edges", [])):
                 try:
-                    strokes = [GuidingStroke(**s) for s in e["strokes"]]
+                    commands = [command_from_dict(c) for c in e["commands" if "commands" in e else "strokes"]]
                 except (TypeError, ValueError, KeyError) as exc:
                     raise ConfigError(f"invalid edge ({exc})", key=(name, "edges", i), expected="an edge written by get_state") from None
                 if e["name"] in self._edges:  # the same command built already (from clips, say): the saved one replaces it
                     _, a, b, old = self._edges[e["name"]]
                     g.remove_edge(a, b, old)
-                key = g.add_edge(e["from"], e["to"], name=e["name"], strokes=strokes, source="loaded")
+                key = g.add_edge(e["from"], e["to"], name=e["name"], commands=commands, source="loaded")
                 self._edges[e["name"]] = (name, e["from"], e["to"], key)
                 self._counter = max(self._counter, int(e["name"].rsplit(":e", 1)[-1]))
             self.sequences.update(entry.get("sequences", {}))

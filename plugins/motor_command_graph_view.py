@@ -60,8 +60,11 @@ class MotorCommandGraphView(View):
         pl = plotter((self.params["width"], self.params["height"]))
         try:
             draw_bodies(pl, body, motor.rest[None], radius=0.02, opacity=0.35)
-            n_edges = 0
+            n_edges, hands = 0, []
             for subsystem, graph in motor.graphs.items():
+                if motor.is_hand(subsystem):  # joint angles, not places: listed in the title, not drawn in space
+                    hands.append(f"{subsystem} {graph.number_of_nodes()} nodes/{graph.number_of_edges()} commands")
+                    continue
                 idx = motor.subsystems[subsystem]
                 candidates = set(prediction["candidates"]) if prediction and prediction["subsystem"] == subsystem else set()
                 dropped = set(prediction["initial"]) - candidates if prediction and prediction["subsystem"] == subsystem else set()
@@ -69,7 +72,7 @@ class MotorCommandGraphView(View):
                     n_edges += 1
                     name = data["name"]
                     width, opacity = (7, 1.0) if name in candidates else (1.5, 0.35) if name in dropped else (3, 0.9)
-                    for part, path in zip(idx, edge_trajectories(data["strokes"])):
+                    for part, path in zip(idx, edge_trajectories(data["commands"])):
                         colour = "red" if name in candidates else colours[part]
                         pl.add_mesh(pv.lines_from_points(path), color=colour, line_width=width, opacity=opacity)
                 for node, d in graph.nodes(data=True):
@@ -83,7 +86,8 @@ class MotorCommandGraphView(View):
                                     style="wireframe", line_width=2)
                     add_labels(pl, state[:1] + [0.0, 0.05, 0.0], [f"{subsystem}:{node}"], font_size=10, align="centre",
                                colour="#303030")
-            title = (f"{character.name}: motor command graphs, {len(motor.graphs)} subsystem(s), {n_edges} command(s)")
+            title = (f"{character.name}: motor command graphs, {len(motor.graphs)} subsystem(s), {n_edges} command(s)"
+                     + (f"\nhands: {'; '.join(hands)}" if hands else ""))
             if prediction:
                 seen = prediction["observed"]
                 for j in range(seen.shape[1]):

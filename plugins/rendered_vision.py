@@ -114,12 +114,13 @@ class RenderedVision(SyntheticVision):
         # an object the observer holds is not in its view of the world (as in synthetic-vision)
         shown = np.array([world.objects[n].held_by != observer.id for n in names], dtype=bool)
         radii = np.concatenate([self._radii(target.body), [world.objects[n].radius for n in names]])
-        points = np.concatenate([truth, centres])
+        points = np.concatenate([self._places(target.body, truth), centres])
         positions, seen = self.render_view(eye, observer.heading, points, radii,
                                            np.concatenate([np.ones(len(truth), bool), shown]))
         n = len(truth)
         objects = {name: positions[n + i].copy() for i, name in enumerate(names) if seen[n + i]}
-        return np.where(seen[:n, None], positions[:n], np.nan), seen[:n], objects
+        parts, found = self._hand_percepts(target.body, truth, positions[:n], seen[:n])
+        return np.where(found[:, None], parts, np.nan), found, objects
 
     def render_view(self, eye: np.ndarray, heading: float, points: np.ndarray, radii: np.ndarray,
                     shown: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -80,8 +80,8 @@ def draw_bodies(pl: Any, body: Body, poses: np.ndarray, *, radius: float = 0.03,
     """
     import pyvista as pv
 
-    poses = np.asarray(poses, dtype=float).reshape(-1, body.n_parts, 3)
-    finite = np.isfinite(poses).all(axis=2)
+    poses = np.where(body.angle_mask[:, None], np.nan, np.asarray(poses, dtype=float).reshape(-1, body.n_parts, 3))
+    finite = np.isfinite(poses).all(axis=2)  # fingers (joint angles, not places) are not drawn as points
     rgb = np.array([hex_to_rgb(c) for c in (colours if colours is not None else part_colours(body))], dtype=np.uint8)
     points = pv.PolyData(poses[finite])
     points["rgb"] = np.broadcast_to(rgb, (*poses.shape[:2], 3))[finite]
@@ -186,8 +186,8 @@ class BodyFigure:
         self.update(pose)
 
     def update(self, pose: np.ndarray, visible: np.ndarray | None = None) -> None:
-        """Move to ``pose`` (P, 3); parts not ``visible`` are greyed, NaN parts hidden."""
-        pose = np.asarray(pose, dtype=float)
+        """Move to ``pose`` (P, 3); parts not ``visible`` are greyed, NaN parts and fingers (joint angles) hidden."""
+        pose = np.where(self.body.angle_mask[:, None], np.nan, np.asarray(pose, dtype=float))
         finite = np.isfinite(pose).all(axis=1)
         for i, actor in enumerate(self.spheres):
             actor.SetVisibility(bool(finite[i]))

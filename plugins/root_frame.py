@@ -137,7 +137,8 @@ def to_root_relative(
     Returns
     -------
     pose : array, shape (..., P, 3)
-        Root-relative positions, rotated so the body faces +z.
+        Root-relative positions, rotated so the body faces +z; the joint angles of
+        fingers (angle parts) unchanged, seen only when their wrist is.
     visible : array of bool, shape (..., P)
         The input mask, cleared where root or heading were not found.
     root : array, shape (..., 3)
@@ -160,5 +161,9 @@ def to_root_relative(
         flat = safe_world.reshape(-1, *world.shape[-2:])
         pose = world_to_local(flat, safe_root.reshape(-1, 3), safe_heading.reshape(-1)).reshape(world.shape)
     mask = visible & ok[..., None]
+    angles = body.angle_mask
+    if angles.any():  # finger joint angles are not positions: kept as they are, seen when their wrist is seen
+        pose[..., angles, :] = world[..., angles, :]
+        mask = mask & mask[..., body.carriers]
     pose = np.where(mask[..., None], pose, np.nan)
     return pose, mask, np.where(ok[..., None], root, np.nan), heading

@@ -52,11 +52,14 @@ class SpeedProfileView(View):
         fps = observer.fps
         chosen = segmenter.params["parts"] or list(character.body.parts)
         idx = [character.body.parts.index(p) for p in chosen]
+        scale = np.where(character.body.angle_mask[idx], segmenter.params["angle_scale"], 1.0)  # fingers: rad -> m
         poses = np.where(np.array(observer.visible)[:, idx, None], np.array(observer.poses)[:, idx], np.nan)
+        poses = poses * scale[:, None]
         speed = np.nanmax(np.linalg.norm(np.diff(poses, axis=0), axis=2), axis=1) * fps if len(poses) > 1 else np.zeros(0)
+        placed = [j for j, i in enumerate(idx) if not character.body.angle_mask[i]]  # parts with a trajectory in space
 
         fig = blank(self.params["width"], self.params["height"])
-        k = len(idx)  # the left three quarters: the timeline and the speed; the right quarter: one trajectory per part
+        k = len(placed)  # the left three quarters: the timeline and the speed; the right quarter: one trajectory per part
         rows = [["top", "."]] * k + [["speed", f"part{j}"] for j in range(k) for _ in range(4)]
         axes = fig.subplot_mosaic(rows, width_ratios=[3, 1])
         top, ax = axes["top"], axes["speed"]
@@ -84,14 +87,14 @@ class SpeedProfileView(View):
             n_speed, n_direction, n_kept = n_speed + len(analysis.speed_breaks), n_direction + len(
                 analysis.direction_breaks), n_kept + len(kept)
             window = analysis.window.reshape(len(analysis.window), -1, 3)
-            for j, tax in enumerate(trajectory_axes):
+            for j, tax in zip(placed, trajectory_axes):
                 xy = window[:, j, :2]
                 for c in np.unique(analysis.clusters):
                     sel = np.flatnonzero(analysis.clusters == c)
                     tax.scatter(xy[sel + 1, 0], xy[sel + 1, 1], s=5,
                                 color=PALETTE[c % len(PALETTE)] if c >= 0 else "#b0b0b0")
                 tax.scatter(xy[kept, 0], xy[kept, 1], s=30, color="black", zorder=3)
-        for j, tax in enumerate(trajectory_axes):
+        for j, tax in zip(placed, trajectory_axes):
             tax.ticklabel_format(useOffset=False)
             x0, x1 = tax.get_xlim()
             y0, y1 = tax.get_ylim()
@@ -105,11 +108,12 @@ class SpeedProfileView(View):
         ax.plot([], [], color="#4363d8", ls="--", label=f"direction break points ({n_direction})")
         ax.scatter([], [], marker="v", color="black", label=f"breaks kept ({n_kept})")
         ax.set_xlabel("time (s)")
-        ax.set_ylabel("speed (m/s)")
+        ax.set_ylabel("speed (m/s; fingers: rad/s x angle_scale)" if len(placed) < len(idx) else "speed (m/s)")
         ax.set_xlim(0, demo.motion.duration)
         ax.set_ylim(bottom=0)
         ax.legend(loc="upper right", fontsize=8)
-        ax.set_title(f"{character.name} watching {', '.join(chosen)}: {len(movements)} movement(s) in working memory, "
+        watched = ", ".join(chosen[j] for j in placed) + (f" and {len(idx) - len(placed)} fingers" if len(placed) < len(idx) else "")
+        ax.set_title(f"{character.name} watching {watched}: {len(movements)} movement(s) in working memory, "
                      f"points coloured by direction cluster", fontsize=10, loc="left")
         return [save_figure(fig, out)]
 

@@ -99,11 +99,27 @@ class SyntheticVision(Perception):
         self._facing: HeadingFilter | None = None
 
     def _radii(self, body: Any) -> np.ndarray:
+        """Sphere radius of every part; 0 for fingers, which are joint angles carried by a wrist, not places."""
         radii = np.full(body.n_parts, self.params["part_radius"])
         for part, r in self.params["radii"].items():
             if part in body.parts:
                 radii[body.index(part)] = float(r)
+        radii[body.angle_mask] = 0.0
         return radii
+
+    @staticmethod
+    def _places(body: Any, positions: np.ndarray) -> np.ndarray:
+        """Where each part is in space: a finger (its values are joint angles) is where its wrist is."""
+        return np.where(body.angle_mask[:, None], positions[body.carriers], positions)
+
+    @staticmethod
+    def _hand_percepts(body: Any, truth: np.ndarray, positions: np.ndarray, seen: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The hand percept carries the finger joint angles, seen whenever the wrist is (K&G §4.1)."""
+        angles = body.angle_mask
+        if not angles.any():
+            return positions, seen
+        seen = np.where(angles, seen[body.carriers], seen)
+        return np.where(angles[:, None] & seen[:, None], truth, positions), seen
 
     def visible_parts(self, observer: Any, target: Any, world: Any) -> tuple[np.ndarray, np.ndarray]:
         """World positions of the target's parts and which of them the eye sees (before noise and dropouts)."""
@@ -112,7 +128,8 @@ class SyntheticVision(Perception):
 
     def _look(self, observer: Any, target: Any, world: Any) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
         """The target's part positions, which parts the eye sees, and the objects it sees (name to position)."""
-        positions = target.world_pose()
+        truth = target.world_pose()
+        positions = self._places(target.body, truth)
         eye = observer.world_pose()[observer.body.index(self.params["eye"])]
         seen = self._in_view(eye, observer.heading, positions)
         names = list(world.objects)
@@ -130,6 +147,7 @@ class SyntheticVision(Perception):
                 seen &= ~line_of_sight_blocked(eye, positions, radii, all_centres, all_radii, same=same)
             if objects_seen.any():  # objects hidden behind the target's body
                 objects_seen &= ~line_of_sight_blocked(eye, centres, sizes, positions, radii)
+        positions, seen = self._hand_percepts(target.body, truth, positions, seen)
         return positions, seen, {n: centres[i].copy() for i, n in enumerate(names) if objects_seen[i]}
 
     def _in_view(self, eye: np.ndarray, heading: float, points: np.ndarray) -> np.ndarray:

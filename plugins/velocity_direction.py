@@ -25,8 +25,15 @@ With ``level = "movement"`` the segmenter reports whole movements (onset to
 end, as the sensory memory finds them) instead of strokes.
 
 It reads any body's pose stream: ``parts`` names the parts whose velocity is
-used (the wrists for Max and Moritz; all parts when empty). Hidden parts do not
-move; a frame with none of the parts visible carries no evidence.
+used (the wrists and fingers for Max and Moritz; all parts when empty). Hidden
+parts do not move; a frame with none of the parts visible carries no evidence.
+
+Hands (§4.3): a finger of the observer's body (an angle part, whose values
+are joint angles) moves at an *angular* velocity. Its angles are multiplied by
+``angle_scale`` (metres per radian) as they enter the memories, so one rest
+speed, one drop criterion and one direction clustering serve wrists and
+fingers: a hand movement is cut at the minima of its angular velocity and
+where its direction in joint-angle space changes cluster.
 """
 
 from __future__ import annotations
@@ -131,6 +138,8 @@ class VelocityDirection(Segmenter):
         Parameter("min_stroke", float, 0.15, "Shortest stroke (s); shorter pieces merge with a neighbour.", minimum=0.0),
         Parameter("smooth", float, 0.2, "Seconds of Savitzky-Golay smoothing of the working memory before it is "
                   "segmented (0: none).", minimum=0.0),
+        Parameter("angle_scale", float, 0.25, "Metres one radian of a finger's joint angles counts as (0.25: a finger "
+                  "turning at 0.6 rad/s moves as fast as a wrist at 0.15 m/s).", minimum=0.0),
         Parameter("level", str, "stroke", "Report strokes (break points) or whole movements (onset to end).",
                   choices=("stroke", "movement")),
     )
@@ -146,6 +155,9 @@ class VelocityDirection(Segmenter):
             raise ConfigError(f"parts {missing} are not in the observed body", key=("parts",),
                               expected="parts of the observed body", available=list(parts))
         self._idx = np.array([parts.index(p) for p in chosen])
+        body = getattr(self.owner, "body", None)
+        angles = set(body.angle_parts) if body is not None else set()
+        self._scale = np.array([self.params["angle_scale"] if p in angles else 1.0 for p in chosen])[:, None]
         self._fps = float(fps)
         self._frame = -1
         self._prev: np.ndarray | None = None
@@ -162,7 +174,7 @@ class VelocityDirection(Segmenter):
 
     def push(self, pose: np.ndarray, visible: np.ndarray) -> list[Segment]:
         self._frame += 1
-        points = np.where(visible[self._idx, None], pose[self._idx], np.nan)
+        points = np.where(visible[self._idx, None], pose[self._idx] * self._scale, np.nan)
         seen = np.isfinite(points).all(axis=1)
         if self._prev is not None:
             points = np.where(seen[:, None], points, self._prev)  # a hidden part keeps its last position

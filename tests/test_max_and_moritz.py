@@ -74,7 +74,8 @@ def test_the_graph_after_the_games_and_where_max_ends_up(games):
     edges = sorted((a, b) for a, b, _ in left.edges)
     assert edges == [("hub", "n1"), ("hub", "n2"), ("n1", "hub"), ("n2", "n3"), ("n3", "hub")]
     assert motor.graphs["right_wrist"].number_of_edges() == 0
-    assert motor.active == {"left_wrist": "hub", "right_wrist": "hub"}
+    assert motor.active == {"left_wrist": "hub", "right_wrist": "hub", "left_hand": "hub", "right_hand": "hub"}
+    assert motor.graphs["left_hand"].number_of_edges() == 0  # Moritz's hands stayed relaxed
     # Max's wrist is back at rest, as Moritz's is
     max_ = games.actors["max"]
     np.testing.assert_allclose(max_.local_pose()[max_.body.index("left_wrist")], motor.rest[max_.body.index("left_wrist")], atol=0.05)

@@ -208,8 +208,8 @@ def test_a_clip_built_motor_command_graph_saves_and_loads_its_labels_without_dou
 
     def by_name(s):  # edges in name order, stroke numbers to 5 decimals (a stroke's normal is normalised on load)
         body = dict(s["body"])
-        body["edges"] = [{**e, "strokes": [{k: np.round(v, 5).tolist() if isinstance(v, list | float) else v
-                                           for k, v in stroke.items()} for stroke in e["strokes"]]}
+        body["edges"] = [{**e, "commands": [{k: np.round(v, 5).tolist() if isinstance(v, list | float) else v
+                                            for k, v in stroke.items()} for stroke in e["commands"]]}
                          for e in sorted(body["edges"], key=lambda e: e["name"])]
         return body
 

@@ -16,7 +16,7 @@ Typical use::
         print(event.time, event.kind, event.actor)
 """
 
-from toolkit.body import Body, Facing
+from toolkit.body import Body, Facing, Hand
 from toolkit.character import Character, load_character
 from toolkit.components import (
     ActionSystem,
@@ -54,6 +54,7 @@ __all__ = [
     "ConfigError",
     "Event",
     "Facing",
+    "Hand",
     "LikemeError",
     "Match",
     "Matcher",

@@ -18,13 +18,14 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
 
 from toolkit.errors import ConfigError
 
-__all__ = ["Body", "Facing"]
+__all__ = ["Body", "Facing", "Hand"]
 
 
 @dataclass(frozen=True)
@@ -46,6 +47,20 @@ class Facing:
 
 
 @dataclass(frozen=True)
+class Hand:
+    """A hand whose configuration is the joint angles of its fingers (Kopp & Graeser 2006, §4.1).
+
+    ``wrist`` is the (position) part that carries the hand; ``fingers`` are *angle
+    parts*: each one's three values are joint angles in radians, not a position
+    (see ``docs/conventions.md``). A finger is seen when its wrist is seen (the
+    hand percept "comprises the configurations of the finger joints", §4.1).
+    """
+
+    wrist: str
+    fingers: tuple[str, ...]
+
+
+@dataclass(frozen=True)
 class Body:
     """The tracked body parts of a character.
 
@@ -61,6 +76,8 @@ class Body:
         Pairs of parts drawn as bones and used for occlusion between parts.
     colours : mapping of str to str, optional
         Colour code of each part (``"#rrggbb"``), used by colour-coded vision and pictures.
+    hands : mapping of str to Hand, optional
+        Hands by name (``left_hand``...): the angle parts (fingers) each wrist carries.
     """
 
     parts: tuple[str, ...]
@@ -68,9 +85,11 @@ class Body:
     facing: Facing
     bones: tuple[tuple[str, str], ...] = ()
     colours: Mapping[str, str] = field(default_factory=dict)
+    hands: Mapping[str, Hand] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "parts", tuple(self.parts))
+        object.__setattr__(self, "hands", {n: Hand(h.wrist, tuple(h.fingers)) for n, h in dict(self.hands).items()})
         object.__setattr__(self, "bones", tuple(tuple(b) for b in self.bones))
         object.__setattr__(self, "colours", dict(self.colours))
         if len(set(self.parts)) != len(self.parts):
@@ -93,6 +112,21 @@ class Body:
             self.index(b, key=("bones", i))
         for part in self.colours:
             self.index(part, key=("colours", part))
+        seen: dict[str, str] = {}
+        for name, hand in self.hands.items():
+            self.index(hand.wrist, key=("hands", name, "wrist"))
+            if not hand.fingers:
+                raise ConfigError("a hand without fingers", key=("hands", name, "fingers"), expected="a non-empty list of parts")
+            for finger in hand.fingers:
+                self.index(finger, key=("hands", name, "fingers"))
+                if finger in seen or finger in (self.root, self.facing.left, self.facing.right, hand.wrist):
+                    raise ConfigError(f"part {finger!r} cannot be a finger of {name!r}", key=("hands", name, "fingers"),
+                                      expected="parts that belong to one hand only and are not the root, facing or wrist parts")
+                seen[finger] = name
+        for i, (a, b) in enumerate(self.bones):
+            if a in seen or b in seen:
+                raise ConfigError(f"bone [{a!r}, {b!r}] joins a finger", key=("bones", i),
+                                  expected="bones between position parts (fingers are drawn from their joint angles)")
 
     # -- lookups -----------------------------------------------------------------
 
@@ -103,6 +137,26 @@ class Body:
     @property
     def root_index(self) -> int:
         return self.parts.index(self.root)
+
+    @property
+    def angle_parts(self) -> tuple[str, ...]:
+        """The parts whose values are joint angles (radians), every hand's fingers in order."""
+        return tuple(f for hand in self.hands.values() for f in hand.fingers)
+
+    @cached_property
+    def angle_mask(self) -> np.ndarray:
+        """Boolean (P,): which parts are angle parts (their values are not positions)."""
+        angles = set(self.angle_parts)
+        return np.array([p in angles for p in self.parts], dtype=bool)
+
+    @cached_property
+    def carriers(self) -> np.ndarray:
+        """Integer (P,): for a finger the index of its wrist, for a position part its own index."""
+        out = np.arange(self.n_parts)
+        for hand in self.hands.values():
+            for finger in hand.fingers:
+                out[self.parts.index(finger)] = self.parts.index(hand.wrist)
+        return out
 
     def index(self, part: str, *, key: Sequence[str | int] = ()) -> int:
         """Index of ``part`` on the ``P`` axis; a :class:`ConfigError` listing the parts if unknown."""
@@ -129,7 +183,7 @@ class Body:
 
         Raises :class:`ConfigError` with a key path relative to the table.
         """
-        known = {"parts", "root", "facing", "bones", "colours"}
+        known = {"parts", "root", "facing", "bones", "colours", "hands"}
         for key in table:
             if key not in known:
                 raise ConfigError(f"unknown key {key!r}", key=(key,), expected="a body key", available=sorted(known))
@@ -165,12 +219,27 @@ class Body:
         colours = table.get("colours", {})
         if not isinstance(colours, Mapping) or not all(_is_hex_colour(c) for c in colours.values()):
             raise ConfigError("invalid", key=("colours",), expected='a table of part = "#rrggbb"')
+        hands = table.get("hands", {})
+        if not isinstance(hands, Mapping):
+            raise ConfigError("invalid", key=("hands",), expected='a table like { left_hand = { wrist = "left_wrist", '
+                              'fingers = ["left_thumb", ...] } }')
+        parsed: dict[str, Hand] = {}
+        for name, spec in hands.items():
+            if not isinstance(spec, Mapping) or set(spec) != {"wrist", "fingers"}:
+                raise ConfigError("invalid", key=("hands", name), expected='{ wrist = "PART", fingers = ["PART", ...] }',
+                                  available=("fingers", "wrist"))
+            fingers = spec["fingers"]
+            if not isinstance(spec["wrist"], str) or not isinstance(fingers, list) or not all(isinstance(f, str) for f in fingers):
+                raise ConfigError("invalid", key=("hands", name), expected="a wrist part name and a list of finger part names",
+                                  available=parts)
+            parsed[name] = Hand(spec["wrist"], tuple(fingers))
         return cls(
             parts=tuple(parts),
             root=root,
             facing=Facing(facing["left"], facing["right"], forward, behind),
             bones=tuple((a, b) for a, b in bones),
             colours=dict(colours),
+            hands=parsed,
         )
 
 

@@ -26,9 +26,9 @@ from toolkit.manager import PluginManager, create_plugin_manager
 __all__ = ["main", "build_parser"]
 
 
-DEMO_SCENARIOS = ("demo", "ice_cream", "imitation_games")
+DEMO_SCENARIOS = ("demo", "ice_cream", "imitation_games", "hand_games")
 """What ``likeme demo`` runs: Max imitating Morris's random movements, Max working out why Morris eats,
-and Max learning Moritz's arm movements in three imitation games."""
+and Max learning Moritz's arm movements in three imitation games and his finger movements in three more."""
 
 
 class _Parser(argparse.ArgumentParser):

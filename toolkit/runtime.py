@@ -189,8 +189,13 @@ class Actor:
         return self._motion.positions[min(self._frame, self._motion.n_frames - 1)]
 
     def world_pose(self) -> np.ndarray:
-        """Current positions in world coordinates, shape (P, 3)."""
-        return local_to_world(self.local_pose(), self.position, self.heading)
+        """Current positions in world coordinates, shape (P, 3); finger joint angles (angle parts) as they are."""
+        local = self.local_pose()
+        world = local_to_world(local, self.position, self.heading)
+        angles = self.body.angle_mask
+        if angles.any():
+            world[angles] = local[angles]
+        return world
 
     def request(self, request: MovementRequest) -> None:
         """Perform ``request`` now if idle, else after the current movement."""
