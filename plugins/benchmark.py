@@ -296,10 +296,14 @@ def likeme_register_commands(subparsers):
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(handler=cmd_watch)
 
-    p = sub.add_parser("facilitation", help="Max learns Moritz's arm movements and imitates familiar ones early (K&G §4-5)")
+    p = sub.add_parser("facilitation", help="Max learns Moritz's arm and finger movements and imitates familiar ones early (K&G §4-5)")
     p.add_argument("--demonstrations", type=int, default=200, help="demonstrations after the repertoire (default: 200)")
     p.add_argument("--repertoire", type=int, default=6, help="random movements learned first (default: 6)")
     p.add_argument("--noise", type=float, default=0.002, help="observation noise, metres (default: 0.002)")
+    p.add_argument("--hands", type=float, default=0.3, help="share of finger movements of the left hand among the "
+                   "demonstrations (default: 0.3; 0: arms only)")
+    p.add_argument("--angle-noise", type=float, default=0.005, help="observation noise on finger joint angles, radians "
+                   "(default: 0.005)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--json", metavar="FILE", help="also write the results as JSON")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -434,6 +438,37 @@ def _random_arm_movement(rng: np.random.Generator, rest: np.ndarray, body: Any, 
     return Motion(frames, fps, body.parts), strokes_out
 
 
+def _random_hand_movement(rng: np.random.Generator, rest: np.ndarray, body: Any, fps: float, *, speed: float = 1.0,
+                          transitions_out: list | None = None) -> tuple[Any, list]:
+    """Out (one transition, or two through a via posture, of the left hand's fingers), hold, back to rest.
+
+    Returns (motion, the out key postures as hand transitions, one per finger)."""
+    from plugins.hand_transition import HandTransition
+    from toolkit import Motion
+
+    idx = body.indices(body.hands["left_hand"].fingers)
+    if transitions_out is None:
+        count = int(rng.integers(1, 3))
+        low, high = np.radians([0.0, 0.0, -20.0]), np.radians([90.0, 100.0, 30.0])
+        keys = [rest[idx], *(rng.uniform(low, high, size=(len(idx), 3)) for _ in range(count))]
+        times = np.concatenate([[0.0], np.cumsum(rng.uniform(0.4, 0.8, count))])
+        peak = float(rng.uniform(0.4, 0.6))
+        transitions_out = [HandTransition(np.stack([k[j] for k in keys]), times, peak) for j in range(len(idx))]
+    # Moritz plays the key postures as a key-frame animation (monotone cubic through the keys, as his key poses are):
+    # the fingers do not all stop at a via posture, so it stays one movement for the sensory memory
+    from scipy.interpolate import PchipInterpolator
+
+    t = np.arange(int(round(transitions_out[0].duration / speed * fps))) / fps * speed
+    out = [PchipInterpolator(tr.times, tr.keys, axis=0)(t) for tr in transitions_out]  # (n, 3) per finger
+    back = [HandTransition(np.stack([t.target, rest[i]]), np.array([0.0, 0.6])).trajectory(fps) for t, i in zip(transitions_out, idx)]
+    hold = int(0.6 * fps)
+    fingers = np.stack([np.concatenate([o, np.repeat(t.target[None], hold, axis=0), b])
+                        for o, t, b in zip(out, transitions_out, back)], axis=1)
+    frames = np.repeat(rest[None], len(fingers), axis=0)
+    frames[:, idx] = fingers
+    return Motion(frames, fps, body.parts), transitions_out
+
+
 def _shape_error(a: np.ndarray, b: np.ndarray, n: int = 50) -> float:
     """Mean distance (m) between two paths resampled at ``n`` points equally spaced along each."""
     def resample(p: np.ndarray) -> np.ndarray:
@@ -445,9 +480,13 @@ def _shape_error(a: np.ndarray, b: np.ndarray, n: int = 50) -> float:
 
 
 def facilitation_benchmark(pm: Any, *, demonstrations: int = 200, repertoire: int = 6, seed: int = 0, noise: float = 0.002,
-                           novel: float = 0.3, progress: bool = False) -> dict[str, Any]:
-    """Max learns ``repertoire`` random arm movements by watching, then watches ``demonstrations`` more (known ones,
-    some at other speeds, and novel ones) with observation noise; see ``docs/benchmarks.md``."""
+                           novel: float = 0.3, hands: float = 0.3, angle_noise: float = 0.005,
+                           progress: bool = False) -> dict[str, Any]:
+    """Max learns ``repertoire`` random arm movements (and as many finger movements of the left hand when ``hands``)
+    by watching, then watches ``demonstrations`` more (known ones, some at other speeds, and novel ones; a share
+    ``hands`` of them finger movements) with observation noise (``noise`` metres on positions, ``angle_noise``
+    radians on finger joint angles); see ``docs/benchmarks.md``. The wrist figures are at the top level, the hand
+    figures under ``"hand"``."""
     rng = np.random.default_rng(seed)
     moritz = load_character("moritz", pm, override={"action": {"plugin": "script", "movements": []}})
     learner = load_character("max_learner", pm)
@@ -467,8 +506,10 @@ def facilitation_benchmark(pm: Any, *, demonstrations: int = 200, repertoire: in
         from toolkit import Motion, MovementRequest
 
         noisy = motion.positions.copy()
-        if noise:  # metres of noise on the positions (the fingers' joint angles are not part of this benchmark)
+        if noise:  # metres of noise on the positions
             noisy[:, points] += rng.normal(0.0, noise, noisy[:, points].shape)
+        if angle_noise:  # radians on the fingers' joint angles
+            noisy[:, ~points] += rng.normal(0.0, angle_noise, noisy[:, ~points].shape)
         replay.motions[name] = Motion(noisy, fps, motion.parts)
         first = len(world.events)
         demo.request(MovementRequest(name))
@@ -491,12 +532,16 @@ def facilitation_benchmark(pm: Any, *, demonstrations: int = 200, repertoire: in
                 groups[segments.index(seg)].append(e)
         return groups
 
-    for i in range(repertoire):
-        motion, strokes = _random_arm_movement(rng, replay.rest, moritz.body, fps)
-        groups = show(f"teach-{i}", motion)
-        final = groups[0][-1].data["match"] if groups else None
-        if final is not None and final.path:
-            known.append((final.path[0], strokes))
+    makers = {"wrist": _random_arm_movement, "hand": _random_hand_movement}
+    subsystem = {"wrist": "left_wrist", "hand": "left_hand"}
+    known_by: dict[str, list[tuple[str, list]]] = {"wrist": known, "hand": []}
+    for kind in ("wrist", "hand") if hands > 0 else ("wrist",):
+        for i in range(repertoire):
+            motion, strokes = makers[kind](rng, replay.rest, moritz.body, fps)
+            groups = show(f"teach-{kind}-{i}", motion)
+            final = groups[0][-1].data["match"] if groups else None
+            if final is not None and final.path:
+                known_by[kind].append((final.path[0], strokes))
     rows = []
     jobs = range(demonstrations)
     if progress:
@@ -506,15 +551,18 @@ def facilitation_benchmark(pm: Any, *, demonstrations: int = 200, repertoire: in
     started = time.perf_counter()
     frames_before = world.frame
     for i in jobs:
+        kind = "hand" if hands > 0 and rng.random() < hands and known_by["hand"] else "wrist"
         is_novel = bool(rng.random() < novel)
         speed = float(rng.choice([1.0, 1.0, rng.uniform(0.6, 1.6)]))
         if is_novel:
-            motion, strokes = _random_arm_movement(rng, replay.rest, moritz.body, fps, speed=speed)
+            motion, strokes = makers[kind](rng, replay.rest, moritz.body, fps, speed=speed)
             truth = None
         else:
-            truth, strokes = known[int(rng.integers(len(known)))]
-            motion, _ = _random_arm_movement(rng, replay.rest, moritz.body, fps, speed=speed, strokes_out=strokes)
-        edges_before = learner.motor.graphs["left_wrist"].number_of_edges()
+            truth, strokes = known_by[kind][int(rng.integers(len(known_by[kind])))]
+            motion, _ = makers[kind](rng, replay.rest, moritz.body, fps, speed=speed, **{
+                "strokes_out" if kind == "wrist" else "transitions_out": strokes})
+        graph = learner.motor.graphs[subsystem[kind]]
+        edges_before = graph.number_of_edges()
         segments_before = len(world.events_of("segment_found", "max"))
         groups = show(f"demo-{i}", motion)
         segs = world.events_of("segment_found", "max")[segments_before:]
@@ -525,11 +573,21 @@ def facilitation_benchmark(pm: Any, *, demonstrations: int = 200, repertoire: in
         seg = segs[0].data["segment"] if segs else None
         learned_out = bool(final is not None and final.details.get("learned"))
         imitation_error = None
-        if final is not None and final.path:
+        if final is not None and final.path and kind == "wrist":
             executed = np.concatenate([st.trajectory(fps) for e in final.path for st in learner.motor.edge(e)[3]["commands"]])
             shown = np.concatenate([st.trajectory(fps) for st in strokes])
             imitation_error = _shape_error(executed, shown)
+        elif final is not None and final.path and learner.motor.edge(final.path[0])[0] == "left_hand":
+            # per finger, the path of its joint angles (radians) along the commands performed against the one shown
+            executed = [np.concatenate([learner.motor.edge(e)[3]["commands"][j].trajectory(fps) for e in final.path])
+                        for j in range(len(strokes))]
+            from scipy.interpolate import PchipInterpolator
+
+            grid = np.linspace(0.0, strokes[0].duration, 100)
+            imitation_error = float(np.mean([_shape_error(x, PchipInterpolator(t.times, t.keys, axis=0)(grid))
+                                             for x, t in zip(executed, strokes)]))
         rows.append({
+            "kind": kind,
             "novel": is_novel,
             "speed": speed,
             "truth": truth,
@@ -539,16 +597,31 @@ def facilitation_benchmark(pm: Any, *, demonstrations: int = 200, repertoire: in
             "fraction": (early.decided_at / seg.n_frames) if early is not None and seg is not None and early.decided_at else None,
             "correct": (not is_novel) and not learned_out and answer == truth,
             "false_commit": early is not None and (is_novel or (early.path[0] if early.path else early.movement) != truth),
-            "edges_learned": learner.motor.graphs["left_wrist"].number_of_edges() - edges_before,
-            "strokes": len(strokes),
+            "edges_learned": graph.number_of_edges() - edges_before,
+            "strokes": len(strokes) if kind == "wrist" else 1,  # a hand movement is one edge, via postures and all
         })
     elapsed = time.perf_counter() - started
+    figures = _facilitation_figures([r for r in rows if r["kind"] == "wrist"])
+    return {
+        "benchmark": "facilitation", "seed": seed, "demonstrations": demonstrations, "repertoire": repertoire, "noise": noise,
+        "angle_noise": angle_noise, "hands": hands, **figures,
+        "hand": _facilitation_figures([r for r in rows if r["kind"] == "hand"]),
+        "frames_per_second": (world.frame - frames_before) / elapsed if elapsed > 0 else float("inf"),
+        "rows": rows, "python": platform.python_version(), "numpy": np.__version__,
+    }
+
+
+def _facilitation_figures(rows: list[dict[str, Any]]) -> dict[str, Any]:
+    """Recognition, decision, false-commit, learning and imitation figures of some demonstrations' rows."""
+    def stat(values: list[float], f: Any) -> float:
+        return float(f(values)) if values else float("nan")
+
     known_rows = [r for r in rows if not r["novel"]]
     novel_rows = [r for r in rows if r["novel"]]
     fractions = [r["fraction"] for r in known_rows if r["committed"] and r["correct"] and r["fraction"] is not None]
     other_speed = [r for r in known_rows if abs(r["speed"] - 1.0) > 0.15]
+    errors = [r["imitation_error"] for r in rows if r["imitation_error"] is not None]
     return {
-        "benchmark": "facilitation", "seed": seed, "demonstrations": demonstrations, "repertoire": repertoire, "noise": noise,
         "known": len(known_rows), "novel": len(novel_rows),
         "recognition_accuracy": sum(r["correct"] for r in known_rows) / max(len(known_rows), 1),
         "accuracy_other_speed": sum(r["correct"] for r in other_speed) / max(len(other_speed), 1),
@@ -559,34 +632,46 @@ def facilitation_benchmark(pm: Any, *, demonstrations: int = 200, repertoire: in
         "false_commits": sum(r["false_commit"] for r in rows),
         "edges_per_novel_movement": float(np.mean([r["edges_learned"] for r in novel_rows])) if novel_rows else float("nan"),
         "strokes_per_novel_movement": float(np.mean([r["strokes"] for r in novel_rows])) if novel_rows else float("nan"),
-        "imitation_error_mean": float(np.mean([r["imitation_error"] for r in rows if r["imitation_error"] is not None])),
-        "imitation_error_p90": float(np.percentile([r["imitation_error"] for r in rows if r["imitation_error"] is not None], 90)),
-        "frames_per_second": (world.frame - frames_before) / elapsed if elapsed > 0 else float("inf"),
-        "rows": rows, "python": platform.python_version(), "numpy": np.__version__,
+        "imitation_error_mean": stat(errors, np.mean),
+        "imitation_error_p90": stat(errors, lambda v: np.percentile(v, 90)),
     }
 
 
 def render_facilitation(r: dict[str, Any]) -> str:
-    rows = [
-        ("demonstrations (known / novel)", f"{r['known']} / {r['novel']}"),
-        ("recognition accuracy, known movements", f"{r['recognition_accuracy']:.3f}"),
-        (f"  of which at another speed ({r['other_speed']})", f"{r['accuracy_other_speed']:.3f}"),
-        ("committed before the end (known)", f"{r['committed_share']:.3f}"),
-        ("decision fraction, median / 90th percentile", f"{r['decision_fraction_median']:.2f} / {r['decision_fraction_p90']:.2f}"),
-        ("false commits", f"{r['false_commits']}"),
-        ("edges learned per novel movement (its strokes + the return)", f"{r['edges_per_novel_movement']:.2f} ({r['strokes_per_novel_movement'] + 1:.2f})"),
-        ("imitation path error, mean / 90th percentile (m)", f"{r['imitation_error_mean']:.3f} / {r['imitation_error_p90']:.3f}"),
-        ("frames per second (world)", f"{r['frames_per_second']:.0f}"),
-    ]
-    width = max(len(a) for a, _ in rows)
-    head = (f"likeme bench facilitation: Max watches Moritz (seed {r['seed']}, {r['repertoire']} movements learned first, "
-            f"noise {r['noise']} m)")
-    return "\n".join([head] + [f"  {a:<{width}}  {b}" for a, b in rows])
+    """The table: one column for the wrist (arm) movements, one for the finger movements of the left hand."""
+    columns = [("wrists", r, "m")] + ([("hands", r["hand"], "rad")] if r.get("hand", {}).get("known", 0) + r.get("hand", {}).get("novel", 0) else [])
+
+    def cells(f: dict[str, Any], unit: str) -> list[str]:
+        return [
+            f"{f['known']} / {f['novel']}",
+            f"{f['recognition_accuracy']:.3f}",
+            f"{f['accuracy_other_speed']:.3f} ({f['other_speed']})",
+            f"{f['committed_share']:.3f}",
+            f"{f['decision_fraction_median']:.2f} / {f['decision_fraction_p90']:.2f}",
+            f"{f['false_commits']}",
+            f"{f['edges_per_novel_movement']:.2f} ({f['strokes_per_novel_movement'] + 1:.2f})",
+            f"{f['imitation_error_mean']:.3f} / {f['imitation_error_p90']:.3f} {unit}",
+        ]
+
+    labels = ["demonstrations (known / novel)", "recognition accuracy, known movements", "  at another speed (how many)",
+              "committed before the end (known)", "decision fraction, median / 90th percentile", "false commits",
+              "edges learned per novel movement (expected: strokes or 1 hand edge, + the return)",
+              "imitation path error, mean / 90th percentile"]
+    table = [cells(f, unit) for _, f, unit in columns]
+    width = max(len(a) for a in labels)
+    widths = [max(len(name), *(len(c) for c in col)) for (name, _, _), col in zip(columns, table)]
+    head = (f"likeme bench facilitation: Max watches Moritz (seed {r['seed']}, {r['repertoire']} movements of each kind "
+            f"learned first, noise {r['noise']} m and {r.get('angle_noise', 0.0)} rad)")
+    lines = [head, f"  {'':<{width}}  " + "  ".join(f"{name:>{w}}" for (name, _, _), w in zip(columns, widths))]
+    for i, label in enumerate(labels):
+        lines.append(f"  {label:<{width}}  " + "  ".join(f"{col[i]:>{w}}" for col, w in zip(table, widths)))
+    lines.append(f"  {'frames per second (world)':<{width}}  {r['frames_per_second']:.0f}")
+    return "\n".join(lines)
 
 
 def cmd_facilitation(args: argparse.Namespace, pm: Any) -> int:
     result = facilitation_benchmark(pm, demonstrations=args.demonstrations, repertoire=args.repertoire, seed=args.seed,
-                                    noise=args.noise, progress=not args.quiet)
+                                    noise=args.noise, hands=args.hands, angle_noise=args.angle_noise, progress=not args.quiet)
     print(render_facilitation(result))
     if args.json:
         _write_json(Path(args.json), result)

@@ -10,13 +10,16 @@ transitions" (§3).
 A hand configuration is the joint angles of its fingers: every finger is an
 *angle part* of the body whose three values are radians (base flexion, middle
 flexion, spread; :class:`toolkit.body.Hand`). A :class:`HandTransition` moves
-one finger through key postures: ``keys`` (m, 3) reached at ``times`` (m,)
-seconds from 0 to ``duration``. Between two key postures the angles follow
-the bell-shaped velocity profile of a guiding stroke
-(:func:`plugins.guiding_stroke.progress` with end gain 0), peaking at
-``peak`` of each transition, so the fingers pass every via posture at a
-minimum of their angular velocity, which is where the ``velocity-direction``
-segmenter finds it again (§4.3). The fingers of one hand share their timing: an
+one finger through key postures: ``keys`` (m, 3) at ``times`` (m,), a
+monotone cubic (:class:`scipy.interpolate.PchipInterpolator`) through them,
+as a key-frame animation plays its key poses. The whole movement runs through
+that curve with one bell-shaped velocity profile
+(:func:`plugins.guiding_stroke.progress` with end gain 0, peaking at
+``peak`` of the duration): it starts and ends at rest, and flows through the
+via postures, where the angular velocity dips as the fingers change direction
+and the ``velocity-direction`` segmenter finds them again (§4.3). ``times``
+are on the curve's own clock (from 0 to ``duration``); a key posture is reached
+when the bell-shaped progress reaches its time. The fingers of one hand share their timing: an
 edge of a hand subsystem holds one transition per finger with the same times.
 
 :meth:`HandTransition.position` is the forward model (edge plus elapsed time
@@ -33,6 +36,8 @@ from typing import Any
 
 import numpy as np
 
+from scipy.interpolate import PchipInterpolator
+
 from plugins.guiding_stroke import progress
 
 __all__ = ["HandTransition"]
@@ -47,14 +52,19 @@ class HandTransition:
     keys : array, shape (m, 3), m >= 2
         Key postures (radians): the start configuration, via postures, the target configuration.
     times : array, shape (m,)
-        When each key posture is reached (seconds; 0 first, strictly increasing).
+        Each key posture's place on the curve's clock (seconds; 0 first, strictly increasing; the last is the duration).
     peak : float
-        Moment of maximum angular velocity within each transition, as a share of it (0.05 to 0.95).
+        Moment of maximum angular velocity, as a share of the duration (0.05 to 0.95).
     """
 
     keys: np.ndarray
     times: np.ndarray
     peak: float = 0.5
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, HandTransition) and self.to_dict() == other.to_dict()
+
+    __hash__ = None  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
         keys = np.asarray(self.keys, dtype=float)
@@ -68,6 +78,7 @@ class HandTransition:
         object.__setattr__(self, "keys", keys)
         object.__setattr__(self, "times", times)
         object.__setattr__(self, "peak", float(self.peak))
+        object.__setattr__(self, "_curve", PchipInterpolator(times, keys, axis=0))
 
     @property
     def start(self) -> np.ndarray:
@@ -93,11 +104,8 @@ class HandTransition:
 
     def position(self, t: float | np.ndarray) -> np.ndarray:
         """Forward model: the joint angles at elapsed time(s) ``t`` (clamped to the transition), shape (..., 3)."""
-        t = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
-        i = np.clip(np.searchsorted(self.times, t, side="right") - 1, 0, len(self.times) - 2)
-        u = (t - self.times[i]) / (self.times[i + 1] - self.times[i])
-        s = progress(u, self.peak, 0.0)
-        return self.keys[i] + s[..., None] * (self.keys[i + 1] - self.keys[i])
+        u = np.clip(np.asarray(t, dtype=float), 0.0, self.duration) / self.duration
+        return self._curve(self.duration * progress(u, self.peak, 0.0))
 
     def trajectory(self, fps: float) -> np.ndarray:
         """Joint angles sampled at ``fps`` from 0 to the end inclusive, shape (n, 3)."""

@@ -24,8 +24,8 @@ and according to a clustering of movement directions, to detect the start, end,
 and via postures of the sighted hand movements. These configurations are used
 as key postures to create a new edge in the hand motor command graph".
 :func:`transitions_from_segment` takes those break points as key postures and
-fits the one remaining parameter, the moment of peak angular velocity, by a
-bounded scalar search; :func:`learn_commands` makes one edge of them.
+fits the one remaining parameter, the moment of peak angular velocity (which
+also places the key postures on the curve's clock), by a bounded scalar search; :func:`learn_commands` makes one edge of them.
 """
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ from scipy.integrate import trapezoid
 from scipy.optimize import least_squares, minimize_scalar
 from scipy.signal import savgol_filter
 
-from plugins.guiding_stroke import GuidingStroke
+from plugins.guiding_stroke import GuidingStroke, progress
 from plugins.hand_transition import HandTransition
 
 __all__ = ["stroke_from_segment", "transitions_from_segment", "trajectory_error", "learn_commands"]
@@ -145,10 +145,12 @@ def transitions_from_segment(angles: np.ndarray, fps: float, breaks: list[int] |
     if a.ndim != 3 or a.shape[2] != 3 or len(a) < 2 or not np.isfinite(a).all():
         raise ValueError("the hand inverse model needs two or more finite configurations (N, k, 3)")
     frames = np.array(sorted({0, *(int(b) for b in breaks if 0 < b < len(a) - 1), len(a) - 1}))
-    times = frames / fps
+    duration = (len(a) - 1) / fps
     t = np.arange(len(a)) / fps
 
     def build(peak: float) -> list[HandTransition]:
+        # the key postures' places on the curve's clock: where the bell-shaped progress is when they were seen
+        times = duration * progress(frames / (len(a) - 1), peak, 0.0)
         return [HandTransition(a[frames, j], times, peak) for j in range(a.shape[1])]
 
     def error(peak: float) -> float:

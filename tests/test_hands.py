@@ -10,6 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from plugins.guiding_stroke import progress
 from plugins.hand_transition import HandTransition
 from plugins.inverse_model import transitions_from_segment
 from plugins.motor_command_graph import command_from_dict
@@ -89,46 +90,54 @@ def test_a_subsystem_that_mixes_fingers_and_positions_is_refused(pm):
 
 @st.composite
 def transitions(draw):
+    """A random transition whose key postures are seen on frames (the segmenter's break points are frames)."""
     m = draw(st.integers(2, 4))
     keys = np.array([[draw(st.floats(-0.3, 1.6)) for _ in range(3)] for _ in range(m)])
-    steps = [draw(st.integers(9, 30)) for _ in range(m - 1)]  # frames between key postures
-    times = np.concatenate([[0.0], np.cumsum(steps)]) / FPS
-    return HandTransition(keys, times, draw(st.floats(0.3, 0.7)))
+    frames = np.concatenate([[0], np.cumsum([draw(st.integers(9, 30)) for _ in range(m - 1)])])
+    peak = draw(st.floats(0.3, 0.7))
+    duration = frames[-1] / FPS
+    times = duration * progress(frames / frames[-1], peak, 0.0)  # on the curve's clock
+    return HandTransition(keys, times, peak), frames
 
 
 @settings(max_examples=40, deadline=None)
-@given(transition=transitions())
-def test_transition_to_trajectory_to_inverse_model_gives_the_transition_back(transition):
+@given(case=transitions())
+def test_transition_to_trajectory_to_inverse_model_gives_the_transition_back(case):
+    transition, frames = case
     angles = transition.trajectory(FPS)
     assert np.allclose(angles[0], transition.start) and np.allclose(angles[-1], transition.target)
-    breaks = np.round(transition.times[1:-1] * FPS).astype(int)
-    (back,) = transitions_from_segment(angles[:, None, :], FPS, breaks)
-    np.testing.assert_allclose(back.keys, transition.keys, atol=1e-9)
+    np.testing.assert_allclose(angles[frames], transition.keys, atol=1e-6)  # each key posture seen on its frame
+    (back,) = transitions_from_segment(angles[:, None, :], FPS, frames[1:-1])
+    np.testing.assert_allclose(back.keys, transition.keys, atol=1e-6)
     assert np.abs(back.trajectory(FPS) - angles).max() < 0.01  # radians
-    assert command_from_dict(json.loads(json.dumps(back.to_dict()))).to_dict() == back.to_dict()
+    assert command_from_dict(json.loads(json.dumps(back.to_dict()))) == back
 
 
-def test_the_angular_velocity_is_bell_shaped_and_zero_at_every_key_posture():
-    transition = HandTransition(np.radians([[20, 25, 5], [70, 80, 0], [85, 95, 0]]), np.array([0.0, 0.5, 1.0]), 0.5)
+def test_the_angular_velocity_is_bell_shaped_and_dips_at_a_via_posture_where_the_fingers_turn():
+    straight = HandTransition(np.radians([[20, 25, 5], [85, 95, 0]]), np.array([0.0, 1.0]), 0.5)
     t = np.linspace(0.0, 1.0, 201)
-    speed = np.linalg.norm(np.gradient(transition.position(t), t, axis=0), axis=1)
-    assert speed[0] < 0.02 * speed.max() and speed[100] < 0.02 * speed.max() and speed[-1] < 0.02 * speed.max()
-    assert 40 <= np.argmax(speed[:100]) <= 60  # each transition peaks half way
-    assert transition.retimed(2.0).position(1.0).tolist() == transition.position(0.5).tolist()
+    speed = np.linalg.norm(np.gradient(straight.position(t), t, axis=0), axis=1)
+    assert speed[0] < 0.02 * speed.max() and speed[-1] < 0.02 * speed.max() and 95 <= np.argmax(speed) <= 105
+    turning = HandTransition(np.radians([[20, 25, 5], [0, 0, 30], [85, 95, 0]]), np.array([0.0, 0.5, 1.0]), 0.5)
+    speed = np.linalg.norm(np.gradient(turning.position(t), t, axis=0), axis=1)
+    via = int(np.argmin(np.abs(turning.position(t) - turning.keys[1]).sum(axis=1)))
+    assert speed[via] < 0.1 * speed.max() and 60 < via < 140  # the fingers open, stop, and close
+    assert straight.retimed(2.0).position(1.0).tolist() == straight.position(0.5).tolist()
 
 
 def test_the_segmenter_finds_the_via_posture_at_the_angular_velocity_minimum():
-    keys = np.radians([[[20, 25, 5]] * 5, [[75, 85, 0], [70, 80, 0], [30, 35, -4], [33, 38, -8], [25, 20, 25]],
-                       [[85, 95, 0]] * 5])
-    times = np.array([0.0, 0.6, 1.3])
+    keys = np.radians([[[20, 25, 5]] * 5, [[0, 0, 50], [0, 0, 15], [0, 0, 0], [0, 0, -12], [0, 0, -25]],
+                       [[85, 95, 0]] * 5])  # open wide, then a fist
+    frames = np.array([0, 18, 39])
+    times = 1.3 * progress(frames / 39, 0.5, 0.0)
     hand = [HandTransition(keys[:, j], times, 0.5) for j in range(5)]
-    angles = np.stack([h.trajectory(FPS) for h in hand], axis=1)  # (N, 5, 3)
+    angles = np.stack([h.trajectory(FPS) for h in hand], axis=1)  # (N, 5, 3); the open hand on frame 18
     rng = np.random.default_rng(3)
     noisy = angles + rng.normal(0.0, 0.003, angles.shape)
     segmenter = VelocityDirection()
     segmenter.reset([f"f{j}" for j in range(5)], FPS)
     breaks = segmenter.breaks(noisy.reshape(len(noisy), -1))
-    assert len(breaks) == 1 and abs(breaks[0] - 0.6 * FPS) <= 2
+    assert len(breaks) == 1 and abs(breaks[0] - 18) <= 2
     back = transitions_from_segment(noisy, FPS, breaks)
     assert max(np.abs(b.trajectory(FPS)[: len(angles)] - angles[:, j]).max() for j, b in enumerate(back)) < 0.05
 
