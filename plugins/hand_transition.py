@@ -35,7 +35,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-
 from scipy.interpolate import PchipInterpolator
 
 from plugins.guiding_stroke import progress
