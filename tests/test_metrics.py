@@ -68,5 +68,8 @@ def test_bench_facilitation_runs(tmp_path):
     result = likeme("bench", "facilitation", "--demonstrations", "12", "--repertoire", "3", "--quiet", "--json", out)
     assert result.returncode == 0, result.stderr
     data = json.loads(out.read_text())
-    assert data["known"] + data["novel"] == 12
+    hand = data["hand"]
+    assert data["known"] + data["novel"] + hand["known"] + hand["novel"] == 12 and hand["known"] + hand["novel"] > 0
     assert data["recognition_accuracy"] >= 0.5 and data["imitation_error_mean"] < 0.05
+    assert hand["recognition_accuracy"] >= 0.5 and hand["imitation_error_mean"] < 0.1  # radians
+    assert "hands" in result.stdout  # the table has a column for them
