@@ -454,12 +454,10 @@ def _random_hand_movement(rng: np.random.Generator, rest: np.ndarray, body: Any,
         times = np.concatenate([[0.0], np.cumsum(rng.uniform(0.4, 0.8, count))])
         peak = float(rng.uniform(0.4, 0.6))
         transitions_out = [HandTransition(np.stack([k[j] for k in keys]), times, peak) for j in range(len(idx))]
-    # Moritz plays the key postures as a key-frame animation (monotone cubic through the keys, as his key poses are):
+    # Moritz plays the key postures as a key-frame animation (the monotone cubic through the keys, at constant pace):
     # the fingers do not all stop at a via posture, so it stays one movement for the sensory memory
-    from scipy.interpolate import PchipInterpolator
-
     t = np.arange(int(round(transitions_out[0].duration / speed * fps))) / fps * speed
-    out = [PchipInterpolator(tr.times, tr.keys, axis=0)(t) for tr in transitions_out]  # (n, 3) per finger
+    out = [tr.curve(t) for tr in transitions_out]  # (n, 3) per finger
     back = [HandTransition(np.stack([t.target, rest[i]]), np.array([0.0, 0.6])).trajectory(fps) for t, i in zip(transitions_out, idx)]
     hold = int(0.6 * fps)
     fingers = np.stack([np.concatenate([o, np.repeat(t.target[None], hold, axis=0), b])
@@ -581,11 +579,8 @@ def facilitation_benchmark(pm: Any, *, demonstrations: int = 200, repertoire: in
             # per finger, the path of its joint angles (radians) along the commands performed against the one shown
             executed = [np.concatenate([learner.motor.edge(e)[3]["commands"][j].trajectory(fps) for e in final.path])
                         for j in range(len(strokes))]
-            from scipy.interpolate import PchipInterpolator
-
             grid = np.linspace(0.0, strokes[0].duration, 100)
-            imitation_error = float(np.mean([_shape_error(x, PchipInterpolator(t.times, t.keys, axis=0)(grid))
-                                             for x, t in zip(executed, strokes)]))
+            imitation_error = float(np.mean([_shape_error(x, t.curve(grid)) for x, t in zip(executed, strokes)]))
         rows.append({
             "kind": kind,
             "novel": is_novel,

@@ -95,7 +95,6 @@ class ForwardModel(Matcher):
         self.motor = motor
         # observed root-relative positions are placed at the observer's own root height; finger angles stay as they are
         self._root_height = np.where(owner.body.angle_mask[:, None], 0.0, motor.rest_pose()[owner.body.root_index])
-        self._scales = {name: self.params["angle_scale"] if motor.is_hand(name) else 1.0 for name in motor.subsystems}
         self._strokes = VelocityDirection(drop=self.params["drop"], angle=self.params["angle"])
         self._tables: dict[int, tuple] = {}
 
@@ -169,20 +168,24 @@ class ForwardModel(Matcher):
         first, last = self.frames[0], self.frames[-1]
         best, moved = None, self.params["min_move"]
         for name, idx in self.motor.subsystems.items():
-            d = float(np.nanmax(np.linalg.norm(last[idx] - first[idx], axis=-1))) * self._scales[name]
+            d = float(np.nanmax(np.linalg.norm(last[idx] - first[idx], axis=-1))) * self._scale_of(name)
             if d > moved:
                 best, moved = name, d
         if best is None:
             return False
         self.subsystem = best
-        self._scale = self._scales[best]
         self._hand = self.motor.is_hand(best)
+        self._scale = self._scale_of(best)
         self.start_node = self.motor.active[best]
         # a command that moves no part farther than min_move (standing still) cannot be seen to begin
         self.candidates = {(name,): 0.0 for name, _ in self.motor.edges_from(best, self.start_node)
                            if name not in self.excluded and self._length(name) * self._scale > self.params["min_move"]}
         self.initial = sorted(p[0] for p in self.candidates)
         return True
+
+    def _scale_of(self, subsystem: str) -> float:
+        """Metres one unit of the subsystem's values counts as: ``angle_scale`` for a hand's radians, else 1."""
+        return self.params["angle_scale"] if self.motor.is_hand(subsystem) else 1.0
 
     def _length(self, name: str) -> float:
         """Path length (m, or radians for a hand) of a command's lead part."""

@@ -101,10 +101,14 @@ class HandTransition:
         """Radians from the start to the target configuration."""
         return float(np.linalg.norm(self.target - self.start))
 
+    def curve(self, w: float | np.ndarray) -> np.ndarray:
+        """The joint angles at ``w`` on the curve's own clock (the key postures at ``times``, no velocity profile)."""
+        return self._curve(np.clip(np.asarray(w, dtype=float), 0.0, self.duration))
+
     def position(self, t: float | np.ndarray) -> np.ndarray:
         """Forward model: the joint angles at elapsed time(s) ``t`` (clamped to the transition), shape (..., 3)."""
         u = np.clip(np.asarray(t, dtype=float), 0.0, self.duration) / self.duration
-        return self._curve(self.duration * progress(u, self.peak, 0.0))
+        return self.curve(self.duration * progress(u, self.peak, 0.0))
 
     def trajectory(self, fps: float) -> np.ndarray:
         """Joint angles sampled at ``fps`` from 0 to the end inclusive, shape (n, 3)."""
