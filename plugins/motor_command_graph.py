@@ -41,7 +41,7 @@ import networkx as nx
 import numpy as np
 
 from plugins.clip_repertoire import CLIP_PARAMETERS, example_name, repertoire_for
-from plugins.guiding_stroke import GuidingStroke
+from plugins.guiding_stroke import GuidingStroke, progress
 from plugins.hand_transition import HandTransition
 from plugins.inverse_model import learn_commands
 from plugins.key_poses import parse_poses
@@ -142,6 +142,7 @@ class MotorCommandGraph(MotorSystem):
             self.active[name] = "hub"
         self._edges: dict[str, tuple[str, str, str, int]] = {}  # movement name -> (subsystem, from, to, key)
         self.sequences: dict[str, list[str]] = {}  # a learned path of several edges, performed as one movement
+        self.together: dict[str, list[str]] = {}  # movements of several subsystems performed at once
         self._counter = 0
         self._state = self.rest.copy()
         self.labels: dict[str, str] = {}  # sequence name -> movement, for sequences learned from labelled clips
@@ -240,6 +241,21 @@ class MotorCommandGraph(MotorSystem):
             self.labels[name] = label
         return name
 
+    def add_together(self, movements: list[str]) -> str:
+        """Name movements of different subsystems performed at once (a hand-arm movement, §4.2); one is itself."""
+        if len(movements) == 1:
+            return movements[0]
+        subsystems = [self.subsystem_of(m) for m in movements]
+        if len(set(subsystems)) < len(subsystems):
+            raise ValueError(f"movements performed together need subsystems of their own, not {subsystems}")
+        name = "+".join(movements)
+        self.together[name] = list(movements)
+        return name
+
+    def subsystem_of(self, movement: str) -> str:
+        """The subsystem an edge or a path of edges moves."""
+        return self._edges[self.sequences.get(movement, [movement])[0]][0]
+
     def label(self, movement: str) -> str:
         return self.labels.get(movement, movement)
 
@@ -253,32 +269,78 @@ class MotorCommandGraph(MotorSystem):
     def movements(self) -> list[str]:
         if self.labels:
             return list(dict.fromkeys(self.labels.values()))
-        return [*self._edges, *self.sequences]
+        return [*self._edges, *self.sequences, *self.together]
 
     def rest_pose(self) -> np.ndarray:
         return self.rest
 
-    def perform(self, movement: str, *, speed: float = 1.0, fps: float = 30.0) -> Motion:
-        """Execute one edge (or a named path of edges) from the current posture; the active node becomes its end."""
-        if movement not in self.sequences and movement in self.labels.values():  # a clip's movement: its first clip
-            movement = next(n for n, label in self.labels.items() if label == movement)
+    def _paths(self, movement: str) -> list[list[str]]:
+        """The edge paths a movement runs, one per subsystem, all at once."""
+        if movement not in self.sequences and movement not in self.together and movement in self.labels.values():
+            movement = next(n for n, label in self.labels.items() if label == movement)  # a clip movement's first clip
+        if movement in self.together:
+            return [path for part in self.together[movement] for path in self._paths(part)]
         if movement in self.sequences:
-            from toolkit.motion import concatenate
+            return [list(self.sequences[movement])]
+        if movement in self._edges:
+            return [[movement]]
+        raise ConfigError(f"unknown movement {movement!r}", expected="a learned motor command", available=self.movements())
 
-            return concatenate([self.perform(e, speed=speed, fps=fps) for e in self.sequences[movement]])
-        if movement not in self._edges:
-            raise ConfigError(f"unknown movement {movement!r}", expected="a learned motor command", available=self.movements())
-        subsystem, _, end, data = self.edge(movement)
-        commands = [c.retimed(c.duration / speed) for c in data["commands"]]
-        duration = max(c.duration for c in commands)
-        t = np.linspace(0.0, duration, max(2, int(round(duration * fps)) + 1))
-        frames = np.repeat(self._state[None], len(t), axis=0)
-        for part, command in zip(self.subsystems[subsystem], commands):
-            frames[:, part] = command.position(t)
+    def perform(self, movement: str, *, speed: float = 1.0, fps: float = 30.0) -> Motion:
+        """Execute an edge, a path of edges or subsystems' movements together, from the current posture.
+
+        Each subsystem runs its path while the others hold their state (and go on holding once their own path
+        has ended); the active nodes become the paths' ends.
+        """
+        tracks, self._schedule = [], []
+        for path in self._paths(movement):
+            pieces, first = [], 0
+            for name in path:
+                subsystem, start, end, data = self.edge(name)
+                commands = [c.retimed(c.duration / speed) for c in data["commands"]]
+                duration = max(c.duration for c in commands)
+                t = np.linspace(0.0, duration, max(2, int(round(duration * fps)) + 1))
+                pieces.append(np.stack([c.position(t) for c in commands], axis=1))
+                self._schedule.append((subsystem, start, first, first + len(t)))
+                first += len(t)
+            tracks.append((self.subsystems[subsystem], np.concatenate(pieces)))
+            self.active[subsystem] = end
+        frames = np.repeat(self._state[None], max(len(p) for _, p in tracks), axis=0)
+        for idx, positions in tracks:
+            frames[: len(positions), idx] = positions
+            frames[len(positions):, idx] = positions[-1]
+        self._place_elbows(frames)
+        self._state = frames[-1].copy()
+        return Motion(frames, fps, self.body.parts)
+
+    def _place_elbows(self, frames: np.ndarray) -> None:
         for s, e, w, upper, fore, outward in self.arms:
             frames[:, e] = place_elbows(frames[:, s], frames[:, w], upper, fore, outward)
+
+    def interrupt(self, frame: int, pose: np.ndarray, *, fps: float = 30.0) -> Motion | None:
+        """Back to the last correct node after an imitation was stopped at ``frame`` of its motion (K&G §4.4, Fig. 3).
+
+        Every subsystem the stopped motion was moving goes back to the start node of the edge it was on (edges it
+        had finished were correct), along a straight path with a bell-shaped velocity profile that takes as long
+        as the edge had run; that node becomes active. Returns the way back from ``pose``, or ``None`` when no
+        subsystem was on an edge.
+        """
+        back: dict[str, tuple[str, int]] = {}
+        for subsystem, start, first, stop in getattr(self, "_schedule", []):
+            if subsystem not in back and first <= frame < stop:
+                back[subsystem] = (start, frame - first)
+        if not back:
+            return None
+        target = np.asarray(pose, dtype=float).copy()
+        for subsystem, (node, _) in back.items():
+            self.reset_to(subsystem, node)
+            target[self.subsystems[subsystem]] = self._state[self.subsystems[subsystem]]
+        run = max(ran for _, ran in back.values())
+        u = np.linspace(0.0, 1.0, max(2, run + 1))
+        frames = pose + progress(u, 0.5, 0.0)[:, None, None] * (target - pose)
+        self._place_elbows(frames)
         self._state = frames[-1].copy()
-        self.active[subsystem] = end
+        self._schedule = []
         return Motion(frames, fps, self.body.parts)
 
     def reset_to(self, subsystem: str, node: str) -> None:
@@ -305,6 +367,7 @@ class MotorCommandGraph(MotorSystem):
                           for a, b, d in g.edges(data=True)],
                 "sequences": sequences,
                 "labels": {m: label for m, label in self.labels.items() if m in sequences},
+                "together": {m: parts for m, parts in self.together.items() if self.subsystem_of(parts[0]) == name},
             }
         return state
 
@@ -328,6 +391,7 @@ class MotorCommandGraph(MotorSystem):
                 self._counter = max(self._counter, int(e["name"].rsplit(":e", 1)[-1]))
             self.sequences.update(entry.get("sequences", {}))
             self.labels.update(entry.get("labels", {}))
+            self.together.update(entry.get("together", {}))
 
 
 @hookimpl

@@ -6,13 +6,27 @@ import numpy as np
 import pytest
 
 from tests.conftest import CHARACTERS
-from toolkit import create_plugin_manager, load_character, load_scenario
+from toolkit import create_plugin_manager, hookimpl, load_character, load_scenario
+
+
+class _MaxsPoses:
+    """Records Max's posture at every world frame (his own local frame)."""
+
+    def __init__(self) -> None:
+        self.frames: list[np.ndarray] = []
+
+    @hookimpl
+    def likeme_world_stepped(self, world):
+        self.frames.append(world.actors["max"].local_pose().copy())
 
 
 @pytest.fixture(scope="module")
 def games():
     pm = create_plugin_manager(autoload=False)
+    poses = _MaxsPoses()
+    pm.register(poses, name="max-poses")
     world = load_scenario(CHARACTERS / "scenarios" / "imitation_games.toml", pm).run()
+    world.maxs_poses = np.array(poses.frames)  # row i: world frame i + 1
     return world
 
 
@@ -50,6 +64,25 @@ def test_game_2_facilitated_until_it_deviates_then_learns_the_new_branch(games):
     assert branch.details["learned"][0] == "left_wrist:e3"
     back = recognised[4].data["match"]
     assert back.details["to"] == "hub"
+
+
+def test_after_the_deviation_max_moves_back_to_the_last_correct_node_before_imitating_the_branch(games):
+    max_ = games.actors["max"]
+    wrist = games.maxs_poses[:, max_.body.index("left_wrist")]
+    hub = max_.character.motor.graphs["left_wrist"].nodes["hub"]["state"][0]
+    # no jumps anywhere: he stops where he is and moves back, and every movement starts where he stands
+    assert np.linalg.norm(np.diff(wrist, axis=0), axis=1).max() < 0.05
+    stopped = next(e for e in games.events_of("imitation_stopped", "max") if e.data["reason"] == "deviation")
+    assert 0.1 < stopped.data["returning"] < 1.5
+    at_stop = wrist[stopped.frame - 1]
+    assert np.linalg.norm(at_stop - hub) > 0.1  # he had gone some way along the wrong edge
+    branch = next(e for e in games.events_of("imitation_started", "max") if e.frame > stopped.frame)
+    assert branch.data["request"].movement == games.events_of("movement_recognised", "max")[3].data["match"].movement
+    returned = stopped.frame + round(stopped.data["returning"] * games.fps)
+    assert branch.frame >= returned  # the branch waits for the way back
+    np.testing.assert_allclose(wrist[returned - 2], hub, atol=1e-6)  # he is at the hub, the last correct node
+    way = wrist[stopped.frame - 1: returned - 1]
+    assert np.all(np.diff(np.linalg.norm(way - hub, axis=1)) <= 1e-9)  # straight back, never farther away
 
 
 def test_game_3_waits_between_two_candidates_then_imitates_at_once(games):

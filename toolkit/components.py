@@ -409,6 +409,14 @@ class MotorSystem(Component):
     def perform(self, movement: str, *, speed: float = 1.0, fps: float = 30.0) -> Motion:
         """The motion of one of :meth:`movements`, sampled at ``fps``, from hub to hub."""
 
+    def interrupt(self, frame: int, pose: np.ndarray, *, fps: float = 30.0) -> Motion | None:
+        """The motion last returned by :meth:`perform` was stopped at its ``frame``, the body in ``pose`` (P, 3).
+
+        Return the motion that takes the body from ``pose`` to where the motor system now stands (Kopp &
+        Graeser 2006, Fig. 3: "return to last correct motor state node"), or ``None`` to hold ``pose``.
+        """
+        return None
+
     def describe(self) -> dict[str, Any]:
         """A summary for reports (counts of movements, nodes, edges...)."""
         return {"movements": len(self.movements())}

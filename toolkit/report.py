@@ -75,7 +75,8 @@ def _watching(actor: Actor, world: World) -> dict[str, Any]:
                 entry[key] = m.details[key]
         out["recognised"].append(entry)
     out["imitations_stopped"] = [
-        {"time": round(e.time, 3), "movement": e.data["movement"], "reason": e.data["reason"]}
+        {"time": round(e.time, 3), "movement": e.data["movement"], "reason": e.data["reason"],
+         "returning": e.data.get("returning", 0.0)}
         for e in world.events_of("imitation_stopped", actor.id) if e.data["reason"] != "completed"
     ]
     out["behaviours"] = [_behaviour(e.data["behaviour"], e.time) for e in world.events_of("behaviour_identified", actor.id)]
@@ -199,7 +200,8 @@ def render_text(summary: dict[str, Any]) -> str:
                     text += f"; {r['speed']:.1f}x his own speed"
                 lines.append(text)
             for s_ in w["imitations_stopped"]:
-                lines.append(f"    at {s_['time']:.2f}s stopped imitating {s_['movement']}: {s_['reason']}")
+                back = f", {s_['returning']:.2f}s back to the last correct node" if s_.get("returning") else ""
+                lines.append(f"    at {s_['time']:.2f}s stopped imitating {s_['movement']}: {s_['reason']}{back}")
         else:
             recs = ", ".join(
                 (r["movement"] or "unknown") + f" ({r['confidence']:.2f}" + (f", committed {r['decided_at']} frames in" if r["early"] else "") + ")"

@@ -163,7 +163,7 @@ class Actor:
         self._motion: Motion | None = None
         self._frame = 0
         self._queue: list[MovementRequest] = []
-        self._rest = np.asarray(character.motor.rest_pose(), dtype=float)
+        self._posture = np.asarray(character.motor.rest_pose(), dtype=float)  # held while no motion plays
         self.memory: ObservationLog | None = None
         self.percepts = 0
         self._committed: Match | None = None
@@ -180,12 +180,13 @@ class Actor:
 
     @property
     def idle(self) -> bool:
-        return self.performing is None
+        """Neither performing a movement nor on the way back from a stopped one."""
+        return self._motion is None
 
     def local_pose(self) -> np.ndarray:
-        """Current positions in the actor's local frame, shape (P, 3)."""
+        """Current positions in the actor's local frame, shape (P, 3): the motion playing, else the posture held."""
         if self._motion is None:
-            return self._rest
+            return self._posture
         return self._motion.positions[min(self._frame, self._motion.n_frames - 1)]
 
     def world_pose(self) -> np.ndarray:
@@ -230,7 +231,8 @@ class Actor:
         if self._motion is not None:
             self._frame += 1
             if self._frame >= self._motion.n_frames:
-                done = self.performing
+                done = self.performing  # None after the way back from a stopped movement
+                self._posture = self._motion.positions[-1]
                 self._motion, self.performing = None, None
                 if done is not None and self.character.action is not None:
                     self._call("action", "completed", self, done, self.world)
@@ -367,9 +369,18 @@ class Actor:
             return
         self._queue = [r for r in self._queue if r.imitating != target.id]
         if self.performing is not None and self.performing.imitating == target.id:
-            movement = self.performing.movement
+            movement, frame, pose = self.performing.movement, self._frame, self.local_pose()
+            self._posture = pose
             self._motion, self.performing = None, None
-            self.world.emit("imitation_stopped", self, target, movement=movement, reason=reason)
+            back = self._call("motor", "interrupt", frame, pose, fps=self.world.fps)
+            if back is not None:  # the way back to the last correct state: plays before anything else starts
+                if not isinstance(back, Motion) or back.parts != self.body.parts:
+                    raise PluginError(self.character.motor.name, f"{type(self.character.motor).__name__}.interrupt",
+                                      f"returned {back!r}, expected None or a Motion of the parts {list(self.body.parts)}")
+                if back.n_frames:
+                    self._motion, self._frame = back, 0
+            self.world.emit("imitation_stopped", self, target, movement=movement, reason=reason,
+                            returning=0.0 if self._motion is None else round(self._motion.n_frames / self.world.fps, 3))
 
     def _recognised(self, segment: Segment | None, match: Match) -> None:
         c, target, world = self.character, self.target, self.world
