@@ -34,6 +34,7 @@ angular-velocity minima and direction changes (§4.3).
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -43,7 +44,7 @@ from plugins.inverse_model import learn_commands
 from plugins.velocity_direction import VelocityDirection
 from toolkit import ConfigError, Match, Matcher, Motion, Parameter, hookimpl
 
-__all__ = ["ForwardModel"]
+__all__ = ["ForwardModel", "Track"]
 
 
 def _arc(points: np.ndarray) -> np.ndarray:
@@ -61,6 +62,43 @@ def _observed_length(points: np.ndarray) -> float:
     return float(_arc(uniform_filter1d(points, size=3, axis=0, mode="nearest"))[-1])
 
 
+@dataclass
+class Track:
+    """One motor subsystem under consideration during a demonstration (K&G §4.1): its candidates, commitment, errors.
+
+    ``onset`` is the row of the segment's working memory from which the subsystem is followed (0 for the first
+    subsystem to move; a subsystem that starts later is followed from when it started). ``trace`` holds, per
+    frame, the prediction error of every candidate path evaluated (dropped ones at the frame they drop); while
+    imitating, the committed path's error. ``committed_at`` and ``deviated_at`` count the segment's frames seen.
+    """
+
+    subsystem: str
+    scale: float
+    hand: bool
+    start_node: str
+    onset: int
+    candidates: dict[tuple[str, ...], float]
+    initial: list[str]
+    excluded: set[str] = field(default_factory=set)
+    committed: str | None = None
+    committed_path: tuple[str, ...] = ()
+    confidence: float = 0.0
+    speed: float = 1.0
+    progress: float = 0.0
+    reported: bool = False
+    deviated: bool = False
+    last_correct: str | None = None
+    learn_from: int = 0
+    trace: list[tuple[int, dict[tuple[str, ...], float]]] = field(default_factory=list)
+    committed_at: int | None = None
+    deviated_at: int | None = None
+
+    @property
+    def decided(self) -> bool:
+        """Committed to a path that still fits, or out of candidates (to be learned)."""
+        return (self.committed is not None and not self.deviated) or self.deviated or not self.candidates
+
+
 class ForwardModel(Matcher):
     """Edges of the active node predict the demonstration in parallel; the last one left is imitated at once (K&G §4.4)."""
 
@@ -71,7 +109,7 @@ class ForwardModel(Matcher):
         Parameter("deviation", float, 0.05, "Error (m) between the imitated edge and the demonstration that stops the "
                   "imitation (also checked at the end: the demonstration must end where the edge does).", minimum=0.0),
         Parameter("min_progress", float, 0.2, "Share of the edge's path that must be seen before committing.", minimum=0.0, maximum=1.0),
-        Parameter("min_move", float, 0.02, "Displacement (m) of a subsystem that makes it the one under consideration.", minimum=0.0),
+        Parameter("min_move", float, 0.02, "Displacement (m) of a subsystem that makes it one under consideration.", minimum=0.0),
         Parameter("angle_scale", float, 0.25, "Metres one radian of finger joint angle counts as when a hand "
                   "subsystem's errors and movement are compared with threshold, deviation and min_move "
                   "(0.25: the 0.05 m threshold is 0.2 rad, 11 degrees).", minimum=1e-6),
@@ -81,6 +119,8 @@ class ForwardModel(Matcher):
                   choices=("max", "mean")),
         Parameter("relative", bool, False, "Compare displacements since the onset instead of positions, so that a "
                   "demonstrator whose posture differs from the observer's own (another style's stance) still fits."),
+        Parameter("together", bool, True, "Follow every subsystem that moves during a demonstration, each with its "
+                  "own candidates, and imitate them at once (a hand-arm movement, §4.2); off: only the first to move."),
         Parameter("learn", bool, True, "Learn new edges by the inverse model when no edge predicts the demonstration."),
         Parameter("drop", float, 0.5, "Speed-minimum criterion of the stroke segmentation used for learning.", minimum=0.0, maximum=1.0),
         Parameter("angle", float, 50.0, "Direction criterion (degrees) of the stroke segmentation used for learning.", minimum=1.0, maximum=180.0),
@@ -103,20 +143,24 @@ class ForwardModel(Matcher):
     def begin(self, fps: float) -> None:
         self.fps = fps
         self.frames: list[np.ndarray] = []
-        self.subsystem: str | None = None
-        self._scale, self._hand = 1.0, False
-        self.start_node: str | None = None
-        self.candidates: dict[tuple[str, ...], float] = {}
-        self.excluded: set[str] = set()
-        self.committed: str | None = None
-        self.committed_path: tuple[str, ...] = ()
-        self.deviated = False
-        self.initial: list[str] = []
-        # per frame of the segment (once a subsystem moves): the prediction error of every candidate path evaluated,
-        # dropped ones included at the frame they drop; while imitating, the committed path's error
-        self.trace: list[tuple[int, dict[tuple[str, ...], float]]] = []
-        self.committed_at: int | None = None  # frames of the segment seen when it committed, and when it deviated
-        self.deviated_at: int | None = None
+        self.tracks: dict[str, Track] = {}  # in the order the subsystems began to move
+        self.reported = False  # a commitment to the tracks decided so far has been announced
+
+    # the first subsystem to move, as the views and single-subsystem users see it
+    @property
+    def main(self) -> Track | None:
+        return next(iter(self.tracks.values()), None) if getattr(self, "tracks", None) else None
+
+    subsystem = property(lambda self: self.main.subsystem if self.main else None)
+    start_node = property(lambda self: self.main.start_node if self.main else None)
+    candidates = property(lambda self: self.main.candidates if self.main else {})
+    initial = property(lambda self: self.main.initial if self.main else [])
+    committed = property(lambda self: self.main.committed if self.main else None)
+    committed_path = property(lambda self: self.main.committed_path if self.main else ())
+    deviated = property(lambda self: bool(self.main and self.main.deviated))
+    trace = property(lambda self: self.main.trace if self.main else [])
+    committed_at = property(lambda self: self.main.committed_at if self.main else None)
+    deviated_at = property(lambda self: self.main.deviated_at if self.main else None)
 
     def _local(self, pose: np.ndarray) -> np.ndarray:
         """Root-relative observed positions in the observer's motor frame (root at its own rest height; angles as seen)."""
@@ -127,61 +171,146 @@ class ForwardModel(Matcher):
         if self.frames:
             points = np.where(np.isfinite(points), points, self.frames[-1])
         self.frames.append(points)
-        if self.subsystem is None and not self._choose_subsystem():
+        self._start_tracks()
+        if not self.tracks:
             return None
-        observed = np.array(self.frames)[:, self.motor.subsystems[self.subsystem]]  # (n, k, 3)
+        memory = np.array(self.frames)
+        stop = None
+        for track in self.tracks.values():
+            stop = self._follow(track, memory) or stop
+        if stop is not None:
+            return stop
+        tracks = list(self.tracks.values())
+        if self.reported or not all(t.committed is not None and not t.deviated for t in tracks) or self._joining():
+            return None
+        self.reported = True  # every subsystem under consideration has one prevailing command: imitate them at once
+        for t in tracks:
+            t.reported = True
+        movement = self.motor.add_together([t.committed for t in tracks])
+        labels = [self._path_label(t.committed_path) or self.motor.label(t.committed) for t in tracks]
+        main = tracks[0]
+        details = {"candidates": [c for t in tracks for c in t.initial], "speed": main.speed,
+                   "progress": main.progress}
+        if len(tracks) > 1:
+            details["subsystems"] = {t.subsystem: {"candidates": t.initial, "path": list(t.committed_path),
+                                                    "speed": t.speed, "progress": t.progress} for t in tracks}
+        return Match(labels[0] if len(tracks) == 1 else movement, min(t.confidence for t in tracks), len(self.frames),
+                     path=tuple(e for t in tracks for e in t.committed_path), details=details)
+
+    def _start_tracks(self) -> None:
+        """Follow every subsystem not yet followed that has moved more than ``min_move`` since the onset.
+
+        The first follows from the onset; one that starts later (three-frame means, against observation noise)
+        from the last frame it was still within a quarter of ``min_move`` of where it was at the onset.
+        """
+        if self.tracks and not self.params["together"]:
+            return
+        late = bool(self.tracks)
+        waiting = [name for name in self.motor.subsystems if name not in self.tracks]
+        if late:
+            memory = np.array(self.frames)
+            first = memory[:3].mean(axis=0)
+            moved = self._moved(waiting, first, memory[-3:].mean(axis=0))
+        else:
+            moved = self._moved(waiting, self.frames[0], self.frames[-1])
+        moved = {name: d for name, d in moved.items() if d > self.params["min_move"]}
+        for name in sorted(moved, key=moved.get, reverse=True):
+            onset = 0
+            if late:
+                idx = self.motor.subsystems[name]
+                away = np.linalg.norm(memory[:, idx] - first[idx], axis=-1).max(axis=1) * self._scale_of(name)
+                still = np.flatnonzero(away <= 0.25 * self.params["min_move"])
+                onset = int(still[-1]) if len(still) else 0
+            self._track(name, onset)
+            if not self.params["together"]:
+                return
+
+    def _moved(self, names: list[str], first: np.ndarray, last: np.ndarray) -> dict[str, float]:
+        """How far (m; a hand's radians scaled) each subsystem's parts have moved at most from ``first`` to ``last``."""
+        return {name: float(np.nanmax(np.linalg.norm(last[idx] - first[idx], axis=-1))) * self._scale_of(name)
+                for name, idx in self.motor.subsystems.items() if name in names}
+
+    def _joining(self) -> bool:
+        """Whether a subsystem not yet followed has begun to move (half of ``min_move``): the decision waits for it."""
+        if not self.params["together"]:
+            return False
+        waiting = [n for n in self.motor.subsystems if n not in self.tracks]
+        memory = np.array(self.frames)
+        moved = self._moved(waiting, memory[:3].mean(axis=0), memory[-3:].mean(axis=0))
+        return any(d > 0.5 * self.params["min_move"] for d in moved.values())
+
+    def _track(self, name: str, onset: int) -> None:
+        scale = self._scale_of(name)
+        start = self.motor.active[name]
+        # a command that moves no part farther than min_move (standing still) cannot be seen to begin
+        candidates = {(edge,): 0.0 for edge, _ in self.motor.edges_from(name, start)
+                      if self._length(edge) * scale > self.params["min_move"]}
+        self.tracks[name] = Track(name, scale, self.motor.is_hand(name), start, onset, candidates,
+                                  sorted(p[0] for p in candidates), last_correct=start, learn_from=onset)
+
+    def _observed(self, track: Track, memory: np.ndarray) -> np.ndarray:
+        """The working memory of a subsystem's parts since it is followed, (n, k, 3)."""
+        return memory[track.onset:, self.motor.subsystems[track.subsystem]]
+
+    def _follow(self, track: Track, memory: np.ndarray) -> Match | None:
+        """One frame of a subsystem's predictions (Fig. 3); a :class:`Match` with ``stop`` when its imitation deviates."""
+        observed = self._observed(track, memory)
         lengths = np.array([_observed_length(observed[:, j]) for j in range(observed.shape[1])])  # once per frame
         last = observed[-1]
         frame = len(self.frames) - 1
-        if self.committed is not None:
-            if self.deviated:
+        if track.committed is not None:
+            if track.deviated:
                 return None
-            error = self._error(self.committed_path, lengths, last)
-            self.trace.append((frame, {self.committed_path: error}))
-            if error > self.params["deviation"]:
-                self.deviated = True
-                self.deviated_at = len(self.frames)
-                self.excluded.add(self.committed_path[0])
-                return Match(self.committed, 0.0, len(self.frames), details={"stop": True, "reason": "deviation"})
+            error = self._error(track, track.committed_path, lengths, last)
+            track.trace.append((frame, {track.committed_path: error}))
+            if error <= self.params["deviation"]:
+                return None
+            track.deviated, track.deviated_at = True, len(self.frames)
+            self._last_correct(track, lengths)
+            if not track.reported:
+                return None
+            # stop the imitation; the others' commands were right and are completed by the motor system
+            self.motor.reset_to(track.subsystem, track.last_correct)
+            return Match(track.committed, 0.0, len(self.frames), details={"stop": True, "reason": "deviation",
+                                                                         "subsystem": track.subsystem,
+                                                                         "return_to": track.last_correct})
+        if not track.candidates:
             return None
-        errors = {path: self._error(path, lengths, last) for path in self._extended(list(self.candidates), lengths)}
-        self.trace.append((frame, errors))
+        errors = {path: self._error(track, path, lengths, last) for path in self._extended(track, lengths)}
+        track.trace.append((frame, errors))
         alive = {path: error for path, error in errors.items() if error <= self.params["threshold"]}
         if len(alive) > self.params["max_candidates"]:  # keep the best predictions
             alive = dict(sorted(alive.items(), key=lambda kv: kv[1])[: self.params["max_candidates"]])
-        self.candidates = alive
+        track.candidates = alive
         if alive and len({self._movement_key(p) for p in alive}) == 1:  # one first command (or movement) prevails
             path = min(alive, key=alive.get)
             progress = self._progress(path[0], lengths)
             if progress >= self.params["min_progress"] or len(path) > 1:
-                self.committed_path = self._known_continuation(path)
-                self.committed = self.motor.add_sequence(list(self.committed_path))
-                self.committed_at = len(self.frames)
-                speed = self._speed(path[0], lengths, len(observed))
-                label = self._path_label(self.committed_path) or self.motor.label(self.committed)
-                return Match(label, float(np.exp(-alive[path] / self.params["threshold"])), len(self.frames),
-                             path=self.committed_path,
-                             details={"candidates": list(self.initial), "speed": speed, "progress": progress})
+                track.committed_path = self._known_continuation(path)
+                track.committed = self.motor.add_sequence(list(track.committed_path))
+                track.committed_at = len(self.frames)
+                track.speed = self._speed(path[0], lengths, len(observed))
+                track.progress = progress
+                track.confidence = float(np.exp(-alive[path] / self.params["threshold"]))
         return None
 
-    def _choose_subsystem(self) -> bool:
-        first, last = self.frames[0], self.frames[-1]
-        best, moved = None, self.params["min_move"]
-        for name, idx in self.motor.subsystems.items():
-            d = float(np.nanmax(np.linalg.norm(last[idx] - first[idx], axis=-1))) * self._scale_of(name)
-            if d > moved:
-                best, moved = name, d
-        if best is None:
-            return False
-        self.subsystem = best
-        self._hand = self.motor.is_hand(best)
-        self._scale = self._scale_of(best)
-        self.start_node = self.motor.active[best]
-        # a command that moves no part farther than min_move (standing still) cannot be seen to begin
-        self.candidates = {(name,): 0.0 for name, _ in self.motor.edges_from(best, self.start_node)
-                           if name not in self.excluded and self._length(name) * self._scale > self.params["min_move"]}
-        self.initial = sorted(p[0] for p in self.candidates)
-        return True
+    def _last_correct(self, track: Track, lengths: np.ndarray) -> None:
+        """The node at which the demonstration last agreed with the committed path: the start of the edge it was on.
+
+        The edges before it were followed correctly; learning starts from the frame the demonstration passed it.
+        """
+        lead = self._lead(track.committed_path[0])
+        arcs = np.cumsum([self._table(self._strokes_of(e)[lead])[2][-1] for e in track.committed_path])
+        on = int(np.searchsorted(arcs, lengths[lead] - 0.01 / track.scale))
+        on = min(on, len(track.committed_path) - 1)
+        track.last_correct = self.motor.edge(track.committed_path[on])[1]
+        track.excluded.add(track.committed_path[on])
+        if on == 0:
+            return
+        observed = self._observed(track, np.array(self.frames))[:, lead]
+        walked = _arc(uniform_filter1d(observed, size=3, axis=0, mode="nearest"))
+        track.learn_from = track.onset + int(np.searchsorted(walked, arcs[on - 1]))
+        track.committed_path = track.committed_path[:on]  # the part that was right
 
     def _scale_of(self, subsystem: str) -> float:
         """Metres one unit of the subsystem's values counts as: ``angle_scale`` for a hand's radians, else 1."""
@@ -208,18 +337,19 @@ class ForwardModel(Matcher):
             self._tables[id(stroke)] = table
         return table[1], table[2], table[3]
 
-    def _extended(self, paths: list[tuple[str, ...]], lengths: np.ndarray) -> list[tuple[str, ...]]:
-        """Paths whose commands have all been covered by the observation continue along every edge of their end node.
+    def _extended(self, track: Track, lengths: np.ndarray) -> list[tuple[str, ...]]:
+        """Candidate paths whose commands have all been covered by the observation continue along every edge of
+        their end node.
 
         ``lengths`` holds the observed path length of each part of the subsystem.
         """
         out = []
-        for path in paths:
+        for path in track.candidates:
             lead = self._lead(path[0])
             seen = lengths[lead]
             total = sum(self._table(self._strokes_of(e)[lead])[2][-1] for e in path)
             end = self.motor.edge(path[-1])[2]
-            nxt = [name for name, _ in self.motor.edges_from(self.subsystem, end)] if seen > total + 0.01 / self._scale else []
+            nxt = [name for name, _ in self.motor.edges_from(track.subsystem, end)] if seen > total + 0.01 / track.scale else []
             out.extend([(*path, n) for n in nxt if n not in path] or [path])
         return out
 
@@ -245,14 +375,14 @@ class ForwardModel(Matcher):
         grid, _, arc = self._table(stroke)
         return float(np.interp(min(length, arc[-1]), arc, grid))
 
-    def _predict(self, path: tuple[str, ...], lengths: np.ndarray) -> np.ndarray:
+    def _predict(self, track: Track, path: tuple[str, ...], lengths: np.ndarray) -> np.ndarray:
         """Where each part of the subsystem should be after as much path as it has been observed to cover.
 
         The fingers of a hand share their timing (one transition function, §4.2): they are all predicted at the
         time at which the lead finger has covered its observed path, so fingers that move in another order than
         the command's do not fit it.
         """
-        if self._hand:
+        if track.hand:
             lead = self._lead(path[0])
             left = lengths[lead]
             for i, name in enumerate(path):
@@ -274,24 +404,24 @@ class ForwardModel(Matcher):
                 left -= arc[-1]
         return np.array(out)
 
-    def _error(self, path: tuple[str, ...], lengths: np.ndarray, last: np.ndarray) -> float:
+    def _error(self, track: Track, path: tuple[str, ...], lengths: np.ndarray, last: np.ndarray) -> float:
         """Distance between the path's prediction and the parts' last observed positions ``last`` (k, 3).
 
         The largest over the parts, or their mean (``error``); with ``relative`` the prediction is moved by
         the offset between the observed onset posture and the path's start.
         """
-        return self._distance(self._predict(path, lengths) + self._onset_offset(path[0]), last)
+        return self._distance(track, self._predict(track, path, lengths) + self._onset_offset(track, path[0]), last)
 
-    def _onset_offset(self, name: str) -> np.ndarray | float:
+    def _onset_offset(self, track: Track, name: str) -> np.ndarray | float:
         """With ``relative``: the observed onset posture minus where command ``name`` starts (k, 3); else 0."""
         if not self.params["relative"]:
             return 0.0
         start = np.array([self._table(st)[1][0] for st in self._strokes_of(name)])
-        return self.frames[0][self.motor.subsystems[self.subsystem]] - start
+        return self.frames[track.onset][self.motor.subsystems[track.subsystem]] - start
 
-    def _distance(self, predicted: np.ndarray, observed: np.ndarray) -> float:
+    def _distance(self, track: Track, predicted: np.ndarray, observed: np.ndarray) -> float:
         """Per-part distances (k, 3 each) combined as ``error`` says: the largest or the mean (radians of a hand scaled)."""
-        d = np.linalg.norm(predicted - observed, axis=-1) * self._scale
+        d = np.linalg.norm(predicted - observed, axis=-1) * track.scale
         return float(d.max() if self.params["error"] == "max" else d.mean())
 
     def _progress(self, name: str, lengths: np.ndarray) -> float:
@@ -309,40 +439,88 @@ class ForwardModel(Matcher):
     # -- the end of the demonstration ------------------------------------------------------------
 
     def conclude(self, motion: Motion) -> Match | None:
+        """The demonstration has ended: check each subsystem's commitment against where it ended, learn the rest.
+
+        A subsystem whose committed path ended where the demonstration did is in the path's end node. One that
+        deviated (now, or while imitating) goes back to its last correct node and the rest of its movement is
+        learned by the inverse model (true imitation, §4.3), as is the movement of a subsystem no edge predicted.
+        Whatever was not yet imitated is returned as one movement (several subsystems: performed together).
+        """
         if not getattr(self, "frames", None):
             self.begin(motion.fps)
             for f in range(motion.n_frames):
                 self.observe(motion.positions[f], motion.visible[f])
-        if self.subsystem is None:
+        if not self.tracks:
             return Match.unknown(reason="nothing moved")
-        if self.committed is not None and not self.deviated:
-            end = self.motor.edge(self.committed_path[-1])[2]
-            state = self.motor.graphs[self.subsystem].nodes[end]["state"]
-            observed_end = self.frames[-1][self.motor.subsystems[self.subsystem]]
-            expected = state + self._onset_offset(self.committed_path[0])
-            if self._distance(expected, observed_end) <= self.params["deviation"]:
-                self.motor.active[self.subsystem] = end
+        memory = np.array(self.frames)
+        perform, learned, paths = [], [], []
+        first_from, first_to = None, None
+        for track in self.tracks.values():
+            idx = self.motor.subsystems[track.subsystem]
+            if track.committed is not None and not track.deviated:
+                end = self.motor.edge(track.committed_path[-1])[2]
+                expected = self.motor.graphs[track.subsystem].nodes[end]["state"] + self._onset_offset(track, track.committed_path[0])
+                if self._distance(track, expected, memory[-1, idx]) <= self.params["deviation"]:
+                    self.motor.active[track.subsystem] = end
+                    if not track.reported:  # recognised, but not imitated yet (another subsystem had to be learned)
+                        perform.append(track.committed)
+                        paths.extend(track.committed_path)
+                    continue
+                # it ended somewhere else: the committed command was not the right one
+                track.deviated = True
+                lengths = np.array([_observed_length(o) for o in self._observed(track, memory).transpose(1, 0, 2)])
+                self._last_correct(track, lengths)
+            if track.committed is not None and track.reported and not track.deviated:
+                continue
+            if track.deviated or track.committed is None:
+                self.motor.reset_to(track.subsystem, track.last_correct)  # back to the last correct node
+            if not self.params["learn"]:
+                continue
+            names = self._learn(track, memory)
+            if not names:
+                continue
+            new = self.motor.add_sequence(names)
+            if track.committed_path and track.deviated:  # the right part, then the new one
+                self.motor.add_sequence([*track.committed_path, *names])
+            self.motor.active[track.subsystem] = self.motor.edge(names[-1])[2]
+            perform.append(new)
+            paths.extend(names)
+            learned.extend(names)
+            if first_from is None:
+                first_from, first_to = track.last_correct, self.motor.edge(names[-1])[2]
+        if not perform:
+            if self.reported:
                 return None  # already reported when it committed
-            self.deviated = True  # it ended somewhere else: the committed command was not the right one
-        start = self.start_node
-        if self.deviated:
-            self.motor.reset_to(self.subsystem, start)  # back to the last correct node
-        if not self.params["learn"]:
             return Match.unknown(reason="no edge predicts the demonstration")
-        observed = np.array(self.frames)[:, self.motor.subsystems[self.subsystem]]
-        names = self._learn(observed, start)
-        movement = self.motor.add_sequence(names)
-        end = self.motor.edge(names[-1])[2]
-        self.motor.active[self.subsystem] = end
-        return Match(movement, 1.0, None, tuple(names),
-                     details={"learned": names, "from": start, "to": end, "candidates": list(self.initial),
-                              "deviated": self.deviated})
+        movement = self.motor.add_together(perform)
+        main = self.main
+        details: dict[str, Any] = {"candidates": [c for t in self.tracks.values() for c in t.initial],
+                                   "deviated": any(t.deviated for t in self.tracks.values())}
+        if learned:
+            details.update({"learned": learned, "from": first_from, "to": first_to})
+        else:  # recognised only at the end
+            details.update({"speed": main.speed, "progress": main.progress})
+        if len(perform) > 1:
+            details["subsystems"] = {self.motor.subsystem_of(m): m for m in perform}
+        label = movement if len(perform) > 1 else (self._path_label(tuple(paths)) or self.motor.label(movement))
+        return Match(label, 1.0 if learned else min(t.confidence for t in self.tracks.values() if t.committed),
+                     None, tuple(paths), details=details)
 
-    def _learn(self, observed: np.ndarray, start: str) -> list[str]:
-        """Cut the working memory into strokes and add one edge per stroke, chained from ``start``."""
-        k = observed.shape[1]
+    def _learn(self, track: Track, memory: np.ndarray) -> list[str]:
+        """Cut a subsystem's working memory since its last correct node into strokes, one edge each, chained from it.
+
+        A subsystem followed from a later onset than the first is learned up to where it came to rest.
+        """
+        observed = memory[track.learn_from:, self.motor.subsystems[track.subsystem]]
+        if track.onset > 0 and len(observed) > 3:  # it may have stopped before the others did
+            away = np.linalg.norm(observed - observed[-1], axis=-1).max(axis=1) * track.scale
+            moving = np.flatnonzero(away > 0.25 * self.params["min_move"])
+            observed = observed[: (int(moving[-1]) + 2 if len(moving) else len(observed))]
+        if len(observed) < 3:
+            return []
+        n, k = observed.shape[:2]
         self._strokes.reset(tuple(f"p{i}" for i in range(k)), self.fps)
-        return learn_commands(self.motor, self.subsystem, observed, self.fps, start, self._strokes.breaks)
+        return learn_commands(self.motor, track.subsystem, observed, self.fps, track.last_correct, self._strokes.breaks)
 
     def match(self, motion: Motion) -> Match:
         """Batch use: the whole segment at once (no facilitation)."""

@@ -292,17 +292,15 @@ class MotorCommandGraph(MotorSystem):
         Each subsystem runs its path while the others hold their state (and go on holding once their own path
         has ended); the active nodes become the paths' ends.
         """
-        tracks, self._schedule = [], []
+        tracks = []
         for path in self._paths(movement):
-            pieces, first = [], 0
+            pieces = []
             for name in path:
-                subsystem, start, end, data = self.edge(name)
+                subsystem, _, end, data = self.edge(name)
                 commands = [c.retimed(c.duration / speed) for c in data["commands"]]
                 duration = max(c.duration for c in commands)
                 t = np.linspace(0.0, duration, max(2, int(round(duration * fps)) + 1))
                 pieces.append(np.stack([c.position(t) for c in commands], axis=1))
-                self._schedule.append((subsystem, start, first, first + len(t)))
-                first += len(t)
             tracks.append((self.subsystems[subsystem], np.concatenate(pieces)))
             self.active[subsystem] = end
         frames = np.repeat(self._state[None], max(len(p) for _, p in tracks), axis=0)
@@ -318,29 +316,22 @@ class MotorCommandGraph(MotorSystem):
             frames[:, e] = place_elbows(frames[:, s], frames[:, w], upper, fore, outward)
 
     def interrupt(self, frame: int, pose: np.ndarray, *, fps: float = 30.0) -> Motion | None:
-        """Back to the last correct node after an imitation was stopped at ``frame`` of its motion (K&G §4.4, Fig. 3).
+        """The body's way from ``pose``, where an imitation was stopped at ``frame`` of its motion, to the motor state.
 
-        Every subsystem the stopped motion was moving goes back to the start node of the edge it was on (edges it
-        had finished were correct), along a straight path with a bell-shaped velocity profile that takes as long
-        as the edge had run; that node becomes active. Returns the way back from ``pose``, or ``None`` when no
-        subsystem was on an edge.
+        The matcher that stopped the imitation has put the deviating subsystem back in its last correct node
+        (:meth:`reset_to`, K&G §4.4, Fig. 3); the other subsystems of the motion were right and go on to the end
+        of their commands. The way is straight, with a bell-shaped velocity profile, and takes as long as the
+        stopped motion had run (at least a fifth of a second). ``None`` when the body is there already.
         """
-        back: dict[str, tuple[str, int]] = {}
-        for subsystem, start, first, stop in getattr(self, "_schedule", []):
-            if subsystem not in back and first <= frame < stop:
-                back[subsystem] = (start, frame - first)
-        if not back:
+        pose = np.asarray(pose, dtype=float)
+        target = self._state.copy()
+        self._place_elbows(target[None])
+        if np.allclose(pose, target, atol=1e-9):
             return None
-        target = np.asarray(pose, dtype=float).copy()
-        for subsystem, (node, _) in back.items():
-            self.reset_to(subsystem, node)
-            target[self.subsystems[subsystem]] = self._state[self.subsystems[subsystem]]
-        run = max(ran for _, ran in back.values())
-        u = np.linspace(0.0, 1.0, max(2, run + 1))
+        u = np.linspace(0.0, 1.0, max(int(round(0.2 * fps)), frame) + 1)
         frames = pose + progress(u, 0.5, 0.0)[:, None, None] * (target - pose)
         self._place_elbows(frames)
         self._state = frames[-1].copy()
-        self._schedule = []
         return Motion(frames, fps, self.body.parts)
 
     def reset_to(self, subsystem: str, node: str) -> None:
