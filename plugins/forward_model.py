@@ -67,7 +67,9 @@ class Track:
     """One motor subsystem under consideration during a demonstration (K&G §4.1): its candidates, commitment, errors.
 
     ``onset`` is the row of the segment's working memory from which the subsystem is followed (0 for the first
-    subsystem to move; a subsystem that starts later is followed from when it started). ``trace`` holds, per
+    subsystem to move; a subsystem that starts later is followed from when it started). After a deviation,
+    ``last_correct`` is the node where the demonstration last agreed with the committed path, ``right`` the
+    edges of that path before it, and ``learn_from`` the row from which the rest is learned. ``trace`` holds, per
     frame, the prediction error of every candidate path evaluated (dropped ones at the frame they drop); while
     imitating, the committed path's error. ``committed_at`` and ``deviated_at`` count the segment's frames seen.
     """
@@ -88,6 +90,7 @@ class Track:
     reported: bool = False
     deviated: bool = False
     last_correct: str | None = None
+    right: tuple[str, ...] = ()
     learn_from: int = 0
     trace: list[tuple[int, dict[tuple[str, ...], float]]] = field(default_factory=list)
     committed_at: int | None = None
@@ -305,12 +308,11 @@ class ForwardModel(Matcher):
         on = min(on, len(track.committed_path) - 1)
         track.last_correct = self.motor.edge(track.committed_path[on])[1]
         track.excluded.add(track.committed_path[on])
-        if on == 0:
-            return
-        observed = self._observed(track, np.array(self.frames))[:, lead]
-        walked = _arc(uniform_filter1d(observed, size=3, axis=0, mode="nearest"))
-        track.learn_from = track.onset + int(np.searchsorted(walked, arcs[on - 1]))
-        track.committed_path = track.committed_path[:on]  # the part that was right
+        track.right = track.committed_path[:on]  # the part that was right
+        if track.right:
+            observed = self._observed(track, np.array(self.frames))[:, lead]
+            walked = _arc(uniform_filter1d(observed, size=3, axis=0, mode="nearest"))
+            track.learn_from = track.onset + int(np.searchsorted(walked, arcs[on - 1]))
 
     def _scale_of(self, subsystem: str) -> float:
         """Metres one unit of the subsystem's values counts as: ``angle_scale`` for a hand's radians, else 1."""
@@ -480,8 +482,8 @@ class ForwardModel(Matcher):
             if not names:
                 continue
             new = self.motor.add_sequence(names)
-            if track.committed_path and track.deviated:  # the right part, then the new one
-                self.motor.add_sequence([*track.committed_path, *names])
+            if track.right:  # the part that was right, then the new one
+                self.motor.add_sequence([*track.right, *names])
             self.motor.active[track.subsystem] = self.motor.edge(names[-1])[2]
             perform.append(new)
             paths.extend(names)
