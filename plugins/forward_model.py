@@ -8,7 +8,10 @@ prevails (and enough of its path has been seen) it is executed at once, well
 before the demonstration ends: *response facilitation*. While imitating, the
 observation keeps being compared with the chosen edge; if they part by more
 than ``deviation`` the imitation is stopped, the edge is excluded for this
-segment, the subsystem returns to the last correct node and the rest is learned.
+segment, the subsystem returns to the last correct node (the start of the edge
+the demonstration was on: the edges before it were right) and the rest is
+learned from there (§4.4: "the imitator returns into the last node at which
+accordance with the demonstrated movement was found").
 
 Speed: the forward model is evaluated not at the elapsed time but at the time at
 which the edge would have covered the same length of path as has been observed,
@@ -21,8 +24,18 @@ segmenter's break points and each stroke is turned into a guiding stroke by the
 inverse model; the strokes become new edges and nodes leading from the active
 node (ending in the hub when the demonstration returns there).
 
-The subsystem "under consideration" is the one whose parts have moved most
-since the onset; subsystems moving at the same time are handled one at a time.
+Subsystems moving at once (§4.2: "multiple graphs at once in order to account
+for the possibly concurrent execution of submovements in different motor
+subsystems within a complex hand-arm-motion"): every subsystem whose parts move
+more than ``min_move`` during the demonstration is under consideration, each
+followed by a :class:`Track` with its own candidates from its own active node.
+One that starts later is followed from when it started. The commitment waits
+until every moving subsystem has one prevailing command (and for a subsystem
+that has begun to move but not yet far enough to be judged), then the commands
+are imitated together (:meth:`MotorCommandGraph.add_together`). If one of them
+has no candidate left, nothing is committed early: at the end its movement is
+learned and imitated together with the others' recognised commands. With
+``together = false`` only the first subsystem to move is followed.
 
 Hands: a hand subsystem's edges are hand transitions over the fingers' joint
 angles (:mod:`plugins.hand_transition`); they predict the observed finger

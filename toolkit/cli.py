@@ -26,9 +26,10 @@ from toolkit.manager import PluginManager, create_plugin_manager
 __all__ = ["main", "build_parser"]
 
 
-DEMO_SCENARIOS = ("demo", "ice_cream", "imitation_games", "hand_games")
+DEMO_SCENARIOS = ("demo", "ice_cream", "imitation_games", "hand_games", "hand_arm_games")
 """What ``likeme demo`` runs: Max imitating Morris's random movements, Max working out why Morris eats,
-and Max learning Moritz's arm movements in three imitation games and his finger movements in three more."""
+Max learning Moritz's arm movements in three imitation games and his finger movements in three more, and
+following Moritz's wrist and hand at once in the hand-arm games."""
 
 
 class _Parser(argparse.ArgumentParser):
