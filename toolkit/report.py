@@ -83,6 +83,13 @@ def _watching(actor: Actor, world: World) -> dict[str, Any]:
     return out
 
 
+def _edges(names: list[str]) -> str:
+    """Edge names without their subsystem when they share one (``e1, e2``), else in full."""
+    if len({n.rsplit(":", 1)[0] for n in names}) > 1:
+        return ", ".join(names)
+    return ", ".join(n.split(":")[-1] for n in names)
+
+
 def behaviour_sentence(observer: str, target: str, b: dict[str, Any]) -> str:
     """One identified (or not identified) behaviour as a sentence."""
     if not b["known"]:
@@ -190,11 +197,11 @@ def render_text(summary: dict[str, Any]) -> str:
             for r in w["recognised"]:
                 text = f"    at {r['time']:.2f}s {r['movement'] or 'unknown'}"
                 if "candidates" in r:
-                    text += f"; candidates {', '.join(x.split(':')[-1] for x in r['candidates']) or 'none'}"
+                    text += f"; candidates {_edges(r['candidates']) or 'none'}"
                 if r["early"] and r["fraction"] is not None:
                     text += f"; committed after {100 * r['fraction']:.0f}% of the demonstration"
                 if r.get("learned"):
-                    text += f"; learned {', '.join(x.split(':')[-1] for x in r['learned'])}"
+                    text += f"; learned {_edges(r['learned'])}"
                     text += " (after a deviation)" if r.get("deviated") else ""
                 if r.get("speed") and abs(r["speed"] - 1) > 0.3:
                     text += f"; {r['speed']:.1f}x his own speed"
