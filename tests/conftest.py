@@ -5,14 +5,41 @@ from __future__ import annotations
 import textwrap
 from pathlib import Path
 
+import numpy as np
 import pytest
 
-from toolkit import create_plugin_manager
+from toolkit import create_plugin_manager, hookimpl, load_scenario
 
 ROOT = Path(__file__).resolve().parent.parent
 CHARACTERS = ROOT / "characters"
 BANDAI = ROOT.parent / "shared" / "data" / "bandai-namco-1"
 """Real motion capture (CC BY-NC, never copied into the repository); tests that read it skip where it is absent."""
+
+def play_recording_postures(path: Path | str, actor: str = "max", **matcher_params):
+    """Run a scenario (``matcher_params`` set on the actor's matcher) recording the actor's posture at every frame.
+
+    Returns the world; ``world.postures[i]`` is the actor's local pose at world frame ``i + 1``.
+    """
+
+    class Postures:
+        def __init__(self) -> None:
+            self.frames: list = []
+
+        @hookimpl
+        def likeme_world_stepped(self, world):
+            self.frames.append(world.actors[actor].local_pose().copy())
+
+    pm = create_plugin_manager(autoload=False)
+    postures = Postures()
+    pm.register(postures, name="postures")
+    scenario = load_scenario(path, pm)
+    if matcher_params:
+        matcher = scenario.world.actors[actor].character.matcher
+        matcher.params = {**matcher.params, **matcher_params}
+    world = scenario.run()
+    world.postures = np.array(postures.frames)
+    return world
+
 
 STICK = """
 [character]

@@ -14,32 +14,14 @@ import numpy as np
 import pytest
 
 from plugins.guiding_stroke import GuidingStroke
-from tests.conftest import CHARACTERS
-from toolkit import create_plugin_manager, hookimpl, load_character, load_scenario
+from tests.conftest import CHARACTERS, play_recording_postures
+from toolkit import create_plugin_manager, load_character
 
 GAMES = CHARACTERS / "scenarios" / "hand_arm_games.toml"
 
 
-class _MaxsPoses:
-    def __init__(self) -> None:
-        self.frames: list[np.ndarray] = []
-
-    @hookimpl
-    def likeme_world_stepped(self, world):
-        self.frames.append(world.actors["max"].local_pose().copy())
-
-
 def _play(path, **override):
-    pm = create_plugin_manager(autoload=False)
-    poses = _MaxsPoses()
-    pm.register(poses, name="max-poses")
-    scenario = load_scenario(path, pm)
-    if override:
-        matcher = scenario.world.actors["max"].character.matcher
-        matcher.params = {**matcher.params, **override}
-    world = scenario.run()
-    world.maxs_poses = np.array(poses.frames)  # row i: world frame i + 1
-    return world
+    return play_recording_postures(path, "max", **override)
 
 
 @pytest.fixture(scope="module")
@@ -68,7 +50,7 @@ def test_game_1_both_subsystems_are_learned_and_imitated_at_once(games):
     # Max's wrist and fingers move in the same frames while he imitates the first movement
     max_ = games.actors["max"]
     started = next(e for e in games.events_of("imitation_started", "max"))
-    poses = games.maxs_poses[started.frame - 1: started.frame + 40]
+    poses = games.postures[started.frame - 1: started.frame + 40]
     wrist = np.linalg.norm(np.diff(poses[:, max_.body.index("left_wrist")], axis=0), axis=1)
     fingers = np.abs(np.diff(poses[:, motor.subsystems["left_hand"]], axis=0)).max(axis=(1, 2))
     moving = (wrist > 1e-4), (fingers > 1e-4)

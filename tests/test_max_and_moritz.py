@@ -5,29 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.conftest import CHARACTERS
-from toolkit import create_plugin_manager, hookimpl, load_character, load_scenario
-
-
-class _MaxsPoses:
-    """Records Max's posture at every world frame (his own local frame)."""
-
-    def __init__(self) -> None:
-        self.frames: list[np.ndarray] = []
-
-    @hookimpl
-    def likeme_world_stepped(self, world):
-        self.frames.append(world.actors["max"].local_pose().copy())
+from tests.conftest import CHARACTERS, play_recording_postures
+from toolkit import create_plugin_manager, load_character, load_scenario
 
 
 @pytest.fixture(scope="module")
 def games():
-    pm = create_plugin_manager(autoload=False)
-    poses = _MaxsPoses()
-    pm.register(poses, name="max-poses")
-    world = load_scenario(CHARACTERS / "scenarios" / "imitation_games.toml", pm).run()
-    world.maxs_poses = np.array(poses.frames)  # row i: world frame i + 1
-    return world
+    return play_recording_postures(CHARACTERS / "scenarios" / "imitation_games.toml")
 
 
 def _segments(world):
@@ -68,7 +52,7 @@ def test_game_2_facilitated_until_it_deviates_then_learns_the_new_branch(games):
 
 def test_after_the_deviation_max_moves_back_to_the_last_correct_node_before_imitating_the_branch(games):
     max_ = games.actors["max"]
-    wrist = games.maxs_poses[:, max_.body.index("left_wrist")]
+    wrist = games.postures[:, max_.body.index("left_wrist")]
     hub = max_.character.motor.graphs["left_wrist"].nodes["hub"]["state"][0]
     # no jumps anywhere: he stops where he is and moves back, and every movement starts where he stands
     assert np.linalg.norm(np.diff(wrist, axis=0), axis=1).max() < 0.05
