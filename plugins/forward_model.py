@@ -187,17 +187,17 @@ class ForwardModel(Matcher):
         if self.frames:
             points = np.where(np.isfinite(points), points, self.frames[-1])
         self.frames.append(points)
-        self._start_tracks()
+        memory = np.array(self.frames)
+        self._start_tracks(memory)
         if not self.tracks:
             return None
-        memory = np.array(self.frames)
         stop = None
         for track in self.tracks.values():
             stop = self._follow(track, memory) or stop
         if stop is not None:
             return stop
         tracks = list(self.tracks.values())
-        if self.reported or not all(t.committed is not None and not t.deviated for t in tracks) or self._joining():
+        if self.reported or not all(t.committed is not None and not t.deviated for t in tracks) or self._joining(memory):
             return None
         self.reported = True  # every subsystem under consideration has one prevailing command: imitate them at once
         for t in tracks:
@@ -213,7 +213,7 @@ class ForwardModel(Matcher):
         return Match(labels[0] if len(tracks) == 1 else movement, min(t.confidence for t in tracks), len(self.frames),
                      path=tuple(e for t in tracks for e in t.committed_path), details=details)
 
-    def _start_tracks(self) -> None:
+    def _start_tracks(self, memory: np.ndarray) -> None:
         """Follow every subsystem not yet followed that has moved more than ``min_move`` since the onset.
 
         The first follows from the onset; one that starts later (three-frame means, against observation noise)
@@ -224,7 +224,6 @@ class ForwardModel(Matcher):
         late = bool(self.tracks)
         waiting = [name for name in self.motor.subsystems if name not in self.tracks]
         if late:
-            memory = np.array(self.frames)
             first = memory[:3].mean(axis=0)
             moved = self._moved(waiting, first, memory[-3:].mean(axis=0))
         else:
@@ -246,12 +245,11 @@ class ForwardModel(Matcher):
         return {name: float(np.nanmax(np.linalg.norm(last[idx] - first[idx], axis=-1))) * self._scale_of(name)
                 for name, idx in self.motor.subsystems.items() if name in names}
 
-    def _joining(self) -> bool:
+    def _joining(self, memory: np.ndarray) -> bool:
         """Whether a subsystem not yet followed has begun to move (half of ``min_move``): the decision waits for it."""
         if not self.params["together"]:
             return False
         waiting = [n for n in self.motor.subsystems if n not in self.tracks]
-        memory = np.array(self.frames)
         moved = self._moved(waiting, memory[:3].mean(axis=0), memory[-3:].mean(axis=0))
         return any(d > 0.5 * self.params["min_move"] for d in moved.values())
 
