@@ -109,10 +109,10 @@ class Track:
     committed_at: int | None = None
     deviated_at: int | None = None
 
-    @property
-    def decided(self) -> bool:
-        """Committed to a path that still fits, or out of candidates (to be learned)."""
-        return (self.committed is not None and not self.deviated) or self.deviated or not self.candidates
+
+def _lengths(observed: np.ndarray) -> np.ndarray:
+    """The observed path length of each part of a working memory (n, k, 3)."""
+    return np.array([_observed_length(observed[:, j]) for j in range(observed.shape[1])])
 
 
 class ForwardModel(Matcher):
@@ -269,7 +269,7 @@ class ForwardModel(Matcher):
     def _follow(self, track: Track, memory: np.ndarray) -> Match | None:
         """One frame of a subsystem's predictions (Fig. 3); a :class:`Match` with ``stop`` when its imitation deviates."""
         observed = self._observed(track, memory)
-        lengths = np.array([_observed_length(observed[:, j]) for j in range(observed.shape[1])])  # once per frame
+        lengths = _lengths(observed)  # once per frame
         last = observed[-1]
         frame = len(self.frames) - 1
         if track.committed is not None:
@@ -280,7 +280,7 @@ class ForwardModel(Matcher):
             if error <= self.params["deviation"]:
                 return None
             track.deviated, track.deviated_at = True, len(self.frames)
-            self._last_correct(track, lengths)
+            self._last_correct(track, lengths, memory)
             if not track.reported:
                 return None
             # stop the imitation; the others' commands were right and are completed by the motor system
@@ -308,7 +308,7 @@ class ForwardModel(Matcher):
                 track.confidence = float(np.exp(-alive[path] / self.params["threshold"]))
         return None
 
-    def _last_correct(self, track: Track, lengths: np.ndarray) -> None:
+    def _last_correct(self, track: Track, lengths: np.ndarray, memory: np.ndarray) -> None:
         """The node at which the demonstration last agreed with the committed path: the start of the edge it was on.
 
         The edges before it were followed correctly; learning starts from the frame the demonstration passed it.
@@ -321,7 +321,7 @@ class ForwardModel(Matcher):
         track.excluded.add(track.committed_path[on])
         track.right = track.committed_path[:on]  # the part that was right
         if track.right:
-            observed = self._observed(track, np.array(self.frames))[:, lead]
+            observed = self._observed(track, memory)[:, lead]
             walked = _arc(uniform_filter1d(observed, size=3, axis=0, mode="nearest"))
             track.learn_from = track.onset + int(np.searchsorted(walked, arcs[on - 1]))
 
@@ -481,8 +481,7 @@ class ForwardModel(Matcher):
                     continue
                 # it ended somewhere else: the committed command was not the right one
                 track.deviated = True
-                lengths = np.array([_observed_length(o) for o in self._observed(track, memory).transpose(1, 0, 2)])
-                self._last_correct(track, lengths)
+                self._last_correct(track, _lengths(self._observed(track, memory)), memory)
             if track.committed is not None and track.reported and not track.deviated:
                 continue
             if track.deviated or track.committed is None:
