@@ -351,7 +351,7 @@ class MotorCommandGraph(MotorSystem):
         """Learned nodes, edges, sequences and the movement labels of clip sequences, per subsystem."""
         state = {}
         for name, g in self.graphs.items():
-            sequences = {m: e for m, e in self.sequences.items() if self._edges[e[0]][0] == name}
+            sequences = {m: e for m, e in self.sequences.items() if self.subsystem_of(m) == name}
             state[name] = {
                 "nodes": {n: d["state"].round(6).tolist() for n, d in g.nodes(data=True) if n != "hub"},
                 "edges": [{"from": a, "to": b, "name": d["name"], "commands": [c.to_dict() for c in d["commands"]]}
