@@ -9,9 +9,13 @@ distance over all root-relative part coordinates) and the closest template's
 movement wins. DTW needs the whole segment: it decides at the segment's end
 (decision fraction 1.0). It learns nothing.
 
-The distance is divided by the summed lengths of the two series so that long
-and short templates compete fairly; a segment farther than ``max_distance``
-from every template is "unknown".
+dtaidistance returns the square root of the summed squared distances along the
+warping path; its square is divided by the summed lengths of the two series and
+the root taken again (a root-mean-square distance per frame, in metres), so that
+long and short templates compete fairly. (Dividing the root itself by the
+length, as earlier versions did, shrinks with the template's length and made the
+longest template nearest to everything.) A segment farther than
+``max_distance`` from every template is "unknown".
 """
 
 from __future__ import annotations
@@ -23,7 +27,20 @@ from dtaidistance import dtw_ndim
 
 from toolkit import Match, Matcher, Motion, Parameter, hookimpl
 
-__all__ = ["DTW"]
+__all__ = ["DTW", "frame_distance"]
+
+
+def frame_distance(series: np.ndarray, template: np.ndarray, window: float = 0.0) -> float:
+    """Root-mean-square distance per frame (m) of two series (n, D) and (m, D) warped onto each other.
+
+    ``window``: Sakoe-Chiba band as a share of the longer series (0: none). The same series at any length
+    (every frame repeated k times) is at the same distance from the same template.
+    """
+    band = int(window * max(len(series), len(template))) or None
+    if band is not None:
+        band = max(band, abs(len(series) - len(template)) + 1)
+    d = dtw_ndim.distance_fast(series, template, window=band)
+    return float(np.sqrt(d * d / (len(series) + len(template))))
 
 
 class DTW(Matcher):
@@ -35,7 +52,7 @@ class DTW(Matcher):
                   minimum=1),
         Parameter("window", float, 0.0, "Sakoe-Chiba band as a share of the longer series (0: no band).",
                   minimum=0.0, maximum=1.0),
-        Parameter("max_distance", float, 0.0, "Mean per-frame distance (m) above which a segment is unknown "
+        Parameter("max_distance", float, 0.0, "Root-mean-square per-frame distance (m) above which a segment is unknown "
                   "(0: always the nearest).", minimum=0.0),
     )
 
@@ -66,13 +83,7 @@ class DTW(Matcher):
         fill = np.nanmedian(rel, axis=0)
         rel = np.where(np.isnan(rel), np.nan_to_num(fill), rel)
         series = self._series(rel)
-        distances = np.empty(len(self.templates))
-        for i, template in enumerate(self.templates):
-            window = int(self.params["window"] * max(len(series), len(template))) or None
-            if window is not None:
-                window = max(window, abs(len(series) - len(template)) + 1)
-            d = dtw_ndim.distance_fast(series, template, window=window)
-            distances[i] = d / (len(series) + len(template))
+        distances = np.array([frame_distance(series, template, self.params["window"]) for template in self.templates])
         best = int(np.argmin(distances))
         per_frame = float(distances[best])
         if self.params["max_distance"] and per_frame > self.params["max_distance"]:

@@ -334,6 +334,11 @@ class MotorCommandGraph(MotorSystem):
         self._state = frames[-1].copy()
         return Motion(frames, fps, self.body.parts)
 
+    def reset(self) -> None:
+        """Every subsystem back in its hub node, the body at rest."""
+        for name in self.subsystems:
+            self.reset_to(name, "hub")
+
     def reset_to(self, subsystem: str, node: str) -> None:
         """Put a subsystem back in ``node`` (returning to the last correct node after a deviation, §4.4)."""
         self.active[subsystem] = node

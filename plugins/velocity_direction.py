@@ -43,7 +43,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import argrelextrema, savgol_filter
+from scipy.signal import find_peaks, savgol_filter
 
 from toolkit import ConfigError, Parameter, Segment, Segmenter, hookimpl
 
@@ -51,22 +51,22 @@ __all__ = ["VelocityDirection", "StrokeAnalysis", "speed_breaks", "direction_clu
 
 
 def speed_breaks(speed: np.ndarray, drop: float) -> list[int]:
-    """Indices of speed minima below ``drop`` times the smaller neighbouring maximum."""
+    """Indices of speed minima below ``drop`` times the smaller of the highest speeds on either side.
+
+    A side reaches to the neighbouring minimum or to the end of the movement, so a movement that starts or
+    ends at full speed still brackets its minima, and a hold (a run of equal speeds, a flat minimum) counts
+    once, at its middle.
+    """
     if len(speed) < 3:
         return []
-    minima = argrelextrema(speed, np.less_equal, order=2)[0]
-    maxima = argrelextrema(speed, np.greater_equal, order=2)[0]
+    minima, _ = find_peaks(-np.asarray(speed, dtype=float))
+    bounds = [0, *minima.tolist(), len(speed) - 1]
     out = []
-    for m in minima:
-        if m == 0 or m == len(speed) - 1:
-            continue
-        left = maxima[maxima < m]
-        right = maxima[maxima > m]
-        if not len(left) or not len(right):
-            continue
-        if speed[m] < drop * min(speed[left[-1]], speed[right[0]]):
+    for i, m in enumerate(minima):
+        left, right = speed[bounds[i] : m + 1].max(), speed[m : bounds[i + 2] + 1].max()
+        if speed[m] < drop * min(left, right):
             out.append(int(m))
-    return sorted(set(out))
+    return out
 
 
 def direction_clusters(vectors: np.ndarray, angle: float, max_clusters: int = 12) -> np.ndarray:

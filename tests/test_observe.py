@@ -10,8 +10,11 @@ import json
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from plugins.clip_repertoire import load_clip_repertoire
+from plugins.dtw import frame_distance
 from plugins.metrics import segmentation_scores
 from plugins.mocap_benchmark import make_data, read_segments, recognition
 from tests.conftest import BANDAI, CHARACTERS
@@ -104,6 +107,34 @@ def test_the_forward_model_commits_before_a_familiar_demo_ends(data, profile, pm
     obs = Observer(character, profile.body, motion.fps).classify(motion)
     assert obs.movement == "jump"
     assert obs.decision_fraction < 1.0
+
+
+def test_every_clip_is_watched_from_the_hub_whatever_came_before(data, profile, pm):
+    """Observer.reset puts the motor system back at rest: the forward model's candidates are the hub's edges for
+    every clip, so a clip's answer does not depend on the clips classified before it."""
+    character = compose_observer(pm, profile, data / "repertoire", matcher="forward-model")
+    observer = Observer(character, profile.body, 30.0)
+    nod = profile.read(data / "demos" / "nod" / "morris_1.0.bvh")
+    alone = observer.classify(nod)
+    motor = character.motor
+    motor.reset_to("body", motor.edge(motor.sequences["bow"][0])[2])  # as a clip that ended half-way leaves it
+    again = observer.classify(nod)
+    assert character.matcher.start_node == "hub"
+    assert (again.movement, again.decided_at) == (alone.movement, alone.decided_at) == ("nod", alone.decided_at)
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(5, 30), st.integers(1, 6), st.floats(0.01, 1.0), st.integers(0, 2**16))
+def test_the_dtw_distance_per_frame_does_not_shrink_with_length(n, k, offset, seed):
+    """The same series at any length is at the same distance from the same template (the distance used to be
+    divided by the length after the root, so the longest template came out nearest to everything)."""
+    rng = np.random.default_rng(seed)
+    x = rng.normal(size=(n, 6))
+    shift = np.full(6, offset / np.sqrt(6))
+    base = frame_distance(x, x + shift)
+    long = frame_distance(np.repeat(x, k, axis=0), np.repeat(x + shift, k, axis=0))
+    assert long == pytest.approx(base, rel=1e-6)
+    assert base == pytest.approx(offset / np.sqrt(2), rel=1e-6)
 
 
 def test_recognition_scores_every_matcher_on_the_same_demos(data, profile, pm):

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from plugins.guiding_stroke import SHAPES, GuidingStroke
 from plugins.metrics import segmentation_scores
@@ -101,3 +103,19 @@ def test_building_blocks():
     labels = direction_clusters(np.array([right] * 5 + [up] * 5), 45)
     assert direction_breaks(labels) == [5]
     assert len(set(direction_clusters(np.array([right] * 10), 45))) == 1
+
+
+@settings(max_examples=60, deadline=None)
+@given(out=st.integers(4, 40), hold=st.integers(1, 20), back=st.integers(4, 40), top=st.floats(0.1, 3.0),
+       start=st.floats(0.0, 1.0), end=st.floats(0.0, 1.0))
+def test_a_hold_inside_a_movement_is_one_break_even_when_the_movement_starts_at_full_speed(out, hold, back, top,
+                                                                                            start, end):
+    """Out, hold, back: one break in the hold, whatever the speed at the movement's ends (a clip cropped
+    while moving, a key-pose animation that leaves its first key at speed). The hold is found although no
+    maximum of the speed lies before it inside the movement."""
+    speed = np.r_[np.linspace(start * top, top, out // 2), np.linspace(top, 0.0, out - out // 2),
+                  np.zeros(hold), np.linspace(0.0, top, back - back // 2), np.linspace(top, end * top, back // 2)]
+    breaks = speed_breaks(speed, 0.5)
+    assert len(breaks) == 1
+    first, last = out - 1, out + hold  # the zero-speed frames of the hold (both ramps end at zero)
+    assert first <= breaks[0] <= last and abs(breaks[0] - (first + last) / 2) <= 0.5

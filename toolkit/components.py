@@ -409,6 +409,11 @@ class MotorSystem(Component):
     def perform(self, movement: str, *, speed: float = 1.0, fps: float = 30.0) -> Motion:
         """The motion of one of :meth:`movements`, sampled at ``fps``, from hub to hub."""
 
+    def reset(self) -> None:
+        """Stand at rest again, as at the start: a motor system with a current state (the active node of a motor
+        command graph) returns to its hub; one without keeps nothing. Called when an observer starts a new stream
+        or clip (:meth:`toolkit.observe.Observer.reset`), so that each is watched from the same state."""
+
     def interrupt(self, frame: int, pose: np.ndarray, *, fps: float = 30.0) -> Motion | None:
         """The motion last returned by :meth:`perform` was stopped at its ``frame``, the body in ``pose`` (P, 3).
 

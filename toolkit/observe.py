@@ -82,8 +82,10 @@ class Observer:
         self.reset()
 
     def reset(self) -> None:
-        """Start a new stream: frame numbering, memory, segmenter and matcher restart."""
+        """Start a new stream: frame numbering, memory, segmenter and matcher restart; the motor system stands at rest."""
         c = self.character
+        if c.motor is not None:
+            c.motor.reset()
         self.perception.fps = self.fps
         self.perception.reset()
         c.segmenter.reset(self.body.parts, self.fps)
