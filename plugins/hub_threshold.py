@@ -104,23 +104,38 @@ class HubThreshold(Segmenter):
 
     def distance(self, pose: np.ndarray, visible: np.ndarray) -> float:
         """eq. 1 between one observed root-relative pose and the hub template (NaN if nothing visible)."""
+        return float(self.distances(np.asarray(pose)[None], np.asarray(visible)[None])[0])
+
+    def distances(self, poses: np.ndarray, visible: np.ndarray) -> np.ndarray:
+        """eq. 1 between observed root-relative poses (n, P, 3) and the nearest hub (n,); NaN where nothing is seen."""
         ok = self._index >= 0
-        obs = np.zeros_like(self.template)
-        vis = np.zeros(len(self.template), dtype=bool)
-        obs[ok] = pose[self._index[ok]]
-        vis[ok] = visible[self._index[ok]]
-        return float(_nearest(pose_distance(obs, self.templates, vis)))
+        obs = np.zeros((len(poses), *self.template.shape))
+        vis = np.zeros((len(poses), len(self.template)), dtype=bool)
+        obs[:, ok] = poses[:, self._index[ok]]
+        vis[:, ok] = visible[:, self._index[ok]]
+        return _nearest(pose_distance(obs[:, None], self.templates, vis[:, None]), axis=-1)
 
     def push(self, pose: np.ndarray, visible: np.ndarray) -> list[Segment]:
-        self._frame += 1
-        raw = self.distance(pose, visible)
-        if np.isnan(raw):  # no evidence: hold
-            raw = self._last if not np.isnan(self._last) else 0.0
-        self._last = raw
+        closed, _ = self.push_block(np.asarray(pose)[None], np.asarray(visible)[None])
+        return [segment for _, segment in closed]
+
+    def push_block(self, poses: np.ndarray, visible: np.ndarray) -> tuple[list[tuple[int, Segment]], np.ndarray]:
+        """A block of frames: the distances and the low-pass filter for all of them at once, then the
+        thresholds frame by frame (the same as one push per frame)."""
+        raw = _hold(np.concatenate([[self._last], self.distances(poses, visible)]))[1:]  # no evidence: hold
+        if not len(raw):
+            return [], np.zeros(0, dtype=int)
+        self._last = float(raw[-1])
         if self._zi is None:
-            self._zi = lfilter_zi(self._b, self._a) * raw
-        y, self._zi = lfilter(self._b, self._a, [raw], zi=self._zi)
-        return self._step(float(y[0]))
+            self._zi = lfilter_zi(self._b, self._a) * raw[0]
+        filtered, self._zi = lfilter(self._b, self._a, raw, zi=self._zi)
+        closed: list[tuple[int, Segment]] = []
+        since = np.empty(len(raw), dtype=int)
+        for i, value in enumerate(filtered.tolist()):
+            self._frame += 1
+            closed.extend((i, segment) for segment in self._step(value))
+            since[i] = -1 if self._start is None else self._start
+        return closed, since
 
     def _above_floor(self, value: float) -> float:
         """``value`` minus the running minimum of the last ``floor`` seconds (itself if there is no floor)."""

@@ -36,14 +36,23 @@ class MotionCapture(Perception):
 
     def perceive_pose(self, positions, visible, body, time) -> Percept:
         """Root-relative percept of recorded world positions (P, 3); non-finite or masked parts are not seen."""
-        positions = np.asarray(positions, dtype=float)
+        pose, mask, root, heading = self._root_relative(np.asarray(positions, dtype=float)[None],
+                                                        None if visible is None else np.asarray(visible)[None], body)
+        world = np.where(mask[0, :, None], positions, np.nan)
+        return Percept(time, pose[0], mask[0], world, root[0], float(heading[0]))
+
+    def perceive_poses(self, positions, visible, body, times) -> tuple[np.ndarray, np.ndarray]:
+        """A block of recorded frames (n, P, 3) at once: the same poses and masks as one perceive_pose per frame."""
+        pose, mask, _, _ = self._root_relative(np.asarray(positions, dtype=float), visible, body)
+        return pose, mask
+
+    def _root_relative(self, positions: np.ndarray, visible, body):
         seen = np.isfinite(positions).all(axis=-1)
         visible = seen if visible is None else seen & np.asarray(visible, dtype=bool)
         if getattr(self, "_facing", None) is None:
             self._facing = HeadingFilter(round(self.params["facing_window"] * getattr(self, "fps", 30.0)))
-        found = facing_heading(np.where(visible[:, None], positions, 0.0), visible, body)
-        pose, mask, root, heading = to_root_relative(positions, visible, body, self._facing.update(float(found)))
-        return Percept(time, pose, mask, np.where(mask[:, None], positions, np.nan), root, float(heading))
+        found = facing_heading(np.where(visible[..., None], positions, 0.0), visible, body)
+        return to_root_relative(positions, visible, body, self._facing.update_many(found))
 
 
 @hookimpl

@@ -145,24 +145,20 @@ class PathSearch(Matcher):
         nodes = self.motor.node_root_relative
         k = self.params["k"]
         for t in frames:
-            ends = paths[:, -1] if append else paths[:, 0]
-            beam = np.concatenate([np.full(len(table[e]), b) for b, e in enumerate(ends)])
-            cand = np.concatenate([table[e] for e in ends])
-            if vis[t].any():
-                step = pose_distance(nodes[cand], obs[t], vis[t])
+            reach = [table[e] for e in (paths[:, -1] if append else paths[:, 0])]
+            beam = np.repeat(np.arange(len(reach)), [len(r) for r in reach])
+            cand = np.concatenate(reach)
+            seen = vis[t]
+            if seen.any():  # eq. 1 over the parts seen in this sample
+                diff = nodes[cand][:, seen] - obs[t, seen]
+                step = np.sqrt(np.einsum("npi,npi->np", diff, diff)).mean(axis=1)
             else:
                 step = np.zeros(len(cand))
             total = costs[beam] + step
             order = np.argsort(total, kind="stable")
-            keep, seen = [], set()
-            for i in order:  # k best, one path per end node (distinct hypotheses)
-                if cand[i] in seen:
-                    continue
-                seen.add(cand[i])
-                keep.append(i)
-                if len(keep) == k:
-                    break
-            keep = np.array(keep)
+            # k best, one path per end node (distinct hypotheses): the first time each end node comes in the order
+            _, first = np.unique(cand[order], return_index=True)
+            keep = order[np.sort(first)[:k]]
             new = cand[keep][:, None]
             paths = np.hstack([paths[beam[keep]], new]) if append else np.hstack([new, paths[beam[keep]]])
             costs = total[keep]

@@ -91,14 +91,36 @@ class HeadingFilter:
 
     def update(self, heading: float) -> float:
         """Add one estimate (NaN when there was none) and return the filtered facing (NaN if none yet)."""
-        if np.isfinite(heading):
-            self._recent.append(float(heading))
-            del self._recent[: -self.window]
-        if not self._recent:
-            return float("nan")
-        ref = self._recent[-1]
-        unwrapped = ref + np.angle(np.exp(1j * (np.asarray(self._recent) - ref)))
-        return float(np.angle(np.exp(1j * np.median(unwrapped))))
+        return float(self.update_many(np.array([heading], dtype=float))[0])
+
+    def update_many(self, headings: np.ndarray) -> np.ndarray:
+        """Add estimates (n,) one after another; the filtered facing after each, as :meth:`update` gives it.
+
+        Each output is the circular median of the last ``window`` finite estimates up to its frame, unwrapped
+        around the newest of them; vectorised over the block.
+        """
+        h = np.asarray(headings, dtype=float)
+        finite = np.isfinite(h)
+        estimates = np.concatenate([np.asarray(self._recent, dtype=float), h[finite]])
+        ends = len(self._recent) + np.cumsum(finite)  # estimates available after each frame
+        self._recent = estimates[-self.window :].tolist()
+        out = np.full(len(h), np.nan)
+        have = ends > 0
+        if not have.any():
+            return out
+        w = self.window
+        padded = np.concatenate([np.full(w - 1, np.nan), estimates])
+        windows = np.lib.stride_tricks.sliding_window_view(padded, w)[ends[have] - 1]  # the last w up to each frame
+        ref = estimates[ends[have] - 1][:, None]
+        unwrapped = ref + np.angle(np.exp(1j * (windows - ref)))
+        full = ends[have] >= w
+        med = np.empty(len(windows))
+        if full.any():
+            med[full] = np.median(unwrapped[full], axis=1)
+        if not full.all():  # the first frames of a stream: fewer than w estimates yet (the rest is padding)
+            med[~full] = np.nanmedian(unwrapped[~full], axis=1)
+        out[have] = np.angle(np.exp(1j * med))
+        return out
 
 
 def smooth_heading(heading: np.ndarray, window: int) -> np.ndarray:

@@ -85,6 +85,46 @@ def test_a_live_loop_gives_what_watching_the_whole_file_gives(data, profile, pm)
     assert [(o.segment, o.movement) for o in got] == [(o.segment, o.movement) for o in whole]
 
 
+@pytest.mark.parametrize("segmenter, matcher", [("hub-threshold", "path-search"), ("hub-threshold", "forward-model"),
+                                               ("velocity-direction", "dtw")])
+def test_blocks_of_frames_give_what_frame_by_frame_gives(data, profile, segmenter, matcher):
+    """Observer.push_block (a packet of frames, perceived and segmented at once) answers the same segments with
+    the same movements at the same decision frames as push, frame by frame, whatever the packet sizes: for a
+    vectorised perception and segmenter and for ones that use the frame-by-frame defaults, with a streaming
+    matcher that commits early (forward-model) and batch matchers."""
+    pm = create_plugin_manager(autoload=False, trace=False)
+    # (velocity-direction: above the speed the stream's 3 mm noise gives the fastest of the parts)
+    settings = {"segmenter": {"level": "movement", "rest_speed": 0.2}} if segmenter == "velocity-direction" else {}
+    character = compose_observer(pm, profile, data / "repertoire", segmenter=segmenter, matcher=matcher,
+                                 settings=settings)
+    motion = profile.read(data / "streams" / "stream_2.bvh")
+    positions = motion.positions.copy()
+    positions[40:52, 3] = np.nan  # a part lost for a while
+    observer = Observer(character, profile.body, motion.fps)
+
+    def key(found):
+        return [(o.segment.start, o.segment.end, o.movement, o.decided_at) for o in found]
+
+    one = []
+    for f in range(motion.n_frames):
+        one.extend(observer.push(positions[f]))
+    one.extend(observer.flush())
+    assert len(one) >= 3
+    rng = np.random.default_rng(0)
+    for _ in range(3):
+        observer.reset()
+        cuts = np.sort(rng.choice(np.arange(1, motion.n_frames), size=12, replace=False))
+        blocks = []
+        for a, b in zip([0, *cuts], [*cuts, motion.n_frames]):
+            blocks.extend(observer.push_block(positions[a:b]))
+        blocks.extend(observer.flush())
+        assert key(blocks) == key(one)
+    observer.reset()
+    whole = observer.push_block(positions) + observer.flush()
+    assert key(whole) == key(one)
+    np.testing.assert_array_equal(observer.visible[40:52, 3], False)
+
+
 def test_nan_frames_and_hidden_parts_are_not_seen_rather_than_a_crash(data, profile, pm):
     character = compose_observer(pm, profile, data / "repertoire", matcher="path-search")
     motion = profile.read(data / "streams" / "stream_1.bvh")

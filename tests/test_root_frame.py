@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from plugins.root_frame import facing_heading, to_root_relative
+from plugins.root_frame import HeadingFilter, facing_heading, to_root_relative
 from tests.conftest import CHARACTERS
 from toolkit import load_character
 from toolkit.motion import local_to_world
@@ -70,3 +71,23 @@ def test_vectorised_over_frames(pm):
     np.testing.assert_allclose(h, headings, atol=1e-9)
     expected = motion.positions - motion.positions[:, c.body.root_index : c.body.root_index + 1]
     np.testing.assert_allclose(pose, expected, atol=1e-9)
+
+
+@settings(max_examples=60, deadline=None)
+@given(window=st.integers(1, 12), seed=st.integers(0, 2**16), cuts=st.lists(st.integers(0, 40), max_size=5))
+def test_a_block_of_facing_estimates_filters_as_one_estimate_at_a_time(window, seed, cuts):
+    """HeadingFilter.update_many (a block of frames) gives what update gives frame by frame, whatever the blocks:
+    NaN estimates are skipped, angles near +-pi are unwrapped around the newest estimate."""
+    rng = np.random.default_rng(seed)
+    headings = np.angle(np.exp(1j * (np.pi + np.cumsum(rng.normal(0, 0.3, 40)))))
+    headings[rng.random(40) < 0.25] = np.nan
+    one = HeadingFilter(window)
+    expected = np.array([one.update(h) for h in headings])
+    block = HeadingFilter(window)
+    edges = [0, *sorted(set(cuts)), 40]
+    got = np.concatenate([block.update_many(headings[a:b]) for a, b in zip(edges, edges[1:])])
+    np.testing.assert_allclose(got, expected, atol=1e-12, equal_nan=True)
+    finite = headings[np.isfinite(headings)]
+    if len(finite):  # the first estimate comes through unchanged; before it there is no facing
+        first = int(np.flatnonzero(np.isfinite(headings))[0])
+        assert np.isnan(expected[:first]).all() and expected[first] == pytest.approx(finite[0])

@@ -303,6 +303,19 @@ class Perception(Component):
         """
         raise NotImplementedError(f"perception {self.name!r} needs a world; it cannot watch recorded poses")
 
+    def perceive_poses(self, positions: np.ndarray, visible: np.ndarray | None, body: Any,
+                       times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Root-relative poses (n, P, 3) and visibility (n, P) of ``n`` recorded frames of world positions.
+
+        Exactly what ``n`` calls of :meth:`perceive_pose` would give, in order (the default makes those calls);
+        a perception that can work on a block of frames at once overrides it for speed.
+        """
+        percepts = [self.perceive_pose(positions[i], None if visible is None else visible[i], body, float(times[i]))
+                    for i in range(len(positions))]
+        if not percepts:
+            return np.zeros((0, *np.shape(positions)[1:])), np.zeros((0, np.shape(positions)[1]), dtype=bool)
+        return np.stack([p.pose for p in percepts]), np.stack([p.visible for p in percepts])
+
 
 class Segmenter(Component):
     """Divides a stream of observed poses into segments, one frame at a time or in batch.
@@ -332,6 +345,23 @@ class Segmenter(Component):
     @abstractmethod
     def active_since(self) -> int | None:
         """Start frame of the segment under way, or ``None`` between segments."""
+
+    def push_block(self, poses: np.ndarray, visible: np.ndarray) -> tuple[list[tuple[int, Segment]], np.ndarray]:
+        """``n`` poses (n, P, 3) with masks (n, P) pushed one after another.
+
+        Returns the segments that closed, each with the index into the block of the frame whose push closed
+        it, and :attr:`active_since` after each frame (n,) (-1: none). Exactly what ``n`` calls of
+        :meth:`push` give (the default makes them); a segmenter that can compute its per-frame evidence for a
+        block at once overrides it for speed.
+        """
+        closed: list[tuple[int, Segment]] = []
+        since = np.full(len(poses), -1, dtype=int)
+        for i in range(len(poses)):
+            closed.extend((i, s) for s in self.push(poses[i], visible[i]))
+            start = self.active_since
+            if start is not None:
+                since[i] = start
+        return closed, since
 
     def segment(self, motion: Motion) -> list[Segment]:
         """All segments of a root-relative motion."""

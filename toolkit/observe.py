@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from toolkit.character import Character, compose_character
-from toolkit.components import Match, Perception, Segment
+from toolkit.components import Match, Matcher, Perception, Segment
 from toolkit.errors import ConfigError, PluginError
 from toolkit.motion import Motion
 from toolkit.profile import BodyProfile
@@ -65,6 +65,13 @@ class Observer:
     ``perception`` replaces the character's own for this stream (a character that
     looks at a world through ``synthetic-vision`` can watch recordings through
     ``motion-capture``); its segmenter and matcher are the character's.
+
+    Frames come one at a time (:meth:`push`) or as a block of the frames that have
+    arrived (:meth:`push_block`, as a tracker delivers a packet or a file is read).
+    Both give the same observations at the same frames: a block is perceived and
+    segmented at once where the plugins can do so (``Perception.perceive_poses``,
+    ``Segmenter.push_block``), then a streaming matcher is fed frame by frame as
+    before, and each segment is answered at the frame its end was detected.
     """
 
     def __init__(self, character: Character, body: Any, fps: float, *, perception: Perception | None = None) -> None:
@@ -79,6 +86,9 @@ class Observer:
                               key=("perception", "plugin"), expected="a perception that implements perceive_pose",
                               available=able)
         self.character, self.body, self.fps, self.perception = character, body, float(fps), perception
+        m = character.matcher
+        # a matcher that cannot commit early is not fed frame by frame (it answers at the segment's end)
+        self._streaming = m is not None and type(m).observe is not Matcher.observe
         self.reset()
 
     def reset(self) -> None:
@@ -89,32 +99,79 @@ class Observer:
         self.perception.fps = self.fps
         self.perception.reset()
         c.segmenter.reset(self.body.parts, self.fps)
-        self.poses: list[np.ndarray] = []
-        self.visible: list[np.ndarray] = []
+        n_parts = len(self.body.parts)
+        self._poses = np.zeros((256, n_parts, 3))
+        self._visible = np.zeros((256, n_parts), dtype=bool)
+        self._n = 0
         self._early: Match | None = None
         self._open: int | None = None
 
     @property
     def n_frames(self) -> int:
-        return len(self.poses)
+        return self._n
+
+    @property
+    def poses(self) -> np.ndarray:
+        """The root-relative poses perceived so far (frames, P, 3)."""
+        return self._poses[: self._n]
+
+    @property
+    def visible(self) -> np.ndarray:
+        """Which parts were seen in each frame so far (frames, P)."""
+        return self._visible[: self._n]
+
+    def _remember(self, poses: np.ndarray, visible: np.ndarray) -> None:
+        n = self._n + len(poses)
+        if n > len(self._poses):
+            size = max(n, 2 * len(self._poses))
+            self._poses = np.concatenate([self._poses[: self._n], np.zeros((size - self._n, *self._poses.shape[1:]))])
+            self._visible = np.concatenate([self._visible[: self._n],
+                                            np.zeros((size - self._n, self._visible.shape[1]), dtype=bool)])
+        self._poses[self._n : n] = poses
+        self._visible[self._n : n] = visible
+        self._n = n
+
+    def _perceive(self, positions: np.ndarray, visible: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+        positions = np.asarray(positions, dtype=float)
+        visible = None if visible is None else np.asarray(visible, dtype=bool)
+        times = (self._n + np.arange(len(positions))) / self.fps
+        poses, seen = self.perception.perceive_poses(positions, visible, self.body, times)
+        self._remember(poses, seen)
+        return poses, seen
 
     def push(self, positions: np.ndarray, visible: np.ndarray | None = None) -> list[Observation]:
         """One frame of world positions (P, 3); returns the observations of segments that closed here."""
-        c = self.character
-        percept = self.perception.perceive_pose(positions, visible, self.body, self.n_frames / self.fps)
-        self.poses.append(percept.pose)
-        self.visible.append(percept.visible)
-        closed = c.segmenter.push(percept.pose, percept.visible)
-        out = self._close(closed)
-        self._follow()
+        return self.push_block(np.asarray(positions, dtype=float)[None],
+                               None if visible is None else np.asarray(visible, dtype=bool)[None])
+
+    def push_block(self, positions: np.ndarray, visible: np.ndarray | None = None) -> list[Observation]:
+        """Frames of world positions (n, P, 3) in the order they arrived; the observations of segments that
+        closed during them (the same as pushing them one by one)."""
+        first = self._n
+        poses, seen = self._perceive(positions, visible)
+        if not len(poses):
+            return []
+        closed, since = self.character.segmenter.push_block(poses, seen)
+        out: list[Observation] = []
+        k = 0
+        for i in range(len(poses)):
+            while k < len(closed) and closed[k][0] == i:
+                out.extend(self._close([closed[k][1]]))
+                k += 1
+            self._follow(int(since[i]), first + i)
         return out
 
-    def watch(self, motion: Motion) -> list[Observation]:
-        """Stream a whole motion of world positions (reset first, flushed at the end)."""
+    def watch(self, motion: Motion, *, block: int = 0) -> list[Observation]:
+        """Stream a whole motion of world positions (reset first, flushed at the end).
+
+        ``block``: frames delivered at a time (0: the whole motion as one block); the observations do not
+        depend on it.
+        """
         self.reset()
+        step = block if block > 0 else max(1, motion.n_frames)
         out: list[Observation] = []
-        for f in range(motion.n_frames):
-            out.extend(self.push(motion.positions[f], motion.visible[f]))
+        for f in range(0, motion.n_frames, step):
+            out.extend(self.push_block(motion.positions[f : f + step], motion.visible[f : f + step]))
         out.extend(self.flush())
         return out
 
@@ -129,36 +186,36 @@ class Observer:
             raise ConfigError(f"character {c.name} cannot classify", expected="a matcher")
         self.reset()
         c.matcher.begin(self.fps)
+        poses, seen = self._perceive(motion.positions, motion.visible)
         early = None
-        for f in range(motion.n_frames):
-            percept = self.perception.perceive_pose(motion.positions[f], motion.visible[f], self.body, f / self.fps)
-            self.poses.append(percept.pose)
-            self.visible.append(percept.visible)
-            match = c.matcher.observe(percept.pose, percept.visible)
-            if early is None and match is not None and not match.details.get("stop"):
-                early = match
+        if self._streaming:
+            for f in range(len(poses)):
+                match = c.matcher.observe(poses[f], seen[f])
+                if early is None and match is not None and not match.details.get("stop"):
+                    early = match
         segment = Segment(0, max(1, motion.n_frames), self.fps)
-        late = c.matcher.conclude(Motion(np.array(self.poses), self.fps, self.body.parts, np.array(self.visible)))
+        late = c.matcher.conclude(Motion(poses.copy(), self.fps, self.body.parts, seen.copy()))
         return _answer(segment, early, late)
 
     def flush(self) -> list[Observation]:
         """End of the stream: the segment under way (if the segmenter accepts it)."""
         return self._close(self.character.segmenter.flush())
 
-    def _follow(self) -> None:
-        """Feed the streaming matcher the frames of the segment under way (from its onset)."""
-        m, since = self.character.matcher, self.character.segmenter.active_since
-        if m is None or since is None:
-            self._open = None
+    def _follow(self, since: int, frame: int) -> None:
+        """After ``frame``: feed the streaming matcher the frames of the segment under way (from its onset ``since``;
+        -1: none)."""
+        if since < 0 or not self._streaming:
+            self._open = None if since < 0 else since
             return
+        m = self.character.matcher
         if self._open != since:
             self._open, self._early = since, None
             m.begin(self.fps)
-            frames = range(since, self.n_frames)
+            frames = range(since, frame + 1)
         else:
-            frames = range(self.n_frames - 1, self.n_frames)
+            frames = range(frame, frame + 1)
         for f in frames:
-            match = m.observe(self.poses[f], self.visible[f])
+            match = m.observe(self._poses[f], self._visible[f])
             if match is not None and self._early is None and not match.details.get("stop"):
                 self._early = match
 
@@ -171,8 +228,8 @@ class Observer:
             if m is None:
                 out.append(Observation(segment, None, None))
                 continue
-            motion = Motion(np.array(self.poses[segment.start : segment.end]), self.fps, self.body.parts,
-                            np.array(self.visible[segment.start : segment.end]))
+            motion = Motion(self._poses[segment.start : segment.end].copy(), self.fps, self.body.parts,
+                            self._visible[segment.start : segment.end].copy())
             early = self._early if self._open == segment.start else None
             if early is None:  # a batch matcher, or a segmenter that only reports segments once they are over
                 m.begin(self.fps)
