@@ -108,6 +108,7 @@ class Track:
     trace: list[tuple[int, dict[tuple[str, ...], float]]] = field(default_factory=list)
     committed_at: int | None = None
     deviated_at: int | None = None
+    anchors: dict[str, np.ndarray] = field(default_factory=dict)
 
 
 def _lengths(observed: np.ndarray) -> np.ndarray:
@@ -255,12 +256,32 @@ class ForwardModel(Matcher):
 
     def _track(self, name: str, onset: int) -> None:
         scale = self._scale_of(name)
-        start = self.motor.active[name]
+        start = self._where(name, self.frames[onset][self.motor.subsystems[name]])
         # a command that moves no part farther than min_move (standing still) cannot be seen to begin
         candidates = {(edge,): 0.0 for edge, _ in self.motor.edges_from(name, start)
                       if self._length(edge) * scale > self.params["min_move"]}
         self.tracks[name] = Track(name, scale, self.motor.is_hand(name), start, onset, candidates,
                                   sorted(p[0] for p in candidates), last_correct=start, learn_from=onset)
+
+    def _where(self, name: str, seen: np.ndarray) -> str:
+        """The node a subsystem's demonstration begins in: the active node or the hub, whichever state is nearer
+        to where the parts were seen at the onset (``seen``, (k, 3)).
+
+        The active node is where the last movement the matcher followed ended; a demonstrator who went back to
+        the hub without being followed (a movement that was not recognised, a posture that differed from the
+        observer's own at its end) begins his next movement there. With ``relative`` the observed posture is not
+        comparable with the states, and the active node is kept.
+        """
+        active = self.motor.active[name]
+        if active == "hub" or self.params["relative"] or not np.isfinite(seen).any():
+            return active
+        graph = self.motor.graphs[name]
+        far = [self._distance_to(name, graph.nodes[n]["state"], seen) for n in (active, "hub")]
+        return active if far[0] <= far[1] else "hub"
+
+    def _distance_to(self, name: str, state: np.ndarray, seen: np.ndarray) -> float:
+        d = np.linalg.norm(state - seen, axis=-1) * self._scale_of(name)
+        return float(np.nanmax(d) if self.params["error"] == "max" else np.nanmean(d))
 
     def _observed(self, track: Track, memory: np.ndarray) -> np.ndarray:
         """The working memory of a subsystem's parts since it is followed, (n, k, 3)."""
@@ -298,12 +319,13 @@ class ForwardModel(Matcher):
         track.candidates = alive
         if alive and len({self._movement_key(p) for p in alive}) == 1:  # one first command (or movement) prevails
             path = min(alive, key=alive.get)
-            progress = self._progress(path[0], lengths)
+            along = self._along(track, path[0], lengths)
+            progress = self._progress(path[0], along)
             if progress >= self.params["min_progress"] or len(path) > 1:
                 track.committed_path = self._known_continuation(path)
                 track.committed = self.motor.add_sequence(list(track.committed_path))
                 track.committed_at = len(self.frames)
-                track.speed = self._speed(path[0], lengths, len(observed))
+                track.speed = self._speed(path[0], along, self._anchor(track, path[0]), len(observed))
                 track.progress = progress
                 track.confidence = float(np.exp(-alive[path] / self.params["threshold"]))
         return None
@@ -315,7 +337,8 @@ class ForwardModel(Matcher):
         """
         lead = self._lead(track.committed_path[0])
         arcs = np.cumsum([self._table(self._strokes_of(e)[lead])[2][-1] for e in track.committed_path])
-        on = int(np.searchsorted(arcs, lengths[lead] - 0.01 / track.scale))
+        joined = self._anchor(track, track.committed_path[0])[lead]
+        on = int(np.searchsorted(arcs, lengths[lead] + joined - 0.01 / track.scale))
         on = min(on, len(track.committed_path) - 1)
         track.last_correct = self.motor.edge(track.committed_path[on])[1]
         track.excluded.add(track.committed_path[on])
@@ -323,7 +346,7 @@ class ForwardModel(Matcher):
         if track.right:
             observed = self._observed(track, memory)[:, lead]
             walked = _arc(uniform_filter1d(observed, size=3, axis=0, mode="nearest"))
-            track.learn_from = track.onset + int(np.searchsorted(walked, arcs[on - 1]))
+            track.learn_from = track.onset + int(np.searchsorted(walked, arcs[on - 1] - joined))
 
     def _scale_of(self, subsystem: str) -> float:
         """Metres one unit of the subsystem's values counts as: ``angle_scale`` for a hand's radians, else 1."""
@@ -359,7 +382,7 @@ class ForwardModel(Matcher):
         out = []
         for path in track.candidates:
             lead = self._lead(path[0])
-            seen = lengths[lead]
+            seen = self._along(track, path[0], lengths)[lead]
             total = sum(self._table(self._strokes_of(e)[lead])[2][-1] for e in path)
             end = self.motor.edge(path[-1])[2]
             nxt = [name for name, _ in self.motor.edges_from(track.subsystem, end)] if seen > total + 0.01 / track.scale else []
@@ -423,7 +446,35 @@ class ForwardModel(Matcher):
         The largest over the parts, or their mean (``error``); with ``relative`` the prediction is moved by
         the offset between the observed onset posture and the path's start.
         """
-        return self._distance(track, self._predict(track, path, lengths) + self._onset_offset(track, path[0]), last)
+        predicted = self._predict(track, path, self._along(track, path[0], lengths))
+        return self._distance(track, predicted + self._onset_offset(track, path[0]), last)
+
+    def _along(self, track: Track, name: str, lengths: np.ndarray) -> np.ndarray:
+        """How far along a path beginning with command ``name`` each part is: the observed path length plus
+        where the demonstration joined the command (:meth:`_anchor`)."""
+        return lengths + self._anchor(track, name)
+
+    def _anchor(self, track: Track, name: str) -> np.ndarray:
+        """Where, along each part's stroke of command ``name`` (path length), the demonstration was first seen.
+
+        A segment often begins a little after the movement did (a hub threshold is crossed once the body has
+        left the hub; a stream starts in motion): each part is placed at the point of the first half of its
+        stroke nearest to where it was seen at the track's onset, and predicted from there (0 when it was seen
+        at the stroke's start). With ``relative`` the observed posture is not comparable with the command's
+        positions, and a hand's fingers share one clock: both are followed from the start (0).
+        """
+        anchor = track.anchors.get(name)
+        if anchor is None:
+            strokes = self._strokes_of(name)
+            anchor = np.zeros(len(strokes))
+            if not (self.params["relative"] or track.hand):
+                first = self.frames[track.onset][self.motor.subsystems[track.subsystem]]
+                for j, stroke in enumerate(strokes):
+                    _, positions, arc = self._table(stroke)
+                    half = arc <= 0.5 * arc[-1]
+                    anchor[j] = arc[half][np.argmin(np.linalg.norm(positions[half] - first[j], axis=1))]
+            track.anchors[name] = anchor
+        return anchor
 
     def _onset_offset(self, track: Track, name: str) -> np.ndarray | float:
         """With ``relative``: the observed onset posture minus where command ``name`` starts (k, 3); else 0."""
@@ -437,17 +488,19 @@ class ForwardModel(Matcher):
         d = np.linalg.norm(predicted - observed, axis=-1) * track.scale
         return float(d.max() if self.params["error"] == "max" else d.mean())
 
-    def _progress(self, name: str, lengths: np.ndarray) -> float:
+    def _progress(self, name: str, along: np.ndarray) -> float:
+        """The share of command ``name``'s time its lead part has covered, ``along`` its path."""
         lead = self._lead(name)
         stroke = self._strokes_of(name)[lead]
-        return self._mapped_time(stroke, lengths[lead]) / stroke.duration
+        return self._mapped_time(stroke, along[lead]) / stroke.duration
 
-    def _speed(self, name: str, lengths: np.ndarray, n_frames: int) -> float:
-        """How much faster than the command the demonstration goes (1: same speed)."""
+    def _speed(self, name: str, along: np.ndarray, joined: np.ndarray, n_frames: int) -> float:
+        """How much faster than the command the demonstration goes (1: same speed), from where it was joined."""
         lead = self._lead(name)
         stroke = self._strokes_of(name)[lead]
         elapsed = (n_frames - 1) / self.fps
-        return float(np.clip(self._mapped_time(stroke, lengths[lead]) / max(elapsed, 1e-6), 0.25, 4.0))
+        covered = self._mapped_time(stroke, along[lead]) - self._mapped_time(stroke, joined[lead])
+        return float(np.clip(covered / max(elapsed, 1e-6), 0.25, 4.0))
 
     # -- the end of the demonstration ------------------------------------------------------------
 

@@ -16,7 +16,9 @@ in inverse direction."
 5. Those closed-form estimates start a bounded least-squares refinement
    (:func:`scipy.optimize.least_squares`) of the timing and shape parameters
    against the observed positions, so noise in one estimate is corrected by the
-   trajectory as a whole.
+   trajectory as a whole. A curved stroke is refined both as a C and as an S
+   (noise near the ends can make a flat C's residual change sides) and the one
+   closer to the observation is kept.
 
 Hands (§4.3): "if Max observes a completed, unknown finger movement by the
 demonstrator, the movement will be segmented both, at angular velocity minima
@@ -48,7 +50,7 @@ def trajectory_error(stroke: GuidingStroke | HandTransition, positions: np.ndarr
     return float(np.linalg.norm(stroke.position(t) - positions, axis=1).max())
 
 
-def _closed_form(p: np.ndarray, fps: float, straight: float) -> dict:
+def _closed_form(p: np.ndarray, fps: float, straight: float, family: str | None = None) -> dict:
     start, target = p[0], p[-1]
     chord = target - start
     length = float(np.linalg.norm(chord))
@@ -71,7 +73,8 @@ def _closed_form(p: np.ndarray, fps: float, straight: float) -> dict:
     normal = np.cross(axis, side)  # then normal x chord points along side: positive lateral is "left"
     lateral = residual @ side / (0.5 * length)
     hi, lo = lateral.max(), lateral.min()
-    if min(hi, -lo) > 0.3 * max(hi, -lo):  # both ways: an S, whose first half bends to the left for "left-s"
+    s_shape = min(hi, -lo) > 0.3 * max(hi, -lo) if family is None else family == "s"
+    if s_shape:  # both ways: an S, whose first half bends to the left for "left-s"
         first = lateral[s < 0.5]
         left_first = first.size > 0 and first.max() >= -first.min()
         shape, amplitude = ("left-s" if left_first else "right-s"), 2 * max(hi, -lo)
@@ -111,9 +114,19 @@ def stroke_from_segment(positions: np.ndarray, fps: float, *, straight: float = 
     if p.ndim != 2 or p.shape[1] != 3 or len(p) < 2 or not np.isfinite(p).all():
         raise ValueError("the inverse model needs two or more finite positions (N, 3)")
     est = _closed_form(p, fps, straight)
-    stroke = GuidingStroke(**est)
     if not refine:
-        return stroke
+        return GuidingStroke(**est)
+    if est["shape"] == "linear":
+        return _refined(est, p, fps)
+    # C or S: observation noise at the ends can make a C's residual change sides; both families are fitted and
+    # the one that reproduces the observation better is kept
+    fits = [_refined(_closed_form(p, fps, straight, family), p, fps) for family in ("c", "s")]
+    return min(fits, key=lambda stroke: (trajectory_error(stroke, p, fps), stroke.shape != est["shape"]))
+
+
+def _refined(est: dict, p: np.ndarray, fps: float) -> GuidingStroke:
+    """The closed-form stroke ``est`` refined by bounded least squares against positions ``p``; the better of the two."""
+    stroke = GuidingStroke(**est)
     t = np.arange(len(p)) / fps
     curved = stroke.shape != "linear"
     names = ["peak", "end_gain"] + (["curvature", "roundness", "skewness"] if curved else [])

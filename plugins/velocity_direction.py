@@ -43,29 +43,45 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import find_peaks, savgol_filter
+from scipy.signal import argrelextrema, savgol_filter
 
 from toolkit import ConfigError, Parameter, Segment, Segmenter, hookimpl
 
 __all__ = ["VelocityDirection", "StrokeAnalysis", "speed_breaks", "direction_clusters", "direction_breaks"]
 
 
-def speed_breaks(speed: np.ndarray, drop: float) -> list[int]:
+def speed_breaks(speed: np.ndarray, drop: float, moving: float = 0.0) -> list[int]:
     """Indices of speed minima below ``drop`` times the smaller of the highest speeds on either side.
 
-    A side reaches to the neighbouring minimum or to the end of the movement, so a movement that starts or
-    ends at full speed still brackets its minima, and a hold (a run of equal speeds, a flat minimum) counts
-    once, at its middle.
+    A minimum is no higher than the two samples on each side of it. A hold counts once, at its middle: a run
+    of such samples, or minima with nothing faster than ``moving`` (the rest speed) between them (the ripples
+    of a pause). A side reaches to the neighbouring minimum or to the end of the movement, so a movement that
+    starts or ends at full speed still brackets its minima; both sides must rise above ``moving``, so a dip
+    between two flickers of noise at rest separates no strokes.
     """
-    if len(speed) < 3:
+    speed = np.asarray(speed, dtype=float)
+    n = len(speed)
+    if n < 3:
         return []
-    minima, _ = find_peaks(-np.asarray(speed, dtype=float))
-    bounds = [0, *minima.tolist(), len(speed) - 1]
+    low = argrelextrema(speed, np.less_equal, order=2)[0]
+    low = low[(low >= 2) & (low <= n - 3)]  # two samples on each side, inside the movement
+    if not len(low):
+        return []
+    holds = [[int(low[0])]]
+    for m in low[1:]:
+        previous = holds[-1][-1]
+        if m == previous + 1 or speed[previous : m + 1].max() <= moving:
+            holds[-1].append(int(m))
+        else:
+            holds.append([int(m)])
+    minima = [(h[0] + h[-1]) // 2 for h in holds]
+    bounds = [0, *(h[-1] for h in holds[:-1])], [*(h[0] for h in holds[1:]), n - 1]  # the neighbouring holds
     out = []
-    for i, m in enumerate(minima):
-        left, right = speed[bounds[i] : m + 1].max(), speed[m : bounds[i + 2] + 1].max()
-        if speed[m] < drop * min(left, right):
-            out.append(int(m))
+    for i, (m, hold) in enumerate(zip(minima, holds)):
+        left, right = speed[bounds[0][i] : hold[0] + 1].max(), speed[hold[-1] : bounds[1][i] + 1].max()
+        side = min(left, right)
+        if speed[hold].min() < drop * side and side > moving:
+            out.append(m)
     return out
 
 
@@ -246,7 +262,7 @@ class VelocityDirection(Segmenter):
         vectors = np.diff(window, axis=0)
         speed = np.linalg.norm(vectors.reshape(len(vectors), -1, 3), axis=2).max(axis=1) * self._fps
         moving = speed > self.params["rest_speed"]
-        by_speed = sorted(b + 1 for b in speed_breaks(speed, self.params["drop"]))
+        by_speed = sorted(b + 1 for b in speed_breaks(speed, self.params["drop"], self.params["rest_speed"]))
         cuts = set(by_speed)
         by_direction: list[int] = []
         units = np.array([_unit(v) for v in vectors])
@@ -257,7 +273,7 @@ class VelocityDirection(Segmenter):
                 if labels[i] < 0:
                     labels[i] = labels[i - 1]
             k = max(2, int(round(0.1 * self._fps)))
-            dips = np.array(speed_breaks(speed, self.params["corner"]), dtype=int) + 1
+            dips = np.array(speed_breaks(speed, self.params["corner"], self.params["rest_speed"]), dtype=int) + 1
             for b in direction_breaks(labels):
                 # a cluster change inside one stroke is no break: the direction must turn sharply there, at a dip
                 # of the speed (a C stroke turns gradually, an S stroke swings its direction at full speed)

@@ -163,6 +163,23 @@ def test_every_clip_is_watched_from_the_hub_whatever_came_before(data, profile, 
     assert (again.movement, again.decided_at) == (alone.movement, alone.decided_at) == ("nod", alone.decided_at)
 
 
+def test_a_movement_begun_at_the_hub_is_followed_from_the_hub_wherever_the_last_one_left_off(data, profile, pm):
+    """Within a stream the forward model's active node is where the last movement it followed ended; one that
+    ended away from it (a posture that differs at the end) must not make the next, begun at the hub, unreadable."""
+    character = compose_observer(pm, profile, data / "repertoire", matcher="forward-model")
+    motor, matcher = character.motor, character.matcher
+    nod = profile.read(data / "demos" / "nod" / "morris_1.0.bvh")
+    elsewhere = motor.edge(motor.sequences["bow"][0])[2]
+    observer = Observer(character, profile.body, nod.fps)
+    motor.reset_to("body", elsewhere)  # as an earlier segment of the stream left it
+    matcher.begin(nod.fps)
+    early = None
+    for f in range(nod.n_frames):
+        percept = observer.perception.perceive_pose(nod.positions[f], None, profile.body, f / nod.fps)
+        early = early or matcher.observe(percept.pose, percept.visible)
+    assert matcher.start_node == "hub" and early is not None and early.movement == "nod"
+
+
 @settings(max_examples=30, deadline=None)
 @given(st.integers(5, 30), st.integers(1, 6), st.floats(0.01, 1.0), st.integers(0, 2**16))
 def test_the_dtw_distance_per_frame_does_not_shrink_with_length(n, k, offset, seed):

@@ -15,6 +15,8 @@ network socket, a tracker. Each segment that closes comes back as an
 :func:`compose_observer` builds the observing character from a body profile, a
 folder of labelled clips and plugin names, as ``likeme observe`` does. The
 observer never learns: matchers with a ``learn`` parameter get ``learn = false``.
+Every stream (and every clip classified) is watched from the motor system's
+rest state (:meth:`MotorSystem.reset`).
 """
 
 from __future__ import annotations
