@@ -65,16 +65,6 @@ def _arc(points: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
 
 
-def _observed_length(points: np.ndarray) -> float:
-    """Path length of an observed trajectory (N, 3), robust to observation noise.
-
-    Noise adds length at every frame; the positions are averaged over three frames first.
-    """
-    if len(points) < 3:
-        return float(_arc(points)[-1])
-    return float(_arc(uniform_filter1d(points, size=3, axis=0, mode="nearest"))[-1])
-
-
 @dataclass
 class Track:
     """One motor subsystem under consideration during a demonstration (K&G §4.1): its candidates, commitment, errors.
@@ -111,9 +101,37 @@ class Track:
     anchors: dict[str, np.ndarray] = field(default_factory=dict)
 
 
+@dataclass(frozen=True)
+class _EdgeTable:
+    """A command's strokes, one per part, on a fine grid: positions (k, G, 3), cumulative path lengths (k, G), and
+    the lead part (the one that moves farthest)."""
+
+    commands: list
+    positions: np.ndarray
+    arcs: np.ndarray
+    lead: int
+
+
+def _along_rows(arcs: np.ndarray, positions: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Per row r, the point of ``positions[r]`` (G, 3) at path length ``x[r]`` along ``arcs[r]`` (G,), linearly
+    interpolated (``np.interp`` row by row); 0 <= x[r] <= arcs[r, -1]."""
+    j = np.clip((arcs <= x[:, None]).sum(axis=1) - 1, 0, arcs.shape[1] - 2)
+    rows = np.arange(len(x))
+    a0, a1 = arcs[rows, j], arcs[rows, j + 1]
+    step = a1 - a0
+    w = np.divide(x - a0, step, out=np.zeros_like(x), where=step > 0)
+    return positions[rows, j] + np.clip(w, 0.0, 1.0)[:, None] * (positions[rows, j + 1] - positions[rows, j])
+
+
 def _lengths(observed: np.ndarray) -> np.ndarray:
-    """The observed path length of each part of a working memory (n, k, 3)."""
-    return np.array([_observed_length(observed[:, j]) for j in range(observed.shape[1])])
+    """The observed path length of each part of a working memory (n, k, 3), robust to observation noise.
+
+    Noise adds length at every frame; the positions are averaged over three frames first.
+    """
+    if len(observed) >= 3:
+        observed = uniform_filter1d(observed, size=3, axis=0, mode="nearest")
+    return np.linalg.norm(np.diff(observed, axis=0), axis=-1).sum(axis=0) if len(observed) > 1 else \
+        np.zeros(observed.shape[1])
 
 
 class ForwardModel(Matcher):
@@ -154,6 +172,7 @@ class ForwardModel(Matcher):
         self._root_height = np.where(owner.body.angle_mask[:, None], 0.0, motor.rest_pose()[owner.body.root_index])
         self._strokes = VelocityDirection(drop=self.params["drop"], angle=self.params["angle"])
         self._tables: dict[int, tuple] = {}
+        self._edges: dict[str, _EdgeTable] = {}
 
     # -- streaming ------------------------------------------------------------------------------
 
@@ -336,7 +355,7 @@ class ForwardModel(Matcher):
         The edges before it were followed correctly; learning starts from the frame the demonstration passed it.
         """
         lead = self._lead(track.committed_path[0])
-        arcs = np.cumsum([self._table(self._strokes_of(e)[lead])[2][-1] for e in track.committed_path])
+        arcs = np.cumsum([self._edge(e).arcs[lead, -1] for e in track.committed_path])
         joined = self._anchor(track, track.committed_path[0])[lead]
         on = int(np.searchsorted(arcs, lengths[lead] + joined - 0.01 / track.scale))
         on = min(on, len(track.committed_path) - 1)
@@ -354,14 +373,27 @@ class ForwardModel(Matcher):
 
     def _length(self, name: str) -> float:
         """Path length (m, or radians for a hand) of a command's lead part."""
-        return float(self._table(self._strokes_of(name)[self._lead(name)])[2][-1])
+        edge = self._edge(name)
+        return float(edge.arcs[edge.lead, -1])
 
     def _strokes_of(self, name: str) -> list[Any]:
         return self.motor.edge(name)[3]["commands"]
 
     def _lead(self, name: str) -> int:
         """The part of the subsystem that moves farthest along a command: progress and speed are measured on it."""
-        return int(np.argmax([self._table(st)[2][-1] for st in self._strokes_of(name)]))
+        return self._edge(name).lead
+
+    def _edge(self, name: str) -> _EdgeTable:
+        """Every part's stroke of command ``name`` on the fine grid, stacked (computed once per command)."""
+        commands = self._strokes_of(name)
+        table = self._edges.get(name)
+        if table is None or table.commands is not commands:
+            tables = [self._table(stroke) for stroke in commands]
+            arcs = np.stack([arc for _, _, arc in tables])
+            table = _EdgeTable(commands, np.stack([positions for _, positions, _ in tables]), arcs,
+                               int(np.argmax(arcs[:, -1])))
+            self._edges[name] = table
+        return table
 
     def _table(self, stroke: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(times, positions, cumulative path length) of a stroke on a fine grid, computed once per stroke."""
@@ -383,7 +415,7 @@ class ForwardModel(Matcher):
         for path in track.candidates:
             lead = self._lead(path[0])
             seen = self._along(track, path[0], lengths)[lead]
-            total = sum(self._table(self._strokes_of(e)[lead])[2][-1] for e in path)
+            total = sum(self._edge(e).arcs[lead, -1] for e in path)
             end = self.motor.edge(path[-1])[2]
             nxt = [name for name, _ in self.motor.edges_from(track.subsystem, end)] if seen > total + 0.01 / track.scale else []
             out.extend([(*path, n) for n in nxt if n not in path] or [path])
@@ -428,17 +460,21 @@ class ForwardModel(Matcher):
                     t = self._mapped_time(commands[lead], left)
                     return np.array([c.position(t) for c in commands])
                 left -= arc[-1]
-        out = []
-        for j, left in enumerate(lengths):
-            strokes = [self._strokes_of(e)[j] for e in path]
-            for i, stroke in enumerate(strokes):
-                _, positions, arc = self._table(stroke)
-                if left <= arc[-1] or i == len(strokes) - 1:
-                    x = min(left, arc[-1])
-                    out.append([np.interp(x, arc, positions[:, d]) for d in range(3)])
-                    break
-                left -= arc[-1]
-        return np.array(out)
+        # each part along its own strokes: on the first edge whose stroke is longer than what is left to place
+        out = np.empty((len(lengths), 3))
+        left = np.array(lengths, dtype=float)
+        open_ = np.ones(len(left), dtype=bool)
+        for i, name in enumerate(path):
+            edge = self._edge(name)
+            total = edge.arcs[:, -1]
+            here = open_ & ((left <= total) | (i == len(path) - 1))
+            if here.any():
+                out[here] = _along_rows(edge.arcs[here], edge.positions[here], np.minimum(left[here], total[here]))
+                open_ &= ~here
+            if not open_.any():
+                break
+            left = np.where(open_, left - total, left)
+        return out
 
     def _error(self, track: Track, path: tuple[str, ...], lengths: np.ndarray, last: np.ndarray) -> float:
         """Distance between the path's prediction and the parts' last observed positions ``last`` (k, 3).
@@ -465,14 +501,13 @@ class ForwardModel(Matcher):
         """
         anchor = track.anchors.get(name)
         if anchor is None:
-            strokes = self._strokes_of(name)
-            anchor = np.zeros(len(strokes))
+            edge = self._edge(name)
+            anchor = np.zeros(len(edge.arcs))
             if not (self.params["relative"] or track.hand):
                 first = self.frames[track.onset][self.motor.subsystems[track.subsystem]]
-                for j, stroke in enumerate(strokes):
-                    _, positions, arc = self._table(stroke)
-                    half = arc <= 0.5 * arc[-1]
-                    anchor[j] = arc[half][np.argmin(np.linalg.norm(positions[half] - first[j], axis=1))]
+                far = np.linalg.norm(edge.positions - first[:, None], axis=-1)
+                far[edge.arcs > 0.5 * edge.arcs[:, -1:]] = np.inf  # the first half of each stroke
+                anchor = edge.arcs[np.arange(len(far)), np.argmin(far, axis=1)]
             track.anchors[name] = anchor
         return anchor
 
@@ -480,7 +515,7 @@ class ForwardModel(Matcher):
         """With ``relative``: the observed onset posture minus where command ``name`` starts (k, 3); else 0."""
         if not self.params["relative"]:
             return 0.0
-        start = np.array([self._table(st)[1][0] for st in self._strokes_of(name)])
+        start = self._edge(name).positions[:, 0]
         return self.frames[track.onset][self.motor.subsystems[track.subsystem]] - start
 
     def _distance(self, track: Track, predicted: np.ndarray, observed: np.ndarray) -> float:

@@ -260,11 +260,20 @@ class MotorCommandGraph(MotorSystem):
         return self.labels.get(movement, movement)
 
     def label_of_path(self, path: tuple[str, ...]) -> str | None:
-        """The movement every labelled sequence beginning with ``path`` is an example of; ``None`` if not one."""
+        """The labelled movement (clip repertoires) ``path`` stands for; ``None`` if none or several.
+
+        The labelled sequences that agree with ``path`` longest (their first edges are its first edges) decide:
+        a path that runs through a whole clip and on, or that leaves a clip's edges for an edge of another
+        (nodes of different clips can be shared), is the movement whose edges it followed first and longest.
+        Unlabelled sequences (a path the forward model committed to, one learned by watching) do not count.
+        """
         path = tuple(path)
-        labels = {self.labels.get(n) for n, edges in self.sequences.items()
-                  if tuple(edges[: len(path)]) == path or path[: len(edges)] == tuple(edges)}
-        return labels.pop() if len(labels) == 1 and None not in labels else None
+        labelled = [(tuple(edges), self.labels[n]) for n, edges in self.sequences.items() if n in self.labels]
+        for k in range(len(path), 0, -1):
+            labels = {label for edges, label in labelled if edges[:k] == path[:k]}
+            if labels:
+                return labels.pop() if len(labels) == 1 else None
+        return None
 
     def movements(self) -> list[str]:
         if self.labels:

@@ -58,6 +58,20 @@ def test_the_same_clips_become_a_posegraph_and_a_motor_command_graph(data, profi
     assert graph.perform("jump", fps=30).n_frames > 10 and commands.perform("jump", fps=30).n_frames > 10
 
 
+def test_a_path_is_the_labelled_movement_it_follows_first_and_longest(data, profile, pm):
+    motor = compose_observer(pm, profile, data / "repertoire", matcher="forward-model").motor
+    bow, nod = motor.sequences["bow"], motor.sequences["nod"]
+    assert len(bow) >= 2  # out to the bow, back from it (the hold between them cuts the clip)
+    assert motor.label_of_path(tuple(bow)) == motor.label_of_path((bow[0],)) == "bow"
+    assert motor.label_of_path((*bow, nod[0])) == "bow"  # the whole bow, then on into a nod
+    assert motor.label_of_path((bow[0], nod[-1])) == "bow"  # leaves the bow for the nod's last edge
+    motor.add_sequence([bow[0], nod[-1]])  # an unlabelled sequence (a commitment) does not veto the label
+    assert motor.label_of_path((bow[0], nod[-1])) == "bow"
+    motor.add_sequence([bow[0]], name="bow-like", label="curtsy")  # another movement with the same first edge
+    assert motor.label_of_path((bow[0],)) is None and motor.label_of_path(tuple(bow[:2])) == "bow"
+    assert motor.label_of_path(("no-such-edge",)) is None
+
+
 def test_observing_a_stream_finds_and_names_its_movements(data, profile, pm):
     character = compose_observer(pm, profile, data / "repertoire", matcher="path-search")
     tp = found_n = true_n = right = 0
