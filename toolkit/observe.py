@@ -33,6 +33,7 @@ from toolkit.components import Match, Matcher, Perception, Segment
 from toolkit.errors import ConfigError, PluginError
 from toolkit.motion import Motion
 from toolkit.profile import BodyProfile
+from toolkit.runtime import ObservationLog
 
 __all__ = ["Observation", "Observer", "compose_observer", "observe_motion"]
 
@@ -101,44 +102,30 @@ class Observer:
         self.perception.fps = self.fps
         self.perception.reset()
         c.segmenter.reset(self.body.parts, self.fps)
-        n_parts = len(self.body.parts)
-        self._poses = np.zeros((256, n_parts, 3))
-        self._visible = np.zeros((256, n_parts), dtype=bool)
-        self._n = 0
+        self.memory = ObservationLog(tuple(self.body.parts), self.fps, capacity=256)
         self._early: Match | None = None
         self._open: int | None = None
 
     @property
     def n_frames(self) -> int:
-        return self._n
+        return self.memory.n
 
     @property
     def poses(self) -> np.ndarray:
-        """The root-relative poses perceived so far (frames, P, 3)."""
-        return self._poses[: self._n]
+        """The root-relative poses perceived so far (frames, P, 3): the working memory."""
+        return self.memory.positions
 
     @property
     def visible(self) -> np.ndarray:
         """Which parts were seen in each frame so far (frames, P)."""
-        return self._visible[: self._n]
-
-    def _remember(self, poses: np.ndarray, visible: np.ndarray) -> None:
-        n = self._n + len(poses)
-        if n > len(self._poses):
-            size = max(n, 2 * len(self._poses))
-            self._poses = np.concatenate([self._poses[: self._n], np.zeros((size - self._n, *self._poses.shape[1:]))])
-            self._visible = np.concatenate([self._visible[: self._n],
-                                            np.zeros((size - self._n, self._visible.shape[1]), dtype=bool)])
-        self._poses[self._n : n] = poses
-        self._visible[self._n : n] = visible
-        self._n = n
+        return self.memory.visible
 
     def _perceive(self, positions: np.ndarray, visible: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
         positions = np.asarray(positions, dtype=float)
         visible = None if visible is None else np.asarray(visible, dtype=bool)
-        times = (self._n + np.arange(len(positions))) / self.fps
+        times = (self.memory.n + np.arange(len(positions))) / self.fps
         poses, seen = self.perception.perceive_poses(positions, visible, self.body, times)
-        self._remember(poses, seen)
+        self.memory.extend(poses, seen)
         return poses, seen
 
     def push(self, positions: np.ndarray, visible: np.ndarray | None = None) -> list[Observation]:
@@ -149,7 +136,7 @@ class Observer:
     def push_block(self, positions: np.ndarray, visible: np.ndarray | None = None) -> list[Observation]:
         """Frames of world positions (n, P, 3) in the order they arrived; the observations of segments that
         closed during them (the same as pushing them one by one)."""
-        first = self._n
+        first = self.memory.n
         poses, seen = self._perceive(positions, visible)
         if not len(poses):
             return []
@@ -217,7 +204,7 @@ class Observer:
         else:
             frames = range(frame, frame + 1)
         for f in frames:
-            match = m.observe(self._poses[f], self._visible[f])
+            match = m.observe(self.memory.positions[f], self.memory.visible[f])
             if match is not None and self._early is None and not match.details.get("stop"):
                 self._early = match
 
@@ -230,8 +217,7 @@ class Observer:
             if m is None:
                 out.append(Observation(segment, None, None))
                 continue
-            motion = Motion(self._poses[segment.start : segment.end].copy(), self.fps, self.body.parts,
-                            self._visible[segment.start : segment.end].copy())
+            motion = self.memory.motion(segment.start, segment.end)
             early = self._early if self._open == segment.start else None
             if early is None:  # a batch matcher, or a segmenter that only reports segments once they are over
                 m.begin(self.fps)

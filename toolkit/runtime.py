@@ -102,15 +102,29 @@ class ObservationLog:
         self.n = 0
 
     def append(self, pose: np.ndarray, visible: np.ndarray, world: np.ndarray | None = None) -> None:
-        if self.n == self._pos.shape[0]:
-            self._pos = np.concatenate([self._pos, np.full_like(self._pos, np.nan)])
-            self._world = np.concatenate([self._world, np.full_like(self._world, np.nan)])
-            self._vis = np.concatenate([self._vis, np.zeros_like(self._vis)])
+        self._reserve(self.n + 1)
         self._pos[self.n] = pose
         self._vis[self.n] = visible
         if world is not None:
             self._world[self.n] = world
         self.n += 1
+
+    def extend(self, poses: np.ndarray, visible: np.ndarray) -> None:
+        """Several frames at once: poses (n, P, 3) and their visibility (n, P)."""
+        end = self.n + len(poses)
+        self._reserve(end)
+        self._pos[self.n : end] = poses
+        self._vis[self.n : end] = visible
+        self.n = end
+
+    def _reserve(self, size: int) -> None:
+        """Room for ``size`` frames (the arrays double when full)."""
+        if size <= self._pos.shape[0]:
+            return
+        more = max(size, 2 * self._pos.shape[0]) - self._pos.shape[0]
+        self._pos = np.concatenate([self._pos, np.full((more, *self._pos.shape[1:]), np.nan)])
+        self._world = np.concatenate([self._world, np.full((more, *self._world.shape[1:]), np.nan)])
+        self._vis = np.concatenate([self._vis, np.zeros((more, self._vis.shape[1]), dtype=bool)])
 
     @property
     def world(self) -> np.ndarray:
