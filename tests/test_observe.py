@@ -18,7 +18,7 @@ from plugins.dtw import frame_distance
 from plugins.metrics import segmentation_scores
 from plugins.mocap_benchmark import make_data, read_segments, recognition
 from tests.conftest import BANDAI, CHARACTERS
-from toolkit import ConfigError, create_plugin_manager, load_character
+from toolkit import ConfigError, Motion, create_plugin_manager, load_character
 from toolkit.cli import main
 from toolkit.observe import Observer, compose_observer
 from toolkit.profile import load_profile
@@ -175,6 +175,21 @@ def test_every_clip_is_watched_from_the_hub_whatever_came_before(data, profile, 
     again = observer.classify(nod)
     assert character.matcher.start_node == "hub"
     assert (again.movement, again.decided_at) == (alone.movement, alone.decided_at) == ("nod", alone.decided_at)
+
+
+def test_a_demonstration_watched_from_a_few_frames_in_is_still_predicted(data, profile, pm):
+    """A segment often begins after its movement did (a hub threshold is crossed once the body has left the hub):
+    each part is predicted from the point of its stroke nearest to where it was first seen, so the forward model
+    still commits early. Predicted from the strokes' starts, every candidate dropped out at once."""
+    character = compose_observer(pm, profile, data / "repertoire", matcher="forward-model")
+    observer = Observer(character, profile.body, 30.0)
+    for movement in ("salute", "stretch", "jump"):
+        motion = profile.read(data / "demos" / movement / "morris_1.0.bvh")
+        for late in (0, 3):
+            cut = Motion(motion.positions[late:], motion.fps, motion.parts, motion.visible[late:])
+            obs = observer.classify(cut)
+            assert obs.movement == movement and obs.decision_fraction < 0.5, (movement, late, obs)
+        assert character.matcher.main.anchors[character.matcher.committed_path[0]].max() > 0.01
 
 
 def test_a_movement_begun_at_the_hub_is_followed_from_the_hub_wherever_the_last_one_left_off(data, profile, pm):
