@@ -352,7 +352,8 @@ def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
         print(json.dumps(report, indent=1))
         return 0
     for entry in report:
-        print(f"{entry['file']}: {entry['frames']} frames at {entry['fps']:g} fps, {len(entry['segments'])} segments")
+        n = len(entry["segments"])
+        print(f"{entry['file']}: {entry['frames']} frames at {entry['fps']:g} fps, {n} segment{'' if n == 1 else 's'}")
         for seg in entry["segments"]:
             print(f"  frames {seg['start_frame']:5d}-{seg['end_frame']:<5d} ({seg['start_s']:6.2f}-{seg['end_s']:6.2f} s)  "
                   f"{seg['movement']:<16} confidence {seg['confidence']:.2f}  decided at frame {seg['decided_at_frame']} "
