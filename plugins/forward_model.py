@@ -18,6 +18,14 @@ which the edge would have covered the same length of path as has been observed,
 so a familiar movement performed faster or slower still fits; the ratio of the
 two times re-parameterises the command's speed for the imitation.
 
+Joining late: a segment often begins after its movement did (a hub threshold is
+crossed once the body has left the hub; a take is cropped in motion). Each part
+is then predicted from the point of its stroke, in the stroke's first half,
+nearest to where it was first seen (the anchor), not from the stroke's start.
+And a subsystem whose active node is not its hub begins at the hub instead when
+the body is seen nearer to the hub's state than to the active node's (a
+demonstrator who returned to rest without the matcher following him there).
+
 *True imitation* (§4.3, Fig. 3 top): when no edge predicts the demonstration,
 the working memory of the segment is cut into strokes by the velocity/direction
 segmenter's break points and each stroke is turned into a guiding stroke by the
@@ -299,6 +307,7 @@ class ForwardModel(Matcher):
         return active if far[0] <= far[1] else "hub"
 
     def _distance_to(self, name: str, state: np.ndarray, seen: np.ndarray) -> float:
+        """How far the parts seen (k, 3) are from a state of subsystem ``name``, combined as ``error`` says."""
         d = np.linalg.norm(state - seen, axis=-1) * self._scale_of(name)
         return float(np.nanmax(d) if self.params["error"] == "max" else np.nanmean(d))
 
