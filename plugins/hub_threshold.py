@@ -185,13 +185,7 @@ class HubThreshold(Segmenter):
         distance itself without a floor). Frames with nothing visible hold the last value.
         """
         self.reset(motion.parts, motion.fps)
-        ok = self._index >= 0
-        obs = np.zeros((motion.n_frames, *self.template.shape))
-        vis = np.zeros((motion.n_frames, len(self.template)), dtype=bool)
-        obs[:, ok] = motion.positions[:, self._index[ok]]
-        vis[:, ok] = motion.visible[:, self._index[ok]]
-        raw = _nearest(pose_distance(obs[:, None], self.templates, vis[:, None]), axis=-1)
-        raw = _hold(raw)
+        raw = _hold(self.distances(motion.positions, motion.visible))
         if raw.size == 0:
             return raw, raw, raw
         filtered, _ = lfilter(self._b, self._a, raw, zi=lfilter_zi(self._b, self._a) * raw[0])
@@ -206,14 +200,9 @@ class HubThreshold(Segmenter):
         return self.params["threshold"], self.params["threshold"] * self.params["release"]
 
     def segment(self, motion: Motion) -> list[Segment]:
-        _, filtered, _ = self.signal(motion)
         self.reset(motion.parts, motion.fps)
-        out: list[Segment] = []
-        for value in filtered:
-            self._frame += 1
-            out.extend(self._step(float(value)))
-        out.extend(self.flush())
-        return out
+        closed, _ = self.push_block(motion.positions, motion.visible)
+        return [segment for _, segment in closed] + self.flush()
 
 
 def _nearest(distances: np.ndarray, axis: int = -1) -> np.ndarray:
