@@ -183,7 +183,7 @@ class Observer:
                 if early is None and match is not None and not match.details.get("stop"):
                     early = match
         segment = Segment(0, max(1, motion.n_frames), self.fps)
-        late = c.matcher.conclude(Motion(poses.copy(), self.fps, self.body.parts, seen.copy()))
+        late = c.matcher.conclude(self.memory.motion())
         return _answer(segment, early, late)
 
     def flush(self) -> list[Observation]:
