@@ -149,7 +149,8 @@ class PathSearch(Matcher):
             beam = np.repeat(np.arange(len(reach)), [len(r) for r in reach])
             cand = np.concatenate(reach)
             seen = vis[t]
-            if seen.any():  # eq. 1 over the parts seen in this sample
+            if seen.any():  # eq. 1 over the parts seen in this sample (pose_distance without its masking: the hot
+                # loop of the search; the mask is the same for every candidate, so the seen parts are taken first)
                 diff = nodes[cand][:, seen] - obs[t, seen]
                 step = np.sqrt(np.einsum("npi,npi->np", diff, diff)).mean(axis=1)
             else:
