@@ -7,8 +7,8 @@ import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from plugins.guiding_stroke import SHAPES, GuidingStroke, progress, velocity_profile
-from plugins.inverse_model import stroke_from_segment, trajectory_error
+from plugins.lib.guiding_stroke import SHAPES, GuidingStroke, progress, velocity_profile
+from plugins.lib.inverse_model import stroke_from_segment, trajectory_error
 
 vec = st.tuples(st.floats(-0.4, 0.4), st.floats(0.6, 1.4), st.floats(0.0, 0.5)).map(np.array)
 

@@ -13,7 +13,7 @@ import json
 import numpy as np
 import pytest
 
-from plugins.guiding_stroke import GuidingStroke
+from plugins.lib.guiding_stroke import GuidingStroke
 from tests.conftest import CHARACTERS, play_recording_postures
 from toolkit import create_plugin_manager, load_character
 
@@ -145,7 +145,7 @@ def test_an_interrupted_motion_goes_back_to_the_motor_state_the_others_to_their_
     rest = motor.rest
     reach = motor.learn("left_wrist", "hub", [GuidingStroke(rest[w], rest[w] + [0.0, 0.3, 0.2], 1.0)])
     fist = rest[hand] + np.radians([50.0, 60.0, 0.0])
-    from plugins.hand_transition import HandTransition
+    from plugins.lib.hand_transition import HandTransition
 
     close = motor.learn("left_hand", "hub", [HandTransition(np.stack([s, e]), np.array([0.0, 1.0]))
                                              for s, e in zip(rest[hand], fist)])

@@ -10,11 +10,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from plugins.guiding_stroke import progress
-from plugins.hand_transition import HandTransition
-from plugins.inverse_model import transitions_from_segment
-from plugins.motor_command_graph import command_from_dict
-from plugins.velocity_direction import VelocityDirection
+from plugins.lib.guiding_stroke import progress
+from plugins.lib.hand_transition import HandTransition
+from plugins.lib.inverse_model import transitions_from_segment
+from plugins.motor.motor_command_graph import command_from_dict
+from plugins.segmenters.velocity_direction import VelocityDirection
 from tests.conftest import CHARACTERS
 from toolkit import Body, ConfigError, create_plugin_manager, load_character, load_scenario
 
@@ -67,7 +67,7 @@ def test_key_poses_give_finger_angles_in_degrees_and_shift_moves_positions_only(
     index = moritz.body.index("left_index")
     np.testing.assert_allclose(rest[index], np.radians([20.0, 25.0, 5.0]))
     np.testing.assert_allclose(fist[index], np.radians([85.0, 95.0, 0.0]))
-    from plugins.key_poses import parse_poses
+    from plugins.motor.key_poses import parse_poses
 
     table = {"rest": {p: (v.tolist() if not moritz.body.angle_mask[i] else np.degrees(v).tolist())
                       for i, (p, v) in enumerate(zip(moritz.body.parts, rest))},
@@ -146,7 +146,7 @@ def test_the_segmenter_finds_the_via_posture_at_the_angular_velocity_minimum():
 
 
 def test_finger_angles_pass_through_perception_seen_with_their_wrist(pm):
-    from plugins.motion_capture import MotionCapture
+    from plugins.perception.motion_capture import MotionCapture
 
     moritz = load_character("moritz", pm)
     body = moritz.body

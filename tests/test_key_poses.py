@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from plugins.key_poses import interpolate
+from plugins.motor.key_poses import interpolate
 from tests.conftest import CHARACTERS
 from toolkit import load_character
 

@@ -7,7 +7,7 @@ import json
 from hypothesis import given
 from hypothesis import strategies as st
 
-from plugins.metrics import edit_distance, match_segments, movement_error_rate, segmentation_scores
+from plugins.bench.metrics import edit_distance, match_segments, movement_error_rate, segmentation_scores
 from tests.test_cli import likeme
 
 

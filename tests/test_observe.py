@@ -13,10 +13,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from plugins.clip_repertoire import load_clip_repertoire
-from plugins.dtw import frame_distance
-from plugins.metrics import segmentation_scores
-from plugins.mocap_benchmark import make_data, read_segments, recognition
+from plugins.lib.clip_repertoire import load_clip_repertoire
+from plugins.matchers.dtw import frame_distance
+from plugins.bench.metrics import segmentation_scores
+from plugins.bench.data import make_data, read_segments
+from plugins.bench.mocap import recognition
 from tests.conftest import BANDAI, CHARACTERS
 from toolkit import ConfigError, Motion, create_plugin_manager, load_character
 from toolkit.cli import main

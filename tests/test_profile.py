@@ -101,7 +101,7 @@ def test_the_shipped_bandai_namco_profile_loads():
 
 @pytest.mark.skipif(not BANDAI.is_dir(), reason=f"Bandai-Namco motion capture not found at {BANDAI}")
 def test_the_facing_of_every_bandai_namco_clip_is_steady():
-    from plugins.root_frame import facing_heading
+    from plugins.lib.root_frame import facing_heading
 
     profile = load_profile(CHARACTERS / "profiles" / "bandai-namco.toml")
     flips = frames = 0

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from plugins.root_frame import HeadingFilter, facing_heading, to_root_relative
+from plugins.lib.root_frame import HeadingFilter, facing_heading, to_root_relative
 from tests.conftest import CHARACTERS
 from toolkit import load_character
 from toolkit.motion import local_to_world

@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from plugins.demonstration import perform_sequence, watch
-from plugins.rendering import hex_to_rgb
+from plugins.views.demonstration import perform_sequence, watch
+from plugins.lib.rendering import hex_to_rgb
 from toolkit import Motion, create_plugin_manager, load_character
 from toolkit.cli import main
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from plugins.sensory_buffer import SensoryBuffer
-from plugins.synthetic_vision import line_of_sight_blocked
+from plugins.perception.sensory_buffer import SensoryBuffer
+from plugins.perception.synthetic_vision import line_of_sight_blocked
 from tests.conftest import CHARACTERS
 from toolkit import World, WorldObject, load_character
 

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from plugins.rendering import draw_bodies, frame_2d, hex_to_rgb, part_colours, plotter
+from plugins.lib.rendering import draw_bodies, frame_2d, hex_to_rgb, part_colours, plotter
 from tests.conftest import STICK
 from toolkit import World, create_plugin_manager, load_character
 from toolkit.cli import main
@@ -115,7 +115,7 @@ def test_a_scenario_renders_to_png_frames_gif_and_mp4_at_its_frame_rate(tmp_path
 
 
 def test_the_scenario_view_greys_parts_the_observer_does_not_see(tmp_path):
-    from plugins.scenario_view import ScenarioView
+    from plugins.views.scenario import ScenarioView
 
     pm = create_plugin_manager(autoload=False)
     scenario = load_scenario("jump_then_cover_face", pm)
@@ -143,8 +143,8 @@ def watching():
 
 
 def test_rendered_vision_sees_what_synthetic_vision_sees_at_the_same_positions(watching):
-    from plugins.rendered_vision import RenderedVision
-    from plugins.synthetic_vision import SyntheticVision
+    from plugins.perception.rendered_vision import RenderedVision
+    from plugins.perception.synthetic_vision import SyntheticVision
 
     world = watching
     observer, target = world.actors["max"], world.actors["morris"]
@@ -170,7 +170,7 @@ def test_rendered_vision_sees_what_synthetic_vision_sees_at_the_same_positions(w
 
 
 def test_rendered_vision_hides_a_part_behind_an_object_and_outside_the_field_of_view(write):
-    from plugins.rendered_vision import RenderedVision
+    from plugins.perception.rendered_vision import RenderedVision
     from toolkit import WorldObject
 
     pm = create_plugin_manager(autoload=False)
@@ -201,7 +201,7 @@ def test_a_character_can_watch_with_rendered_vision(write):
     pm = create_plugin_manager(autoload=False)
     scenario = load_scenario("jump_then_cover_face", pm)
     max_ = scenario.world.actors["max"].character
-    from plugins.rendered_vision import RenderedVision
+    from plugins.perception.rendered_vision import RenderedVision
 
     max_.perception = RenderedVision(resolution=320, facing_window=max_.perception.params["facing_window"])
     max_.perception.attach(max_)
@@ -236,7 +236,7 @@ def test_a_third_party_view_registers_through_the_hook_and_draws(tmp_path):
 
 
 def test_the_vision_benchmark_compares_both_perceptions_on_the_same_frames():
-    from plugins.benchmark import vision_benchmark
+    from plugins.bench.vision import vision_benchmark
 
     rows = vision_benchmark(create_plugin_manager(autoload=False), "jump_then_cover_face", "max", [240], 20)
     assert [r["perception"] for r in rows] == ["synthetic-vision", "rendered-vision 240 px"]

@@ -153,7 +153,7 @@ def load_profile(path: str | Path) -> BodyProfile:
     else:
         raise fail(f"invalid units {units!r}", ("profile", "units"), expected="a unit name or a positive number")
     up = head.get("up", "+y")
-    if up not in UP_AXES:
+    if not isinstance(up, str) or up not in UP_AXES:
         raise fail(f"unknown up axis {up!r}", ("profile", "up"), expected="an axis", available=UP_AXES)
     parts = table.get("parts")
     if not isinstance(parts, Mapping) or not parts:

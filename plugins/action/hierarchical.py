@@ -1,0 +1,298 @@
+"""Action system ``hierarchical``: a motivational hierarchy of action tuples (Buchsbaum & Blumberg 2005, §6).
+
+Acting: drives rise over time. When the character is idle, the top-level
+tuples (one per motivational subsystem) compete; a tuple's value is the product
+of its should-I and can-I trigger values, and the winner is drawn with
+probability proportional to ``exp(value / temperature)`` among those whose
+value is positive (so one tuple is active per level and the character does not
+dither). The object selection trigger of the winner picks the object of
+attention for everything below it. The same competition repeats in each level's
+action group down to a leaf, whose movement is requested from the motor system.
+When the movement ends its effect is applied (grasp the object, consume it and
+satisfy the drive, toss it) and the do-until contexts are checked.
+
+While acting the character keeps two maps (§6.1, §7.4):
+
+- the *movement-action correspondence map*: for each movement, how often each
+  path of tuples (top to leaf) was active when it was performed;
+- the *transition map*: how often one leaf tuple followed another.
+
+Watching: :meth:`Hierarchical.interpret` identifies the target's behaviour with
+the observer's own hierarchy (:mod:`plugins.action.behaviour_identification`), and
+:meth:`Hierarchical.respond` imitates the movement or, when the behaviour could
+not be identified, shrugs.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from typing import Any
+
+import numpy as np
+
+from plugins.action.action_tuple import ActionHierarchy, ActionTuple, parse_hierarchy
+from plugins.triggers.drives import Drive, parse_drives
+from toolkit import ActionSystem, Behaviour, ConfigError, MovementRequest, Parameter, TriggerContext, hookimpl
+
+__all__ = ["Hierarchical"]
+
+
+class Hierarchical(ActionSystem):
+    """Motivational hierarchy of action tuples with can-I / should-I triggers; identifies others' behaviour (§6)."""
+
+    name = "hierarchical"
+    parameters = (
+        Parameter("drives", dict, doc="Drives by name: { level = 0..1, rate = rise per second }."),
+        Parameter("beliefs", dict, {}, "What each object type affords, as this character believes: { cheese = \"food\" }."),
+        Parameter("tuples", dict, doc="Action tuples by name (see plugins/action/action_tuple.py and the character format)."),
+        Parameter("experience", dict, {}, "Prior correspondence counts: { MOVEMENT = { \"top > ... > leaf\" = COUNT } }, "
+                  "what the character has done before this run."),
+        Parameter("temperature", float, 0.1, "Randomness of the competition between tuples (0: always the best).", minimum=0.0),
+        Parameter("pause", float, 0.5, "Seconds between the end of one behaviour and the next decision.", minimum=0.0),
+        Parameter("identify", bool, True, "Identify the behaviour behind recognised movements of others (§6.1)."),
+        Parameter("learn_affordances", bool, True, "Learn what unknown objects afford by watching (§6.3)."),
+        Parameter("sight_angle", float, 20.0, "Degrees (horizontal) around the target's head-to-nose line within which "
+                  "an object counts as in its line of sight (§6.1.2).", minimum=0.0, maximum=180.0),
+        Parameter("gaze", list, ["head", "nose"], "The target's parts whose line gives its line of sight.", items=str),
+        Parameter("imitate", bool, False, "Imitate every recognised movement (§5.3); takes precedence over shrugging."),
+        Parameter("shrug", str, "", "Movement performed when a behaviour cannot be identified (\"I don't know\"); empty: none."),
+        Parameter("seed", int, 0, "Seed of the probabilistic competition."),
+    )
+
+    def attach(self, owner: Any) -> None:
+        super().attach(owner)
+        movements = owner.motor.movements()
+        self.drives: dict[str, Drive] = parse_drives(self.params["drives"])
+        if owner.pm is None:
+            raise ConfigError("the hierarchical action system needs a plugin manager for its triggers")
+        self.hierarchy: ActionHierarchy = parse_hierarchy(self.params["tuples"], owner.pm.registry, movements, list(self.drives))
+        for key, value in self.params["beliefs"].items():
+            if not isinstance(value, str):
+                raise ConfigError(f"invalid belief {value!r}", key=("beliefs", key), expected="a category name (food, toy)")
+        if self.params["shrug"] and self.params["shrug"] not in movements:
+            raise ConfigError(f"unknown movement {self.params['shrug']!r}", key=("shrug",), expected="a movement of this character", available=movements)
+        self.beliefs: dict[str, str] = dict(self.params["beliefs"])
+        self.correspondence: dict[str, Counter[tuple[str, ...]]] = {}
+        for movement, counts in self.params["experience"].items():
+            if movement not in movements or not isinstance(counts, dict):
+                raise ConfigError(f"invalid experience for {movement!r}", key=("experience", movement),
+                                  expected="a movement mapped to { \"path > of > tuples\" = count }", available=movements)
+            for path_text, n in counts.items():
+                path = tuple(p.strip() for p in path_text.split(">"))
+                known = path[-1] in self.hierarchy.tuples and path in self.hierarchy.paths_to(path[-1])
+                if not known or self.hierarchy.tuples[path[-1]].movement != movement:
+                    raise ConfigError(f"not a path of the hierarchy: {path_text!r}", key=("experience", movement, path_text),
+                                      expected="top > ... > leaf tuple names joined by '>'")
+                self.correspondence.setdefault(movement, Counter())[path] += int(n)
+        self.transitions: Counter[tuple[str, str]] = Counter()
+        self.history: list[tuple[int, tuple[str, ...], str | None]] = []  # (frame, path, object) of each behaviour begun
+        self._rng = np.random.default_rng(self.params["seed"])
+        self._current: tuple[tuple[str, ...], str | None] | None = None
+        self._last_leaf: str | None = None
+        self._last_time: float | None = None
+        self._idle_since: float | None = None
+
+    # -- acting --------------------------------------------------------------------------
+
+    def context(self, actor: Any, world: Any, obj: str | None) -> TriggerContext:
+        return TriggerContext(actor, world, obj, self.beliefs, {n: d.level for n, d in self.drives.items()})
+
+    def value(self, t: ActionTuple, context: TriggerContext) -> tuple[float, str | None]:
+        """A tuple's value (product of its trigger values) and the object of attention it selects."""
+        obj = context.object
+        if t.select is not None:
+            obj = t.select.select(context)
+            if obj is None:
+                return 0.0, None
+            context = TriggerContext(context.actor, context.world, obj, context.beliefs, context.drives, context.params)
+        v = 1.0
+        for trigger in (*t.should, *t.can):
+            v *= trigger.evaluate(context)
+            if v <= 0:
+                return 0.0, obj
+        return v, obj
+
+    def _compete(self, names: list[str], context: TriggerContext) -> tuple[str, str | None] | None:
+        scored = [(n, *self.value(self.hierarchy.tuples[n], context)) for n in names]
+        scored = [(n, v, o) for n, v, o in scored if v > 0]
+        if not scored:
+            return None
+        values = np.array([v for _, v, _ in scored])
+        temp = self.params["temperature"]
+        if temp <= 0:
+            i = int(np.argmax(values))
+        else:
+            p = np.exp((values - values.max()) / temp)
+            i = int(self._rng.choice(len(scored), p=p / p.sum()))
+        return scored[i][0], scored[i][2]
+
+    def decide(self, actor: Any, world: Any) -> tuple[tuple[str, ...], str | None] | None:
+        """The path of tuples (top to leaf) and object the character would act on now, or ``None``."""
+        context = self.context(actor, world, None)
+        names, path = self.hierarchy.top, []
+        obj = None
+        while True:
+            won = self._compete(names, context)
+            if won is None:
+                return None
+            name, obj = won
+            path.append(name)
+            context = TriggerContext(actor, world, obj, context.beliefs, context.drives)
+            t = self.hierarchy.tuples[name]
+            if t.leaf:
+                return tuple(path), obj
+            names = t.children
+
+    def choose(self, actor: Any, world: Any) -> MovementRequest | None:
+        now = world.time
+        if self._last_time is not None:
+            for drive in self.drives.values():
+                drive.rise(now - self._last_time)
+        self._last_time = now
+        if self._idle_since is None:
+            self._idle_since = now
+        if now - self._idle_since < self.params["pause"]:
+            return None
+        decision = self.decide(actor, world)
+        if decision is None:
+            return None
+        path, obj = decision
+        self._current = decision
+        self._idle_since = None
+        leaf = self.hierarchy.tuples[path[-1]]
+        reason = " > ".join(path) + (f" ({obj})" if obj else "")
+        return MovementRequest(leaf.movement, reason=reason, object=obj)
+
+    def performed(self, actor: Any, request: MovementRequest, world: Any) -> None:
+        if self._current is None or request.imitating is not None:
+            return
+        path, _ = self._current
+        if self.hierarchy.tuples[path[-1]].movement != request.movement:
+            return
+        self.correspondence.setdefault(request.movement, Counter())[path] += 1
+        self.history.append((world.frame, path, self._current[1]))
+        if self._last_leaf is not None:
+            self.transitions[(self._last_leaf, path[-1])] += 1
+        self._last_leaf = path[-1]
+
+    def completed(self, actor: Any, request: MovementRequest, world: Any) -> None:
+        self._idle_since = world.time
+        if self._current is None or request.imitating is not None:
+            return
+        path, obj = self._current
+        self._current = None
+        leaf = self.hierarchy.tuples[path[-1]]
+        if leaf.movement != request.movement:
+            return
+        target = world.objects.get(obj) if obj else None
+        if leaf.effect == "grasp" and target is not None:
+            context = self.context(actor, world, obj)
+            if all(t.evaluate(context) > 0 for t in leaf.can):  # still within reach when the movement ends
+                target.held_by = actor.id
+                target.properties["held_in"] = target.properties.get("held_in", "right_hand")
+        elif leaf.effect == "consume" and target is not None and target.held_by == actor.id:
+            world.remove_object(obj)
+            self._satisfy(path, leaf)
+        elif leaf.effect == "toss" and target is not None and target.held_by == actor.id:
+            target.held_by = None
+            front = actor.world_pose()[actor.body.root_index]
+            heading = np.array([np.sin(actor.heading), 0.0, np.cos(actor.heading)])
+            target.position = np.array([front[0], target.radius, front[2]]) + 0.35 * heading
+            self._satisfy(path, leaf)
+
+    def _satisfy(self, path: tuple[str, ...], leaf: ActionTuple) -> None:
+        drive = self.hierarchy.drive_of(path)
+        if drive is not None and leaf.satisfies > 0:
+            self.drives[drive].satisfy(leaf.satisfies)
+
+    # -- watching ------------------------------------------------------------------------
+
+    def interpret(self, actor: Any, target: Any, segment: Any, match: Any, world: Any) -> Behaviour | None:
+        if not self.params["identify"] or not match.known:
+            return None
+        from plugins.action.behaviour_identification import identify
+
+        if segment is not None:
+            start = actor.watch_start + segment.start
+            middle = (segment.start + segment.end) // 2
+        else:  # committed early: the segment began decided_at frames ago
+            start = world.frame - (match.decided_at or 0)
+            middle = actor.memory.n - 1 - (match.decided_at or 0) // 2
+        return identify(self, actor, target, match.movement, start, middle, world)
+
+    def respond(self, actor: Any, target: Any, match: Any, behaviour: Behaviour | None, world: Any) -> MovementRequest | None:
+        """Imitate the movement (if ``imitate``); otherwise shrug at a behaviour it cannot identify (if ``shrug``)."""
+        if self.params["imitate"] and match.known and match.movement in actor.character.motor.movements():
+            return MovementRequest(match.movement, reason=f"imitating {target.id}'s {match.movement}", imitating=target.id)
+        if behaviour is not None and not behaviour.known and self.params["shrug"]:
+            return MovementRequest(self.params["shrug"], reason=f"does not know why {target.id} did {match.movement}")
+        return None
+
+    # -- reports ---------------------------------------------------------------------------
+
+    def most_frequent_path(self, movement: str) -> tuple[str, ...] | None:
+        counts = self.correspondence.get(movement)
+        return counts.most_common(1)[0][0] if counts else None
+
+    def get_state(self) -> dict[str, Any]:
+        """Drives, beliefs, the correspondence and transition maps: everything this character learns by acting and watching."""
+        return {
+            "drives": {n: d.level for n, d in self.drives.items()},
+            "beliefs": dict(self.beliefs),
+            "correspondence": {m: {" > ".join(p): n for p, n in c.items()} for m, c in self.correspondence.items()},
+            "transitions": [[a, b, n] for (a, b), n in self.transitions.items()],
+        }
+
+    def set_state(self, state: dict[str, Any]) -> None:
+        known = ("drives", "beliefs", "correspondence", "transitions")
+        for key in state:
+            if key not in known:
+                raise ConfigError(f"unknown key {key!r}", key=(key,), expected="a hierarchical state key", available=known)
+        for name, level in state.get("drives", {}).items():
+            if name not in self.drives:
+                raise ConfigError(f"unknown drive {name!r}", key=("drives", name), expected="a drive of this character", available=list(self.drives))
+            if isinstance(level, bool) or not isinstance(level, (int, float)) or not 0 <= level <= 1:
+                raise ConfigError(f"invalid level {level!r}", key=("drives", name), expected="a number in [0, 1]")
+            self.drives[name].level = float(level)
+        beliefs = state.get("beliefs", {})
+        if not all(isinstance(v, str) for v in beliefs.values()):
+            raise ConfigError("invalid beliefs", key=("beliefs",), expected="object types mapped to categories")
+        self.beliefs = dict(beliefs)
+        self.correspondence = {}
+        for movement, counts in state.get("correspondence", {}).items():
+            for text, n in counts.items():
+                path = tuple(p.strip() for p in text.split(">"))
+                if path[-1] not in self.hierarchy.tuples or path not in self.hierarchy.paths_to(path[-1]):
+                    raise ConfigError(f"not a path of the hierarchy: {text!r}", key=("correspondence", movement, text),
+                                      expected="top > ... > leaf tuple names")
+                self.correspondence.setdefault(movement, Counter())[path] = int(n)
+        self.transitions = Counter()
+        for i, item in enumerate(state.get("transitions", [])):
+            if not (isinstance(item, list) and len(item) == 3 and all(x in self.hierarchy.tuples for x in item[:2])):
+                raise ConfigError(f"invalid transition {item!r}", key=("transitions", i), expected="[from_leaf, to_leaf, count]")
+            self.transitions[(item[0], item[1])] = int(item[2])
+
+    def render(self) -> str:
+        lines = ["action hierarchy (top level: motivational subsystems; children: the next level's action group):"]
+        lines += ["  " + line for line in self.hierarchy.render().splitlines()]
+        lines.append("drives: " + ", ".join(f"{n} {d.level:.2f} (+{d.rate:g}/s)" for n, d in self.drives.items()))
+        lines.append("beliefs: " + (", ".join(f"{k} is {v}" for k, v in sorted(self.beliefs.items())) or "none"))
+        lines.append("movement-action correspondence map:")
+        for movement, counts in sorted(self.correspondence.items()):
+            paths = ", ".join(f"{' > '.join(p)} x{n}" for p, n in counts.most_common())
+            lines.append(f"  {movement}: {paths}")
+        if self.transitions:
+            lines.append("transition map: " + ", ".join(f"{a} -> {b} x{n}" for (a, b), n in self.transitions.most_common()))
+        return "\n".join(lines)
+
+    def describe(self) -> dict[str, Any]:
+        return {
+            "tuples": len(self.hierarchy.tuples),
+            "drives": {n: round(d.level, 3) for n, d in self.drives.items()},
+            "beliefs": dict(self.beliefs),
+        }
+
+
+@hookimpl
+def likeme_register_action_systems():
+    return [Hierarchical]

@@ -1,0 +1,120 @@
+"""``likeme bench behaviour``: an observer identifies what a demonstrator does and why (Buchsbaum & Blumberg 2005, §6).
+
+Random episodes in which Morris is hungry or playful and food and a toy lie around him (the one he wants in front
+of him, the other to his side, or both close together; with or without a screen that hides his head and nose from
+Max). Max watches and identifies the first behaviour; the accuracy of the identified tuple path, motivation (the
+top-level tuple) and object is reported per condition against what Morris really did.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from toolkit import World, load_character
+from toolkit.state import write_atomic
+
+__all__ = ["BEHAVIOUR_CONDITIONS", "behaviour_benchmark", "render_behaviour", "cmd_behaviour"]
+
+
+BEHAVIOUR_CONDITIONS = ("line-of-sight", "no-line-of-sight", "close-together")
+
+
+def _episode(pm: Any, rng: np.random.Generator, condition: str) -> dict[str, Any]:
+    """One random episode: Morris is hungry or playful, food and a toy lie around him; Max watches and identifies."""
+    from toolkit import WorldObject
+
+    drive = str(rng.choice(["hunger", "play"]))
+    morris = load_character("morris", pm, override={"action": {"drives": {
+        "hunger": {"level": 0.8 if drive == "hunger" else 0.0, "rate": 0.0},
+        "play": {"level": 0.8 if drive == "play" else 0.0, "rate": 0.0}}, "seed": int(rng.integers(1 << 30))}})
+    max_ = load_character("max", pm, override={"action": {"imitate": False}})
+    world = World(fps=30.0, pm=pm)
+    target = world.add_actor(morris, "morris", (0.0, 0.0, 1.6), np.pi)
+    watcher = world.add_actor(max_, "max", (0.0, 0.0, 0.0), 0.0)
+    watcher.watch(target)
+    wanted = "cheese" if drive == "hunger" else str(rng.choice(["ball", "baton"]))
+    other = str(rng.choice(["ball", "baton"])) if drive == "hunger" else "cheese"
+
+    def place(azimuth_deg: float, distance: float, high: bool) -> np.ndarray:
+        a = np.radians(azimuth_deg)  # 0: straight ahead of Morris (towards -z)
+        height = rng.uniform(0.75, 1.0) if high else rng.uniform(0.3, 0.5)
+        return np.array([distance * np.sin(a), height, 1.6 - distance * np.cos(a)])
+
+    high = bool(rng.random() < 0.3)
+    pos_wanted = place(rng.uniform(-12, 12), rng.uniform(0.25, 0.42), high)
+    if condition == "close-together":
+        pos_other = pos_wanted + np.array([rng.normal(0, 0.02), rng.uniform(-0.02, 0.02), rng.normal(0, 0.02)])
+    else:
+        side = rng.choice([-1.0, 1.0])
+        pos_other = place(side * rng.uniform(45, 80), rng.uniform(0.25, 0.42), bool(rng.random() < 0.3))
+    world.add_object(WorldObject(wanted, wanted, pos_wanted, radius=0.035))
+    world.add_object(WorldObject(other, other, pos_other, radius=0.035))
+    if condition == "no-line-of-sight":
+        world.add_object(WorldObject("screen", "screen", (0.0, 0.62, 1.0), radius=0.12))
+    world.run(until_idle=True, tail=1.0, max_duration=12.0)
+    truth = target.character.action.history
+    first = truth[0] if truth else None
+    got = None
+    if first is not None:  # Max's identification of that same movement (not of a later one)
+        movement = target.character.action.hierarchy.tuples[first[1][-1]].movement
+        got = next((b for b in world.behaviours("max") if b.movement == movement), None)
+    return {
+        "condition": condition,
+        "drive": drive,
+        "object": wanted,
+        "true_path": list(first[1]) if first else None,
+        "true_object": first[2] if first else None,
+        "identified": bool(got is not None and got.known),
+        "path": list(got.path) if got is not None and got.known else None,
+        "identified_object": got.object if got is not None and got.known else None,
+    }
+
+
+def behaviour_benchmark(pm: Any, *, episodes: int = 100, seed: int = 0, progress: bool = False) -> dict[str, Any]:
+    """Identification accuracy (tuple path, motivation, object) per condition over random episodes (B&B §6)."""
+    rng = np.random.default_rng(seed)
+    jobs = [c for c in BEHAVIOUR_CONDITIONS for _ in range(episodes)]
+    started = time.perf_counter()
+    if progress:
+        from rich.progress import track
+
+        jobs = track(jobs, description="behaviour episodes", transient=True)
+    rows = [_episode(pm, rng, c) for c in jobs]
+    elapsed = time.perf_counter() - started
+    table = {}
+    for c in BEHAVIOUR_CONDITIONS:
+        sub = [r for r in rows if r["condition"] == c and r["true_path"]]
+        n = max(len(sub), 1)
+        table[c] = {
+            "episodes": len(sub),
+            "identified": sum(r["identified"] for r in sub) / n,
+            "path": sum(r["path"] == r["true_path"] for r in sub) / n,
+            "motivation": sum(bool(r["path"]) and r["path"][0] == r["true_path"][0] for r in sub) / n,
+            "object": sum(r["identified_object"] == r["true_object"] for r in sub) / n,
+        }
+    return {"benchmark": "behaviour", "seed": seed, "episodes_per_condition": episodes, "conditions": table,
+            "episodes": rows, "seconds": elapsed, "python": platform.python_version(), "numpy": np.__version__}
+
+
+def render_behaviour(r: dict[str, Any]) -> str:
+    lines = [f"likeme bench behaviour: Max identifies what Morris does (seed {r['seed']}, {r['episodes_per_condition']} "
+             f"episodes per condition, {r['seconds']:.0f} s)",
+             f"  {'condition':<18} {'episodes':>8} {'identified':>10} {'path':>6} {'motivation':>10} {'object':>6}"]
+    for c, t in r["conditions"].items():
+        lines.append(f"  {c:<18} {t['episodes']:>8} {t['identified']:>10.3f} {t['path']:>6.3f} {t['motivation']:>10.3f} {t['object']:>6.3f}")
+    return "\n".join(lines)
+
+
+def cmd_behaviour(args: argparse.Namespace, pm: Any) -> int:
+    result = behaviour_benchmark(pm, episodes=args.episodes, seed=args.seed, progress=not args.quiet)
+    print(render_behaviour(result))
+    if args.json:
+        write_atomic(Path(args.json), json.dumps(result, indent=2, default=float) + "\n")
+    return 0

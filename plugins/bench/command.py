@@ -1,0 +1,126 @@
+"""The ``likeme bench`` command: one sub-command per benchmark (see :mod:`plugins.bench` and ``docs/benchmarks.md``).
+
+Only the parsers are built here; a benchmark's module is imported when its sub-command runs, so ``likeme`` starts
+without the benchmarks' imports.
+"""
+
+from __future__ import annotations
+
+import argparse
+from importlib import import_module
+from pathlib import Path
+from typing import Any
+
+from toolkit import hookimpl
+
+MATCHERS = ("path-search", "forward-model", "dtw")
+"""The matchers ``likeme bench recognition`` and ``stream`` compare when none is named."""
+SEGMENTERS = ("hub-threshold", "velocity-direction", "ruptures")
+"""The segmenters ``likeme bench segmentation`` compares when none is named (``stream``: the first two)."""
+
+
+def _handler(module: str, function: str, *extra: Any):
+    """A handler that imports ``plugins.bench.MODULE`` when it runs and calls ``FUNCTION(*extra, args, pm)``."""
+
+    def run(args: argparse.Namespace, pm: Any) -> int:
+        return getattr(import_module(f"plugins.bench.{module}"), function)(*extra, args, pm)
+
+    return run
+
+
+def _common(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--body", required=True, metavar="PROFILE", help="body profile TOML of the files")
+    p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
+                   help="override a parameter of the observer, e.g. --set matcher.k=4 (repeatable)")
+    p.add_argument("--json", metavar="FILE", help="also write the results as JSON")
+    p.add_argument("--csv", metavar="FILE", help="also write the results as CSV (one row per plugin and per item)")
+    p.add_argument("--plot", metavar="PNG", help="draw the results (confusion matrices, scores per plugin)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def _motion_capture_commands(sub: Any) -> None:
+    """``recognition``, ``segmentation`` and ``stream`` on motion-capture files, and the data they read."""
+    p = sub.add_parser("recognition", help="classify labelled demo clips with every matcher named")
+    _common(p)
+    p.add_argument("--repertoire", required=True, metavar="DIR", help="labelled clips: one folder per movement")
+    p.add_argument("--demos", required=True, metavar="DIR", help="demo clips: one folder per true movement")
+    p.add_argument("--matcher", action="append", metavar="NAME", help=f"matcher (repeatable; default: {', '.join(MATCHERS)})")
+    p.set_defaults(handler=_handler("mocap", "run", "recognition"))
+
+    p = sub.add_parser("segmentation", help="segment streams with known segments with every segmenter named")
+    _common(p)
+    p.add_argument("--streams", required=True, metavar="DIR", help="NAME.bvh files with NAME.segments.csv")
+    p.add_argument("--repertoire", metavar="DIR", help="clips the hubs are found from (default: the streams' ends)")
+    p.add_argument("--segmenter", action="append", metavar="NAME", help=f"segmenter (repeatable; default: {', '.join(SEGMENTERS)})")
+    p.set_defaults(handler=_handler("mocap", "run", "segmentation"))
+
+    p = sub.add_parser("stream", help="segment and recognise streams end to end with every pairing")
+    _common(p)
+    p.add_argument("--repertoire", required=True, metavar="DIR", help="labelled clips: one folder per movement")
+    p.add_argument("--streams", required=True, metavar="DIR", help="NAME.bvh files with NAME.segments.csv")
+    p.add_argument("--segmenter", action="append", metavar="NAME", help="segmenter (repeatable)")
+    p.add_argument("--matcher", action="append", metavar="NAME", help="matcher (repeatable)")
+    p.set_defaults(handler=_handler("mocap", "run", "stream"))
+
+    p = sub.add_parser("make-data", help="write repertoire, demos, streams and a profile from the built-in characters")
+    p.add_argument("dest", metavar="DIR")
+    p.add_argument("--seed", type=int, default=0)
+    p.set_defaults(handler=_handler("data", "cmd_make_data"))
+
+    p = sub.add_parser("bandai", help="build benchmark folders from the Bandai-Namco clips (links; nothing copied)")
+    p.add_argument("src", metavar="BANDAI_DIR")
+    p.add_argument("dest", metavar="DIR")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--profile", default=str(Path(__file__).resolve().parents[2] / "characters" / "profiles"
+                                            / "bandai-namco.toml"), help="the body profile to put beside the data")
+    p.set_defaults(handler=_handler("data", "cmd_bandai"))
+
+
+@hookimpl
+def likeme_register_commands(subparsers):
+    bench = subparsers.add_parser("bench", help="measure accuracy and speed (benchmarks)")
+    sub = bench.add_subparsers(dest="benchmark", metavar="BENCHMARK", parser_class=type(bench), required=True)
+    _motion_capture_commands(sub)
+
+    p = sub.add_parser("watch", help="an observer watches a demonstrator's random movements (B&B §5)")
+    p.add_argument("--observer", default="max", help="observer character (default: max)")
+    p.add_argument("--demonstrator", default="morris", help="demonstrator character (default: morris)")
+    p.add_argument("--movements", type=int, default=200, help="number of random movements (default: 200)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--noise", type=float, default=0.005, help="vision noise, metres (default: 0.005)")
+    p.add_argument("--dropout", type=float, default=0.05, help="per-part dropout probability (default: 0.05)")
+    p.add_argument("--no-occlusion", action="store_true", help="switch occlusion off")
+    p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
+                   help="override an observer parameter, e.g. --set segmenter.floor=0 (repeatable)")
+    p.add_argument("--json", metavar="FILE", help="also write the results as JSON")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(handler=_handler("watch", "cmd_watch"))
+
+    p = sub.add_parser("facilitation", help="Max learns Moritz's arm and finger movements and imitates familiar ones early (K&G §4-5)")
+    p.add_argument("--demonstrations", type=int, default=200, help="demonstrations after the repertoire (default: 200)")
+    p.add_argument("--repertoire", type=int, default=6, help="random movements learned first (default: 6)")
+    p.add_argument("--noise", type=float, default=0.002, help="observation noise, metres (default: 0.002)")
+    p.add_argument("--hands", type=float, default=0.3, help="share of finger movements of the left hand among the "
+                   "demonstrations (default: 0.3; 0: arms only)")
+    p.add_argument("--angle-noise", type=float, default=0.005, help="observation noise on finger joint angles, radians "
+                   "(default: 0.005)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--json", metavar="FILE", help="also write the results as JSON")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(handler=_handler("facilitation", "cmd_facilitation"))
+
+    p = sub.add_parser("behaviour", help="an observer identifies the behaviour, motivation and object of a demonstrator (B&B §6)")
+    p.add_argument("--episodes", type=int, default=100, help="random episodes per condition (default: 100)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--json", metavar="FILE", help="also write the results (every episode) as JSON")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(handler=_handler("behaviour", "cmd_behaviour"))
+
+    p = sub.add_parser("vision", help="rendered-vision against synthetic-vision on the same frames: agreement, "
+                       "position difference, milliseconds per frame")
+    p.add_argument("--scenario", default="jump_then_cover_face", help="scenario to watch (default: jump_then_cover_face)")
+    p.add_argument("--observer", default="max", help="the watching actor (default: max)")
+    p.add_argument("--resolution", type=int, action="append", help="rendered-vision resolution, repeatable "
+                   "(default: 240, 480, 960)")
+    p.add_argument("--frames", type=int, default=240, help="frames to compare (default: 240)")
+    p.set_defaults(handler=_handler("vision", "cmd_vision"))

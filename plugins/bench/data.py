@@ -1,0 +1,160 @@
+"""The folders the motion-capture benchmarks read, written from the project's own characters or from Bandai-Namco clips.
+
+- ``make_data``: ``repertoire/NAME/max.bvh`` (Max's own movements), ``demos/NAME/morris_S.bvh`` (Morris's versions
+  at three speeds, with noise), ``streams/stream_K.bvh`` with ``stream_K.segments.csv``, and ``profile.toml``;
+- ``bandai``: the same layout from the Bandai-Namco clips (links and generated streams; nothing is copied);
+- ``read_segments``: a stream's true segments (header ``start_frame,end_frame,movement``, end exclusive).
+"""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+
+from toolkit import ConfigError
+
+__all__ = ["read_segments", "make_data", "bandai"]
+
+
+def read_segments(path: Path) -> list[tuple[int, int, str]]:
+    """A ``NAME.segments.csv`` file: (start, end exclusive, movement) rows, checked, with the line of any error."""
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except OSError as exc:
+        raise ConfigError(f"cannot read ({exc.strerror})", file=path, expected="start_frame,end_frame,movement rows") from None
+    if not lines or [h.strip() for h in lines[0].split(",")] != ["start_frame", "end_frame", "movement"]:
+        raise ConfigError(f"found header {lines[0] if lines else ''!r}", file=path, line=1,
+                          expected="the header start_frame,end_frame,movement")
+    out = []
+    for number, row in enumerate(csv.reader(lines[1:]), 2):
+        if not row:
+            continue
+        try:
+            start, end, label = int(row[0]), int(row[1]), row[2].strip()
+        except (ValueError, IndexError):
+            raise ConfigError(f"found {','.join(row)!r}", file=path, line=number,
+                              expected="two frame numbers and a movement name") from None
+        if not 0 <= start < end:
+            raise ConfigError(f"segment {start}..{end}", file=path, line=number, expected="0 <= start_frame < end_frame")
+        out.append((start, end, label))
+    return out
+
+
+def make_data(pm, dest: Path, *, seed: int = 0, streams: int = 6, per_stream: int = 6, noise: float = 0.003) -> Path:
+    """Write a benchmark folder from the project's own characters.
+
+    ``repertoire/NAME/max.bvh``: Max's own movements; ``demos/NAME/morris_S.bvh``: Morris's versions of them at
+    speeds 0.8, 1.0 and 1.25 with observation noise; ``streams/stream_K.bvh`` with ``.segments.csv``: Morris's
+    movements one after another from his rest pose; ``profile.toml``: the body profile (metres, +y up).
+    """
+    from toolkit import load_character
+    from toolkit.bvh import from_joint_positions, write_bvh
+    from toolkit.character import resolve_file
+    from toolkit.motion import Motion, concatenate
+
+    rng = np.random.default_rng(seed)
+    max_c = load_character(resolve_file("max.toml", None, pm), pm)
+    morris = load_character(resolve_file("morris.toml", None, pm), pm)
+    body = max_c.body
+    root = body.root_index
+    order = [root] + [i for i in range(body.n_parts) if i != root]
+    names = [body.parts[i] for i in order]
+    parents = [-1] + [0] * (len(order) - 1)
+
+    def save(motion, path: Path, jitter: float = 0.0) -> None:
+        positions = motion.positions[:, order] + rng.normal(0.0, jitter, motion.positions.shape) if jitter else \
+            motion.positions[:, order]
+        path.parent.mkdir(parents=True, exist_ok=True)
+        write_bvh(from_joint_positions(names, parents, positions, motion.fps), path)
+
+    dest = Path(dest)
+    movements = [m for m in max_c.motor.movements() if m in morris.motor.movements()]
+    for m in movements:
+        save(max_c.motor.perform(m, fps=30.0), dest / "repertoire" / m / "max.bvh")
+        for speed in (0.8, 1.0, 1.25):
+            save(morris.motor.perform(m, fps=30.0, speed=speed), dest / "demos" / m / f"morris_{speed}.bvh", noise)
+    rest = morris.motor.rest_pose()
+    for k in range(streams):
+        pieces, rows, at = [], [], 0
+        for m in rng.choice(movements, per_stream):
+            still = int(rng.integers(10, 30))
+            pieces.append(Motion(np.repeat(rest[None], still, axis=0), 30.0, body.parts))
+            motion = morris.motor.perform(str(m), fps=30.0, speed=float(rng.choice([0.8, 1.0, 1.25])))
+            pieces.append(motion)
+            rows.append((at + still, at + still + motion.n_frames, str(m)))
+            at += still + motion.n_frames
+        pieces.append(Motion(np.repeat(rest[None], 15, axis=0), 30.0, body.parts))
+        save(concatenate(pieces), dest / "streams" / f"stream_{k + 1}.bvh", noise)
+        _write_segments(dest / "streams" / f"stream_{k + 1}.segments.csv", rows)
+    parts = "\n".join(f'{p} = "{p}"' for p in body.parts)
+    f = body.facing
+    facing = f'left = "{f.left}"\nright = "{f.right}"' + (f'\nforward = "{f.forward}"' if f.forward else "")
+    (dest / "profile.toml").write_text(f'[profile]\nname = "max"\nunits = "metre"\nup = "+y"\n\n[parts]\n{parts}\n\n'
+                                       f"[facing]\n{facing}\n", encoding="utf-8")
+    return dest
+
+
+def _write_segments(path: Path, rows: list[tuple[int, int, str]]) -> None:
+    path.write_text("start_frame,end_frame,movement\n" + "".join(f"{a},{b},{m}\n" for a, b, m in rows),
+                    encoding="utf-8")
+
+
+def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams: int = 12, per_stream: int = 5,
+           gestures_only: bool = True) -> Path:
+    """Benchmark folders from the Bandai-Namco clips (links and generated streams; nothing is copied).
+
+    ``repertoire/``: the normal-style clips; ``demos/``: every other style of the movements the repertoire has;
+    ``streams/``: ``per_stream`` random gesture demos (other styles) one after another, with their segments.
+    Locomotion never returns to a standing pose, so streams hold gestures only unless told otherwise.
+    """
+    from toolkit.bvh import BVH, read_bvh, write_bvh
+
+    src, dest = Path(src), Path(dest)
+    files = sorted(src.glob("dataset-1_*.bvh"))
+    if not files:
+        raise ConfigError("no Bandai-Namco clips", file=src, expected="dataset-1_{content}_{style}_{take}.bvh files")
+    clips: dict[tuple[str, str], list[Path]] = {}
+    for f in files:
+        _, content, style, _ = f.stem.split("_")
+        clips.setdefault((content, style), []).append(f)
+    known = {c for c, s in clips if s == "normal"}
+    for (content, style), paths in clips.items():
+        for p in paths:
+            target = dest / ("repertoire" if style == "normal" else "demos") / content / p.name
+            if style != "normal" and content not in known:
+                continue
+            target.parent.mkdir(parents=True, exist_ok=True)
+            if not target.exists():
+                target.symlink_to(p.resolve())
+    locomotion = {"walk", "run", "dash", "walk-back", "walk-left", "walk-right", "dance-short"}
+    pool = [p for (c, s), ps in clips.items() if s != "normal" and c in known and
+            (c not in locomotion or not gestures_only) for p in ps]
+    rng = np.random.default_rng(seed)
+    (dest / "streams").mkdir(parents=True, exist_ok=True)
+    for k in range(streams):
+        chosen = [pool[i] for i in rng.choice(len(pool), per_stream, replace=False)]
+        parts = [read_bvh(p) for p in chosen]
+        rows, at = [], 0
+        for p, b in zip(chosen, parts):
+            rows.append((at, at + b.n_frames, p.stem.split("_")[1]))
+            at += b.n_frames
+        first = parts[0]
+        values = np.concatenate([b.values for b in parts])
+        write_bvh(BVH(first.joints, first.frame_time, values, "stream"), dest / "streams" / f"stream_{k + 1:02d}.bvh")
+        _write_segments(dest / "streams" / f"stream_{k + 1:02d}.segments.csv", rows)
+    (dest / "profile.toml").write_text(Path(profile_path).read_text(encoding="utf-8"), encoding="utf-8")
+    return dest
+
+
+def cmd_make_data(args, pm) -> int:
+    """``likeme bench make-data DIR``."""
+    print(make_data(pm, Path(args.dest), seed=args.seed))
+    return 0
+
+
+def cmd_bandai(args, pm) -> int:
+    """``likeme bench bandai SRC DIR``."""
+    print(bandai(Path(args.src), Path(args.dest), Path(args.profile), seed=args.seed))
+    return 0

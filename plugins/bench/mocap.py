@@ -1,0 +1,295 @@
+"""Benchmarks on motion-capture files: ``likeme bench recognition|segmentation|stream``.
+
+Every sub-command reads BVH files through a body profile (:mod:`toolkit.profile`) and watches them with
+:class:`toolkit.observe.Observer`, so the toolkit's segmenters and matchers and the baselines (``dtw``,
+``ruptures``) are measured on the same clips in the same loop:
+
+- ``recognition``: each demo clip (a folder per true movement) is one segment; every matcher named classifies it.
+  Accuracy, macro F1, the confusion matrix, the decision fraction (share of the clip seen when the matcher
+  committed; 1.0 for matchers that wait for the end) and frames per second.
+- ``segmentation``: each stream ``NAME.bvh`` has ``NAME.segments.csv`` (:func:`plugins.bench.data.read_segments`).
+  Precision, recall, F1 and boundary error (:mod:`plugins.bench.metrics`) per segmenter.
+- ``stream``: segment and recognise end to end for every pairing; the movement error rate (edit distance over the
+  true count).
+
+The folders are written by ``likeme bench make-data`` and ``likeme bench bandai`` (:mod:`plugins.bench.data`).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import platform
+import time
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from plugins.bench.command import MATCHERS, SEGMENTERS
+from plugins.bench.data import read_segments
+from plugins.bench.metrics import movement_error_rate, segmentation_scores
+from toolkit import ConfigError
+from toolkit.observe import Observer, compose_observer
+from toolkit.profile import load_profile
+
+__all__ = ["MATCHERS", "SEGMENTERS", "recognition", "segmentation", "stream", "table", "write_outputs", "plot", "run"]
+
+
+
+
+
+
+def _labelled(folder: Path) -> list[tuple[str, Path]]:
+    from plugins.lib.clip_repertoire import clip_files
+
+    return [(label, p) for label, files in clip_files(folder).items() for p in files]
+
+
+def _streams(folder: Path) -> list[tuple[Path, list[tuple[int, int, str]]]]:
+    files = sorted(Path(folder).glob("*.bvh"))
+    if not files:
+        raise ConfigError("no streams found", file=folder, expected="NAME.bvh files with NAME.segments.csv beside them")
+    out = []
+    for path in files:
+        csv_path = path.with_suffix(".segments.csv")
+        if not csv_path.exists():
+            raise ConfigError("missing segment file", file=csv_path, expected=f"the true segments of {path.name}")
+        out.append((path, read_segments(csv_path)))
+    return out
+
+
+def _settings(values: Sequence[str]) -> dict[str, dict[str, Any]]:
+    from toolkit.params import parse_settings
+
+    return parse_settings(list(values))
+
+
+def _versions() -> dict[str, str]:
+    from importlib.metadata import PackageNotFoundError, version
+
+    out = {"python": platform.python_version()}
+    for name in ("likeme", "numpy", "scipy", "networkx", "dtaidistance", "ruptures"):
+        try:
+            out[name] = version(name)
+        except PackageNotFoundError:
+            out[name] = "not installed"
+    return out
+
+
+class _Clock:
+    """Runs an observer over motions and counts the frames and the seconds spent, for frames per second."""
+
+    def __init__(self, character, profile) -> None:
+        self.character, self.profile, self.frames, self.seconds = character, profile, 0, 0.0
+
+    def run(self, how: str, motion):
+        """``Observer.watch`` or ``Observer.classify`` on ``motion``, timed."""
+        observer = Observer(self.character, self.profile.body, motion.fps)
+        t0 = time.perf_counter()
+        out = getattr(observer, how)(motion)
+        self.seconds += time.perf_counter() - t0
+        self.frames += motion.n_frames
+        return out
+
+    @property
+    def fps(self) -> float:
+        return self.frames / max(self.seconds, 1e-9)
+
+
+def _progress(items: list, label: str, quiet: bool):
+    if quiet:
+        return items
+    from rich.progress import track
+
+    return track(items, description=label, transient=True)
+
+
+def recognition(pm, profile, repertoire: Path, demos: Path, matchers: Sequence[str], *, settings=None,
+                quiet: bool = True) -> dict[str, Any]:
+    """Classify every demo clip with every matcher; per-plugin scores and per-item rows."""
+    items = _labelled(demos)
+    motions = [(label, path, profile.read(path)) for label, path in items]
+    plugins, rows = [], []
+    for name in matchers:
+        clock = _Clock(compose_observer(pm, profile, repertoire, matcher=name, settings=settings), profile)
+        truth, predicted, fractions = [], [], []
+        for label, path, motion in _progress(motions, f"recognition {name}", quiet):
+            obs = clock.run("classify", motion)
+            truth.append(label)
+            predicted.append(obs.movement or "unknown")
+            fractions.append(obs.decision_fraction)
+            rows.append({"plugin": name, "item": path.name, "truth": label, "recognised": obs.movement or "unknown",
+                         "confidence": round(obs.match.confidence, 4) if obs.match else 0.0,
+                         "decision_fraction": round(obs.decision_fraction, 4), "frames": motion.n_frames})
+        labels = sorted(set(truth) | set(predicted))
+        confusion = np.zeros((len(labels), len(labels)), dtype=int)
+        for t, p in zip(truth, predicted):
+            confusion[labels.index(t), labels.index(p)] += 1
+        plugins.append({"plugin": name, "accuracy": float(np.mean([t == p for t, p in zip(truth, predicted)])),
+                        "macro_f1": _macro_f1(truth, predicted), "decision_median": float(np.median(fractions)),
+                        "decision_p90": float(np.percentile(fractions, 90)), "fps": clock.fps,
+                        "items": len(truth), "labels": labels, "confusion": confusion.tolist()})
+    return {"benchmark": "recognition", "plugins": plugins, "items": rows}
+
+
+def _macro_f1(truth: Sequence[str], predicted: Sequence[str]) -> float:
+    scores = []
+    for label in sorted(set(truth)):
+        tp = sum(t == label and p == label for t, p in zip(truth, predicted))
+        fp = sum(t != label and p == label for t, p in zip(truth, predicted))
+        fn = sum(t == label and p != label for t, p in zip(truth, predicted))
+        scores.append(2 * tp / (2 * tp + fp + fn) if tp else 0.0)
+    return float(np.mean(scores)) if scores else 0.0
+
+
+def segmentation(pm, profile, streams: Path, segmenters: Sequence[str], *, repertoire: Path | None = None,
+                 settings=None, quiet: bool = True) -> dict[str, Any]:
+    """Segment every stream with every segmenter; precision, recall, F1, boundary error and speed."""
+    data = [(path, truth, profile.read(path)) for path, truth in _streams(streams)]
+    plugins, rows = [], []
+    for name in segmenters:
+        clock = _Clock(compose_observer(pm, profile, repertoire or streams, segmenter=name, matcher=None,
+                                        settings=settings), profile)
+        found_all = true_all = tp = 0
+        errors = []
+        for path, truth, motion in _progress(data, f"segmentation {name}", quiet):
+            found = [o.segment for o in clock.run("watch", motion)]
+            s = segmentation_scores([(f.start, f.end) for f in found], [(a, b) for a, b, _ in truth])
+            found_all, true_all, tp = found_all + s["found"], true_all + s["true"], tp + s["true_positives"]
+            if s["true_positives"]:
+                errors.append((s["boundary_error"], s["true_positives"]))
+            rows.append({"plugin": name, "item": path.name, "found": s["found"], "true": s["true"],
+                         "f1": round(s["f1"], 4), "boundary_error": round(s["boundary_error"], 2)})
+        precision = tp / found_all if found_all else 0.0
+        recall = tp / true_all if true_all else 0.0
+        f1 = 2 * precision * recall / (precision + recall) if precision + recall else 0.0
+        boundary = sum(e * n for e, n in errors) / max(1, sum(n for _, n in errors))
+        plugins.append({"plugin": name, "precision": precision, "recall": recall, "f1": f1,
+                        "boundary_error": boundary, "fps": clock.fps, "items": len(data)})
+    return {"benchmark": "segmentation", "plugins": plugins, "items": rows}
+
+
+def stream(pm, profile, repertoire: Path, streams: Path, segmenters: Sequence[str], matchers: Sequence[str], *,
+           settings=None, quiet: bool = True) -> dict[str, Any]:
+    """Segment and recognise every stream with every pairing; the movement error rate."""
+    data = [(path, truth, profile.read(path)) for path, truth in _streams(streams)]
+    plugins, rows = [], []
+    for seg in segmenters:
+        for mat in matchers:
+            clock = _Clock(compose_observer(pm, profile, repertoire, segmenter=seg, matcher=mat, settings=settings),
+                           profile)
+            errors, true_count = 0.0, 0
+            for path, truth, motion in _progress(data, f"stream {seg} + {mat}", quiet):
+                recognised = [o.movement or "unknown" for o in clock.run("watch", motion)]
+                labels = [label for _, _, label in truth]
+                rate = movement_error_rate(recognised, labels)
+                errors += rate * len(labels)
+                true_count += len(labels)
+                rows.append({"plugin": f"{seg}+{mat}", "item": path.name, "truth": " ".join(labels),
+                             "recognised": " ".join(recognised), "error_rate": round(rate, 4)})
+            plugins.append({"plugin": f"{seg}+{mat}", "segmenter": seg, "matcher": mat,
+                            "error_rate": errors / max(true_count, 1), "fps": clock.fps,
+                            "items": len(data)})
+    return {"benchmark": "stream", "plugins": plugins, "items": rows}
+
+
+COLUMNS = {
+    "recognition": [("accuracy", "{:.3f}"), ("macro_f1", "{:.3f}"), ("decision_median", "{:.2f}"),
+                    ("decision_p90", "{:.2f}"), ("fps", "{:.0f}"), ("items", "{}")],
+    "segmentation": [("precision", "{:.3f}"), ("recall", "{:.3f}"), ("f1", "{:.3f}"), ("boundary_error", "{:.1f}"),
+                     ("fps", "{:.0f}"), ("items", "{}")],
+    "stream": [("error_rate", "{:.3f}"), ("fps", "{:.0f}"), ("items", "{}")],
+}
+
+
+def table(result: dict[str, Any]) -> str:
+    """A markdown table of a result's per-plugin rows."""
+    cols = COLUMNS[result["benchmark"]]
+    lines = ["| plugin | " + " | ".join(c for c, _ in cols) + " |", "|---" * (len(cols) + 1) + "|"]
+    for row in result["plugins"]:
+        lines.append(f"| {row['plugin']} | " + " | ".join(fmt.format(row[c]) for c, fmt in cols) + " |")
+    return "\n".join(lines)
+
+
+def write_outputs(result: dict[str, Any], args: Any) -> None:
+    from toolkit.state import write_atomic as atomic_write_text
+
+    result = {**result, "settings": {"seed": getattr(args, "seed", None), "versions": _versions(),
+                                     "set": list(getattr(args, "set", []))}}
+    if args.json:
+        atomic_write_text(Path(args.json), json.dumps(result, indent=1, default=float) + "\n")
+    if args.csv:
+        keys = ["kind", "plugin", "item"] + sorted({k for r in result["plugins"] + result["items"] for k in r}
+                                                   - {"plugin", "item", "labels", "confusion"})
+        rows = [{"kind": "plugin", **{k: v for k, v in r.items() if k not in ("labels", "confusion")}}
+                for r in result["plugins"]] + [{"kind": "item", **r} for r in result["items"]]
+        out = io.StringIO()
+        writer = csv.DictWriter(out, fieldnames=keys, extrasaction="ignore", lineterminator="\n")
+        writer.writeheader()
+        for r in rows:
+            writer.writerow(r)
+        out.write(f"# versions: {json.dumps(result['settings']['versions'])}\n")
+        atomic_write_text(Path(args.csv), out.getvalue())
+    if args.plot:
+        plot(result, Path(args.plot))
+
+
+def plot(result: dict[str, Any], path: Path) -> Path:
+    """Draw a result to PNG: confusion matrices (recognition) or the main score per plugin."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    kind = result["benchmark"]
+    if kind == "recognition":
+        n = len(result["plugins"])
+        fig, axes = plt.subplots(1, n, figsize=(5.5 * n, 5), squeeze=False)
+        for ax, row in zip(axes[0], result["plugins"]):
+            m = np.array(row["confusion"])
+            ax.imshow(m, cmap="Blues")
+            ax.set_xticks(range(len(row["labels"])), row["labels"], rotation=90, fontsize=7)
+            ax.set_yticks(range(len(row["labels"])), row["labels"], fontsize=7)
+            ax.set_title(f"{row['plugin']}: accuracy {row['accuracy']:.2f}")
+            ax.set_xlabel("recognised")
+            ax.set_ylabel("true")
+    else:
+        key = "f1" if kind == "segmentation" else "error_rate"
+        fig, ax = plt.subplots(figsize=(1.2 + 1.1 * len(result["plugins"]), 4))
+        names = [r["plugin"] for r in result["plugins"]]
+        ax.bar(range(len(names)), [r[key] for r in result["plugins"]], color="#4878a8")
+        ax.set_xticks(range(len(names)), names, rotation=30, ha="right", fontsize=8)
+        ax.set_ylabel(key.replace("_", " "))
+        ax.set_title(f"{kind}: {key.replace('_', ' ')} per plugin")
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return path
+
+
+def run(kind: str, args: Any, pm: Any) -> int:
+    """``likeme bench recognition|segmentation|stream``: run the benchmark, print its table, write its outputs."""
+    profile = load_profile(args.body)
+    settings = _settings(args.set)
+    if kind == "recognition":
+        result = recognition(pm, profile, Path(args.repertoire), Path(args.demos), args.matcher or MATCHERS,
+                             settings=settings, quiet=args.quiet)
+    elif kind == "segmentation":
+        result = segmentation(pm, profile, Path(args.streams), args.segmenter or SEGMENTERS,
+                              repertoire=Path(args.repertoire) if args.repertoire else None, settings=settings,
+                              quiet=args.quiet)
+    else:
+        result = stream(pm, profile, Path(args.repertoire), Path(args.streams), args.segmenter or SEGMENTERS[:2],
+                        args.matcher or MATCHERS, settings=settings, quiet=args.quiet)
+    print(table(result))
+    if kind == "recognition":
+        for row in result["plugins"]:
+            print(f"\n{row['plugin']} confusion (rows true, columns recognised): {', '.join(row['labels'])}")
+            for label, counts in zip(row["labels"], row["confusion"]):
+                print(f"  {label:>12} " + " ".join(f"{c:3d}" for c in counts))
+    write_outputs(result, args)
+    return 0

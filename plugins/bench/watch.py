@@ -1,0 +1,165 @@
+"""``likeme bench watch``: an observer watches a demonstrator's random movements (Buchsbaum & Blumberg 2005, §5).
+
+The observer watches the demonstrator perform a long random sequence of movements through its own perception
+(with noise, dropouts and occlusion) and the benchmark reports
+
+- segmentation precision, recall, F1 and boundary error of its segmenter against what the demonstrator really
+  performed (:mod:`plugins.bench.metrics`);
+- recognition accuracy of its matcher on the *true* segments;
+- the end-to-end movement error rate of what it recognised while watching;
+- frames per second of the whole world (acting, perceiving, segmenting, matching).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from plugins.bench.metrics import match_segments, movement_error_rate, segmentation_scores
+from toolkit import World, load_character
+from toolkit.character import merge_tables
+from toolkit.params import parse_settings
+from toolkit.state import write_atomic
+
+__all__ = ["watch_benchmark", "render_watch", "cmd_watch"]
+
+
+def watch_benchmark(
+    pm: Any,
+    *,
+    observer: str = "max",
+    demonstrator: str = "morris",
+    movements: int = 200,
+    seed: int = 0,
+    noise: float = 0.005,
+    dropout: float = 0.05,
+    occlusion: bool = True,
+    progress: bool = False,
+    settings: dict[str, Any] | None = None,
+    exclude: tuple[str, ...] = ("windmill",),
+) -> dict[str, Any]:
+    """Run the watch benchmark and return its figures (see the module docstring).
+
+    ``exclude``: demonstrator movements never drawn (by default Morris's windmill, which Max does not have).
+
+    ``settings`` are tables merged over the observer's character (``{"segmenter": {"floor": 0.0}}``).
+    """
+    demo = load_character(demonstrator, pm, override={
+        "action": {"plugin": "script", "random": movements, "exclude": ["stand", *exclude], "seed": seed, "pause": 0.5}
+    })
+    obs_override = {"perception": {"plugin": "synthetic-vision", "noise": noise, "dropout": dropout,
+                                   "occlusion": occlusion, "seed": seed + 1}}
+    obs = load_character(observer, pm, override=merge_tables(obs_override, settings or {}))
+    obs.action = None  # watch only: the benchmark measures perception, segmentation and recognition
+    world = World(fps=30.0, pm=pm)
+    target = world.add_actor(demo, "demonstrator", (0.0, 0.0, 1.6), np.pi)
+    watcher = world.add_actor(obs, "observer", (0.0, 0.0, 0.0), 0.0)
+    watcher.watch(target)
+
+    limit = int(movements * 4 * world.fps) + 300
+    started = time.perf_counter()
+    steps = range(limit)
+    if progress:
+        from rich.progress import track
+
+        steps = track(steps, description=f"{observer} watches {demonstrator}", transient=True)
+    quiet = 0
+    for _ in steps:
+        world.step()
+        quiet = quiet + 1 if world.all_idle() else 0
+        if quiet > world.fps:
+            break
+    watcher._finish()
+    elapsed = time.perf_counter() - started
+
+    truth, labels = [], []
+    for frame, request in target.performed:
+        n = demo.motor.perform(request.movement, fps=world.fps).n_frames
+        truth.append((frame - watcher.watch_start, frame - watcher.watch_start + n))
+        labels.append(request.movement)
+    found = [(e.data["segment"].start, e.data["segment"].end) for e in world.events_of("segment_found", "observer")]
+    seg = segmentation_scores(found, truth)
+    claimed = {j for _, j in match_segments(found, truth)}
+    missed: dict[str, int] = {}
+    for j, label in enumerate(labels):
+        if j not in claimed:
+            missed[label] = missed.get(label, 0) + 1
+
+    correct = 0
+    confusions: dict[str, int] = {}
+    for (s, e), label in zip(truth, labels):
+        match = obs.matcher.match(watcher.memory.motion(s, e))
+        got = match.movement or "unknown"
+        correct += got == label
+        if got != label:
+            confusions[f"{label} -> {got}"] = confusions.get(f"{label} -> {got}", 0) + 1
+    recognised = [e.data["match"].movement or "unknown" for e in world.events_of("movement_recognised", "observer")]
+
+    return {
+        "benchmark": "watch",
+        "observer": obs.name,
+        "demonstrator": demo.name,
+        "components": {k: c.name for k, c in obs.components().items()},
+        "movements": len(truth),
+        "seed": seed,
+        "noise": noise,
+        "dropout": dropout,
+        "occlusion": occlusion,
+        "settings": settings or {},
+        "visible_fraction": float(watcher.memory.visible.mean()),
+        "segmentation": seg,
+        "recognition_accuracy": correct / max(len(truth), 1),
+        "confusions": dict(sorted(confusions.items(), key=lambda kv: -kv[1])),
+        "unsegmented": dict(sorted(missed.items(), key=lambda kv: -kv[1])),
+        "movement_error_rate": movement_error_rate(recognised, labels),
+        "frames": world.frame,
+        "seconds": elapsed,
+        "frames_per_second": world.frame / elapsed if elapsed > 0 else float("inf"),
+        "real_time_factor": (world.frame / world.fps) / elapsed if elapsed > 0 else float("inf"),
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+    }
+
+
+def render_watch(r: dict[str, Any]) -> str:
+    s = r["segmentation"]
+    rows = [
+        ("movements performed", f"{r['movements']}"),
+        ("parts visible", f"{100 * r['visible_fraction']:.1f}%"),
+        ("segmentation precision / recall", f"{s['precision']:.3f} / {s['recall']:.3f}"),
+        ("segmentation F1", f"{s['f1']:.3f}"),
+        ("boundary error (frames)", f"{s['boundary_error']:.1f}"),
+        ("recognition accuracy (true segments)", f"{r['recognition_accuracy']:.3f}"),
+        ("movement error rate (end to end)", f"{r['movement_error_rate']:.3f}"),
+        ("frames per second (world)", f"{r['frames_per_second']:.0f} ({r['real_time_factor']:.1f}x real time)"),
+    ]
+    head = (f"likeme bench watch: {r['observer']} watches {r['demonstrator']} "
+            f"(seed {r['seed']}, noise {r['noise']} m, dropout {r['dropout']}, occlusion {'on' if r['occlusion'] else 'off'})")
+    comps = ", ".join(f"{k} {v}" for k, v in r["components"].items())
+    if r["settings"]:
+        comps += "; " + ", ".join(f"{t}.{k} = {v!r}" for t, table in r["settings"].items() for k, v in table.items())
+    width = max(len(a) for a, _ in rows)
+    lines = [head, f"  {comps}"] + [f"  {a:<{width}}  {b}" for a, b in rows]
+    if r["unsegmented"]:
+        lines.append("  movements without a matching segment: " + ", ".join(f"{k} ({v})" for k, v in list(r["unsegmented"].items())[:8]))
+    if r["confusions"]:
+        lines.append("  most frequent confusions: " + ", ".join(f"{k} ({v})" for k, v in list(r["confusions"].items())[:6]))
+    return "\n".join(lines)
+
+
+def cmd_watch(args: argparse.Namespace, pm: Any) -> int:
+    result = watch_benchmark(
+        pm, observer=args.observer, demonstrator=args.demonstrator, movements=args.movements, seed=args.seed,
+        noise=args.noise, dropout=args.dropout, occlusion=not args.no_occlusion, progress=not args.quiet,
+        settings=parse_settings(args.set),
+    )
+    print(render_watch(result))
+    if args.json:
+        write_atomic(Path(args.json), json.dumps(result, indent=2, default=float) + "\n")
+    return 0

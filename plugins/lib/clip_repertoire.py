@@ -1,0 +1,200 @@
+"""A movement repertoire from labelled motion-capture clips, with hubs found from the clips.
+
+A folder with one sub-folder per movement name, each holding BVH clips of that
+movement, read through a body profile (:mod:`toolkit.profile`), becomes the
+repertoire of a motor system: the ``posegraph`` makes each clip a path of pose
+nodes (Buchsbaum & Blumberg 2005, §4.1), the ``motor-command-graph`` turns each
+clip into a chain of guiding-stroke commands by its inverse model (Kopp &
+Graeser 2006, §4.3). Both use the same clips, hubs and body.
+
+Hubs (B&B §4.1: the poses movements start and end in) are found rather than
+assumed: the first and last pose of every clip are clustered (average linkage
+on the eq. 1 pose distance, :mod:`plugins.lib.pose_distance`); every cluster that
+holds at least ``hub_share`` of the clip ends is a hub, its medoid the hub
+pose. The largest cluster is always a hub, so locomotion clips that never stand
+still still get one.
+
+Poses are root-relative in the body's own frame (§5.1), lifted to the median
+height of the root at the hubs, which is the local frame a motor system uses.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy.cluster.hierarchy import fcluster, linkage
+from scipy.spatial.distance import squareform
+
+from plugins.lib.pose_distance import pose_distance
+from plugins.lib.root_frame import facing_heading, smooth_heading, to_root_relative
+from toolkit import ConfigError, Motion, Parameter
+from toolkit.profile import BodyProfile, load_profile
+
+__all__ = ["Clip", "ClipRepertoire", "load_clip_repertoire", "find_hubs", "root_relative_motion", "clip_files", "example_name",
+           "CLIP_PARAMETERS", "repertoire_for"]
+
+CLIP_SUFFIXES = (".bvh",)
+
+
+@dataclass(frozen=True)
+class Clip:
+    """One example of a movement: its label, file and local-frame motion (root at hub height)."""
+
+    movement: str
+    source: Path
+    motion: Motion
+
+
+@dataclass(frozen=True)
+class ClipRepertoire:
+    """Clips by movement, the hub poses found from them, and the profile they were read with."""
+
+    profile: BodyProfile
+    clips: tuple[Clip, ...]
+    hubs: np.ndarray  # (H, P, 3), local frame
+    folder: Path
+
+    @property
+    def movements(self) -> list[str]:
+        return sorted({c.movement for c in self.clips})
+
+    def of(self, movement: str) -> list[Clip]:
+        return [c for c in self.clips if c.movement == movement]
+
+
+def root_relative_motion(world: Motion, profile: BodyProfile, facing_window: float = 1.0) -> Motion:
+    """World positions to root-relative positions in the body's frame, the facing a centred running median."""
+    heading = facing_heading(np.where(world.visible[..., None], world.positions, 0.0), world.visible, profile.body)
+    heading = smooth_heading(heading, max(1, int(round(facing_window * world.fps))))
+    pose, mask, _, _ = to_root_relative(world.positions, world.visible, profile.body, heading)
+    return Motion(pose, world.fps, world.parts, mask)
+
+
+def example_name(movement: str, earlier: int) -> str:
+    """The name of a movement's next example clip, after ``earlier`` ones: ``bow``, ``bow#2``, ``bow#3``..."""
+    return movement if earlier == 0 else f"{movement}#{earlier + 1}"
+
+
+def clip_files(folder: Path) -> dict[str, list[Path]]:
+    """Clip files by movement name (sub-folder name), sorted; a :class:`ConfigError` if there are none."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise ConfigError("not a folder", file=folder, expected="a folder with one sub-folder of BVH clips per movement")
+    out: dict[str, list[Path]] = {}
+    for sub in sorted(p for p in folder.iterdir() if p.is_dir()):
+        files = sorted(p for p in sub.iterdir() if p.suffix.lower() in CLIP_SUFFIXES)
+        if files:
+            out[sub.name] = files
+    if not out:  # a flat folder of recordings: each file on its own (its ends still give hubs)
+        for path in sorted(p for p in folder.iterdir() if p.suffix.lower() in CLIP_SUFFIXES):
+            out[path.stem] = [path]
+    if not out:
+        raise ConfigError("no clips found", file=folder,
+                          expected="sub-folders named after movements holding .bvh clips (walk/take1.bvh ...)",
+                          available=[p.name for p in folder.iterdir()])
+    return out
+
+
+def find_hubs(ends: np.ndarray, radius: float, share: float) -> np.ndarray:
+    """Hub poses (H, P, 3) among the clip end poses ``ends`` (N, P, 3), largest cluster first.
+
+    Average-linkage clusters of eq. 1 distance cut at ``radius`` metres; a cluster
+    with at least ``share`` of the ends is a hub, its medoid the hub pose.
+    """
+    n = len(ends)
+    if n == 1:
+        return ends.copy()
+    d = pose_distance(ends[:, None], ends[None, :], True)
+    d = 0.5 * (d + d.T)
+    np.fill_diagonal(d, 0.0)
+    labels = fcluster(linkage(squareform(d, checks=False), "average"), t=radius, criterion="distance")
+    clusters = sorted((np.flatnonzero(labels == k) for k in np.unique(labels)), key=len, reverse=True)
+    hubs = []
+    for i, members in enumerate(clusters):
+        if i > 0 and len(members) < share * n:
+            break
+        medoid = members[np.argmin(d[np.ix_(members, members)].sum(axis=1))]
+        hubs.append(ends[medoid])
+    return np.stack(hubs)
+
+
+def load_clip_repertoire(folder: str | Path, profile: str | Path | BodyProfile, *, hub_radius: float = 0.06,
+                         hub_share: float = 0.2) -> ClipRepertoire:
+    """Read every clip of ``folder`` through ``profile`` and find the hubs."""
+    profile = profile if isinstance(profile, BodyProfile) else load_profile(profile)
+    rel: list[tuple[str, Path, Motion]] = []
+    for movement, files in clip_files(Path(folder)).items():
+        for path in files:
+            motion = root_relative_motion(profile.read(path), profile)
+            if motion.n_frames < 2:
+                raise ConfigError(f"clip has {motion.n_frames} frame", file=path, expected="at least two frames")
+            rel.append((movement, path, motion))
+    ends = np.stack([_filled(m, i) for _, _, m in rel for i in (0, -1)])
+    hubs_rel = find_hubs(ends, hub_radius, hub_share)
+    height = _root_height(rel, profile)
+    lift = np.array([0.0, height, 0.0])
+    clips = tuple(Clip(mv, path, Motion(m.positions + lift, m.fps, m.parts, m.visible)) for mv, path, m in rel)
+    return ClipRepertoire(profile, clips, hubs_rel + lift, Path(folder))
+
+
+def _filled(motion: Motion, frame: int) -> np.ndarray:
+    """A frame with hidden parts filled from the clip's nearest frame where they are seen."""
+    pose = motion.positions[frame].copy()
+    for p in np.flatnonzero(~motion.visible[frame]):
+        seen = np.flatnonzero(motion.visible[:, p])
+        pose[p] = motion.positions[seen[np.argmin(np.abs(seen - (frame % motion.n_frames)))], p] if len(seen) else 0.0
+    return pose
+
+
+def _root_height(rel: list[tuple[str, Path, Motion]], profile: BodyProfile) -> float:
+    """Median height of the root above the lowest part at the clips' ends: the hub's standing height."""
+    heights = []
+    for _, _, m in rel:
+        for f in (0, -1):
+            pose = m.positions[f]
+            if m.visible[f].any():
+                heights.append(-float(np.nanmin(np.where(m.visible[f], pose[:, 1], np.nan))))
+    return float(np.median(heights)) if heights else 0.0
+
+
+CLIP_PARAMETERS = (
+    Parameter("clips", str, "", "Folder of labelled BVH clips, one sub-folder per movement, to build the repertoire "
+              "from (relative to the character file); replaces poses and movements."),
+    Parameter("profile", str, "", "Body profile TOML the clips are read with (relative to the character file); "
+              "required with clips, and its parts must be the character's body parts."),
+    Parameter("hub_radius", float, 0.06, "Clip end poses closer than this (eq. 1, m, average linkage) share a hub.",
+              minimum=0.0),
+    Parameter("hub_share", float, 0.2, "Share of clip ends a cluster needs to be a hub (the largest always is one).",
+              minimum=0.0, maximum=1.0),
+)
+"""The parameters of a motor system that can build its repertoire from clips."""
+
+_CACHE: dict[tuple, ClipRepertoire] = {}
+
+
+def repertoire_for(params: dict, owner: object) -> ClipRepertoire | None:
+    """The clip repertoire a motor system's ``clips`` and ``profile`` parameters name, or ``None`` without clips.
+
+    Paths are relative to the owner's character file; a repertoire read once is shared (by path and settings).
+    """
+    if not params["clips"]:
+        return None
+    if not params["profile"]:
+        raise ConfigError("clips without a profile", key=("profile",), expected="the body profile the clips are read with")
+    file = getattr(owner, "file", None)
+    base = file.parent if file is not None else Path.cwd()
+    folder, profile_path = (base / params["clips"]).resolve(), (base / params["profile"]).resolve()
+    key = (folder, profile_path, params["hub_radius"], params["hub_share"])
+    if key not in _CACHE:
+        if len(_CACHE) > 8:
+            _CACHE.clear()
+        _CACHE[key] = load_clip_repertoire(folder, profile_path, hub_radius=params["hub_radius"],
+                                           hub_share=params["hub_share"])
+    repertoire = _CACHE[key]
+    body = getattr(owner, "body", None)
+    if body is not None and tuple(body.parts) != tuple(repertoire.profile.body.parts):
+        raise ConfigError("the body's parts are not the profile's parts", key=("profile",),
+                          expected=f"[body] parts = {list(repertoire.profile.body.parts)}", available=list(body.parts))
+    return repertoire

@@ -1,0 +1,208 @@
+"""The inverse model: from an observed segment to the motor command that reproduces it (guiding stroke or hand transition).
+
+Kopp & Graeser 2006, §4.3: "after segmentation, an inverse model is applied to
+each segment in order to calculate the parameters needed to produce it by a
+guiding stroke. To this end, the equations for trajectory formation are applied
+in inverse direction."
+
+1. Start, target and duration are the segment's first and last samples and its length.
+2. The progress along the chord and the perpendicular residual are measured;
+   the residual's principal direction gives the movement plane. A residual
+   smaller than ``straight`` times the chord makes the stroke linear.
+3. A residual that changes sides is an S, otherwise a C. The largest residual is
+   the curvature. The area under the profile gives the roundness (the area
+   of ``1 - |2s - 1|^q`` is ``q / (q + 1)``), and where it peaks gives the skewness.
+4. The speed profile gives the moment of peak velocity and the end gain.
+5. Those closed-form estimates start a bounded least-squares refinement
+   (:func:`scipy.optimize.least_squares`) of the timing and shape parameters
+   against the observed positions, so noise in one estimate is corrected by the
+   trajectory as a whole. A curved stroke is refined both as a C and as an S
+   (noise near the ends can make a flat C's residual change sides) and the one
+   closer to the observation is kept.
+
+Hands (§4.3): "if Max observes a completed, unknown finger movement by the
+demonstrator, the movement will be segmented both, at angular velocity minima
+and according to a clustering of movement directions, to detect the start, end,
+and via postures of the sighted hand movements. These configurations are used
+as key postures to create a new edge in the hand motor command graph".
+:func:`transitions_from_segment` takes those break points as key postures and
+fits the one remaining parameter, the moment of peak angular velocity (which
+also places the key postures on the curve's clock), by a bounded scalar search; :func:`learn_commands` makes one edge of them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.integrate import trapezoid
+from scipy.optimize import least_squares, minimize_scalar
+from scipy.signal import savgol_filter
+
+from plugins.lib.guiding_stroke import GuidingStroke, progress
+from plugins.lib.hand_transition import HandTransition
+
+__all__ = ["stroke_from_segment", "transitions_from_segment", "trajectory_error", "learn_commands"]
+
+
+def trajectory_error(stroke: GuidingStroke | HandTransition, positions: np.ndarray, fps: float) -> float:
+    """Largest distance (m, or radians for a hand transition) between the command's trajectory and observed
+    ``positions`` sampled at ``fps``."""
+    t = np.arange(len(positions)) / fps
+    return float(np.linalg.norm(stroke.position(t) - positions, axis=1).max())
+
+
+def _closed_form(p: np.ndarray, fps: float, straight: float, family: str | None = None) -> dict:
+    start, target = p[0], p[-1]
+    chord = target - start
+    length = float(np.linalg.norm(chord))
+    axis = chord / max(length, 1e-12)
+    s = np.clip((p - start) @ axis / max(length, 1e-12), 0.0, 1.0)
+    residual = p - (start + s[:, None] * chord)
+    speed = np.linalg.norm(np.diff(p, axis=0), axis=1) * fps
+    if len(speed) >= 7:
+        speed = savgol_filter(speed, 7 if len(speed) >= 7 else len(speed) | 1, 2, mode="interp")
+    peak = float(np.clip((np.argmax(speed) + 0.5) / max(len(speed), 1), 0.1, 0.9))
+    end_gain = float(np.clip(speed[-1] / max(speed.max(), 1e-12), 0.0, 0.9))
+    est = {"start": start, "target": target, "duration": (len(p) - 1) / fps, "peak": peak, "end_gain": end_gain}
+    size = np.linalg.norm(residual, axis=1)
+    if length < 1e-6 or size.max() < straight * length:
+        return {**est, "shape": "linear"}
+    # movement plane: the residual's principal direction, perpendicular to the chord
+    _, _, vt = np.linalg.svd(residual, full_matrices=False)
+    side = vt[0] - (vt[0] @ axis) * axis
+    side /= max(np.linalg.norm(side), 1e-12)
+    normal = np.cross(axis, side)  # then normal x chord points along side: positive lateral is "left"
+    lateral = residual @ side / (0.5 * length)
+    hi, lo = lateral.max(), lateral.min()
+    s_shape = min(hi, -lo) > 0.3 * max(hi, -lo) if family is None else family == "s"
+    if s_shape:  # both ways: an S, whose first half bends to the left for "left-s"
+        first = lateral[s < 0.5]
+        left_first = first.size > 0 and first.max() >= -first.min()
+        shape, amplitude = ("left-s" if left_first else "right-s"), 2 * max(hi, -lo)
+        profile = np.abs(lateral) * 2
+    else:
+        sign = 1.0 if hi >= -lo else -1.0
+        shape, amplitude = ("left-c" if sign > 0 else "right-c"), max(hi, -lo)
+        profile = sign * lateral
+    # a normal pointing backwards (towards -z, the body's back) is flipped with the side, for readable parameters
+    if normal[2] < 0 or (abs(normal[2]) < 1e-9 and normal[1] < 0):
+        normal = -normal
+        shape = shape.replace("left", "RIGHT").replace("right", "left").replace("RIGHT", "right")
+    area = float(trapezoid(np.clip(profile / max(profile.max(), 1e-12), 0, 1), s)) if len(s) > 1 else 0.5
+    area = float(np.clip(area, 0.51, 0.93))
+    q = area / (1 - area)
+    roundness = float(np.clip(1 - np.log(q) / np.log(8), 0.0, 1.0))
+    s_peak = float(np.clip(s[np.argmax(profile)], 0.05, 0.95)) if shape.endswith("-c") else 0.5
+    skewness = float(np.clip(np.log2(np.log(0.5) / np.log(s_peak)), -1, 1)) if shape.endswith("-c") else 0.0
+    return {**est, "shape": shape, "normal": normal, "curvature": float(np.clip(amplitude, 0.0, 1.0)),
+            "roundness": roundness, "skewness": skewness}
+
+
+def stroke_from_segment(positions: np.ndarray, fps: float, *, straight: float = 0.03, refine: bool = True) -> GuidingStroke:
+    """The guiding stroke that reproduces a segment of wrist positions (N, 3) sampled at ``fps`` (N >= 2).
+
+    Parameters
+    ----------
+    positions : array, shape (N, 3)
+        Observed positions in the body frame, NaN-free (hidden samples interpolated beforehand).
+    fps : float
+    straight : float
+        Largest sideways deviation, as a share of the chord, still taken as a straight stroke.
+    refine : bool
+        Refine the closed-form estimates by least squares.
+    """
+    p = np.asarray(positions, dtype=float)
+    if p.ndim != 2 or p.shape[1] != 3 or len(p) < 2 or not np.isfinite(p).all():
+        raise ValueError("the inverse model needs two or more finite positions (N, 3)")
+    est = _closed_form(p, fps, straight)
+    if not refine:
+        return GuidingStroke(**est)
+    if est["shape"] == "linear":
+        return _refined(est, p, fps)
+    # C or S: observation noise at the ends can make a C's residual change sides; both families are fitted and
+    # the one that reproduces the observation better is kept
+    fits = [_refined(_closed_form(p, fps, straight, family), p, fps) for family in ("c", "s")]
+    return min(fits, key=lambda stroke: (trajectory_error(stroke, p, fps), stroke.shape != est["shape"]))
+
+
+def _refined(est: dict, p: np.ndarray, fps: float) -> GuidingStroke:
+    """The closed-form stroke ``est`` refined by bounded least squares against positions ``p``; the better of the two."""
+    stroke = GuidingStroke(**est)
+    t = np.arange(len(p)) / fps
+    curved = stroke.shape != "linear"
+    names = ["peak", "end_gain"] + (["curvature", "roundness", "skewness"] if curved else [])
+    lower = {"peak": 0.05, "end_gain": 0.0, "curvature": 0.0, "roundness": 0.0, "skewness": -1.0}
+    upper = {"peak": 0.95, "end_gain": 0.95, "curvature": 1.0, "roundness": 1.0, "skewness": 1.0}
+    x0 = np.array([np.clip(est.get(n, 0.0), lower[n] + 1e-6, upper[n] - 1e-6) for n in names])
+
+    def residual(x: np.ndarray) -> np.ndarray:
+        candidate = GuidingStroke(**{**est, **dict(zip(names, x))})
+        return (candidate.position(t) - p).ravel()
+
+    fit = least_squares(residual, x0, bounds=([lower[n] for n in names], [upper[n] for n in names]), x_scale="jac", max_nfev=200)
+    refined = GuidingStroke(**{**est, **dict(zip(names, fit.x))})
+    return refined if trajectory_error(refined, p, fps) <= trajectory_error(stroke, p, fps) else stroke
+
+
+def transitions_from_segment(angles: np.ndarray, fps: float, breaks: list[int] | tuple[int, ...] = ()) -> list[HandTransition]:
+    """The hand transitions (one per finger, shared timing) that reproduce a segment of finger joint angles.
+
+    Parameters
+    ----------
+    angles : array, shape (N, k, 3)
+        Observed joint angles (radians) of the hand's k fingers, NaN-free, N >= 2.
+    fps : float
+    breaks : list of int
+        Frames of the via postures (the angular-velocity minima and direction changes found by the segmenter).
+    """
+    a = np.asarray(angles, dtype=float)
+    if a.ndim != 3 or a.shape[2] != 3 or len(a) < 2 or not np.isfinite(a).all():
+        raise ValueError("the hand inverse model needs two or more finite configurations (N, k, 3)")
+    frames = np.array(sorted({0, *(int(b) for b in breaks if 0 < b < len(a) - 1), len(a) - 1}))
+    duration = (len(a) - 1) / fps
+    t = np.arange(len(a)) / fps
+
+    def build(peak: float) -> list[HandTransition]:
+        # the key postures' places on the curve's clock: where the bell-shaped progress is when they were seen
+        times = duration * progress(frames / (len(a) - 1), peak, 0.0)
+        return [HandTransition(a[frames, j], times, peak) for j in range(a.shape[1])]
+
+    def error(peak: float) -> float:
+        return float(sum(np.sum((tr.position(t) - a[:, j]) ** 2) for j, tr in enumerate(build(peak))))
+
+    fit = minimize_scalar(error, bounds=(0.05, 0.95), method="bounded", options={"xatol": 1e-3})
+    return build(float(fit.x) if error(float(fit.x)) <= error(0.5) else 0.5)
+
+
+def learn_commands(motor, subsystem: str, observed: np.ndarray, fps: float, start: str, breaks, *,
+                   source: str = "inverse model", hub_tolerance: float = 0.05, refine: bool = True) -> list[str]:
+    """Turn an observed segment into new edges of a motor command graph, chained from node ``start`` (§4.3).
+
+    ``observed`` (n, k, 3) holds the positions of the subsystem's k parts; ``breaks``
+    maps the flattened (n, 3k) trajectory to the frames where one stroke ends and
+    the next begins (the velocity/direction segmenter's break points). Each
+    stroke of each part is inverted into a guiding stroke; the last edge ends in
+    the hub when the segment returns there. Returns the new edges' movement names.
+
+    A hand subsystem (its parts are fingers, ``observed`` holds joint angles) gets
+    one edge whose key postures are the break points, by
+    :func:`transitions_from_segment`; it ends in the hub when within the motor
+    system's hand tolerance (radians) of it.
+    """
+    n, k, _ = observed.shape
+    hub_state = motor.graphs[subsystem].nodes["hub"]["state"]
+    if motor.is_hand(subsystem):
+        transitions = transitions_from_segment(observed, fps, breaks(observed.reshape(n, k * 3)))
+        home = np.linalg.norm(observed[-1] - hub_state, axis=-1).max() <= motor.tolerance(subsystem)
+        return [motor.learn(subsystem, start, transitions, end="hub" if home else None, source=source)]
+    cuts = [0, *breaks(observed.reshape(n, k * 3)), n - 1]
+    names, node = [], start
+    for i, (a, b) in enumerate(zip(cuts, cuts[1:])):
+        if b - a < 2:
+            continue
+        strokes = [stroke_from_segment(observed[a : b + 1, j], fps, refine=refine) for j in range(k)]
+        last = i == len(cuts) - 2
+        end = "hub" if last and np.linalg.norm(observed[-1] - hub_state, axis=-1).max() <= hub_tolerance else None
+        name = motor.learn(subsystem, node, strokes, end=end, source=source)
+        names.append(name)
+        node = motor.edge(name)[2]
+    return names

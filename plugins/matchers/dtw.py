@@ -1,0 +1,101 @@
+"""Matcher ``dtw``: the nearest template by multivariate dynamic time warping (a baseline, via dtaidistance).
+
+What most users compare against: every example of every movement of the
+observer's repertoire is a template (the clips of a clip repertoire,
+:mod:`plugins.lib.clip_repertoire`, else the motor system's own performance of each
+movement), the observed segment is warped onto each with multivariate DTW
+(:func:`dtaidistance.dtw_ndim.distance_fast`, squared Euclidean inner
+distance over all root-relative part coordinates) and the closest template's
+movement wins. DTW needs the whole segment: it decides at the segment's end
+(decision fraction 1.0). It learns nothing.
+
+dtaidistance returns the square root of the summed squared distances along the
+warping path; its square is divided by the summed lengths of the two series and
+the root taken again (a root-mean-square distance per frame, in metres), so that
+long and short templates compete fairly. (Dividing the root itself by the
+length, as earlier versions did, shrinks with the template's length and made the
+longest template nearest to everything.) A segment farther than
+``max_distance`` from every template is "unknown".
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from dtaidistance import dtw_ndim
+
+from toolkit import Match, Matcher, Motion, Parameter, hookimpl
+
+__all__ = ["DTW", "frame_distance"]
+
+
+def frame_distance(series: np.ndarray, template: np.ndarray, window: float = 0.0) -> float:
+    """Root-mean-square distance per frame (m) of two series (n, D) and (m, D) warped onto each other.
+
+    ``window``: Sakoe-Chiba band as a share of the longer series (0: none). The same series at any length
+    (every frame repeated k times) is at the same distance from the same template.
+    """
+    band = int(window * max(len(series), len(template))) or None
+    if band is not None:
+        band = max(band, abs(len(series) - len(template)) + 1)
+    d = dtw_ndim.distance_fast(series, template, window=band)
+    return float(np.sqrt(d * d / (len(series) + len(template))))
+
+
+class DTW(Matcher):
+    """Nearest example by multivariate dynamic time warping (dtaidistance); decides at the segment's end."""
+
+    name = "dtw"
+    parameters = (
+        Parameter("stride", int, 2, "Use every n-th frame of segments and templates (DTW is quadratic in length).",
+                  minimum=1),
+        Parameter("window", float, 0.0, "Sakoe-Chiba band as a share of the longer series (0: no band).",
+                  minimum=0.0, maximum=1.0),
+        Parameter("max_distance", float, 0.0, "Root-mean-square per-frame distance (m) above which a segment is unknown "
+                  "(0: always the nearest).", minimum=0.0),
+    )
+
+    def attach(self, owner: Any) -> None:
+        super().attach(owner)
+        motor, body = owner.motor, owner.body
+        root = body.root_index
+        clips = getattr(motor, "clips", None)
+        examples: list[tuple[str, np.ndarray]] = []
+        if clips is not None:
+            examples = [(c.movement, c.motion.positions) for c in clips.clips]
+        else:
+            examples = [(m, motor.perform(m, fps=30.0).positions) for m in motor.movements()]
+        self.labels = [label for label, _ in examples]
+        self.templates = []
+        for _, positions in examples:
+            rel = positions - positions[:, root : root + 1]
+            self.templates.append(self._series(np.where(np.isnan(rel), np.nanmedian(rel, axis=0), rel)))
+
+    def _series(self, rel: np.ndarray) -> np.ndarray:
+        series = np.nan_to_num(rel[:: self.params["stride"]]).reshape(-1, rel.shape[1] * 3)
+        return np.ascontiguousarray(series, dtype=np.double)
+
+    def match(self, motion: Motion) -> Match:
+        if not motion.visible.any() or not self.templates:
+            return Match.unknown(reason="nothing visible")
+        rel = np.where(motion.visible[..., None], motion.positions, np.nan)
+        fill = np.nanmedian(rel, axis=0)
+        rel = np.where(np.isnan(rel), np.nan_to_num(fill), rel)
+        series = self._series(rel)
+        distances = np.array([frame_distance(series, template, self.params["window"]) for template in self.templates])
+        best = int(np.argmin(distances))
+        per_frame = float(distances[best])
+        if self.params["max_distance"] and per_frame > self.params["max_distance"]:
+            return Match.unknown(distance=per_frame)
+        label = self.labels[best]
+        others = [d for d, lab in zip(distances, self.labels) if lab != label]
+        runner_up = min(others) if others else np.inf
+        confidence = float(1.0 - per_frame / runner_up) if np.isfinite(runner_up) and runner_up > 0 else 1.0
+        return Match(label, max(0.0, confidence), None, details={"distance": per_frame,
+                                                                  "runner_up": float(runner_up)})
+
+
+@hookimpl
+def likeme_register_matchers():
+    return [DTW]

@@ -1,0 +1,646 @@
+"""Matcher ``forward-model``: predicting the ongoing demonstration from the active node's edges (Kopp & Graeser 2006, §4.4, Fig. 3).
+
+When a demonstration begins, every edge leaving the active node of the moving
+subsystem's motor command graph predicts, in parallel, where the demonstrator's
+part should be (its forward model, :meth:`GuidingStroke.position`). A candidate
+whose prediction error exceeds ``threshold`` drops out. When exactly one
+prevails (and enough of its path has been seen) it is executed at once, well
+before the demonstration ends: *response facilitation*. While imitating, the
+observation keeps being compared with the chosen edge; if they part by more
+than ``deviation`` the imitation is stopped, the edge is excluded for this
+segment, the subsystem returns to the last correct node (the start of the edge
+the demonstration was on: the edges before it were right) and the rest is
+learned from there (§4.4: "the imitator returns into the last node at which
+accordance with the demonstrated movement was found").
+
+Speed: the forward model is evaluated not at the elapsed time but at the time at
+which the edge would have covered the same length of path as has been observed,
+so a familiar movement performed faster or slower still fits; the ratio of the
+two times re-parameterises the command's speed for the imitation.
+
+Joining late: a segment often begins after its movement did (a hub threshold is
+crossed once the body has left the hub; a take is cropped in motion). Each part
+is then predicted from the point of its stroke, in the stroke's first half,
+nearest to where it was first seen (the anchor), not from the stroke's start.
+And a subsystem whose active node is not its hub begins at the hub instead when
+the body is seen nearer to the hub's state than to the active node's (a
+demonstrator who returned to rest without the matcher following him there).
+
+*True imitation* (§4.3, Fig. 3 top): when no edge predicts the demonstration,
+the working memory of the segment is cut into strokes by the velocity/direction
+segmenter's break points and each stroke is turned into a guiding stroke by the
+inverse model; the strokes become new edges and nodes leading from the active
+node (ending in the hub when the demonstration returns there).
+
+Subsystems moving at once (§4.2: "multiple graphs at once in order to account
+for the possibly concurrent execution of submovements in different motor
+subsystems within a complex hand-arm-motion"): every subsystem whose parts move
+more than ``min_move`` during the demonstration is under consideration, each
+followed by a :class:`Track` with its own candidates from its own active node.
+One that starts later is followed from when it started. The commitment waits
+until every moving subsystem has one prevailing command (and for a subsystem
+that has begun to move but not yet far enough to be judged), then the commands
+are imitated together (:meth:`MotorCommandGraph.add_together`). If one of them
+has no candidate left, nothing is committed early: at the end its movement is
+learned and imitated together with the others' recognised commands. With
+``together = false`` only the first subsystem to move is followed.
+
+Hands: a hand subsystem's edges are hand transitions over the fingers' joint
+angles (:mod:`plugins.lib.hand_transition`); they predict the observed finger
+configuration just as guiding strokes predict the wrist. Angles are compared
+with the same thresholds through ``angle_scale`` (metres one radian counts as),
+and a new hand movement is learned as one edge whose key postures are the
+angular-velocity minima and direction changes (§4.3).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy.ndimage import uniform_filter1d
+
+from plugins.lib.inverse_model import learn_commands
+from plugins.segmenters.velocity_direction import VelocityDirection
+from toolkit import ConfigError, Match, Matcher, Motion, Parameter, hookimpl
+
+__all__ = ["ForwardModel", "Track"]
+
+
+def _arc(points: np.ndarray) -> np.ndarray:
+    """Cumulative path length along points (N, 3)."""
+    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+
+
+@dataclass
+class Track:
+    """One motor subsystem under consideration during a demonstration (K&G §4.1): its candidates, commitment, errors.
+
+    ``onset`` is the row of the segment's working memory from which the subsystem is followed (0 for the first
+    subsystem to move; a subsystem that starts later is followed from when it started). After a deviation,
+    ``last_correct`` is the node where the demonstration last agreed with the committed path, ``right`` the
+    edges of that path before it, and ``learn_from`` the row from which the rest is learned. ``trace`` holds, per
+    frame, the prediction error of every candidate path evaluated (dropped ones at the frame they drop); while
+    imitating, the committed path's error. ``committed_at`` and ``deviated_at`` count the segment's frames seen.
+    """
+
+    subsystem: str
+    scale: float
+    hand: bool
+    start_node: str
+    onset: int
+    candidates: dict[tuple[str, ...], float]
+    initial: list[str]
+    excluded: set[str] = field(default_factory=set)
+    committed: str | None = None
+    committed_path: tuple[str, ...] = ()
+    confidence: float = 0.0
+    speed: float = 1.0
+    progress: float = 0.0
+    reported: bool = False
+    deviated: bool = False
+    last_correct: str | None = None
+    right: tuple[str, ...] = ()
+    learn_from: int = 0
+    trace: list[tuple[int, dict[tuple[str, ...], float]]] = field(default_factory=list)
+    committed_at: int | None = None
+    deviated_at: int | None = None
+    anchors: dict[str, np.ndarray] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class _EdgeTable:
+    """A command's strokes, one per part, on a fine grid: positions (k, G, 3), cumulative path lengths (k, G), and
+    the lead part (the one that moves farthest)."""
+
+    commands: list
+    positions: np.ndarray
+    arcs: np.ndarray
+    lead: int
+
+
+def _along_rows(arcs: np.ndarray, positions: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Per row r, the point of ``positions[r]`` (G, 3) at path length ``x[r]`` along ``arcs[r]`` (G,), linearly
+    interpolated (``np.interp`` row by row); 0 <= x[r] <= arcs[r, -1]."""
+    j = np.clip((arcs <= x[:, None]).sum(axis=1) - 1, 0, arcs.shape[1] - 2)
+    rows = np.arange(len(x))
+    a0, a1 = arcs[rows, j], arcs[rows, j + 1]
+    step = a1 - a0
+    w = np.divide(x - a0, step, out=np.zeros_like(x), where=step > 0)
+    return positions[rows, j] + np.clip(w, 0.0, 1.0)[:, None] * (positions[rows, j + 1] - positions[rows, j])
+
+
+def _lengths(observed: np.ndarray) -> np.ndarray:
+    """The observed path length of each part of a working memory (n, k, 3), robust to observation noise.
+
+    Noise adds length at every frame; the positions are averaged over three frames first.
+    """
+    if len(observed) >= 3:
+        observed = uniform_filter1d(observed, size=3, axis=0, mode="nearest")
+    return np.linalg.norm(np.diff(observed, axis=0), axis=-1).sum(axis=0) if len(observed) > 1 else \
+        np.zeros(observed.shape[1])
+
+
+class ForwardModel(Matcher):
+    """Edges of the active node predict the demonstration in parallel; the last one left is imitated at once (K&G §4.4)."""
+
+    name = "forward-model"
+    motor_systems = ("motor-command-graph",)
+    parameters = (
+        Parameter("threshold", float, 0.05, "Prediction error (m) above which a candidate edge drops out.", minimum=0.0),
+        Parameter("deviation", float, 0.05, "Error (m) between the imitated edge and the demonstration that stops the "
+                  "imitation (also checked at the end: the demonstration must end where the edge does).", minimum=0.0),
+        Parameter("min_progress", float, 0.2, "Share of the edge's path that must be seen before committing.", minimum=0.0, maximum=1.0),
+        Parameter("min_move", float, 0.02, "Displacement (m) of a subsystem that makes it one under consideration.", minimum=0.0),
+        Parameter("angle_scale", float, 0.25, "Metres one radian of finger joint angle counts as when a hand "
+                  "subsystem's errors and movement are compared with threshold, deviation and min_move "
+                  "(0.25: the 0.05 m threshold is 0.2 rad, 11 degrees).", minimum=1e-6),
+        Parameter("max_candidates", int, 24, "Most candidate command paths followed at once (the best predictions).", minimum=1),
+        Parameter("error", str, "max", "How the prediction errors of a subsystem's parts combine: the largest "
+                  "(a wrist subsystem, §4.4) or the mean (eq. 1 of B&B 2005, for whole-body subsystems).",
+                  choices=("max", "mean")),
+        Parameter("relative", bool, False, "Compare displacements since the onset instead of positions, so that a "
+                  "demonstrator whose posture differs from the observer's own (another style's stance) still fits."),
+        Parameter("together", bool, True, "Follow every subsystem that moves during a demonstration, each with its "
+                  "own candidates, and imitate them at once (a hand-arm movement, §4.2); off: only the first to move."),
+        Parameter("learn", bool, True, "Learn new edges by the inverse model when no edge predicts the demonstration."),
+        Parameter("drop", float, 0.5, "Speed-minimum criterion of the stroke segmentation used for learning.", minimum=0.0, maximum=1.0),
+        Parameter("angle", float, 50.0, "Direction criterion (degrees) of the stroke segmentation used for learning.", minimum=1.0, maximum=180.0),
+    )
+
+    def attach(self, owner: Any) -> None:
+        super().attach(owner)
+        motor = owner.motor
+        if not hasattr(motor, "graphs"):
+            raise ConfigError(f"forward-model needs a motor command graph, not {motor.name!r}", key=("plugin",),
+                              expected='[motor] plugin = "motor-command-graph"')
+        self.motor = motor
+        # observed root-relative positions are placed at the observer's own root height; finger angles stay as they are
+        self._root_height = np.where(owner.body.angle_mask[:, None], 0.0, motor.rest_pose()[owner.body.root_index])
+        self._strokes = VelocityDirection(drop=self.params["drop"], angle=self.params["angle"])
+        self._tables: dict[int, tuple] = {}
+        self._edges: dict[str, _EdgeTable] = {}
+
+    # -- streaming ------------------------------------------------------------------------------
+
+    def begin(self, fps: float) -> None:
+        self.fps = fps
+        self.frames: list[np.ndarray] = []
+        self.tracks: dict[str, Track] = {}  # in the order the subsystems began to move
+        self.reported = False  # a commitment to the tracks decided so far has been announced
+
+    # the first subsystem to move, as the views and single-subsystem users see it
+    @property
+    def main(self) -> Track | None:
+        return next(iter(self.tracks.values()), None) if getattr(self, "tracks", None) else None
+
+    subsystem = property(lambda self: self.main.subsystem if self.main else None)
+    start_node = property(lambda self: self.main.start_node if self.main else None)
+    candidates = property(lambda self: self.main.candidates if self.main else {})
+    initial = property(lambda self: self.main.initial if self.main else [])
+    committed = property(lambda self: self.main.committed if self.main else None)
+    committed_path = property(lambda self: self.main.committed_path if self.main else ())
+    deviated = property(lambda self: bool(self.main and self.main.deviated))
+    trace = property(lambda self: self.main.trace if self.main else [])
+    committed_at = property(lambda self: self.main.committed_at if self.main else None)
+    deviated_at = property(lambda self: self.main.deviated_at if self.main else None)
+
+    def _local(self, pose: np.ndarray) -> np.ndarray:
+        """Root-relative observed positions in the observer's motor frame (root at its own rest height; angles as seen)."""
+        return pose + self._root_height
+
+    def observe(self, pose: np.ndarray, visible: np.ndarray) -> Match | None:
+        points = np.where(visible[:, None], self._local(pose), np.nan)
+        if self.frames:
+            points = np.where(np.isfinite(points), points, self.frames[-1])
+        self.frames.append(points)
+        memory = np.array(self.frames)
+        self._start_tracks(memory)
+        if not self.tracks:
+            return None
+        stop = None
+        for track in self.tracks.values():
+            stop = self._follow(track, memory) or stop
+        if stop is not None:
+            return stop
+        tracks = list(self.tracks.values())
+        if self.reported or not all(t.committed is not None and not t.deviated for t in tracks) or self._joining(memory):
+            return None
+        self.reported = True  # every subsystem under consideration has one prevailing command: imitate them at once
+        for t in tracks:
+            t.reported = True
+        movement = self.motor.add_together([t.committed for t in tracks])
+        labels = [self._path_label(t.committed_path) or self.motor.label(t.committed) for t in tracks]
+        main = tracks[0]
+        details = {"candidates": [c for t in tracks for c in t.initial], "speed": main.speed,
+                   "progress": main.progress}
+        if len(tracks) > 1:
+            details["subsystems"] = {t.subsystem: {"candidates": t.initial, "path": list(t.committed_path),
+                                                    "speed": t.speed, "progress": t.progress} for t in tracks}
+        return Match(labels[0] if len(tracks) == 1 else movement, min(t.confidence for t in tracks), len(self.frames),
+                     path=tuple(e for t in tracks for e in t.committed_path), details=details)
+
+    def _start_tracks(self, memory: np.ndarray) -> None:
+        """Follow every subsystem not yet followed that has moved more than ``min_move`` since the onset.
+
+        The first follows from the onset; one that starts later (three-frame means, against observation noise)
+        from the last frame it was still within a quarter of ``min_move`` of where it was at the onset.
+        """
+        if self.tracks and not self.params["together"]:
+            return
+        late = bool(self.tracks)
+        waiting = [name for name in self.motor.subsystems if name not in self.tracks]
+        if late:
+            first = memory[:3].mean(axis=0)
+            moved = self._moved(waiting, first, memory[-3:].mean(axis=0))
+        else:
+            moved = self._moved(waiting, self.frames[0], self.frames[-1])
+        moved = {name: d for name, d in moved.items() if d > self.params["min_move"]}
+        for name in sorted(moved, key=moved.get, reverse=True):
+            onset = 0
+            if late:
+                idx = self.motor.subsystems[name]
+                away = np.linalg.norm(memory[:, idx] - first[idx], axis=-1).max(axis=1) * self._scale_of(name)
+                still = np.flatnonzero(away <= 0.25 * self.params["min_move"])
+                onset = int(still[-1]) if len(still) else 0
+            self._track(name, onset)
+            if not self.params["together"]:
+                return
+
+    def _moved(self, names: list[str], first: np.ndarray, last: np.ndarray) -> dict[str, float]:
+        """How far (m; a hand's radians scaled) each subsystem's parts have moved at most from ``first`` to ``last``."""
+        return {name: float(np.nanmax(np.linalg.norm(last[idx] - first[idx], axis=-1))) * self._scale_of(name)
+                for name, idx in self.motor.subsystems.items() if name in names}
+
+    def _joining(self, memory: np.ndarray) -> bool:
+        """Whether a subsystem not yet followed has begun to move (half of ``min_move``): the decision waits for it."""
+        if not self.params["together"]:
+            return False
+        waiting = [n for n in self.motor.subsystems if n not in self.tracks]
+        moved = self._moved(waiting, memory[:3].mean(axis=0), memory[-3:].mean(axis=0))
+        return any(d > 0.5 * self.params["min_move"] for d in moved.values())
+
+    def _track(self, name: str, onset: int) -> None:
+        scale = self._scale_of(name)
+        start = self._where(name, self.frames[onset][self.motor.subsystems[name]])
+        # a command that moves no part farther than min_move (standing still) cannot be seen to begin
+        candidates = {(edge,): 0.0 for edge, _ in self.motor.edges_from(name, start)
+                      if self._length(edge) * scale > self.params["min_move"]}
+        self.tracks[name] = Track(name, scale, self.motor.is_hand(name), start, onset, candidates,
+                                  sorted(p[0] for p in candidates), last_correct=start, learn_from=onset)
+
+    def _where(self, name: str, seen: np.ndarray) -> str:
+        """The node a subsystem's demonstration begins in: the active node or the hub, whichever state is nearer
+        to where the parts were seen at the onset (``seen``, (k, 3)).
+
+        The active node is where the last movement the matcher followed ended; a demonstrator who went back to
+        the hub without being followed (a movement that was not recognised, a posture that differed from the
+        observer's own at its end) begins his next movement there. With ``relative`` the observed posture is not
+        comparable with the states, and the active node is kept.
+        """
+        active = self.motor.active[name]
+        if active == "hub" or self.params["relative"] or not np.isfinite(seen).any():
+            return active
+        graph = self.motor.graphs[name]
+        far = [self._distance_to(name, graph.nodes[n]["state"], seen) for n in (active, "hub")]
+        return active if far[0] <= far[1] else "hub"
+
+    def _distance_to(self, name: str, state: np.ndarray, seen: np.ndarray) -> float:
+        """How far the parts seen (k, 3) are from a state of subsystem ``name``, combined as ``error`` says."""
+        d = np.linalg.norm(state - seen, axis=-1) * self._scale_of(name)
+        return float(np.nanmax(d) if self.params["error"] == "max" else np.nanmean(d))
+
+    def _observed(self, track: Track, memory: np.ndarray) -> np.ndarray:
+        """The working memory of a subsystem's parts since it is followed, (n, k, 3)."""
+        return memory[track.onset:, self.motor.subsystems[track.subsystem]]
+
+    def _follow(self, track: Track, memory: np.ndarray) -> Match | None:
+        """One frame of a subsystem's predictions (Fig. 3); a :class:`Match` with ``stop`` when its imitation deviates."""
+        observed = self._observed(track, memory)
+        lengths = _lengths(observed)  # once per frame
+        last = observed[-1]
+        frame = len(self.frames) - 1
+        if track.committed is not None:
+            if track.deviated:
+                return None
+            error = self._error(track, track.committed_path, lengths, last)
+            track.trace.append((frame, {track.committed_path: error}))
+            if error <= self.params["deviation"]:
+                return None
+            track.deviated, track.deviated_at = True, len(self.frames)
+            self._last_correct(track, lengths, memory)
+            if not track.reported:
+                return None
+            # stop the imitation; the others' commands were right and are completed by the motor system
+            self.motor.reset_to(track.subsystem, track.last_correct)
+            return Match(track.committed, 0.0, len(self.frames), details={"stop": True, "reason": "deviation",
+                                                                         "subsystem": track.subsystem,
+                                                                         "return_to": track.last_correct})
+        if not track.candidates:
+            return None
+        errors = {path: self._error(track, path, lengths, last) for path in self._extended(track, lengths)}
+        track.trace.append((frame, errors))
+        alive = {path: error for path, error in errors.items() if error <= self.params["threshold"]}
+        if len(alive) > self.params["max_candidates"]:  # keep the best predictions
+            alive = dict(sorted(alive.items(), key=lambda kv: kv[1])[: self.params["max_candidates"]])
+        track.candidates = alive
+        if alive and len({self._movement_key(p) for p in alive}) == 1:  # one first command (or movement) prevails
+            path = min(alive, key=alive.get)
+            along = self._along(track, path[0], lengths)
+            progress = self._progress(path[0], along)
+            if progress >= self.params["min_progress"] or len(path) > 1:
+                track.committed_path = self._known_continuation(path)
+                track.committed = self.motor.add_sequence(list(track.committed_path))
+                track.committed_at = len(self.frames)
+                track.speed = self._speed(path[0], along, self._anchor(track, path[0]), len(observed))
+                track.progress = progress
+                track.confidence = float(np.exp(-alive[path] / self.params["threshold"]))
+        return None
+
+    def _last_correct(self, track: Track, lengths: np.ndarray, memory: np.ndarray) -> None:
+        """The node at which the demonstration last agreed with the committed path: the start of the edge it was on.
+
+        The edges before it were followed correctly; learning starts from the frame the demonstration passed it.
+        """
+        lead = self._lead(track.committed_path[0])
+        arcs = np.cumsum([self._edge(e).arcs[lead, -1] for e in track.committed_path])
+        joined = self._anchor(track, track.committed_path[0])[lead]
+        on = int(np.searchsorted(arcs, lengths[lead] + joined - 0.01 / track.scale))
+        on = min(on, len(track.committed_path) - 1)
+        track.last_correct = self.motor.edge(track.committed_path[on])[1]
+        track.excluded.add(track.committed_path[on])
+        track.right = track.committed_path[:on]  # the part that was right
+        if track.right:
+            observed = self._observed(track, memory)[:, lead]
+            walked = _arc(uniform_filter1d(observed, size=3, axis=0, mode="nearest"))
+            track.learn_from = track.onset + int(np.searchsorted(walked, arcs[on - 1] - joined))
+
+    def _scale_of(self, subsystem: str) -> float:
+        """Metres one unit of the subsystem's values counts as: ``angle_scale`` for a hand's radians, else 1."""
+        return self.params["angle_scale"] if self.motor.is_hand(subsystem) else 1.0
+
+    def _length(self, name: str) -> float:
+        """Path length (m, or radians for a hand) of a command's lead part."""
+        edge = self._edge(name)
+        return float(edge.arcs[edge.lead, -1])
+
+    def _strokes_of(self, name: str) -> list[Any]:
+        return self.motor.edge(name)[3]["commands"]
+
+    def _lead(self, name: str) -> int:
+        """The part of the subsystem that moves farthest along a command: progress and speed are measured on it."""
+        return self._edge(name).lead
+
+    def _edge(self, name: str) -> _EdgeTable:
+        """Every part's stroke of command ``name`` on the fine grid, stacked (computed once per command)."""
+        commands = self._strokes_of(name)
+        table = self._edges.get(name)
+        if table is None or table.commands is not commands:
+            tables = [self._table(stroke) for stroke in commands]
+            arcs = np.stack([arc for _, _, arc in tables])
+            table = _EdgeTable(commands, np.stack([positions for _, positions, _ in tables]), arcs,
+                               int(np.argmax(arcs[:, -1])))
+            self._edges[name] = table
+        return table
+
+    def _table(self, stroke: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(times, positions, cumulative path length) of a stroke on a fine grid, computed once per stroke."""
+        table = self._tables.get(id(stroke))
+        if table is None or table[0] is not stroke:
+            grid = np.linspace(0.0, stroke.duration, 200)
+            positions = stroke.position(grid)
+            table = (stroke, grid, positions, _arc(positions))
+            self._tables[id(stroke)] = table
+        return table[1], table[2], table[3]
+
+    def _extended(self, track: Track, lengths: np.ndarray) -> list[tuple[str, ...]]:
+        """Candidate paths whose commands have all been covered by the observation continue along every edge of
+        their end node.
+
+        ``lengths`` holds the observed path length of each part of the subsystem.
+        """
+        out = []
+        for path in track.candidates:
+            lead = self._lead(path[0])
+            seen = self._along(track, path[0], lengths)[lead]
+            total = sum(self._edge(e).arcs[lead, -1] for e in path)
+            end = self.motor.edge(path[-1])[2]
+            nxt = [name for name, _ in self.motor.edges_from(track.subsystem, end)] if seen > total + 0.01 / track.scale else []
+            out.extend([(*path, n) for n in nxt if n not in path] or [path])
+        return out
+
+    def _path_label(self, path: tuple[str, ...]) -> str | None:
+        """The labelled movement (clip repertoires) every sequence along ``path`` is an example of, else ``None``."""
+        label_of_path = getattr(self.motor, "label_of_path", None)
+        return label_of_path(path) if label_of_path is not None else None
+
+    def _movement_key(self, path: tuple[str, ...]) -> str:
+        """What a candidate stands for: the labelled movement its sequences are examples of, else its first command."""
+        label = self._path_label(path)
+        return label if label is not None else path[0]
+
+    def _known_continuation(self, path: tuple[str, ...]) -> tuple[str, ...]:
+        """The whole learned command sequence that ``path`` begins, else ``path`` itself."""
+        for edges in self.motor.sequences.values():
+            if tuple(edges[: len(path)]) == path:
+                return tuple(edges)
+        return path
+
+    def _mapped_time(self, stroke: Any, length: float) -> float:
+        """The stroke time at which it has covered ``length`` metres of path (the speed-free forward model)."""
+        grid, _, arc = self._table(stroke)
+        return float(np.interp(min(length, arc[-1]), arc, grid))
+
+    def _predict(self, track: Track, path: tuple[str, ...], lengths: np.ndarray) -> np.ndarray:
+        """Where each part of the subsystem should be after as much path as it has been observed to cover.
+
+        The fingers of a hand share their timing (one transition function, §4.2): they are all predicted at the
+        time at which the lead finger has covered its observed path, so fingers that move in another order than
+        the command's do not fit it.
+        """
+        if track.hand:
+            lead = self._lead(path[0])
+            left = lengths[lead]
+            for i, name in enumerate(path):
+                commands = self._strokes_of(name)
+                arc = self._table(commands[lead])[2]
+                if left <= arc[-1] or i == len(path) - 1:
+                    t = self._mapped_time(commands[lead], left)
+                    return np.array([c.position(t) for c in commands])
+                left -= arc[-1]
+        # each part along its own strokes: on the first edge whose stroke is longer than what is left to place
+        out = np.empty((len(lengths), 3))
+        left = np.array(lengths, dtype=float)
+        open_ = np.ones(len(left), dtype=bool)
+        for i, name in enumerate(path):
+            edge = self._edge(name)
+            total = edge.arcs[:, -1]
+            here = open_ & ((left <= total) | (i == len(path) - 1))
+            if here.any():
+                out[here] = _along_rows(edge.arcs[here], edge.positions[here], np.minimum(left[here], total[here]))
+                open_ &= ~here
+            if not open_.any():
+                break
+            left = np.where(open_, left - total, left)
+        return out
+
+    def _error(self, track: Track, path: tuple[str, ...], lengths: np.ndarray, last: np.ndarray) -> float:
+        """Distance between the path's prediction and the parts' last observed positions ``last`` (k, 3).
+
+        The largest over the parts, or their mean (``error``); with ``relative`` the prediction is moved by
+        the offset between the observed onset posture and the path's start.
+        """
+        predicted = self._predict(track, path, self._along(track, path[0], lengths))
+        return self._distance(track, predicted + self._onset_offset(track, path[0]), last)
+
+    def _along(self, track: Track, name: str, lengths: np.ndarray) -> np.ndarray:
+        """How far along a path beginning with command ``name`` each part is: the observed path length plus
+        where the demonstration joined the command (:meth:`_anchor`)."""
+        return lengths + self._anchor(track, name)
+
+    def _anchor(self, track: Track, name: str) -> np.ndarray:
+        """Where, along each part's stroke of command ``name`` (path length), the demonstration was first seen.
+
+        A segment often begins a little after the movement did (a hub threshold is crossed once the body has
+        left the hub; a stream starts in motion): each part is placed at the point of the first half of its
+        stroke nearest to where it was seen at the track's onset, and predicted from there (0 when it was seen
+        at the stroke's start). With ``relative`` the observed posture is not comparable with the command's
+        positions, and a hand's fingers share one clock: both are followed from the start (0).
+        """
+        anchor = track.anchors.get(name)
+        if anchor is None:
+            edge = self._edge(name)
+            anchor = np.zeros(len(edge.arcs))
+            if not (self.params["relative"] or track.hand):
+                first = self.frames[track.onset][self.motor.subsystems[track.subsystem]]
+                far = np.linalg.norm(edge.positions - first[:, None], axis=-1)
+                far[edge.arcs > 0.5 * edge.arcs[:, -1:]] = np.inf  # the first half of each stroke
+                anchor = edge.arcs[np.arange(len(far)), np.argmin(far, axis=1)]
+            track.anchors[name] = anchor
+        return anchor
+
+    def _onset_offset(self, track: Track, name: str) -> np.ndarray | float:
+        """With ``relative``: the observed onset posture minus where command ``name`` starts (k, 3); else 0."""
+        if not self.params["relative"]:
+            return 0.0
+        start = self._edge(name).positions[:, 0]
+        return self.frames[track.onset][self.motor.subsystems[track.subsystem]] - start
+
+    def _distance(self, track: Track, predicted: np.ndarray, observed: np.ndarray) -> float:
+        """Per-part distances (k, 3 each) combined as ``error`` says: the largest or the mean (radians of a hand scaled)."""
+        d = np.linalg.norm(predicted - observed, axis=-1) * track.scale
+        return float(d.max() if self.params["error"] == "max" else d.mean())
+
+    def _progress(self, name: str, along: np.ndarray) -> float:
+        """The share of command ``name``'s time its lead part has covered, ``along`` its path."""
+        lead = self._lead(name)
+        stroke = self._strokes_of(name)[lead]
+        return self._mapped_time(stroke, along[lead]) / stroke.duration
+
+    def _speed(self, name: str, along: np.ndarray, joined: np.ndarray, n_frames: int) -> float:
+        """How much faster than the command the demonstration goes (1: same speed), from where it was joined."""
+        lead = self._lead(name)
+        stroke = self._strokes_of(name)[lead]
+        elapsed = (n_frames - 1) / self.fps
+        covered = self._mapped_time(stroke, along[lead]) - self._mapped_time(stroke, joined[lead])
+        return float(np.clip(covered / max(elapsed, 1e-6), 0.25, 4.0))
+
+    # -- the end of the demonstration ------------------------------------------------------------
+
+    def conclude(self, motion: Motion) -> Match | None:
+        """The demonstration has ended: check each subsystem's commitment against where it ended, learn the rest.
+
+        A subsystem whose committed path ended where the demonstration did is in the path's end node. One that
+        deviated (now, or while imitating) goes back to its last correct node and the rest of its movement is
+        learned by the inverse model (true imitation, §4.3), as is the movement of a subsystem no edge predicted.
+        Whatever was not yet imitated is returned as one movement (several subsystems: performed together).
+        """
+        if not getattr(self, "frames", None):
+            self.begin(motion.fps)
+            for f in range(motion.n_frames):
+                self.observe(motion.positions[f], motion.visible[f])
+        if not self.tracks:
+            return Match.unknown(reason="nothing moved")
+        memory = np.array(self.frames)
+        perform, learned, paths = [], [], []
+        first_from, first_to = None, None
+        for track in self.tracks.values():
+            idx = self.motor.subsystems[track.subsystem]
+            if track.committed is not None and not track.deviated:
+                end = self.motor.edge(track.committed_path[-1])[2]
+                expected = self.motor.graphs[track.subsystem].nodes[end]["state"] + self._onset_offset(track, track.committed_path[0])
+                if self._distance(track, expected, memory[-1, idx]) <= self.params["deviation"]:
+                    self.motor.active[track.subsystem] = end
+                    if not track.reported:  # recognised, but not imitated yet (another subsystem had to be learned)
+                        perform.append(track.committed)
+                        paths.extend(track.committed_path)
+                    continue
+                # it ended somewhere else: the committed command was not the right one
+                track.deviated = True
+                self._last_correct(track, _lengths(self._observed(track, memory)), memory)
+            if track.committed is not None and track.reported and not track.deviated:
+                continue
+            if track.deviated or track.committed is None:
+                self.motor.reset_to(track.subsystem, track.last_correct)  # back to the last correct node
+            if not self.params["learn"]:
+                continue
+            names = self._learn(track, memory)
+            if not names:
+                continue
+            new = self.motor.add_sequence(names)
+            if track.right:  # the part that was right, then the new one
+                self.motor.add_sequence([*track.right, *names])
+            self.motor.active[track.subsystem] = self.motor.edge(names[-1])[2]
+            perform.append(new)
+            paths.extend(names)
+            learned.extend(names)
+            if first_from is None:
+                first_from, first_to = track.last_correct, self.motor.edge(names[-1])[2]
+        if not perform:
+            if self.reported:
+                return None  # already reported when it committed
+            return Match.unknown(reason="no edge predicts the demonstration")
+        movement = self.motor.add_together(perform)
+        main = self.main
+        details: dict[str, Any] = {"candidates": [c for t in self.tracks.values() for c in t.initial],
+                                   "deviated": any(t.deviated for t in self.tracks.values())}
+        if learned:
+            details.update({"learned": learned, "from": first_from, "to": first_to})
+        else:  # recognised only at the end
+            details.update({"speed": main.speed, "progress": main.progress})
+        if len(perform) > 1:
+            details["subsystems"] = {self.motor.subsystem_of(m): m for m in perform}
+        label = movement if len(perform) > 1 else (self._path_label(tuple(paths)) or self.motor.label(movement))
+        return Match(label, 1.0 if learned else min(t.confidence for t in self.tracks.values() if t.committed),
+                     None, tuple(paths), details=details)
+
+    def _learn(self, track: Track, memory: np.ndarray) -> list[str]:
+        """Cut a subsystem's working memory since its last correct node into strokes, one edge each, chained from it.
+
+        A subsystem followed from a later onset than the first is learned up to where it came to rest.
+        """
+        observed = memory[track.learn_from:, self.motor.subsystems[track.subsystem]]
+        if track.onset > 0 and len(observed) > 3:  # it may have stopped before the others did
+            away = np.linalg.norm(observed - observed[-1], axis=-1).max(axis=1) * track.scale
+            moving = np.flatnonzero(away > 0.25 * self.params["min_move"])
+            observed = observed[: (int(moving[-1]) + 2 if len(moving) else len(observed))]
+        if len(observed) < 3:
+            return []
+        n, k = observed.shape[:2]
+        self._strokes.reset(tuple(f"p{i}" for i in range(k)), self.fps)
+        return learn_commands(self.motor, track.subsystem, observed, self.fps, track.last_correct, self._strokes.breaks)
+
+    def match(self, motion: Motion) -> Match:
+        """Batch use: the whole segment at once (no facilitation)."""
+        self.begin(motion.fps)
+        early = None
+        for f in range(motion.n_frames):
+            early = early or self.observe(motion.positions[f], motion.visible[f])
+        late = self.conclude(motion)
+        return late or early or Match.unknown()
+
+
+@hookimpl
+def likeme_register_matchers():
+    return [ForwardModel]

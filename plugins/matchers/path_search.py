@@ -1,0 +1,191 @@
+"""Matcher ``path-search``: the observed movement as the closest path through one's own posegraph.
+
+Buchsbaum & Blumberg 2005, §5.2 (Fig. 5-8):
+
+1. take a *representative frame from the middle* of the observed segment (the
+   middle is less generic than the transitional beginning and end);
+2. search *the whole graph* for the k poses nearest to it by eq. 1 (the only
+   whole-graph search);
+3. from those k nodes explore outward along the graph's edges, one observed
+   frame at a time, keeping the k best paths by eq. 3 (the summed eq. 1);
+4. the movement to which the majority of the best path's nodes belong is the
+   recognised movement (§5.2.3: a partly seen movement, or one with extra frames
+   before and after, still has most of its path inside the right movement).
+
+Observed frames are sampled at the posegraph's ``node_rate`` so one step along
+an edge corresponds to one observed sample; a path may also stay on a node or
+skip up to ``max_skip - 1`` nodes per sample, so the same movement performed
+slower or faster (Morris's longer cover face, §5.2.2) still aligns. Hub nodes
+belong to no movement and do not vote. Hidden parts are left out of every
+distance (eq. 1 over visible parts); samples with nothing visible cost nothing.
+
+The answer is "unknown" when the best path's mean pose distance exceeds
+``max_distance``; with ``learn = true`` that path is then added to the
+posegraph as a new movement (§5.2.3, §7.3).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from plugins.lib.pose_distance import pose_distance
+from toolkit import ConfigError, Match, Matcher, Motion, Parameter, hookimpl
+
+
+class PathSearch(Matcher):
+    """k-best path search through the observer's posegraph from the middle frame outward (§5.2)."""
+
+    name = "path-search"
+    motor_systems = ("posegraph",)
+    parameters = (
+        Parameter("k", int, 8, "Number of start poses and of paths kept at every step (the beam width). "
+                  "Larger is more robust to noise and occlusion, and slower.", minimum=1),
+        Parameter("max_skip", int, 2, "Most nodes a path may advance per observed sample (0 = stay is always "
+                  "allowed); 2 tolerates movements up to twice as fast as one's own.", minimum=1, maximum=5),
+        Parameter("max_distance", float, 0.03, "Mean eq. 1 distance (m) per sample above which the answer is "
+                  "'unknown'. Must stay above the noise of the input (about 1.8 x its standard deviation).", minimum=0.0),
+        Parameter("scale", float, 0.02, "Distance (m) at which confidence falls to 1/e.", minimum=1e-6),
+        Parameter("learn", bool, False, "Add an unknown movement's path to the posegraph as a new movement."),
+        Parameter("learn_prefix", str, "learned", "Name prefix of learned movements (learned-1, learned-2...)."),
+    )
+
+    def attach(self, owner: Any) -> None:
+        super().attach(owner)
+        motor = owner.motor
+        if not hasattr(motor, "graph") or not hasattr(motor, "node_root_relative"):
+            raise ConfigError(
+                f"path-search needs a posegraph motor system, not {motor.name!r}",
+                key=("plugin",), expected="[motor] plugin = \"posegraph\"",
+            )
+        self.motor = motor
+        self._cache_version = -1
+
+    def _refresh(self) -> None:
+        """(Re)build the successor and predecessor tables after the graph changed (learning)."""
+        motor = self.motor
+        n = motor.graph.number_of_nodes()
+        if n == self._cache_version:
+            return
+        nodes = motor.nodes
+        index = {node: i for i, node in enumerate(nodes)}
+        self.node_names = nodes
+        self.labels = np.array([motor.movement_of(nd) or "" for nd in nodes], dtype=object)
+        self.succ = _reach(motor.graph, nodes, index, self.params["max_skip"], forward=True)
+        self.pred = _reach(motor.graph, nodes, index, self.params["max_skip"], forward=False)
+        self._cache_version = n
+
+    # -- matching ----------------------------------------------------------------------------
+
+    def samples(self, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
+        """The observed motion at the posegraph's node rate, in the observer's part order."""
+        rate = self.motor.params["node_rate"]
+        n = max(1, int(round(motion.duration * rate)))
+        idx = np.minimum(np.round(np.arange(n) * motion.fps / rate).astype(int), motion.n_frames - 1)
+        parts = self.owner.body.parts
+        obs = np.zeros((n, len(parts), 3))
+        vis = np.zeros((n, len(parts)), dtype=bool)
+        for j, part in enumerate(parts):
+            if part in motion.parts:
+                i = motion.parts.index(part)
+                obs[:, j] = motion.positions[idx, i]
+                vis[:, j] = motion.visible[idx, i]
+        obs = np.where(vis[..., None], obs, 0.0)
+        return obs, vis
+
+    def match(self, motion: Motion) -> Match:
+        if motion.n_frames == 0 or not motion.visible.any():
+            return Match.unknown(reason="nothing visible")
+        self._refresh()
+        obs, vis = self.samples(motion)
+        path, cost, evidence = self.search(obs, vis)
+        if path is None:
+            return Match.unknown(reason="nothing visible")
+        labels = self.labels[path]
+        voting = labels[labels != ""]
+        mean = cost / max(evidence, 1)
+        details: dict[str, Any] = {"mean_distance": mean, "samples": len(path)}
+        if voting.size == 0:
+            return Match.unknown(reason="only hub poses", path=tuple(self.node_names[i] for i in path), **details)
+        names, counts = np.unique(voting, return_counts=True)
+        best = int(np.argmax(counts))
+        movement, share = str(names[best]), counts[best] / voting.size
+        details["votes"] = {str(n): int(c) for n, c in zip(names, counts)}
+        node_path = tuple(self.node_names[i] for i in path)
+        if mean > self.params["max_distance"]:
+            if self.params["learn"]:
+                return self._learn(obs, vis, details)
+            return Match(None, 0.0, None, node_path, {"reason": "too far from every path", "nearest": movement, **details})
+        confidence = float(np.exp(-mean / self.params["scale"]) * share)
+        return Match(movement, confidence, None, node_path, details)
+
+    def search(self, obs: np.ndarray, vis: np.ndarray) -> tuple[np.ndarray | None, float, int]:
+        """The best path (node indices, one per sample), its eq. 3 cost and the number of samples with evidence."""
+        has = vis.any(axis=1)
+        if not has.any():
+            return None, 0.0, 0
+        n = len(obs)
+        mid = n // 2
+        ev = np.flatnonzero(has)
+        mid = int(ev[np.argmin(np.abs(ev - mid))])  # the visible frame nearest the middle
+        nodes = self.motor.node_root_relative
+        k = self.params["k"]
+        first = pose_distance(nodes, obs[mid], vis[mid])
+        start = np.argsort(first, kind="stable")[:k]
+        # beams: array of paths (B, length) and costs (B,)
+        paths = start[:, None]
+        costs = first[start]
+        paths, costs = self._extend(paths, costs, obs, vis, range(mid + 1, n), self.succ, append=True)
+        paths, costs = self._extend(paths, costs, obs, vis, range(mid - 1, -1, -1), self.pred, append=False)
+        best = int(np.argmin(costs))
+        return paths[best], float(costs[best]), int(has.sum())
+
+    def _extend(self, paths, costs, obs, vis, frames, table, *, append: bool):
+        nodes = self.motor.node_root_relative
+        k = self.params["k"]
+        for t in frames:
+            reach = [table[e] for e in (paths[:, -1] if append else paths[:, 0])]
+            beam = np.repeat(np.arange(len(reach)), [len(r) for r in reach])
+            cand = np.concatenate(reach)
+            seen = vis[t]
+            if seen.any():  # eq. 1 over the parts seen in this sample (pose_distance without its masking: the hot
+                # loop of the search; the mask is the same for every candidate, so the seen parts are taken first)
+                diff = nodes[cand][:, seen] - obs[t, seen]
+                step = np.sqrt(np.einsum("npi,npi->np", diff, diff)).mean(axis=1)
+            else:
+                step = np.zeros(len(cand))
+            total = costs[beam] + step
+            order = np.argsort(total, kind="stable")
+            # k best, one path per end node (distinct hypotheses): the first time each end node comes in the order
+            _, first = np.unique(cand[order], return_index=True)
+            keep = order[np.sort(first)[:k]]
+            new = cand[keep][:, None]
+            paths = np.hstack([paths[beam[keep]], new]) if append else np.hstack([new, paths[beam[keep]]])
+            costs = total[keep]
+        return paths, costs
+
+    def _learn(self, obs: np.ndarray, vis: np.ndarray, details: dict[str, Any]) -> Match:
+        n = sum(1 for m in self.motor.movements() if m.startswith(self.params["learn_prefix"] + "-")) + 1
+        name = f"{self.params['learn_prefix']}-{n}"
+        path = self.motor.learn(name, obs, vis, source="path-search")
+        self._refresh()
+        return Match(name, 1.0, None, tuple(path), {"learned": True, **details})
+
+
+def _reach(graph, nodes, index, max_skip: int, *, forward: bool) -> list[np.ndarray]:
+    """For every node, the nodes reachable in 0..max_skip steps along (or against) the edges."""
+    step = graph.successors if forward else graph.predecessors
+    out = []
+    for node in nodes:
+        frontier, found = {node}, {node}
+        for _ in range(max_skip):
+            frontier = {m for f in frontier for m in step(f)}
+            found |= frontier
+        out.append(np.array(sorted(index[m] for m in found), dtype=np.intp))
+    return out
+
+
+@hookimpl
+def likeme_register_matchers():
+    return [PathSearch]

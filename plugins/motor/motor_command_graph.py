@@ -1,0 +1,404 @@
+"""Motor system ``motor-command-graph``: one graph of motor commands per motor subsystem (Kopp & Graeser 2006, §4.2).
+
+Nodes are motor states of a subsystem (the positions of its parts in the body
+frame, e.g. where the left wrist is); *hub nodes* are the rest states in which
+movements start and end. Edges are motor commands that lead from one state to
+another: for wrist subsystems, guiding strokes (:mod:`plugins.lib.guiding_stroke`),
+one per part of the subsystem; for hand subsystems, whose parts are the
+fingers of a hand and whose states are their joint angles, hand transitions
+through key postures (:mod:`plugins.lib.hand_transition`), one per finger with
+shared timing. Every hand of the body gets a subsystem of its own (``hands``),
+so Max and Moritz have the paper's four graphs: left and right wrist, left and
+right hand. Several edges may join the same two nodes
+(a :class:`networkx.MultiDiGraph`). At every moment each subsystem is in its
+*active node* (or on an edge between two).
+
+A learner starts with the hub nodes only and learns edges and nodes by watching
+(:meth:`MotorCommandGraph.learn`, used by the ``forward-model`` matcher's inverse
+model). Performing an edge (its name is a movement of this motor system) moves
+the subsystem's parts along the edge's strokes from the rest of the body's
+pose; elbows follow by two-link inverse kinematics with the elbow hanging down
+and out (the swivel heuristic of §3, simplified).
+
+Subsystems are configurable (``subsystems = { left_wrist = ["left_wrist"], ... }``),
+including one whole-body subsystem with every part; a subsystem moves either
+positions or finger joint angles, never both.
+
+Clips (:mod:`plugins.lib.clip_repertoire`): with ``clips`` and ``profile`` the graph
+is learned from labelled motion-capture clips by the inverse model, as if the
+character had watched each one: the rest state is the first hub found from the
+clips, the default subsystem is the whole body (every part but the root, no
+arm inverse kinematics), every clip becomes a chain of edges from the hub, and
+the chain is a named movement (the clip's sub-folder name; several clips of one
+movement share it, :meth:`MotorCommandGraph.label`).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import networkx as nx
+import numpy as np
+
+from plugins.lib.clip_repertoire import CLIP_PARAMETERS, example_name, repertoire_for
+from plugins.lib.guiding_stroke import GuidingStroke, progress
+from plugins.lib.hand_transition import HandTransition
+from plugins.lib.inverse_model import learn_commands
+from plugins.motor.key_poses import parse_poses
+from plugins.segmenters.velocity_direction import VelocityDirection
+from toolkit import ConfigError, Motion, MotorSystem, Parameter, hookimpl
+
+__all__ = ["MotorCommandGraph", "place_elbows", "command_from_dict"]
+
+
+def command_from_dict(entry: dict[str, Any]) -> GuidingStroke | HandTransition:
+    """A motor command from its ``to_dict()``: a hand transition (it has key postures) or a guiding stroke."""
+    return HandTransition(**entry) if "keys" in entry else GuidingStroke(**entry)
+
+
+def place_elbows(shoulder: np.ndarray, wrist: np.ndarray, upper: float, fore: float, outward: np.ndarray) -> np.ndarray:
+    """Elbow positions (F, 3) for shoulders and wrists (F, 3) by two-link IK, bending towards ``outward`` and down."""
+    d_vec = wrist - shoulder
+    d = np.linalg.norm(d_vec, axis=-1, keepdims=True)
+    d_safe = np.clip(d, 1e-6, upper + fore - 1e-6)
+    u = d_vec / np.maximum(d, 1e-9)
+    along = (upper**2 - fore**2 + d_safe**2) / (2 * d_safe)
+    h = np.sqrt(np.clip(upper**2 - along**2, 0.0, None))
+    pole = outward + np.array([0.0, -1.0, 0.0])
+    v = pole - np.sum(pole * u, axis=-1, keepdims=True) * u
+    v = v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-9)
+    return shoulder + along * u + h * v
+
+
+class MotorCommandGraph(MotorSystem):
+    """Per-subsystem graphs of motor states and guiding-stroke commands; learns edges by watching (K&G §4.2)."""
+
+    name = "motor-command-graph"
+    parameters = (
+        Parameter("rest", str, "rest", "The pose every subsystem's hub node is taken from."),
+        Parameter("poses", dict, {}, "Named poses (at least the rest pose), as for keyframe. Not needed with clips."),
+        Parameter("subsystems", dict, {"left_wrist": ["left_wrist"], "right_wrist": ["right_wrist"]},
+                  "Motor subsystems: name = [parts it moves]."),
+        Parameter("hands", bool, True, "Give every hand of the body a subsystem of its own, named as the hand, that "
+                  "moves its fingers (the paper's hand motor command graphs)."),
+        Parameter("tolerance", float, 0.04, "Metres within which two wrist states are the same node.", minimum=0.0),
+        Parameter("hand_tolerance", float, 0.15, "Radians of finger joint angle within which two hand configurations "
+                  "are the same node (and a hand movement has come back to its hub).", minimum=0.0),
+        Parameter("arms", list, [["left_shoulder", "left_elbow", "left_wrist"], ["right_shoulder", "right_elbow", "right_wrist"]],
+                  "Shoulder, elbow, wrist triples whose elbow follows the wrist by inverse kinematics."),
+        *CLIP_PARAMETERS,
+        Parameter("drop", float, 0.5, "With clips: speed-minimum criterion of the stroke segmentation.", minimum=0.0,
+                  maximum=1.0),
+        Parameter("angle", float, 50.0, "With clips: direction criterion (degrees) of the stroke segmentation.",
+                  minimum=1.0, maximum=180.0),
+    )
+
+    def attach(self, owner: Any) -> None:
+        super().attach(owner)
+        body = owner.body
+        self.body = body
+        clips = repertoire_for(self.params, owner)
+        if clips is not None:
+            self.rest = clips.hubs[0].copy()
+            defaults = {p.name: p.default for p in self.parameters}
+            if self.params["subsystems"] == defaults["subsystems"]:  # the whole body unless told otherwise
+                self.params = {**self.params, "subsystems": {"body": [p for p in body.parts if p != body.root]}}
+            if self.params["arms"] == defaults["arms"]:
+                self.params = {**self.params, "arms": []}
+        else:
+            poses = parse_poses(self.params["poses"], body)
+            if self.params["rest"] not in poses.names:
+                raise ConfigError(f"unknown pose {self.params['rest']!r}", key=("rest",), expected="a declared pose",
+                                  available=poses.names)
+            self.rest = poses[self.params["rest"]]
+        self.subsystems: dict[str, np.ndarray] = {}
+        declared = dict(self.params["subsystems"])
+        if self.params["hands"]:
+            declared.update({name: list(hand.fingers) for name, hand in body.hands.items() if name not in declared})
+        angles = body.angle_mask
+        for name, parts in declared.items():
+            if not isinstance(parts, list) or not parts:
+                raise ConfigError("invalid", key=("subsystems", name), expected="a non-empty list of part names")
+            self.subsystems[name] = np.array([body.index(p, key=("subsystems", name)) for p in parts])
+            if 0 < angles[self.subsystems[name]].sum() < len(parts):
+                raise ConfigError("a subsystem mixes fingers and position parts", key=("subsystems", name),
+                                  expected="only fingers (a hand) or only position parts",
+                                  available=[f"fingers: {', '.join(body.angle_parts)}"])
+        self.arms = []
+        for i, triple in enumerate(self.params["arms"]):
+            if not isinstance(triple, list) or len(triple) != 3:
+                raise ConfigError("invalid", key=("arms", i), expected="[shoulder, elbow, wrist]")
+            s, e, w = (body.index(p, key=("arms", i)) for p in triple)
+            upper = float(np.linalg.norm(self.rest[e] - self.rest[s]))
+            fore = float(np.linalg.norm(self.rest[w] - self.rest[e]))
+            outward = np.sign(self.rest[s, 0] - self.rest[body.root_index, 0]) * np.array([1.0, 0.0, 0.0])
+            self.arms.append((s, e, w, upper, fore, outward))
+        self.graphs: dict[str, nx.MultiDiGraph] = {}
+        self.active: dict[str, str] = {}
+        for name, idx in self.subsystems.items():
+            g = nx.MultiDiGraph()
+            g.add_node("hub", state=self.rest[idx].copy(), hub=True)
+            self.graphs[name] = g
+            self.active[name] = "hub"
+        self._edges: dict[str, tuple[str, str, str, int]] = {}  # movement name -> (subsystem, from, to, key)
+        self.sequences: dict[str, list[str]] = {}  # a learned path of several edges, performed as one movement
+        self.together: dict[str, list[str]] = {}  # movements of several subsystems performed at once
+        self._counter = 0
+        self._state = self.rest.copy()
+        self.labels: dict[str, str] = {}  # sequence name -> movement, for sequences learned from labelled clips
+        if clips is not None:
+            self._learn_clips(clips)
+
+    def _learn_clips(self, clips: Any) -> None:
+        """Every clip through the inverse model into a chain of edges from the hub, named by its movement."""
+        (subsystem, idx), = list(self.subsystems.items())[:1]
+        strokes = VelocityDirection(drop=self.params["drop"], angle=self.params["angle"])
+        for clip in clips.clips:
+            m = clip.motion
+            observed = np.where(m.visible[:, idx, None], m.positions[:, idx], np.nan)
+            fill = np.nanmedian(observed, axis=0)
+            observed = np.where(np.isnan(observed), np.where(np.isnan(fill), self.rest[idx], fill), observed)
+            strokes.reset(tuple(f"p{i}" for i in range(len(idx))), m.fps)
+            names = learn_commands(self, subsystem, observed, m.fps, "hub", strokes.breaks, source=str(clip.source),
+                                   hub_tolerance=self.params["hub_radius"], refine=False)
+            if not names:
+                continue
+            n = sum(1 for label in self.labels.values() if label == clip.movement)
+            self.add_sequence(names, name=example_name(clip.movement, n), label=clip.movement)
+            self.active[subsystem] = "hub"
+            self._state = self.rest.copy()
+
+    # -- the graph ------------------------------------------------------------------------------
+
+    def edges_from(self, subsystem: str, node: str) -> list[tuple[str, dict[str, Any]]]:
+        """(movement name, edge data) of every edge leaving ``node``: the candidates of the forward model."""
+        g = self.graphs[subsystem]
+        return [(data["name"], data) for _, _, data in g.out_edges(node, data=True)]
+
+    def is_hand(self, subsystem: str) -> bool:
+        """Whether the subsystem moves fingers (its states are joint angles) rather than positions."""
+        return bool(self.body.angle_mask[self.subsystems[subsystem]].all())
+
+    def tolerance(self, subsystem: str) -> float:
+        """How close (metres, or radians for a hand) two states of the subsystem must be to be the same node."""
+        return self.params["hand_tolerance"] if self.is_hand(subsystem) else self.params["tolerance"]
+
+    def learn(self, subsystem: str, start: str, commands: list[GuidingStroke | HandTransition], *,
+              end: str | None = None, source: str = "") -> str:
+        """Add an edge of ``commands`` (one per part of the subsystem) from node ``start``; returns its movement name.
+
+        Guiding strokes for a wrist subsystem, hand transitions for a hand. The edge ends in ``end`` if given
+        (a hub, say), else in the node at the commands' targets (an existing one within :meth:`tolerance`, or a new one).
+        """
+        g = self.graphs[subsystem]
+        if end is None:
+            target = np.stack([c.target for c in commands])
+            end = self._near_node(subsystem, target) or self._new_node(subsystem, target)
+        self._counter += 1
+        name = f"{subsystem}:e{self._counter}"
+        key = g.add_edge(start, end, name=name, commands=list(commands), source=source)
+        self._edges[name] = (subsystem, start, end, key)
+        if self.owner is not None:
+            self.owner.announce("likeme_movement_learned", character=self.owner, movement=name,
+                                details={"subsystem": subsystem, "from": start, "to": end, "commands": len(commands)})
+        return name
+
+    def _new_node(self, subsystem: str, state: np.ndarray) -> str:
+        g = self.graphs[subsystem]
+        name = f"n{sum(1 for n in g.nodes if n != 'hub') + 1}"
+        g.add_node(name, state=np.asarray(state, dtype=float), hub=False)
+        return name
+
+    def _near_node(self, subsystem: str, state: np.ndarray) -> str | None:
+        """An existing node within :meth:`tolerance` (every part) of ``state``: the same motor state."""
+        tolerance = self.tolerance(subsystem)
+        for node, data in self.graphs[subsystem].nodes(data=True):
+            if np.linalg.norm(data["state"] - state, axis=-1).max() <= tolerance:
+                return node
+        return None
+
+    def edge(self, movement: str) -> tuple[str, str, str, dict[str, Any]]:
+        """(subsystem, from node, to node, edge data) of a movement (edge) name."""
+        subsystem, a, b, key = self._edges[movement]
+        return subsystem, a, b, self.graphs[subsystem].edges[a, b, key]
+
+    # -- the motor system interface -------------------------------------------------------------
+
+    def add_sequence(self, edges: list[str], *, name: str | None = None, label: str | None = None) -> str:
+        """Name a path of edges (a movement learned as several strokes) so it can be performed as one movement.
+
+        ``label`` is the movement it is an example of (a clip's movement); ``name`` defaults to a new number.
+        """
+        if len(edges) == 1 and name is None:
+            return edges[0]
+        for known_name, known in self.sequences.items():
+            if known == list(edges) and name is None:
+                return known_name
+        subsystem = self._edges[edges[0]][0]
+        name = name or f"{subsystem}:m{len(self.sequences) + 1}"
+        self.sequences[name] = list(edges)
+        if label is not None:
+            self.labels[name] = label
+        return name
+
+    def add_together(self, movements: list[str]) -> str:
+        """Name movements of different subsystems performed at once (a hand-arm movement, §4.2); one is itself."""
+        if len(movements) == 1:
+            return movements[0]
+        subsystems = [self.subsystem_of(m) for m in movements]
+        if len(set(subsystems)) < len(subsystems):
+            raise ValueError(f"movements performed together need subsystems of their own, not {subsystems}")
+        name = "+".join(movements)
+        self.together[name] = list(movements)
+        return name
+
+    def subsystem_of(self, movement: str) -> str:
+        """The subsystem an edge or a path of edges moves."""
+        return self._edges[self.sequences.get(movement, [movement])[0]][0]
+
+    def label(self, movement: str) -> str:
+        return self.labels.get(movement, movement)
+
+    def label_of_path(self, path: tuple[str, ...]) -> str | None:
+        """The labelled movement (clip repertoires) ``path`` stands for; ``None`` if none or several.
+
+        The labelled sequences that agree with ``path`` longest (their first edges are its first edges) decide:
+        a path that runs through a whole clip and on, or that leaves a clip's edges for an edge of another
+        (nodes of different clips can be shared), is the movement whose edges it followed first and longest.
+        Unlabelled sequences (a path the forward model committed to, one learned by watching) do not count.
+        """
+        path = tuple(path)
+        labelled = [(tuple(edges), self.labels[n]) for n, edges in self.sequences.items() if n in self.labels]
+        for k in range(len(path), 0, -1):
+            labels = {label for edges, label in labelled if edges[:k] == path[:k]}
+            if labels:
+                return labels.pop() if len(labels) == 1 else None
+        return None
+
+    def movements(self) -> list[str]:
+        if self.labels:
+            return list(dict.fromkeys(self.labels.values()))
+        return [*self._edges, *self.sequences, *self.together]
+
+    def rest_pose(self) -> np.ndarray:
+        return self.rest
+
+    def _paths(self, movement: str) -> list[list[str]]:
+        """The edge paths a movement runs, one per subsystem, all at once."""
+        if movement not in self.sequences and movement not in self.together and movement in self.labels.values():
+            movement = next(n for n, label in self.labels.items() if label == movement)  # a clip movement's first clip
+        if movement in self.together:
+            return [path for part in self.together[movement] for path in self._paths(part)]
+        if movement in self.sequences:
+            return [list(self.sequences[movement])]
+        if movement in self._edges:
+            return [[movement]]
+        raise ConfigError(f"unknown movement {movement!r}", expected="a learned motor command", available=self.movements())
+
+    def perform(self, movement: str, *, speed: float = 1.0, fps: float = 30.0) -> Motion:
+        """Execute an edge, a path of edges or subsystems' movements together, from the current posture.
+
+        Each subsystem runs its path while the others hold their state (and go on holding once their own path
+        has ended); the active nodes become the paths' ends.
+        """
+        tracks = []
+        for path in self._paths(movement):
+            pieces = []
+            for name in path:
+                subsystem, _, end, data = self.edge(name)
+                commands = [c.retimed(c.duration / speed) for c in data["commands"]]
+                duration = max(c.duration for c in commands)
+                t = np.linspace(0.0, duration, max(2, int(round(duration * fps)) + 1))
+                pieces.append(np.stack([c.position(t) for c in commands], axis=1))
+            tracks.append((self.subsystems[subsystem], np.concatenate(pieces)))
+            self.active[subsystem] = end
+        frames = np.repeat(self._state[None], max(len(p) for _, p in tracks), axis=0)
+        for idx, positions in tracks:
+            frames[: len(positions), idx] = positions
+            frames[len(positions):, idx] = positions[-1]
+        self._place_elbows(frames)
+        self._state = frames[-1].copy()
+        return Motion(frames, fps, self.body.parts)
+
+    def _place_elbows(self, frames: np.ndarray) -> None:
+        for s, e, w, upper, fore, outward in self.arms:
+            frames[:, e] = place_elbows(frames[:, s], frames[:, w], upper, fore, outward)
+
+    def interrupt(self, frame: int, pose: np.ndarray, *, fps: float = 30.0) -> Motion | None:
+        """The body's way from ``pose``, where an imitation was stopped at ``frame`` of its motion, to the motor state.
+
+        The matcher that stopped the imitation has put the deviating subsystem back in its last correct node
+        (:meth:`reset_to`, K&G §4.4, Fig. 3); the other subsystems of the motion were right and go on to the end
+        of their commands. The way is straight, with a bell-shaped velocity profile, and takes as long as the
+        stopped motion had run (at least a fifth of a second). ``None`` when the body is there already.
+        """
+        pose = np.asarray(pose, dtype=float)
+        target = self._state.copy()
+        self._place_elbows(target[None])
+        if np.allclose(pose, target, atol=1e-9):
+            return None
+        u = np.linspace(0.0, 1.0, max(int(round(0.2 * fps)), frame) + 1)
+        frames = pose + progress(u, 0.5, 0.0)[:, None, None] * (target - pose)
+        self._place_elbows(frames)
+        self._state = frames[-1].copy()
+        return Motion(frames, fps, self.body.parts)
+
+    def reset(self) -> None:
+        """Every subsystem back in its hub node, the body at rest."""
+        for name in self.subsystems:
+            self.reset_to(name, "hub")
+
+    def reset_to(self, subsystem: str, node: str) -> None:
+        """Put a subsystem back in ``node`` (returning to the last correct node after a deviation, §4.4)."""
+        self.active[subsystem] = node
+        self._state[self.subsystems[subsystem]] = self.graphs[subsystem].nodes[node]["state"]
+
+    def describe(self) -> dict[str, Any]:
+        return {
+            "movements": len(self._edges),
+            "subsystems": {n: {"nodes": g.number_of_nodes(), "edges": g.number_of_edges(), "active": self.active[n],
+                               "commands": [f"{a} -> {b} ({d['name'].split(':')[-1]})" for a, b, d in g.edges(data=True)]}
+                           for n, g in self.graphs.items()},
+        }
+
+    def get_state(self) -> dict[str, Any]:
+        """Learned nodes, edges, sequences and the movement labels of clip sequences, per subsystem."""
+        state = {}
+        for name, g in self.graphs.items():
+            sequences = {m: e for m, e in self.sequences.items() if self.subsystem_of(m) == name}
+            state[name] = {
+                "nodes": {n: d["state"].round(6).tolist() for n, d in g.nodes(data=True) if n != "hub"},
+                "edges": [{"from": a, "to": b, "name": d["name"], "commands": [c.to_dict() for c in d["commands"]]}
+                          for a, b, d in g.edges(data=True)],
+                "sequences": sequences,
+                "labels": {m: label for m, label in self.labels.items() if m in sequences},
+                "together": {m: parts for m, parts in self.together.items() if self.subsystem_of(parts[0]) == name},
+            }
+        return state
+
+    def set_state(self, state: dict[str, Any]) -> None:
+        for name, entry in state.items():
+            if name not in self.graphs:
+                raise ConfigError(f"unknown subsystem {name!r}", key=(name,), expected="a subsystem", available=list(self.graphs))
+            g = self.graphs[name]
+            for node, value in entry.get("nodes", {}).items():
+                g.add_node(node, state=np.asarray(value, dtype=float), hub=False)
+            for i, e in enumerate(entry.get("edges", [])):
+                try:
+                    commands = [command_from_dict(c) for c in e["commands" if "commands" in e else "strokes"]]
+                except (TypeError, ValueError, KeyError) as exc:
+                    raise ConfigError(f"invalid edge ({exc})", key=(name, "edges", i), expected="an edge written by get_state") from None
+                if e["name"] in self._edges:  # the same command built already (from clips, say): the saved one replaces it
+                    _, a, b, old = self._edges[e["name"]]
+                    g.remove_edge(a, b, old)
+                key = g.add_edge(e["from"], e["to"], name=e["name"], commands=commands, source="loaded")
+                self._edges[e["name"]] = (name, e["from"], e["to"], key)
+                self._counter = max(self._counter, int(e["name"].rsplit(":e", 1)[-1]))
+            self.sequences.update(entry.get("sequences", {}))
+            self.labels.update(entry.get("labels", {}))
+            self.together.update(entry.get("together", {}))
+
+
+@hookimpl
+def likeme_register_motor_systems():
+    return [MotorCommandGraph]

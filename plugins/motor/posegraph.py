@@ -1,0 +1,236 @@
+"""Motor system ``posegraph``: poses as nodes, movements as paths, transitions through hubs.
+
+Buchsbaum & Blumberg 2005, §4.1. Source animation (here: the timed key poses of
+the character file, see :mod:`plugins.motor.key_poses`) is broken into *poses*; the
+poses of one *movement* are connected in order, and every movement starts and
+ends in a *hub* pose (standing), which all movements share. Any movement the
+character performs is a path through the graph, and a transition from one
+movement to another passes through a hub.
+
+Resolution: each movement is sampled into pose nodes at ``node_rate`` poses per
+second (the "multi-resolution" of the paper's posegraph: the graph is as fine
+as recognition needs, the played animation stays as smooth as its key poses).
+All node poses sit in one contiguous array ``node_poses`` of shape (N, P, 3),
+local frame, so the matcher searches the whole graph with one vectorised
+distance; ``graph`` is a :class:`networkx.DiGraph` whose nodes carry their index
+into that array, their movement and whether they are hubs.
+
+Learning (§5.2.3, §7.3): :meth:`Posegraph.learn` adds an observed path as a new
+movement (new nodes from the observed poses, entered from and returning to the
+hub), and :meth:`Posegraph.play_path` plays any path.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import networkx as nx
+import numpy as np
+
+from plugins.lib.clip_repertoire import CLIP_PARAMETERS, example_name, repertoire_for
+from plugins.motor.key_poses import REPERTOIRE_PARAMETERS, KeyPoses, interpolate, play, read_repertoire
+from plugins.lib.pose_distance import pose_distance
+from toolkit import ConfigError, Motion, MotorSystem, Parameter, hookimpl
+
+_OPTIONAL = {"poses": {}, "movements": {}}  # with clips, the key-pose repertoire is not needed
+
+
+class Posegraph(MotorSystem):
+    """Key poses as graph nodes, movements as paths hub to hub; plays and learns paths (§4.1)."""
+
+    name = "posegraph"
+    parameters = (
+        *(p if p.name not in _OPTIONAL else Parameter(p.name, p.type, _OPTIONAL[p.name], p.doc + " Not needed with clips.")
+          for p in REPERTOIRE_PARAMETERS),
+        *CLIP_PARAMETERS,
+        Parameter("node_rate", float, 10.0, "Pose nodes per second of movement: the graph's resolution. Higher "
+                  "recognises finer timing at the cost of search time.", minimum=1.0, maximum=120.0),
+    )
+
+    def attach(self, owner: Any) -> None:
+        super().attach(owner)
+        self.body = owner.body
+        self.clips = repertoire_for(self.params, owner)
+        if self.clips is None:
+            if not self.params["poses"]:
+                raise ConfigError("no repertoire", key=("poses",), expected="poses and movements, or clips and profile")
+            self.key_poses, self.hubs, self.repertoire = read_repertoire(self.params, self.body)
+        else:
+            names = tuple("hub" if i == 0 else f"hub{i + 1}" for i in range(len(self.clips.hubs)))
+            self.key_poses, self.hubs, self.repertoire = KeyPoses(names, self.clips.hubs), names, {}
+        self.learned: dict[str, dict[str, Any]] = {}
+        self._build()
+
+    # -- the graph -------------------------------------------------------------------------
+
+    def _build(self) -> None:
+        rate = self.params["node_rate"]
+        poses: list[np.ndarray] = [self.key_poses[h] for h in self.hubs]
+        self.graph = nx.DiGraph()
+        for i, hub in enumerate(self.hubs):
+            self.graph.add_node(hub, index=i, movement=None, hub=True)
+        self.paths: dict[str, list[str]] = {}
+        self.paths_label: dict[str, str] = {}  # path name -> movement (several clips of one movement)
+        for name, m in self.repertoire.items():
+            sampled = play(self.key_poses, m, self.body.parts, fps=rate).positions
+            self._add_path(name, m.poses[0], sampled[1:-1], m.poses[-1], poses)
+        for clip in self.clips.clips if self.clips is not None else ():
+            self._add_clip(clip.movement, clip.motion, poses)
+        self.node_poses = np.stack(poses)
+        root = self.body.root_index
+        self.node_root_relative = self.node_poses - self.node_poses[:, root : root + 1]
+
+    def _add_clip(self, movement: str, motion: Motion, poses: list[np.ndarray]) -> None:
+        """One example clip as a path between the hubs nearest its ends, sampled at ``node_rate``."""
+        rate = self.params["node_rate"]
+        t = np.arange(motion.n_frames) / motion.fps
+        keep = np.unique(np.clip(np.round(np.arange(0.0, t[-1] + 1e-9, 1.0 / rate) * motion.fps), 0,
+                                 motion.n_frames - 1).astype(int))
+        sampled = np.where(motion.visible[keep, :, None], motion.positions[keep], np.nan)
+        sampled = np.where(np.isnan(sampled), np.nanmedian(motion.positions, axis=0), sampled)
+        hub_rel = self.key_poses.array - self.key_poses.array[:, self.body.root_index : self.body.root_index + 1]
+        root = self.body.root_index
+        ends = [self.hubs[int(np.argmin(pose_distance(hub_rel, sampled[i] - sampled[i, root], True)))] for i in (0, -1)]
+        n = sum(1 for p in self.paths if self.paths_label.get(p) == movement)
+        self._add_path(example_name(movement, n), ends[0], sampled[1:-1], ends[1], poses,
+                       label=movement)
+
+    def _add_path(self, name: str, start: str, interior: np.ndarray, end: str, poses: list[np.ndarray], *,
+                  label: str | None = None) -> None:
+        label = label or name
+        path = [start]
+        for j, pose in enumerate(interior, 1):
+            node = f"{name}/{j}"
+            self.graph.add_node(node, index=len(poses), movement=label, hub=False)
+            poses.append(pose)
+            path.append(node)
+        path.append(end)
+        nx.add_path(self.graph, path, movement=label)
+        self.paths[name] = path
+        self.paths_label[name] = label
+
+    @property
+    def nodes(self) -> list[str]:
+        """Node names in the order of ``node_poses``."""
+        order = sorted(self.graph.nodes, key=lambda n: self.graph.nodes[n]["index"])
+        return order
+
+    def node_index(self, node: str) -> int:
+        return int(self.graph.nodes[node]["index"])
+
+    def movement_of(self, node: str) -> str | None:
+        """The movement a node belongs to (``None`` for hubs, which all movements share)."""
+        return self.graph.nodes[node]["movement"]
+
+    # -- the motor system interface ----------------------------------------------------------
+
+    def movements(self) -> list[str]:
+        return list(dict.fromkeys(self.paths_label[p] for p in self.paths))
+
+    def rest_pose(self) -> np.ndarray:
+        return self.key_poses[self.hubs[0]]
+
+    def hub_poses(self) -> np.ndarray:
+        return np.stack([self.key_poses[h] for h in self.hubs])
+
+    def perform(self, movement: str, *, speed: float = 1.0, fps: float = 30.0) -> Motion:
+        if movement in self.repertoire:
+            return play(self.key_poses, self.repertoire[movement], self.body.parts, fps=fps, speed=speed)
+        if movement in self.paths:
+            return self.play_path(self.paths[movement], fps=fps, speed=speed)
+        raise ConfigError(f"unknown movement {movement!r}", expected="a movement of this character", available=self.movements())
+
+    def play_path(self, path: list[str], *, fps: float = 30.0, speed: float = 1.0) -> Motion:
+        """Interpolate any path of nodes, one node every ``1 / node_rate`` seconds."""
+        if len(path) < 2:
+            raise ValueError("a path needs at least two nodes")
+        for a, b in zip(path, path[1:]):
+            if a != b and not self.graph.has_edge(a, b):
+                raise ValueError(f"no edge {a} -> {b} in the posegraph")
+        keys = self.node_poses[[self.node_index(n) for n in path]]
+        times = np.arange(len(path)) / self.params["node_rate"]
+        return interpolate(keys, times, self.body.parts, fps=fps, speed=speed)
+
+    def learn(self, name: str, poses: np.ndarray, visible: np.ndarray | None = None, *, source: str = "",
+              announce: bool = True) -> list[str]:
+        """Add an observed movement as a new path through new nodes (§5.2.3, §7.3).
+
+        Parameters
+        ----------
+        name : str
+            The new movement's name (must be new).
+        poses : array, shape (K, P, 3)
+            Root-relative poses sampled at ``node_rate``; the first and last are taken as hub.
+        visible : array of bool, shape (K, P), optional
+            Hidden parts are filled from the nearest existing node over the visible ones.
+
+        Returns the new path.
+        """
+        if name in self.paths or name in self.movements():
+            raise ConfigError(f"movement {name!r} already exists", expected="a new movement name", available=self.movements())
+        poses = np.asarray(poses, dtype=float)
+        if visible is None:
+            visible = np.isfinite(poses).all(axis=-1)
+        root = self.body.root_index
+        rest_root = self.rest_pose()[root]
+        interior = []
+        for pose, vis in zip(poses[1:-1], visible[1:-1]):
+            if not vis.any():
+                continue
+            if not vis.all():
+                from plugins.lib.pose_distance import pose_distance
+
+                nearest = int(np.nanargmin(pose_distance(self.node_root_relative, np.nan_to_num(pose), vis)))
+                pose = np.where(vis[:, None], pose, self.node_root_relative[nearest])
+            interior.append(pose + rest_root)
+        if not interior:
+            raise ValueError("nothing to learn: no visible pose between the hubs")
+        poses_list = list(self.node_poses)
+        self._add_path(name, self.hubs[0], np.stack(interior), self.hubs[0], poses_list)
+        self.node_poses = np.stack(poses_list)
+        self.node_root_relative = self.node_poses - self.node_poses[:, root : root + 1]
+        self.learned[name] = {"nodes": len(interior), "source": source}
+        if announce and self.owner is not None:
+            self.owner.announce("likeme_movement_learned", character=self.owner, movement=name, details=dict(self.learned[name]))
+        return self.paths[name]
+
+    def get_state(self) -> dict[str, Any]:
+        """The learned movements: for each, its interior node poses (local frame) and where it came from."""
+        return {
+            "learned": {
+                name: {
+                    "source": info["source"],
+                    "poses": self.node_poses[[self.node_index(n) for n in self.paths[name][1:-1]]].round(6).tolist(),
+                }
+                for name, info in self.learned.items()
+            }
+        }
+
+    def set_state(self, state: dict[str, Any]) -> None:
+        for key in state:
+            if key != "learned":
+                raise ConfigError(f"unknown key {key!r}", key=(key,), expected="a posegraph state key", available=["learned"])
+        root = self.body.root_index
+        for name, entry in state.get("learned", {}).items():
+            poses = np.asarray(entry.get("poses"), dtype=float)
+            if poses.ndim != 3 or poses.shape[1:] != (self.body.n_parts, 3) or not np.isfinite(poses).all():
+                raise ConfigError(f"invalid poses of learned movement {name!r}", key=("learned", name, "poses"),
+                                  expected=f"an array of shape (nodes, {self.body.n_parts}, 3) of finite numbers")
+            hub = self.rest_pose() - self.rest_pose()[root]
+            interior = poses - self.rest_pose()[root]  # learn() stores root-relative poses lifted to the rest root
+            self.learn(name, np.concatenate([[hub], interior, [hub]]), source=str(entry.get("source", "")), announce=False)
+
+    def describe(self) -> dict[str, Any]:
+        return {
+            "movements": len(self.movements()),
+            "clips": len(self.clips.clips) if self.clips is not None else 0,
+            "nodes": self.graph.number_of_nodes(),
+            "edges": self.graph.number_of_edges(),
+            "hubs": list(self.hubs),
+            "learned": sorted(self.learned),
+        }
+
+
+@hookimpl
+def likeme_register_motor_systems():
+    return [Posegraph]

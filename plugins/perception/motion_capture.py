@@ -1,0 +1,60 @@
+"""Perception ``motion-capture``: every part of the target, exactly, as a tracking suit reports it.
+
+The perfect-input baseline for the perception stage: no field of view, no
+occlusion, no noise. The world positions are converted to root-relative
+coordinates with the facing found from the body's facing parts (Buchsbaum &
+Blumberg 2005, §5.1, see :mod:`plugins.lib.root_frame`), so the result is what the
+``synthetic-vision`` perception gives when nothing is hidden.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from plugins.lib.root_frame import HeadingFilter, facing_heading, to_root_relative
+from toolkit import Parameter, Percept, Perception, hookimpl
+
+
+class MotionCapture(Perception):
+    """Sees every part of the target exactly (no occlusion or noise); root-relative by §5.1."""
+
+    name = "motion-capture"
+    parameters = (
+        Parameter("facing_window", float, 3.0, "Seconds over which the target's facing is a running median "
+                  "(steady through kicks and head turns; a real turn is followed after half of it; 0: every "
+                  "frame on its own).", minimum=0.0),
+    )
+
+    def reset(self) -> None:
+        self._facing: HeadingFilter | None = None
+
+    def perceive(self, observer, target, world) -> Percept:
+        self.fps = world.fps
+        percept = self.perceive_pose(target.world_pose(), None, target.body, world.time)
+        objects = {name: obj.position.copy() for name, obj in world.objects.items()}
+        return Percept(percept.time, percept.pose, percept.visible, percept.world, percept.root, percept.heading, objects)
+
+    def perceive_pose(self, positions, visible, body, time) -> Percept:
+        """Root-relative percept of recorded world positions (P, 3); non-finite or masked parts are not seen."""
+        pose, mask, root, heading = self._root_relative(np.asarray(positions, dtype=float)[None],
+                                                        None if visible is None else np.asarray(visible)[None], body)
+        world = np.where(mask[0, :, None], positions, np.nan)
+        return Percept(time, pose[0], mask[0], world, root[0], float(heading[0]))
+
+    def perceive_poses(self, positions, visible, body, times) -> tuple[np.ndarray, np.ndarray]:
+        """A block of recorded frames (n, P, 3) at once: the same poses and masks as one perceive_pose per frame."""
+        pose, mask, _, _ = self._root_relative(np.asarray(positions, dtype=float), visible, body)
+        return pose, mask
+
+    def _root_relative(self, positions: np.ndarray, visible, body):
+        seen = np.isfinite(positions).all(axis=-1)
+        visible = seen if visible is None else seen & np.asarray(visible, dtype=bool)
+        if getattr(self, "_facing", None) is None:
+            self._facing = HeadingFilter(round(self.params["facing_window"] * getattr(self, "fps", 30.0)))
+        found = facing_heading(np.where(visible[..., None], positions, 0.0), visible, body)
+        return to_root_relative(positions, visible, body, self._facing.update_many(found))
+
+
+@hookimpl
+def likeme_register_perceptions():
+    return [MotionCapture]

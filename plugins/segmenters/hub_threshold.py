@@ -1,0 +1,237 @@
+"""Segmenter ``hub-threshold``: movements begin and end where the observed body leaves and returns to a hub.
+
+Buchsbaum & Blumberg 2005, §5.1. Almost every movement of the observer's own
+repertoire starts and ends in a hub (standing), so the observer compares each
+incoming frame with *its own* hub pose (root-relative, from its motor system)
+by eq. 1 over the visible parts, low-pass filters that distance, and marks a
+segment's beginning where the filtered distance rises above a threshold and its
+end where it falls back below.
+
+Additions a real stream needs, each a parameter:
+
+- hysteresis: the end threshold may be lower than the start threshold, so
+  noise around the threshold does not chatter;
+- frames with no visible part carry no evidence: the filter holds its value
+  (a long dropout neither starts nor ends a movement);
+- ``min_duration`` drops blips, ``max_gap`` joins a dip below the threshold
+  shorter than it to the surrounding segment;
+- the reported start and end are moved back by the filter's delay, so they
+  mark where the raw distance crossed, not where the lagging filter did;
+- noise floor: noisy observations never reach distance 0 even at rest (eq. 1
+  averages norms, which noise only increases). With ``floor`` > 0 the
+  threshold applies to the filtered distance minus its minimum over the last
+  ``floor`` seconds, so the same threshold works for clean and noisy input.
+  (A stream that starts in the middle of a movement is then not segmented
+  until the body has once been at rest.)
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from scipy.ndimage import minimum_filter1d
+from scipy.signal import butter, lfilter, lfilter_zi
+
+from plugins.lib.pose_distance import pose_distance
+from toolkit import ConfigError, Motion, Parameter, Segment, Segmenter, hookimpl
+
+
+class HubThreshold(Segmenter):
+    """Segments where the distance from the observer's own hub pose crosses a threshold (§5.1)."""
+
+    name = "hub-threshold"
+    parameters = (
+        Parameter("threshold", float, 0.02, "Filtered eq. 1 distance (m) from the hub above which a movement has begun. "
+                  "Lower finds subtler movements and more noise; higher misses small movements.", minimum=0.0),
+        Parameter("release", float, 0.75, "End threshold as a fraction of `threshold` (hysteresis; 1 = none).", minimum=0.0, maximum=1.0),
+        Parameter("cutoff", float, 4.0, "Low-pass cut-off frequency in Hz (second-order Butterworth). "
+                  "Lower smooths more noise but delays and merges boundaries.", minimum=0.1),
+        Parameter("min_duration", float, 0.25, "Segments shorter than this (s) are dropped as noise.", minimum=0.0),
+        Parameter("max_gap", float, 0.1, "Dips below the end threshold shorter than this (s) do not end a segment.", minimum=0.0),
+        Parameter("floor", float, 10.0, "Seconds over which the running minimum of the filtered distance is "
+                  "taken as the noise floor and subtracted (0: no floor, the paper's plain threshold).", minimum=0.0),
+        Parameter("hub", str, "", "The hub pose to compare with (default: the observer's rest pose)."),
+    )
+
+    def attach(self, owner: Any) -> None:
+        super().attach(owner)
+        motor = owner.motor
+        if self.params["hub"]:
+            poses = getattr(motor, "key_poses", None)
+            if poses is None or self.params["hub"] not in poses.names:
+                raise ConfigError(
+                    f"unknown hub pose {self.params['hub']!r}", key=("hub",), expected="a pose of the observer's motor system",
+                    available=list(poses.names) if poses is not None else [],
+                )
+            hubs = poses[self.params["hub"]][None]
+        else:
+            hubs = motor.hub_poses()
+        hubs = np.asarray(hubs, dtype=float)
+        root = owner.body.root_index
+        self.templates = hubs - hubs[:, root : root + 1]  # every hub: the distance is to the nearest one
+        self.template = self.templates[0]
+        self.template_parts = owner.body.parts
+
+    # -- streaming ---------------------------------------------------------------------
+
+    def reset(self, parts: Sequence[str], fps: float) -> None:
+        parts = tuple(parts)
+        missing = [p for p in self.template_parts if p not in parts]
+        if missing and len(missing) == len(self.template_parts):
+            raise ConfigError(f"the observed body shares no part with the hub template {list(self.template_parts)}",
+                              expected="observed parts named like the observer's own", available=list(parts))
+        self._index = np.array([parts.index(p) if p in parts else -1 for p in self.template_parts])
+        self._fps = float(fps)
+        nyquist = 0.5 * self._fps
+        wn = min(self.params["cutoff"] / nyquist, 0.99)
+        self._b, self._a = butter(2, wn)
+        self._zi: np.ndarray | None = None
+        self._delay = int(round(_group_delay(self._b, self._a, self._fps)))
+        self._frame = -1
+        self._last = np.nan
+        self._window = max(1, int(round(self.params["floor"] * self._fps))) if self.params["floor"] > 0 else 0
+        self._recent: deque[tuple[int, float]] = deque()  # monotonic queue of (frame, value) for the running minimum
+        self._start: int | None = None
+        self._below = 0
+        self._on, self._off = self.thresholds
+
+    @property
+    def active_since(self) -> int | None:
+        return self._start
+
+    def distance(self, pose: np.ndarray, visible: np.ndarray) -> float:
+        """eq. 1 between one observed root-relative pose and the hub template (NaN if nothing visible)."""
+        return float(self.distances(np.asarray(pose)[None], np.asarray(visible)[None])[0])
+
+    def distances(self, poses: np.ndarray, visible: np.ndarray) -> np.ndarray:
+        """eq. 1 between observed root-relative poses (n, P, 3) and the nearest hub (n,); NaN where nothing is seen."""
+        ok = self._index >= 0
+        obs = np.zeros((len(poses), *self.template.shape))
+        vis = np.zeros((len(poses), len(self.template)), dtype=bool)
+        obs[:, ok] = poses[:, self._index[ok]]
+        vis[:, ok] = visible[:, self._index[ok]]
+        return _nearest(pose_distance(obs[:, None], self.templates, vis[:, None]), axis=-1)
+
+    def push(self, pose: np.ndarray, visible: np.ndarray) -> list[Segment]:
+        closed, _ = self.push_block(np.asarray(pose)[None], np.asarray(visible)[None])
+        return [segment for _, segment in closed]
+
+    def push_block(self, poses: np.ndarray, visible: np.ndarray) -> tuple[list[tuple[int, Segment]], np.ndarray]:
+        """A block of frames: the distances and the low-pass filter for all of them at once, then the
+        thresholds frame by frame (the same as one push per frame)."""
+        raw = _hold(np.concatenate([[self._last], self.distances(poses, visible)]))[1:]  # no evidence: hold
+        if not len(raw):
+            return [], np.zeros(0, dtype=int)
+        self._last = float(raw[-1])
+        if self._zi is None:
+            self._zi = lfilter_zi(self._b, self._a) * raw[0]
+        filtered, self._zi = lfilter(self._b, self._a, raw, zi=self._zi)
+        closed: list[tuple[int, Segment]] = []
+        since = np.empty(len(raw), dtype=int)
+        for i, value in enumerate(filtered.tolist()):
+            self._frame += 1
+            closed.extend((i, segment) for segment in self._step(value))
+            since[i] = -1 if self._start is None else self._start
+        return closed, since
+
+    def _above_floor(self, value: float) -> float:
+        """``value`` minus the running minimum of the last ``floor`` seconds (itself if there is no floor)."""
+        if not self._window:
+            return value
+        while self._recent and self._recent[-1][1] >= value:
+            self._recent.pop()
+        self._recent.append((self._frame, value))
+        while self._recent[0][0] <= self._frame - self._window:
+            self._recent.popleft()
+        return value - self._recent[0][1]
+
+    def _step(self, value: float) -> list[Segment]:
+        value = self._above_floor(value)
+        f = self._frame
+        if self._start is None:
+            if value > self._on:
+                self._start = max(0, f - self._delay)
+                self._below = 0
+            return []
+        if value < self._off:
+            self._below += 1
+            gap = int(round(self.params["max_gap"] * self._fps))
+            if self._below > gap:
+                end = max(self._start + 1, f - self._below + 1 - self._delay)
+                return self._close(end)
+        else:
+            self._below = 0
+        return []
+
+    def flush(self) -> list[Segment]:
+        if self._start is None:
+            return []
+        return self._close(self._frame + 1)
+
+    def _close(self, end: int) -> list[Segment]:
+        start, self._start, self._below = self._start, None, 0
+        if (end - start) / self._fps < self.params["min_duration"] or end <= start:
+            return []
+        return [Segment(start, end, self._fps)]
+
+    # -- batch ---------------------------------------------------------------------------
+
+    def signal(self, motion: Motion) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The distance-to-hub of a root-relative motion (Fig. 4): raw, low-pass filtered, and the level the
+        thresholds apply to (the filtered distance minus its running minimum over ``floor`` seconds; the filtered
+        distance itself without a floor). Frames with nothing visible hold the last value.
+        """
+        self.reset(motion.parts, motion.fps)
+        raw = _hold(self.distances(motion.positions, motion.visible))
+        if raw.size == 0:
+            return raw, raw, raw
+        filtered, _ = lfilter(self._b, self._a, raw, zi=lfilter_zi(self._b, self._a) * raw[0])
+        if not self._window:
+            return raw, filtered, filtered
+        w = self._window  # the running minimum of the last w frames, this one included (trailing window)
+        return raw, filtered, filtered - minimum_filter1d(filtered, w, mode="nearest", origin=(w - 1) // 2)
+
+    @property
+    def thresholds(self) -> tuple[float, float]:
+        """The level at which a movement begins and the level below which it ends (hysteresis)."""
+        return self.params["threshold"], self.params["threshold"] * self.params["release"]
+
+    def segment(self, motion: Motion) -> list[Segment]:
+        self.reset(motion.parts, motion.fps)
+        closed, _ = self.push_block(motion.positions, motion.visible)
+        return [segment for _, segment in closed] + self.flush()
+
+
+def _nearest(distances: np.ndarray, axis: int = -1) -> np.ndarray:
+    """The distance to the nearest hub (NaN where nothing was visible)."""
+    if distances.shape[axis] == 1:
+        return np.take(distances, 0, axis=axis)
+    with np.errstate(all="ignore"):
+        return np.where(np.isnan(distances).all(axis=axis), np.nan, np.nanmin(np.nan_to_num(distances, nan=np.inf), axis=axis))
+
+
+def _hold(x: np.ndarray) -> np.ndarray:
+    """Replace NaN by the last valid value (0 before the first), vectorised."""
+    x = np.asarray(x, dtype=float)
+    if x.size == 0:
+        return x
+    valid = ~np.isnan(x)
+    idx = np.where(valid, np.arange(len(x)), -1)
+    np.maximum.accumulate(idx, out=idx)
+    return np.where(idx >= 0, x[np.maximum(idx, 0)], 0.0)
+
+
+def _group_delay(b: np.ndarray, a: np.ndarray, fps: float) -> float:
+    """Delay in frames of the filter at low frequencies (where movements live)."""
+    from scipy.signal import group_delay
+
+    _, gd = group_delay((b, a), w=[0.01])
+    return float(gd[0])
+
+
+@hookimpl
+def likeme_register_segmenters():
+    return [HubThreshold]

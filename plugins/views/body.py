@@ -1,0 +1,96 @@
+"""View ``body``: a character's colour-coded body in its hub pose and a strip of key poses per movement.
+
+Buchsbaum & Blumberg 2005, §4.2 and Fig. 2-3: each tracked body part is a sphere
+in its own colour, the root node is marked (a black ring), bones join the
+parts. Below the hub pose, every movement of the repertoire is a row of
+``keys`` poses sampled evenly over the movement as the motor system performs
+it, labelled with the movement's name. Everything is in the character's own
+frame (it faces +z), seen from the front.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from plugins.lib.rendering import add_labels, draw_bodies, frame_2d, plotter, save_png
+from toolkit import ConfigError, Parameter, View, hookimpl
+
+__all__ = ["BodyView", "key_pose_strip"]
+
+
+def key_pose_strip(motion_positions: np.ndarray, keys: int, root: int) -> np.ndarray:
+    """``keys`` poses sampled evenly from a motion (F, P, 3), each moved so its root is over the origin (x, z)."""
+    frames = np.linspace(0, len(motion_positions) - 1, keys).round().astype(int)
+    poses = motion_positions[frames].copy()
+    poses[..., [0, 2]] -= poses[:, root : root + 1, [0, 2]]
+    return poses
+
+
+class BodyView(View):
+    """The body in its hub pose, parts in their colours, root marked; each movement as a strip of key poses."""
+
+    name = "body"
+    parameters = (
+        Parameter("keys", int, 6, "Key poses shown per movement.", minimum=1, maximum=30),
+        Parameter("movements", list, [], "Movements to show (default: all of the repertoire)."),
+        Parameter("columns", int, 0, "Columns of movement strips (0: one per 12 movements).", minimum=0),
+        Parameter("width", int, 1600, "Image width in pixels.", minimum=64),
+        Parameter("height", int, 0, "Image height in pixels (0: from the number of rows).", minimum=0),
+        Parameter("fps", float, 30.0, "Frame rate the movements are performed at before sampling.", minimum=1.0),
+    )
+
+    def draw(self, subject: Any, out: Path) -> list[Path]:
+        character = subject
+        body, motor = character.body, character.motor
+        movements = list(self.params["movements"]) or sorted(motor.movements())
+        unknown = [m for m in movements if m not in motor.movements()]
+        if unknown:
+            raise ConfigError(f"unknown movement {unknown[0]!r}", key=("movements",), expected="a movement of "
+                              f"{character.name}", available=sorted(motor.movements()))
+        rest = np.asarray(motor.rest_pose(), dtype=float)
+        extent = np.ptp(rest[np.isfinite(rest).all(axis=1)], axis=0)
+        height = max(float(extent[1]), 0.2)
+        cell = max(float(extent[0]), float(extent[2]), height * 0.5) * 1.5  # one pose's width in the strip
+        row = height * 1.6
+        keys = self.params["keys"]
+        columns = self.params["columns"] or max(1, int(np.ceil(len(movements) / 12)))
+        rows = int(np.ceil(len(movements) / columns))
+        label_width = cell * 3.2
+        strip = label_width + keys * cell + cell * 0.5
+        root = body.root_index
+        poses, labels, points = [], [], []
+        hub = rest.copy()
+        hub[:, [0, 2]] -= hub[root, [0, 2]]
+        top = (columns * strip) / 2
+        poses.append(hub * 1.4 + np.array([top, row * 0.1, 0.0]))
+        labels.append(f"{character.name}: hub pose")
+        points.append([top, row * 0.1 + height * 1.55, 0.0])
+        for i, movement in enumerate(movements):
+            c, r = divmod(i, rows)
+            motion = motor.perform(movement, fps=self.params["fps"])
+            y = -(r + 1) * row - height * 0.3
+            x = c * strip + label_width
+            for k, pose in enumerate(key_pose_strip(motion.positions, keys, root)):
+                poses.append(pose + np.array([x + (k + 0.5) * cell, y, 0.0]))
+            labels.append(f"{motor.label(movement)}  {motion.duration:.2f} s")
+            points.append([x - cell * 0.1, y + height * 0.5, 0.0])
+        width = self.params["width"]
+        lower = (0.0, -(rows + 1) * row)
+        upper = (columns * strip, row * 0.1 + height * 1.8)
+        size = (width, self.params["height"] or int(width * (upper[1] - lower[1]) / (upper[0] - lower[0])))
+        pl = plotter(size)
+        try:
+            draw_bodies(pl, body, np.stack(poses), radius=max(height / 28.0, 0.006))
+            add_labels(pl, np.array(points), labels, font_size=max(10, min(20, int(size[1] / (rows + 2) / 5))), align="right")
+            frame_2d(pl, lower, upper)
+            return [save_png(pl, out)]
+        finally:
+            pl.close()
+
+
+@hookimpl
+def likeme_register_views():
+    return [BodyView]
