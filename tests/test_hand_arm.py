@@ -15,7 +15,8 @@ import pytest
 
 from plugins.lib.guiding_stroke import GuidingStroke
 from tests.conftest import CHARACTERS, play_recording_postures
-from toolkit import create_plugin_manager, load_character
+from toolkit import Motion, create_plugin_manager, load_character
+from toolkit.watching import feed
 
 GAMES = CHARACTERS / "scenarios" / "hand_arm_games.toml"
 
@@ -102,7 +103,7 @@ def test_movements_performed_together_are_saved_and_loaded(games, tmp_path):
     assert name in fresh.movements()
     np.testing.assert_allclose(fresh.perform(name).positions, motor.perform(name).positions, atol=1e-5)
     for subsystem in ("left_wrist", "left_hand"):
-        motor.reset_to(subsystem, "hub")
+        motor.move_to(subsystem, "hub")
 
 
 def test_a_deviation_on_the_second_edge_of_a_path_learns_only_the_rest_from_the_node_between():
@@ -112,9 +113,9 @@ def test_a_deviation_on_the_second_edge_of_a_path_learns_only_the_rest_from_the_
     rest = motor.rest[w]
     a, b = rest + [0.0, 0.2, 0.12], rest + [0.0, 0.2, 0.12] + [0.22, 0.0, 0.0]
     first = motor.learn("left_wrist", "hub", [GuidingStroke(rest, a, 0.6)])
-    second = motor.learn("left_wrist", motor.edge(first)[2], [GuidingStroke(a, b, 0.6)])
+    second = motor.learn("left_wrist", motor.edge(first).target, [GuidingStroke(a, b, 0.6)])
     known = motor.add_sequence([first, second])
-    middle = motor.edge(first)[2]
+    middle = motor.edge(first).target
     # Moritz goes along the first edge, then up instead of out to the side
     fps = 30.0
     up = GuidingStroke(a, a + [0.0, 0.2, 0.0], 0.6)
@@ -122,9 +123,7 @@ def test_a_deviation_on_the_second_edge_of_a_path_learns_only_the_rest_from_the_
     root = motor.rest[body.root_index]
     frames = np.repeat((motor.rest - root)[None], len(path), axis=0)
     frames[:, w] = path - root
-    visible = np.ones(len(body.parts), dtype=bool)
-    matcher.begin(fps)
-    answers = [matcher.observe(f, visible) for f in frames]
+    answers = list(feed(matcher, Motion(frames, fps, body.parts)))
     commit = next(m for m in answers if m is not None)
     assert commit.movement == known and commit.path == (first, second)
     stop = next(m for m in answers if m is not None and m.details.get("stop"))
@@ -133,8 +132,8 @@ def test_a_deviation_on_the_second_edge_of_a_path_learns_only_the_rest_from_the_
     assert learned.details["from"] == middle and learned.details["deviated"]
     assert len(learned.details["learned"]) == 1
     new = learned.details["learned"][0]
-    assert motor.edge(new)[1] == middle  # from the node between, not from the hub
-    np.testing.assert_allclose(motor.edge(new)[3]["commands"][0].target, a + [0.0, 0.2, 0.0], atol=0.02)
+    assert motor.edge(new).source == middle  # from the node between, not from the hub
+    np.testing.assert_allclose(motor.edge(new).commands[0].target, a + [0.0, 0.2, 0.0], atol=0.02)
     assert [first, new] in motor.sequences.values()  # the right part and the new one, as one movement
 
 
@@ -153,7 +152,7 @@ def test_an_interrupted_motion_goes_back_to_the_motor_state_the_others_to_their_
     motion = motor.perform(both)
     assert motor.active["left_wrist"] != "hub" and motor.active["left_hand"] != "hub"
     stopped = motion.positions[12]
-    motor.reset_to("left_wrist", "hub")  # the matcher found the wrist wrong: back to its last correct node
+    motor.move_to("left_wrist", "hub")  # the matcher found the wrist wrong: back to its last correct node
     back = motor.interrupt(12, stopped, fps=30.0)
     assert back.n_frames == 13
     np.testing.assert_allclose(back.positions[0], stopped)

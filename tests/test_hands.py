@@ -136,7 +136,7 @@ def test_the_segmenter_finds_the_via_posture_at_the_angular_velocity_minimum():
     noisy = angles + rng.normal(0.0, 0.003, angles.shape)
     segmenter = VelocityDirection()
     segmenter.reset([f"f{j}" for j in range(5)], FPS)
-    breaks = segmenter.breaks(noisy.reshape(len(noisy), -1))
+    breaks = segmenter.analyse(noisy.reshape(len(noisy), -1)).breaks
     assert len(breaks) == 1 and abs(breaks[0] - 18) <= 2
     back = transitions_from_segment(noisy, FPS, breaks)
     assert max(np.abs(b.trajectory(FPS)[: len(angles)] - angles[:, j]).max() for j, b in enumerate(back)) < 0.05
@@ -156,13 +156,16 @@ def test_finger_angles_pass_through_perception_seen_with_their_wrist(pm):
 
     world = local_to_world(pose, np.array([1.0, 0.0, 2.0]), np.pi / 3)
     world[angles] = pose[angles]
-    percept = MotionCapture().perceive_pose(world, None, body, 0.0)
+    perception = MotionCapture()
+    perception.reset(FPS)
+    percept = perception.perceive_pose(world, None, body, 0.0)
     np.testing.assert_allclose(percept.pose[angles], pose[angles])
     assert percept.visible.all()
     hidden = world.copy()
     hidden[body.index("left_wrist")] = np.nan
     hidden[body.index("right_index")] = np.nan  # a bad finger value is not seen, never a crash
-    percept = MotionCapture().perceive_pose(hidden, None, body, 0.0)
+    perception.reset(FPS)
+    percept = perception.perceive_pose(hidden, None, body, 0.0)
     unseen = {body.parts[i] for i in np.flatnonzero(~percept.visible)}
     assert unseen == {"left_wrist", *FINGERS, "right_index"}
 
@@ -174,6 +177,7 @@ def test_synthetic_vision_sees_the_fingers_of_a_hand_it_sees(pm):
     moritz = world.add_actor(load_character("moritz", pm), "moritz", (0.0, 0.0, 2.0), np.pi)
     max_ = world.add_actor(load_character("max_learner", pm, override={"perception": {"plugin": "synthetic-vision"}}),
                            "max", (0.0, 0.0, 0.0), 0.0)
+    max_.character.perception.reset(world.fps)
     percept = max_.character.perception.perceive(max_, moritz, world)
     body = moritz.body
     wrists = {h.wrist: h.fingers for h in body.hands.values()}
@@ -227,8 +231,7 @@ def test_game_3_the_fist_fails_and_a_new_edge_with_a_via_posture_is_learned(game
     assert grab.details["candidates"] == ["left_hand:e1"]  # the fist predicted it at first
     assert grab.details["learned"] == ["left_hand:e3"] and (grab.details["from"], grab.details["to"]) == ("hub", "n1")
     motor = games.actors["max"].character.motor
-    _, _, _, data = motor.edge("left_hand:e3")
-    commands = data["commands"]
+    commands = motor.edge("left_hand:e3").commands
     assert len(commands) == 5 and all(len(c.keys) == 3 for c in commands)  # start, the via posture, the fist
     hook = games.actors["moritz"].character.motor.key_poses["left_hook"][motor.subsystems["left_hand"]]
     assert np.abs(np.stack([c.keys[1] for c in commands]) - hook).max() < np.radians(15)
@@ -257,8 +260,8 @@ def test_learned_hand_commands_are_saved_and_loaded(games, pm, tmp_path):
     fresh.set_state(json.loads(path.read_text()))
     for name in ("left_hand:e1", "left_hand:e2", "left_hand:e3"):
         a, b = motor.edge(name), fresh.edge(name)
-        assert a[:3] == b[:3]
-        t = np.linspace(0.0, a[3]["commands"][0].duration, 17)
-        for x, y in zip(a[3]["commands"], b[3]["commands"]):
+        assert (a.subsystem, a.source, a.target) == (b.subsystem, b.source, b.target)
+        t = np.linspace(0.0, a.commands[0].duration, 17)
+        for x, y in zip(a.commands, b.commands):
             np.testing.assert_allclose(x.position(t), y.position(t), atol=1e-5)
     assert fresh.perform("left_hand:e3").n_frames == motor.perform("left_hand:e3").n_frames

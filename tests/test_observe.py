@@ -23,6 +23,7 @@ from toolkit import ConfigError, Motion, create_plugin_manager, load_character
 from toolkit.cli import main
 from toolkit.observe import Observer, compose_observer
 from toolkit.profile import load_profile
+from toolkit.watching import feed
 
 
 @pytest.fixture(scope="module")
@@ -55,7 +56,7 @@ def test_the_same_clips_become_a_posegraph_and_a_motor_command_graph(data, profi
         data / "repertoire", profile).movements
     assert list(commands.subsystems) == ["body"]
     sequence = commands.sequences["jump"]
-    assert commands.edge(sequence[0])[1] == "hub" and commands.label("jump") == "jump"
+    assert commands.edge(sequence[0]).source == "hub" and commands.label("jump") == "jump"
     assert graph.perform("jump", fps=30).n_frames > 10 and commands.perform("jump", fps=30).n_frames > 10
 
 
@@ -172,9 +173,9 @@ def test_every_clip_is_watched_from_the_hub_whatever_came_before(data, profile, 
     nod = profile.read(data / "demos" / "nod" / "morris_1.0.bvh")
     alone = observer.classify(nod)
     motor = character.motor
-    motor.reset_to("body", motor.edge(motor.sequences["bow"][0])[2])  # as a clip that ended half-way leaves it
+    motor.move_to("body", motor.edge(motor.sequences["bow"][0]).target)  # as a clip that ended half-way leaves it
     again = observer.classify(nod)
-    assert character.matcher.start_node == "hub"
+    assert character.matcher.inspect()["start_node"] == "hub"
     assert (again.movement, again.decided_at) == (alone.movement, alone.decided_at) == ("nod", alone.decided_at)
 
 
@@ -190,7 +191,8 @@ def test_a_demonstration_watched_from_a_few_frames_in_is_still_predicted(data, p
             cut = Motion(motion.positions[late:], motion.fps, motion.parts, motion.visible[late:])
             obs = observer.classify(cut)
             assert obs.movement == movement and obs.decision_fraction < 0.5, (movement, late, obs)
-        assert character.matcher.main.anchors[character.matcher.committed_path[0]].max() > 0.01
+        signals = character.matcher.inspect()
+        assert signals["anchors"][signals["committed_path"][0]].max() > 0.01
 
 
 def test_a_movement_begun_at_the_hub_is_followed_from_the_hub_wherever_the_last_one_left_off(data, profile, pm):
@@ -199,15 +201,14 @@ def test_a_movement_begun_at_the_hub_is_followed_from_the_hub_wherever_the_last_
     character = compose_observer(pm, profile, data / "repertoire", matcher="forward-model")
     motor, matcher = character.motor, character.matcher
     nod = profile.read(data / "demos" / "nod" / "morris_1.0.bvh")
-    elsewhere = motor.edge(motor.sequences["bow"][0])[2]
+    elsewhere = motor.edge(motor.sequences["bow"][0]).target
     observer = Observer(character, profile.body, nod.fps)
-    motor.reset_to("body", elsewhere)  # as an earlier segment of the stream left it
-    matcher.begin(nod.fps)
-    early = None
-    for f in range(nod.n_frames):
-        percept = observer.perception.perceive_pose(nod.positions[f], None, profile.body, f / nod.fps)
-        early = early or matcher.observe(percept.pose, percept.visible)
-    assert matcher.start_node == "hub" and early is not None and early.movement == "nod"
+    motor.move_to("body", elsewhere)  # as an earlier segment of the stream left it
+    percepts = [observer.perception.perceive_pose(nod.positions[f], None, profile.body, f / nod.fps)
+                for f in range(nod.n_frames)]
+    seen = Motion(np.stack([p.pose for p in percepts]), nod.fps, profile.body.parts, np.stack([p.visible for p in percepts]))
+    early = next((m for m in feed(matcher, seen) if m is not None), None)
+    assert matcher.inspect()["start_node"] == "hub" and early is not None and early.movement == "nod"
 
 
 @settings(max_examples=30, deadline=None)

@@ -84,9 +84,14 @@ def test_hub_signal_view_shades_each_segment_and_draws_the_thresholds(tmp_path):
 def test_recorded_analyses_are_where_the_velocity_direction_segmenter_cut(pm):
     max_ = load_character("max_learner", pm, override={"segmenter": {"level": "stroke"}})
     demo = perform_sequence(max_, "moritz", ["left_side", "left_front"], "movements", rest=0.8)
-    max_.segmenter.record = []
-    _, found = watch(max_, demo)
-    record = max_.segmenter.record
+    analysed = {}  # each movement the segmenter's working memory closed, read through inspect() as it closes
+
+    def keep(_):
+        signals = max_.segmenter.inspect()
+        analysed.setdefault(signals["movement"], signals["analysis"])
+
+    _, found = watch(max_, demo, each=keep)
+    record = [(start, end, analysis) for (start, end), analysis in analysed.items()]
     assert len(record) == 4  # out and back, twice
     cuts = {o.segment.start for o in found} | {o.segment.end for o in found}
     expected = set()
@@ -122,8 +127,12 @@ def test_the_trace_shows_facilitation_deviation_and_waiting_between_candidates(p
     demo = perform_sequence(max_, "moritz", GAMES, "movements", rest=0.8)
     matcher = max_.matcher
     segments = []
-    watch(max_, demo, each=lambda o: segments.append((o, list(matcher.trace), matcher.committed_at, matcher.deviated_at,
-                                                      matcher.committed_path)))
+    def keep(o):
+        signals = matcher.inspect()
+        segments.append((o, list(signals["trace"]), signals["committed_at"], signals["deviated_at"],
+                         signals["committed_path"]))
+
+    watch(max_, demo, each=keep)
     assert len(segments) == 6  # each game: out and back
     threshold, deviation = matcher.params["threshold"], matcher.params["deviation"]
     # game 1: nothing to predict with (only the hub): no candidate, no commitment

@@ -9,7 +9,8 @@ from hypothesis import strategies as st
 
 from plugins.lib.guiding_stroke import SHAPES, GuidingStroke
 from plugins.bench.metrics import segmentation_scores
-from plugins.segmenters.velocity_direction import VelocityDirection, direction_breaks, direction_clusters, speed_breaks
+from plugins.lib.strokes import direction_breaks, direction_clusters, speed_breaks
+from plugins.segmenters.velocity_direction import VelocityDirection
 from tests.conftest import CHARACTERS
 from toolkit import ConfigError, Motion, create_plugin_manager, load_character
 

@@ -156,8 +156,8 @@ def test_rendered_vision_sees_what_synthetic_vision_sees_at_the_same_positions(w
     try:
         for _ in range(150):  # the jump and the start of covering the face
             world.step()
-            p1, s1, _ = geometric._look(observer, target, world)
-            p2, s2, _ = rendered._look(observer, target, world)
+            p1, s1, _ = geometric.look(observer, target, world)
+            p2, s2, _ = rendered.look(observer, target, world)
             agree += int((s1 == s2).sum())
             total += len(s1)
             both = s1 & s2
@@ -182,16 +182,16 @@ def test_rendered_vision_hides_a_part_behind_an_object_and_outside_the_field_of_
     vision = RenderedVision(eye="head", resolution=320)
     vision.attach(observer.character)
     try:
-        _, seen, _ = vision._look(observer, target, world)
+        _, seen, _ = vision.look(observer, target, world)
         assert seen.all()
         head = target.world_pose()[target.body.index("head")]
         eye = observer.world_pose()[observer.body.index("head")]
         world.add_object(WorldObject("board", "board", position=eye + (head - eye) * 0.5, radius=0.15))
-        _, seen, objects = vision._look(observer, target, world)
+        _, seen, objects = vision.look(observer, target, world)
         assert not seen[target.body.index("head")] and seen[target.body.index("lk")] and "board" in objects
         np.testing.assert_allclose(objects["board"], eye + (head - eye) * 0.5, atol=0.03)
         observer.heading = np.pi  # turn away: nothing of the target is in view
-        _, seen, _ = vision._look(observer, target, world)
+        _, seen, _ = vision.look(observer, target, world)
         assert not seen.any()
     finally:
         vision.close()
@@ -205,6 +205,7 @@ def test_a_character_can_watch_with_rendered_vision(write):
 
     max_.perception = RenderedVision(resolution=320, facing_window=max_.perception.params["facing_window"])
     max_.perception.attach(max_)
+    max_.perception.reset(scenario.world.fps)  # watching had begun: the new perception starts a stream too
     world = scenario.run()
     recognised = [e.data["match"].movement for e in world.events_of("movement_recognised", "max")]
     max_.perception.close()

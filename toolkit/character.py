@@ -107,9 +107,12 @@ class Character:
         ]
 
     def announce(self, hook: str, **kwargs: Any) -> None:
-        """Call a run-event hook if this character has a plugin manager."""
+        """Call a run-event hook if this character has a plugin manager (components announce what they learn).
+
+        Through the plugin manager: traced, and under the failure policy of the world that is stepping, if any.
+        """
         if self.pm is not None:
-            getattr(self.pm.hook, hook)(**kwargs)
+            self.pm.announce(hook, **kwargs)
 
 
 # -- reading files -------------------------------------------------------------------
@@ -312,12 +315,7 @@ def compose_character(table: Mapping[str, Any], pm: PluginManager, *, files: tup
     )
     for key, component in character.components().items():  # motor first: the others read it
         _guard(component, key, "attach", lambda c=component: c.attach(character))
-    try:
-        pm.hook.likeme_character_composed(character=character)
-    except LikemeError:
-        raise
-    except Exception as exc:
-        raise PluginError("(a plugin)", "likeme_character_composed", f"{type(exc).__name__}: {exc}") from exc
+    pm.hook.likeme_character_composed(character=character)  # a failing plugin is named by the plugin manager
     return character
 
 

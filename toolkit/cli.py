@@ -89,8 +89,9 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p.add_argument("files", nargs="+", metavar="FILE.bvh")
     p.add_argument("--body", required=True, metavar="PROFILE", help="body profile TOML of the files")
     p.add_argument("--repertoire", required=True, metavar="DIR", help="labelled clips: one folder per movement")
-    p.add_argument("--segmenter", default="hub-threshold", metavar="NAME", help="segmenter (default: hub-threshold)")
-    p.add_argument("--matcher", default="path-search", metavar="NAME", help="matcher (default: path-search)")
+    p.add_argument("--segmenter", metavar="NAME", help="segmenter (default: the observer template's, "
+                   "characters/observers/recordings.toml)")
+    p.add_argument("--matcher", metavar="NAME", help="matcher (default: the observer template's)")
     p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
                    help="override a parameter of the observer, e.g. --set matcher.k=4 (repeatable)")
     p.add_argument("--json", action="store_true", help="print JSON instead of text")
@@ -334,8 +335,9 @@ def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
 
     profile = load_profile(args.body)
     for name, kind in ((args.segmenter, "segmenter"), (args.matcher, "matcher")):
-        pm.registry.get(kind, name)  # an unknown name fails here, listing the registered ones
-    character = compose_observer(pm, profile, args.repertoire, segmenter=args.segmenter, matcher=args.matcher,
+        if name is not None:
+            pm.registry.get(kind, name)  # an unknown name fails here, listing the registered ones
+    character = compose_observer(pm, profile, args.repertoire, segmenter=args.segmenter, matcher=args.matcher or "",
                                  settings=parse_settings(list(args.set)))
     report = []
     for path in args.files:

@@ -20,6 +20,15 @@ system evaluates (can-I, should-I, do-until).
 Every component is built from validated parameters (its ``parameters`` tuple)
 and then attached to the character that owns it, so it can reach the owner's
 body and motor system (a segmenter compares with the owner's own hub pose).
+
+What a component can do beyond its kind's minimum is *declared* on its class
+(``Perception.watches_recordings``, ``Matcher.streaming``, ``Matcher.motor_systems``)
+and checked when it is registered, never found out by comparing its methods with
+the base class. The watching loop (:mod:`toolkit.watching`) gives segmenters and
+matchers poses in the observer's own parts, with hidden parts held as
+``docs/conventions.md`` says; the frame rate reaches every stage through its
+``reset`` (``Perception.reset(fps)``, ``Segmenter.reset(parts, fps)``) or, for a
+matcher, through the working memory it is given (``memory.fps``).
 """
 
 from __future__ import annotations
@@ -33,7 +42,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 
 from toolkit.errors import ConfigError
-from toolkit.motion import Motion
+from toolkit.motion import Motion, fill_hidden
 from toolkit.params import Parameter, validate_params
 
 if TYPE_CHECKING:  # pragma: no cover - imports for annotations only
@@ -41,6 +50,7 @@ if TYPE_CHECKING:  # pragma: no cover - imports for annotations only
 
     from toolkit.character import Character
     from toolkit.runtime import Actor, World
+    from toolkit.watching import WorkingMemory
 
 __all__ = [
     "Component",
@@ -58,6 +68,8 @@ __all__ = [
     "Behaviour",
     "MovementRequest",
     "TriggerContext",
+    "provides",
+    "protocol_members",
 ]
 
 
@@ -93,6 +105,11 @@ class Percept:
     root: np.ndarray
     heading: float
     objects: Mapping[str, np.ndarray] = field(default_factory=dict)
+
+    def __repr__(self) -> str:
+        seen = int(np.count_nonzero(self.visible))
+        return (f"Percept(t={self.time:.3f}s, {seen} of {len(self.visible)} parts seen, "
+                f"{len(self.objects)} object(s) seen)")
 
 
 @dataclass(frozen=True)
@@ -263,6 +280,14 @@ class Component(ABC):
         """Called once the owning character is composed. Override to read the owner's body or motor system."""
         self.owner = owner
 
+    def inspect(self) -> Mapping[str, Any]:
+        """What the component holds now, read-only, for views and tests (its signals: a segmenter's last
+        analysis, a matcher's candidates and prediction errors). Empty by default.
+
+        The one way to look inside a component: views never reach for its attributes or write into it.
+        """
+        return MappingProxyType({})
+
     def get_state(self) -> dict[str, Any]:
         """What this component has learned, as JSON-ready data (empty if it learns nothing).
 
@@ -285,12 +310,18 @@ class Component(ABC):
 
 
 class Perception(Component):
-    """Turns what the observer's eye gets of the world into root-relative percepts of a target."""
+    """Turns what the observer's eye gets of the world into root-relative percepts of a target.
+
+    A perception that can read recorded world positions without a world (a motion-capture file, a tracker)
+    declares ``watches_recordings = True`` and implements :meth:`perceive_pose`.
+    """
 
     kind = "perception"
+    watches_recordings: ClassVar[bool] = False
+    """Whether it perceives recorded poses without a world (:meth:`perceive_pose`): ``likeme observe`` needs one."""
 
-    def reset(self) -> None:
-        """Forget buffered state (called when the observer starts watching a new target)."""
+    def reset(self, fps: float) -> None:
+        """A new stream of frames at ``fps`` begins (a new target, a new recording): forget buffered state."""
 
     @abstractmethod
     def perceive(self, observer: Actor, target: Actor, world: World) -> Percept:
@@ -299,7 +330,8 @@ class Perception(Component):
     def perceive_pose(self, positions: np.ndarray, visible: np.ndarray, body: Any, time: float) -> Percept:
         """A percept of a body from recorded world positions (P, 3) alone, without a world: live or recorded input.
 
-        Perceptions that need the world (an eye, occluders) do not implement it.
+        Implemented by perceptions that declare ``watches_recordings``; those that need the world (an eye,
+        occluders) do not implement it.
         """
         raise NotImplementedError(f"perception {self.name!r} needs a world; it cannot watch recorded poses")
 
@@ -325,6 +357,9 @@ class Segmenter(Component):
     end of the stream. :attr:`active_since` is the start frame of a segment
     that has begun but not ended. :meth:`segment` runs the protocol over a whole
     motion; subclasses may override it with a vectorised equivalent.
+
+    Poses come in the observer's own parts (``parts`` of :meth:`reset`), hidden
+    parts held at their last seen value (``docs/conventions.md``).
     """
 
     kind = "segmenter"
@@ -364,11 +399,12 @@ class Segmenter(Component):
         return closed, since
 
     def segment(self, motion: Motion) -> list[Segment]:
-        """All segments of a root-relative motion."""
+        """All segments of a root-relative motion (its hidden parts filled by the convention first)."""
         self.reset(motion.parts, motion.fps)
+        positions = fill_hidden(motion.positions, motion.visible)
         found: list[Segment] = []
         for f in range(motion.n_frames):
-            found.extend(self.push(motion.positions[f], motion.visible[f]))
+            found.extend(self.push(positions[f], motion.visible[f]))
         found.extend(self.flush())
         return found
 
@@ -376,26 +412,32 @@ class Segmenter(Component):
 class Matcher(Component):
     """Recognises an observed segment as one of the observer's own movements.
 
-    A batch matcher implements :meth:`match`. A streaming matcher (one that can
-    commit before the segment ends: response facilitation) also implements
-    :meth:`begin` and :meth:`observe`; the runtime calls ``begin`` when a
-    segment starts, ``observe`` every frame until it returns a match, and
-    :meth:`conclude` when the segment ends.
+    A batch matcher implements :meth:`match` and answers when a segment has ended. A *streaming* matcher (one
+    that can commit before the segment ends: response facilitation, Kopp & Graeser 2006, §4.4) declares
+    ``streaming = True`` and implements :meth:`begin` and :meth:`observe`: the watching loop
+    (:class:`toolkit.watching.WatchingLoop`) calls ``begin`` when a segment starts, ``observe`` after every
+    frame of it, and :meth:`conclude` when it ends. Both read the segment from the
+    :class:`~toolkit.watching.WorkingMemory` they are given, in the observer's own parts; a matcher keeps no
+    frames of its own.
     """
 
     kind = "matcher"
     motor_systems: ClassVar[tuple[str, ...]] = ()
     """Names of the motor systems this matcher works with (empty: any); the first is used when one is composed."""
+    streaming: ClassVar[bool] = False
+    """Whether it can commit before a segment ends; if so it implements :meth:`begin` and :meth:`observe`."""
 
     @abstractmethod
     def match(self, motion: Motion) -> Match:
         """The movement in a whole root-relative motion segment."""
 
-    def begin(self, fps: float) -> None:
-        """A segment has started."""
+    def begin(self, memory: WorkingMemory) -> None:
+        """A segment has started: ``memory`` is its working memory, holding the frames given so far (it grows,
+        one frame before each :meth:`observe`). ``memory.fps`` is the frame rate."""
 
-    def observe(self, pose: np.ndarray, visible: np.ndarray) -> Match | None:
-        """One more frame of the ongoing segment; return a match to commit now.
+    def observe(self, memory: WorkingMemory) -> Match | None:
+        """One more frame of the ongoing segment is in ``memory`` (the newest is ``memory.positions[-1]``);
+        return a match to commit now.
 
         After committing, a match whose ``details["stop"]`` is true tells the runtime that the
         demonstration deviates from the committed movement: an imitation of it is stopped.
@@ -434,6 +476,11 @@ class MotorSystem(Component):
     def label(self, movement: str) -> str:
         """The movement a performable name stands for (several example clips may share one movement)."""
         return movement
+
+    def examples(self, fps: float = 30.0) -> list[tuple[str, Motion]]:
+        """(movement, motion) examples of every movement, local frame: the clips the repertoire was built from,
+        else one performance of each movement at ``fps``. The templates of matchers that compare examples."""
+        return [(m, self.perform(m, fps=fps)) for m in self.movements()]
 
     @abstractmethod
     def perform(self, movement: str, *, speed: float = 1.0, fps: float = 30.0) -> Motion:
@@ -526,6 +573,32 @@ class View(Component):
     @abstractmethod
     def draw(self, subject: Any, out: Path) -> list[Path]:
         """Draw ``subject`` to ``out`` (an image file, or a folder for an animation); return the files written."""
+
+
+def provides(obj: Any, protocol: type, *, needed_by: str, what: str, key: tuple = ("plugin",),
+             expected: str | None = None) -> None:
+    """Check that ``obj`` (a motor system, say) has every member of ``protocol``, a :class:`typing.Protocol` in which
+    a component declares what it needs of another; a :class:`ConfigError` naming what is missing otherwise.
+
+    Called at ``attach``: ``needed_by`` names the component (``"path-search"``), ``what`` the kind of thing it
+    needs (``"a posegraph motor system"``), ``expected`` what would do (by default the protocol's members).
+    """
+    names = protocol_members(protocol)
+    missing = [n for n in names if not hasattr(obj, n)]
+    if missing:
+        raise ConfigError(f"{needed_by} needs {what}, not {getattr(obj, 'name', obj)!r} (it lacks {', '.join(missing)})",
+                          key=key, expected=expected or f"one with {', '.join(names)}")
+
+
+def protocol_members(protocol: type) -> list[str]:
+    """The attributes and methods a :class:`typing.Protocol` declares (its own and its bases'), sorted."""
+    names: set[str] = set()
+    for cls in protocol.__mro__:
+        if cls is object or cls.__name__ in ("Protocol", "Generic"):
+            continue
+        names |= set(getattr(cls, "__annotations__", {}))
+        names |= {n for n, v in vars(cls).items() if not n.startswith("_") and (callable(v) or isinstance(v, property))}
+    return sorted(names)
 
 
 KINDS: dict[str, type[Component]] = {

@@ -16,7 +16,10 @@ Hooks are grouped by the stage of a run that calls them:
    notifications: return values are ignored, and a plugin may keep state of its
    own to extend a run (log, render, change a character's beliefs).
 
-No hook here is ``firstresult``: every implementation is called.
+No hook here is ``firstresult``: every implementation is called, through pluggy
+(``LIKEME_TRACE_HOOKS=1`` prints every call), and a failing implementation is
+named or, in a world that skips failing plugins, dropped
+(:meth:`toolkit.manager.PluginManager.failure_policy`).
 """
 
 from __future__ import annotations
@@ -36,6 +39,7 @@ if TYPE_CHECKING:  # pragma: no cover
         Matcher,
         MotorSystem,
         MovementRequest,
+        Percept,
         Perception,
         Segment,
         Segmenter,
@@ -158,6 +162,23 @@ def likeme_register_commands(subparsers: argparse._SubParsersAction) -> None:
 # ---------------------------------------------------------------------------------
 # 4. run events, in the order a run announces them
 # ---------------------------------------------------------------------------------
+
+
+@hookspec
+def likeme_movement_started(world: World, actor: Actor, request: MovementRequest) -> None:
+    """``actor`` began performing a movement of its own (chosen, imitating, shrugging): ``request`` says which and why.
+
+    Announced before ``likeme_imitation_started`` when the movement imitates someone.
+    """
+
+
+@hookspec
+def likeme_target_perceived(world: World, observer: Actor, target: Actor, percept: Percept) -> None:
+    """``observer`` perceived ``target`` this frame (every frame it watches, before segmenting).
+
+    Only announced, not kept in ``world.events``: the observer's working memory (``observer.memory``) keeps
+    what it perceived.
+    """
 
 
 @hookspec

@@ -12,6 +12,12 @@ Environment variables:
 ``LIKEME_TRACE_HOOKS=1``
     Print every hook call and its result to standard error.
 
+Every hook call goes through pluggy (run events, registration, loading, commands), so tracing shows all of them.
+A hook implementation that raises is handled in one place, a hook-call monitor (:meth:`PluginManager.failure_policy`):
+by default it becomes a :class:`~toolkit.errors.PluginError` naming the plugin and the hook; under the ``"skip"``
+policy a world runs with (``likeme run --keep-going``) the plugin is unregistered, the failure reported, and the
+implementations not yet called are called.
+
 Nothing is loaded at import time: call :func:`create_plugin_manager`.
 """
 
@@ -20,17 +26,18 @@ from __future__ import annotations
 import os
 import re
 import sys
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from importlib import metadata
-from types import ModuleType
+from types import ModuleType, TracebackType
 from typing import Any
 
 import pluggy
 
 from toolkit import hookspecs
-from toolkit.components import KINDS, Component
-from toolkit.errors import ConfigError, PluginError
+from toolkit.components import KINDS, Component, Matcher, Perception
+from toolkit.errors import ConfigError, LikemeError, PluginError
 
 __all__ = [
     "ENTRY_POINT_GROUP",
@@ -111,8 +118,15 @@ class Registry:
         return self._by_kind[kind][name]
 
 
+Failed = Callable[[str, str, PluginError], None]
+"""``failed(plugin name, hook name, error)``: told of a plugin dropped under the ``"skip"`` policy."""
+
+
 class PluginManager(pluggy.PluginManager):
-    """A pluggy manager for the ``likeme`` hooks that remembers where each plugin came from."""
+    """A pluggy manager for the ``likeme`` hooks that remembers where each plugin came from.
+
+    It monitors every hook call (:meth:`failure_policy`): a failing implementation is named, or skipped.
+    """
 
     def __init__(self) -> None:
         super().__init__(hookspecs.PROJECT)
@@ -120,6 +134,47 @@ class PluginManager(pluggy.PluginManager):
         self.plugin_infos: dict[str, PluginInfo] = {}
         self.skipped: list[PluginInfo] = []
         self._registry: Registry | None = None
+        self._policies: list[tuple[str, Failed | None]] = []
+        self.add_hookcall_monitoring(lambda *_: None, self._after_hookcall)
+
+    # -- failures --------------------------------------------------------------------
+
+    @contextmanager
+    def failure_policy(self, policy: str, failed: Failed | None = None) -> Iterator[None]:
+        """Hook calls made inside the ``with`` block follow ``policy``.
+
+        ``"stop"`` (also the policy outside any block): an implementation that raises anything but a likeme error
+        becomes a :class:`PluginError` naming its plugin and the hook. ``"skip"``: its plugin is unregistered,
+        ``failed(plugin, hook, error)`` is told, and the implementations that had not been called yet are called.
+        """
+        if policy not in ("stop", "skip"):
+            raise ValueError("a failure policy is 'stop' or 'skip'")
+        self._policies.append((policy, failed))
+        try:
+            yield
+        finally:
+            self._policies.pop()
+
+    def _after_hookcall(self, outcome: pluggy.Result, hook_name: str, impls: Sequence[pluggy.HookImpl],
+                        kwargs: dict[str, Any]) -> None:
+        exc = outcome.exception
+        if not isinstance(exc, Exception):
+            return
+        culprit = _culprit(exc.__traceback__, impls)
+        name = culprit.plugin_name if culprit is not None else "(a plugin)"
+        policy, failed = self._policies[-1] if self._policies else ("stop", None)
+        if policy == "skip" and culprit is not None:
+            error = exc if isinstance(exc, PluginError) else PluginError(name, hook_name, f"{type(exc).__name__}: {exc}")
+            self.unregister(culprit.plugin)
+            if failed is not None:
+                failed(name, hook_name, error)
+            # pluggy calls the implementations last to first: those before the culprit in the list had not run
+            waiting = [impl for impl in impls[: list(impls).index(culprit)] if self.is_registered(impl.plugin)]
+            outcome.force_result(self._inner_hookexec(hook_name, waiting, kwargs, False) if waiting else [])
+        elif not isinstance(exc, LikemeError):
+            error = PluginError(name, hook_name, f"{type(exc).__name__}: {exc}")
+            error.__cause__ = exc
+            outcome.force_exception(error)
 
     # -- loading -------------------------------------------------------------------
 
@@ -161,6 +216,12 @@ class PluginManager(pluggy.PluginManager):
         self.plugin_infos[info.name] = info
         self._registry = None
 
+    # -- run events ------------------------------------------------------------------
+
+    def announce(self, hook_name: str, **kwargs: Any) -> None:
+        """Call a run-event hook (through pluggy: traced, and under the failure policy in force)."""
+        getattr(self.hook, hook_name)(**kwargs)
+
     # -- components ----------------------------------------------------------------
 
     @property
@@ -171,18 +232,18 @@ class PluginManager(pluggy.PluginManager):
         return self._registry
 
     def _collect(self) -> list[ComponentInfo]:
+        """Each plugin's registration hooks called through pluggy (one plugin at a time, so that every class is
+        credited to the plugin that returned it)."""
         found: dict[tuple[str, str], ComponentInfo] = {}
         for kind, hook_name in REGISTER_HOOKS.items():
-            caller = getattr(self.hook, hook_name)
-            for impl in caller.get_hookimpls():  # registration order
+            impls = getattr(self.hook, hook_name).get_hookimpls()  # registration order
+            for impl in impls:
                 info = self.plugin_infos.get(impl.plugin_name) or PluginInfo(
                     impl.plugin_name, repr(impl.plugin), "(registered in Python)", ""
                 )
-                try:
-                    classes = impl.function()
-                except Exception as exc:
-                    raise PluginError(info.name, hook_name, f"{type(exc).__name__}: {exc}") from exc
-                for cls in _check_registered(classes, kind, info, hook_name):
+                others = [other.plugin for other in impls if other is not impl]
+                results = self.subset_hook_caller(hook_name, remove_plugins=others)()
+                for cls in _check_registered(results[0] if results else None, kind, info, hook_name):
                     key = (kind, cls.name)
                     if key in found:
                         other = found[key].plugin
@@ -194,6 +255,24 @@ class PluginManager(pluggy.PluginManager):
                         )
                     found[key] = ComponentInfo(kind, cls.name, cls, info)
         return list(found.values())
+
+
+def _culprit(tb: TracebackType | None, impls: Sequence[pluggy.HookImpl]) -> pluggy.HookImpl | None:
+    """The implementation whose frame is the outermost in a traceback: the one that raised (or called what did)."""
+    codes: dict[Any, list[pluggy.HookImpl]] = {}
+    for impl in impls:
+        code = getattr(impl.function, "__code__", None)
+        if code is not None:
+            codes.setdefault(code, []).append(impl)
+    while tb is not None:
+        found = codes.get(tb.tb_frame.f_code)
+        if found:
+            if len(found) == 1:
+                return found[0]
+            this = tb.tb_frame.f_locals.get("self")  # one method, several instances registered
+            return next((i for i in found if getattr(i.function, "__self__", None) is this), found[0])
+        tb = tb.tb_next
+    return None
 
 
 def _check_registered(classes: Any, kind: str, info: PluginInfo, hook_name: str) -> list[type[Component]]:
@@ -214,7 +293,26 @@ def _check_registered(classes: Any, kind: str, info: PluginInfo, hook_name: str)
         if getattr(cls, "__abstractmethods__", None):
             missing = ", ".join(sorted(cls.__abstractmethods__))
             raise PluginError(info.name, hook_name, f"{cls.__qualname__} does not implement {missing}")
+        _check_declared(cls, info, hook_name)
     return list(classes)
+
+
+def _check_declared(cls: type, info: PluginInfo, hook_name: str) -> None:
+    """A declared capability must be implemented, and an implemented one declared (the runtime goes by the
+    declaration)."""
+    pairs = []
+    if issubclass(cls, Matcher):
+        pairs.append(("streaming", cls.streaming, "observe", cls.observe is not Matcher.observe))
+    if issubclass(cls, Perception):
+        pairs.append(("watches_recordings", cls.watches_recordings, "perceive_pose",
+                      cls.perceive_pose is not Perception.perceive_pose))
+    for flag, declared, method, implemented in pairs:
+        if declared and not implemented:
+            raise PluginError(info.name, hook_name, f"{cls.__qualname__} declares {flag} = True but does not "
+                              f"implement {method}")
+        if implemented and not declared:
+            raise PluginError(info.name, hook_name, f"{cls.__qualname__} implements {method} but does not declare "
+                              f"{flag} = True")
 
 
 def _normalise(name: str) -> str:

@@ -14,6 +14,13 @@ Frames (see :mod:`toolkit.body` for the axes):
   heading 0 faces ``+z`` and the facing direction is ``(sin h, 0, cos h)``.
 - :meth:`Motion.root_relative` subtracts the root part from every part.
 
+Hidden parts (``docs/conventions.md``): ``visible`` says what was seen; what a hidden part's coordinates hold is
+fixed by one rule, :func:`fill_hidden`: the value it had when it was last seen (sample and hold), before its first
+sighting the value of that sighting, and NaN for a part never seen at all (or ``default``, where a caller has an
+assumption to put there). Working memory (:class:`toolkit.watching.ObservationLog`) keeps every observation that
+way, so segmenters and matchers never fill hidden parts themselves. :meth:`Motion.onto` maps a motion onto
+another body's parts by name.
+
 Operations return new objects; nothing here modifies its input.
 """
 
@@ -28,6 +35,8 @@ __all__ = [
     "Motion",
     "Pose",
     "concatenate",
+    "fill_hidden",
+    "part_index",
     "heading_matrix",
     "local_to_world",
     "world_to_local",
@@ -158,6 +167,24 @@ class Motion:
         visible = self.visible & self.visible[:, r : r + 1]
         return Motion(rel, self.fps, self.parts, visible)
 
+    def onto(self, parts: Sequence[str]) -> Motion:
+        """The same motion in the order of ``parts``, taken by name; a part this motion lacks is never visible
+        (its coordinates NaN)."""
+        parts = tuple(parts)
+        if parts == self.parts:
+            return self
+        index = part_index(self.parts, parts)
+        have = index >= 0
+        positions = np.full((self.n_frames, len(parts), 3), np.nan)
+        visible = np.zeros((self.n_frames, len(parts)), dtype=bool)
+        positions[:, have] = self.positions[:, index[have]]
+        visible[:, have] = self.visible[:, index[have]]
+        return Motion(positions, self.fps, parts, visible)
+
+    def filled(self, default: np.ndarray | None = None) -> Motion:
+        """The same motion with hidden parts' coordinates set by :func:`fill_hidden` (the mask unchanged)."""
+        return Motion(fill_hidden(self.positions, self.visible, default), self.fps, self.parts, self.visible)
+
     def with_visibility(self, visible: np.ndarray) -> Motion:
         """The same positions with a further mask applied (logical and)."""
         return Motion(self.positions, self.fps, self.parts, self.visible & np.asarray(visible, dtype=bool))
@@ -184,6 +211,45 @@ def concatenate(motions: Sequence[Motion]) -> Motion:
         first.parts,
         np.concatenate([m.visible for m in motions]),
     )
+
+
+def part_index(source: Sequence[str], parts: Sequence[str]) -> np.ndarray:
+    """For each name of ``parts``, its index in ``source`` (-1 where ``source`` has no part of that name)."""
+    where = {name: i for i, name in enumerate(source)}
+    return np.array([where.get(name, -1) for name in parts], dtype=np.intp)
+
+
+def fill_hidden(positions: np.ndarray, visible: np.ndarray, default: np.ndarray | None = None) -> np.ndarray:
+    """Coordinates of hidden parts by the one rule of likeme (``docs/conventions.md``).
+
+    A hidden part holds the value it had when it was last seen; before its first sighting it holds the value of
+    that sighting; a part never seen is NaN, or its row of ``default`` when one is given.
+
+    Parameters
+    ----------
+    positions : array, shape (F, P, 3)
+    visible : array of bool, shape (F, P)
+    default : array, shape (P, 3), optional
+        What a never-seen part is assumed to be (a motor system puts its own rest posture there).
+
+    Returns
+    -------
+    array, shape (F, P, 3)
+        A new array; visible coordinates unchanged.
+    """
+    positions = np.asarray(positions, dtype=float)
+    visible = np.asarray(visible, dtype=bool)
+    n, p = visible.shape
+    if n == 0:
+        return positions.copy()
+    last = np.where(visible, np.arange(n)[:, None], -1)
+    np.maximum.accumulate(last, axis=0, out=last)  # the last frame each part was seen, up to each frame
+    ever = visible.any(axis=0)
+    first = np.argmax(visible, axis=0)  # the first sighting (0 for a part never seen)
+    rows = np.where(last >= 0, last, first[None, :])
+    out = positions[rows, np.arange(p)[None, :]]
+    out[:, ~ever] = np.nan if default is None else np.asarray(default, dtype=float)[~ever]
+    return out
 
 
 # -- frames ---------------------------------------------------------------------

@@ -40,7 +40,7 @@ def _watching(actor: Actor, world: World) -> dict[str, Any]:
     out["perceived"] = {
         "frames": mem.n if mem else 0,
         "visible_fraction": round(float(mem.visible.mean()), 4) if mem and mem.n else 0.0,
-        "frames_with_root": int(mem.visible[:, actor.target.body.root_index].sum()) if mem and mem.n else 0,
+        "frames_with_root": int(mem.visible.any(axis=1).sum()) if mem and mem.n else 0,  # nothing is seen without it
     }
     offset = actor.watch_start
     out["segments"] = [

@@ -5,21 +5,24 @@ One :meth:`World.step` advances every actor by one frame:
 1. *act*: an actor that is performing moves one frame along its motion; an idle
    actor asks its action system what to do (:meth:`ActionSystem.choose`) and, if
    answered, asks its motor system for the motion (:meth:`MotorSystem.perform`).
-2. *observe*: an actor that watches a target runs its pipeline on the new frame:
-   perceive → segment → match → interpret → respond. Percepts are kept in the
-   actor's working memory (:class:`ObservationLog`); a segment that closes is
-   matched on the memory's frames; a streaming matcher may commit earlier.
+2. *observe*: an actor that watches a target perceives it and hands the percept
+   to its :class:`~toolkit.watching.WatchingLoop` (the same loop an
+   :class:`~toolkit.observe.Observer` runs): working memory, segment, match.
+   What the loop reports becomes run events, and a recognised movement is
+   interpreted and answered by the action system (interpret → respond).
 3. the world announces the step through the ``likeme_world_stepped`` hook.
 
 Every pipeline result is also recorded as an :class:`Event` in ``world.events``
 and announced through the matching run-event hook, so a plugin can observe or
-extend any run.
+extend any run. Hook calls and component calls made while a world steps follow
+its ``on_plugin_error`` policy.
 """
 
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Iterator, Mapping
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -29,8 +32,9 @@ from toolkit.character import Character
 from toolkit.components import Behaviour, Match, MovementRequest, Percept, Segment
 from toolkit.errors import ConfigError, LikemeError, PluginError
 from toolkit.motion import Motion, local_to_world
+from toolkit.watching import Listener, ObservationLog, WatchingLoop
 
-__all__ = ["World", "Actor", "WorldObject", "Event", "ObservationLog"]
+__all__ = ["World", "Actor", "WorldObject", "Event"]
 
 
 @dataclass
@@ -84,66 +88,6 @@ class Event:
     data: Mapping[str, Any] = field(default_factory=dict)
 
 
-class ObservationLog:
-    """Working memory of what an actor perceived of its target, as growing arrays.
-
-    One row per frame since watching began: ``positions`` (F, P, 3) root-relative,
-    ``visible`` (F, P), and ``world`` (F, P, 3), the world positions that were
-    seen (NaN where hidden), which behaviour identification uses for the
-    target's line of sight.
-    """
-
-    def __init__(self, parts: tuple[str, ...], fps: float, capacity: int = 1024) -> None:
-        self.parts = parts
-        self.fps = fps
-        self._pos = np.full((capacity, len(parts), 3), np.nan)
-        self._world = np.full((capacity, len(parts), 3), np.nan)
-        self._vis = np.zeros((capacity, len(parts)), dtype=bool)
-        self.n = 0
-
-    def append(self, pose: np.ndarray, visible: np.ndarray, world: np.ndarray | None = None) -> None:
-        self._reserve(self.n + 1)
-        self._pos[self.n] = pose
-        self._vis[self.n] = visible
-        if world is not None:
-            self._world[self.n] = world
-        self.n += 1
-
-    def extend(self, poses: np.ndarray, visible: np.ndarray) -> None:
-        """Several frames at once: poses (n, P, 3) and their visibility (n, P)."""
-        end = self.n + len(poses)
-        self._reserve(end)
-        self._pos[self.n : end] = poses
-        self._vis[self.n : end] = visible
-        self.n = end
-
-    def _reserve(self, size: int) -> None:
-        """Room for ``size`` frames (the arrays double when full)."""
-        if size <= self._pos.shape[0]:
-            return
-        more = max(size, 2 * self._pos.shape[0]) - self._pos.shape[0]
-        self._pos = np.concatenate([self._pos, np.full((more, *self._pos.shape[1:]), np.nan)])
-        self._world = np.concatenate([self._world, np.full((more, *self._world.shape[1:]), np.nan)])
-        self._vis = np.concatenate([self._vis, np.zeros((more, self._vis.shape[1]), dtype=bool)])
-
-    @property
-    def world(self) -> np.ndarray:
-        return self._world[: self.n]
-
-    @property
-    def positions(self) -> np.ndarray:
-        return self._pos[: self.n]
-
-    @property
-    def visible(self) -> np.ndarray:
-        return self._vis[: self.n]
-
-    def motion(self, start: int = 0, stop: int | None = None) -> Motion:
-        """Frames ``start`` to ``stop`` as a root-relative :class:`Motion`."""
-        stop = self.n if stop is None else min(stop, self.n)
-        return Motion(self._pos[start:stop], self.fps, self.parts, self._vis[start:stop])
-
-
 class Actor:
     """A character placed in a world: where it stands, what it performs, what it watches.
 
@@ -160,7 +104,7 @@ class Actor:
     performing : MovementRequest or None
         The movement under way.
     memory : ObservationLog or None
-        Working memory of what it perceived of ``target``.
+        Working memory of what it perceived of ``target``, in its own parts (its watching loop's).
     performed : list of (frame, MovementRequest)
         Everything it started performing.
     """
@@ -178,9 +122,8 @@ class Actor:
         self._frame = 0
         self._queue: list[MovementRequest] = []
         self._posture = np.asarray(character.motor.rest_pose(), dtype=float)  # held while no motion plays
-        self.memory: ObservationLog | None = None
         self.percepts = 0
-        self._committed: Match | None = None
+        self.loop = WatchingLoop(character, call=self._call, listener=_Reports(self))
         self.performed: list[tuple[int, MovementRequest]] = []
 
     def __repr__(self) -> str:
@@ -189,6 +132,11 @@ class Actor:
     @property
     def body(self):
         return self.character.body
+
+    @property
+    def memory(self) -> ObservationLog | None:
+        """Working memory of what it perceived of its target since it began watching (``None`` when not watching)."""
+        return self.loop.memory if self.target is not None else None
 
     # -- acting ----------------------------------------------------------------------
 
@@ -235,6 +183,7 @@ class Actor:
                               f"returned {motion!r}, expected a Motion of at least one frame of the parts {list(self.body.parts)}")
         self._motion, self._frame, self.performing = motion, 0, request
         self.performed.append((self.world.frame, request))
+        self.world.emit("movement_started", self, request=request)
         if self.character.action is not None:
             self._call("action", "performed", self, request, self.world)
         if request.imitating is not None:
@@ -293,10 +242,8 @@ class Actor:
     # -- observing -------------------------------------------------------------------
 
     def watch(self, target: Actor | None) -> None:
-        """Start watching ``target`` (``None`` to stop); working memory and segmenter restart."""
+        """Start watching ``target`` (``None`` to stop); perception, working memory and segmenter restart."""
         self.target = target
-        self.memory = None
-        self._committed = None
         if target is None:
             return
         c = self.character
@@ -307,14 +254,13 @@ class Actor:
                 available=c.pm.registry.names("perception") if c.pm else None,
             )
         self.watch_start = self.world.frame + 1  # the world frame of the first percept (memory row 0)
-        self.memory = ObservationLog(target.body.parts, self.world.fps)
-        self._call("perception", "reset")
-        if c.segmenter is not None:
-            self._call("segmenter", "reset", target.body.parts, self.world.fps)
+        self._call("perception", "reset", self.world.fps)
+        self.loop.reset(target.body.parts, self.world.fps)
 
     def _observe(self) -> None:
+        """Perceive the target and hand the percept to the watching loop."""
         target, c, world = self.target, self.character, self.world
-        assert target is not None and self.memory is not None
+        assert target is not None
         if c.perception is None:  # dropped after failing (skip mode): the observer is blind from now on
             return
         percept: Percept | None = self._call("perception", "perceive", self, target, world)
@@ -330,52 +276,11 @@ class Actor:
                               f"returned {type(percept).__name__} with pose {np.shape(getattr(percept, 'pose', None))} and "
                               f"visible {np.shape(getattr(percept, 'visible', None))}, expected a Percept with pose ({n}, 3) "
                               f"and visible ({n},)")
-        self.memory.append(percept.pose, percept.visible, percept.world)
         self.percepts += 1
-        if c.segmenter is None:
-            return
-        was_open = c.segmenter.active_since is not None
-        closed = self._call("segmenter", "push", percept.pose, percept.visible)
-        if c.segmenter is not None:
-            self._handle_segments(closed or [], was_open)
-
-    def _handle_segments(self, closed: list[Segment], was_open: bool) -> None:
-        c, target, world = self.character, self.target, self.world
-        assert target is not None and self.memory is not None and c.segmenter is not None
-        for segment in closed:
-            if not isinstance(segment, Segment):
-                raise PluginError(c.segmenter.name, "Segmenter.push", f"returned {segment!r}, expected Segment objects")
-            world.emit("segment_found", self, target, segment=segment)
-            if c.matcher is None:
-                continue
-            motion = self.memory.motion(segment.start, segment.end)
-            match = self._call("matcher", "conclude", motion)  # None: nothing beyond what it committed to
-            if match is not None and not (self._committed is not None and match == self._committed):
-                self._recognised(segment, match)
-            self._committed = None
-        opened = c.segmenter.active_since is not None and (not was_open or closed)
-        if c.matcher is not None and opened:
-            self._call("matcher", "begin", world.fps)
-            self._committed = None
-            start = c.segmenter.active_since
-            for f in range(start, self.memory.n):  # catch the matcher up on the frames since onset
-                if self._early(self.memory.positions[f], self.memory.visible[f]):
-                    break
-        elif c.matcher is not None and c.segmenter.active_since is not None:
-            self._early(self.memory.positions[-1], self.memory.visible[-1])  # after a commit too: it may deviate
-
-    def _early(self, pose: np.ndarray, visible: np.ndarray) -> bool:
-        match = self._call("matcher", "observe", pose, visible)
-        if match is None:
-            return False
-        if match.details.get("stop"):  # the committed movement deviates from the demonstration
-            self.stop_imitation(self.target, str(match.details.get("reason", "deviation")))
-            return False
-        if self._committed is not None:  # one commitment per segment
-            return False
-        self._committed = match
-        self._recognised(None, match)
-        return True
+        world.announce("likeme_target_perceived", world=world, observer=self, target=target, percept=percept)
+        world_positions = percept.world if np.shape(percept.world) == (n, 3) else None
+        self.loop.push(np.asarray(percept.pose, dtype=float)[None], np.asarray(percept.visible, dtype=bool)[None],
+                       None if world_positions is None else np.asarray(world_positions, dtype=float)[None])
 
     def stop_imitation(self, target: Actor | None, reason: str) -> None:
         """Stop imitating ``target`` now (and drop queued imitations of it); announces ``imitation_stopped``."""
@@ -397,10 +302,9 @@ class Actor:
                             returning=0.0 if self._motion is None else round(self._motion.n_frames / self.world.fps, 3))
 
     def _recognised(self, segment: Segment | None, match: Match) -> None:
+        """The matcher answered: announce it, then interpret and respond (§6.1, §5.3)."""
         c, target, world = self.character, self.target, self.world
         assert target is not None
-        if not isinstance(match, Match):
-            raise PluginError(c.matcher.name, "Matcher", f"returned {match!r}, expected a Match")
         world.emit("movement_recognised", self, target, segment=segment, match=match)
         if c.action is None or not match.known:
             return
@@ -412,12 +316,25 @@ class Actor:
             self.request(request)
 
     def _finish(self) -> None:
-        c = self.character
-        if self.target is None or c.segmenter is None:
-            return
-        closed = self._call("segmenter", "flush")
-        if c.segmenter is not None:
-            self._handle_segments(closed or [], True)
+        """The end of the run: the segment still under way is closed."""
+        if self.target is not None:
+            self.loop.flush()
+
+
+class _Reports(Listener):
+    """What an actor's watching loop reports, turned into run events, interpretation and responses."""
+
+    def __init__(self, actor: Actor) -> None:
+        self.actor = actor
+
+    def segment_found(self, segment: Segment) -> None:
+        self.actor.world.emit("segment_found", self.actor, self.actor.target, segment=segment)
+
+    def recognised(self, segment: Segment | None, match: Match) -> None:
+        self.actor._recognised(segment, match)
+
+    def deviated(self, match: Match) -> None:  # the committed movement deviates from the demonstration
+        self.actor.stop_imitation(self.actor.target, str(match.details.get("reason", "deviation")))
 
 
 class World:
@@ -434,7 +351,10 @@ class World:
         What a failing component or hook implementation does to the run: stop it
         with a :class:`PluginError` naming the plugin and where it failed, or
         go on without it (the component is removed from its character, the
-        plugin is unregistered) and record a ``plugin_failed`` event.
+        plugin is unregistered) and record a ``plugin_failed`` event. Hook
+        failures go through the plugin manager's failure policy
+        (:meth:`~toolkit.manager.PluginManager.failure_policy`), so every hook,
+        whoever calls it during a step, is handled the same way.
     """
 
     def __init__(self, fps: float = 30.0, pm: Any = None, on_plugin_error: str = "stop") -> None:
@@ -479,41 +399,47 @@ class World:
     def emit(self, kind: str, actor: Actor, target: Actor | None = None, **data: Any) -> None:
         """Record an event and call the ``likeme_<kind>`` hook."""
         self.events.append(Event(self.frame, self.time, kind, actor.id, target.id if target else None, data))
-        if kind in ("imitation_started", "imitation_stopped"):
+        if kind == "movement_started":
+            self.announce(f"likeme_{kind}", world=self, actor=actor, **data)
+        elif kind in ("imitation_started", "imitation_stopped"):
             self.announce(f"likeme_{kind}", world=self, actor=actor, target=target, **data)
         else:
             self.announce(f"likeme_{kind}", world=self, observer=actor, target=target, **data)
 
     def announce(self, hook_name: str, **kwargs: Any) -> None:
-        """Call every implementation of a run-event hook; a failing one is named (or dropped, in skip mode)."""
+        """Call a run-event hook through the plugin manager (traced; a failing implementation is named, or dropped
+        under the world's skip policy)."""
+        if self.pm is not None:
+            self.pm.announce(hook_name, **kwargs)
+
+    @contextmanager
+    def _policy(self) -> Iterator[None]:
+        """Hook calls in the block follow ``on_plugin_error`` (a dropped hook plugin is recorded as an event)."""
         if self.pm is None:
+            yield
             return
-        for impl in list(getattr(self.pm.hook, hook_name).get_hookimpls()):
-            try:
-                impl.function(**{k: kwargs[k] for k in impl.argnames})
-            except Exception as exc:
-                error = exc if isinstance(exc, PluginError) else PluginError(
-                    impl.plugin_name, hook_name, f"{type(exc).__name__}: {exc}")
-                if self.on_plugin_error != "skip":
-                    raise error from exc
-                self.pm.unregister(impl.plugin)
-                self.events.append(Event(self.frame, self.time, "plugin_failed", "", None,
-                                         {"plugin": impl.plugin_name, "where": hook_name, "error": str(error)}))
+        with self.pm.failure_policy(self.on_plugin_error, self._plugin_failed):
+            yield
+
+    def _plugin_failed(self, plugin: str, hook_name: str, error: PluginError) -> None:
+        self.events.append(Event(self.frame, self.time, "plugin_failed", "", None,
+                                 {"plugin": plugin, "where": hook_name, "error": str(error)}))
 
     def step(self) -> None:
         """Advance one frame: every actor acts, then every watching actor observes."""
-        self.frame += 1
-        for actor in self.actors.values():
-            actor._advance()
-        for obj in self.objects.values():
-            if obj.held_by is not None and obj.held_by in self.actors:
-                holder = self.actors[obj.held_by]
-                obj.position = holder.world_pose()[holder.body.index(obj.properties.get("held_in", holder.body.root))]
-        self._remember()
-        for actor in self.actors.values():
-            if actor.target is not None:
-                actor._observe()
-        self.announce("likeme_world_stepped", world=self)
+        with self._policy():
+            self.frame += 1
+            for actor in self.actors.values():
+                actor._advance()
+            for obj in self.objects.values():
+                if obj.held_by is not None and obj.held_by in self.actors:
+                    holder = self.actors[obj.held_by]
+                    obj.position = holder.world_pose()[holder.body.index(obj.properties.get("held_in", holder.body.root))]
+            self._remember()
+            for actor in self.actors.values():
+                if actor.target is not None:
+                    actor._observe()
+            self.announce("likeme_world_stepped", world=self)
 
     def _remember(self) -> None:
         self._history[self.frame] = {n: (o.position.copy(), o.held_by) for n, o in self.objects.items()}
@@ -569,8 +495,9 @@ class World:
                 quiet = quiet + 1 if self.all_idle() else 0
                 if quiet > settle:
                     break
-        for actor in self.actors.values():
-            actor._finish()
+        with self._policy():
+            for actor in self.actors.values():
+                actor._finish()
 
     def all_idle(self) -> bool:
         return all(a.idle and not a._queue for a in self.actors.values())

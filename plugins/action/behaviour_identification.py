@@ -47,8 +47,8 @@ def line_of_sight(system: Any, observer: Any, target: Any, row: int, objects: di
     memory = observer.memory
     if memory is None or memory.n == 0:
         return None
-    body = target.body
-    a, b = (body.parts.index(p) if p in body.parts else None for p in system.params["gaze"])
+    parts = memory.parts  # the observer's own parts, onto which it perceives the target's
+    a, b = (parts.index(p) if p in parts else None for p in system.params["gaze"])
     if a is None or b is None:
         return None
     both = memory.visible[:, a] & memory.visible[:, b]

@@ -205,12 +205,12 @@ def facilitation_benchmark(pm: Any, *, demonstrations: int = 200, repertoire: in
         learned_out = bool(final is not None and final.details.get("learned"))
         imitation_error = None
         if final is not None and final.path and kind == "wrist":
-            executed = np.concatenate([st.trajectory(fps) for e in final.path for st in learner.motor.edge(e)[3]["commands"]])
+            executed = np.concatenate([st.trajectory(fps) for e in final.path for st in learner.motor.edge(e).commands])
             shown = np.concatenate([st.trajectory(fps) for st in strokes])
             imitation_error = _shape_error(executed, shown)
-        elif final is not None and final.path and learner.motor.edge(final.path[0])[0] == "left_hand":
+        elif final is not None and final.path and learner.motor.edge(final.path[0]).subsystem == "left_hand":
             # per finger, the path of its joint angles (radians) along the commands performed against the one shown
-            executed = [np.concatenate([learner.motor.edge(e)[3]["commands"][j].trajectory(fps) for e in final.path])
+            executed = [np.concatenate([learner.motor.edge(e).commands[j].trajectory(fps) for e in final.path])
                         for j in range(len(strokes))]
             grid = np.linspace(0.0, strokes[0].duration, 100)
             imitation_error = float(np.mean([_shape_error(x, t.curve(grid)) for x, t in zip(executed, strokes)]))

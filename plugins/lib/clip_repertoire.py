@@ -14,8 +14,9 @@ holds at least ``hub_share`` of the clip ends is a hub, its medoid the hub
 pose. The largest cluster is always a hub, so locomotion clips that never stand
 still still get one.
 
-Poses are root-relative in the body's own frame (§5.1), lifted to the median
-height of the root at the hubs, which is the local frame a motor system uses.
+Poses are root-relative in the body's own frame (§5.1, :func:`plugins.lib.root_frame.root_relative` with the
+facing a centred running median over the clip), lifted to the median height of the root at the hubs, which is the
+local frame a motor system uses. Hidden parts follow ``docs/conventions.md`` (held where last seen).
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ from scipy.cluster.hierarchy import fcluster, linkage
 from scipy.spatial.distance import squareform
 
 from plugins.lib.pose_distance import pose_distance
-from plugins.lib.root_frame import facing_heading, smooth_heading, to_root_relative
+from plugins.lib.root_frame import root_relative, smooth_heading
 from toolkit import ConfigError, Motion, Parameter
 from toolkit.profile import BodyProfile, load_profile
 
@@ -65,11 +66,11 @@ class ClipRepertoire:
 
 
 def root_relative_motion(world: Motion, profile: BodyProfile, facing_window: float = 1.0) -> Motion:
-    """World positions to root-relative positions in the body's frame, the facing a centred running median."""
-    heading = facing_heading(np.where(world.visible[..., None], world.positions, 0.0), world.visible, profile.body)
-    heading = smooth_heading(heading, max(1, int(round(facing_window * world.fps))))
-    pose, mask, _, _ = to_root_relative(world.positions, world.visible, profile.body, heading)
-    return Motion(pose, world.fps, world.parts, mask)
+    """World positions to root-relative positions in the body's frame (§5.1), the facing a centred running median
+    over ``facing_window`` seconds; hidden parts held (docs/conventions.md)."""
+    window = max(1, int(round(facing_window * world.fps)))
+    pose, mask, _, _ = root_relative(world.positions, world.visible, profile.body, lambda h: smooth_heading(h, window))
+    return Motion(pose, world.fps, world.parts, mask).filled()
 
 
 def example_name(movement: str, earlier: int) -> str:
@@ -140,12 +141,8 @@ def load_clip_repertoire(folder: str | Path, profile: str | Path | BodyProfile, 
 
 
 def _filled(motion: Motion, frame: int) -> np.ndarray:
-    """A frame with hidden parts filled from the clip's nearest frame where they are seen."""
-    pose = motion.positions[frame].copy()
-    for p in np.flatnonzero(~motion.visible[frame]):
-        seen = np.flatnonzero(motion.visible[:, p])
-        pose[p] = motion.positions[seen[np.argmin(np.abs(seen - (frame % motion.n_frames)))], p] if len(seen) else 0.0
-    return pose
+    """A frame of a clip (hidden parts held, as the clip is kept), a part never seen at 0."""
+    return np.nan_to_num(motion.positions[frame])
 
 
 def _root_height(rel: list[tuple[str, Path, Motion]], profile: BodyProfile) -> float:

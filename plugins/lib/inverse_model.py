@@ -27,7 +27,11 @@ and via postures of the sighted hand movements. These configurations are used
 as key postures to create a new edge in the hand motor command graph".
 :func:`transitions_from_segment` takes those break points as key postures and
 fits the one remaining parameter, the moment of peak angular velocity (which
-also places the key postures on the curve's clock), by a bounded scalar search; :func:`learn_commands` makes one edge of them.
+also places the key postures on the curve's clock), by a bounded scalar search.
+
+Everything here is mathematics: observed segment in, commands out
+(:func:`commands_from_segment`). Adding them to a graph as edges is the motor command
+graph's (:meth:`plugins.motor.motor_command_graph.MotorCommandGraph.learn_observed`).
 """
 
 from __future__ import annotations
@@ -40,7 +44,7 @@ from scipy.signal import savgol_filter
 from plugins.lib.guiding_stroke import GuidingStroke, progress
 from plugins.lib.hand_transition import HandTransition
 
-__all__ = ["stroke_from_segment", "transitions_from_segment", "trajectory_error", "learn_commands"]
+__all__ = ["stroke_from_segment", "transitions_from_segment", "trajectory_error", "commands_from_segment"]
 
 
 def trajectory_error(stroke: GuidingStroke | HandTransition, positions: np.ndarray, fps: float) -> float:
@@ -173,36 +177,38 @@ def transitions_from_segment(angles: np.ndarray, fps: float, breaks: list[int] |
     return build(float(fit.x) if error(float(fit.x)) <= error(0.5) else 0.5)
 
 
-def learn_commands(motor, subsystem: str, observed: np.ndarray, fps: float, start: str, breaks, *,
-                   source: str = "inverse model", hub_tolerance: float = 0.05, refine: bool = True) -> list[str]:
-    """Turn an observed segment into new edges of a motor command graph, chained from node ``start`` (§4.3).
+def commands_from_segment(observed: np.ndarray, fps: float, breaks: list[int] | tuple[int, ...], *, hand: bool,
+                          refine: bool = True) -> list[tuple[list[GuidingStroke] | list[HandTransition], bool]]:
+    """The motor commands that reproduce an observed segment of a subsystem's k parts, stroke by stroke (§4.3).
 
-    ``observed`` (n, k, 3) holds the positions of the subsystem's k parts; ``breaks``
-    maps the flattened (n, 3k) trajectory to the frames where one stroke ends and
-    the next begins (the velocity/direction segmenter's break points). Each
-    stroke of each part is inverted into a guiding stroke; the last edge ends in
-    the hub when the segment returns there. Returns the new edges' movement names.
+    Parameters
+    ----------
+    observed : array, shape (n, k, 3)
+        Positions of a wrist subsystem's parts, or joint angles of a hand's fingers, NaN-free.
+    fps : float
+    breaks : list of int
+        Frames where one stroke ends and the next begins (:func:`plugins.lib.strokes.breaks`).
+    hand : bool
+        A hand: one piece, whose key postures are the break points (:func:`transitions_from_segment`); else one
+        piece per stroke between break points, a guiding stroke per part (:func:`stroke_from_segment`), pieces
+        shorter than two frames left out.
+    refine : bool
+        Refine the guiding strokes by least squares.
 
-    A hand subsystem (its parts are fingers, ``observed`` holds joint angles) gets
-    one edge whose key postures are the break points, by
-    :func:`transitions_from_segment`; it ends in the hub when within the motor
-    system's hand tolerance (radians) of it.
+    Returns
+    -------
+    list of (commands, last)
+        Each piece's commands (one per part), and whether it is the segment's last piece (which a motor command
+        graph may end in its hub).
     """
     n, k, _ = observed.shape
-    hub_state = motor.graphs[subsystem].nodes["hub"]["state"]
-    if motor.is_hand(subsystem):
-        transitions = transitions_from_segment(observed, fps, breaks(observed.reshape(n, k * 3)))
-        home = np.linalg.norm(observed[-1] - hub_state, axis=-1).max() <= motor.tolerance(subsystem)
-        return [motor.learn(subsystem, start, transitions, end="hub" if home else None, source=source)]
-    cuts = [0, *breaks(observed.reshape(n, k * 3)), n - 1]
-    names, node = [], start
+    if hand:
+        return [(transitions_from_segment(observed, fps, breaks), True)]
+    cuts = [0, *breaks, n - 1]
+    pieces: list[tuple[list[GuidingStroke] | list[HandTransition], bool]] = []
     for i, (a, b) in enumerate(zip(cuts, cuts[1:])):
         if b - a < 2:
             continue
-        strokes = [stroke_from_segment(observed[a : b + 1, j], fps, refine=refine) for j in range(k)]
-        last = i == len(cuts) - 2
-        end = "hub" if last and np.linalg.norm(observed[-1] - hub_state, axis=-1).max() <= hub_tolerance else None
-        name = motor.learn(subsystem, node, strokes, end=end, source=source)
-        names.append(name)
-        node = motor.edge(name)[2]
-    return names
+        pieces.append(([stroke_from_segment(observed[a : b + 1, j], fps, refine=refine) for j in range(k)],
+                       i == len(cuts) - 2))
+    return pieces

@@ -17,18 +17,21 @@ import numpy as np
 __all__ = ["pose_distance", "path_distance"]
 
 
-def pose_distance(a: np.ndarray, b: np.ndarray, visible: np.ndarray) -> np.ndarray:
+def pose_distance(a: np.ndarray, b: np.ndarray, visible: np.ndarray | None = None) -> np.ndarray:
     """eq. 1: mean distance over visible parts; NaN where nothing is visible.
 
     Parameters
     ----------
     a, b : array, shape (..., P, 3)
         Root-relative poses (broadcast against each other).
-    visible : array of bool, shape (..., P)
-        Parts that take part in the comparison (broadcast likewise).
+    visible : array of bool, shape (..., P), optional
+        Parts that take part in the comparison (broadcast likewise); ``None``: every part (the caller has taken
+        the visible parts already, as path search does in its beam).
     """
     diff = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
     d = np.sqrt(np.einsum("...i,...i->...", diff, diff))  # eq. 2 per part
+    if visible is None:
+        return d.mean(axis=-1)
     visible = np.broadcast_to(np.asarray(visible, dtype=bool), d.shape)
     d = np.where(visible, d, 0.0)
     n = visible.sum(axis=-1)
@@ -37,5 +40,12 @@ def pose_distance(a: np.ndarray, b: np.ndarray, visible: np.ndarray) -> np.ndarr
 
 
 def path_distance(observed: np.ndarray, path: np.ndarray, visible: np.ndarray) -> float:
-    """eq. 3: the sum of eq. 1 over aligned poses ``observed[i]`` and ``path[i]`` (frames without evidence skipped)."""
+    """eq. 3: the sum of eq. 1 over aligned poses ``observed[i]`` and ``path[i]`` (frames without evidence skipped).
+
+    Parameters
+    ----------
+    observed, path : array, shape (N, P, 3)
+        The observed samples and the poses of the graph path aligned with them.
+    visible : array of bool, shape (N, P)
+    """
     return float(np.nansum(pose_distance(observed, path, visible)))

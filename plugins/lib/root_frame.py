@@ -5,17 +5,21 @@ the target's visible parts to positions relative to the target's *root node*,
 with the facing found from a forward marker (the nose, "always somewhat in front
 of the body") against the line through the knees. Only visible parts are used.
 
-All functions are vectorised over leading frame axes.
+:func:`root_relative` is the transform every perception and the clip repertoire use: the facing found from the
+visible parts, smoothed over time (a running median while frames stream in, a centred one over a whole recording),
+then root-relative coordinates. All functions are vectorised over leading frame axes.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from collections.abc import Callable
+
 from toolkit.body import Body
 from toolkit.motion import world_to_local
 
-__all__ = ["facing_heading", "to_root_relative", "HeadingFilter", "smooth_heading"]
+__all__ = ["facing_heading", "to_root_relative", "root_relative", "HeadingFilter", "smooth_heading"]
 
 _UP = np.array([0.0, 1.0, 0.0])
 
@@ -189,3 +193,22 @@ def to_root_relative(
         mask = mask & mask[..., body.carriers]
     pose = np.where(mask[..., None], pose, np.nan)
     return pose, mask, np.where(ok[..., None], root, np.nan), heading
+
+
+def root_relative(world: np.ndarray, visible: np.ndarray | None, body: Body,
+                  smooth: Callable[[np.ndarray], np.ndarray] | None = None
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """§5.1 in one place: world positions of frames (n, P, 3) to root-relative positions in the body's own frame.
+
+    The facing is found from the visible parts of each frame (:func:`facing_heading`) and smoothed over the frames
+    by ``smooth`` (headings (n,) to headings (n,)): :meth:`HeadingFilter.update_many` while frames stream in,
+    :func:`smooth_heading` over a whole recording, ``None`` for none. Non-finite coordinates are never visible.
+
+    Returns what :func:`to_root_relative` returns: poses (n, P, 3) (NaN where hidden), visibility (n, P), the root's
+    world position (n, 3) and the heading (n,).
+    """
+    world = np.asarray(world, dtype=float)
+    seen = np.isfinite(world).all(axis=-1)
+    visible = seen if visible is None else seen & np.asarray(visible, dtype=bool)
+    found = facing_heading(np.where(visible[..., None], world, 0.0), visible, body)
+    return to_root_relative(world, visible, body, found if smooth is None else smooth(found))

@@ -1,9 +1,9 @@
 """Matcher ``dtw``: the nearest template by multivariate dynamic time warping (a baseline, via dtaidistance).
 
 What most users compare against: every example of every movement of the
-observer's repertoire is a template (the clips of a clip repertoire,
-:mod:`plugins.lib.clip_repertoire`, else the motor system's own performance of each
-movement), the observed segment is warped onto each with multivariate DTW
+observer's repertoire is a template (``MotorSystem.examples``: the clips of a clip
+repertoire, :mod:`plugins.lib.clip_repertoire`, else the motor system's own
+performance of each movement), the observed segment is warped onto each with multivariate DTW
 (:func:`dtaidistance.dtw_ndim.distance_fast`, squared Euclidean inner
 distance over all root-relative part coordinates) and the closest template's
 movement wins. DTW needs the whole segment: it decides at the segment's end
@@ -58,19 +58,13 @@ class DTW(Matcher):
 
     def attach(self, owner: Any) -> None:
         super().attach(owner)
-        motor, body = owner.motor, owner.body
-        root = body.root_index
-        clips = getattr(motor, "clips", None)
-        examples: list[tuple[str, np.ndarray]] = []
-        if clips is not None:
-            examples = [(c.movement, c.motion.positions) for c in clips.clips]
-        else:
-            examples = [(m, motor.perform(m, fps=30.0).positions) for m in motor.movements()]
+        root = owner.body.root_index
+        examples = owner.motor.examples(fps=30.0)  # the clips of a clip repertoire, else one performance of each
         self.labels = [label for label, _ in examples]
         self.templates = []
-        for _, positions in examples:
-            rel = positions - positions[:, root : root + 1]
-            self.templates.append(self._series(np.where(np.isnan(rel), np.nanmedian(rel, axis=0), rel)))
+        for _, motion in examples:
+            positions = motion.filled().positions  # hidden parts held (docs/conventions.md); never seen: 0
+            self.templates.append(self._series(positions - positions[:, root : root + 1]))
 
     def _series(self, rel: np.ndarray) -> np.ndarray:
         series = np.nan_to_num(rel[:: self.params["stride"]]).reshape(-1, rel.shape[1] * 3)
@@ -79,10 +73,7 @@ class DTW(Matcher):
     def match(self, motion: Motion) -> Match:
         if not motion.visible.any() or not self.templates:
             return Match.unknown(reason="nothing visible")
-        rel = np.where(motion.visible[..., None], motion.positions, np.nan)
-        fill = np.nanmedian(rel, axis=0)
-        rel = np.where(np.isnan(rel), np.nan_to_num(fill), rel)
-        series = self._series(rel)
+        series = self._series(motion.filled().positions)
         distances = np.array([frame_distance(series, template, self.params["window"]) for template in self.templates])
         best = int(np.argmin(distances))
         per_frame = float(distances[best])

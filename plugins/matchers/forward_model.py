@@ -27,10 +27,18 @@ the body is seen nearer to the hub's state than to the active node's (a
 demonstrator who returned to rest without the matcher following him there).
 
 *True imitation* (§4.3, Fig. 3 top): when no edge predicts the demonstration,
-the working memory of the segment is cut into strokes by the velocity/direction
-segmenter's break points and each stroke is turned into a guiding stroke by the
-inverse model; the strokes become new edges and nodes leading from the active
-node (ending in the hub when the demonstration returns there).
+the motor command graph learns it (``learn_observed``): the working memory of the
+segment is cut into strokes at the break points of the stroke analysis
+(:mod:`plugins.lib.strokes`, with this matcher's ``drop`` and ``angle``), each
+stroke becomes a guiding stroke by the inverse model, and the strokes become new
+edges and nodes leading from the active node (ending in the hub when the
+demonstration returns there).
+
+Working memory: the matcher reads the segment from the
+:class:`~toolkit.watching.WorkingMemory` the watching loop gives it (root-relative,
+in the observer's parts, hidden parts held) and keeps no frames of its own; what it
+needs of the motor system is the :class:`CommandGraphs` protocol, checked when it
+is attached. :meth:`ForwardModel.inspect` shows its candidates and prediction errors.
 
 Subsystems moving at once (§4.2: "multiple graphs at once in order to account
 for the possibly concurrent execution of submovements in different motor
@@ -55,17 +63,73 @@ angular-velocity minima and direction changes (§4.3).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from types import MappingProxyType
+from typing import Any, Protocol
 
 import numpy as np
 from scipy.ndimage import uniform_filter1d
 
-from plugins.lib.inverse_model import learn_commands
-from plugins.segmenters.velocity_direction import VelocityDirection
-from toolkit import ConfigError, Match, Matcher, Motion, Parameter, hookimpl
+from plugins.lib.strokes import StrokeCriteria
+from toolkit import Match, Matcher, Motion, Parameter, hookimpl
+from toolkit.components import provides
+from toolkit.watching import WorkingMemory, follow
 
-__all__ = ["ForwardModel", "Track"]
+__all__ = ["ForwardModel", "Track", "CommandGraphs"]
+
+
+class CommandGraphs(Protocol):
+    """A motor system of motor command graphs, one per subsystem, whose edges are commands (K&G §4.2).
+
+    What the forward model needs of it: ``plugins.motor.motor_command_graph`` provides it.
+    """
+
+    subsystems: Mapping[str, np.ndarray]
+    """The parts (indices into the body) each subsystem moves."""
+
+    def is_hand(self, subsystem: str) -> bool:
+        """Whether a subsystem's states are a hand's finger joint angles (radians) rather than positions."""
+
+    def active_node(self, subsystem: str) -> str:
+        """The node a subsystem is in: where the last movement followed or performed ended."""
+
+    def move_to(self, subsystem: str, node: str, *, posture: bool = True) -> None:
+        """Put a subsystem in ``node`` (with ``posture``, the body's parts too)."""
+
+    def state(self, subsystem: str, node: str) -> np.ndarray:
+        """A node's motor state, (k, 3) for the subsystem's k parts."""
+
+    def edges_from(self, subsystem: str, node: str) -> list[Any]:
+        """The edges leaving ``node``: records with ``name``, ``source``, ``target`` and ``commands``."""
+
+    def edge(self, movement: str) -> Any:
+        """The edge record of a movement (edge) name."""
+
+    def known_sequence(self, path: tuple[str, ...]) -> tuple[str, ...]:
+        """The whole learned sequence of edges ``path`` begins, else ``path``."""
+
+    def add_sequence(self, edges: list[str], *, name: str | None = None, label: str | None = None) -> str:
+        """A path of edges named as one movement."""
+
+    def add_together(self, movements: list[str]) -> str:
+        """Movements of several subsystems named as one, performed at once."""
+
+    def subsystem_of(self, movement: str) -> str:
+        """The subsystem a movement moves."""
+
+    def label(self, movement: str) -> str:
+        """The movement a performable name is an example of."""
+
+    def label_of_path(self, path: tuple[str, ...]) -> str | None:
+        """The labelled movement a path of edges stands for, if one."""
+
+    def learn_observed(self, subsystem: str, start: str, observed: np.ndarray, fps: float, *,
+                       criteria: StrokeCriteria = StrokeCriteria()) -> list[str]:
+        """Learn an observed movement as new edges from ``start`` (true imitation); their names."""
+
+    def rest_pose(self) -> np.ndarray:
+        """The body's rest pose, local frame (P, 3)."""
 
 
 def _arc(points: np.ndarray) -> np.ndarray:
@@ -169,63 +233,76 @@ class ForwardModel(Matcher):
         Parameter("angle", float, 50.0, "Direction criterion (degrees) of the stroke segmentation used for learning.", minimum=1.0, maximum=180.0),
     )
 
+    streaming = True
+
     def attach(self, owner: Any) -> None:
         super().attach(owner)
         motor = owner.motor
-        if not hasattr(motor, "graphs"):
-            raise ConfigError(f"forward-model needs a motor command graph, not {motor.name!r}", key=("plugin",),
-                              expected='[motor] plugin = "motor-command-graph"')
+        provides(motor, CommandGraphs, needed_by="forward-model", what="a motor command graph",
+                 expected=" or ".join(f'[motor] plugin = "{name}"' for name in self.motor_systems))
         self.motor = motor
         # observed root-relative positions are placed at the observer's own root height; finger angles stay as they are
         self._root_height = np.where(owner.body.angle_mask[:, None], 0.0, motor.rest_pose()[owner.body.root_index])
-        self._strokes = VelocityDirection(drop=self.params["drop"], angle=self.params["angle"])
+        self._criteria = StrokeCriteria(drop=self.params["drop"], angle=self.params["angle"])
         self._tables: dict[int, tuple] = {}
         self._edges: dict[str, _EdgeTable] = {}
+        self._memory: WorkingMemory | None = None
+        self.tracks: dict[str, Track] = {}
+        self.reported = False
 
     # -- streaming ------------------------------------------------------------------------------
 
-    def begin(self, fps: float) -> None:
-        self.fps = fps
-        self.frames: list[np.ndarray] = []
-        self.tracks: dict[str, Track] = {}  # in the order the subsystems began to move
+    def begin(self, memory: WorkingMemory) -> None:
+        self._memory = memory
+        self.fps = memory.fps
+        self.tracks = {}  # in the order the subsystems began to move
         self.reported = False  # a commitment to the tracks decided so far has been announced
 
-    # the first subsystem to move, as the views and single-subsystem users see it
     @property
     def main(self) -> Track | None:
-        return next(iter(self.tracks.values()), None) if getattr(self, "tracks", None) else None
+        """The first subsystem to move, as the views and single-subsystem users see it."""
+        return next(iter(self.tracks.values()), None)
 
-    subsystem = property(lambda self: self.main.subsystem if self.main else None)
-    start_node = property(lambda self: self.main.start_node if self.main else None)
-    candidates = property(lambda self: self.main.candidates if self.main else {})
-    initial = property(lambda self: self.main.initial if self.main else [])
-    committed = property(lambda self: self.main.committed if self.main else None)
-    committed_path = property(lambda self: self.main.committed_path if self.main else ())
-    deviated = property(lambda self: bool(self.main and self.main.deviated))
-    trace = property(lambda self: self.main.trace if self.main else [])
-    committed_at = property(lambda self: self.main.committed_at if self.main else None)
-    deviated_at = property(lambda self: self.main.deviated_at if self.main else None)
+    def inspect(self) -> Mapping[str, Any]:
+        """The segment followed last: for its first subsystem to move (and, under ``tracks``, for each) the start
+        node, the candidate paths still alive, the initial candidates, the commitment and when it came, whether and
+        when it deviated, the per-frame prediction errors (``trace``) and the anchors; read-only snapshots."""
+        def view(track: Track | None) -> dict[str, Any]:
+            if track is None:
+                return {"subsystem": None, "start_node": None, "candidates": {}, "initial": [], "committed": None,
+                        "committed_path": (), "deviated": False, "trace": (), "committed_at": None,
+                        "deviated_at": None, "anchors": {}}
+            return {"subsystem": track.subsystem, "start_node": track.start_node,
+                    "candidates": dict(track.candidates), "initial": list(track.initial), "committed": track.committed,
+                    "committed_path": tuple(track.committed_path), "deviated": track.deviated,
+                    "trace": tuple(track.trace), "committed_at": track.committed_at, "deviated_at": track.deviated_at,
+                    "anchors": {k: v.copy() for k, v in track.anchors.items()}}
+        return MappingProxyType({**view(self.main), "frames": 0 if self._memory is None else self._memory.n,
+                                 "tracks": {name: view(track) for name, track in self.tracks.items()}})
 
-    def _local(self, pose: np.ndarray) -> np.ndarray:
-        """Root-relative observed positions in the observer's motor frame (root at its own rest height; angles as seen)."""
-        return pose + self._root_height
+    def _local(self) -> np.ndarray:
+        """The working memory in the observer's motor frame (n, P, 3): root-relative positions placed at its own
+        root height (finger angles as seen); hidden parts held, never-seen parts NaN."""
+        return self._memory.positions + self._root_height
 
-    def observe(self, pose: np.ndarray, visible: np.ndarray) -> Match | None:
-        points = np.where(visible[:, None], self._local(pose), np.nan)
-        if self.frames:
-            points = np.where(np.isfinite(points), points, self.frames[-1])
-        self.frames.append(points)
-        memory = np.array(self.frames)
-        self._start_tracks(memory)
+    def _at(self, row: int) -> np.ndarray:
+        """One row of the working memory in the motor frame (P, 3)."""
+        return self._memory.positions[row] + self._root_height
+
+    def observe(self, memory: WorkingMemory) -> Match | None:
+        if memory is not self._memory:
+            self.begin(memory)
+        local = self._local()
+        self._start_tracks(local)
         if not self.tracks:
             return None
         stop = None
         for track in self.tracks.values():
-            stop = self._follow(track, memory) or stop
+            stop = self._follow(track, local) or stop
         if stop is not None:
             return stop
         tracks = list(self.tracks.values())
-        if self.reported or not all(t.committed is not None and not t.deviated for t in tracks) or self._joining(memory):
+        if self.reported or not all(t.committed is not None and not t.deviated for t in tracks) or self._joining(local):
             return None
         self.reported = True  # every subsystem under consideration has one prevailing command: imitate them at once
         for t in tracks:
@@ -238,7 +315,7 @@ class ForwardModel(Matcher):
         if len(tracks) > 1:
             details["subsystems"] = {t.subsystem: {"candidates": t.initial, "path": list(t.committed_path),
                                                     "speed": t.speed, "progress": t.progress} for t in tracks}
-        return Match(labels[0] if len(tracks) == 1 else movement, min(t.confidence for t in tracks), len(self.frames),
+        return Match(labels[0] if len(tracks) == 1 else movement, min(t.confidence for t in tracks), memory.n,
                      path=tuple(e for t in tracks for e in t.committed_path), details=details)
 
     def _start_tracks(self, memory: np.ndarray) -> None:
@@ -255,7 +332,7 @@ class ForwardModel(Matcher):
             first = memory[:3].mean(axis=0)
             moved = self._moved(waiting, first, memory[-3:].mean(axis=0))
         else:
-            moved = self._moved(waiting, self.frames[0], self.frames[-1])
+            moved = self._moved(waiting, memory[0], memory[-1])
         moved = {name: d for name, d in moved.items() if d > self.params["min_move"]}
         for name in sorted(moved, key=moved.get, reverse=True):
             onset = 0
@@ -283,10 +360,10 @@ class ForwardModel(Matcher):
 
     def _track(self, name: str, onset: int) -> None:
         scale = self._scale_of(name)
-        start = self._where(name, self.frames[onset][self.motor.subsystems[name]])
+        start = self._where(name, self._at(onset)[self.motor.subsystems[name]])
         # a command that moves no part farther than min_move (standing still) cannot be seen to begin
-        candidates = {(edge,): 0.0 for edge, _ in self.motor.edges_from(name, start)
-                      if self._length(edge) * scale > self.params["min_move"]}
+        candidates = {(edge.name,): 0.0 for edge in self.motor.edges_from(name, start)
+                      if self._length(edge.name) * scale > self.params["min_move"]}
         self.tracks[name] = Track(name, scale, self.motor.is_hand(name), start, onset, candidates,
                                   sorted(p[0] for p in candidates), last_correct=start, learn_from=onset)
 
@@ -299,11 +376,10 @@ class ForwardModel(Matcher):
         observer's own at its end) begins his next movement there. With ``relative`` the observed posture is not
         comparable with the states, and the active node is kept.
         """
-        active = self.motor.active[name]
+        active = self.motor.active_node(name)
         if active == "hub" or self.params["relative"] or not np.isfinite(seen).any():
             return active
-        graph = self.motor.graphs[name]
-        far = [self._distance_to(name, graph.nodes[n]["state"], seen) for n in (active, "hub")]
+        far = [self._distance_to(name, self.motor.state(name, n), seen) for n in (active, "hub")]
         return active if far[0] <= far[1] else "hub"
 
     def _distance_to(self, name: str, state: np.ndarray, seen: np.ndarray) -> float:
@@ -320,7 +396,7 @@ class ForwardModel(Matcher):
         observed = self._observed(track, memory)
         lengths = _lengths(observed)  # once per frame
         last = observed[-1]
-        frame = len(self.frames) - 1
+        frame = self._memory.n - 1
         if track.committed is not None:
             if track.deviated:
                 return None
@@ -328,13 +404,13 @@ class ForwardModel(Matcher):
             track.trace.append((frame, {track.committed_path: error}))
             if error <= self.params["deviation"]:
                 return None
-            track.deviated, track.deviated_at = True, len(self.frames)
+            track.deviated, track.deviated_at = True, self._memory.n
             self._last_correct(track, lengths, memory)
             if not track.reported:
                 return None
             # stop the imitation; the others' commands were right and are completed by the motor system
-            self.motor.reset_to(track.subsystem, track.last_correct)
-            return Match(track.committed, 0.0, len(self.frames), details={"stop": True, "reason": "deviation",
+            self.motor.move_to(track.subsystem, track.last_correct)
+            return Match(track.committed, 0.0, self._memory.n, details={"stop": True, "reason": "deviation",
                                                                          "subsystem": track.subsystem,
                                                                          "return_to": track.last_correct})
         if not track.candidates:
@@ -352,7 +428,7 @@ class ForwardModel(Matcher):
             if progress >= self.params["min_progress"] or len(path) > 1:
                 track.committed_path = self._known_continuation(path)
                 track.committed = self.motor.add_sequence(list(track.committed_path))
-                track.committed_at = len(self.frames)
+                track.committed_at = self._memory.n
                 track.speed = self._speed(path[0], along, self._anchor(track, path[0]), len(observed))
                 track.progress = progress
                 track.confidence = float(np.exp(-alive[path] / self.params["threshold"]))
@@ -368,7 +444,7 @@ class ForwardModel(Matcher):
         joined = self._anchor(track, track.committed_path[0])[lead]
         on = int(np.searchsorted(arcs, lengths[lead] + joined - 0.01 / track.scale))
         on = min(on, len(track.committed_path) - 1)
-        track.last_correct = self.motor.edge(track.committed_path[on])[1]
+        track.last_correct = self.motor.edge(track.committed_path[on]).source
         track.excluded.add(track.committed_path[on])
         track.right = track.committed_path[:on]  # the part that was right
         if track.right:
@@ -386,7 +462,7 @@ class ForwardModel(Matcher):
         return float(edge.arcs[edge.lead, -1])
 
     def _strokes_of(self, name: str) -> list[Any]:
-        return self.motor.edge(name)[3]["commands"]
+        return self.motor.edge(name).commands
 
     def _lead(self, name: str) -> int:
         """The part of the subsystem that moves farthest along a command: progress and speed are measured on it."""
@@ -425,8 +501,8 @@ class ForwardModel(Matcher):
             lead = self._lead(path[0])
             seen = self._along(track, path[0], lengths)[lead]
             total = sum(self._edge(e).arcs[lead, -1] for e in path)
-            end = self.motor.edge(path[-1])[2]
-            nxt = [name for name, _ in self.motor.edges_from(track.subsystem, end)] if seen > total + 0.01 / track.scale else []
+            end = self.motor.edge(path[-1]).target
+            nxt = [edge.name for edge in self.motor.edges_from(track.subsystem, end)] if seen > total + 0.01 / track.scale else []
             out.extend([(*path, n) for n in nxt if n not in path] or [path])
         return out
 
@@ -442,10 +518,7 @@ class ForwardModel(Matcher):
 
     def _known_continuation(self, path: tuple[str, ...]) -> tuple[str, ...]:
         """The whole learned command sequence that ``path`` begins, else ``path`` itself."""
-        for edges in self.motor.sequences.values():
-            if tuple(edges[: len(path)]) == path:
-                return tuple(edges)
-        return path
+        return self.motor.known_sequence(path)
 
     def _mapped_time(self, stroke: Any, length: float) -> float:
         """The stroke time at which it has covered ``length`` metres of path (the speed-free forward model)."""
@@ -513,7 +586,7 @@ class ForwardModel(Matcher):
             edge = self._edge(name)
             anchor = np.zeros(len(edge.arcs))
             if not (self.params["relative"] or track.hand):
-                first = self.frames[track.onset][self.motor.subsystems[track.subsystem]]
+                first = self._at(track.onset)[self.motor.subsystems[track.subsystem]]
                 far = np.linalg.norm(edge.positions - first[:, None], axis=-1)
                 far[edge.arcs > 0.5 * edge.arcs[:, -1:]] = np.inf  # the first half of each stroke
                 anchor = edge.arcs[np.arange(len(far)), np.argmin(far, axis=1)]
@@ -525,7 +598,7 @@ class ForwardModel(Matcher):
         if not self.params["relative"]:
             return 0.0
         start = self._edge(name).positions[:, 0]
-        return self.frames[track.onset][self.motor.subsystems[track.subsystem]] - start
+        return self._at(track.onset)[self.motor.subsystems[track.subsystem]] - start
 
     def _distance(self, track: Track, predicted: np.ndarray, observed: np.ndarray) -> float:
         """Per-part distances (k, 3 each) combined as ``error`` says: the largest or the mean (radians of a hand scaled)."""
@@ -556,22 +629,26 @@ class ForwardModel(Matcher):
         learned by the inverse model (true imitation, §4.3), as is the movement of a subsystem no edge predicted.
         Whatever was not yet imitated is returned as one movement (several subsystems: performed together).
         """
-        if not getattr(self, "frames", None):
-            self.begin(motion.fps)
-            for f in range(motion.n_frames):
-                self.observe(motion.positions[f], motion.visible[f])
+        if self._memory is None:  # concluded without having followed the segment: follow it now, frame by frame
+            return follow(self, motion)[1]
+        try:
+            return self._conclude()
+        finally:
+            self._memory = None  # the next segment begins anew
+
+    def _conclude(self) -> Match | None:
         if not self.tracks:
             return Match.unknown(reason="nothing moved")
-        memory = np.array(self.frames)
+        memory = self._local()
         perform, learned, paths = [], [], []
         first_from, first_to = None, None
         for track in self.tracks.values():
             idx = self.motor.subsystems[track.subsystem]
             if track.committed is not None and not track.deviated:
-                end = self.motor.edge(track.committed_path[-1])[2]
-                expected = self.motor.graphs[track.subsystem].nodes[end]["state"] + self._onset_offset(track, track.committed_path[0])
+                end = self.motor.edge(track.committed_path[-1]).target
+                expected = self.motor.state(track.subsystem, end) + self._onset_offset(track, track.committed_path[0])
                 if self._distance(track, expected, memory[-1, idx]) <= self.params["deviation"]:
-                    self.motor.active[track.subsystem] = end
+                    self.motor.move_to(track.subsystem, end, posture=False)  # the body is where imitating left it
                     if not track.reported:  # recognised, but not imitated yet (another subsystem had to be learned)
                         perform.append(track.committed)
                         paths.extend(track.committed_path)
@@ -582,7 +659,7 @@ class ForwardModel(Matcher):
             if track.committed is not None and track.reported and not track.deviated:
                 continue
             if track.deviated or track.committed is None:
-                self.motor.reset_to(track.subsystem, track.last_correct)  # back to the last correct node
+                self.motor.move_to(track.subsystem, track.last_correct)  # back to the last correct node
             if not self.params["learn"]:
                 continue
             names = self._learn(track, memory)
@@ -591,12 +668,12 @@ class ForwardModel(Matcher):
             new = self.motor.add_sequence(names)
             if track.right:  # the part that was right, then the new one
                 self.motor.add_sequence([*track.right, *names])
-            self.motor.active[track.subsystem] = self.motor.edge(names[-1])[2]
+            self.motor.move_to(track.subsystem, self.motor.edge(names[-1]).target, posture=False)
             perform.append(new)
             paths.extend(names)
             learned.extend(names)
             if first_from is None:
-                first_from, first_to = track.last_correct, self.motor.edge(names[-1])[2]
+                first_from, first_to = track.last_correct, self.motor.edge(names[-1]).target
         if not perform:
             if self.reported:
                 return None  # already reported when it committed
@@ -627,17 +704,11 @@ class ForwardModel(Matcher):
             observed = observed[: (int(moving[-1]) + 2 if len(moving) else len(observed))]
         if len(observed) < 3:
             return []
-        n, k = observed.shape[:2]
-        self._strokes.reset(tuple(f"p{i}" for i in range(k)), self.fps)
-        return learn_commands(self.motor, track.subsystem, observed, self.fps, track.last_correct, self._strokes.breaks)
+        return self.motor.learn_observed(track.subsystem, track.last_correct, observed, self.fps, criteria=self._criteria)
 
     def match(self, motion: Motion) -> Match:
-        """Batch use: the whole segment at once (no facilitation)."""
-        self.begin(motion.fps)
-        early = None
-        for f in range(motion.n_frames):
-            early = early or self.observe(motion.positions[f], motion.visible[f])
-        late = self.conclude(motion)
+        """Batch use: the whole segment at once (no facilitation): followed frame by frame, then concluded."""
+        early, late = follow(self, motion)
         return late or early or Match.unknown()
 
 

@@ -19,19 +19,53 @@ slower or faster (Morris's longer cover face, §5.2.2) still aligns. Hub nodes
 belong to no movement and do not vote. Hidden parts are left out of every
 distance (eq. 1 over visible parts); samples with nothing visible cost nothing.
 
-The answer is "unknown" when the best path's mean pose distance exceeds
-``max_distance``; with ``learn = true`` that path is then added to the
-posegraph as a new movement (§5.2.3, §7.3).
+The answer is "unknown" when the best path's mean pose distance (eq. 3 over
+the samples with evidence, :func:`plugins.lib.pose_distance.path_distance`)
+exceeds ``max_distance``; with ``learn = true`` that path is then added to the
+posegraph as a new movement (§5.2.3, §7.3). What path search needs of the motor
+system is the :class:`PoseGraph` protocol, checked when it is attached.
 """
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Protocol
 
+import networkx as nx
 import numpy as np
 
-from plugins.lib.pose_distance import pose_distance
-from toolkit import ConfigError, Match, Matcher, Motion, Parameter, hookimpl
+from plugins.lib.pose_distance import path_distance, pose_distance
+from toolkit import Match, Matcher, Motion, Parameter, hookimpl
+from toolkit.components import provides
+
+__all__ = ["PathSearch", "PoseGraph"]
+
+
+class PoseGraph(Protocol):
+    """A posegraph: whole-body poses as nodes, movements as paths between hubs (Buchsbaum & Blumberg 2005, §4.1).
+
+    What path search needs of a motor system: ``plugins.motor.posegraph`` provides it.
+    """
+
+    graph: nx.DiGraph
+    """Nodes by name; an edge from each pose to the next of its movement (hubs are shared)."""
+    node_root_relative: np.ndarray
+    """Every node's pose, root-relative, (N, P, 3), in the order of :attr:`nodes`."""
+    node_rate: float
+    """Pose nodes per second of movement."""
+
+    @property
+    def nodes(self) -> list[str]:
+        """Node names in the order of ``node_root_relative``."""
+
+    def movement_of(self, node: str) -> str | None:
+        """The movement a node belongs to (``None`` for a hub)."""
+
+    def movements(self) -> list[str]:
+        """The movements of the repertoire."""
+
+    def learn(self, name: str, poses: np.ndarray, visible: np.ndarray | None = None, *, source: str = "",
+              announce: bool = True) -> list[str]:
+        """Add an observed path of root-relative poses as a new movement; its nodes."""
 
 
 class PathSearch(Matcher):
@@ -53,13 +87,9 @@ class PathSearch(Matcher):
 
     def attach(self, owner: Any) -> None:
         super().attach(owner)
-        motor = owner.motor
-        if not hasattr(motor, "graph") or not hasattr(motor, "node_root_relative"):
-            raise ConfigError(
-                f"path-search needs a posegraph motor system, not {motor.name!r}",
-                key=("plugin",), expected="[motor] plugin = \"posegraph\"",
-            )
-        self.motor = motor
+        provides(owner.motor, PoseGraph, needed_by="path-search", what="a posegraph motor system",
+                 expected=" or ".join(f'[motor] plugin = "{name}"' for name in self.motor_systems))
+        self.motor = owner.motor
         self._cache_version = -1
 
     def _refresh(self) -> None:
@@ -79,20 +109,15 @@ class PathSearch(Matcher):
     # -- matching ----------------------------------------------------------------------------
 
     def samples(self, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
-        """The observed motion at the posegraph's node rate, in the observer's part order."""
-        rate = self.motor.params["node_rate"]
+        """The observed motion (in the observer's own parts) at the posegraph's node rate: poses (n, P, 3), visible
+        (n, P)."""
+        if motion.parts != self.owner.body.parts:
+            raise ValueError(f"path-search matches motions of the observer's own parts {list(self.owner.body.parts)}, "
+                             f"not {list(motion.parts)} (Motion.onto maps them by name)")
+        rate = self.motor.node_rate
         n = max(1, int(round(motion.duration * rate)))
         idx = np.minimum(np.round(np.arange(n) * motion.fps / rate).astype(int), motion.n_frames - 1)
-        parts = self.owner.body.parts
-        obs = np.zeros((n, len(parts), 3))
-        vis = np.zeros((n, len(parts)), dtype=bool)
-        for j, part in enumerate(parts):
-            if part in motion.parts:
-                i = motion.parts.index(part)
-                obs[:, j] = motion.positions[idx, i]
-                vis[:, j] = motion.visible[idx, i]
-        obs = np.where(vis[..., None], obs, 0.0)
-        return obs, vis
+        return motion.positions[idx], motion.visible[idx]
 
     def match(self, motion: Motion) -> Match:
         if motion.n_frames == 0 or not motion.visible.any():
@@ -104,7 +129,7 @@ class PathSearch(Matcher):
             return Match.unknown(reason="nothing visible")
         labels = self.labels[path]
         voting = labels[labels != ""]
-        mean = cost / max(evidence, 1)
+        mean = path_distance(obs, self.motor.node_root_relative[path], vis) / max(evidence, 1)  # eq. 3 per sample
         details: dict[str, Any] = {"mean_distance": mean, "samples": len(path)}
         if voting.size == 0:
             return Match.unknown(reason="only hub poses", path=tuple(self.node_names[i] for i in path), **details)
@@ -149,10 +174,9 @@ class PathSearch(Matcher):
             beam = np.repeat(np.arange(len(reach)), [len(r) for r in reach])
             cand = np.concatenate(reach)
             seen = vis[t]
-            if seen.any():  # eq. 1 over the parts seen in this sample (pose_distance without its masking: the hot
-                # loop of the search; the mask is the same for every candidate, so the seen parts are taken first)
-                diff = nodes[cand][:, seen] - obs[t, seen]
-                step = np.sqrt(np.einsum("npi,npi->np", diff, diff)).mean(axis=1)
+            if seen.any():  # eq. 1 over the parts seen in this sample: the mask is the same for every candidate, so
+                # the seen parts are taken first and pose_distance needs no mask (the hot loop of the search)
+                step = pose_distance(nodes[cand][:, seen], obs[t, seen])
             else:
                 step = np.zeros(len(cand))
             total = costs[beam] + step

@@ -35,6 +35,7 @@ movement share it, :meth:`MotorCommandGraph.label`).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import networkx as nx
@@ -43,12 +44,37 @@ import numpy as np
 from plugins.lib.clip_repertoire import CLIP_PARAMETERS, example_name, repertoire_for
 from plugins.lib.guiding_stroke import GuidingStroke, progress
 from plugins.lib.hand_transition import HandTransition
-from plugins.lib.inverse_model import learn_commands
+from plugins.lib.inverse_model import commands_from_segment
+from plugins.lib.strokes import StrokeCriteria, breaks
 from plugins.motor.key_poses import parse_poses
-from plugins.segmenters.velocity_direction import VelocityDirection
 from toolkit import ConfigError, Motion, MotorSystem, Parameter, hookimpl
+from toolkit.motion import fill_hidden
 
-__all__ = ["MotorCommandGraph", "place_elbows", "command_from_dict"]
+__all__ = ["MotorCommandGraph", "Edge", "place_elbows", "command_from_dict"]
+
+Command = GuidingStroke | HandTransition
+
+
+@dataclass(frozen=True, eq=False)
+class Edge:
+    """A motor command of one subsystem's graph, leading from motor state ``source`` to ``target`` (K&G §4.2).
+
+    ``commands`` holds one guiding stroke per part of a wrist subsystem, or one hand transition per finger of a
+    hand (they share their timing); ``name`` is the movement it is performed and recognised as
+    (``left_wrist:e3``); ``origin`` says where it was learned (a clip file, ``"inverse model"``, ``"loaded"``).
+    """
+
+    name: str
+    subsystem: str
+    source: str
+    target: str
+    commands: tuple[Command, ...]
+    origin: str = ""
+
+    @property
+    def duration(self) -> float:
+        """Seconds the edge takes: its longest command's."""
+        return max(c.duration for c in self.commands)
 
 
 def command_from_dict(entry: dict[str, Any]) -> GuidingStroke | HandTransition:
@@ -97,7 +123,7 @@ class MotorCommandGraph(MotorSystem):
         super().attach(owner)
         body = owner.body
         self.body = body
-        clips = repertoire_for(self.params, owner)
+        self.clips = clips = repertoire_for(self.params, owner)
         if clips is not None:
             self.rest = clips.hubs[0].copy()
             defaults = {p.name: p.default for p in self.parameters}
@@ -140,7 +166,7 @@ class MotorCommandGraph(MotorSystem):
             g.add_node("hub", state=self.rest[idx].copy(), hub=True)
             self.graphs[name] = g
             self.active[name] = "hub"
-        self._edges: dict[str, tuple[str, str, str, int]] = {}  # movement name -> (subsystem, from, to, key)
+        self._edges: dict[str, Edge] = {}  # by movement name; the graphs' edges are keyed by it too
         self.sequences: dict[str, list[str]] = {}  # a learned path of several edges, performed as one movement
         self.together: dict[str, list[str]] = {}  # movements of several subsystems performed at once
         self._counter = 0
@@ -152,28 +178,41 @@ class MotorCommandGraph(MotorSystem):
     def _learn_clips(self, clips: Any) -> None:
         """Every clip through the inverse model into a chain of edges from the hub, named by its movement."""
         (subsystem, idx), = list(self.subsystems.items())[:1]
-        strokes = VelocityDirection(drop=self.params["drop"], angle=self.params["angle"])
+        criteria = StrokeCriteria(drop=self.params["drop"], angle=self.params["angle"])
         for clip in clips.clips:
             m = clip.motion
-            observed = np.where(m.visible[:, idx, None], m.positions[:, idx], np.nan)
-            fill = np.nanmedian(observed, axis=0)
-            observed = np.where(np.isnan(observed), np.where(np.isnan(fill), self.rest[idx], fill), observed)
-            strokes.reset(tuple(f"p{i}" for i in range(len(idx))), m.fps)
-            names = learn_commands(self, subsystem, observed, m.fps, "hub", strokes.breaks, source=str(clip.source),
-                                   hub_tolerance=self.params["hub_radius"], refine=False)
+            observed = fill_hidden(m.positions[:, idx], m.visible[:, idx], default=self.rest[idx])
+            names = self.learn_observed(subsystem, "hub", observed, m.fps, criteria=criteria, origin=str(clip.source),
+                                        hub_tolerance=self.params["hub_radius"], refine=False)
             if not names:
                 continue
             n = sum(1 for label in self.labels.values() if label == clip.movement)
             self.add_sequence(names, name=example_name(clip.movement, n), label=clip.movement)
-            self.active[subsystem] = "hub"
-            self._state = self.rest.copy()
+            self.move_to(subsystem, "hub")
+
+    def examples(self, fps: float = 30.0) -> list[tuple[str, Motion]]:
+        """The clips the graphs were learned from, by movement; else one performance of each movement."""
+        if self.clips is not None:
+            return [(c.movement, c.motion) for c in self.clips.clips]
+        return super().examples(fps)
 
     # -- the graph ------------------------------------------------------------------------------
 
-    def edges_from(self, subsystem: str, node: str) -> list[tuple[str, dict[str, Any]]]:
-        """(movement name, edge data) of every edge leaving ``node``: the candidates of the forward model."""
-        g = self.graphs[subsystem]
-        return [(data["name"], data) for _, _, data in g.out_edges(node, data=True)]
+    def edges(self, subsystem: str) -> list[Edge]:
+        """Every edge of a subsystem's graph."""
+        return [data["edge"] for _, _, data in self.graphs[subsystem].edges(data=True)]
+
+    def edges_from(self, subsystem: str, node: str) -> list[Edge]:
+        """Every edge leaving ``node``: the candidates of the forward model."""
+        return [data["edge"] for _, _, data in self.graphs[subsystem].out_edges(node, data=True)]
+
+    def state(self, subsystem: str, node: str) -> np.ndarray:
+        """The motor state of ``node``: the positions (or a hand's joint angles) of the subsystem's parts (k, 3)."""
+        return self.graphs[subsystem].nodes[node]["state"]
+
+    def active_node(self, subsystem: str) -> str:
+        """The node the subsystem is in (where its last movement ended)."""
+        return self.active[subsystem]
 
     def is_hand(self, subsystem: str) -> bool:
         """Whether the subsystem moves fingers (its states are joint angles) rather than positions."""
@@ -183,25 +222,50 @@ class MotorCommandGraph(MotorSystem):
         """How close (metres, or radians for a hand) two states of the subsystem must be to be the same node."""
         return self.params["hand_tolerance"] if self.is_hand(subsystem) else self.params["tolerance"]
 
-    def learn(self, subsystem: str, start: str, commands: list[GuidingStroke | HandTransition], *,
-              end: str | None = None, source: str = "") -> str:
+    def learn(self, subsystem: str, start: str, commands: list[Command], *, end: str | None = None,
+              origin: str = "") -> str:
         """Add an edge of ``commands`` (one per part of the subsystem) from node ``start``; returns its movement name.
 
         Guiding strokes for a wrist subsystem, hand transitions for a hand. The edge ends in ``end`` if given
         (a hub, say), else in the node at the commands' targets (an existing one within :meth:`tolerance`, or a new one).
         """
-        g = self.graphs[subsystem]
         if end is None:
             target = np.stack([c.target for c in commands])
             end = self._near_node(subsystem, target) or self._new_node(subsystem, target)
         self._counter += 1
-        name = f"{subsystem}:e{self._counter}"
-        key = g.add_edge(start, end, name=name, commands=list(commands), source=source)
-        self._edges[name] = (subsystem, start, end, key)
+        edge = Edge(f"{subsystem}:e{self._counter}", subsystem, start, end, tuple(commands), origin)
+        self._add(edge)
         if self.owner is not None:
-            self.owner.announce("likeme_movement_learned", character=self.owner, movement=name,
+            self.owner.announce("likeme_movement_learned", character=self.owner, movement=edge.name,
                                 details={"subsystem": subsystem, "from": start, "to": end, "commands": len(commands)})
-        return name
+        return edge.name
+
+    def _add(self, edge: Edge) -> None:
+        self.graphs[edge.subsystem].add_edge(edge.source, edge.target, key=edge.name, edge=edge)
+        self._edges[edge.name] = edge
+
+    def learn_observed(self, subsystem: str, start: str, observed: np.ndarray, fps: float, *,
+                       criteria: StrokeCriteria = StrokeCriteria(), origin: str = "inverse model",
+                       hub_tolerance: float = 0.05, refine: bool = True) -> list[str]:
+        """True imitation (K&G §4.3): an observed movement of the subsystem's parts becomes new edges from ``start``.
+
+        ``observed`` (n, k, 3) holds the positions (a hand: the fingers' joint angles) of the subsystem's k parts.
+        It is cut into strokes at the break points of :func:`plugins.lib.strokes.breaks` (``criteria``), the
+        inverse model turns each into a command (:func:`plugins.lib.inverse_model.commands_from_segment`), and
+        the commands become a chain of edges from ``start``; the last ends in the hub when the movement came back
+        within ``hub_tolerance`` metres of it (a hand: within :meth:`tolerance`). Returns the new edges' names.
+        """
+        n, k, _ = observed.shape
+        hand = self.is_hand(subsystem)
+        cuts = breaks(observed.reshape(n, k * 3), fps, criteria)
+        home = np.linalg.norm(observed[-1] - self.state(subsystem, "hub"), axis=-1).max() <= (
+            self.tolerance(subsystem) if hand else hub_tolerance)
+        names, node = [], start
+        for commands, last in commands_from_segment(observed, fps, cuts, hand=hand, refine=refine):
+            name = self.learn(subsystem, node, commands, end="hub" if last and home else None, origin=origin)
+            names.append(name)
+            node = self.edge(name).target
+        return names
 
     def _new_node(self, subsystem: str, state: np.ndarray) -> str:
         g = self.graphs[subsystem]
@@ -217,10 +281,9 @@ class MotorCommandGraph(MotorSystem):
                 return node
         return None
 
-    def edge(self, movement: str) -> tuple[str, str, str, dict[str, Any]]:
-        """(subsystem, from node, to node, edge data) of a movement (edge) name."""
-        subsystem, a, b, key = self._edges[movement]
-        return subsystem, a, b, self.graphs[subsystem].edges[a, b, key]
+    def edge(self, movement: str) -> Edge:
+        """The edge a movement (edge) name stands for."""
+        return self._edges[movement]
 
     # -- the motor system interface -------------------------------------------------------------
 
@@ -234,7 +297,7 @@ class MotorCommandGraph(MotorSystem):
         for known_name, known in self.sequences.items():
             if known == list(edges) and name is None:
                 return known_name
-        subsystem = self._edges[edges[0]][0]
+        subsystem = self._edges[edges[0]].subsystem
         name = name or f"{subsystem}:m{len(self.sequences) + 1}"
         self.sequences[name] = list(edges)
         if label is not None:
@@ -254,10 +317,17 @@ class MotorCommandGraph(MotorSystem):
 
     def subsystem_of(self, movement: str) -> str:
         """The subsystem an edge or a path of edges moves."""
-        return self._edges[self.sequences.get(movement, [movement])[0]][0]
+        return self._edges[self.sequences.get(movement, [movement])[0]].subsystem
 
     def label(self, movement: str) -> str:
         return self.labels.get(movement, movement)
+
+    def known_sequence(self, path: tuple[str, ...]) -> tuple[str, ...]:
+        """The whole learned command sequence that ``path`` begins, else ``path`` itself."""
+        for edges in self.sequences.values():
+            if tuple(edges[: len(path)]) == tuple(path):
+                return tuple(edges)
+        return tuple(path)
 
     def label_of_path(self, path: tuple[str, ...]) -> str | None:
         """The labelled movement (clip repertoires) ``path`` stands for; ``None`` if none or several.
@@ -305,8 +375,9 @@ class MotorCommandGraph(MotorSystem):
         for path in self._paths(movement):
             pieces = []
             for name in path:
-                subsystem, _, end, data = self.edge(name)
-                commands = [c.retimed(c.duration / speed) for c in data["commands"]]
+                edge = self.edge(name)
+                subsystem, end = edge.subsystem, edge.target
+                commands = [c.retimed(c.duration / speed) for c in edge.commands]
                 duration = max(c.duration for c in commands)
                 t = np.linspace(0.0, duration, max(2, int(round(duration * fps)) + 1))
                 pieces.append(np.stack([c.position(t) for c in commands], axis=1))
@@ -328,7 +399,7 @@ class MotorCommandGraph(MotorSystem):
         """The body's way from ``pose``, where an imitation was stopped at ``frame`` of its motion, to the motor state.
 
         The matcher that stopped the imitation has put the deviating subsystem back in its last correct node
-        (:meth:`reset_to`, K&G §4.4, Fig. 3); the other subsystems of the motion were right and go on to the end
+        (:meth:`move_to`, K&G §4.4, Fig. 3); the other subsystems of the motion were right and go on to the end
         of their commands. The way is straight, with a bell-shaped velocity profile, and takes as long as the
         stopped motion had run (at least a fifth of a second). ``None`` when the body is there already.
         """
@@ -346,18 +417,25 @@ class MotorCommandGraph(MotorSystem):
     def reset(self) -> None:
         """Every subsystem back in its hub node, the body at rest."""
         for name in self.subsystems:
-            self.reset_to(name, "hub")
+            self.move_to(name, "hub")
 
-    def reset_to(self, subsystem: str, node: str) -> None:
-        """Put a subsystem back in ``node`` (returning to the last correct node after a deviation, §4.4)."""
+    def move_to(self, subsystem: str, node: str, *, posture: bool = True) -> None:
+        """Put a subsystem in ``node``: back at its hub, back in the last correct node after a deviation (§4.4), or
+        where a demonstration a matcher followed ended.
+
+        With ``posture`` the body's posture of the subsystem's parts goes to the node's state too (what the next
+        movement starts from); without, only the active node changes (the body stays where performing the
+        commands left it, within :meth:`tolerance` of the node).
+        """
         self.active[subsystem] = node
-        self._state[self.subsystems[subsystem]] = self.graphs[subsystem].nodes[node]["state"]
+        if posture:
+            self._state[self.subsystems[subsystem]] = self.state(subsystem, node)
 
     def describe(self) -> dict[str, Any]:
         return {
             "movements": len(self._edges),
             "subsystems": {n: {"nodes": g.number_of_nodes(), "edges": g.number_of_edges(), "active": self.active[n],
-                               "commands": [f"{a} -> {b} ({d['name'].split(':')[-1]})" for a, b, d in g.edges(data=True)]}
+                               "commands": [f"{e.source} -> {e.target} ({e.name.split(':')[-1]})" for e in self.edges(n)]}
                            for n, g in self.graphs.items()},
         }
 
@@ -368,8 +446,8 @@ class MotorCommandGraph(MotorSystem):
             sequences = {m: e for m, e in self.sequences.items() if self.subsystem_of(m) == name}
             state[name] = {
                 "nodes": {n: d["state"].round(6).tolist() for n, d in g.nodes(data=True) if n != "hub"},
-                "edges": [{"from": a, "to": b, "name": d["name"], "commands": [c.to_dict() for c in d["commands"]]}
-                          for a, b, d in g.edges(data=True)],
+                "edges": [{"from": e.source, "to": e.target, "name": e.name, "commands": [c.to_dict() for c in e.commands]}
+                          for e in self.edges(name)],
                 "sequences": sequences,
                 "labels": {m: label for m, label in self.labels.items() if m in sequences},
                 "together": {m: parts for m, parts in self.together.items() if self.subsystem_of(parts[0]) == name},
@@ -389,10 +467,9 @@ class MotorCommandGraph(MotorSystem):
                 except (TypeError, ValueError, KeyError) as exc:
                     raise ConfigError(f"invalid edge ({exc})", key=(name, "edges", i), expected="an edge written by get_state") from None
                 if e["name"] in self._edges:  # the same command built already (from clips, say): the saved one replaces it
-                    _, a, b, old = self._edges[e["name"]]
-                    g.remove_edge(a, b, old)
-                key = g.add_edge(e["from"], e["to"], name=e["name"], commands=commands, source="loaded")
-                self._edges[e["name"]] = (name, e["from"], e["to"], key)
+                    known = self._edges[e["name"]]
+                    self.graphs[known.subsystem].remove_edge(known.source, known.target, known.name)
+                self._add(Edge(e["name"], name, e["from"], e["to"], tuple(commands), "loaded"))
                 self._counter = max(self._counter, int(e["name"].rsplit(":e", 1)[-1]))
             self.sequences.update(entry.get("sequences", {}))
             self.labels.update(entry.get("labels", {}))

@@ -86,8 +86,7 @@ class Posegraph(MotorSystem):
         t = np.arange(motion.n_frames) / motion.fps
         keep = np.unique(np.clip(np.round(np.arange(0.0, t[-1] + 1e-9, 1.0 / rate) * motion.fps), 0,
                                  motion.n_frames - 1).astype(int))
-        sampled = np.where(motion.visible[keep, :, None], motion.positions[keep], np.nan)
-        sampled = np.where(np.isnan(sampled), np.nanmedian(motion.positions, axis=0), sampled)
+        sampled = motion.filled(default=self.rest_pose()).positions[keep]  # hidden parts held (docs/conventions.md)
         hub_rel = self.key_poses.array - self.key_poses.array[:, self.body.root_index : self.body.root_index + 1]
         root = self.body.root_index
         ends = [self.hubs[int(np.argmin(pose_distance(hub_rel, sampled[i] - sampled[i, root], True)))] for i in (0, -1)]
@@ -110,6 +109,11 @@ class Posegraph(MotorSystem):
         self.paths_label[name] = label
 
     @property
+    def node_rate(self) -> float:
+        """Pose nodes per second of movement: the graph's resolution."""
+        return float(self.params["node_rate"])
+
+    @property
     def nodes(self) -> list[str]:
         """Node names in the order of ``node_poses``."""
         order = sorted(self.graph.nodes, key=lambda n: self.graph.nodes[n]["index"])
@@ -129,6 +133,12 @@ class Posegraph(MotorSystem):
 
     def rest_pose(self) -> np.ndarray:
         return self.key_poses[self.hubs[0]]
+
+    def examples(self, fps: float = 30.0) -> list[tuple[str, Motion]]:
+        """The clips the graph was built from, by movement; else one performance of each movement."""
+        if self.clips is not None:
+            return [(c.movement, c.motion) for c in self.clips.clips]
+        return super().examples(fps)
 
     def hub_poses(self) -> np.ndarray:
         return np.stack([self.key_poses[h] for h in self.hubs])

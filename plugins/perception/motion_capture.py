@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from plugins.lib.root_frame import HeadingFilter, facing_heading, to_root_relative
+from plugins.lib.root_frame import HeadingFilter, root_relative
 from toolkit import Parameter, Percept, Perception, hookimpl
 
 
@@ -19,40 +19,40 @@ class MotionCapture(Perception):
     """Sees every part of the target exactly (no occlusion or noise); root-relative by §5.1."""
 
     name = "motion-capture"
+    watches_recordings = True
     parameters = (
         Parameter("facing_window", float, 3.0, "Seconds over which the target's facing is a running median "
                   "(steady through kicks and head turns; a real turn is followed after half of it; 0: every "
                   "frame on its own).", minimum=0.0),
     )
 
-    def reset(self) -> None:
-        self._facing: HeadingFilter | None = None
+    def reset(self, fps: float) -> None:
+        self._facing = HeadingFilter(round(self.params["facing_window"] * fps))
+
+    def _smooth(self, headings: np.ndarray) -> np.ndarray:
+        """The facing's running median over the frames so far (made by :meth:`reset`)."""
+        facing = getattr(self, "_facing", None)
+        if facing is None:
+            raise RuntimeError("perceive before reset(fps): an observer resets its perception when it begins watching")
+        return facing.update_many(headings)
 
     def perceive(self, observer, target, world) -> Percept:
-        self.fps = world.fps
         percept = self.perceive_pose(target.world_pose(), None, target.body, world.time)
         objects = {name: obj.position.copy() for name, obj in world.objects.items()}
         return Percept(percept.time, percept.pose, percept.visible, percept.world, percept.root, percept.heading, objects)
 
     def perceive_pose(self, positions, visible, body, time) -> Percept:
         """Root-relative percept of recorded world positions (P, 3); non-finite or masked parts are not seen."""
-        pose, mask, root, heading = self._root_relative(np.asarray(positions, dtype=float)[None],
-                                                        None if visible is None else np.asarray(visible)[None], body)
+        positions = np.asarray(positions, dtype=float)
+        pose, mask, root, heading = root_relative(positions[None], None if visible is None else np.asarray(visible)[None],
+                                                  body, self._smooth)
         world = np.where(mask[0, :, None], positions, np.nan)
         return Percept(time, pose[0], mask[0], world, root[0], float(heading[0]))
 
     def perceive_poses(self, positions, visible, body, times) -> tuple[np.ndarray, np.ndarray]:
         """A block of recorded frames (n, P, 3) at once: the same poses and masks as one perceive_pose per frame."""
-        pose, mask, _, _ = self._root_relative(np.asarray(positions, dtype=float), visible, body)
+        pose, mask, _, _ = root_relative(positions, visible, body, self._smooth)
         return pose, mask
-
-    def _root_relative(self, positions: np.ndarray, visible, body):
-        seen = np.isfinite(positions).all(axis=-1)
-        visible = seen if visible is None else seen & np.asarray(visible, dtype=bool)
-        if getattr(self, "_facing", None) is None:
-            self._facing = HeadingFilter(round(self.params["facing_window"] * getattr(self, "fps", 30.0)))
-        found = facing_heading(np.where(visible[..., None], positions, 0.0), visible, body)
-        return to_root_relative(positions, visible, body, self._facing.update_many(found))
 
 
 @hookimpl

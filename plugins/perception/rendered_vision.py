@@ -73,9 +73,10 @@ class RenderedVision(SyntheticVision):
     def attach(self, owner: Any) -> None:
         self._pl = None
         super().attach(owner)
+        self.close()
 
-    def reset(self) -> None:
-        super().reset()
+    def reset(self, fps: float) -> None:
+        super().reset(fps)
         self.close()
 
     def close(self) -> None:
@@ -106,7 +107,7 @@ class RenderedVision(SyntheticVision):
             self._spheres.append(actor)
         return self._spheres
 
-    def _look(self, observer: Any, target: Any, world: Any) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
+    def look(self, observer: Any, target: Any, world: Any) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
         truth = target.world_pose()
         eye = observer.world_pose()[observer.body.index(self.params["eye"])]
         names = list(world.objects)

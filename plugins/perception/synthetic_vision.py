@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from plugins.lib.root_frame import HeadingFilter, facing_heading, to_root_relative
+from plugins.lib.root_frame import HeadingFilter, root_relative
 from plugins.perception.sensory_buffer import SensoryBuffer
 from toolkit import ConfigError, Parameter, Percept, Perception, hookimpl
 from toolkit.motion import facing_vector
@@ -91,12 +91,13 @@ class SyntheticVision(Perception):
         for part, r in self.params["radii"].items():
             if isinstance(r, bool) or not isinstance(r, (int, float)) or r < 0:
                 raise ConfigError(f"invalid radius {r!r}", key=("radii", part), expected="a radius in metres >= 0")
-        self.reset()
+        self._facing: HeadingFilter | None = None  # made by reset(fps), when watching begins
 
-    def reset(self) -> None:
+    def reset(self, fps: float) -> None:
         self._rng = np.random.default_rng(self.params["seed"])
+        self._fps = float(fps)
         self._buffer: SensoryBuffer | None = None
-        self._facing: HeadingFilter | None = None
+        self._facing = HeadingFilter(round(self.params["facing_window"] * fps))
 
     def _radii(self, body: Any) -> np.ndarray:
         """Sphere radius of every part; 0 for fingers, which are joint angles carried by a wrist, not places."""
@@ -121,13 +122,9 @@ class SyntheticVision(Perception):
         seen = np.where(angles, seen[body.carriers], seen)
         return np.where(angles[:, None] & seen[:, None], truth, positions), seen
 
-    def visible_parts(self, observer: Any, target: Any, world: Any) -> tuple[np.ndarray, np.ndarray]:
-        """World positions of the target's parts and which of them the eye sees (before noise and dropouts)."""
-        positions, seen, _ = self._look(observer, target, world)
-        return positions, seen
-
-    def _look(self, observer: Any, target: Any, world: Any) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
-        """The target's part positions, which parts the eye sees, and the objects it sees (name to position)."""
+    def look(self, observer: Any, target: Any, world: Any) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
+        """What the eye gets now, before noise and dropouts: the target's part positions (P, 3), which of them it
+        sees (P,), and the objects it sees (name to position)."""
         truth = target.world_pose()
         positions = self._places(target.body, truth)
         eye = observer.world_pose()[observer.body.index(self.params["eye"])]
@@ -160,20 +157,20 @@ class SyntheticVision(Perception):
         return inside & (dist <= self.params["range"]) & np.isfinite(points).all(axis=-1)
 
     def perceive(self, observer: Any, target: Any, world: Any) -> Percept:
-        positions, seen, objects = self._look(observer, target, world)
+        if self._facing is None:
+            raise RuntimeError("perceive before reset(fps): an observer resets its perception when it begins watching")
+        positions, seen, objects = self.look(observer, target, world)
         p = self.params
         if p["noise"] > 0:
             positions = positions + self._rng.normal(0.0, p["noise"], positions.shape)
         if p["dropout"] > 0:
             seen &= self._rng.random(len(seen)) >= p["dropout"]
         if self._buffer is None or len(self._buffer.last) != len(positions):
-            self._buffer = SensoryBuffer(len(positions), int(round(p["buffer"] * world.fps)))
+            self._buffer = SensoryBuffer(len(positions), int(round(p["buffer"] * self._fps)))
         positions, seen = self._buffer.update(positions, seen)
-        if self._facing is None:
-            self._facing = HeadingFilter(round(p["facing_window"] * world.fps))
-        found = facing_heading(np.where(seen[:, None], positions, 0.0), seen, target.body)
-        pose, mask, root, heading = to_root_relative(positions, seen, target.body, self._facing.update(float(found)))
-        return Percept(world.time, pose, mask, np.where(seen[:, None], positions, np.nan), root, float(heading), objects)
+        pose, mask, root, heading = root_relative(positions[None], seen[None], target.body, self._facing.update_many)
+        return Percept(world.time, pose[0], mask[0], np.where(seen[:, None], positions, np.nan), root[0],
+                       float(heading[0]), objects)
 
 
 @hookimpl

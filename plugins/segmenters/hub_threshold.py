@@ -29,7 +29,7 @@ from __future__ import annotations
 
 from collections import deque
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 from scipy.ndimage import minimum_filter1d
@@ -37,6 +37,15 @@ from scipy.signal import butter, lfilter, lfilter_zi
 
 from plugins.lib.pose_distance import pose_distance
 from toolkit import ConfigError, Motion, Parameter, Segment, Segmenter, hookimpl
+from toolkit.components import provides
+
+
+class NamedPoses(Protocol):
+    """A motor system whose poses have names (``key_poses``), as ``keyframe`` and ``posegraph`` have: the ``hub``
+    parameter names one of them."""
+
+    key_poses: Any
+    """Named poses: ``key_poses.names`` and ``key_poses[name]``, a pose (P, 3) in the motor system's local frame."""
 
 
 class HubThreshold(Segmenter):
@@ -60,12 +69,12 @@ class HubThreshold(Segmenter):
         super().attach(owner)
         motor = owner.motor
         if self.params["hub"]:
-            poses = getattr(motor, "key_poses", None)
-            if poses is None or self.params["hub"] not in poses.names:
-                raise ConfigError(
-                    f"unknown hub pose {self.params['hub']!r}", key=("hub",), expected="a pose of the observer's motor system",
-                    available=list(poses.names) if poses is not None else [],
-                )
+            provides(motor, NamedPoses, needed_by="hub-threshold's hub", what="a motor system with named poses",
+                     key=("hub",), expected="a motor system that declares poses (keyframe, posegraph), or no hub")
+            poses = motor.key_poses
+            if self.params["hub"] not in poses.names:
+                raise ConfigError(f"unknown hub pose {self.params['hub']!r}", key=("hub",),
+                                  expected="a pose of the observer's motor system", available=list(poses.names))
             hubs = poses[self.params["hub"]][None]
         else:
             hubs = motor.hub_poses()
@@ -78,12 +87,10 @@ class HubThreshold(Segmenter):
     # -- streaming ---------------------------------------------------------------------
 
     def reset(self, parts: Sequence[str], fps: float) -> None:
-        parts = tuple(parts)
-        missing = [p for p in self.template_parts if p not in parts]
-        if missing and len(missing) == len(self.template_parts):
-            raise ConfigError(f"the observed body shares no part with the hub template {list(self.template_parts)}",
-                              expected="observed parts named like the observer's own", available=list(parts))
-        self._index = np.array([parts.index(p) if p in parts else -1 for p in self.template_parts])
+        if tuple(parts) != tuple(self.template_parts):
+            raise ConfigError("hub-threshold compares poses in the observer's own parts", expected=f"the parts "
+                              f"{list(self.template_parts)} (the watching loop maps the observed body's parts onto "
+                              f"them; Motion.onto does it by name)", available=list(parts))
         self._fps = float(fps)
         nyquist = 0.5 * self._fps
         wn = min(self.params["cutoff"] / nyquist, 0.99)
@@ -108,12 +115,7 @@ class HubThreshold(Segmenter):
 
     def distances(self, poses: np.ndarray, visible: np.ndarray) -> np.ndarray:
         """eq. 1 between observed root-relative poses (n, P, 3) and the nearest hub (n,); NaN where nothing is seen."""
-        ok = self._index >= 0
-        obs = np.zeros((len(poses), *self.template.shape))
-        vis = np.zeros((len(poses), len(self.template)), dtype=bool)
-        obs[:, ok] = poses[:, self._index[ok]]
-        vis[:, ok] = visible[:, self._index[ok]]
-        return _nearest(pose_distance(obs[:, None], self.templates, vis[:, None]), axis=-1)
+        return _nearest(pose_distance(np.asarray(poses)[:, None], self.templates, np.asarray(visible)[:, None]), axis=-1)
 
     def push(self, pose: np.ndarray, visible: np.ndarray) -> list[Segment]:
         closed, _ = self.push_block(np.asarray(pose)[None], np.asarray(visible)[None])

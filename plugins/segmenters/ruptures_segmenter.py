@@ -19,6 +19,7 @@ import numpy as np
 import ruptures as rpt
 
 from toolkit import Motion, Parameter, Segment, Segmenter, hookimpl
+from toolkit.motion import fill_hidden
 
 __all__ = ["RupturesSegmenter"]
 
@@ -64,8 +65,7 @@ class RupturesSegmenter(Segmenter):
         seen = visible.any(axis=1)
         if seen.sum() < 2:
             return []
-        x = np.where(visible[..., None], poses, np.nan).reshape(n, -1)
-        x = _hold(x)
+        x = fill_hidden(poses, visible, default=np.zeros(poses.shape[1:])).reshape(n, -1)  # docs/conventions.md
         x = np.nan_to_num(x - np.nanmean(x, axis=0))[::stride]
         min_size = max(2, int(round(self.params["min_length"] * self._fps / stride)))
         if len(x) < 2 * min_size:
@@ -74,21 +74,6 @@ class RupturesSegmenter(Segmenter):
         bounds = [0, *[min(n, int(e) * stride) for e in ends[:-1]], n]
         return [Segment(a, b, self._fps) for a, b in zip(bounds, bounds[1:])
                 if b > a and (b - a) / self._fps >= self.params["min_length"] and seen[a:b].any()]
-
-
-def _hold(x: np.ndarray) -> np.ndarray:
-    """Carry the last seen value of each column forward (and the first one backward) over NaNs."""
-    x = x.copy()
-    for j in range(x.shape[1]):
-        col = x[:, j]
-        ok = np.flatnonzero(~np.isnan(col))
-        if len(ok) == 0:
-            x[:, j] = 0.0
-            continue
-        idx = np.maximum.accumulate(np.where(~np.isnan(col), np.arange(len(col)), 0))
-        idx[: ok[0]] = ok[0]
-        x[:, j] = col[idx]
-    return x
 
 
 @hookimpl

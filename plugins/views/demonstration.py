@@ -19,12 +19,13 @@ import numpy as np
 from toolkit import ConfigError, Motion, load_character
 from toolkit.motion import concatenate
 
-__all__ = ["Demonstration", "demonstration", "onto", "perform_sequence", "require", "watch"]
+__all__ = ["Demonstration", "demonstration", "perform_sequence", "require", "watch"]
 
 
 @dataclass(frozen=True)
 class Demonstration:
-    """Movements performed one after another: who performed them, the motion (body frame), and where each lies.
+    """Movements performed one after another: who performed them (name and body), the motion (body frame), and where
+    each lies.
 
     ``truth`` holds ``(start_frame, end_frame, movement)`` per movement, end exclusive.
     """
@@ -32,6 +33,7 @@ class Demonstration:
     who: str
     motion: Motion
     truth: tuple[tuple[int, int, str], ...]
+    body: Any = None
 
 
 def require(character: Any, kind: str, plugin: str, key: str = "--view") -> Any:
@@ -94,22 +96,23 @@ def perform_sequence(character: Any, demonstrator: str, movements: Sequence[str]
     if noise > 0:
         rng = np.random.default_rng(seed)
         motion = Motion(motion.positions + rng.normal(0.0, noise, motion.positions.shape), fps, parts)
-    return Demonstration(who.name, motion, tuple(truth))
+    return Demonstration(who.name, motion, tuple(truth), who.body)
 
 
 def watch(character: Any, demo: Demonstration, each: Callable[[Any], None] | None = None) -> tuple[Any, list[Any]]:
     """``character`` watches ``demo`` through ``motion-capture`` with its own segmenter and matcher, frame by frame.
 
-    The demonstrator's parts are taken by name onto the watcher's own body (a part the demonstrator lacks is
-    never seen). ``each`` is called with every observation the moment its segment closes (while the matcher
-    still holds what it made of that segment). Returns the :class:`~toolkit.observe.Observer` (its ``poses``
-    and ``visible`` hold what was perceived, in the watcher's parts) and the observations.
+    The demonstrator's parts are perceived with the demonstrator's body and taken by name onto the watcher's own
+    (the watching loop does it; a part the demonstrator lacks is never seen). ``each`` is called with every
+    observation the moment its segment closes (while the segmenter and matcher still hold what they made of that
+    segment: their ``inspect()``). Returns the :class:`~toolkit.observe.Observer` (its ``poses`` and ``visible``
+    hold what was perceived, in the watcher's parts) and the observations.
     """
     from toolkit.observe import Observer
 
     perception = character.pm.registry.get("perception", "motion-capture")()
-    observer = Observer(character, character.body, demo.motion.fps, perception=perception)
-    motion = onto(demo.motion, character.body.parts)
+    observer = Observer(character, demo.body or character.body, demo.motion.fps, perception=perception)
+    motion = demo.motion
     found: list[Any] = []
     for f in range(motion.n_frames + 1):
         closed = observer.push(motion.positions[f], motion.visible[f]) if f < motion.n_frames else observer.flush()
@@ -118,13 +121,3 @@ def watch(character: Any, demo: Demonstration, each: Callable[[Any], None] | Non
                 each(observation)
             found.append(observation)
     return observer, found
-
-
-def onto(motion: Motion, parts: Sequence[str]) -> Motion:
-    """``motion`` with its parts taken by name onto ``parts``; a part it lacks is NaN and not visible."""
-    index = np.array([motion.parts.index(p) if p in motion.parts else -1 for p in parts], dtype=int)
-    positions = np.full((motion.n_frames, len(parts), 3), np.nan)
-    visible = np.zeros((motion.n_frames, len(parts)), dtype=bool)
-    positions[:, index >= 0] = motion.positions[:, index[index >= 0]]
-    visible[:, index >= 0] = motion.visible[:, index[index >= 0]]
-    return Motion(positions, motion.fps, parts, visible)

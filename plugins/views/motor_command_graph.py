@@ -23,7 +23,8 @@ from typing import Any
 
 import numpy as np
 
-from plugins.views.demonstration import demonstration, onto, require
+from plugins.views.demonstration import demonstration, require
+from toolkit.watching import ObservationLog
 from plugins.lib.rendering import add_labels, draw_bodies, part_colours, plotter, save_png
 from toolkit import Parameter, View, hookimpl
 
@@ -68,11 +69,11 @@ class MotorCommandGraphView(View):
                 idx = motor.subsystems[subsystem]
                 candidates = set(prediction["candidates"]) if prediction and prediction["subsystem"] == subsystem else set()
                 dropped = set(prediction["initial"]) - candidates if prediction and prediction["subsystem"] == subsystem else set()
-                for _, _, data in graph.edges(data=True):
+                for edge in motor.edges(subsystem):
                     n_edges += 1
-                    name = data["name"]
+                    name = edge.name
                     width, opacity = (7, 1.0) if name in candidates else (1.5, 0.35) if name in dropped else (3, 0.9)
-                    for part, path in zip(idx, edge_trajectories(data["commands"])):
+                    for part, path in zip(idx, edge_trajectories(edge.commands)):
                         colour = "red" if name in candidates else colours[part]
                         pl.add_mesh(pv.lines_from_points(path), color=colour, line_width=width, opacity=opacity)
                 for node, d in graph.nodes(data=True):
@@ -110,19 +111,26 @@ class MotorCommandGraphView(View):
         """Feed the first ``at`` of the demonstration to the character's forward model; what it holds then."""
         matcher = require(character, "matcher", "forward-model", "predict")
         who, motion = demonstration(character, self.params["demonstrator"], self.params["predict"], "predict")
-        motion = onto(motion, character.body.parts)
+        motion = motion.onto(character.body.parts)
         n = max(1, int(round(self.params["at"] * motion.n_frames)))
-        matcher.begin(motion.fps)
+        log = ObservationLog(character.body.parts, motion.fps)  # working memory, fed a frame at a time
+        memory = log.since(0)
+        matcher.begin(memory)
         committed = None
         for f in range(n):
-            answer = matcher.observe(np.nan_to_num(motion.positions[f]), motion.visible[f])
+            log.append(motion.positions[f], motion.visible[f])
+            memory.feed(f + 1)
+            answer = matcher.observe(memory)
             if answer is not None and answer.movement and committed is None:
                 committed = answer.movement
-        observed = np.array(matcher.frames)
-        subsystem = matcher.subsystem or next(iter(character.motor.graphs))
-        return {"who": who, "subsystem": subsystem, "active": matcher.start_node or "hub",
-                "candidates": sorted({p[0] for p in matcher.candidates}), "initial": list(matcher.initial),
-                "committed": committed, "observed": observed[:, character.motor.subsystems[subsystem]]}
+        signals = matcher.inspect()
+        subsystem = signals["subsystem"] or next(iter(character.motor.graphs))
+        idx = character.motor.subsystems[subsystem]
+        observed = np.where(log.visible[:, idx, None], log.positions[:, idx], np.nan) + character.motor.rest_pose()[
+            character.body.root_index]
+        return {"who": who, "subsystem": subsystem, "active": signals["start_node"] or "hub",
+                "candidates": sorted({p[0] for p in signals["candidates"]}), "initial": list(signals["initial"]),
+                "committed": committed, "observed": observed}
 
 
 @hookimpl

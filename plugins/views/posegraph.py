@@ -103,7 +103,7 @@ class PosegraphView(View):
         matcher = require(character, "matcher", "path-search", "match")
         _, motion = demonstration(character, self.params["demonstrator"], self.params["match"], "match",
                                   speed=self.params["speed"])
-        return matcher.match(motion)
+        return matcher.match(motion.onto(character.body.parts))
 
 
 @hookimpl

@@ -44,10 +44,8 @@ class PredictionErrorView(View):
         matcher = require(character, "matcher", "forward-model")
         demo = demonstrate(self, character)
         segments: list[dict[str, Any]] = []
-        observer, found = watch(character, demo, each=lambda o: segments.append({
-            "observation": o, "trace": list(matcher.trace), "committed_at": matcher.committed_at,
-            "deviated_at": matcher.deviated_at, "committed": matcher.committed,
-            "committed_path": matcher.committed_path}))
+        observer, found = watch(character, demo, each=lambda o: segments.append({"observation": o,
+                                                                               **matcher.inspect()}))
         fps = observer.fps
         threshold, deviation = matcher.params["threshold"], matcher.params["deviation"]
         fig, (top, ax) = figure(self.params["width"], self.params["height"], (1, 4))

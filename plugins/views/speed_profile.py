@@ -43,12 +43,15 @@ class SpeedProfileView(View):
         character = subject
         segmenter = require(character, "segmenter", "velocity-direction")
         demo = demonstrate(self, character)
-        segmenter.record = []
-        try:
-            observer, found = watch(character, demo)
-            movements = list(segmenter.record)
-        finally:
-            segmenter.record = None
+        analysed: dict[tuple[int, int], object] = {}  # each movement the working memory closed, once
+
+        def keep(_observation: object) -> None:
+            signals = segmenter.inspect()
+            if signals:
+                analysed.setdefault(signals["movement"], signals["analysis"])
+
+        observer, found = watch(character, demo, each=keep)
+        movements = [(start, end, analysis) for (start, end), analysis in analysed.items()]
         fps = observer.fps
         chosen = segmenter.params["parts"] or list(character.body.parts)
         idx = [character.body.parts.index(p) for p in chosen]

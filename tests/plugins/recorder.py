@@ -13,6 +13,16 @@ class Recorder:
         return [name for name, _ in self.calls]
 
     @hookimpl
+    def likeme_movement_started(self, world, actor, request):
+        self.calls.append(("movement_started", {"actor": actor.id, "movement": request.movement,
+                                                "imitating": request.imitating}))
+
+    @hookimpl
+    def likeme_target_perceived(self, world, observer, target, percept):
+        self.calls.append(("target_perceived", {"observer": observer.id, "target": target.id, "frame": world.frame,
+                                                "seen": int(percept.visible.sum())}))
+
+    @hookimpl
     def likeme_segment_found(self, world, observer, target, segment):
         self.calls.append(("segment_found", {"observer": observer.id, "target": target.id, "segment": segment}))
 

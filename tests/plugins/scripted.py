@@ -71,13 +71,14 @@ class EarlyCommit(Matcher):
     """Commits to `movement` after `after` frames of every segment."""
 
     name = "early-commit"
+    streaming = True
     parameters = (Parameter("movement", str, "jump"), Parameter("after", int, 5))
 
-    def begin(self, fps):
+    def begin(self, memory):
         self.seen = 0
 
-    def observe(self, pose, visible):
-        self.seen += 1
+    def observe(self, memory):
+        self.seen = memory.n
         if self.seen == self.params["after"]:
             return Match(self.params["movement"], 1.0, decided_at=self.seen)
         return None

@@ -1,0 +1,186 @@
+"""Stroke analysis: where one movement's working memory is cut into guiding strokes (Kopp & Graeser 2006, §4.3).
+
+"When the movement ends it is segmented in two ways": the working memory of one movement (positions of the chosen
+parts, (N, 3k)) is cut
+
+- at *speed* minima that fall below ``drop`` times the smaller of their neighbouring maxima (a minimum that stays
+  high relative to its surroundings belongs to one curved stroke);
+- where the *direction* of movement changes cluster: the normalised movement vectors are clustered divisively (one
+  cluster; while some vector differs from its cluster's mean direction by more than ``angle`` degrees, it founds a
+  new cluster and all vectors are redistributed to the nearest mean, until every cluster is tight); a break lies
+  where two successive vectors fall into different clusters and the direction turns there by at least half of
+  ``angle`` within a tenth of a second ("a significant change in movement direction compared to the overall
+  curvature": a smooth C stroke crosses clusters gradually and is not cut), at a minimum of the speed below
+  ``corner`` times its neighbouring maxima (an S stroke swings its direction at full speed and is not cut either).
+
+Pieces shorter than ``min_stroke`` seconds are merged into their neighbour. These are pure functions: the
+``velocity-direction`` segmenter cuts observed movements with them, the motor command graph cuts what it learns
+into strokes with them before the inverse model turns each stroke into a command. A hand's fingers come in as
+joint angles scaled to metres (``angle_scale``), so one rest speed and one direction clustering serve both.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.signal import argrelextrema, savgol_filter
+
+__all__ = ["StrokeCriteria", "StrokeAnalysis", "analyse", "breaks", "speed_breaks", "direction_clusters",
+           "direction_breaks"]
+
+
+@dataclass(frozen=True)
+class StrokeCriteria:
+    """The criteria of the stroke analysis (the ``velocity-direction`` segmenter's parameters of the same names).
+
+    ``rest_speed`` (m/s) below which the parts are at rest; ``drop`` and ``corner`` the shares of the neighbouring
+    maxima a speed minimum must fall below to cut (by speed; to accompany a direction break); ``angle`` (degrees)
+    between directions that makes a new cluster; ``min_stroke`` (s), the shortest stroke; ``smooth`` (s) of
+    Savitzky-Golay smoothing of the working memory first (0: none).
+    """
+
+    rest_speed: float = 0.08
+    drop: float = 0.5
+    angle: float = 50.0
+    corner: float = 0.9
+    min_stroke: float = 0.15
+    smooth: float = 0.2
+
+
+def speed_breaks(speed: np.ndarray, drop: float, moving: float = 0.0) -> list[int]:
+    """Indices of speed minima below ``drop`` times the smaller of the highest speeds on either side.
+
+    A minimum is no higher than the two samples on each side of it. A hold counts once, at its middle: a run
+    of such samples, or minima with nothing faster than ``moving`` (the rest speed) between them (the ripples
+    of a pause). A side reaches to the neighbouring minimum or to the end of the movement, so a movement that
+    starts or ends at full speed still brackets its minima; both sides must rise above ``moving``, so a dip
+    between two flickers of noise at rest separates no strokes.
+    """
+    speed = np.asarray(speed, dtype=float)
+    n = len(speed)
+    if n < 3:
+        return []
+    low = argrelextrema(speed, np.less_equal, order=2)[0]
+    low = low[(low >= 2) & (low <= n - 3)]  # two samples on each side, inside the movement
+    if not len(low):
+        return []
+    holds = [[int(low[0])]]
+    for m in low[1:]:
+        previous = holds[-1][-1]
+        if m == previous + 1 or speed[previous : m + 1].max() <= moving:
+            holds[-1].append(int(m))
+        else:
+            holds.append([int(m)])
+    minima = [(h[0] + h[-1]) // 2 for h in holds]
+    bounds = [0, *(h[-1] for h in holds[:-1])], [*(h[0] for h in holds[1:]), n - 1]  # the neighbouring holds
+    out = []
+    for i, (m, hold) in enumerate(zip(minima, holds)):
+        left, right = speed[bounds[0][i] : hold[0] + 1].max(), speed[hold[-1] : bounds[1][i] + 1].max()
+        side = min(left, right)
+        if speed[hold].min() < drop * side and side > moving:
+            out.append(m)
+    return out
+
+
+def direction_clusters(vectors: np.ndarray, angle: float, max_clusters: int = 12) -> np.ndarray:
+    """Divisive clustering of unit movement vectors (N, D); returns a cluster label per vector."""
+    n = len(vectors)
+    if n == 0:
+        return np.zeros(0, dtype=int)
+    cos_limit = np.cos(np.radians(angle))
+    means = [_unit(vectors.mean(axis=0))]
+    for _ in range(4 * max_clusters):
+        sims = vectors @ np.array(means).T
+        labels = np.argmax(sims, axis=1)
+        best = sims[np.arange(n), labels]
+        worst = int(np.argmin(best))
+        if best[worst] >= cos_limit or len(means) >= max_clusters:
+            break
+        means.append(vectors[worst].copy())  # a new cluster around the most different element
+        for _ in range(10):  # redistribute and re-average until stable
+            labels = np.argmax(vectors @ np.array(means).T, axis=1)
+            new = [_unit(vectors[labels == k].mean(axis=0)) if np.any(labels == k) else means[k] for k in range(len(means))]
+            if np.allclose(new, means):
+                break
+            means = new
+    return np.argmax(vectors @ np.array(means).T, axis=1)
+
+
+def direction_breaks(labels: np.ndarray) -> list[int]:
+    """Indices where two successive vectors fall into different clusters."""
+    return [int(i) for i in np.flatnonzero(np.diff(labels) != 0) + 1]
+
+
+@dataclass(frozen=True)
+class StrokeAnalysis:
+    """How one movement's working memory was cut into strokes (indices are frames into the movement).
+
+    ``window``: the (smoothed) positions (N, 3k); ``speed``: the speed of the fastest chosen part between
+    successive frames (N - 1,); ``clusters``: the direction cluster of each movement vector (-1: none, at rest);
+    ``speed_breaks`` and ``direction_breaks``: the candidates each criterion found; ``breaks``: the ones kept.
+    """
+
+    window: np.ndarray
+    speed: np.ndarray
+    clusters: np.ndarray
+    speed_breaks: list[int]
+    direction_breaks: list[int]
+    breaks: list[int]
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    n = np.linalg.norm(v)
+    return v / n if n > 1e-12 else v
+
+
+def breaks(window: np.ndarray, fps: float, criteria: StrokeCriteria = StrokeCriteria()) -> list[int]:
+    """Break points (indices into ``window``, positions (N, 3k) of the chosen parts) by speed and direction."""
+    return analyse(window, fps, criteria).breaks
+
+
+def analyse(window: np.ndarray, fps: float, criteria: StrokeCriteria = StrokeCriteria()) -> StrokeAnalysis:
+    """The working memory of one movement (positions (N, 3k) of the chosen parts, sampled at ``fps``) analysed for
+    break points.
+
+    Speed minima below ``drop`` of their neighbouring maxima cut; direction-cluster changes cut where the
+    direction turns sharply at a dip of the speed (see the module). Pieces shorter than ``min_stroke`` merge.
+    """
+    c = criteria
+    n = len(window)
+    empty = np.zeros(max(0, n - 1))
+    if n < 4:
+        return StrokeAnalysis(np.asarray(window, dtype=float), empty, np.full(len(empty), -1), [], [], [])
+    smooth = int(round(c.smooth * fps)) | 1
+    if smooth >= 5 and n > smooth:
+        window = savgol_filter(window, smooth, 2, axis=0, mode="interp")
+    vectors = np.diff(window, axis=0)
+    speed = np.linalg.norm(vectors.reshape(len(vectors), -1, 3), axis=2).max(axis=1) * fps
+    moving = speed > c.rest_speed
+    by_speed = sorted(b + 1 for b in speed_breaks(speed, c.drop, c.rest_speed))
+    cuts = set(by_speed)
+    by_direction: list[int] = []
+    units = np.array([_unit(v) for v in vectors])
+    labels = np.full(len(units), -1)
+    if moving.any():
+        labels[moving] = direction_clusters(units[moving], c.angle)
+        for i in range(1, len(labels)):  # slow vectors take the cluster of the one before
+            if labels[i] < 0:
+                labels[i] = labels[i - 1]
+        k = max(2, int(round(0.1 * fps)))
+        dips = np.array(speed_breaks(speed, c.corner, c.rest_speed), dtype=int) + 1
+        for b in direction_breaks(labels):
+            # a cluster change inside one stroke is no break: the direction must turn sharply there, at a dip
+            # of the speed (a C stroke turns gradually, an S stroke swings its direction at full speed)
+            before, after = _unit(vectors[max(0, b - k) : b].sum(axis=0)), _unit(vectors[b : b + k].sum(axis=0))
+            sharp = np.degrees(np.arccos(np.clip(before @ after, -1.0, 1.0))) >= 0.5 * c.angle
+            near = dips[np.abs(dips - b) <= k]
+            if sharp and near.size:
+                by_direction.append(int(near[np.argmin(np.abs(near - b))]))
+    cuts.update(by_direction)
+    shortest = max(1, int(round(c.min_stroke * fps)))
+    kept: list[int] = []
+    for cut in sorted(cuts):
+        if cut - (kept[-1] if kept else 0) >= shortest and n - cut >= shortest:
+            kept.append(cut)
+    return StrokeAnalysis(window, speed, labels, by_speed, sorted(set(by_direction)), kept)
