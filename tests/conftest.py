@@ -9,11 +9,41 @@ import numpy as np
 import pytest
 
 from toolkit import create_plugin_manager, hookimpl, load_scenario
+from toolkit.manager import PluginManager
 
 ROOT = Path(__file__).resolve().parent.parent
 CHARACTERS = ROOT / "characters"
 BANDAI = ROOT.parent / "shared" / "data" / "bandai-namco-1"
 """Real motion capture (CC BY-NC, never copied into the repository); tests that read it skip where it is absent."""
+
+CALLED_HOOKS: set[str] = set()
+"""Every hook called, with at least one implementation, through any plugin manager made during the test session."""
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _record_hook_calls():
+    """Monitor every plugin manager the tests make (the way tracing does) and note the hooks that ran an implementation:
+    ``tests/test_docs.py`` checks that every hook was really called by some test."""
+    original = PluginManager.__init__
+
+    def init(self, *args, **kwargs):
+        original(self, *args, **kwargs)
+        self.add_hookcall_monitoring(lambda name, impls, kwargs: CALLED_HOOKS.add(name) if impls else None,
+                                     lambda *_: None)
+
+    PluginManager.__init__ = init
+    yield
+    PluginManager.__init__ = original
+
+
+def pytest_collection_modifyitems(session, config, items):
+    """The check that every hook was called runs last, when every other test has run; ``config.whole_suite`` says
+    whether every test module was collected (run alone, that check cannot know)."""
+    last = [i for i in items if i.name.startswith("test_every_hook_is_called_by_a_test")]
+    items[:] = [i for i in items if i not in last] + last
+    collected = {Path(str(i.fspath)).name for i in items}
+    config.whole_suite = {p.name for p in (ROOT / "tests").glob("test_*.py")} <= collected
+
 
 def play_recording_postures(path: Path | str, actor: str = "max", **matcher_params):
     """Run a scenario (``matcher_params`` set on the actor's matcher) recording the actor's posture at every frame.

@@ -200,8 +200,8 @@ def render_text(summary: dict[str, Any]) -> str:
                     text += f"; candidates {_edges(r['candidates']) or 'none'}"
                 if r["early"] and r["fraction"] is not None:
                     text += f"; committed after {100 * r['fraction']:.0f}% of the demonstration"
-                if r.get("learned"):
-                    text += f"; learned {_edges(r['learned'])}"
+                if r.get("learned"):  # the edges a motor command graph learned, or (a posegraph) the new movement
+                    text += f"; learned {_edges(r['learned'] if isinstance(r['learned'], list) else [r['movement']])}"
                     text += " (after a deviation)" if r.get("deviated") else ""
                 if r.get("speed") and abs(r["speed"] - 1) > 0.3:
                     text += f"; {r['speed']:.1f}x his own speed"

@@ -377,6 +377,9 @@ class World:
     def time(self) -> float:
         return self.frame / self.fps
 
+    def __repr__(self) -> str:
+        return f"World(frame {self.frame}, {self.time:.2f} s, actors {', '.join(self.actors) or 'none'})"
+
     def add_actor(
         self, character: Character, id: str | None = None, position: Iterable[float] = (0, 0, 0), heading: float = 0.0
     ) -> Actor:
