@@ -1,0 +1,117 @@
+"""Path search (Buchsbaum & Blumberg 2005, §5.2) on a posegraph small enough to work out by hand.
+
+A stick figure of five parts whose hand either rises (``raise``) or goes forward (``reach``) and back, 0.5 s out and
+0.5 s back, sampled at 10 pose nodes a second: each movement is a path of nine nodes out of the hub and back.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from toolkit import Motion, load_character
+
+STICK = """
+[character]
+name = "Stick"
+
+[body]
+parts = ["root", "head", "lk", "rk", "hand"]
+root = "root"
+facing = { left = "lk", right = "rk", forward = "head" }
+
+[motor]
+plugin = "posegraph"
+node_rate = 10.0
+
+[motor.poses.stand]
+root = [0.0, 1.0, 0.0]
+head = [0.0, 1.6, 0.1]
+lk = [0.1, 0.5, 0.0]
+rk = [-0.1, 0.5, 0.0]
+hand = [0.3, 1.0, 0.0]
+
+[motor.poses.up]
+base = "stand"
+hand = [0.3, 1.6, 0.0]
+
+[motor.poses.front]
+base = "stand"
+hand = [0.3, 1.0, 0.6]
+
+[motor.movements.raise]
+keys = [{ pose = "stand", at = 0.0 }, { pose = "up", at = 0.5 }, { pose = "stand", at = 1.0 }]
+
+[motor.movements.reach]
+keys = [{ pose = "stand", at = 0.0 }, { pose = "front", at = 0.5 }, { pose = "stand", at = 1.0 }]
+
+[matcher]
+plugin = "path-search"
+"""
+
+FPS = 30.0
+
+
+@pytest.fixture
+def stick(write, pm):
+    return load_character(write("stick.toml", STICK), pm)
+
+
+def observed(stick, movement: str, *, speed: float = 1.0, offset=(0.0, 0.0, 0.0), hidden: str | None = None) -> Motion:
+    """The stick's own movement, root-relative as an observer perceives it, the hand moved by ``offset``."""
+    motion = stick.motor.perform(movement, fps=FPS, speed=speed).root_relative(stick.body.root)
+    positions = motion.positions.copy()
+    positions[:, stick.body.index("hand")] += offset
+    visible = np.ones(positions.shape[:2], dtype=bool)
+    if hidden is not None:
+        visible[:, stick.body.index(hidden)] = False
+    return Motion(positions, FPS, motion.parts, visible)
+
+
+def test_the_graph_is_two_paths_of_nine_nodes_through_one_hub(stick):
+    motor = stick.motor
+    assert motor.graph.number_of_nodes() == 1 + 2 * 9
+    assert [motor.movement_of(n) for n in motor.paths["raise"]] == [None] + ["raise"] * 9 + [None]
+
+
+def test_its_own_movement_is_found_on_its_own_path_at_distance_zero(stick):
+    match = stick.matcher.match(observed(stick, "raise"))
+    assert match.movement == "raise"
+    assert match.details["mean_distance"] == pytest.approx(0.0, abs=1e-9)
+    assert set(match.path) <= set(stick.motor.paths["raise"])
+    assert match.details["votes"] == {"raise": sum(stick.motor.movement_of(n) == "raise" for n in match.path)}
+
+
+def test_the_mean_distance_is_eq_1_per_sample_averaged_over_the_visible_parts(stick):
+    """1 cm off at the hand, across the hand's path (no node is nearer): eq. 1 is 0.01 / 5 parts at every sample, and
+    0.01 / 4 when the head is hidden (the mean is over the visible parts)."""
+    match = stick.matcher.match(observed(stick, "reach", offset=(0.01, 0.0, 0.0)))
+    assert match.movement == "reach" and match.details["mean_distance"] == pytest.approx(0.01 / 5)
+    match = stick.matcher.match(observed(stick, "reach", offset=(0.01, 0.0, 0.0), hidden="head"))
+    assert match.movement == "reach" and match.details["mean_distance"] == pytest.approx(0.01 / 4)
+    assert match.confidence == pytest.approx(np.exp(-(0.01 / 4) / stick.matcher.params["scale"]))
+
+
+def test_farther_than_max_distance_is_unknown_not_the_nearest(stick):
+    """The hand 20 cm out to the side all along: 0.2 / 5 = 0.04 m per sample, past max_distance (0.03 m)."""
+    match = stick.matcher.match(observed(stick, "raise", offset=(0.2, 0.0, 0.0)))
+    assert match.movement is None and match.details["reason"] == "too far from every path"
+    assert match.details["nearest"] == "raise" and match.details["mean_distance"] == pytest.approx(0.04)
+
+
+def test_a_path_may_skip_nodes_so_a_faster_movement_still_aligns(stick):
+    """Twice as fast: each observed sample is two nodes along. With max_skip = 2 the path keeps up exactly; with
+    max_skip = 1 it falls behind and every sample costs distance."""
+    fast = observed(stick, "raise", speed=2.0)
+    match = stick.matcher.match(fast)
+    assert match.movement == "raise" and match.details["mean_distance"] == pytest.approx(0.0, abs=1e-9)
+    stick.matcher.params = {**stick.matcher.params, "max_skip": 1}
+    stick.matcher._cache_version = -1  # the reach tables are rebuilt for the new max_skip
+    slow = stick.matcher.match(fast)
+    assert slow.details["mean_distance"] > 0.01
+
+
+def test_hub_poses_do_not_vote(stick):
+    stand = observed(stick, "raise").slice(0, 1)  # one frame: standing
+    match = stick.matcher.match(stand)
+    assert match.movement is None and match.details["reason"] == "only hub poses"
