@@ -340,3 +340,34 @@ def test_a_clip_built_motor_command_graph_saves_and_loads_its_labels_without_dou
     assert sorted(unlabelled.movements()) != sorted(commands.movements())  # example names, not movements
     unlabelled.set_state(state)  # the labels come back with the state
     assert unlabelled.labels == commands.labels and sorted(unlabelled.movements()) == sorted(commands.movements())
+
+
+def test_an_observer_takes_what_it_is_not_told_from_the_observer_template(data, profile, pm, write, capsys):
+    default = compose_observer(pm, profile, data / "repertoire")
+    assert [default.perception.name, default.segmenter.name, default.matcher.name, default.motor.name] == [
+        "motion-capture", "hub-threshold", "path-search", "posegraph"]  # characters/observers/recordings.toml
+    mine = write("mine.toml", """
+        [observer]
+        name = "mine"
+        [motor]
+        plugin = "posegraph"
+        [perception]
+        plugin = "motion-capture"
+        [segmenter]
+        plugin = "velocity-direction"
+        level = "movement"
+        [matcher]
+        plugin = "dtw"
+        """)
+    observer = compose_observer(pm, profile, data / "repertoire", template=mine)
+    assert observer.segmenter.name == "velocity-direction" and observer.segmenter.params["level"] == "movement"
+    assert observer.matcher.name == "dtw"
+    follows = compose_observer(pm, profile, data / "repertoire", matcher="forward-model")
+    assert follows.motor.name == "motor-command-graph" and follows.matcher.params["learn"] is False
+    assert compose_observer(pm, profile, data / "repertoire", matcher=None).matcher is None
+    assert main(["validate", str(mine)]) == 0
+    assert "observer template: motor posegraph, perception motion-capture, segmenter velocity-direction" in \
+        capsys.readouterr().out
+    write("bad.toml", '[observer]\nname = "bad"\n[matcher]\nplugin = "dtw"\nwindow = 2.0\n')
+    with pytest.raises(ConfigError, match=r"bad.toml:5: key matcher.window: value 2.0 out of range"):
+        compose_observer(pm, profile, data / "repertoire", template=mine.parent / "bad.toml")

@@ -366,6 +366,7 @@ def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
 def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
     from toolkit.bvh import read_bvh
     from toolkit.character import load_character, read_toml
+    from toolkit.observe import check_observer_template, is_observer_template
     from toolkit.profile import is_profile, load_profile
     from toolkit.report import describe_character
     from toolkit.scenario import is_scenario, load_scenario
@@ -391,6 +392,10 @@ def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
                 scenario = load_scenario(path, pm)
                 world = scenario.world
                 print(f"ok    {path}: scenario {scenario.name!r}: {len(world.actors)} actor(s) ({', '.join(world.actors)}), {len(world.objects)} object(s)")
+            elif is_observer_template(table):
+                plugins = check_observer_template(path, pm)
+                comps = ", ".join(f"{k} {v}" for k, v in plugins.items())
+                print(f"ok    {path}: observer template: {comps} (a body profile and clips complete it)")
             elif is_profile(table):
                 prof = load_profile(path)
                 print(f"ok    {path}: body profile {prof.name!r}: {len(prof.joints)} parts, units {prof.scale:g} m, up {prof.up}")

@@ -34,7 +34,8 @@ from toolkit.motion import Motion
 from toolkit.profile import BodyProfile
 from toolkit.watching import Observation, WatchingLoop
 
-__all__ = ["Observation", "Observer", "compose_observer", "OBSERVER_TEMPLATE"]
+__all__ = ["Observation", "Observer", "compose_observer", "OBSERVER_TEMPLATE", "is_observer_template",
+           "check_observer_template"]
 
 OBSERVER_TEMPLATE = "observers/recordings.toml"
 """The observer template on the character path: the components an observer of recordings has by default."""
@@ -147,7 +148,8 @@ def compose_observer(pm: Any, profile: BodyProfile, repertoire: str | Path, *, s
                      matcher: str | None = "", settings: Mapping[str, Mapping[str, Any]] | None = None,
                      motor: str | None = None, template: str | Path = OBSERVER_TEMPLATE) -> Character:
     """The observing character: ``profile``'s body, a repertoire from the clips in ``repertoire``, its components
-    from ``template`` (an observer template, a character file without a body) unless named here.
+    from ``template`` (an observer template: an ``[observer]`` table and component tables, no body) unless named
+    here.
 
     Parameters
     ----------
@@ -159,6 +161,7 @@ def compose_observer(pm: Any, profile: BodyProfile, repertoire: str | Path, *, s
     """
     settings = {k: dict(v) for k, v in (settings or {}).items()}
     path = Path(template) if Path(template).is_file() else resolve_file(str(template), None, pm)
+    check_observer_template(path, pm)
     base = read_toml(path)
     tables: dict[str, dict[str, Any]] = {k: dict(v) for k, v in base.items() if k in COMPONENT_TABLES}
     for key, name in (("segmenter", segmenter), ("matcher", matcher), ("motor", motor)):
@@ -182,7 +185,7 @@ def compose_observer(pm: Any, profile: BodyProfile, repertoire: str | Path, *, s
         facing["forward"] = profile.body.facing.forward
     if profile.body.facing.behind:
         facing["behind"] = profile.body.facing.behind
-    head = dict(base.get("character", {}))
+    head = dict(base["observer"])
     table: dict[str, Any] = {
         "character": {"name": head.get("name", "observer"),
                       "description": f"watches {profile.name} motion" + (f": {head['description']}"
@@ -194,3 +197,44 @@ def compose_observer(pm: Any, profile: BodyProfile, repertoire: str | Path, *, s
     table["motor"] = {**table.get("motor", {}), "clips": str(Path(repertoire).resolve()),
                       "profile": str(profile.file.resolve()) if profile.file else ""}
     return compose_character(table, pm)
+
+
+OBSERVER_KEYS = ("name", "description")
+
+
+def is_observer_template(table: Mapping[str, Any]) -> bool:
+    """Whether a parsed TOML table is an observer template: an ``[observer]`` table (name, description) and a
+    character's component tables, without a ``[body]`` (a body profile gives it when the observer is composed)."""
+    return "observer" in table and "character" not in table
+
+
+def check_observer_template(path: str | Path, pm: Any) -> dict[str, str]:
+    """The plugin of each component table of an observer template, every name and parameter checked (a
+    :class:`ConfigError` naming the file, key and line otherwise); attaching waits for a body and clips."""
+    from toolkit.character import build_component, find_key_line
+
+    path = Path(path)
+    table = read_toml(path)
+    plugins = {}
+    try:
+        for key in table:
+            if key not in ("observer", *COMPONENT_TABLES):
+                raise ConfigError(f"unknown table {key!r}", key=(key,), expected="an observer template table",
+                                  available=("observer", *COMPONENT_TABLES))
+        head = table["observer"]
+        if not isinstance(head, Mapping):
+            raise ConfigError("not a table", key=("observer",), expected="an [observer] table")
+        for key in head:
+            if key not in OBSERVER_KEYS:
+                raise ConfigError(f"unknown key {key!r}", key=("observer", key), expected="an [observer] key",
+                                  available=OBSERVER_KEYS)
+        for key in COMPONENT_TABLES:
+            if key in table:
+                if not isinstance(table[key], Mapping):
+                    raise ConfigError("not a table", key=(key,), expected=f"a [{key}] table")
+                plugins[key] = build_component(key, table[key], pm).name
+    except ConfigError as err:
+        line = find_key_line(path, err.key) if err.key else None
+        raise ConfigError(err.problem, file=path, key=err.key, line=line, expected=err.expected,
+                          available=err.available) from None
+    return plugins

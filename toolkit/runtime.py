@@ -223,15 +223,15 @@ class Actor:
             return getattr(component, method)(*args, **kwargs)
         except LikemeError as exc:
             if self.world.on_plugin_error == "skip" and isinstance(exc, PluginError):
-                return self._drop(key, component, method, exc)
+                return self._drop(key, component, exc)
             raise
         except Exception as exc:
             error = PluginError(component.name, f"{type(component).__name__}.{method}", f"{type(exc).__name__}: {exc}")
             if self.world.on_plugin_error == "skip":
-                return self._drop(key, component, method, error)
+                return self._drop(key, component, error)
             raise error from exc
 
-    def _drop(self, key: str, component: Any, method: str, error: PluginError) -> None:
+    def _drop(self, key: str, component: Any, error: PluginError) -> None:
         setattr(self.character, key, None)
         self.world.events.append(
             Event(self.world.frame, self.world.time, "plugin_failed", self.id, None,

@@ -64,10 +64,6 @@ class ActionTuple:
     def leaf(self) -> bool:
         return self.movement is not None
 
-    def can_i(self) -> list[Trigger]:
-        """Every can-I trigger, the object selection first."""
-        return ([self.select] if self.select is not None else []) + self.can
-
 
 @dataclass
 class ActionHierarchy:

@@ -230,10 +230,6 @@ class Hierarchical(ActionSystem):
 
     # -- reports ---------------------------------------------------------------------------
 
-    def most_frequent_path(self, movement: str) -> tuple[str, ...] | None:
-        counts = self.correspondence.get(movement)
-        return counts.most_common(1)[0][0] if counts else None
-
     def get_state(self) -> dict[str, Any]:
         """Drives, beliefs, the correspondence and transition maps: everything this character learns by acting and watching."""
         return {

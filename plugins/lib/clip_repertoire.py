@@ -61,8 +61,6 @@ class ClipRepertoire:
     def movements(self) -> list[str]:
         return sorted({c.movement for c in self.clips})
 
-    def of(self, movement: str) -> list[Clip]:
-        return [c for c in self.clips if c.movement == movement]
 
 
 def root_relative_motion(world: Motion, profile: BodyProfile, facing_window: float = 1.0) -> Motion:
@@ -134,7 +132,7 @@ def load_clip_repertoire(folder: str | Path, profile: str | Path | BodyProfile, 
             rel.append((movement, path, motion))
     ends = np.stack([_filled(m, i) for _, _, m in rel for i in (0, -1)])
     hubs_rel = find_hubs(ends, hub_radius, hub_share)
-    height = _root_height(rel, profile)
+    height = _root_height(rel)
     lift = np.array([0.0, height, 0.0])
     clips = tuple(Clip(mv, path, Motion(m.positions + lift, m.fps, m.parts, m.visible)) for mv, path, m in rel)
     return ClipRepertoire(profile, clips, hubs_rel + lift, Path(folder))
@@ -145,7 +143,7 @@ def _filled(motion: Motion, frame: int) -> np.ndarray:
     return np.nan_to_num(motion.positions[frame])
 
 
-def _root_height(rel: list[tuple[str, Path, Motion]], profile: BodyProfile) -> float:
+def _root_height(rel: list[tuple[str, Path, Motion]]) -> float:
     """Median height of the root above the lowest part at the clips' ends: the hub's standing height."""
     heights = []
     for _, _, m in rel:

@@ -124,7 +124,7 @@ class PathSearch(Matcher):
             return Match.unknown(reason="nothing visible")
         self._refresh()
         obs, vis = self.samples(motion)
-        path, cost, evidence = self.search(obs, vis)
+        path, _, evidence = self.search(obs, vis)  # the beam's eq. 3 cost: recomputed below by the one formula
         if path is None:
             return Match.unknown(reason="nothing visible")
         labels = self.labels[path]

@@ -96,7 +96,7 @@ class HubThreshold(Segmenter):
         wn = min(self.params["cutoff"] / nyquist, 0.99)
         self._b, self._a = butter(2, wn)
         self._zi: np.ndarray | None = None
-        self._delay = int(round(_group_delay(self._b, self._a, self._fps)))
+        self._delay = int(round(_group_delay(self._b, self._a)))
         self._frame = -1
         self._last = np.nan
         self._window = max(1, int(round(self.params["floor"] * self._fps))) if self.params["floor"] > 0 else 0
@@ -226,7 +226,7 @@ def _hold(x: np.ndarray) -> np.ndarray:
     return np.where(idx >= 0, x[np.maximum(idx, 0)], 0.0)
 
 
-def _group_delay(b: np.ndarray, a: np.ndarray, fps: float) -> float:
+def _group_delay(b: np.ndarray, a: np.ndarray) -> float:
     """Delay in frames of the filter at low frequencies (where movements live)."""
     from scipy.signal import group_delay
 
