@@ -56,3 +56,25 @@ def test_component_reference_is_current(pm):
     assert (ROOT / "docs" / "components.md").read_text() == components_markdown(pm), (
         "regenerate with: LIKEME_DISABLE_PLUGIN_AUTOLOAD=1 likeme plugins --markdown > docs/components.md"
     )
+
+
+def test_the_layout_tables_match_the_rooms_of_plugins():
+    """README's layout table and docs/architecture.md's picture of the rooms name every sub-package of plugins/, and
+    the picture every module that registers nothing (a room's helpers, lib/)."""
+    readme = (ROOT / "README.md").read_text()
+    architecture = (ROOT / "docs" / "architecture.md").read_text()
+    rooms = sorted(p.parent.name for p in (ROOT / "plugins").glob("*/__init__.py"))
+    assert rooms == ["action", "bench", "lib", "matchers", "motor", "perception", "segmenters", "triggers", "views"]
+    picture = architecture[architecture.index("## The rooms"):architecture.index("## From files")]
+    for room in rooms:
+        assert f"`plugins/{room}/`" in readme, room
+        assert re.search(rf"^\s+{room}/\s", picture, re.M), room
+        for module in (ROOT / "plugins" / room).glob("*.py"):
+            if module.name != "__init__.py" and "@hookimpl" not in module.read_text():
+                assert module.stem in picture, f"plugins/{room}/{module.name} is not in the picture of the rooms"
+
+
+def test_every_file_the_docs_name_exists():
+    for doc in [ROOT / "README.md", *(ROOT / "docs").glob("*.md")]:
+        for path in re.findall(r"`((?:toolkit|plugins|characters|tests)/[\w/.-]+\.(?:py|toml))`", doc.read_text()):
+            assert (ROOT / path).is_file(), f"{doc.name} names {path}, which does not exist"
