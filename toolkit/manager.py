@@ -26,8 +26,7 @@ from __future__ import annotations
 import os
 import re
 import sys
-from collections.abc import Callable, Iterable, Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from importlib import metadata
 from types import ModuleType, TracebackType
@@ -135,13 +134,24 @@ class PluginManager(pluggy.PluginManager):
         self.skipped: list[PluginInfo] = []
         self._registry: Registry | None = None
         self._policies: list[tuple[str, Failed | None]] = []
+        self.tracing = False
         self.add_hookcall_monitoring(lambda *_: None, self._after_hookcall)
+
+    def enable_tracing(self) -> Callable[[], None]:
+        """Trace every hook call (pluggy's tracing); every run event is then called, implemented or not."""
+        self.tracing = True
+        undo = super().enable_tracing()
+
+        def stop() -> None:
+            self.tracing = False
+            undo()
+
+        return stop
 
     # -- failures --------------------------------------------------------------------
 
-    @contextmanager
-    def failure_policy(self, policy: str, failed: Failed | None = None) -> Iterator[None]:
-        """Hook calls made inside the ``with`` block follow ``policy``.
+    def failure_policy(self, policy: str, failed: Failed | None = None) -> FailurePolicy:
+        """A context manager: hook calls made inside its ``with`` block follow ``policy`` (it may be entered again).
 
         ``"stop"`` (also the policy outside any block): an implementation that raises anything but a likeme error
         becomes a :class:`PluginError` naming its plugin and the hook. ``"skip"``: its plugin is unregistered,
@@ -149,11 +159,7 @@ class PluginManager(pluggy.PluginManager):
         """
         if policy not in ("stop", "skip"):
             raise ValueError("a failure policy is 'stop' or 'skip'")
-        self._policies.append((policy, failed))
-        try:
-            yield
-        finally:
-            self._policies.pop()
+        return FailurePolicy(self._policies, (policy, failed))
 
     def _after_hookcall(self, outcome: pluggy.Result, hook_name: str, impls: Sequence[pluggy.HookImpl],
                         kwargs: dict[str, Any]) -> None:
@@ -219,8 +225,11 @@ class PluginManager(pluggy.PluginManager):
     # -- run events ------------------------------------------------------------------
 
     def announce(self, hook_name: str, **kwargs: Any) -> None:
-        """Call a run-event hook (through pluggy: traced, and under the failure policy in force)."""
-        getattr(self.hook, hook_name)(**kwargs)
+        """Call a run-event hook (through pluggy: traced, and under the failure policy in force). A hook nothing
+        implements is not called unless tracing is on, which shows every call."""
+        caller = getattr(self.hook, hook_name)
+        if self.tracing or caller.get_hookimpls():
+            caller(**kwargs)
 
     # -- components ----------------------------------------------------------------
 
@@ -255,6 +264,19 @@ class PluginManager(pluggy.PluginManager):
                         )
                     found[key] = ComponentInfo(kind, cls.name, cls, info)
         return list(found.values())
+
+
+class FailurePolicy:
+    """The context manager :meth:`PluginManager.failure_policy` returns (reusable: a world enters one every step)."""
+
+    def __init__(self, stack: list, policy: tuple[str, Failed | None]) -> None:
+        self._stack, self._policy = stack, policy
+
+    def __enter__(self) -> None:
+        self._stack.append(self._policy)
+
+    def __exit__(self, *exc: object) -> None:
+        self._stack.pop()
 
 
 def _culprit(tb: TracebackType | None, impls: Sequence[pluggy.HookImpl]) -> pluggy.HookImpl | None:

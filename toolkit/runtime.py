@@ -21,8 +21,8 @@ its ``on_plugin_error`` policy.
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable, Iterator, Mapping
-from contextlib import contextmanager
+from collections.abc import Iterable, Mapping
+from contextlib import nullcontext
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -371,6 +371,8 @@ class World:
         self.pm = pm
         self.history_seconds = 120.0
         self._removed: dict[str, WorldObject] = {}
+        self._policy_key: tuple | None = None
+        self._policy_cm: Any = None
         self._history: dict[int, dict[str, tuple[np.ndarray, str | None]]] = {}
 
     @property
@@ -415,14 +417,15 @@ class World:
         if self.pm is not None:
             self.pm.announce(hook_name, **kwargs)
 
-    @contextmanager
-    def _policy(self) -> Iterator[None]:
+    def _policy(self) -> Any:
         """Hook calls in the block follow ``on_plugin_error`` (a dropped hook plugin is recorded as an event)."""
         if self.pm is None:
-            yield
-            return
-        with self.pm.failure_policy(self.on_plugin_error, self._plugin_failed):
-            yield
+            return nullcontext()
+        key = (id(self.pm), self.on_plugin_error)
+        if self._policy_key != key:  # made once per plugin manager and policy, entered every step
+            self._policy_key = key
+            self._policy_cm = self.pm.failure_policy(self.on_plugin_error, self._plugin_failed)
+        return self._policy_cm
 
     def _plugin_failed(self, plugin: str, hook_name: str, error: PluginError) -> None:
         self.events.append(Event(self.frame, self.time, "plugin_failed", "", None,

@@ -62,6 +62,7 @@ class ObservationLog:
         self._world = np.full((capacity, p, 3), np.nan)
         self._vis = np.zeros((capacity, p), dtype=bool)
         self._seen = np.zeros(p, dtype=bool)  # seen at least once
+        self._all_seen = False
         self.n = 0
 
     def append(self, pose: np.ndarray, visible: np.ndarray, world: np.ndarray | None = None) -> None:
@@ -77,20 +78,27 @@ class ObservationLog:
         if k == 0:
             return
         start, end = self.n, self.n + k
-        self._reserve(end)
+        if end > len(self._pos):
+            self._reserve(end)
         self._vis[start:end] = visible
         self._pos[start:end] = self._held(self._pos, poses, visible)
         if world is not None:
             self._world[start:end] = self._held(self._world, np.asarray(world, dtype=float), visible)
-        first = ~self._seen & visible.any(axis=0)
-        if first.any() and start:  # seen for the first time: the rows before hold that sighting
-            self._pos[:start, first] = self._pos[start:end][np.argmax(visible[:, first], axis=0), first]
-            self._world[:start, first] = self._world[start:end][np.argmax(visible[:, first], axis=0), first]
-        self._seen |= visible.any(axis=0)
+        if not self._all_seen:
+            first = ~self._seen & visible.any(axis=0)
+            if first.any() and start:  # seen for the first time: the rows before hold that sighting
+                self._pos[:start, first] = self._pos[start:end][np.argmax(visible[:, first], axis=0), first]
+                self._world[:start, first] = self._world[start:end][np.argmax(visible[:, first], axis=0), first]
+            self._seen |= visible.any(axis=0)
+            self._all_seen = bool(self._seen.all())
         self.n = end
 
     def _held(self, store: np.ndarray, values: np.ndarray, visible: np.ndarray) -> np.ndarray:
         """``values`` with hidden parts filled by the rule, continuing from the row before (the last seen values)."""
+        if visible.all():
+            return values
+        if self.n and len(values) == 1 and self._all_seen:  # one frame, every part seen before: hold the last row
+            return np.where(visible[..., None], values, store[self.n - 1])
         if self.n:
             before = store[self.n - 1][None]
             return fill_hidden(np.concatenate([before, values]), np.concatenate([self._seen[None], visible]))[1:]
@@ -272,6 +280,7 @@ class WatchingLoop:
         self.listener = listener or Listener()
         self.memory = ObservationLog(character.body.parts, 30.0, capacity=1)
         self._index = np.arange(len(character.body.parts))
+        self._same = True  # the observed body's parts are the observer's, in order
         self._open: int | None = None  # start row of the segment the matcher follows
         self._view: WorkingMemory | None = None
         self._early: Match | None = None
@@ -283,6 +292,7 @@ class WatchingLoop:
         and the segmenter start again; the observed parts are mapped by name onto the observer's own."""
         own = self.character.body.parts
         self._index = part_index(parts, own)
+        self._same = tuple(parts) == tuple(own)
         if not (self._index >= 0).any():
             raise ConfigError("the observed body shares no part with the observer's own", expected=f"parts named "
                               f"like the observer's: {list(own)}", available=list(parts))
@@ -293,7 +303,7 @@ class WatchingLoop:
     def _onto(self, values: np.ndarray, fill: Any) -> np.ndarray:
         """Observed values (n, S, ...) in the observer's parts (n, P, ...); ``fill`` where it has no such part."""
         values = np.asarray(values)
-        if len(self._index) == values.shape[1] and (self._index == np.arange(len(self._index))).all():
+        if self._same:
             return values
         have = self._index >= 0
         out = np.full((values.shape[0], len(self._index), *values.shape[2:]), fill, dtype=values.dtype)

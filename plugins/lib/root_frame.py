@@ -94,8 +94,20 @@ class HeadingFilter:
         self._recent.clear()
 
     def update(self, heading: float) -> float:
-        """Add one estimate (NaN when there was none) and return the filtered facing (NaN if none yet)."""
-        return float(self.update_many(np.array([heading], dtype=float))[0])
+        """Add one estimate (NaN when there was none) and return the filtered facing (NaN if none yet).
+
+        The same as :meth:`update_many` of one estimate, without its block machinery (a perception calls it every
+        frame): the circular median of the last ``window`` estimates, unwrapped around the newest.
+        """
+        if np.isfinite(heading):
+            self._recent.append(float(heading))
+            if len(self._recent) > self.window:
+                del self._recent[0]
+        if not self._recent:
+            return float("nan")
+        recent = np.asarray(self._recent)
+        ref = recent[-1]
+        return float(np.angle(np.exp(1j * np.median(ref + np.angle(np.exp(1j * (recent - ref)))))))
 
     def update_many(self, headings: np.ndarray) -> np.ndarray:
         """Add estimates (n,) one after another; the filtered facing after each, as :meth:`update` gives it.

@@ -508,8 +508,7 @@ class ForwardModel(Matcher):
 
     def _path_label(self, path: tuple[str, ...]) -> str | None:
         """The labelled movement (clip repertoires) every sequence along ``path`` is an example of, else ``None``."""
-        label_of_path = getattr(self.motor, "label_of_path", None)
-        return label_of_path(path) if label_of_path is not None else None
+        return self.motor.label_of_path(path)
 
     def _movement_key(self, path: tuple[str, ...]) -> str:
         """What a candidate stands for: the labelled movement its sequences are examples of, else its first command."""

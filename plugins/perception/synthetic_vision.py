@@ -168,9 +168,9 @@ class SyntheticVision(Perception):
         if self._buffer is None or len(self._buffer.last) != len(positions):
             self._buffer = SensoryBuffer(len(positions), int(round(p["buffer"] * self._fps)))
         positions, seen = self._buffer.update(positions, seen)
-        pose, mask, root, heading = root_relative(positions[None], seen[None], target.body, self._facing.update_many)
-        return Percept(world.time, pose[0], mask[0], np.where(seen[:, None], positions, np.nan), root[0],
-                       float(heading[0]), objects)
+        # one frame (P, 3): the facing's running median takes this frame's estimate
+        pose, mask, root, heading = root_relative(positions, seen, target.body, lambda h: self._facing.update(float(h)))
+        return Percept(world.time, pose, mask, np.where(seen[:, None], positions, np.nan), root, float(heading), objects)
 
 
 @hookimpl
