@@ -26,7 +26,7 @@ def test_builtin_characters_compose(pm):
     np.testing.assert_allclose(morris.motor.perform("point").positions, max_.motor.perform("point").positions)
     assert morris.motor.perform("wave").n_frames < max_.motor.perform("wave").n_frames  # he waves faster
     stages = [stage for stage, _ in max_.pipeline()]
-    assert stages == ["perceive", "segment", "match", "interpret", "respond"]
+    assert stages == ["perceive", "correspond", "segment", "match", "interpret", "respond"]
 
 
 def test_character_by_name_on_the_search_path(pm):

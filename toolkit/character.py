@@ -6,6 +6,7 @@ A character file has these tables (``docs/character-format.md`` is the full refe
     [body]        tracked parts, root, facing parts, bones, colours
     [motor]       plugin = NAME and its parameters (the movement repertoire)
     [perception]  plugin = NAME and its parameters      (optional)
+    [correspondence] plugin = NAME and its parameters   (optional; none: the papers' plain behaviour)
     [segmenter]   plugin = NAME and its parameters      (optional)
     [matcher]     plugin = NAME and its parameters      (optional)
     [action]      plugin = NAME and its parameters      (optional)
@@ -29,7 +30,7 @@ from pathlib import Path
 from typing import Any
 
 from toolkit.body import Body
-from toolkit.components import ActionSystem, Component, Matcher, MotorSystem, Perception, Segmenter
+from toolkit.components import ActionSystem, Component, Correspondence, Matcher, MotorSystem, Perception, Segmenter
 from toolkit.errors import ConfigError, LikemeError, PluginError
 from toolkit.manager import PluginManager
 
@@ -47,6 +48,7 @@ __all__ = [
 COMPONENT_TABLES: dict[str, bool] = {
     "motor": True,
     "perception": False,
+    "correspondence": False,
     "segmenter": False,
     "matcher": False,
     "action": False,
@@ -66,7 +68,7 @@ class Character:
     name : str
     body : Body
     motor : MotorSystem
-    perception, segmenter, matcher, action : component or None
+    perception, correspondence, segmenter, matcher, action : component or None
     files : tuple of Path
         The file it was loaded from first, then the files it extends.
     description : str
@@ -80,6 +82,7 @@ class Character:
     body: Body
     motor: MotorSystem
     perception: Perception | None = None
+    correspondence: Correspondence | None = None
     segmenter: Segmenter | None = None
     matcher: Matcher | None = None
     action: ActionSystem | None = None
@@ -97,9 +100,10 @@ class Character:
         return {k: c for k in COMPONENT_TABLES if (c := getattr(self, k)) is not None}
 
     def pipeline(self) -> list[tuple[str, Component | None]]:
-        """The stages perceive, segment, match, interpret, respond with the component of each."""
+        """The stages perceive, correspond, segment, match, interpret, respond with the component of each."""
         return [
             ("perceive", self.perception),
+            ("correspond", self.correspondence),
             ("segment", self.segmenter),
             ("match", self.matcher),
             ("interpret", self.action),
@@ -305,6 +309,7 @@ def compose_character(table: Mapping[str, Any], pm: PluginManager, *, files: tup
         body=body,
         motor=built["motor"],  # type: ignore[arg-type]
         perception=built["perception"],  # type: ignore[arg-type]
+        correspondence=built["correspondence"],  # type: ignore[arg-type]
         segmenter=built["segmenter"],  # type: ignore[arg-type]
         matcher=built["matcher"],  # type: ignore[arg-type]
         action=built["action"],  # type: ignore[arg-type]

@@ -1,17 +1,18 @@
 """The pluggable component kinds and the values that flow between them.
 
-A character's pipeline is five stages, each a component chosen by name in its
+A character's pipeline is six stages, each a component chosen by name in its
 TOML file and provided by a plugin (see :mod:`toolkit.hookspecs`):
 
-============  ==================  ===============================================
-stage         component kind      turns ...
-============  ==================  ===============================================
-perceive      :class:`Perception`   the world into a :class:`Percept` of the target
-segment       :class:`Segmenter`    the stream of percepts into :class:`Segment` s
-match         :class:`Matcher`      a segment (or its beginning) into a :class:`Match`
-interpret     :class:`ActionSystem` a match into a :class:`Behaviour`
-respond       :class:`ActionSystem` all of it into a :class:`MovementRequest`
-============  ==================  ===============================================
+============  ======================  ===============================================
+stage         component kind          turns ...
+============  ======================  ===============================================
+perceive      :class:`Perception`       the world into a :class:`Percept` of the target
+correspond    :class:`Correspondence`   the target's poses into poses of one's own body
+segment       :class:`Segmenter`        the stream of poses into :class:`Segment` s
+match         :class:`Matcher`          a segment (or its beginning) into a :class:`Match`
+interpret     :class:`ActionSystem`     a match into a :class:`Behaviour`
+respond       :class:`ActionSystem`     all of it into a :class:`MovementRequest`
+============  ======================  ===============================================
 
 and the :class:`MotorSystem` turns a request into a :class:`~toolkit.motion.Motion`
 the character performs. :class:`Trigger` components are the conditions an action
@@ -55,6 +56,7 @@ if TYPE_CHECKING:  # pragma: no cover - imports for annotations only
 __all__ = [
     "Component",
     "Perception",
+    "Correspondence",
     "Segmenter",
     "Matcher",
     "MotorSystem",
@@ -349,6 +351,37 @@ class Perception(Component):
         return np.stack([p.pose for p in percepts]), np.stack([p.visible for p in percepts])
 
 
+class Correspondence(Component):
+    """Maps the observed body onto the observer's own: the correspondence problem (B&B 2005 §7.1, K&G 2006 §6).
+
+    Between perception and the segmenter and matcher: the watching loop gives it the perceived root-relative
+    poses in the observer's own parts, hidden parts held (``docs/conventions.md``), and stores what it returns in
+    working memory, so that everything downstream compares another body's movement with its own movements.
+
+    Streaming protocol: :meth:`reset` when a new stream (a new demonstrator) begins, then :meth:`map_block` for
+    every packet of frames in order. A correspondence estimates what it needs of the demonstrator (their size,
+    their rest posture) from the frames seen so far: row ``i`` of a block depends on the rows up to ``i`` only,
+    so the result does not depend on how the frames were packed.
+    """
+
+    kind = "correspondence"
+
+    @abstractmethod
+    def reset(self, parts: Sequence[str], fps: float) -> None:
+        """A new stream of poses of ``parts`` (the observer's own) at ``fps``: forget the last demonstrator."""
+
+    @abstractmethod
+    def map_block(self, poses: np.ndarray, visible: np.ndarray) -> np.ndarray:
+        """``n`` perceived root-relative poses (n, P, 3) with masks (n, P), in arrival order, mapped onto the
+        observer's body (n, P, 3). Rows of parts never seen are NaN in and may be NaN out."""
+
+    def map_motion(self, motion: Motion) -> Motion:
+        """A whole root-relative motion mapped as one stream (reset first)."""
+        self.reset(motion.parts, motion.fps)
+        filled = fill_hidden(motion.positions, motion.visible)
+        return Motion(self.map_block(filled, motion.visible), motion.fps, motion.parts, motion.visible)
+
+
 class Segmenter(Component):
     """Divides a stream of observed poses into segments, one frame at a time or in batch.
 
@@ -603,6 +636,7 @@ def protocol_members(protocol: type) -> list[str]:
 
 KINDS: dict[str, type[Component]] = {
     "perception": Perception,
+    "correspondence": Correspondence,
     "segmenter": Segmenter,
     "matcher": Matcher,
     "motor": MotorSystem,

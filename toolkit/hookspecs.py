@@ -43,6 +43,7 @@ if TYPE_CHECKING:  # pragma: no cover
         Perception,
         Segment,
         Segmenter,
+        Correspondence,
         Trigger,
         View,
     )
@@ -64,6 +65,16 @@ def likeme_register_perceptions() -> list[type[Perception]]:
 
     A perception turns the world, seen from an observer, into root-relative
     :class:`~toolkit.components.Percept` s of the target it watches.
+    """
+
+
+@hookspec
+def likeme_register_correspondences() -> list[type[Correspondence]]:
+    """Return correspondence component classes (``[correspondence] plugin = NAME``).
+
+    A correspondence maps the observed body's poses onto the observer's own (its size, its rest posture) before
+    they are segmented and matched: the correspondence problem of Buchsbaum & Blumberg 2005, §7.1 and Kopp &
+    Graeser 2006, §6.
     """
 
 

@@ -55,6 +55,7 @@ ENV_TRACE = "LIKEME_TRACE_HOOKS"
 
 REGISTER_HOOKS: dict[str, str] = {
     "perception": "likeme_register_perceptions",
+    "correspondence": "likeme_register_correspondences",
     "segmenter": "likeme_register_segmenters",
     "matcher": "likeme_register_matchers",
     "motor": "likeme_register_motor_systems",

@@ -7,6 +7,8 @@ frames in. :class:`WatchingLoop` is that cycle, and the only copy of it:
 
     perceived frames (n, S, 3), visible (n, S)        in the observed body's S parts
       -> mapped by name onto the observer's own P parts   (once, here: nothing downstream maps parts again)
+      -> [with a correspondence: perceived log, hidden parts held, then correspondence.map_block: the
+          demonstrator's size and rest posture mapped onto the observer's own body]
       -> working memory, ObservationLog (F, P, 3) + (F, P) hidden parts held (toolkit.motion.fill_hidden)
       -> segmenter.push_block(the new rows)              segments that closed, the onset under way after each frame
       -> frame by frame, in order:
@@ -279,6 +281,7 @@ class WatchingLoop:
         self._call = call or (lambda key, method, *a, **k: call_component(character, key, method, *a, **k))
         self.listener = listener or Listener()
         self.memory = ObservationLog(character.body.parts, 30.0, capacity=1)
+        self.perceived: ObservationLog | None = None  # before correspondence (only with one)
         self._index = np.arange(len(character.body.parts))
         self._same = True  # the observed body's parts are the observer's, in order
         self._open: int | None = None  # start row of the segment the matcher follows
@@ -297,7 +300,9 @@ class WatchingLoop:
             raise ConfigError("the observed body shares no part with the observer's own", expected=f"parts named "
                               f"like the observer's: {list(own)}", available=list(parts))
         self.memory = ObservationLog(own, fps, capacity=capacity)
+        self.perceived = ObservationLog(own, fps, capacity=capacity) if self.character.correspondence else None
         self._open, self._view, self._early = None, None, None
+        self._call("correspondence", "reset", own, float(fps))
         self._call("segmenter", "reset", own, float(fps))
 
     def _onto(self, values: np.ndarray, fill: Any) -> np.ndarray:
@@ -310,13 +315,30 @@ class WatchingLoop:
         out[:, have] = values[:, self._index[have]]
         return out
 
+    def _remember(self, poses: np.ndarray, visible: np.ndarray, world: np.ndarray | None) -> int:
+        """Perceived frames in the observed parts into working memory, through the correspondence if there is one;
+        the first new row."""
+        first = self.memory.n
+        poses, visible = self._onto(poses, np.nan), self._onto(np.asarray(visible, dtype=bool), False)
+        world = None if world is None else self._onto(world, np.nan)
+        if self.perceived is not None and self.character.correspondence is not None:
+            self.perceived.extend(poses, visible, world)
+            held, seen = self.perceived.positions[first:], self.perceived.visible[first:]
+            mapped = self._call("correspondence", "map_block", held, seen)
+            if self.character.correspondence is not None:  # not dropped under a skip policy
+                mapped = np.asarray(mapped, dtype=float)
+                if mapped.shape != held.shape:
+                    raise PluginError(self.character.correspondence.name, "Correspondence.map_block",
+                                      f"returned an array of shape {mapped.shape}, expected {held.shape}")
+                poses, visible = mapped, seen
+        self.memory.extend(poses, visible, world)
+        return first
+
     def push(self, poses: np.ndarray, visible: np.ndarray, world: np.ndarray | None = None) -> list[Observation]:
         """Perceived frames in the order they arrived: root-relative poses (n, S, 3), visibility (n, S) and world
         positions (n, S, 3) if known, in the observed body's parts. Returns the observations of the segments that
         closed during them (the same whatever the packet sizes)."""
-        first = self.memory.n
-        self.memory.extend(self._onto(poses, np.nan), self._onto(np.asarray(visible, dtype=bool), False),
-                           None if world is None else self._onto(world, np.nan))
+        first = self._remember(poses, visible, world)
         n = self.memory.n - first
         segmenter = self.character.segmenter
         if n == 0 or segmenter is None:
@@ -349,9 +371,7 @@ class WatchingLoop:
     def classify(self, poses: np.ndarray, visible: np.ndarray, world: np.ndarray | None = None) -> Observation:
         """Frames (n, S, 3) taken as one whole segment, without the segmenter: what the matcher makes of them, and
         when (a streaming matcher is fed them one by one and may commit early)."""
-        first = self.memory.n
-        self.memory.extend(self._onto(poses, np.nan), self._onto(np.asarray(visible, dtype=bool), False),
-                           None if world is None else self._onto(world, np.nan))
+        first = self._remember(poses, visible, world)
         segment = Segment(first, max(first + 1, self.memory.n), self.memory.fps)
         return self._close(segment, announce=False)
 
