@@ -34,8 +34,11 @@ from toolkit.motion import Motion
 from toolkit.profile import BodyProfile
 from toolkit.watching import Observation, WatchingLoop
 
-__all__ = ["Observation", "Observer", "compose_observer", "OBSERVER_TEMPLATE", "is_observer_template",
+__all__ = ["Observation", "Observer", "compose_observer", "OBSERVER_TEMPLATE", "NO_CORRESPONDENCE", "is_observer_template",
            "check_observer_template"]
+
+NO_CORRESPONDENCE = "none"
+"""The correspondence name that means none (``--correspondence none``): the papers' plain observer."""
 
 OBSERVER_TEMPLATE = "observers/recordings.toml"
 """The observer template on the character path: the components an observer of recordings has by default."""
@@ -146,7 +149,8 @@ class Observer:
 
 def compose_observer(pm: Any, profile: BodyProfile, repertoire: str | Path, *, segmenter: str | None = None,
                      matcher: str | None = "", settings: Mapping[str, Mapping[str, Any]] | None = None,
-                     motor: str | None = None, template: str | Path = OBSERVER_TEMPLATE) -> Character:
+                     motor: str | None = None, correspondence: str | None = "",
+                     template: str | Path = OBSERVER_TEMPLATE) -> Character:
     """The observing character: ``profile``'s body, a repertoire from the clips in ``repertoire``, its components
     from ``template`` (an observer template: an ``[observer]`` table and component tables, no body) unless named
     here.
@@ -156,6 +160,9 @@ def compose_observer(pm: Any, profile: BodyProfile, repertoire: str | Path, *, s
     segmenter, matcher, motor : str, optional
         Plugin names replacing the template's; ``matcher=None`` composes no matcher (segmentation only). The motor
         system is the template's unless the matcher declares others (its ``motor_systems``): then its first.
+    correspondence : str, optional
+        A correspondence plugin replacing the template's; ``None`` or ``"none"``: none, the papers' plain
+        observer, which compares the demonstrator's poses with its own as they are.
     settings : mapping, optional
         Extra parameters per table (``{"matcher": {"k": 4}}``; ``{"perception": {"plugin": ...}}`` replaces one).
     """
@@ -169,6 +176,11 @@ def compose_observer(pm: Any, profile: BodyProfile, repertoire: str | Path, *, s
             tables[key] = {"plugin": name}
     if matcher is None:
         tables.pop("matcher", None)
+    if correspondence is None or correspondence == NO_CORRESPONDENCE:
+        tables.pop("correspondence", None)
+        settings.pop("correspondence", None)
+    elif correspondence:
+        tables["correspondence"] = {"plugin": correspondence}
     if "matcher" in tables:
         cls = pm.registry.get("matcher", tables["matcher"]["plugin"])
         wanted = cls.motor_systems
