@@ -33,6 +33,7 @@ from typing import Any, Protocol
 import networkx as nx
 import numpy as np
 
+from plugins.lib.attention import movement_weights
 from plugins.lib.pose_distance import path_distance, pose_distance
 from toolkit import Match, Matcher, Motion, Parameter, hookimpl
 from toolkit.components import provides
@@ -81,6 +82,9 @@ class PathSearch(Matcher):
         Parameter("max_distance", float, 0.03, "Mean eq. 1 distance (m) per sample above which the answer is "
                   "'unknown'. Must stay above the noise of the input (about 1.8 x its standard deviation).", minimum=0.0),
         Parameter("scale", float, 0.02, "Distance (m) at which confidence falls to 1/e.", minimum=1e-6),
+        Parameter("attention", float, 0.0, "How much the parts that move in the segment count over the still ones "
+                  "(plugins.lib.attention): 0 is eq. 1's plain mean over the visible parts, 1 counts only what "
+                  "moves.", minimum=0.0, maximum=1.0),
         Parameter("learn", bool, False, "Add an unknown movement's path to the posegraph as a new movement."),
         Parameter("learn_prefix", str, "learned", "Name prefix of learned movements (learned-1, learned-2...)."),
     )
@@ -124,12 +128,15 @@ class PathSearch(Matcher):
             return Match.unknown(reason="nothing visible")
         self._refresh()
         obs, vis = self.samples(motion)
-        path, _, evidence = self.search(obs, vis)  # the beam's eq. 3 cost: recomputed below by the one formula
+        weights = None
+        if self.params["attention"] > 0:
+            weights = movement_weights(obs, vis, self.params["attention"], ~self.owner.body.angle_mask)
+        path, _, evidence = self.search(obs, vis, weights)  # the beam's eq. 3 cost: recomputed below by the one formula
         if path is None:
             return Match.unknown(reason="nothing visible")
         labels = self.labels[path]
         voting = labels[labels != ""]
-        mean = path_distance(obs, self.motor.node_root_relative[path], vis) / max(evidence, 1)  # eq. 3 per sample
+        mean = path_distance(obs, self.motor.node_root_relative[path], vis, weights) / max(evidence, 1)  # eq. 3 per sample
         details: dict[str, Any] = {"mean_distance": mean, "samples": len(path)}
         if voting.size == 0:
             return Match.unknown(reason="only hub poses", path=tuple(self.node_names[i] for i in path), **details)
@@ -141,12 +148,15 @@ class PathSearch(Matcher):
         if mean > self.params["max_distance"]:
             if self.params["learn"]:
                 return self._learn(obs, vis, details)
-            return Match(None, 0.0, None, node_path, {"reason": "too far from every path", "nearest": movement, **details})
+            return Match(None, 0.0, None, node_path, {"reason": "too far from every path", "nearest": movement,
+                                                      "max_distance": self.params["max_distance"], **details})
         confidence = float(np.exp(-mean / self.params["scale"]) * share)
         return Match(movement, confidence, None, node_path, details)
 
-    def search(self, obs: np.ndarray, vis: np.ndarray) -> tuple[np.ndarray | None, float, int]:
-        """The best path (node indices, one per sample), its eq. 3 cost and the number of samples with evidence."""
+    def search(self, obs: np.ndarray, vis: np.ndarray, weights: np.ndarray | None = None
+               ) -> tuple[np.ndarray | None, float, int]:
+        """The best path (node indices, one per sample), its eq. 3 cost and the number of samples with evidence;
+        ``weights`` (P,): attention to each part (``None``: eq. 1's plain mean)."""
         has = vis.any(axis=1)
         if not has.any():
             return None, 0.0, 0
@@ -156,17 +166,17 @@ class PathSearch(Matcher):
         mid = int(ev[np.argmin(np.abs(ev - mid))])  # the visible frame nearest the middle
         nodes = self.motor.node_root_relative
         k = self.params["k"]
-        first = pose_distance(nodes, obs[mid], vis[mid])
+        first = pose_distance(nodes, obs[mid], vis[mid], weights)
         start = np.argsort(first, kind="stable")[:k]
         # beams: array of paths (B, length) and costs (B,)
         paths = start[:, None]
         costs = first[start]
-        paths, costs = self._extend(paths, costs, obs, vis, range(mid + 1, n), self.succ, append=True)
-        paths, costs = self._extend(paths, costs, obs, vis, range(mid - 1, -1, -1), self.pred, append=False)
+        paths, costs = self._extend(paths, costs, obs, vis, range(mid + 1, n), self.succ, weights, append=True)
+        paths, costs = self._extend(paths, costs, obs, vis, range(mid - 1, -1, -1), self.pred, weights, append=False)
         best = int(np.argmin(costs))
         return paths[best], float(costs[best]), int(has.sum())
 
-    def _extend(self, paths, costs, obs, vis, frames, table, *, append: bool):
+    def _extend(self, paths, costs, obs, vis, frames, table, weights, *, append: bool):
         nodes = self.motor.node_root_relative
         k = self.params["k"]
         for t in frames:
@@ -176,7 +186,8 @@ class PathSearch(Matcher):
             seen = vis[t]
             if seen.any():  # eq. 1 over the parts seen in this sample: the mask is the same for every candidate, so
                 # the seen parts are taken first and pose_distance needs no mask (the hot loop of the search)
-                step = pose_distance(nodes[cand][:, seen], obs[t, seen])
+                step = pose_distance(nodes[cand][:, seen], obs[t, seen], None,
+                                     None if weights is None else weights[seen])
             else:
                 step = np.zeros(len(cand))
             total = costs[beam] + step
