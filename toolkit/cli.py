@@ -92,6 +92,8 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p.add_argument("--segmenter", metavar="NAME", help="segmenter (default: the observer template's, "
                    "characters/observers/recordings.toml)")
     p.add_argument("--matcher", metavar="NAME", help="matcher (default: the observer template's)")
+    p.add_argument("--correspondence", metavar="NAME", help="correspondence (default: the observer template's; "
+                   "none: the papers' plain observer)")
     p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
                    help="override a parameter of the observer, e.g. --set matcher.k=4 (repeatable)")
     p.add_argument("--json", action="store_true", help="print JSON instead of text")
@@ -329,16 +331,16 @@ def cmd_show(args: argparse.Namespace, pm: PluginManager) -> int:
 def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
     import json
 
-    from toolkit.observe import Observer, compose_observer
+    from toolkit.observe import NO_CORRESPONDENCE, Observer, compose_observer
     from toolkit.params import parse_settings
     from toolkit.profile import load_profile
 
     profile = load_profile(args.body)
-    for name, kind in ((args.segmenter, "segmenter"), (args.matcher, "matcher")):
-        if name is not None:
+    for name, kind in ((args.segmenter, "segmenter"), (args.matcher, "matcher"), (args.correspondence, "correspondence")):
+        if name is not None and name != NO_CORRESPONDENCE:
             pm.registry.get(kind, name)  # an unknown name fails here, listing the registered ones
     character = compose_observer(pm, profile, args.repertoire, segmenter=args.segmenter, matcher=args.matcher or "",
-                                 settings=parse_settings(list(args.set)))
+                                 correspondence=args.correspondence or "", settings=parse_settings(list(args.set)))
     report = []
     for path in args.files:
         motion = profile.read(path)
@@ -349,7 +351,7 @@ def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
              "end_s": round(o.segment.end_time, 3), "movement": o.movement or "unknown",
              "confidence": round(o.match.confidence, 3) if o.match else 0.0,
              "decided_at_frame": o.segment.start + (o.decided_at if o.decided_at is not None else o.segment.n_frames),
-             "decision_fraction": round(o.decision_fraction, 3)} for o in found]})
+             "decision_fraction": round(o.decision_fraction, 3), **_why_unknown(o)} for o in found]})
     if args.json:
         print(json.dumps(report, indent=1))
         return 0
@@ -360,7 +362,35 @@ def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
             print(f"  frames {seg['start_frame']:5d}-{seg['end_frame']:<5d} ({seg['start_s']:6.2f}-{seg['end_s']:6.2f} s)  "
                   f"{seg['movement']:<16} confidence {seg['confidence']:.2f}  decided at frame {seg['decided_at_frame']} "
                   f"({seg['decision_fraction']:.0%} of the segment)")
+            if "nearest" in seg or "reason" in seg:
+                print(f"    {_why_text(seg)}")
     return 0
+
+
+_WHY_NUMBERS = ("mean_distance", "max_distance", "predicted_frames", "error_when_dropped", "distance")
+"""The numbers a matcher gives with an unknown answer that say why it rejected the nearest movement."""
+
+
+def _why_unknown(observation: Any) -> dict[str, Any]:
+    """For an unknown segment: the nearest movement and why it was rejected, as the matcher told (else nothing)."""
+    match = observation.match
+    if match is None or match.movement is not None:
+        return {}
+    d = match.details
+    out: dict[str, Any] = {}
+    if d.get("nearest"):
+        out["nearest"] = str(d["nearest"])
+    if d.get("reason"):
+        out["reason"] = str(d["reason"])
+    out.update({k: round(float(d[k]), 4) for k in _WHY_NUMBERS if isinstance(d.get(k), (int, float))})
+    return out
+
+
+def _why_text(seg: dict[str, Any]) -> str:
+    """One line: 'nearest bow, rejected: too far from every path (mean_distance 0.081 > max_distance 0.03)'."""
+    numbers = ", ".join(f"{k} {seg[k]:g}" for k in _WHY_NUMBERS if k in seg)
+    nearest = f"nearest {seg['nearest']}" if "nearest" in seg else "no nearest movement"
+    return f"{nearest}, rejected: {seg.get('reason', 'no reason given')}" + (f" ({numbers})" if numbers else "")
 
 
 def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:

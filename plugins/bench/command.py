@@ -30,6 +30,8 @@ def _handler(module: str, function: str, *extra: Any):
 
 def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--body", required=True, metavar="PROFILE", help="body profile TOML of the files")
+    p.add_argument("--correspondence", metavar="NAME", default="", help="correspondence (default: the observer "
+                   "template's; none: the papers' plain observer)")
     p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
                    help="override a parameter of the observer, e.g. --set matcher.k=4 (repeatable)")
     p.add_argument("--json", metavar="FILE", help="also write the results as JSON")
@@ -45,6 +47,9 @@ def _motion_capture_commands(sub: Any) -> None:
     p.add_argument("--repertoire", required=True, metavar="DIR", help="labelled clips: one folder per movement")
     p.add_argument("--demos", required=True, metavar="DIR", help="demo clips: one folder per true movement")
     p.add_argument("--matcher", action="append", metavar="NAME", help=f"matcher (repeatable; default: {', '.join(MATCHERS)})")
+    p.add_argument("--protocol", choices=("closed", "open"), default="closed",
+                   help="closed: every demo against the whole repertoire; open: the demos of each movement against "
+                   "the repertoire without it (leave one movement out: only 'unknown' is right)")
     p.set_defaults(handler=_handler("mocap", "run", "recognition"))
 
     p = sub.add_parser("segmentation", help="segment streams with known segments with every segmenter named")

@@ -21,8 +21,10 @@ import csv
 import io
 import json
 import platform
+import tempfile
 import time
 from collections.abc import Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -31,6 +33,7 @@ import numpy as np
 from plugins.bench.command import MATCHERS, SEGMENTERS
 from plugins.bench.data import read_segments
 from plugins.bench.metrics import movement_error_rate, segmentation_scores
+from plugins.lib.clip_repertoire import clip_files
 from toolkit import ConfigError
 from toolkit.observe import Observer, compose_observer
 from toolkit.profile import load_profile
@@ -43,8 +46,6 @@ __all__ = ["MATCHERS", "SEGMENTERS", "recognition", "segmentation", "stream", "t
 
 
 def _labelled(folder: Path) -> list[tuple[str, Path]]:
-    from plugins.lib.clip_repertoire import clip_files
-
     return [(label, p) for label, files in clip_files(folder).items() for p in files]
 
 
@@ -108,31 +109,83 @@ def _progress(items: list, label: str, quiet: bool):
 
 
 def recognition(pm, profile, repertoire: Path, demos: Path, matchers: Sequence[str], *, settings=None,
-                quiet: bool = True) -> dict[str, Any]:
-    """Classify every demo clip with every matcher; per-plugin scores and per-item rows."""
+                quiet: bool = True, correspondence: str | None = "", protocol: str = "closed") -> dict[str, Any]:
+    """Classify every demo clip with every matcher; per-plugin scores and per-item rows.
+
+    A demo whose movement (its folder's name) is not in the repertoire is right when it is answered "unknown".
+    ``protocol``: ``"closed"`` classifies every demo against the whole repertoire; ``"open"`` (leave one movement
+    out) classifies the demos of each movement against the repertoire without that movement, so every demo is of
+    a movement the observer does not know and only "unknown" is right: the rejection rate.
+    """
     items = _labelled(demos)
     motions = [(label, path, profile.read(path)) for label, path in items]
+    known = set(clip_files(Path(repertoire)))
+    if protocol == "open":
+        runs = [(label, [m for m in motions if m[0] == label]) for label in sorted({m[0] for m in motions} & known)]
+        if not runs:
+            raise ConfigError("no demo of a repertoire movement to leave out", file=demos,
+                              expected="demo folders named like repertoire movements", available=sorted(known))
+    elif protocol == "closed":
+        runs = [(None, motions)]
+    else:
+        raise ConfigError(f"unknown protocol {protocol!r}", key=("protocol",), expected="a protocol",
+                          available=["closed", "open"])
     plugins, rows = [], []
     for name in matchers:
-        clock = _Clock(compose_observer(pm, profile, repertoire, matcher=name, settings=settings), profile)
-        truth, predicted, fractions = [], [], []
-        for label, path, motion in _progress(motions, f"recognition {name}", quiet):
-            obs = clock.run("classify", motion)
-            truth.append(label)
-            predicted.append(obs.movement or "unknown")
-            fractions.append(obs.decision_fraction)
-            rows.append({"plugin": name, "item": path.name, "truth": label, "recognised": obs.movement or "unknown",
-                         "confidence": round(obs.match.confidence, 4) if obs.match else 0.0,
-                         "decision_fraction": round(obs.decision_fraction, 4), "frames": motion.n_frames})
+        truth, predicted, fractions, frames, seconds = [], [], [], 0, 0.0
+        for left_out, group in runs:
+            with _repertoire_without(Path(repertoire), left_out) as folder:
+                clock = _Clock(compose_observer(pm, profile, folder, matcher=name, settings=settings,
+                                                correspondence=correspondence), profile)
+                movements = set(clock.character.motor.movements())
+                for label, path, motion in _progress(group, f"recognition {name}", quiet):
+                    obs = clock.run("classify", motion)
+                    expected = label if label in movements else UNKNOWN
+                    truth.append(expected)
+                    predicted.append(obs.movement or UNKNOWN)
+                    fractions.append(obs.decision_fraction)
+                    details = obs.match.details if obs.match else {}
+                    rows.append({"plugin": name, "item": path.name, "truth": expected, "movement": label,
+                                 "recognised": obs.movement or UNKNOWN,
+                                 "nearest": str(details.get("nearest", obs.movement or "")),
+                                 "reason": str(details.get("reason", "")),
+                                 "confidence": round(obs.match.confidence, 4) if obs.match else 0.0,
+                                 "decision_fraction": round(obs.decision_fraction, 4), "frames": motion.n_frames})
+                frames, seconds = frames + clock.frames, seconds + clock.seconds
         labels = sorted(set(truth) | set(predicted))
         confusion = np.zeros((len(labels), len(labels)), dtype=int)
         for t, p in zip(truth, predicted):
             confusion[labels.index(t), labels.index(p)] += 1
-        plugins.append({"plugin": name, "accuracy": float(np.mean([t == p for t, p in zip(truth, predicted)])),
+        right = [t == p for t, p in zip(truth, predicted)]
+        seen = [r for r, t in zip(right, truth) if t != UNKNOWN]
+        unseen = [r for r, t in zip(right, truth) if t == UNKNOWN]
+        plugins.append({"plugin": name, "accuracy": float(np.mean(right)),
+                        "known_accuracy": float(np.mean(seen)) if seen else float("nan"),
+                        "rejection": float(np.mean(unseen)) if unseen else float("nan"),
                         "macro_f1": _macro_f1(truth, predicted), "decision_median": float(np.median(fractions)),
-                        "decision_p90": float(np.percentile(fractions, 90)), "fps": clock.fps,
+                        "decision_p90": float(np.percentile(fractions, 90)), "fps": frames / max(seconds, 1e-9),
                         "items": len(truth), "labels": labels, "confusion": confusion.tolist()})
-    return {"benchmark": "recognition", "plugins": plugins, "items": rows}
+    return {"benchmark": "recognition", "protocol": protocol, "plugins": plugins, "items": rows}
+
+
+UNKNOWN = "unknown"
+"""What a demo of a movement the observer does not know should be answered."""
+
+
+@contextmanager
+def _repertoire_without(folder: Path, movement: str | None):
+    """``folder``, or (leaving ``movement`` out) a temporary folder of links to its other movements' clips."""
+    if movement is None:
+        yield folder
+        return
+    with tempfile.TemporaryDirectory(prefix="likeme-open-") as tmp:
+        for name, files in clip_files(folder).items():
+            if name == movement:
+                continue
+            (Path(tmp) / name).mkdir()
+            for f in files:
+                (Path(tmp) / name / f.name).symlink_to(f.resolve())
+        yield Path(tmp)
 
 
 def _macro_f1(truth: Sequence[str], predicted: Sequence[str]) -> float:
@@ -146,12 +199,12 @@ def _macro_f1(truth: Sequence[str], predicted: Sequence[str]) -> float:
 
 
 def segmentation(pm, profile, streams: Path, segmenters: Sequence[str], *, repertoire: Path | None = None,
-                 settings=None, quiet: bool = True) -> dict[str, Any]:
+                 settings=None, quiet: bool = True, correspondence: str | None = "") -> dict[str, Any]:
     """Segment every stream with every segmenter; precision, recall, F1, boundary error and speed."""
     data = [(path, truth, profile.read(path)) for path, truth in _streams(streams)]
     plugins, rows = [], []
     for name in segmenters:
-        clock = _Clock(compose_observer(pm, profile, repertoire or streams, segmenter=name, matcher=None,
+        clock = _Clock(compose_observer(pm, profile, repertoire or streams, segmenter=name, matcher=None, correspondence=correspondence,
                                         settings=settings), profile)
         found_all = true_all = tp = 0
         errors = []
@@ -173,13 +226,14 @@ def segmentation(pm, profile, streams: Path, segmenters: Sequence[str], *, reper
 
 
 def stream(pm, profile, repertoire: Path, streams: Path, segmenters: Sequence[str], matchers: Sequence[str], *,
-           settings=None, quiet: bool = True) -> dict[str, Any]:
+           settings=None, quiet: bool = True, correspondence: str | None = "") -> dict[str, Any]:
     """Segment and recognise every stream with every pairing; the movement error rate."""
     data = [(path, truth, profile.read(path)) for path, truth in _streams(streams)]
     plugins, rows = [], []
     for seg in segmenters:
         for mat in matchers:
-            clock = _Clock(compose_observer(pm, profile, repertoire, segmenter=seg, matcher=mat, settings=settings),
+            clock = _Clock(compose_observer(pm, profile, repertoire, segmenter=seg, matcher=mat, settings=settings,
+                                            correspondence=correspondence),
                            profile)
             errors, true_count = 0.0, 0
             for path, truth, motion in _progress(data, f"stream {seg} + {mat}", quiet):
@@ -197,7 +251,8 @@ def stream(pm, profile, repertoire: Path, streams: Path, segmenters: Sequence[st
 
 
 COLUMNS = {
-    "recognition": [("accuracy", "{:.3f}"), ("macro_f1", "{:.3f}"), ("decision_median", "{:.2f}"),
+    "recognition": [("accuracy", "{:.3f}"), ("known_accuracy", "{:.3f}"), ("rejection", "{:.3f}"),
+                    ("macro_f1", "{:.3f}"), ("decision_median", "{:.2f}"),
                     ("decision_p90", "{:.2f}"), ("fps", "{:.0f}"), ("items", "{}")],
     "segmentation": [("precision", "{:.3f}"), ("recall", "{:.3f}"), ("f1", "{:.3f}"), ("boundary_error", "{:.1f}"),
                      ("fps", "{:.0f}"), ("items", "{}")],
@@ -205,12 +260,17 @@ COLUMNS = {
 }
 
 
+def _cell(fmt: str, value: Any) -> str:
+    """A table cell; a score that does not apply (NaN: no demo of an unknown movement to reject) is '-'."""
+    return "-" if isinstance(value, float) and np.isnan(value) else fmt.format(value)
+
+
 def table(result: dict[str, Any]) -> str:
     """A markdown table of a result's per-plugin rows."""
     cols = COLUMNS[result["benchmark"]]
     lines = ["| plugin | " + " | ".join(c for c, _ in cols) + " |", "|---" * (len(cols) + 1) + "|"]
     for row in result["plugins"]:
-        lines.append(f"| {row['plugin']} | " + " | ".join(fmt.format(row[c]) for c, fmt in cols) + " |")
+        lines.append(f"| {row['plugin']} | " + " | ".join(_cell(fmt, row[c]) for c, fmt in cols) + " |")
     return "\n".join(lines)
 
 
@@ -277,14 +337,16 @@ def run(kind: str, args: Any, pm: Any) -> int:
     settings = _settings(args.set)
     if kind == "recognition":
         result = recognition(pm, profile, Path(args.repertoire), Path(args.demos), args.matcher or MATCHERS,
-                             settings=settings, quiet=args.quiet)
+                             settings=settings, quiet=args.quiet, correspondence=args.correspondence,
+                             protocol=args.protocol)
     elif kind == "segmentation":
         result = segmentation(pm, profile, Path(args.streams), args.segmenter or SEGMENTERS,
                               repertoire=Path(args.repertoire) if args.repertoire else None, settings=settings,
-                              quiet=args.quiet)
+                              quiet=args.quiet, correspondence=args.correspondence)
     else:
         result = stream(pm, profile, Path(args.repertoire), Path(args.streams), args.segmenter or SEGMENTERS[:2],
-                        args.matcher or MATCHERS, settings=settings, quiet=args.quiet)
+                        args.matcher or MATCHERS, settings=settings, quiet=args.quiet,
+                        correspondence=args.correspondence)
     print(table(result))
     if kind == "recognition":
         for row in result["plugins"]:

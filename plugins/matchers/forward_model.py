@@ -280,6 +280,20 @@ class ForwardModel(Matcher):
         return MappingProxyType({**view(self.main), "frames": 0 if self._memory is None else self._memory.n,
                                  "tracks": {name: view(track) for name, track in self.tracks.items()}})
 
+    def _nearest(self) -> dict[str, Any]:
+        """For an unknown answer: the candidate of the first subsystem to move that predicted the demonstration
+        longest before it was dropped (``nearest``, its movement), and for how many frames (``predicted_frames``)."""
+        track = self.main
+        if track is None or not track.trace:
+            return {}
+        last: dict[tuple[str, ...], tuple[int, float]] = {}
+        for frame, errors in track.trace:
+            for path, error in errors.items():
+                last[path] = (frame, error)
+        path, (frame, error) = max(last.items(), key=lambda kv: (kv[1][0], -kv[1][1]))
+        label = self._movement_key(tuple(path)) if path else None
+        return {"nearest": label, "predicted_frames": int(frame), "error_when_dropped": float(error)}
+
     def _local(self) -> np.ndarray:
         """The working memory in the observer's motor frame (n, P, 3): root-relative positions placed at its own
         root height (finger angles as seen); hidden parts held, never-seen parts NaN."""
@@ -676,7 +690,7 @@ class ForwardModel(Matcher):
         if not perform:
             if self.reported:
                 return None  # already reported when it committed
-            return Match.unknown(reason="no edge predicts the demonstration")
+            return Match.unknown(reason="no edge predicts the demonstration", **self._nearest())
         movement = self.motor.add_together(perform)
         main = self.main
         details: dict[str, Any] = {"candidates": [c for t in self.tracks.values() for c in t.initial],
