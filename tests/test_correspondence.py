@@ -6,6 +6,7 @@ skeleton the test builds, the watching loop with and without it, and the open-se
 
 from __future__ import annotations
 
+import warnings
 from types import SimpleNamespace
 
 import numpy as np
@@ -106,7 +107,8 @@ def test_running_lengths_are_the_causal_mean_whatever_the_blocks(sizes):
     values[rng.random(values.shape) < 0.3] = np.nan
     running = RunningLengths(3)
     got = np.concatenate([running.update(values[a:b]) for a, b in _blocks(sizes)])
-    with _quiet():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # nanmean of a column not seen yet
         expected = np.array([np.nanmean(values[: i + 1], axis=0) for i in range(len(values))])
     np.testing.assert_allclose(got, expected, equal_nan=True)
 
@@ -146,6 +148,18 @@ def test_body_mapping_turns_a_larger_leaning_demonstrator_into_ones_own_movement
     assert np.nanmean(pose_distance(mapped[:45], REST)) < 0.01  # their stance reads as one's own rest
 
 
+def test_inspect_reports_the_estimates_so_far():
+    component = mapping()
+    np.testing.assert_allclose(component.inspect()["rest"], REST)  # nothing seen yet: one's own rest
+    component.map_block(demonstrator(1.25, 0.0)[:45], np.ones((45, len(PARTS)), bool))
+    signals = component.inspect()
+    np.testing.assert_allclose(signals["their_lengths"], 1.25 * signals["own_lengths"])
+    stance = demonstrator(1.25, 0.08)[:45]
+    unsized = mapping(size="none")
+    unsized.map_block(stance, np.ones((45, len(PARTS)), bool))
+    assert pose_distance(unsized.inspect()["rest"], stance[0]) < 0.01  # their stance (the prior weighs one frame)
+
+
 def test_each_step_can_be_switched_off():
     seen = demonstrator(1.25, 0.0)
     vis = np.ones(seen.shape[:2], bool)
@@ -179,18 +193,6 @@ def test_hidden_parts_are_mapped_from_where_they_were_last_seen():
 def _blocks(sizes):
     edges = np.concatenate([[0], np.cumsum(sizes)])
     return list(zip(edges[:-1], edges[1:]))
-
-
-class _quiet:
-    def __enter__(self):
-        import warnings
-
-        self._ctx = warnings.catch_warnings()
-        self._ctx.__enter__()
-        warnings.simplefilter("ignore", RuntimeWarning)
-
-    def __exit__(self, *exc):
-        return self._ctx.__exit__(*exc)
 
 
 # -- in the observer ---------------------------------------------------------------------------------------

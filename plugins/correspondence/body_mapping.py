@@ -83,8 +83,6 @@ class BodyMapping(Correspondence):
         self._lengths = RunningLengths(len(self.pairs))
         self._rest = RestPosture(len(self.hub), self._fps, dwell_speed=self.params["dwell_speed"],
                                  window=self.params["window"], memory=self.params["memory"], prior=self.hub)
-        self._last_rest: np.ndarray | None = None
-        self._last_scale: np.ndarray | None = None
 
     def map_block(self, poses: np.ndarray, visible: np.ndarray) -> np.ndarray:
         poses = np.asarray(poses, dtype=float)
@@ -93,13 +91,9 @@ class BodyMapping(Correspondence):
             return poses.copy()
         root = poses[:, self.root : self.root + 1]
         rel = poses - root
-        out = rel.copy()
-        if self.params["size"] == "bones":
-            out = self._resize(rel, visible)
+        out = self._resize(rel, visible) if self.params["size"] == "bones" else rel
         if self.params["rest"] == "dwell":
-            rest = self._rest.update(out, visible, self.size)
-            self._last_rest = rest[-1]
-            out = out - rest + self.hub
+            out = out - self._rest.update(out, visible, self.size) + self.hub
         out = out + root
         out[:, ~self.positions] = poses[:, ~self.positions]
         return out
@@ -110,7 +104,6 @@ class BodyMapping(Correspondence):
         if not len(self.pairs):  # nothing rigid in one's own body: size cannot be measured
             return rel
         theirs = self._lengths.update(bone_lengths(rel, visible, self.pairs))
-        self._last_scale = theirs[-1].copy()
         known = np.isfinite(theirs) & (theirs > 1e-9)
         with np.errstate(invalid="ignore", divide="ignore"):
             whole = (np.where(known, self.own_lengths, 0.0).sum(axis=1) / np.where(known, theirs, 0.0).sum(axis=1))
@@ -126,12 +119,12 @@ class BodyMapping(Correspondence):
         return retarget(out, self.tree, ratio, self.root)
 
     def inspect(self) -> Mapping[str, Any]:
-        """The current estimates: the demonstrator's rest posture (root-relative, after resizing) and bone lengths
-        (or body size without bones), and the observer's own."""
+        """The current estimates: the demonstrator's rest posture (root-relative, after resizing; one's own hub
+        until they have been seen still) and the lengths of the rigid links on them, and the observer's own."""
         return MappingProxyType({
-            "rest": None if self._last_rest is None else self._last_rest.copy(),
+            "rest": self._rest.current if self.params["rest"] == "dwell" else None,
             "hub": self.hub.copy(),
-            "their_lengths": None if self._last_scale is None else self._last_scale.copy(),
+            "their_lengths": self._lengths.mean,
             "own_lengths": self.own_lengths.copy(),
             "rigid_pairs": [(self.owner.body.parts[i], self.owner.body.parts[j]) for i, j in self.pairs],
             "size": self.size,

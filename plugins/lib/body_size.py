@@ -98,8 +98,17 @@ class RunningLengths:
         count = self.count + np.cumsum(seen, axis=0)
         if len(lengths):
             self.total, self.count = total[-1].copy(), count[-1].copy()
-        with np.errstate(invalid="ignore", divide="ignore"):
-            return np.where(count > 0, total / np.maximum(count, 1), np.nan)
+        return _mean(total, count)
+
+    @property
+    def mean(self) -> np.ndarray:
+        """The mean of every length seen so far (B,); NaN for a bone not seen yet."""
+        return _mean(self.total, self.count)
+
+
+def _mean(total: np.ndarray, count: np.ndarray) -> np.ndarray:
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(count > 0, total / np.maximum(count, 1), np.nan)
 
 
 def retarget(poses: np.ndarray, tree: np.ndarray, ratio: np.ndarray, root: int) -> np.ndarray:

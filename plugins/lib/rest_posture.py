@@ -58,6 +58,11 @@ class RestPosture:
         self._sum = np.zeros(n_parts * 3) if prior is None else np.asarray(prior, dtype=float).reshape(-1).copy()
         self._weight = 0.0 if prior is None else 1.0
 
+    @property
+    def current(self) -> np.ndarray | None:
+        """The estimate after the last frame given (P, 3); ``None`` before the first (and without a prior)."""
+        return None if self._weight <= 0 else (self._sum / self._weight).reshape(-1, 3)
+
     def update(self, poses: np.ndarray, visible: np.ndarray, size: float) -> np.ndarray:
         """The rest posture after each frame of a block (n, P, 3): poses (n, P, 3) hidden parts held, masks (n, P),
         ``size`` the body's size (m) that speeds are measured in."""
