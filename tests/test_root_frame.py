@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from plugins.lib.root_frame import HeadingFilter, facing_heading, to_root_relative
+from plugins.lib.root_frame import HeadingFilter, facing_heading, smooth_heading, to_root_relative
 from tests.conftest import CHARACTERS
 from toolkit import load_character
 from toolkit.motion import local_to_world
@@ -91,3 +91,34 @@ def test_a_block_of_facing_estimates_filters_as_one_estimate_at_a_time(window, s
     if len(finite):  # the first estimate comes through unchanged; before it there is no facing
         first = int(np.flatnonzero(np.isfinite(headings))[0])
         assert np.isnan(expected[:first]).all() and expected[first] == pytest.approx(finite[0])
+
+
+@settings(max_examples=50, deadline=None)
+@given(facing=st.floats(-3.14, 3.14), start=st.integers(0, 27), flipped=st.integers(1, 7),
+       noise=st.floats(0.0, 0.05), seed=st.integers(0, 1000))
+def test_a_run_of_estimates_flipped_by_half_a_turn_does_not_turn_the_clip(facing, start, flipped, noise, seed):
+    """A stride puts the toe tip behind its toes for a few frames, flipping the estimate by π: the centred median
+    over a window holds the facing wherever it lies (across ±π too), before, during and after the flipped run."""
+    rng = np.random.default_rng(seed)
+    estimates = facing + rng.uniform(-noise, noise, 30)
+    estimates[start:start + flipped] += np.pi
+    estimates = np.angle(np.exp(1j * estimates))
+    smoothed = smooth_heading(estimates, 15)
+    assert np.abs(np.angle(np.exp(1j * (smoothed - facing)))).max() <= noise + 1e-9
+
+
+def test_smoothing_leaves_frames_without_an_estimate_in_their_window_unknown():
+    estimates = np.r_[np.full(10, np.nan), 0.5, 0.6, np.full(10, np.nan)]
+    smoothed = smooth_heading(estimates, 5)
+    assert np.isnan(smoothed[:8]).all() and np.isnan(smoothed[14:]).all()
+    assert np.allclose(smoothed[8:14], [0.5, 0.55, 0.55, 0.55, 0.55, 0.6])
+    assert np.allclose(smooth_heading(np.r_[0.1, 0.2, 0.3], 30), 0.2)  # a clip shorter than the window: one window
+
+
+def test_a_flipped_newest_estimate_does_not_split_the_stream_at_half_a_turn():
+    """Streaming, the newest estimate flipped by π must not be the reference the others are unwrapped around: they
+    would fall either side of ±π with their noise and the median would land on the flip."""
+    rng = np.random.default_rng(3)
+    filt = HeadingFilter(11)
+    filt.update_many(rng.uniform(-0.02, 0.02, 10))
+    assert abs(filt.update(np.pi - 0.01)) < 0.05

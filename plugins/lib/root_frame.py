@@ -75,13 +75,32 @@ def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body) -> np.nda
     return heading
 
 
+def _circular_median(windows: np.ndarray) -> np.ndarray:
+    """The median of each row of angles (n, w), NaN ignored, unwrapped around the row's own circular mean.
+
+    Unwrapping around one estimate (the newest, say) splits the others at ±π when that estimate is flipped by half
+    a turn; around the mean of the row, the majority stays together and outvotes the flipped few. Rows with no
+    finite angle give NaN.
+    """
+    ok = np.isfinite(windows)
+    angles = np.where(ok, windows, 0.0)
+    ref = np.angle(np.where(ok, np.exp(1j * angles), 0.0).sum(axis=1))[:, None]
+    unwrapped = np.where(ok, ref + np.angle(np.exp(1j * (angles - ref))), np.nan)
+    if ok.all():  # the common case, without nanmedian's cost
+        return np.angle(np.exp(1j * np.median(unwrapped, axis=1)))
+    out = np.full(len(windows), np.nan)
+    some = ok.any(axis=1)
+    out[some] = np.angle(np.exp(1j * np.nanmedian(unwrapped[some], axis=1)))
+    return out
+
+
 class HeadingFilter:
     """A running median of recent facing estimates, for a stream of frames.
 
     The facing found from the knees swings when one knee lifts (a kick, a stomp)
     and the nose swings when the head turns, while a body standing in place turns
     slowly. The median over the last ``window`` frames (circular: angles are
-    unwrapped around the newest estimate) keeps the facing steady through such
+    unwrapped around their circular mean, :func:`_circular_median`) keeps the facing steady through such
     limb movements and still follows a real turn after half a window.
     A window of 1 returns each estimate unchanged.
     """
@@ -97,7 +116,7 @@ class HeadingFilter:
         """Add one estimate (NaN when there was none) and return the filtered facing (NaN if none yet).
 
         The same as :meth:`update_many` of one estimate, without its block machinery (a perception calls it every
-        frame): the circular median of the last ``window`` estimates, unwrapped around the newest.
+        frame): the circular median of the last ``window`` estimates.
         """
         if np.isfinite(heading):
             self._recent.append(float(heading))
@@ -105,15 +124,13 @@ class HeadingFilter:
                 del self._recent[0]
         if not self._recent:
             return float("nan")
-        recent = np.asarray(self._recent)
-        ref = recent[-1]
-        return float(np.angle(np.exp(1j * np.median(ref + np.angle(np.exp(1j * (recent - ref)))))))
+        return float(_circular_median(np.asarray(self._recent)[None])[0])
 
     def update_many(self, headings: np.ndarray) -> np.ndarray:
         """Add estimates (n,) one after another; the filtered facing after each, as :meth:`update` gives it.
 
-        Each output is the circular median of the last ``window`` finite estimates up to its frame, unwrapped
-        around the newest of them; vectorised over the block.
+        Each output is the circular median of the last ``window`` finite estimates up to its frame
+        (:func:`_circular_median`); vectorised over the block.
         """
         h = np.asarray(headings, dtype=float)
         finite = np.isfinite(h)
@@ -124,45 +141,30 @@ class HeadingFilter:
         have = ends > 0
         if not have.any():
             return out
-        w = self.window
-        padded = np.concatenate([np.full(w - 1, np.nan), estimates])
-        windows = np.lib.stride_tricks.sliding_window_view(padded, w)[ends[have] - 1]  # the last w up to each frame
-        ref = estimates[ends[have] - 1][:, None]
-        unwrapped = ref + np.angle(np.exp(1j * (windows - ref)))
-        full = ends[have] >= w
-        med = np.empty(len(windows))
-        if full.any():
-            med[full] = np.median(unwrapped[full], axis=1)
-        if not full.all():  # the first frames of a stream: fewer than w estimates yet (the rest is padding)
-            med[~full] = np.nanmedian(unwrapped[~full], axis=1)
-        out[have] = np.angle(np.exp(1j * med))
+        padded = np.concatenate([np.full(self.window - 1, np.nan), estimates])
+        windows = np.lib.stride_tricks.sliding_window_view(padded, self.window)[ends[have] - 1]  # last w to each frame
+        out[have] = _circular_median(windows)
         return out
 
 
 def smooth_heading(heading: np.ndarray, window: int) -> np.ndarray:
     """A centred running circular median of headings (F,) over ``window`` frames, for whole recordings.
 
-    The batch counterpart of :class:`HeadingFilter` (which, streaming, can only look back).
+    The batch counterpart of :class:`HeadingFilter` (which, streaming, can only look back). Each window's estimates
+    are unwrapped around that window's own circular mean before the median is taken, so a run of estimates that
+    crosses ±π, or a few estimates flipped by half a turn, never pulls the median round (unwrapping the whole clip
+    at once would let one flip carry every later frame with it). Near the clip's ends the window keeps its width and
+    slides inside the clip, so the first and last frames are outvoted as often as the middle ones.
     NaN estimates are ignored; frames with no estimate in their window stay NaN.
     """
     heading = np.asarray(heading, dtype=float)
     n, half = len(heading), max(1, int(window)) // 2
-    if n == 0 or window <= 1:
+    if n == 0 or window <= 1 or not np.isfinite(heading).any():
         return heading.copy()
-    ok = np.isfinite(heading)
-    if not ok.any():
-        return heading.copy()
-    unwrapped = np.full(n, np.nan)
-    unwrapped[ok] = np.unwrap(heading[ok])
-    padded = np.pad(unwrapped, half, constant_values=np.nan)
-    windows = np.lib.stride_tricks.sliding_window_view(padded, 2 * half + 1)[:n]
-    with np.errstate(all="ignore"):
-        import warnings
-
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            med = np.nanmedian(windows, axis=1)
-    return np.angle(np.exp(1j * med))
+    width = min(2 * half + 1, n)  # near the ends the window slides inside the clip rather than shrinking
+    starts = np.clip(np.arange(n) - half, 0, n - width)
+    windows = np.lib.stride_tricks.sliding_window_view(heading, width)[starts]
+    return _circular_median(windows)
 
 
 def to_root_relative(
