@@ -153,17 +153,17 @@ def smooth_heading(heading: np.ndarray, window: int) -> np.ndarray:
     The batch counterpart of :class:`HeadingFilter` (which, streaming, can only look back). Each window's estimates
     are unwrapped around that window's own circular mean before the median is taken, so a run of estimates that
     crosses ±π, or a few estimates flipped by half a turn, never pulls the median round (unwrapping the whole clip
-    at once would let one flip carry every later frame with it). Near the clip's ends the window keeps its width and
-    slides inside the clip, so the first and last frames are outvoted as often as the middle ones.
+    at once would let one flip carry every later frame with it). Near the clip's ends the window is cut short rather
+    than slid inside the clip: a window that stops sliding turns the facing in one jump when it starts again (a
+    kick, whose knees swing the estimate, turned half way through).
     NaN estimates are ignored; frames with no estimate in their window stay NaN.
     """
     heading = np.asarray(heading, dtype=float)
     n, half = len(heading), max(1, int(window)) // 2
     if n == 0 or window <= 1 or not np.isfinite(heading).any():
         return heading.copy()
-    width = min(2 * half + 1, n)  # near the ends the window slides inside the clip rather than shrinking
-    starts = np.clip(np.arange(n) - half, 0, n - width)
-    windows = np.lib.stride_tricks.sliding_window_view(heading, width)[starts]
+    padded = np.pad(heading, half, constant_values=np.nan)  # near the ends the window shrinks: the facing stays
+    windows = np.lib.stride_tricks.sliding_window_view(padded, 2 * half + 1)[:n]  # continuous from frame to frame
     return _circular_median(windows)
 
 
