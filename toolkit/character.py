@@ -2,7 +2,7 @@
 
 A character file has these tables (``docs/character-format.md`` is the full reference)::
 
-    [character]   name, optional extends and description
+    [character]   name, optional extends, description and lengths_for_height
     [body]        tracked parts, root, facing parts, bones, colours
     [motor]       plugin = NAME and its parameters (the movement repertoire)
     [perception]  plugin = NAME and its parameters      (optional)
@@ -28,6 +28,8 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from toolkit.body import Body
 from toolkit.components import ActionSystem, Component, Correspondence, Matcher, MotorSystem, Perception, Segmenter
@@ -56,7 +58,7 @@ COMPONENT_TABLES: dict[str, bool] = {
 """Component tables of a character file and whether each is required."""
 
 TOP_LEVEL = ("character", "body", *COMPONENT_TABLES)
-CHARACTER_KEYS = ("name", "extends", "description")
+CHARACTER_KEYS = ("name", "extends", "description", "lengths_for_height")
 
 
 @dataclass
@@ -72,6 +74,9 @@ class Character:
     files : tuple of Path
         The file it was loaded from first, then the files it extends.
     description : str
+    lengths_for_height : float or None
+        The standing height (m) the length parameters of its components were written for; they are scaled by
+        :attr:`length_scale`. ``None``: lengths are metres as written (the papers).
     config : dict
         The merged declaration.
     pm : PluginManager or None
@@ -88,12 +93,25 @@ class Character:
     action: ActionSystem | None = None
     files: tuple[Path, ...] = ()
     description: str = ""
+    lengths_for_height: float | None = None
     config: dict[str, Any] = field(default_factory=dict)
     pm: PluginManager | None = field(default=None, repr=False)
 
     @property
     def file(self) -> Path | None:
         return self.files[0] if self.files else None
+
+    @property
+    def height(self) -> float:
+        """The character's own standing height (m): the vertical extent of its rest pose's positions."""
+        rest = np.asarray(self.motor.rest_pose(), dtype=float)[~self.body.angle_mask]
+        return float(np.nanmax(rest[:, 1]) - np.nanmin(rest[:, 1]))
+
+    @property
+    def length_scale(self) -> float:
+        """What every length parameter of its components is multiplied by: its own height over
+        :attr:`lengths_for_height` (1 when that is not given)."""
+        return 1.0 if self.lengths_for_height is None else self.height / self.lengths_for_height
 
     def components(self) -> dict[str, Component]:
         """The configured components by table name (``motor``, ``perception``...)."""
@@ -294,6 +312,11 @@ def compose_character(table: Mapping[str, Any], pm: PluginManager, *, files: tup
     description = head.get("description", "")
     if not isinstance(description, str):
         raise ConfigError("wrong type", key=("character", "description"), expected="a string")
+    lengths_for = head.get("lengths_for_height")
+    if lengths_for is not None and (isinstance(lengths_for, bool) or not isinstance(lengths_for, (int, float))
+                                    or not np.isfinite(lengths_for) or lengths_for <= 0):
+        raise ConfigError(f"invalid value {lengths_for!r}", key=("character", "lengths_for_height"),
+                          expected="a positive number: the standing height (m) the length parameters were written for")
     body_table = _table(table, "body", required=True)
     try:
         body = Body.from_config(body_table)
@@ -315,13 +338,26 @@ def compose_character(table: Mapping[str, Any], pm: PluginManager, *, files: tup
         action=built["action"],  # type: ignore[arg-type]
         files=files,
         description=description,
+        lengths_for_height=None if lengths_for is None else float(lengths_for),
         config=dict(table),
         pm=pm,
     )
     for key, component in character.components().items():  # motor first: the others read it
+        if key != "motor" and lengths_for is not None:  # the motor system measures the body: its lengths stay
+            component.scale_lengths(_length_scale(character))
         _guard(component, key, "attach", lambda c=component: c.attach(character))
     pm.hook.likeme_character_composed(character=character)  # a failing plugin is named by the plugin manager
     return character
+
+
+def _length_scale(character: Character) -> float:
+    """The character's length scale, or a :class:`ConfigError` when its rest pose has no height."""
+    scale = character.length_scale
+    if not np.isfinite(scale) or scale <= 0:
+        raise ConfigError(f"the rest pose of motor {character.motor.name!r} has no height ({character.height!r} m)",
+                          key=("character", "lengths_for_height"),
+                          expected="a motor system whose rest pose stands (parts at different heights)")
+    return scale
 
 
 def build_component(key: str, table: Mapping[str, Any], pm: PluginManager) -> Component:

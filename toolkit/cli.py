@@ -94,6 +94,9 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p.add_argument("--matcher", metavar="NAME", help="matcher (default: the observer template's)")
     p.add_argument("--correspondence", metavar="NAME", help="correspondence (default: the observer template's; "
                    "none: the papers' plain observer)")
+    p.add_argument("--lengths-for-height", type=float, default=None, metavar="M", dest="lengths_for_height",
+                   help="the height (m) the length parameters were written for, scaled to the observer's own height "
+                   "(default: the observer template's; 0: metres as written, the papers)")
     p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
                    help="override a parameter of the observer, e.g. --set matcher.k=4 (repeatable)")
     p.add_argument("--json", action="store_true", help="print JSON instead of text")
@@ -340,7 +343,9 @@ def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
         if name is not None and name != NO_CORRESPONDENCE:
             pm.registry.get(kind, name)  # an unknown name fails here, listing the registered ones
     character = compose_observer(pm, profile, args.repertoire, segmenter=args.segmenter, matcher=args.matcher or "",
-                                 correspondence=args.correspondence or "", settings=parse_settings(list(args.set)))
+                                 correspondence=args.correspondence or "",
+                                 lengths_for_height="" if args.lengths_for_height is None else args.lengths_for_height,
+                                 settings=parse_settings(list(args.set)))
     report = []
     for path in args.files:
         motion = profile.read(path)

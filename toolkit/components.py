@@ -271,6 +271,7 @@ class Component(ABC):
         self.params: Mapping[str, Any] = MappingProxyType(
             validate_params(f"{self.kind} {self.name!r}", self.parameters, params)
         )
+        self.declared: Mapping[str, Any] = self.params  # as written, before lengths are scaled to the body
         self.owner: Character | None = None
 
     @classmethod
@@ -281,6 +282,15 @@ class Component(ABC):
     def attach(self, owner: Character) -> None:
         """Called once the owning character is composed. Override to read the owner's body or motor system."""
         self.owner = owner
+
+    def scale_lengths(self, factor: float) -> None:
+        """Multiply every parameter declared a ``length`` by ``factor`` (the character's own height over the height
+        its lengths were meant for). Called by the character before :meth:`attach`; ``declared`` keeps the values
+        as written."""
+        self.declared = self.params
+        if factor != 1.0:
+            lengths = {p.name for p in self.parameters if p.length}
+            self.params = MappingProxyType({k: v * factor if k in lengths else v for k, v in self.declared.items()})
 
     def inspect(self) -> Mapping[str, Any]:
         """What the component holds now, read-only, for views and tests (its signals: a segmenter's last

@@ -150,6 +150,7 @@ class Observer:
 def compose_observer(pm: Any, profile: BodyProfile, repertoire: str | Path, *, segmenter: str | None = None,
                      matcher: str | None = "", settings: Mapping[str, Mapping[str, Any]] | None = None,
                      motor: str | None = None, correspondence: str | None = "",
+                     lengths_for_height: float | None | str = "",
                      template: str | Path = OBSERVER_TEMPLATE) -> Character:
     """The observing character: ``profile``'s body, a repertoire from the clips in ``repertoire``, its components
     from ``template`` (an observer template: an ``[observer]`` table and component tables, no body) unless named
@@ -163,6 +164,9 @@ def compose_observer(pm: Any, profile: BodyProfile, repertoire: str | Path, *, s
     correspondence : str, optional
         A correspondence plugin replacing the template's; ``None`` or ``"none"``: none, the papers' plain
         observer, which compares the demonstrator's poses with its own as they are.
+    lengths_for_height : float, optional
+        The height (m) the length parameters were written for, replacing the template's: each is scaled to the
+        observer's own height (:attr:`Character.length_scale`). ``None`` or 0: metres as written (the papers).
     settings : mapping, optional
         Extra parameters per table (``{"matcher": {"k": 4}}``; ``{"perception": {"plugin": ...}}`` replaces one).
     """
@@ -198,10 +202,14 @@ def compose_observer(pm: Any, profile: BodyProfile, repertoire: str | Path, *, s
     if profile.body.facing.behind:
         facing["behind"] = profile.body.facing.behind
     head = dict(base["observer"])
+    character: dict[str, Any] = {"name": head.get("name", "observer"),
+                                 "description": f"watches {profile.name} motion" + (f": {head['description']}"
+                                                                                     if head.get("description") else "")}
+    lengths_for = head.get("lengths_for_height") if lengths_for_height == "" else lengths_for_height
+    if lengths_for:
+        character["lengths_for_height"] = lengths_for
     table: dict[str, Any] = {
-        "character": {"name": head.get("name", "observer"),
-                      "description": f"watches {profile.name} motion" + (f": {head['description']}"
-                                                                          if head.get("description") else "")},
+        "character": character,
         "body": {"parts": list(profile.body.parts), "root": profile.body.root, "facing": facing,
                  "bones": [list(b) for b in profile.body.bones]},
         **tables,
@@ -211,7 +219,7 @@ def compose_observer(pm: Any, profile: BodyProfile, repertoire: str | Path, *, s
     return compose_character(table, pm)
 
 
-OBSERVER_KEYS = ("name", "description")
+OBSERVER_KEYS = ("name", "description", "lengths_for_height")
 
 
 def is_observer_template(table: Mapping[str, Any]) -> bool:

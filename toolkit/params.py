@@ -58,6 +58,10 @@ class Parameter:
         Element type for ``list`` parameters.
     check : callable, optional
         ``check(value) -> str | None``: a further check returning a problem or ``None``.
+    length : bool
+        A length on the observer's own body (metres, or metres per second or per radian): a character whose file
+        gives ``[character] lengths_for_height`` reads it as meant for a body that tall and scales it to its own
+        standing height (docs/correspondence.md, "Decisions relative to the body").
     """
 
     name: str
@@ -69,6 +73,7 @@ class Parameter:
     choices: Sequence[Any] | None = None
     items: type | None = None
     check: Callable[[Any], str | None] | None = None
+    length: bool = False
 
     @property
     def required(self) -> bool:
@@ -87,6 +92,8 @@ class Parameter:
             text += " (one of " + ", ".join(map(repr, self.choices)) + ")"
         if not article:
             text += ", required" if self.required else f", default {self.default!r}"
+            if self.length:
+                text += ", a length (scaled to the body with lengths_for_height)"
         return text
 
     def coerce(self, value: Any) -> Any:

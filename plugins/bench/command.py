@@ -32,6 +32,9 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--body", required=True, metavar="PROFILE", help="body profile TOML of the files")
     p.add_argument("--correspondence", metavar="NAME", default="", help="correspondence (default: the observer "
                    "template's; none: the papers' plain observer)")
+    p.add_argument("--lengths-for-height", type=float, default=None, metavar="M", dest="lengths_for_height",
+                   help="the height (m) the length parameters were written for, scaled to the observer's own height "
+                   "(default: the observer template's; 0: metres as written, the papers)")
     p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
                    help="override a parameter of the observer, e.g. --set matcher.k=4 (repeatable)")
     p.add_argument("--json", metavar="FILE", help="also write the results as JSON")
@@ -45,11 +48,16 @@ def _motion_capture_commands(sub: Any) -> None:
     p = sub.add_parser("recognition", help="classify labelled demo clips with every matcher named")
     _common(p)
     p.add_argument("--repertoire", required=True, metavar="DIR", help="labelled clips: one folder per movement")
-    p.add_argument("--demos", required=True, metavar="DIR", help="demo clips: one folder per true movement")
+    p.add_argument("--demos", metavar="DIR", help="demo clips: one folder per true movement (not with --protocol "
+                   "groups)")
     p.add_argument("--matcher", action="append", metavar="NAME", help=f"matcher (repeatable; default: {', '.join(MATCHERS)})")
-    p.add_argument("--protocol", choices=("closed", "open"), default="closed",
+    p.add_argument("--protocol", choices=("closed", "open", "groups"), default="closed",
                    help="closed: every demo against the whole repertoire; open: the demos of each movement against "
-                   "the repertoire without it (leave one movement out: only 'unknown' is right)")
+                   "the repertoire without it (leave one movement out: only 'unknown' is right); groups: each group "
+                   "of the repertoire's clips (--group) against a repertoire of the other groups (leave one group "
+                   "out: a style, a performer)")
+    p.add_argument("--group", metavar="REGEX", help="with --protocol groups: a regular expression whose first "
+                   "capture group, searched in a clip's file name, names its group")
     p.set_defaults(handler=_handler("mocap", "run", "recognition"))
 
     p = sub.add_parser("segmentation", help="segment streams with known segments with every segmenter named")

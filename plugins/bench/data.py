@@ -106,8 +106,10 @@ def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams:
     """Benchmark folders from the Bandai-Namco clips (links and generated streams; nothing is copied).
 
     ``repertoire/``: the normal-style clips; ``demos/``: every other style of the movements the repertoire has;
-    ``streams/``: ``per_stream`` random gesture demos (other styles) one after another, with their segments.
-    Locomotion never returns to a standing pose, so streams hold gestures only unless told otherwise.
+    ``all/``: every style of those movements, for leave one style out (``likeme bench recognition --repertoire
+    DIR/all --protocol groups --group STYLE_PATTERN``, :data:`STYLE_PATTERN`); ``streams/``: ``per_stream`` random
+    gesture demos (other styles) one after another, with their segments. Locomotion never returns to a standing
+    pose, so streams hold gestures only unless told otherwise.
     """
     from toolkit.bvh import BVH, read_bvh, write_bvh
 
@@ -121,13 +123,14 @@ def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams:
         clips.setdefault((content, style), []).append(f)
     known = {c for c, s in clips if s == "normal"}
     for (content, style), paths in clips.items():
+        if content not in known:
+            continue
         for p in paths:
-            target = dest / ("repertoire" if style == "normal" else "demos") / content / p.name
-            if style != "normal" and content not in known:
-                continue
-            target.parent.mkdir(parents=True, exist_ok=True)
-            if not target.exists():
-                target.symlink_to(p.resolve())
+            for target in (dest / ("repertoire" if style == "normal" else "demos") / content / p.name,
+                           dest / "all" / content / p.name):
+                target.parent.mkdir(parents=True, exist_ok=True)
+                if not target.exists():
+                    target.symlink_to(p.resolve())
     locomotion = {"walk", "run", "dash", "walk-back", "walk-left", "walk-right", "dance-short"}
     pool = [p for (c, s), ps in clips.items() if s != "normal" and c in known and
             (c not in locomotion or not gestures_only) for p in ps]
@@ -146,6 +149,10 @@ def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams:
         _write_segments(dest / "streams" / f"stream_{k + 1:02d}.segments.csv", rows)
     (dest / "profile.toml").write_text(Path(profile_path).read_text(encoding="utf-8"), encoding="utf-8")
     return dest
+
+
+STYLE_PATTERN = r"^dataset-1_[^_]+_([^_]+)_"
+"""The style in a Bandai-Namco clip's name (``dataset-1_{content}_{style}_{take}.bvh``), for ``--group``."""
 
 
 def cmd_make_data(args, pm) -> int:

@@ -6,7 +6,10 @@ Every sub-command reads BVH files through a body profile (:mod:`toolkit.profile`
 
 - ``recognition``: each demo clip (a folder per true movement) is one segment; every matcher named classifies it.
   Accuracy, macro F1, the confusion matrix, the decision fraction (share of the clip seen when the matcher
-  committed; 1.0 for matchers that wait for the end) and frames per second.
+  committed; 1.0 for matchers that wait for the end) and frames per second. Protocols: ``closed`` (every demo
+  against the whole repertoire), ``open`` (leave one movement out: only "unknown" is right) and ``groups`` (leave
+  one group out: the repertoire folder's clips whose file names share a group, a style or a performer, are the
+  demos of a repertoire made of all the other clips).
 - ``segmentation``: each stream ``NAME.bvh`` has ``NAME.segments.csv`` (:func:`plugins.bench.data.read_segments`).
   Precision, recall, F1 and boundary error (:mod:`plugins.bench.metrics`) per segmenter.
 - ``stream``: segment and recognise end to end for every pairing; the movement error rate (edit distance over the
@@ -21,6 +24,7 @@ import csv
 import io
 import json
 import platform
+import re
 import tempfile
 import time
 from collections.abc import Sequence
@@ -108,37 +112,34 @@ def _progress(items: list, label: str, quiet: bool):
     return track(items, description=label, transient=True)
 
 
-def recognition(pm, profile, repertoire: Path, demos: Path, matchers: Sequence[str], *, settings=None,
-                quiet: bool = True, correspondence: str | None = "", protocol: str = "closed") -> dict[str, Any]:
+PROTOCOLS = ("closed", "open", "groups")
+
+
+def recognition(pm, profile, repertoire: Path, demos: Path | None, matchers: Sequence[str], *, settings=None,
+                quiet: bool = True, observer: dict[str, Any] | None = None, protocol: str = "closed",
+                group: str | None = None) -> dict[str, Any]:
     """Classify every demo clip with every matcher; per-plugin scores and per-item rows.
 
     A demo whose movement (its folder's name) is not in the repertoire is right when it is answered "unknown".
     ``protocol``: ``"closed"`` classifies every demo against the whole repertoire; ``"open"`` (leave one movement
     out) classifies the demos of each movement against the repertoire without that movement, so every demo is of
-    a movement the observer does not know and only "unknown" is right: the rejection rate.
+    a movement the observer does not know and only "unknown" is right: the rejection rate; ``"groups"`` (leave one
+    group out, no ``demos``) takes the repertoire's own clips, groups them by the first capture group of the
+    regular expression ``group`` searched in each file's name (a style, a performer, a session), and classifies
+    each group's clips against a repertoire of every other group's clips. ``observer``: further arguments of
+    :func:`toolkit.observe.compose_observer` (``correspondence``, ``lengths_for_height``).
     """
-    items = _labelled(demos)
-    motions = [(label, path, profile.read(path)) for label, path in items]
-    known = set(clip_files(Path(repertoire)))
-    if protocol == "open":
-        runs = [(label, [m for m in motions if m[0] == label]) for label in sorted({m[0] for m in motions} & known)]
-        if not runs:
-            raise ConfigError("no demo of a repertoire movement to leave out", file=demos,
-                              expected="demo folders named like repertoire movements", available=sorted(known))
-    elif protocol == "closed":
-        runs = [(None, motions)]
-    else:
-        raise ConfigError(f"unknown protocol {protocol!r}", key=("protocol",), expected="a protocol",
-                          available=["closed", "open"])
+    observer = dict(observer or {})
+    runs = _runs(profile, Path(repertoire), demos, protocol, group)
     plugins, rows = [], []
     for name in matchers:
         truth, predicted, fractions, frames, seconds = [], [], [], 0, 0.0
-        for left_out, group in runs:
-            with _repertoire_without(Path(repertoire), left_out) as folder:
-                clock = _Clock(compose_observer(pm, profile, folder, matcher=name, settings=settings,
-                                                correspondence=correspondence), profile)
+        for (left_movement, left_files, run_group), group_items in runs:
+            with _repertoire_without(Path(repertoire), left_movement, left_files) as folder:
+                clock = _Clock(compose_observer(pm, profile, folder, matcher=name, settings=settings, **observer),
+                               profile)
                 movements = set(clock.character.motor.movements())
-                for label, path, motion in _progress(group, f"recognition {name}", quiet):
+                for label, path, motion in _progress(group_items, f"recognition {name}", quiet):
                     obs = clock.run("classify", motion)
                     expected = label if label in movements else UNKNOWN
                     truth.append(expected)
@@ -146,6 +147,7 @@ def recognition(pm, profile, repertoire: Path, demos: Path, matchers: Sequence[s
                     fractions.append(obs.decision_fraction)
                     details = obs.match.details if obs.match else {}
                     rows.append({"plugin": name, "item": path.name, "truth": expected, "movement": label,
+                                 "group": run_group or "",
                                  "recognised": obs.movement or UNKNOWN,
                                  "nearest": str(details.get("nearest", obs.movement or "")),
                                  "reason": str(details.get("reason", "")),
@@ -172,18 +174,73 @@ UNKNOWN = "unknown"
 """What a demo of a movement the observer does not know should be answered."""
 
 
+def _runs(profile, repertoire: Path, demos: Path | None, protocol: str, group: str | None):
+    """The protocol's runs: ((movement left out, files left out, group), [(label, path, motion)...]) each."""
+    if protocol not in PROTOCOLS:
+        raise ConfigError(f"unknown protocol {protocol!r}", key=("protocol",), expected="a protocol",
+                          available=list(PROTOCOLS))
+    if protocol == "groups":
+        return _group_runs(profile, repertoire, group)
+    if demos is None:
+        raise ConfigError(f"protocol {protocol!r} needs demo clips", key=("demos",),
+                          expected="--demos DIR: one folder of clips per true movement")
+    motions = [(label, path, profile.read(path)) for label, path in _labelled(demos)]
+    if protocol == "closed":
+        return [((None, frozenset(), None), motions)]
+    known = set(clip_files(repertoire))
+    runs = [((label, frozenset(), None), [m for m in motions if m[0] == label])
+            for label in sorted({m[0] for m in motions} & known)]
+    if not runs:
+        raise ConfigError("no demo of a repertoire movement to leave out", file=demos,
+                          expected="demo folders named like repertoire movements", available=sorted(known))
+    return runs
+
+
+def _group_runs(profile, repertoire: Path, group: str | None):
+    """Leave one group out: the clips of each group as demos of a repertoire of every other group's clips."""
+    if not group:
+        raise ConfigError("protocol 'groups' needs a pattern", key=("group",),
+                          expected="--group REGEX whose first capture group names a clip's group in its file name "
+                                   "(a style, a performer), e.g. '_([a-z-]+)_[0-9]+\\.bvh$'")
+    try:
+        pattern = re.compile(group)
+    except re.error as err:
+        raise ConfigError(f"not a regular expression: {err}", key=("group",), expected="a Python regular expression "
+                          "with one capture group") from None
+    if pattern.groups < 1:
+        raise ConfigError(f"{group!r} has no capture group", key=("group",),
+                          expected="a regular expression whose first capture group is the group's name")
+    by_group: dict[str, list[tuple[str, Path]]] = {}
+    unmatched = []
+    for label, path in _labelled(repertoire):
+        found = pattern.search(path.name)
+        if found is None or not found.group(1):
+            unmatched.append(path.name)
+            continue
+        by_group.setdefault(found.group(1), []).append((label, path))
+    if unmatched:
+        raise ConfigError(f"{len(unmatched)} clip names without a group", file=repertoire, key=("group",),
+                          expected=f"file names in which {group!r} finds a group", available=unmatched[:10])
+    if len(by_group) < 2:
+        raise ConfigError(f"{len(by_group)} group found", file=repertoire, key=("group",),
+                          expected="at least two groups to leave one out", available=sorted(by_group))
+    return [((None, frozenset(p for _, p in items), name), [(label, p, profile.read(p)) for label, p in items])
+            for name, items in sorted(by_group.items())]
+
+
 @contextmanager
-def _repertoire_without(folder: Path, movement: str | None):
-    """``folder``, or (leaving ``movement`` out) a temporary folder of links to its other movements' clips."""
-    if movement is None:
+def _repertoire_without(folder: Path, movement: str | None, files: frozenset[Path] = frozenset()):
+    """``folder``, or (leaving ``movement`` or ``files`` out) a temporary folder of links to the other clips."""
+    if movement is None and not files:
         yield folder
         return
-    with tempfile.TemporaryDirectory(prefix="likeme-open-") as tmp:
-        for name, files in clip_files(folder).items():
-            if name == movement:
+    with tempfile.TemporaryDirectory(prefix="likeme-left-out-") as tmp:
+        for name, clips in clip_files(folder).items():
+            kept = [f for f in clips if f not in files]
+            if name == movement or not kept:
                 continue
             (Path(tmp) / name).mkdir()
-            for f in files:
+            for f in kept:
                 (Path(tmp) / name / f.name).symlink_to(f.resolve())
         yield Path(tmp)
 
@@ -199,13 +256,13 @@ def _macro_f1(truth: Sequence[str], predicted: Sequence[str]) -> float:
 
 
 def segmentation(pm, profile, streams: Path, segmenters: Sequence[str], *, repertoire: Path | None = None,
-                 settings=None, quiet: bool = True, correspondence: str | None = "") -> dict[str, Any]:
+                 settings=None, quiet: bool = True, observer: dict[str, Any] | None = None) -> dict[str, Any]:
     """Segment every stream with every segmenter; precision, recall, F1, boundary error and speed."""
     data = [(path, truth, profile.read(path)) for path, truth in _streams(streams)]
     plugins, rows = [], []
     for name in segmenters:
-        clock = _Clock(compose_observer(pm, profile, repertoire or streams, segmenter=name, matcher=None, correspondence=correspondence,
-                                        settings=settings), profile)
+        clock = _Clock(compose_observer(pm, profile, repertoire or streams, segmenter=name, matcher=None,
+                                        settings=settings, **(observer or {})), profile)
         found_all = true_all = tp = 0
         errors = []
         for path, truth, motion in _progress(data, f"segmentation {name}", quiet):
@@ -226,15 +283,14 @@ def segmentation(pm, profile, streams: Path, segmenters: Sequence[str], *, reper
 
 
 def stream(pm, profile, repertoire: Path, streams: Path, segmenters: Sequence[str], matchers: Sequence[str], *,
-           settings=None, quiet: bool = True, correspondence: str | None = "") -> dict[str, Any]:
+           settings=None, quiet: bool = True, observer: dict[str, Any] | None = None) -> dict[str, Any]:
     """Segment and recognise every stream with every pairing; the movement error rate."""
     data = [(path, truth, profile.read(path)) for path, truth in _streams(streams)]
     plugins, rows = [], []
     for seg in segmenters:
         for mat in matchers:
             clock = _Clock(compose_observer(pm, profile, repertoire, segmenter=seg, matcher=mat, settings=settings,
-                                            correspondence=correspondence),
-                           profile)
+                                            **(observer or {})), profile)
             errors, true_count = 0.0, 0
             for path, truth, motion in _progress(data, f"stream {seg} + {mat}", quiet):
                 recognised = [o.movement or "unknown" for o in clock.run("watch", motion)]
@@ -335,18 +391,19 @@ def run(kind: str, args: Any, pm: Any) -> int:
     """``likeme bench recognition|segmentation|stream``: run the benchmark, print its table, write its outputs."""
     profile = load_profile(args.body)
     settings = _settings(args.set)
+    observer = {"correspondence": args.correspondence,
+                "lengths_for_height": "" if args.lengths_for_height is None else args.lengths_for_height}
     if kind == "recognition":
-        result = recognition(pm, profile, Path(args.repertoire), Path(args.demos), args.matcher or MATCHERS,
-                             settings=settings, quiet=args.quiet, correspondence=args.correspondence,
-                             protocol=args.protocol)
+        result = recognition(pm, profile, Path(args.repertoire), Path(args.demos) if args.demos else None,
+                             args.matcher or MATCHERS, settings=settings, quiet=args.quiet, observer=observer,
+                             protocol=args.protocol, group=args.group)
     elif kind == "segmentation":
         result = segmentation(pm, profile, Path(args.streams), args.segmenter or SEGMENTERS,
                               repertoire=Path(args.repertoire) if args.repertoire else None, settings=settings,
-                              quiet=args.quiet, correspondence=args.correspondence)
+                              quiet=args.quiet, observer=observer)
     else:
         result = stream(pm, profile, Path(args.repertoire), Path(args.streams), args.segmenter or SEGMENTERS[:2],
-                        args.matcher or MATCHERS, settings=settings, quiet=args.quiet,
-                        correspondence=args.correspondence)
+                        args.matcher or MATCHERS, settings=settings, quiet=args.quiet, observer=observer)
     print(table(result))
     if kind == "recognition":
         for row in result["plugins"]:

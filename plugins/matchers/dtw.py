@@ -53,7 +53,7 @@ class DTW(Matcher):
         Parameter("window", float, 0.0, "Sakoe-Chiba band as a share of the longer series (0: no band).",
                   minimum=0.0, maximum=1.0),
         Parameter("max_distance", float, 0.0, "Root-mean-square per-frame distance (m) above which a segment is unknown "
-                  "(0: always the nearest).", minimum=0.0),
+                  "(0: always the nearest).", minimum=0.0, length=True),
     )
 
     def attach(self, owner: Any) -> None:

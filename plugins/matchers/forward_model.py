@@ -212,14 +212,14 @@ class ForwardModel(Matcher):
     name = "forward-model"
     motor_systems = ("motor-command-graph",)
     parameters = (
-        Parameter("threshold", float, 0.05, "Prediction error (m) above which a candidate edge drops out.", minimum=0.0),
+        Parameter("threshold", float, 0.05, "Prediction error (m) above which a candidate edge drops out.", minimum=0.0, length=True),
         Parameter("deviation", float, 0.05, "Error (m) between the imitated edge and the demonstration that stops the "
-                  "imitation (also checked at the end: the demonstration must end where the edge does).", minimum=0.0),
+                  "imitation (also checked at the end: the demonstration must end where the edge does).", minimum=0.0, length=True),
         Parameter("min_progress", float, 0.2, "Share of the edge's path that must be seen before committing.", minimum=0.0, maximum=1.0),
-        Parameter("min_move", float, 0.02, "Displacement (m) of a subsystem that makes it one under consideration.", minimum=0.0),
+        Parameter("min_move", float, 0.02, "Displacement (m) of a subsystem that makes it one under consideration.", minimum=0.0, length=True),
         Parameter("angle_scale", float, 0.25, "Metres one radian of finger joint angle counts as when a hand "
                   "subsystem's errors and movement are compared with threshold, deviation and min_move "
-                  "(0.25: the 0.05 m threshold is 0.2 rad, 11 degrees).", minimum=1e-6),
+                  "(0.25: the 0.05 m threshold is 0.2 rad, 11 degrees).", minimum=1e-6, length=True),
         Parameter("max_candidates", int, 24, "Most candidate command paths followed at once (the best predictions).", minimum=1),
         Parameter("error", str, "max", "How the prediction errors of a subsystem's parts combine: the largest "
                   "(a wrist subsystem, §4.4) or the mean (eq. 1 of B&B 2005, for whole-body subsystems).",

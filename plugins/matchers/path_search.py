@@ -80,8 +80,8 @@ class PathSearch(Matcher):
         Parameter("max_skip", int, 2, "Most nodes a path may advance per observed sample (0 = stay is always "
                   "allowed); 2 tolerates movements up to twice as fast as one's own.", minimum=1, maximum=5),
         Parameter("max_distance", float, 0.03, "Mean eq. 1 distance (m) per sample above which the answer is "
-                  "'unknown'. Must stay above the noise of the input (about 1.8 x its standard deviation).", minimum=0.0),
-        Parameter("scale", float, 0.02, "Distance (m) at which confidence falls to 1/e.", minimum=1e-6),
+                  "'unknown'. Must stay above the noise of the input (about 1.8 x its standard deviation).", minimum=0.0, length=True),
+        Parameter("scale", float, 0.02, "Distance (m) at which confidence falls to 1/e.", minimum=1e-6, length=True),
         Parameter("attention", float, 0.0, "How much the parts that move in the segment count over the still ones "
                   "(plugins.lib.attention): 0 is eq. 1's plain mean over the visible parts, 1 counts only what "
                   "moves.", minimum=0.0, maximum=1.0),

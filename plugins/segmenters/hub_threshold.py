@@ -54,7 +54,7 @@ class HubThreshold(Segmenter):
     name = "hub-threshold"
     parameters = (
         Parameter("threshold", float, 0.02, "Filtered eq. 1 distance (m) from the hub above which a movement has begun. "
-                  "Lower finds subtler movements and more noise; higher misses small movements.", minimum=0.0),
+                  "Lower finds subtler movements and more noise; higher misses small movements.", minimum=0.0, length=True),
         Parameter("release", float, 0.75, "End threshold as a fraction of `threshold` (hysteresis; 1 = none).", minimum=0.0, maximum=1.0),
         Parameter("cutoff", float, 4.0, "Low-pass cut-off frequency in Hz (second-order Butterworth). "
                   "Lower smooths more noise but delays and merges boundaries.", minimum=0.1),

@@ -58,7 +58,7 @@ class VelocityDirection(Segmenter):
     name = "velocity-direction"
     parameters = (
         Parameter("parts", list, [], "Parts whose velocity is used (the wrists...); empty: every part.", items=str),
-        Parameter("rest_speed", float, 0.08, "Speed (m/s, over the sensory memory) below which the parts are at rest.", minimum=0.0),
+        Parameter("rest_speed", float, 0.08, "Speed (m/s, over the sensory memory) below which the parts are at rest.", minimum=0.0, length=True),
         Parameter("memory", float, 0.1, "Seconds of the sensory memory: how long motion (or rest) must last to count "
                   "as the onset (or the end) of a movement.", minimum=0.0),
         Parameter("drop", float, 0.5, "A speed minimum is a break point when below this share of its neighbouring "
@@ -71,7 +71,7 @@ class VelocityDirection(Segmenter):
         Parameter("smooth", float, 0.2, "Seconds of Savitzky-Golay smoothing of the working memory before it is "
                   "segmented (0: none).", minimum=0.0),
         Parameter("angle_scale", float, 0.25, "Metres one radian of a finger's joint angles counts as (0.25: a finger "
-                  "turning at 0.6 rad/s moves as fast as a wrist at 0.15 m/s).", minimum=0.0),
+                  "turning at 0.6 rad/s moves as fast as a wrist at 0.15 m/s).", minimum=0.0, length=True),
         Parameter("level", str, "stroke", "Report strokes (break points) or whole movements (onset to end).",
                   choices=("stroke", "movement")),
     )
