@@ -111,3 +111,72 @@ def test_a_group_pattern_that_cannot_split_the_clips_is_refused(generated, pm, g
     with pytest.raises(ConfigError, match=problem) as err:
         recognition(pm, profile, generated / "demos", None, ["dtw"], protocol="groups", group=group)
     assert err.value.key == ("group",)
+
+
+# -- path search relative to the repertoire's spread between takes -------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def takes_observer(generated):
+    """An observer whose repertoire is Morris's demos: three takes of each movement (three speeds)."""
+    pm = create_plugin_manager(autoload=False, trace=False)
+    profile = load_profile(generated / "profile.toml")
+    return compose_observer(pm, profile, generated / "demos", settings={"matcher": {"spread": 2.0}})
+
+
+def test_every_movement_of_several_takes_has_a_spread_and_a_threshold_from_it(takes_observer):
+    matcher = takes_observer.matcher
+    matcher._refresh()
+    takes = takes_observer.motor.takes()
+    assert set(matcher.spreads) == {m for m, t in takes.items() if len(t) >= 2} == set(takes)
+    for movement, spread in matcher.spreads.items():
+        assert spread > 0
+        assert matcher.threshold(movement) == pytest.approx(2.0 * spread)
+    assert matcher.threshold("not a movement") == matcher.params["max_distance"]
+
+
+def test_a_take_left_out_of_the_search_is_never_on_the_path(takes_observer):
+    import numpy as np
+
+    matcher = takes_observer.matcher
+    matcher._refresh()
+    index = {n: i for i, n in enumerate(matcher.node_names)}
+    nodes = takes_observer.motor.node_root_relative
+    for movement, takes in list(takes_observer.motor.takes().items())[:5]:
+        own = np.array([index[n] for n in takes[0]])
+        exclude = np.zeros(len(nodes), bool)
+        exclude[own] = True
+        path, cost, _ = matcher.search(nodes[own], np.ones(nodes[own].shape[:2], bool), None, exclude)
+        assert not exclude[path].any() and np.isfinite(cost)
+        free, free_cost, _ = matcher.search(nodes[own], np.ones(nodes[own].shape[:2], bool))
+        assert free_cost == pytest.approx(0.0, abs=1e-9) and cost > 1e-6  # without the exclusion it finds itself
+
+
+def test_spread_thresholds_accept_known_movements_and_reject_left_out_ones(generated, pm):
+    """Max's own clips against three takes of Morris's: a movement in the repertoire is accepted within twice its
+    spread between takes; with the movement left out, most are answered unknown."""
+    from plugins.bench.mocap import recognition
+
+    profile = load_profile(generated / "profile.toml")
+    settings = {"matcher": {"spread": 2.0}}
+    closed = recognition(pm, profile, generated / "demos", generated / "repertoire", ["path-search"],
+                         settings=settings)["plugins"][0]
+    opened = recognition(pm, profile, generated / "demos", generated / "repertoire", ["path-search"],
+                         settings=settings, protocol="open")["plugins"][0]
+    assert closed["accuracy"] > 0.8 and opened["rejection"] > 0.5
+
+
+def test_spread_needs_a_motor_system_that_knows_its_takes(takes_observer):
+    """A posegraph without takes() (a third party's) serves path search, but not its spread."""
+    from types import SimpleNamespace
+
+    from plugins.matchers.path_search import PathSearch, PoseGraph
+    from toolkit.components import protocol_members
+
+    motor = takes_observer.motor
+    bare = SimpleNamespace(**{name: getattr(motor, name) for name in protocol_members(PoseGraph)})
+    owner = SimpleNamespace(motor=bare, body=takes_observer.body)
+    PathSearch().attach(owner)  # the paper's threshold needs no takes
+    with pytest.raises(ConfigError, match="takes") as err:
+        PathSearch(spread=2.0).attach(owner)
+    assert err.value.key == ("spread",)

@@ -24,6 +24,12 @@ the samples with evidence, :func:`plugins.lib.pose_distance.path_distance`)
 exceeds ``max_distance``; with ``learn = true`` that path is then added to the
 posegraph as a new movement (§5.2.3, §7.3). What path search needs of the motor
 system is the :class:`PoseGraph` protocol, checked when it is attached.
+
+Decisions relative to the repertoire (issue 18; not in the paper): with ``spread`` > 0, a movement the
+repertoire holds several takes of (several clips: performers, styles) is accepted up to ``spread`` times its own
+*spread between takes*: the median, over its takes, of the mean eq. 1 distance from the take to the nearest path
+through the rest of the graph when that take's own nodes are left out. A movement people perform alike is then held
+to a tight threshold, one they perform in many ways to a loose one; a movement of one take keeps ``max_distance``.
 """
 
 from __future__ import annotations
@@ -38,7 +44,7 @@ from plugins.lib.pose_distance import path_distance, pose_distance
 from toolkit import Match, Matcher, Motion, Parameter, hookimpl
 from toolkit.components import provides
 
-__all__ = ["PathSearch", "PoseGraph"]
+__all__ = ["PathSearch", "PoseGraph", "Takes"]
 
 
 class PoseGraph(Protocol):
@@ -69,6 +75,13 @@ class PoseGraph(Protocol):
         """Add an observed path of root-relative poses as a new movement; its nodes."""
 
 
+class Takes(Protocol):
+    """A posegraph that knows which nodes came from which take (example clip) of each movement."""
+
+    def takes(self) -> dict[str, list[list[str]]]:
+        """Movement -> the node names of each of its takes (hubs left out)."""
+
+
 class PathSearch(Matcher):
     """k-best path search through the observer's posegraph from the middle frame outward (§5.2)."""
 
@@ -82,6 +95,9 @@ class PathSearch(Matcher):
         Parameter("max_distance", float, 0.03, "Mean eq. 1 distance (m) per sample above which the answer is "
                   "'unknown'. Must stay above the noise of the input (about 1.8 x its standard deviation).", minimum=0.0, length=True),
         Parameter("scale", float, 0.02, "Distance (m) at which confidence falls to 1/e.", minimum=1e-6, length=True),
+        Parameter("spread", float, 0.0, "A movement with several takes is unknown beyond this many times its "
+                  "spread between takes (each take's mean eq. 1 distance to the rest of the graph); 0: "
+                  "max_distance for every movement (the paper).", minimum=0.0),
         Parameter("attention", float, 0.0, "How much the parts that move in the segment count over the still ones "
                   "(plugins.lib.attention): 0 is eq. 1's plain mean over the visible parts, 1 counts only what "
                   "moves.", minimum=0.0, maximum=1.0),
@@ -94,6 +110,9 @@ class PathSearch(Matcher):
         provides(owner.motor, PoseGraph, needed_by="path-search", what="a posegraph motor system",
                  expected=" or ".join(f'[motor] plugin = "{name}"' for name in self.motor_systems))
         self.motor = owner.motor
+        if self.params["spread"] > 0:
+            provides(owner.motor, Takes, needed_by="path-search's spread", what="a posegraph that knows its takes",
+                     key=("spread",), expected="spread = 0, or a motor system with takes() (posegraph)")
         self._cache_version = -1
 
     def _refresh(self) -> None:
@@ -109,6 +128,36 @@ class PathSearch(Matcher):
         self.succ = _reach(motor.graph, nodes, index, self.params["max_skip"], forward=True)
         self.pred = _reach(motor.graph, nodes, index, self.params["max_skip"], forward=False)
         self._cache_version = n
+        self.spreads = self._spreads(index) if self.params["spread"] > 0 else {}
+
+    def _spreads(self, index: dict[str, int]) -> dict[str, float]:
+        """Each movement's spread between takes (movements of several takes only): the median over its takes of the
+        take's mean eq. 1 distance to the best path through the graph without that take's nodes."""
+        nodes = self.motor.node_root_relative
+        out = {}
+        for movement, takes in self.motor.takes().items():
+            if len(takes) < 2:
+                continue
+            distances = []
+            for take in takes:
+                own = np.array([index[n] for n in take], dtype=np.intp)
+                if not len(own):
+                    continue
+                exclude = np.zeros(len(nodes), dtype=bool)
+                exclude[own] = True
+                obs, vis = nodes[own], np.ones(nodes[own].shape[:2], dtype=bool)
+                path, _, evidence = self.search(obs, vis, None, exclude)
+                distances.append(path_distance(obs, nodes[path], vis) / max(evidence, 1))
+            finite = [d for d in distances if np.isfinite(d)]
+            if len(finite) >= 2:
+                out[movement] = float(np.median(finite))
+        return out
+
+    def threshold(self, movement: str) -> float:
+        """The mean eq. 3 distance up to which ``movement`` is accepted: ``spread`` times its spread between takes,
+        or ``max_distance`` (one take, or ``spread = 0``)."""
+        spread = self.spreads.get(movement)
+        return self.params["max_distance"] if spread is None else self.params["spread"] * spread
 
     # -- matching ----------------------------------------------------------------------------
 
@@ -145,18 +194,21 @@ class PathSearch(Matcher):
         movement, share = str(names[best]), counts[best] / voting.size
         details["votes"] = {str(n): int(c) for n, c in zip(names, counts)}
         node_path = tuple(self.node_names[i] for i in path)
-        if mean > self.params["max_distance"]:
+        if movement in self.spreads:
+            details["spread"] = self.spreads[movement]
+        if mean > self.threshold(movement):
             if self.params["learn"]:
                 return self._learn(obs, vis, details)
             return Match(None, 0.0, None, node_path, {"reason": "too far from every path", "nearest": movement,
-                                                      "max_distance": self.params["max_distance"], **details})
+                                                      "max_distance": self.threshold(movement), **details})
         confidence = float(np.exp(-mean / self.params["scale"]) * share)
         return Match(movement, confidence, None, node_path, details)
 
-    def search(self, obs: np.ndarray, vis: np.ndarray, weights: np.ndarray | None = None
-               ) -> tuple[np.ndarray | None, float, int]:
+    def search(self, obs: np.ndarray, vis: np.ndarray, weights: np.ndarray | None = None,
+               exclude: np.ndarray | None = None) -> tuple[np.ndarray | None, float, int]:
         """The best path (node indices, one per sample), its eq. 3 cost and the number of samples with evidence;
-        ``weights`` (P,): attention to each part (``None``: eq. 1's plain mean)."""
+        ``weights`` (P,): attention to each part (``None``: eq. 1's plain mean); ``exclude`` (N,): nodes no path
+        may use."""
         has = vis.any(axis=1)
         if not has.any():
             return None, 0.0, 0
@@ -167,16 +219,19 @@ class PathSearch(Matcher):
         nodes = self.motor.node_root_relative
         k = self.params["k"]
         first = pose_distance(nodes, obs[mid], vis[mid], weights)
+        if exclude is not None:
+            first = np.where(exclude, np.inf, first)
         start = np.argsort(first, kind="stable")[:k]
         # beams: array of paths (B, length) and costs (B,)
         paths = start[:, None]
         costs = first[start]
-        paths, costs = self._extend(paths, costs, obs, vis, range(mid + 1, n), self.succ, weights, append=True)
-        paths, costs = self._extend(paths, costs, obs, vis, range(mid - 1, -1, -1), self.pred, weights, append=False)
+        paths, costs = self._extend(paths, costs, obs, vis, range(mid + 1, n), self.succ, weights, exclude, append=True)
+        paths, costs = self._extend(paths, costs, obs, vis, range(mid - 1, -1, -1), self.pred, weights, exclude,
+                                    append=False)
         best = int(np.argmin(costs))
         return paths[best], float(costs[best]), int(has.sum())
 
-    def _extend(self, paths, costs, obs, vis, frames, table, weights, *, append: bool):
+    def _extend(self, paths, costs, obs, vis, frames, table, weights, exclude, *, append: bool):
         nodes = self.motor.node_root_relative
         k = self.params["k"]
         for t in frames:
@@ -190,6 +245,8 @@ class PathSearch(Matcher):
                                      None if weights is None else weights[seen])
             else:
                 step = np.zeros(len(cand))
+            if exclude is not None:
+                step = np.where(exclude[cand], np.inf, step)
             total = costs[beam] + step
             order = np.argsort(total, kind="stable")
             # k best, one path per end node (distinct hypotheses): the first time each end node comes in the order

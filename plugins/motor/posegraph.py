@@ -131,6 +131,13 @@ class Posegraph(MotorSystem):
     def movements(self) -> list[str]:
         return list(dict.fromkeys(self.paths_label[p] for p in self.paths))
 
+    def takes(self) -> dict[str, list[list[str]]]:
+        """Movement -> the node names of each of its takes (one path per example clip), hubs left out."""
+        out: dict[str, list[list[str]]] = {}
+        for name, path in self.paths.items():
+            out.setdefault(self.paths_label[name], []).append([n for n in path if not self.graph.nodes[n]["hub"]])
+        return out
+
     def rest_pose(self) -> np.ndarray:
         return self.key_poses[self.hubs[0]]
 
