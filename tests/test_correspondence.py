@@ -260,3 +260,22 @@ def test_observe_says_why_a_segment_is_unknown(generated, capsys):
     assert main(["observe", str(demo), "--body", str(profile), "--repertoire", str(generated / "repertoire"),
                  "--set", "matcher.max_distance=0"]) == 0
     assert "rejected: too far from every path (mean_distance" in capsys.readouterr().out
+
+
+def test_likeme_show_draws_a_recording_as_perceived_and_as_mapped(generated, tmp_path, capsys):
+    from PIL import Image
+
+    from toolkit.cli import main
+
+    demo = sorted((generated / "demos").glob("*/*.bvh"))[0]
+    common = ["show", "observers/recordings", "--body", str(generated / "profile.toml"), "--repertoire",
+              str(generated / "repertoire"), "--view", "correspondence", "--set", f"recording={demo}"]
+    out = tmp_path / "mapped.png"
+    assert main([*common, "--correspondence", "body-mapping", "--out", str(out)]) == 0
+    assert f"wrote {out}" in capsys.readouterr().out
+    image = np.asarray(Image.open(out).convert("L"))
+    assert image.shape[1] == 1600 and (image < 128).mean() > 0.001  # bodies drawn, not a blank page
+    assert main([*common, "--correspondence", "none", "--out", str(tmp_path / "plain.png")]) == 1
+    assert "has no correspondence" in capsys.readouterr().err
+    assert main(["show", "observers/recordings", "--body", str(generated / "profile.toml")]) == 1
+    assert "--body and --repertoire go together" in capsys.readouterr().err

@@ -83,6 +83,12 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p.add_argument("--out", metavar="FILE.png", help="where the view writes its picture (default: CHARACTER-VIEW.png)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="a parameter of the view, e.g. --set keys=4 (repeatable)")
+    p.add_argument("--body", metavar="PROFILE", help="with --repertoire: show the observer of recordings of this "
+                   "body that the observer template CHARACTER composes (e.g. observers/recordings), as likeme observe "
+                   "does")
+    p.add_argument("--repertoire", metavar="DIR", help="with --body: the observer's labelled clips")
+    p.add_argument("--correspondence", metavar="NAME", help="with --body: the observer's correspondence (default: "
+                   "the template's)")
     p.set_defaults(handler=cmd_show)
 
     p = sub.add_parser("observe", help="watch motion-capture files: segments, recognised movements, decisions")
@@ -312,6 +318,15 @@ def cmd_show(args: argparse.Namespace, pm: PluginManager) -> int:
             raise ConfigError(f"no actor {args.character!r} in scenario {args.after!r}", key=("character",),
                               expected="the id of an actor of the scenario", available=list(world.actors))
         character = world.actors[args.character].character
+    elif args.body or args.repertoire:
+        from toolkit.observe import compose_observer
+        from toolkit.profile import load_profile
+
+        if not (args.body and args.repertoire):
+            raise ConfigError("--body and --repertoire go together", key=("--repertoire" if args.body else "--body",),
+                              expected="both: the recordings' body profile and the observer's labelled clips")
+        character = compose_observer(pm, load_profile(args.body), args.repertoire, template=args.character,
+                                     correspondence=args.correspondence or "")
     else:
         character = load_character(args.character, pm)
     if args.view:
@@ -372,7 +387,7 @@ def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
     return 0
 
 
-_WHY_NUMBERS = ("mean_distance", "max_distance", "predicted_frames", "error_when_dropped", "distance")
+_WHY_NUMBERS = ("mean_distance", "max_distance", "spread", "predicted_frames", "error_when_dropped", "distance")
 """The numbers a matcher gives with an unknown answer that say why it rejected the nearest movement."""
 
 

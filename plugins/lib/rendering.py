@@ -21,7 +21,7 @@ import numpy as np
 
 from toolkit.body import Body
 
-__all__ = ["plotter", "BodyFigure", "Movie", "part_colours", "hex_to_rgb", "GREY", "save_png", "draw_bodies", "frame_2d", "add_labels"]
+__all__ = ["plotter", "BodyFigure", "Movie", "part_colours", "hex_to_rgb", "GREY", "save_png", "draw_bodies", "frame_2d", "add_labels", "poses_png"]
 
 GREY = "#b0b0b0"
 """The colour of a part the observer does not see."""
@@ -120,6 +120,20 @@ def add_labels(pl: Any, points: np.ndarray, texts: Sequence[str], *, font_size: 
                                 justification_horizontal={"centre": "center"}.get(align, align))
     actor.GetMapper().SetPlaceAllLabels(True)
     return actor
+
+
+def poses_png(out: str | Path, body: Body, poses: np.ndarray, points: np.ndarray, labels: Sequence[str], *,
+              lower: Sequence[float], upper: Sequence[float], size: tuple[int, int], radius: float, font_size: int,
+              align: str = "left") -> Path:
+    """A sheet of still poses (N, P, 3) with labels at ``points``, framed on ``lower``..``upper`` (x, y), as PNG."""
+    pl = plotter(size)
+    try:
+        draw_bodies(pl, body, np.asarray(poses), radius=radius)
+        add_labels(pl, np.asarray(points), labels, font_size=font_size, align=align)
+        frame_2d(pl, lower, upper)
+        return save_png(pl, out)
+    finally:
+        pl.close()
 
 
 def frame_2d(pl: Any, lower: Sequence[float], upper: Sequence[float], *, margin: float = 0.04) -> None:

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from plugins.lib.rendering import add_labels, draw_bodies, frame_2d, plotter, save_png
+from plugins.lib.rendering import poses_png
 from toolkit import ConfigError, Parameter, View, hookimpl
 
 __all__ = ["BodyView", "key_pose_strip"]
@@ -81,14 +81,9 @@ class BodyView(View):
         lower = (0.0, -(rows + 1) * row)
         upper = (columns * strip, row * 0.1 + height * 1.8)
         size = (width, self.params["height"] or int(width * (upper[1] - lower[1]) / (upper[0] - lower[0])))
-        pl = plotter(size)
-        try:
-            draw_bodies(pl, body, np.stack(poses), radius=max(height / 28.0, 0.006))
-            add_labels(pl, np.array(points), labels, font_size=max(10, min(20, int(size[1] / (rows + 2) / 5))), align="right")
-            frame_2d(pl, lower, upper)
-            return [save_png(pl, out)]
-        finally:
-            pl.close()
+        return [poses_png(out, body, np.stack(poses), np.array(points), labels, lower=lower, upper=upper, size=size,
+                          radius=max(height / 28.0, 0.006), font_size=max(10, min(20, int(size[1] / (rows + 2) / 5))),
+                          align="right")]
 
 
 @hookimpl
