@@ -342,9 +342,11 @@ def compose_character(table: Mapping[str, Any], pm: PluginManager, *, files: tup
         config=dict(table),
         pm=pm,
     )
+    scale = None  # known once the motor system is attached (its rest pose gives the height)
     for key, component in character.components().items():  # motor first: the others read it
         if key != "motor" and lengths_for is not None:  # the motor system measures the body: its lengths stay
-            component.scale_lengths(_length_scale(character))
+            scale = scale or _length_scale(character)
+            component.scale_lengths(scale)
         _guard(component, key, "attach", lambda c=component: c.attach(character))
     pm.hook.likeme_character_composed(character=character)  # a failing plugin is named by the plugin manager
     return character

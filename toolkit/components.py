@@ -286,11 +286,9 @@ class Component(ABC):
     def scale_lengths(self, factor: float) -> None:
         """Multiply every parameter declared a ``length`` by ``factor`` (the character's own height over the height
         its lengths were meant for). Called by the character before :meth:`attach`; ``declared`` keeps the values
-        as written."""
-        self.declared = self.params
-        if factor != 1.0:
-            lengths = {p.name for p in self.parameters if p.length}
-            self.params = MappingProxyType({k: v * factor if k in lengths else v for k, v in self.declared.items()})
+        as written, which every call scales from."""
+        lengths = {p.name for p in self.parameters if p.length}
+        self.params = MappingProxyType({k: v * factor if k in lengths else v for k, v in self.declared.items()})
 
     def inspect(self) -> Mapping[str, Any]:
         """What the component holds now, read-only, for views and tests (its signals: a segmenter's last

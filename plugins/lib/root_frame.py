@@ -86,12 +86,12 @@ def _circular_median(windows: np.ndarray) -> np.ndarray:
     angles = np.where(ok, windows, 0.0)
     ref = np.angle(np.where(ok, np.exp(1j * angles), 0.0).sum(axis=1))[:, None]
     unwrapped = np.where(ok, ref + np.angle(np.exp(1j * (angles - ref))), np.nan)
-    if ok.all():  # the common case, without nanmedian's cost
-        return np.angle(np.exp(1j * np.median(unwrapped, axis=1)))
     out = np.full(len(windows), np.nan)
-    some = ok.any(axis=1)
-    out[some] = np.angle(np.exp(1j * np.nanmedian(unwrapped[some], axis=1)))
-    return out
+    full, some = ok.all(axis=1), ok.any(axis=1)
+    out[full] = np.median(unwrapped[full], axis=1)  # most rows: without nanmedian's cost
+    partial = some & ~full  # a stream's first frames, a clip's ends, frames without an estimate
+    out[partial] = np.nanmedian(unwrapped[partial], axis=1)
+    return np.angle(np.exp(1j * out))
 
 
 class HeadingFilter:

@@ -196,11 +196,12 @@ class PathSearch(Matcher):
         node_path = tuple(self.node_names[i] for i in path)
         if movement in self.spreads:
             details["spread"] = self.spreads[movement]
-        if mean > self.threshold(movement):
+        limit = self.threshold(movement)
+        if mean > limit:
             if self.params["learn"]:
                 return self._learn(obs, vis, details)
             return Match(None, 0.0, None, node_path, {"reason": "too far from every path", "nearest": movement,
-                                                      "max_distance": self.threshold(movement), **details})
+                                                      "max_distance": limit, **details})
         confidence = float(np.exp(-mean / self.params["scale"]) * share)
         return Match(movement, confidence, None, node_path, details)
 
