@@ -115,3 +115,35 @@ def test_hub_poses_do_not_vote(stick):
     stand = observed(stick, "raise").slice(0, 1)  # one frame: standing
     match = stick.matcher.match(stand)
     assert match.movement is None and match.details["reason"] == "only hub poses"
+
+
+def test_max_stay_limits_how_long_a_path_stands_on_one_node(stick):
+    """Four times slower than the stick's own raise: a path that may stay on a node as long as it likes keeps up
+    with the hand to within the nodes' spacing; with max_stay = 1 it must move on every second sample, runs ahead
+    of the observed hand, and pays for it."""
+    slow = observed(stick, "raise", speed=0.25)
+    free = stick.matcher.match(slow)
+    assert free.movement == "raise" and free.details["mean_distance"] < 0.01
+    stick.matcher.params = {**stick.matcher.params, "max_stay": 1}
+    limited = stick.matcher.match(slow)
+    assert limited.details["mean_distance"] > 2 * free.details["mean_distance"]
+    runs = [len(list(g)) for _, g in __import__("itertools").groupby(limited.path)]
+    assert max(runs) <= 2  # a node and one stay at most
+
+
+def test_per_movement_keeps_a_hypothesis_for_a_movement_the_k_nearest_start_poses_miss(stick):
+    """A raise whose middle frame is glitched to the reach's forward pose: with k = 1 the only start is on the reach,
+    and the beam spends half the movement there before it can get back into the raise; keeping each movement's
+    best path finds the raise along its whole length."""
+    motion = observed(stick, "raise")
+    positions = motion.positions.copy()
+    mid = motion.n_frames // 2
+    hand = stick.body.index("hand")
+    positions[mid - 1 : mid + 2, hand] = stick.motor.key_poses["front"][hand] - stick.motor.key_poses["front"][0]
+    glitched = Motion(positions, FPS, motion.parts, motion.visible)
+    stick.matcher.params = {**stick.matcher.params, "k": 1, "max_distance": 10.0}
+    narrow = stick.matcher.match(glitched)
+    assert narrow.details["votes"]["reach"] >= narrow.details["votes"].get("raise", 0)  # half the path on the reach
+    stick.matcher.params = {**stick.matcher.params, "per_movement": True}
+    match = stick.matcher.match(glitched)
+    assert match.movement == "raise" and set(match.details["votes"]) == {"raise"}

@@ -94,12 +94,17 @@ class Motion:
     fps : float
         Frames per second.
     parts : tuple of str, length P
+    world : array, shape (F, P, 3), or None
+        Where ``positions`` are root-relative (§5.1 of Buchsbaum & Blumberg 2005), the same parts' world positions
+        in the same frames, when the producer knows them (NaN where not): what the root-relative transform removes
+        (where the body travels, and its facing) stays available. ``None`` when not known.
     """
 
     positions: np.ndarray
     visible: np.ndarray
     fps: float
     parts: tuple[str, ...]
+    world: np.ndarray | None
 
     def __init__(
         self,
@@ -107,6 +112,7 @@ class Motion:
         fps: float,
         parts: Sequence[str],
         visible: np.ndarray | None = None,
+        world: np.ndarray | None = None,
     ) -> None:
         positions = np.asarray(positions, dtype=float)
         parts = tuple(parts)
@@ -114,10 +120,15 @@ class Motion:
             raise ValueError(f"motion positions have shape {positions.shape}, expected (frames, {len(parts)}, 3)")
         if not (np.isfinite(fps) and fps > 0):
             raise ValueError(f"fps must be a positive number, got {fps!r}")
+        if world is not None:
+            world = np.asarray(world, dtype=float)
+            if world.shape != positions.shape:
+                raise ValueError(f"motion world positions have shape {world.shape}, expected {positions.shape}")
         object.__setattr__(self, "positions", positions)
         object.__setattr__(self, "visible", _as_mask(visible, positions))
         object.__setattr__(self, "fps", float(fps))
         object.__setattr__(self, "parts", parts)
+        object.__setattr__(self, "world", world)
 
     # -- shape -------------------------------------------------------------------
 
@@ -149,23 +160,26 @@ class Motion:
 
     def slice(self, start: int, stop: int | None = None) -> Motion:
         """Frames ``start`` to ``stop`` (exclusive), as a new motion."""
-        return Motion(self.positions[start:stop], self.fps, self.parts, self.visible[start:stop])
+        return Motion(self.positions[start:stop], self.fps, self.parts, self.visible[start:stop],
+                      None if self.world is None else self.world[start:stop])
 
     def select(self, parts: Sequence[str]) -> Motion:
         """Only the named parts, in the given order."""
         idx = [self.parts.index(p) for p in parts]
-        return Motion(self.positions[:, idx], self.fps, parts, self.visible[:, idx])
+        return Motion(self.positions[:, idx], self.fps, parts, self.visible[:, idx],
+                      None if self.world is None else self.world[:, idx])
 
     def root_relative(self, root: str) -> Motion:
         """Every part minus the root part, frame by frame (translation only).
 
         Frames where the root is not visible become entirely invisible: without
-        the root there is no reference point (§5.1).
+        the root there is no reference point (§5.1). The positions before the
+        subtraction become :attr:`world` (unless the motion already has one).
         """
         r = self.parts.index(root)
         rel = self.positions - self.positions[:, r : r + 1, :]
         visible = self.visible & self.visible[:, r : r + 1]
-        return Motion(rel, self.fps, self.parts, visible)
+        return Motion(rel, self.fps, self.parts, visible, self.positions if self.world is None else self.world)
 
     def onto(self, parts: Sequence[str]) -> Motion:
         """The same motion in the order of ``parts``, taken by name; a part this motion lacks is never visible
@@ -179,15 +193,21 @@ class Motion:
         visible = np.zeros((self.n_frames, len(parts)), dtype=bool)
         positions[:, have] = self.positions[:, index[have]]
         visible[:, have] = self.visible[:, index[have]]
-        return Motion(positions, self.fps, parts, visible)
+        world = None
+        if self.world is not None:
+            world = np.full((self.n_frames, len(parts), 3), np.nan)
+            world[:, have] = self.world[:, index[have]]
+        return Motion(positions, self.fps, parts, visible, world)
 
     def filled(self, default: np.ndarray | None = None) -> Motion:
         """The same motion with hidden parts' coordinates set by :func:`fill_hidden` (the mask unchanged)."""
-        return Motion(fill_hidden(self.positions, self.visible, default), self.fps, self.parts, self.visible)
+        return Motion(fill_hidden(self.positions, self.visible, default), self.fps, self.parts, self.visible,
+                      self.world)
 
     def with_visibility(self, visible: np.ndarray) -> Motion:
         """The same positions with a further mask applied (logical and)."""
-        return Motion(self.positions, self.fps, self.parts, self.visible & np.asarray(visible, dtype=bool))
+        return Motion(self.positions, self.fps, self.parts, self.visible & np.asarray(visible, dtype=bool),
+                      self.world)
 
     def visible_fraction(self) -> float:
         """Share of (frame, part) cells that are visible; 0.0 for an empty motion."""
@@ -210,6 +230,7 @@ def concatenate(motions: Sequence[Motion]) -> Motion:
         first.fps,
         first.parts,
         np.concatenate([m.visible for m in motions]),
+        np.concatenate([m.world for m in motions]) if all(m.world is not None for m in motions) else None,
     )
 
 

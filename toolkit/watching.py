@@ -131,9 +131,10 @@ class ObservationLog:
         return self._world[: self.n]
 
     def motion(self, start: int = 0, stop: int | None = None) -> Motion:
-        """Rows ``start`` to ``stop`` as a root-relative :class:`Motion` (a copy)."""
+        """Rows ``start`` to ``stop`` as a root-relative :class:`Motion` (a copy), with their world positions."""
         stop = self.n if stop is None else min(stop, self.n)
-        return Motion(self._pos[start:stop].copy(), self.fps, self.parts, self._vis[start:stop])
+        return Motion(self._pos[start:stop].copy(), self.fps, self.parts, self._vis[start:stop],
+                      self._world[start:stop].copy())
 
     def since(self, start: int) -> WorkingMemory:
         """A :class:`WorkingMemory` of the rows from ``start``, holding none of them yet (the loop feeds them)."""

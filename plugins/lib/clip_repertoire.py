@@ -65,10 +65,11 @@ class ClipRepertoire:
 
 def root_relative_motion(world: Motion, profile: BodyProfile, facing_window: float = 1.0) -> Motion:
     """World positions to root-relative positions in the body's frame (§5.1), the facing a centred running median
-    over ``facing_window`` seconds; hidden parts held (docs/conventions.md)."""
+    over ``facing_window`` seconds; hidden parts held (docs/conventions.md); the world positions kept beside them
+    (:attr:`Motion.world`, where the body travels: :mod:`plugins.lib.travel`)."""
     window = max(1, int(round(facing_window * world.fps)))
     pose, mask, _, _ = root_relative(world.positions, world.visible, profile.body, lambda h: smooth_heading(h, window))
-    return Motion(pose, world.fps, world.parts, mask).filled()
+    return Motion(pose, world.fps, world.parts, mask, world.positions).filled()
 
 
 def example_name(movement: str, earlier: int) -> str:
@@ -134,7 +135,7 @@ def load_clip_repertoire(folder: str | Path, profile: str | Path | BodyProfile, 
     hubs_rel = find_hubs(ends, hub_radius, hub_share)
     height = _root_height(rel)
     lift = np.array([0.0, height, 0.0])
-    clips = tuple(Clip(mv, path, Motion(m.positions + lift, m.fps, m.parts, m.visible)) for mv, path, m in rel)
+    clips = tuple(Clip(mv, path, Motion(m.positions + lift, m.fps, m.parts, m.visible, m.world)) for mv, path, m in rel)
     return ClipRepertoire(profile, clips, hubs_rel + lift, Path(folder))
 
 

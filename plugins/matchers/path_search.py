@@ -30,6 +30,21 @@ repertoire holds several takes of (several clips: performers, styles) is accepte
 *spread between takes*: the median, over its takes, of the mean eq. 1 distance from the take to the nearest path
 through the rest of the graph when that take's own nodes are left out. A movement people perform alike is then held
 to a tight threshold, one they perform in many ways to a loose one; a movement of one take keeps ``max_distance``.
+
+Travel (issue 18; not in the paper, which compares root-relative poses only, §5.1): with ``travel`` = τ > 0
+seconds, where the body goes is compared as one more part: the root's displacement over τ at its current velocity
+in the body's own frame (:mod:`plugins.lib.travel`), observed from the motion's world positions and, for the
+graph's nodes, from the clips or key poses they were sampled from (``node_travel``, the :class:`Travelling`
+protocol). A walk forwards, a walk backwards and a run then differ as they do to the eye, not only in the legs.
+Where the motion's world positions are not known the travel part is hidden, and eq. 1 leaves it out.
+
+Two limits on the search itself (issue 18; both off by default, the paper's search). ``per_movement`` keeps, besides
+the k best paths, the best path ending in each movement at every sample (and starts from each movement's nearest
+pose too): §5.2 starts from the k poses nearest the middle frame over the whole graph, and a repertoire of real
+clips has long varied clips (a dance of a minute) whose many poses fill all k starts, so a movement of ten nodes
+never gets a hypothesis. ``max_stay`` limits how many samples in a row a path may stay on one node, as ``max_skip``
+limits how far it may jump: without it a path may stand on one pose of a long clip that resembles the average of a
+whole demonstration, which explains no movement.
 """
 
 from __future__ import annotations
@@ -41,10 +56,11 @@ import numpy as np
 
 from plugins.lib.attention import movement_weights
 from plugins.lib.pose_distance import path_distance, pose_distance
+from plugins.lib.travel import body_velocity, travel_part
 from toolkit import Match, Matcher, Motion, Parameter, hookimpl
 from toolkit.components import provides
 
-__all__ = ["PathSearch", "PoseGraph", "Takes"]
+__all__ = ["PathSearch", "PoseGraph", "Takes", "Travelling"]
 
 
 class PoseGraph(Protocol):
@@ -82,6 +98,13 @@ class Takes(Protocol):
         """Movement -> the node names of each of its takes (hubs left out)."""
 
 
+class Travelling(Protocol):
+    """A posegraph that knows each node's travel: the root's velocity in the body's frame (m/s), (N, 3), in the
+    order of ``node_root_relative`` (:mod:`plugins.lib.travel`)."""
+
+    node_travel: np.ndarray
+
+
 class PathSearch(Matcher):
     """k-best path search through the observer's posegraph from the middle frame outward (§5.2)."""
 
@@ -92,6 +115,13 @@ class PathSearch(Matcher):
                   "Larger is more robust to noise and occlusion, and slower.", minimum=1),
         Parameter("max_skip", int, 2, "Most nodes a path may advance per observed sample (0 = stay is always "
                   "allowed); 2 tolerates movements up to twice as fast as one's own.", minimum=1, maximum=5),
+        Parameter("per_movement", bool, False, "Besides the k best paths, keep the best path ending in each movement "
+                  "at every sample, and start from each movement's nearest pose too: a movement of few nodes is not "
+                  "crowded out of the beam by a long clip's many similar poses (false: the k best only, the "
+                  "paper)."),
+        Parameter("max_stay", int, 0, "Most samples in a row a path may stay on one node; 1 tolerates movements "
+                  "down to half one's own speed, as max_skip = 2 tolerates twice it. 0: no limit (a path may stand "
+                  "on one pose that resembles a whole movement's average, as a long varied clip has).", minimum=0),
         Parameter("max_distance", float, 0.03, "Mean eq. 1 distance (m) per sample above which the answer is "
                   "'unknown'. Must stay above the noise of the input (about 1.8 x its standard deviation).", minimum=0.0, length=True),
         Parameter("scale", float, 0.02, "Distance (m) at which confidence falls to 1/e.", minimum=1e-6, length=True),
@@ -101,6 +131,9 @@ class PathSearch(Matcher):
         Parameter("attention", float, 0.0, "How much the parts that move in the segment count over the still ones "
                   "(plugins.lib.attention): 0 is eq. 1's plain mean over the visible parts, 1 counts only what "
                   "moves.", minimum=0.0, maximum=1.0),
+        Parameter("travel", float, 0.0, "Seconds over which where the body goes counts as one more part: the root's "
+                  "displacement over this time, in the body's frame (plugins.lib.travel); 0: root-relative poses "
+                  "only (the paper).", minimum=0.0, maximum=10.0),
         Parameter("learn", bool, False, "Add an unknown movement's path to the posegraph as a new movement."),
         Parameter("learn_prefix", str, "learned", "Name prefix of learned movements (learned-1, learned-2...)."),
     )
@@ -110,6 +143,10 @@ class PathSearch(Matcher):
         provides(owner.motor, PoseGraph, needed_by="path-search", what="a posegraph motor system",
                  expected=" or ".join(f'[motor] plugin = "{name}"' for name in self.motor_systems))
         self.motor = owner.motor
+        if self.params["travel"] > 0:
+            provides(owner.motor, Travelling, needed_by="path-search's travel", what="a posegraph that knows where "
+                     "its nodes travel", key=("travel",), expected="travel = 0, or a motor system with node_travel "
+                     "(posegraph)")
         if self.params["spread"] > 0:
             provides(owner.motor, Takes, needed_by="path-search's spread", what="a posegraph that knows its takes",
                      key=("spread",), expected="spread = 0, or a motor system with takes() (posegraph)")
@@ -125,6 +162,11 @@ class PathSearch(Matcher):
         index = {node: i for i, node in enumerate(nodes)}
         self.node_names = nodes
         self.labels = np.array([motor.movement_of(nd) or "" for nd in nodes], dtype=object)
+        _, self.label_ids = np.unique(self.labels.astype(str), return_inverse=True)  # a number per movement
+        self.nodes_compared = motor.node_root_relative
+        if self.params["travel"] > 0:  # travel: one more part of every node
+            self.nodes_compared = np.concatenate(
+                [motor.node_root_relative, travel_part(motor.node_travel, self.params["travel"])[:, None]], axis=1)
         self.succ = _reach(motor.graph, nodes, index, self.params["max_skip"], forward=True)
         self.pred = _reach(motor.graph, nodes, index, self.params["max_skip"], forward=False)
         self._cache_version = n
@@ -133,7 +175,7 @@ class PathSearch(Matcher):
     def _spreads(self, index: dict[str, int]) -> dict[str, float]:
         """Each movement's spread between takes (movements of several takes only): the median over its takes of the
         take's mean eq. 1 distance to the best path through the graph without that take's nodes."""
-        nodes = self.motor.node_root_relative
+        nodes = self.nodes_compared
         out = {}
         for movement, takes in self.motor.takes().items():
             if len(takes) < 2:
@@ -163,14 +205,25 @@ class PathSearch(Matcher):
 
     def samples(self, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
         """The observed motion (in the observer's own parts) at the posegraph's node rate: poses (n, P, 3), visible
-        (n, P)."""
+        (n, P); with ``travel``, the travel as one more part (n, P + 1, 3), hidden where the motion has no world
+        positions."""
         if motion.parts != self.owner.body.parts:
             raise ValueError(f"path-search matches motions of the observer's own parts {list(self.owner.body.parts)}, "
                              f"not {list(motion.parts)} (Motion.onto maps them by name)")
         rate = self.motor.node_rate
         n = max(1, int(round(motion.duration * rate)))
         idx = np.minimum(np.round(np.arange(n) * motion.fps / rate).astype(int), motion.n_frames - 1)
-        return motion.positions[idx], motion.visible[idx]
+        poses, visible = motion.positions[idx], motion.visible[idx]
+        if self.params["travel"] <= 0:
+            return poses, visible
+        if motion.world is None:
+            velocity = np.full((n, 3), np.nan)
+        else:
+            velocity = body_velocity(motion.world, motion.positions, motion.visible, self.owner.body.root_index,
+                                     motion.fps)[idx]
+        known = np.isfinite(velocity).all(axis=1)
+        part = np.where(known[:, None], travel_part(velocity, self.params["travel"]), 0.0)
+        return np.concatenate([poses, part[:, None]], axis=1), np.concatenate([visible, known[:, None]], axis=1)
 
     def match(self, motion: Motion) -> Match:
         if motion.n_frames == 0 or not motion.visible.any():
@@ -179,13 +232,16 @@ class PathSearch(Matcher):
         obs, vis = self.samples(motion)
         weights = None
         if self.params["attention"] > 0:
-            weights = movement_weights(obs, vis, self.params["attention"], ~self.owner.body.angle_mask)
+            positions = ~self.owner.body.angle_mask
+            if obs.shape[1] > len(positions):  # the travel part is a position too
+                positions = np.append(positions, True)
+            weights = movement_weights(obs, vis, self.params["attention"], positions)
         path, _, evidence = self.search(obs, vis, weights)  # the beam's eq. 3 cost: recomputed below by the one formula
         if path is None:
             return Match.unknown(reason="nothing visible")
         labels = self.labels[path]
         voting = labels[labels != ""]
-        mean = path_distance(obs, self.motor.node_root_relative[path], vis, weights) / max(evidence, 1)  # eq. 3 per sample
+        mean = path_distance(obs, self.nodes_compared[path], vis, weights) / max(evidence, 1)  # eq. 3 per sample
         details: dict[str, Any] = {"mean_distance": mean, "samples": len(path)}
         if voting.size == 0:
             return Match.unknown(reason="only hub poses", path=tuple(self.node_names[i] for i in path), **details)
@@ -217,28 +273,34 @@ class PathSearch(Matcher):
         mid = n // 2
         ev = np.flatnonzero(has)
         mid = int(ev[np.argmin(np.abs(ev - mid))])  # the visible frame nearest the middle
-        nodes = self.motor.node_root_relative
+        nodes = self.nodes_compared
         k = self.params["k"]
         first = pose_distance(nodes, obs[mid], vis[mid], weights)
         if exclude is not None:
             first = np.where(exclude, np.inf, first)
-        start = np.argsort(first, kind="stable")[:k]
+        start = self._best(np.argsort(first, kind="stable"), np.arange(len(nodes)), k)
         # beams: array of paths (B, length) and costs (B,)
         paths = start[:, None]
         costs = first[start]
         paths, costs = self._extend(paths, costs, obs, vis, range(mid + 1, n), self.succ, weights, exclude, append=True)
+        # the stays the forward half made on the middle node count toward the backward half's
+        repeats = np.cumprod(paths == paths[:, :1], axis=1).sum(axis=1) - 1
         paths, costs = self._extend(paths, costs, obs, vis, range(mid - 1, -1, -1), self.pred, weights, exclude,
-                                    append=False)
+                                    append=False, stays=repeats)
         best = int(np.argmin(costs))
         return paths[best], float(costs[best]), int(has.sum())
 
-    def _extend(self, paths, costs, obs, vis, frames, table, weights, exclude, *, append: bool):
-        nodes = self.motor.node_root_relative
-        k = self.params["k"]
+    def _extend(self, paths, costs, obs, vis, frames, table, weights, exclude, *, append: bool, stays=None):
+        nodes = self.nodes_compared
+        k, limit = self.params["k"], self.params["max_stay"]
+        # samples in a row each path has stayed on the end node it grows from
+        stays = np.zeros(len(paths), dtype=int) if stays is None else stays
         for t in frames:
-            reach = [table[e] for e in (paths[:, -1] if append else paths[:, 0])]
+            ends = paths[:, -1] if append else paths[:, 0]
+            reach = [table[e] for e in ends]
             beam = np.repeat(np.arange(len(reach)), [len(r) for r in reach])
             cand = np.concatenate(reach)
+            stay = np.where(cand == ends[beam], stays[beam] + 1, 0)
             seen = vis[t]
             if seen.any():  # eq. 1 over the parts seen in this sample: the mask is the same for every candidate, so
                 # the seen parts are taken first and pose_distance needs no mask (the hot loop of the search)
@@ -248,20 +310,34 @@ class PathSearch(Matcher):
                 step = np.zeros(len(cand))
             if exclude is not None:
                 step = np.where(exclude[cand], np.inf, step)
+            if limit > 0:
+                step = np.where(stay > limit, np.inf, step)
             total = costs[beam] + step
             order = np.argsort(total, kind="stable")
             # k best, one path per end node (distinct hypotheses): the first time each end node comes in the order
             _, first = np.unique(cand[order], return_index=True)
-            keep = order[np.sort(first)[:k]]
+            keep = self._best(order[np.sort(first)], cand, k)
             new = cand[keep][:, None]
             paths = np.hstack([paths[beam[keep]], new]) if append else np.hstack([new, paths[beam[keep]]])
-            costs = total[keep]
+            costs, stays = total[keep], stay[keep]
         return paths, costs
+
+    def _best(self, ranked: np.ndarray, cand: np.ndarray, k: int) -> np.ndarray:
+        """The first ``k`` of ``ranked`` (indices into ``cand``, best first) and, with ``per_movement``, the first of
+        each movement's nodes among them, in rank order."""
+        if not self.params["per_movement"]:
+            return ranked[:k]
+        _, each = np.unique(self.label_ids[cand[ranked]], return_index=True)
+        chosen = np.zeros(len(ranked), dtype=bool)
+        chosen[:k] = True
+        chosen[each] = True
+        return ranked[chosen]
 
     def _learn(self, obs: np.ndarray, vis: np.ndarray, details: dict[str, Any]) -> Match:
         n = sum(1 for m in self.motor.movements() if m.startswith(self.params["learn_prefix"] + "-")) + 1
         name = f"{self.params['learn_prefix']}-{n}"
-        path = self.motor.learn(name, obs, vis, source="path-search")
+        parts = self.owner.body.n_parts  # the travel part, if any, is not a pose's
+        path = self.motor.learn(name, obs[:, :parts], vis[:, :parts], source="path-search")
         self._refresh()
         return Match(name, 1.0, None, tuple(path), {"learned": True, **details})
 

@@ -13,7 +13,10 @@ as recognition needs, the played animation stays as smooth as its key poses).
 All node poses sit in one contiguous array ``node_poses`` of shape (N, P, 3),
 local frame, so the matcher searches the whole graph with one vectorised
 distance; ``graph`` is a :class:`networkx.DiGraph` whose nodes carry their index
-into that array, their movement and whether they are hubs.
+into that array, their movement and whether they are hubs. ``node_travel`` (N, 3)
+holds each node's *travel*, the root's velocity in the body's own frame
+(:mod:`plugins.lib.travel`; zero at the hubs), which the root-relative poses
+leave out: a walk forwards and a walk backwards have nearly the same poses.
 
 Learning (§5.2.3, §7.3): :meth:`Posegraph.learn` adds an observed path as a new
 movement (new nodes from the observed poses, entered from and returning to the
@@ -30,6 +33,7 @@ import numpy as np
 from plugins.lib.clip_repertoire import CLIP_PARAMETERS, example_name, repertoire_for
 from plugins.motor.key_poses import REPERTOIRE_PARAMETERS, KeyPoses, interpolate, play, read_repertoire
 from plugins.lib.pose_distance import pose_distance
+from plugins.lib.travel import body_velocity
 from toolkit import ConfigError, Motion, MotorSystem, Parameter, hookimpl
 
 _OPTIONAL = {"poses": {}, "movements": {}}  # with clips, the key-pose repertoire is not needed
@@ -43,6 +47,10 @@ class Posegraph(MotorSystem):
         *(p if p.name not in _OPTIONAL else Parameter(p.name, p.type, _OPTIONAL[p.name], p.doc + " Not needed with clips.")
           for p in REPERTOIRE_PARAMETERS),
         *CLIP_PARAMETERS,
+        Parameter("cycles", bool, True, "A clip that ends where it began (within hub_radius), away from every hub "
+                  "(one cycle of a walk or a run, cropped from a longer recording), loops: an edge leads from its "
+                  "last pose back to its first, so a path can follow the movement for as many cycles as it is seen "
+                  "(false: every path leaves through a hub, the paper's posegraph).", ),
         Parameter("node_rate", float, 10.0, "Pose nodes per second of movement: the graph's resolution. Higher "
                   "recognises finer timing at the cost of search time.", minimum=1.0, maximum=120.0),
     )
@@ -66,22 +74,27 @@ class Posegraph(MotorSystem):
     def _build(self) -> None:
         rate = self.params["node_rate"]
         poses: list[np.ndarray] = [self.key_poses[h] for h in self.hubs]
+        travel: list[np.ndarray] = [np.zeros(3) for _ in self.hubs]  # at rest in the hubs
         self.graph = nx.DiGraph()
         for i, hub in enumerate(self.hubs):
             self.graph.add_node(hub, index=i, movement=None, hub=True)
         self.paths: dict[str, list[str]] = {}
         self.paths_label: dict[str, str] = {}  # path name -> movement (several clips of one movement)
+        root = self.body.root_index
         for name, m in self.repertoire.items():
             sampled = play(self.key_poses, m, self.body.parts, fps=rate).positions
-            self._add_path(name, m.poses[0], sampled[1:-1], m.poses[-1], poses)
+            # key poses are in the body's own frame: the root's motion there is its travel
+            velocity = body_velocity(sampled, sampled, np.ones(sampled.shape[:2], dtype=bool), root, rate)
+            self._add_path(name, m.poses[0], sampled[1:-1], m.poses[-1], poses, travel, np.nan_to_num(velocity[1:-1]))
         for clip in self.clips.clips if self.clips is not None else ():
-            self._add_clip(clip.movement, clip.motion, poses)
+            self._add_clip(clip.movement, clip.motion, poses, travel)
         self.node_poses = np.stack(poses)
-        root = self.body.root_index
+        self.node_travel = np.stack(travel)
         self.node_root_relative = self.node_poses - self.node_poses[:, root : root + 1]
 
-    def _add_clip(self, movement: str, motion: Motion, poses: list[np.ndarray]) -> None:
-        """One example clip as a path between the hubs nearest its ends, sampled at ``node_rate``."""
+    def _add_clip(self, movement: str, motion: Motion, poses: list[np.ndarray], travel: list[np.ndarray]) -> None:
+        """One example clip as a path between the hubs nearest its ends, sampled at ``node_rate``; its travel from
+        its world positions (none known: at rest)."""
         rate = self.params["node_rate"]
         t = np.arange(motion.n_frames) / motion.fps
         keep = np.unique(np.clip(np.round(np.arange(0.0, t[-1] + 1e-9, 1.0 / rate) * motion.fps), 0,
@@ -89,19 +102,34 @@ class Posegraph(MotorSystem):
         sampled = motion.filled(default=self.rest_pose()).positions[keep]  # hidden parts held (docs/conventions.md)
         hub_rel = self.key_poses.array - self.key_poses.array[:, self.body.root_index : self.body.root_index + 1]
         root = self.body.root_index
-        ends = [self.hubs[int(np.argmin(pose_distance(hub_rel, sampled[i] - sampled[i, root], True)))] for i in (0, -1)]
+        end_rel = [sampled[i] - sampled[i, root] for i in (0, -1)]
+        to_hubs = [pose_distance(hub_rel, pose, True) for pose in end_rel]
+        ends = [self.hubs[int(np.argmin(d))] for d in to_hubs]
         n = sum(1 for p in self.paths if self.paths_label.get(p) == movement)
-        self._add_path(example_name(movement, n), ends[0], sampled[1:-1], ends[1], poses,
-                       label=movement)
+        velocity = np.zeros((len(keep), 3))
+        if motion.world is not None:
+            velocity = np.nan_to_num(body_velocity(motion.world, motion.positions, motion.visible, root,
+                                                   motion.fps)[keep])
+        name = example_name(movement, n)
+        self._add_path(name, ends[0], sampled[1:-1], ends[1], poses, travel, velocity[1:-1], label=movement)
+        whole = motion.filled(default=self.rest_pose()).positions[[0, -1]]
+        whole = whole - whole[:, root : root + 1]
+        cycle = float(pose_distance(whole[0], whole[1], True))  # its very first and last frames
+        radius = self.params["hub_radius"]
+        if (self.params["cycles"] and len(sampled) > 3 and cycle <= radius
+                and min(float(np.min(d)) for d in to_hubs) > radius):
+            path = self.paths[name]
+            self.graph.add_edge(path[-2], path[1], movement=movement, cycle=True)
 
-    def _add_path(self, name: str, start: str, interior: np.ndarray, end: str, poses: list[np.ndarray], *,
-                  label: str | None = None) -> None:
+    def _add_path(self, name: str, start: str, interior: np.ndarray, end: str, poses: list[np.ndarray],
+                  travel: list[np.ndarray], velocity: np.ndarray, *, label: str | None = None) -> None:
         label = label or name
         path = [start]
-        for j, pose in enumerate(interior, 1):
+        for j, (pose, v) in enumerate(zip(interior, velocity), 1):
             node = f"{name}/{j}"
             self.graph.add_node(node, index=len(poses), movement=label, hub=False)
             poses.append(pose)
+            travel.append(v)
             path.append(node)
         path.append(end)
         nx.add_path(self.graph, path, movement=label)
@@ -202,9 +230,11 @@ class Posegraph(MotorSystem):
             interior.append(pose + rest_root)
         if not interior:
             raise ValueError("nothing to learn: no visible pose between the hubs")
-        poses_list = list(self.node_poses)
-        self._add_path(name, self.hubs[0], np.stack(interior), self.hubs[0], poses_list)
+        poses_list, travel_list = list(self.node_poses), list(self.node_travel)
+        self._add_path(name, self.hubs[0], np.stack(interior), self.hubs[0], poses_list, travel_list,
+                       np.zeros((len(interior), 3)))
         self.node_poses = np.stack(poses_list)
+        self.node_travel = np.stack(travel_list)
         self.node_root_relative = self.node_poses - self.node_poses[:, root : root + 1]
         self.learned[name] = {"nodes": len(interior), "source": source}
         if announce and self.owner is not None:

@@ -1,0 +1,84 @@
+"""Travel: where the body goes, in its own frame, which root-relative coordinates remove.
+
+Buchsbaum & Blumberg 2005, §5.1 make every observed pose relative to the root and the facing, so a posture means
+the same wherever the body stands and whichever way it faces. The same transform removes locomotion: a walk
+forwards, a walk backwards, a side step and a run differ mostly in where the root goes relative to the facing,
+and in root-relative coordinates they are nearly the same leg swings. The papers' movements are gestures made on
+the spot (and a mouse's jump, whose rise stays in the root's height), so they never needed it; real people walk.
+This is part of the correspondence problem both papers leave open (B&B §7.1, K&G §6): the observer must see the
+other's body travel as it would feel its own travel.
+
+*Travel* is the root's velocity in the body's own frame (m/s: +z forward, +x to the body's left, +y up), found
+from the motion's world positions (:attr:`toolkit.motion.Motion.world`) and its root-relative positions, with no
+knowledge of how the facing was found: the heading of each frame is the rotation that takes the parts' horizontal
+offsets from the root in the world onto their offsets in the body's frame (a least-squares fit over the parts,
+:func:`frame_rotation`). A matcher compares it like one more part (:func:`travel_part`): the root's displacement
+over ``horizon`` seconds.
+
+Glossary: F frames, P parts; ``world`` (F, P, 3) world positions; ``local`` (F, P, 3) root-relative positions in
+the body's frame (hidden parts held, ``docs/conventions.md``); ``visible`` (F, P).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.ndimage import uniform_filter1d
+
+__all__ = ["frame_rotation", "body_velocity", "travel_part"]
+
+
+def frame_rotation(world: np.ndarray, local: np.ndarray, visible: np.ndarray, root: int) -> np.ndarray:
+    """The rotation about +y (radians) that takes each frame's world offsets from the root onto its body-frame
+    offsets, (F,); NaN where fewer than one part besides the root is seen with a horizontal offset.
+
+    With horizontal offsets as complex numbers ``a = x + i z`` (world) and ``b`` (body frame), the angle is that of
+    ``sum(conj(a) * b)``: the least-squares rotation (the 2-D Kabsch solution), exact when the offsets are rigid.
+    """
+    world = np.asarray(world, dtype=float)
+    local = np.asarray(local, dtype=float)
+    seen = np.asarray(visible, dtype=bool) & np.asarray(visible, dtype=bool)[:, root : root + 1]
+    seen[:, root] = False
+    a = world - world[:, root : root + 1]
+    b = local - local[:, root : root + 1]
+    ca = a[..., 0] + 1j * a[..., 2]
+    cb = b[..., 0] + 1j * b[..., 2]
+    ok = seen & np.isfinite(ca) & np.isfinite(cb)
+    s = np.where(ok, np.conj(np.where(ok, ca, 0)) * np.where(ok, cb, 0), 0).sum(axis=1)
+    out = np.angle(s)
+    out[np.abs(s) < 1e-12] = np.nan
+    return out
+
+
+def body_velocity(world: np.ndarray, local: np.ndarray, visible: np.ndarray, root: int, fps: float,
+                  window: float = 0.25) -> np.ndarray:
+    """The root's velocity in the body's own frame (F, 3), m/s; NaN where the root or the facing is not known.
+
+    The world velocity is the centred difference of the root's world position, averaged over ``window`` seconds
+    (a step's sway left and right cancels; a change of pace within a second is kept), then turned by each frame's
+    :func:`frame_rotation`. A motion of one frame has no velocity (NaN).
+    """
+    world = np.asarray(world, dtype=float)
+    n = len(world)
+    out = np.full((n, 3), np.nan)
+    if n < 2:
+        return out
+    root_seen = np.asarray(visible, dtype=bool)[:, root] & np.isfinite(world[:, root]).all(axis=1)
+    if root_seen.sum() < 2:
+        return out
+    frames = np.arange(n)
+    track = np.stack([np.interp(frames, frames[root_seen], world[root_seen, root, k]) for k in range(3)], axis=1)
+    velocity = np.gradient(track, axis=0) * fps
+    taps = max(1, int(round(window * fps)))
+    if taps > 1:
+        velocity = uniform_filter1d(velocity, taps, axis=0, mode="nearest")
+    angle = frame_rotation(world, local, visible, root)
+    horizontal = (velocity[:, 0] + 1j * velocity[:, 2]) * np.exp(1j * angle)
+    out[:, 0], out[:, 1], out[:, 2] = horizontal.real, velocity[:, 1], horizontal.imag
+    out[~root_seen | ~np.isfinite(angle)] = np.nan
+    return out
+
+
+def travel_part(velocity: np.ndarray, horizon: float) -> np.ndarray:
+    """Travel as one more part to compare (F, 3): the root's displacement over ``horizon`` seconds at the current
+    velocity, in metres, so eq. 1 compares it with the same weight and units as a part's position."""
+    return np.asarray(velocity, dtype=float) * float(horizon)

@@ -1,0 +1,208 @@
+"""Travel (plugins/lib/travel.py): where the body goes in its own frame, kept beside root-relative poses (issue 18).
+
+Root-relative coordinates (Buchsbaum & Blumberg 2005, §5.1) make a walk forwards and a walk backwards nearly the
+same leg swings. These tests check the formulas on bodies whose heading and velocity are known, that the world
+positions travel with a :class:`Motion` through working memory, that the posegraph knows each node's travel and
+loops a clip that is one cycle of a gait, and that path search with ``travel`` tells apart two movements whose
+root-relative poses are the same.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from plugins.lib.root_frame import root_relative
+from plugins.lib.travel import body_velocity, frame_rotation, travel_part
+from toolkit import Motion, create_plugin_manager, load_character
+from toolkit.bvh import from_joint_positions, write_bvh
+from toolkit.motion import local_to_world
+from toolkit.observe import compose_observer
+from toolkit.profile import load_profile
+from toolkit.watching import ObservationLog
+
+PARTS = ("root", "head", "lk", "rk", "hand", "lf", "rf")
+STAND = np.array([[0.0, 1.0, 0.0], [0.0, 1.6, 0.1], [0.1, 0.5, 0.0], [-0.1, 0.5, 0.0], [0.3, 1.0, 0.0],
+                  [0.1, 0.0, 0.0], [-0.1, 0.0, 0.0]])
+
+
+def walking(heading: float, velocity_local: np.ndarray, frames: int = 60, fps: float = 30.0) -> tuple[np.ndarray, np.ndarray]:
+    """A rigid standing body facing ``heading`` whose root moves at ``velocity_local`` (m/s, body frame): world
+    (F, P, 3) and root-relative local (F, P, 3) positions."""
+    t = np.arange(frames) / fps
+    direction = local_to_world(np.asarray(velocity_local, dtype=float)[None, None], np.zeros(3), heading)[0, 0]
+    roots = np.array([5.0, 0.0, -2.0]) + t[:, None] * direction
+    world = np.stack([local_to_world(STAND - STAND[0], r, heading) for r in roots])
+    local = np.repeat((STAND - STAND[0])[None], frames, axis=0)
+    return world, local
+
+
+@settings(max_examples=50, deadline=None)
+@given(heading=st.floats(-np.pi, np.pi), vx=st.floats(-2, 2), vz=st.floats(-4, 4), vy=st.floats(-1, 1))
+def test_the_velocity_in_the_bodys_frame_is_the_one_it_moved_with_whatever_its_heading(heading, vx, vz, vy):
+    world, local = walking(heading, np.array([vx, vy, vz]))
+    velocity = body_velocity(world, local, np.ones(world.shape[:2], dtype=bool), 0, 30.0)
+    assert np.allclose(velocity, [vx, vy, vz], atol=1e-9)
+
+
+@settings(max_examples=30, deadline=None)
+@given(heading=st.floats(-np.pi, np.pi))
+def test_the_frame_rotation_undoes_the_heading_the_perception_found(heading):
+    """The same root-relative transform the perceptions use (§5.1): with offsets as ``x + iz``, the rotation found
+    is the heading the perception found."""
+    world, _ = walking(heading, np.array([0.0, 0.0, 1.0]), frames=3)
+    from toolkit.body import Body, Facing
+
+    body = Body(PARTS, "root", facing=Facing("lk", "rk", "head"))
+    local, visible, _, found = root_relative(world, None, body)
+    angle = frame_rotation(world, local, visible, 0)
+    assert np.allclose(np.angle(np.exp(1j * (angle - found))), 0.0, atol=1e-9)
+
+
+def test_hidden_roots_and_frames_without_a_facing_have_no_velocity():
+    world, local = walking(0.3, np.array([0.0, 0.0, 1.2]), frames=10)
+    visible = np.ones(world.shape[:2], dtype=bool)
+    visible[4, 0] = False  # the root hidden in one frame
+    visible[6, 1:] = False  # nothing but the root seen: no facing
+    velocity = body_velocity(world, local, visible, 0, 30.0)
+    assert np.isnan(velocity[[4, 6]]).all()
+    assert np.allclose(np.delete(velocity, [4, 6], axis=0), [0.0, 0.0, 1.2])
+    assert np.isnan(body_velocity(world[:1], local[:1], visible[:1], 0, 30.0)).all()  # one frame: no velocity
+
+
+def test_travel_is_the_displacement_over_the_horizon():
+    assert np.allclose(travel_part(np.array([[0.0, 0.0, 1.5]]), 0.5), [[0.0, 0.0, 0.75]])
+
+
+def test_world_positions_stay_with_a_motion_through_every_operation_and_working_memory():
+    world, local = walking(1.0, np.array([0.0, 0.0, 1.0]), frames=8)
+    motion = Motion(local, 30.0, PARTS, None, world)
+    assert np.array_equal(motion.slice(2, 5).world, world[2:5])
+    assert np.array_equal(motion.select(["hand", "root"]).world, world[:, [4, 0]])
+    onto = motion.onto(["hand", "tail"])
+    assert np.array_equal(onto.world[:, 0], world[:, 4]) and np.isnan(onto.world[:, 1]).all()
+    assert np.array_equal(motion.filled().world, world)
+    assert np.array_equal(Motion(world, 30.0, PARTS).root_relative("root").world, world)
+    with pytest.raises(ValueError, match="world positions have shape"):
+        Motion(local, 30.0, PARTS, None, world[:, :2])
+    log = ObservationLog(PARTS, 30.0, capacity=2)
+    log.extend(local, np.ones(local.shape[:2], dtype=bool), world)
+    assert np.array_equal(log.motion(3, 6).world, world[3:6])
+
+
+# -- the posegraph: travel per node, cycles ----------------------------------------------------------------------
+
+def _write_clip(path, positions, fps=30.0):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_bvh(from_joint_positions(list(PARTS), [-1] + [0] * (len(PARTS) - 1), positions, fps), path)
+
+
+def _step_cycle(frames: int, direction: float, fps: float = 30.0, cycles: int = 1, phase: float = 0.0) -> np.ndarray:
+    """``cycles`` gait cycles of ``frames`` frames each, and the first frame of the next: the stick's feet swing
+    forward and back once a cycle while the root travels along the facing (+z) at ``direction`` m/s; a cycle ends
+    where it began, root-relative, with the feet 0.6 m apart (away from standing), or as far into the cycle as
+    ``phase`` says."""
+    k = np.arange(cycles * frames + 1)
+    swing = 0.3 * np.cos(2 * np.pi * k / frames + phase)
+    pose = np.repeat(STAND[None], len(k), axis=0).copy()
+    pose[:, 5, 2] += swing
+    pose[:, 6, 2] -= swing
+    pose[:, :, 2] += direction * (k / fps)[:, None]
+    return pose
+
+
+def _raise_hand(frames: int = 30) -> np.ndarray:
+    pose = np.repeat(STAND[None], frames, axis=0).copy()
+    pose[:, 4, 1] += 0.5 * np.sin(np.linspace(0, np.pi, frames))
+    return pose
+
+
+@pytest.fixture(scope="module")
+def clips(tmp_path_factory):
+    """A repertoire of clips: ``raise`` (a gesture from standing to standing, four takes), ``walk`` and ``back``
+    (one gait cycle each, the same leg swings from two points of the cycle, forwards and backwards: their ends are
+    too few to make a hub), and a profile."""
+    root = tmp_path_factory.mktemp("travel")
+    for take, frames in enumerate((30, 36, 42, 48)):
+        _write_clip(root / "repertoire" / "raise" / f"{take}.bvh", _raise_hand(frames))
+    _write_clip(root / "repertoire" / "walk" / "a.bvh", _step_cycle(30, 1.2)[:-1])
+    _write_clip(root / "repertoire" / "back" / "a.bvh", _step_cycle(30, -1.2, phase=np.pi)[:-1])
+    parts = "\n".join(f'{p} = "{p}"' for p in PARTS)
+    (root / "profile.toml").write_text(f'[profile]\nname = "stick"\nunits = "metre"\nup = "+y"\n\n[parts]\n{parts}\n\n'
+                                       '[facing]\nleft = "lk"\nright = "rk"\nforward = "head"\n', encoding="utf-8")
+    return root
+
+
+def _observer(clips, **matcher):
+    pm = create_plugin_manager(autoload=False, trace=False)
+    profile = load_profile(clips / "profile.toml")
+    return profile, compose_observer(pm, profile, clips / "repertoire", lengths_for_height=0,
+                                     settings={"matcher": {"max_distance": 10.0, **matcher}})
+
+
+def test_each_node_of_a_clip_knows_where_the_body_travelled(clips):
+    _, observer = _observer(clips)
+    motor = observer.motor
+    for movement, speed in (("walk", 1.2), ("back", -1.2), ("raise", 0.0)):
+        nodes = [motor.node_index(n) for n in motor.paths[movement][1:-1]]
+        assert np.allclose(motor.node_travel[nodes], [0.0, 0.0, speed], atol=1e-6)
+    hubs = [motor.node_index(h) for h in motor.hubs]
+    assert np.allclose(motor.node_travel[hubs], 0.0)
+
+
+def test_a_clip_that_is_one_cycle_away_from_every_hub_loops_and_a_gesture_does_not(clips):
+    _, observer = _observer(clips)
+    motor = observer.motor
+    loops = {(a, b) for a, b, d in motor.graph.edges(data=True) if d.get("cycle")}
+    assert loops == {(motor.paths[m][-2], motor.paths[m][1]) for m in ("walk", "back")}
+    pm = create_plugin_manager(autoload=False, trace=False)
+    plain = compose_observer(pm, load_profile(clips / "profile.toml"), clips / "repertoire", lengths_for_height=0,
+                             settings={"motor": {"cycles": False}})
+    assert not any(d.get("cycle") for _, _, d in plain.motor.graph.edges(data=True))
+
+
+def test_travel_tells_forwards_from_backwards_where_the_poses_are_the_same(clips):
+    """Three cycles of the walk and of the walk backwards, watched: the root-relative poses are the same cycle, so
+    the paper's path search cannot tell them apart (both get one answer); with travel each is itself, and the
+    path follows the movement's loop for all three cycles."""
+    from toolkit.observe import Observer
+
+    answers = {}
+    for travel in (0.0, 1.0):
+        profile, observer = _observer(clips, travel=travel)
+        watch = Observer(observer, profile.body, 30.0)
+        for movement, speed in (("walk", 1.2), ("back", -1.2)):
+            gait = _step_cycle(30, speed, cycles=3, phase=0.0 if speed > 0 else np.pi)
+            answers[travel, movement] = watch.classify(Motion(gait, 30.0, PARTS)).match
+    assert answers[0.0, "walk"].movement == answers[0.0, "back"].movement
+    assert answers[1.0, "walk"].movement == "walk" and answers[1.0, "back"].movement == "back"
+    assert set(answers[1.0, "walk"].details["votes"]) == {"walk"}
+
+
+def test_travel_needs_a_motor_system_that_knows_where_its_nodes_travel(pm, write):
+    from toolkit import ConfigError
+
+    text = """
+[character]
+name = "Keys"
+[body]
+parts = ["root", "head", "lk", "rk"]
+root = "root"
+facing = { left = "lk", right = "rk", forward = "head" }
+[motor]
+plugin = "keyframe"
+[motor.poses.stand]
+root = [0.0, 1.0, 0.0]
+head = [0.0, 1.6, 0.1]
+lk = [0.1, 0.5, 0.0]
+rk = [-0.1, 0.5, 0.0]
+[motor.movements.stay]
+keys = [{ pose = "stand", at = 0.0 }, { pose = "stand", at = 1.0 }]
+[matcher]
+plugin = "path-search"
+travel = 1.0
+"""
+    with pytest.raises(ConfigError):
+        load_character(write("keys.toml", text), pm)
