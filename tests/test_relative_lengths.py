@@ -141,7 +141,7 @@ def test_a_take_left_out_of_the_search_is_never_on_the_path(takes_observer):
     matcher = takes_observer.matcher
     matcher._refresh()
     index = {n: i for i, n in enumerate(matcher.node_names)}
-    nodes = takes_observer.motor.node_root_relative
+    nodes = matcher.nodes_compared  # the poses as search compares them (with travel, one part more)
     for movement, takes in list(takes_observer.motor.takes().items())[:5]:
         own = np.array([index[n] for n in takes[0]])
         exclude = np.zeros(len(nodes), bool)

@@ -206,3 +206,35 @@ travel = 1.0
 """
     with pytest.raises(ConfigError):
         load_character(write("keys.toml", text), pm)
+
+
+def test_a_key_posed_hop_travels_up_then_down(pm, write):
+    """Key poses are in the body's own frame: the root's own motion there is the travel of the nodes (a mouse's
+    jump), measured as an observer measures it."""
+    text = """
+[character]
+name = "Hopper"
+[body]
+parts = ["root", "head", "lk", "rk"]
+root = "root"
+facing = { left = "lk", right = "rk", forward = "head" }
+[motor]
+plugin = "posegraph"
+[motor.poses.stand]
+root = [0.0, 1.0, 0.0]
+head = [0.0, 1.6, 0.1]
+lk = [0.1, 0.5, 0.0]
+rk = [-0.1, 0.5, 0.0]
+[motor.poses.up]
+root = [0.0, 1.4, 0.0]
+head = [0.0, 2.0, 0.1]
+lk = [0.1, 0.9, 0.0]
+rk = [-0.1, 0.9, 0.0]
+[motor.movements.hop]
+keys = [{ pose = "stand", at = 0.0 }, { pose = "up", at = 0.5 }, { pose = "stand", at = 1.0 }]
+"""
+    motor = load_character(write("hopper.toml", text), pm).motor
+    nodes = [motor.node_index(n) for n in motor.paths["hop"][1:-1]]
+    rise = motor.node_travel[nodes, 1]
+    assert (rise[:3] > 0.3).all() and (rise[-3:] < -0.3).all()
+    assert np.allclose(motor.node_travel[nodes][:, [0, 2]], 0.0)

@@ -263,9 +263,11 @@ class PathSearch(Matcher):
 
     def search(self, obs: np.ndarray, vis: np.ndarray, weights: np.ndarray | None = None,
                exclude: np.ndarray | None = None) -> tuple[np.ndarray | None, float, int]:
-        """The best path (node indices, one per sample), its eq. 3 cost and the number of samples with evidence;
-        ``weights`` (P,): attention to each part (``None``: eq. 1's plain mean); ``exclude`` (N,): nodes no path
-        may use."""
+        """The best path (node indices, one per sample), its eq. 3 cost and the number of samples with evidence.
+
+        ``obs`` and ``vis`` are samples as :meth:`samples` gives them, compared with :attr:`nodes_compared` (with
+        ``travel``, one part more than the body); ``weights``: attention to each of those parts (``None``: eq. 1's
+        plain mean); ``exclude`` (N,): nodes no path may use."""
         has = vis.any(axis=1)
         if not has.any():
             return None, 0.0, 0

@@ -83,14 +83,22 @@ class Posegraph(MotorSystem):
         root = self.body.root_index
         for name, m in self.repertoire.items():
             sampled = play(self.key_poses, m, self.body.parts, fps=rate).positions
-            # key poses are in the body's own frame: the root's motion there is its travel
-            velocity = body_velocity(sampled, sampled, np.ones(sampled.shape[:2], dtype=bool), root, rate)
-            self._add_path(name, m.poses[0], sampled[1:-1], m.poses[-1], poses, travel, np.nan_to_num(velocity[1:-1]))
+            self._add_path(name, m.poses[0], sampled[1:-1], m.poses[-1], poses, travel,
+                           self._key_pose_travel(m, len(sampled))[1:-1])
         for clip in self.clips.clips if self.clips is not None else ():
             self._add_clip(clip.movement, clip.motion, poses, travel)
         self.node_poses = np.stack(poses)
         self.node_travel = np.stack(travel)
         self.node_root_relative = self.node_poses - self.node_poses[:, root : root + 1]
+
+    def _key_pose_travel(self, movement: Any, n: int, fps: float = 30.0) -> np.ndarray:
+        """The travel of a key-pose movement at its ``n`` nodes (n, 3): key poses are in the body's own frame, so
+        the root's motion there is its travel, measured as an observer measures it (at ``fps``, then taken at the
+        nodes' times)."""
+        fine = play(self.key_poses, movement, self.body.parts, fps=fps).positions
+        velocity = body_velocity(fine, fine, np.ones(fine.shape[:2], dtype=bool), self.body.root_index, fps)
+        at = np.minimum(np.round(np.arange(n) * fps / self.params["node_rate"]).astype(int), len(fine) - 1)
+        return np.nan_to_num(velocity[at])
 
     def _add_clip(self, movement: str, motion: Motion, poses: list[np.ndarray], travel: list[np.ndarray]) -> None:
         """One example clip as a path between the hubs nearest its ends, sampled at ``node_rate``; its travel from
