@@ -371,3 +371,16 @@ def test_an_observer_takes_what_it_is_not_told_from_the_observer_template(data, 
     write("bad.toml", '[observer]\nname = "bad"\n[matcher]\nplugin = "dtw"\nwindow = 2.0\n')
     with pytest.raises(ConfigError, match=r"bad.toml:5: key matcher.window: value 2.0 out of range"):
         compose_observer(pm, profile, data / "repertoire", template=mine.parent / "bad.toml")
+
+
+def test_naming_the_templates_own_matcher_keeps_its_parameters_and_another_starts_afresh(data, profile, pm):
+    """The observer template sets path-search's parameters for recordings; `--matcher path-search` must not drop
+    them (it did: every benchmark that named the matcher ran the plugin's defaults), `--matcher dtw` gets dtw's."""
+    from toolkit.character import read_toml, resolve_file
+
+    template = read_toml(resolve_file("observers/recordings.toml", None, pm))["matcher"]
+    named = compose_observer(pm, profile, data / "repertoire", matcher="path-search")
+    assert template["plugin"] == "path-search" and len(template) > 1
+    assert all(named.matcher.declared[k] == v for k, v in template.items() if k != "plugin")
+    other = compose_observer(pm, profile, data / "repertoire", matcher="dtw")
+    assert other.matcher.name == "dtw" and other.matcher.params == other.matcher.declared

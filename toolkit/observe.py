@@ -159,7 +159,8 @@ def compose_observer(pm: Any, profile: BodyProfile, repertoire: str | Path, *, s
     Parameters
     ----------
     segmenter, matcher, motor : str, optional
-        Plugin names replacing the template's; ``matcher=None`` composes no matcher (segmentation only). The motor
+        Plugin names replacing the template's (the template's own plugin, named, keeps its parameters);
+        ``matcher=None`` composes no matcher (segmentation only). The motor
         system is the template's unless the matcher declares others (its ``motor_systems``): then its first.
     correspondence : str, optional
         A correspondence plugin replacing the template's; ``None`` or ``"none"``: none, the papers' plain
@@ -176,7 +177,7 @@ def compose_observer(pm: Any, profile: BodyProfile, repertoire: str | Path, *, s
     base = read_toml(path)
     tables: dict[str, dict[str, Any]] = {k: dict(v) for k, v in base.items() if k in COMPONENT_TABLES}
     for key, name in (("segmenter", segmenter), ("matcher", matcher), ("motor", motor)):
-        if name:
+        if name and tables.get(key, {}).get("plugin") != name:  # another plugin: none of the template's parameters
             tables[key] = {"plugin": name}
     if matcher is None:
         tables.pop("matcher", None)
