@@ -171,6 +171,8 @@ class Track:
     committed_at: int | None = None
     deviated_at: int | None = None
     anchors: dict[str, np.ndarray] = field(default_factory=dict)
+    first: np.ndarray | None = None
+    """The subsystem's parts as seen at the onset (k, 3); ``None``: read from working memory."""
 
 
 @dataclass(frozen=True)
@@ -220,6 +222,19 @@ class ForwardModel(Matcher):
         Parameter("angle_scale", float, 0.25, "Metres one radian of finger joint angle counts as when a hand "
                   "subsystem's errors and movement are compared with threshold, deviation and min_move "
                   "(0.25: the 0.05 m threshold is 0.2 rad, 11 degrees).", minimum=1e-6, length=True),
+        Parameter("dropout", str, "absolute", "How a candidate drops out (K&G §4.4): 'absolute', the paper's, when "
+                  "its prediction error exceeds threshold; 'relative', when it exceeds ratio times the best living "
+                  "candidate's, or the absolute ceiling (see the module).", choices=("absolute", "relative")),
+        Parameter("ratio", float, 1.5, "With dropout = relative: a candidate drops out when its prediction error "
+                  "exceeds this many times the best living candidate's (errors under min_move count as min_move).",
+                  minimum=1.0),
+        Parameter("ceiling", float, 0.15, "With dropout = relative: prediction error (m) above which a candidate "
+                  "drops out whatever the others do, so a demonstration no edge fits is unknown.", minimum=0.0,
+                  length=True),
+        Parameter("spread", float, 0.0, "A movement with several takes: its candidates drop out beyond this many "
+                  "times its spread between takes (each take's mean prediction error under the nearest other take's "
+                  "commands) instead of threshold (absolute) or ceiling (relative); 0: not used (the paper).",
+                  minimum=0.0),
         Parameter("max_candidates", int, 24, "Most candidate command paths followed at once (the best predictions).", minimum=1),
         Parameter("error", str, "max", "How the prediction errors of a subsystem's parts combine: the largest "
                   "(a wrist subsystem, §4.4) or the mean (eq. 1 of B&B 2005, for whole-body subsystems).",
@@ -247,6 +262,7 @@ class ForwardModel(Matcher):
         self._tables: dict[int, tuple] = {}
         self._edges: dict[str, _EdgeTable] = {}
         self._memory: WorkingMemory | None = None
+        self._spreads: dict[str, float] | None = None
         self.tracks: dict[str, Track] = {}
         self.reported = False
 
@@ -431,7 +447,7 @@ class ForwardModel(Matcher):
             return None
         errors = {path: self._error(track, path, lengths, last) for path in self._extended(track, lengths)}
         track.trace.append((frame, errors))
-        alive = {path: error for path, error in errors.items() if error <= self.params["threshold"]}
+        alive = self._survivors(errors)
         if len(alive) > self.params["max_candidates"]:  # keep the best predictions
             alive = dict(sorted(alive.items(), key=lambda kv: kv[1])[: self.params["max_candidates"]])
         track.candidates = alive
@@ -445,8 +461,67 @@ class ForwardModel(Matcher):
                 track.committed_at = self._memory.n
                 track.speed = self._speed(path[0], along, self._anchor(track, path[0]), len(observed))
                 track.progress = progress
-                track.confidence = float(np.exp(-alive[path] / self.params["threshold"]))
+                track.confidence = float(np.exp(-alive[path] / self._limit(path)))
         return None
+
+    # -- drop-out (K&G §4.4, Fig. 3) ----------------------------------------------------------------
+
+    def _survivors(self, errors: Mapping[tuple[str, ...], float]) -> dict[tuple[str, ...], float]:
+        """The candidates (paths and their prediction errors this frame) that do not drop out.
+
+        ``absolute`` (the paper): those within their limit (:meth:`_limit`: ``threshold``, or ``spread`` times
+        their movement's spread between takes). ``relative``: those within their limit (``ceiling``, or the
+        spread's) and within ``ratio`` times the best of those, errors under ``min_move`` counted as ``min_move``
+        (two predictions closer than the smallest displacement that counts as a movement are not told apart).
+        """
+        alive = {path: error for path, error in errors.items() if error <= self._limit(path)}
+        if self.params["dropout"] == "relative" and alive:
+            bar = self.params["ratio"] * max(min(alive.values()), self.params["min_move"])
+            alive = {path: error for path, error in alive.items() if error <= bar}
+        return alive
+
+    def _limit(self, path: tuple[str, ...]) -> float:
+        """The prediction error above which candidate ``path`` drops out whatever the others do: ``spread`` times
+        its movement's spread between takes (``spread`` > 0 and a movement of several takes), else ``threshold``
+        (``absolute``) or ``ceiling`` (``relative``)."""
+        if self.params["spread"] > 0:
+            spread = self.spreads().get(self._movement_key(path))
+            if spread is not None:
+                return self.params["spread"] * spread
+        return self.params["threshold" if self.params["dropout"] == "absolute" else "ceiling"]
+
+    def spreads(self) -> dict[str, float]:
+        """Each movement's spread between takes (issue 18; not in the paper), for movements of several takes
+        (``MotorCommandGraph.takes``): the median over its takes of the take's mean prediction error (over its
+        frames, as ``error`` combines the parts) under the nearest other take's commands, as the forward model
+        would predict the take from them (:meth:`take_errors`). Computed once, when first needed."""
+        if self._spreads is None:
+            takes = self.motor.takes() if hasattr(self.motor, "takes") else {}
+            self._spreads = {}
+            for movement, examples in takes.items():
+                if len(examples) < 2:
+                    continue
+                distances = []
+                for i, (_, subsystem, observed, _) in enumerate(examples):
+                    others = [tuple(edges) for j, (edges, *_) in enumerate(examples) if j != i]
+                    errors = [self.take_errors(subsystem, observed, path) for path in others]
+                    distances.append(min(float(np.mean(e)) for e in errors if len(e)))
+                finite = [d for d in distances if np.isfinite(d)]
+                if len(finite) >= 2:
+                    self._spreads[movement] = float(np.median(finite))
+        return self._spreads
+
+    def take_errors(self, subsystem: str, observed: np.ndarray, path: tuple[str, ...]) -> np.ndarray:
+        """The prediction error, frame by frame, of command path ``path`` on a subsystem's observed movement
+        ``observed`` (n, k, 3) followed from its first frame: the forward model's own prediction (:meth:`_error`,
+        anchors and ``relative`` included) with the observed path lengths up to each frame (the positions
+        averaged over three frames, as :func:`_lengths` does, over the whole take at once)."""
+        track = Track(subsystem, self._scale_of(subsystem), self.motor.is_hand(subsystem), "hub", 0, {}, [],
+                      first=observed[0])
+        smooth = uniform_filter1d(observed, size=3, axis=0, mode="nearest") if len(observed) >= 3 else observed
+        walked = np.concatenate([np.zeros((1, observed.shape[1])),
+                                 np.cumsum(np.linalg.norm(np.diff(smooth, axis=0), axis=-1), axis=0)])
+        return np.array([self._error(track, path, walked[t], observed[t]) for t in range(1, len(observed))])
 
     def _last_correct(self, track: Track, lengths: np.ndarray, memory: np.ndarray) -> None:
         """The node at which the demonstration last agreed with the committed path: the start of the edge it was on.
@@ -599,7 +674,7 @@ class ForwardModel(Matcher):
             edge = self._edge(name)
             anchor = np.zeros(len(edge.arcs))
             if not (self.params["relative"] or track.hand):
-                first = self._at(track.onset)[self.motor.subsystems[track.subsystem]]
+                first = self._first(track)
                 far = np.linalg.norm(edge.positions - first[:, None], axis=-1)
                 far[edge.arcs > 0.5 * edge.arcs[:, -1:]] = np.inf  # the first half of each stroke
                 anchor = edge.arcs[np.arange(len(far)), np.argmin(far, axis=1)]
@@ -611,7 +686,13 @@ class ForwardModel(Matcher):
         if not self.params["relative"]:
             return 0.0
         start = self._edge(name).positions[:, 0]
-        return self._at(track.onset)[self.motor.subsystems[track.subsystem]] - start
+        return self._first(track) - start
+
+    def _first(self, track: Track) -> np.ndarray:
+        """The subsystem's parts where they were seen at the track's onset (k, 3)."""
+        if track.first is not None:
+            return track.first
+        return self._at(track.onset)[self.motor.subsystems[track.subsystem]]
 
     def _distance(self, track: Track, predicted: np.ndarray, observed: np.ndarray) -> float:
         """Per-part distances (k, 3 each) combined as ``error`` says: the largest or the mean (radians of a hand scaled)."""
