@@ -162,3 +162,43 @@ def test_the_spread_is_the_median_of_each_takes_mean_error_and_sets_the_movement
     assert matcher._limit((takes.up,)) == matcher.params["threshold"]  # one take (unlabelled): the threshold
     assert use(takes, spread=2.0, dropout="relative")._limit((takes.up,)) == matcher.params["ceiling"]
     assert use(takes, spread=0.0, dropout="absolute")._limit(a) == matcher.params["threshold"]  # 0: the paper's
+
+
+def test_the_race_compares_mean_errors_since_the_onset_and_an_extended_path_inherits_them(arms):
+    """a errs 0.05 then 0.05, b 0.02 then 0.09: on the second frame b is 1.8 times a (dropped under ratio 1.25),
+    but its mean, 0.055, is 1.1 times a's 0.05 (kept). A path extended from a carries a's sums on."""
+    from plugins.matchers.forward_model import Track
+
+    frames = [{("a",): 0.05, ("b",): 0.02}, {("a",): 0.05, ("b",): 0.09}]
+    matcher = use(arms, dropout="relative", ratio=1.25, race=True)
+    track = Track("wrists", 1.0, False, "hub", 0, {}, [])
+    for errors in frames:
+        evidence = matcher._evidence(track, errors)
+        alive = matcher._survivors(errors, evidence)
+    assert evidence == {("a",): pytest.approx(0.05), ("b",): pytest.approx(0.055)}
+    assert set(alive) == {("a",), ("b",)}
+    plain = use(arms, dropout="relative", ratio=1.25, race=False)
+    assert set(plain._survivors(frames[1], plain._evidence(Track("wrists", 1.0, False, "hub", 0, {}, []),
+                                                          frames[1]))) == {("a",)}
+    extended = use(arms, dropout="relative", ratio=1.25, race=True)._evidence(track, {("a", "c"): 0.08})
+    assert extended == {("a", "c"): pytest.approx((0.05 + 0.05 + 0.08) / 3)}
+
+
+def test_at_the_end_the_leader_of_the_race_is_the_answer_when_no_candidate_prevailed_alone(arms):
+    """``aside`` is ``out`` turned 3 degrees: along ``out`` it errs at most 2 x 0.3 x sin(1.5°) ≈ 1.6 cm, under
+    min_move x ratio (3 cm), so both stay alive to the end and nothing is committed early. The paper's drop-out then
+    answers unknown (without learning); the relative one answers the better predictor, ``out``."""
+    motor = arms.motor
+    left, right = motor.rest[2], motor.rest[3]
+    turn = np.radians(3.0)
+    aside = motor.learn("wrists", "hub", [GuidingStroke(left, left + 0.3 * np.array([np.cos(turn), np.sin(turn), 0.0]),
+                                                        1.0), GuidingStroke(right, right, 1.0)])
+    demo = demonstration(arms, stroke_path(left, [0.3, 0.0, 0.0]))
+    matcher = use(arms, dropout="absolute", learn=False)
+    assert all(a is None for a in feed(matcher, demo)) and matcher.conclude(demo).movement is None
+    motor.reset()
+    matcher = use(arms, dropout="relative", ratio=1.5, learn=False)
+    assert all(a is None for a in feed(matcher, demo))
+    assert set(matcher.inspect()["candidates"]) == {(arms.out,), (aside,)}
+    answer = matcher.conclude(demo)
+    assert answer.movement == arms.out and answer.decided_at is None

@@ -173,6 +173,9 @@ class Track:
     anchors: dict[str, np.ndarray] = field(default_factory=dict)
     first: np.ndarray | None = None
     """The subsystem's parts as seen at the onset (k, 3); ``None``: read from working memory."""
+    sums: dict[tuple[str, ...], tuple[float, int]] = field(default_factory=dict)
+    """Per candidate path, its summed prediction errors and the frames summed (a path extended from another
+    inherits its sums): the race of ``race``."""
 
 
 @dataclass(frozen=True)
@@ -228,6 +231,9 @@ class ForwardModel(Matcher):
         Parameter("ratio", float, 1.5, "With dropout = relative: a candidate drops out when its prediction error "
                   "exceeds this many times the best living candidate's (errors under min_move count as min_move).",
                   minimum=1.0),
+        Parameter("race", bool, False, "With dropout = relative: compare each candidate's mean prediction error "
+                  "since the onset, not this frame's, with the best's (evidence accumulates; one frame does not "
+                  "decide); the ceiling still applies to this frame's."),
         Parameter("ceiling", float, 0.15, "With dropout = relative: prediction error (m) above which a candidate "
                   "drops out whatever the others do, so a demonstration no edge fits is unknown.", minimum=0.0,
                   length=True),
@@ -447,7 +453,7 @@ class ForwardModel(Matcher):
             return None
         errors = {path: self._error(track, path, lengths, last) for path in self._extended(track, lengths)}
         track.trace.append((frame, errors))
-        alive = self._survivors(errors)
+        alive = self._survivors(errors, self._evidence(track, errors))
         if len(alive) > self.params["max_candidates"]:  # keep the best predictions
             alive = dict(sorted(alive.items(), key=lambda kv: kv[1])[: self.params["max_candidates"]])
         track.candidates = alive
@@ -456,29 +462,64 @@ class ForwardModel(Matcher):
             along = self._along(track, path[0], lengths)
             progress = self._progress(path[0], along)
             if progress >= self.params["min_progress"] or len(path) > 1:
-                track.committed_path = self._known_continuation(path)
-                track.committed = self.motor.add_sequence(list(track.committed_path))
-                track.committed_at = self._memory.n
-                track.speed = self._speed(path[0], along, self._anchor(track, path[0]), len(observed))
-                track.progress = progress
-                track.confidence = float(np.exp(-alive[path] / self._limit(path)))
+                self._commit(track, path, along, progress, len(observed), alive[path])
         return None
+
+    def _commit(self, track: Track, path: tuple[str, ...], along: np.ndarray, progress: float, n_observed: int,
+                error: float) -> None:
+        """Commit a subsystem to candidate ``path`` (the whole learned sequence it begins), at the speed seen."""
+        track.committed_path = self._known_continuation(path)
+        track.committed = self.motor.add_sequence(list(track.committed_path))
+        track.committed_at = self._memory.n
+        track.speed = self._speed(path[0], along, self._anchor(track, path[0]), n_observed)
+        track.progress = progress
+        track.confidence = float(np.exp(-error / self._limit(path)))
+
+    def _leader(self, track: Track, memory: np.ndarray) -> bool:
+        """With ``dropout = relative``, at the end of a demonstration no candidate prevailed in alone: commit the
+        subsystem to the best of those still alive (the lowest error, or with ``race`` the lowest mean error), as
+        the race's finish. Every one of them is within its ceiling, so this never turns an unknown movement into a
+        known one; the ceiling decides that. Whether it did."""
+        if self.params["dropout"] != "relative" or track.committed is not None or not track.candidates:
+            return False
+        score = ({p: t / n for p, (t, n) in track.sums.items() if p in track.candidates} if self.params["race"]
+                 else {}) or track.candidates
+        path = min(score, key=score.get)
+        observed = self._observed(track, memory)
+        along = self._along(track, path[0], _lengths(observed))
+        self._commit(track, path, along, self._progress(path[0], along), len(observed), track.candidates[path])
+        return True
 
     # -- drop-out (K&G §4.4, Fig. 3) ----------------------------------------------------------------
 
-    def _survivors(self, errors: Mapping[tuple[str, ...], float]) -> dict[tuple[str, ...], float]:
+    def _survivors(self, errors: Mapping[tuple[str, ...], float],
+                   evidence: Mapping[tuple[str, ...], float] | None = None) -> dict[tuple[str, ...], float]:
         """The candidates (paths and their prediction errors this frame) that do not drop out.
 
         ``absolute`` (the paper): those within their limit (:meth:`_limit`: ``threshold``, or ``spread`` times
         their movement's spread between takes). ``relative``: those within their limit (``ceiling``, or the
-        spread's) and within ``ratio`` times the best of those, errors under ``min_move`` counted as ``min_move``
-        (two predictions closer than the smallest displacement that counts as a movement are not told apart).
+        spread's) whose ``evidence`` (this frame's errors, or with ``race`` their means since the onset) is within
+        ``ratio`` times the best of them, errors under ``min_move`` counted as ``min_move`` (two predictions closer
+        than the smallest displacement that counts as a movement are not told apart).
         """
         alive = {path: error for path, error in errors.items() if error <= self._limit(path)}
         if self.params["dropout"] == "relative" and alive:
-            bar = self.params["ratio"] * max(min(alive.values()), self.params["min_move"])
-            alive = {path: error for path, error in alive.items() if error <= bar}
+            score = errors if evidence is None else evidence
+            bar = self.params["ratio"] * max(min(score[p] for p in alive), self.params["min_move"])
+            alive = {path: error for path, error in alive.items() if score[path] <= bar}
         return alive
+
+    def _evidence(self, track: Track, errors: Mapping[tuple[str, ...], float]) -> Mapping[tuple[str, ...], float]:
+        """What the relative drop-out compares: this frame's errors, or with ``race`` each candidate's mean error
+        since the onset (its sums updated here; a path extended this frame inherits its parent's)."""
+        if not self.params["race"]:
+            return errors
+        sums = {}
+        for path, error in errors.items():
+            total, n = track.sums.get(path) or track.sums.get(path[:-1]) or (0.0, 0)
+            sums[path] = (total + error, n + 1)
+        track.sums = sums
+        return {path: total / n for path, (total, n) in sums.items()}
 
     def _limit(self, path: tuple[str, ...]) -> float:
         """The prediction error above which candidate ``path`` drops out whatever the others do: ``spread`` times
@@ -738,6 +779,11 @@ class ForwardModel(Matcher):
         first_from, first_to = None, None
         for track in self.tracks.values():
             idx = self.motor.subsystems[track.subsystem]
+            if self._leader(track, memory):  # the race's finish (relative drop-out)
+                self.motor.move_to(track.subsystem, self.motor.edge(track.committed_path[-1]).target, posture=False)
+                perform.append(track.committed)
+                paths.extend(track.committed_path)
+                continue
             if track.committed is not None and not track.deviated:
                 end = self.motor.edge(track.committed_path[-1]).target
                 expected = self.motor.state(track.subsystem, end) + self._onset_offset(track, track.committed_path[0])
