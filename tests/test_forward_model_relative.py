@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from scipy.ndimage import uniform_filter1d
 
 from tests.test_forward_model import ARMS, FPS, demonstration, stroke_path
 from plugins.lib.guiding_stroke import GuidingStroke
@@ -149,6 +150,30 @@ def test_a_takes_error_under_the_other_takes_commands_is_its_distance_from_their
     far = walked > 0.02
     np.testing.assert_allclose(errors[far], 2 * np.sin(angle / 2) * walked[far], rtol=0.1)
     assert matcher.take_errors("wrists", observed, first).max() < 0.01  # its own commands predict it
+
+
+def test_a_takes_errors_are_the_forward_models_own_frame_by_frame_along_a_path_of_several_edges(takes):
+    """take_errors predicts every frame at once; frame by frame, _error (what following does) gives the same, also
+    when the path runs on from one edge into the next (``reach`` then ``up``'s way back is not needed: out then up)."""
+    from plugins.matchers.forward_model import Track
+
+    motor, matcher = takes.motor, takes.matcher
+    left, right = motor.rest[2], motor.rest[3]
+    hold = GuidingStroke(right, right, 1.0)
+    node = motor.edge(takes.out).target
+    onward = motor.learn("wrists", node, [GuidingStroke(left + [0.3, 0.0, 0.0], left + [0.3, 0.2, 0.0], 1.0), hold])
+    observed = np.repeat(motor.rest[[2, 3]][None], 2 * int(FPS) + 1, axis=0)
+    observed[:, 0] = np.concatenate([stroke_path(left, [0.25, 0.05, 0.0]), stroke_path(left + [0.25, 0.05, 0.0],
+                                                                                         [0.0, 0.2, 0.0])[1:]])
+    for error in ("max", "mean"):
+        use(takes, error=error)
+        fast = matcher.take_errors("wrists", observed, (takes.out, onward))
+        track = Track("wrists", 1.0, False, "hub", 0, {}, [], first=observed[0])
+        smooth = uniform_filter1d(observed, size=3, axis=0, mode="nearest")
+        walked = np.concatenate([np.zeros((1, 2)), np.cumsum(np.linalg.norm(np.diff(smooth, axis=0), axis=-1), axis=0)])
+        slow = [matcher._error(track, (takes.out, onward), walked[t], observed[t]) for t in range(1, len(observed))]
+        np.testing.assert_allclose(fast, slow, atol=1e-3)
+        assert fast.max() > 0.05  # not trivially zero
 
 
 def test_the_spread_is_the_median_of_each_takes_mean_error_and_sets_the_movements_limit(takes):

@@ -34,6 +34,33 @@ stroke becomes a guiding stroke by the inverse model, and the strokes become new
 edges and nodes leading from the active node (ending in the hub when the
 demonstration returns there).
 
+Drop-out relative to the other candidates (issue 18; not in the paper, which leaves the correspondence problem
+open, §6): the paper's drop-out (``dropout = "absolute"``, the default) compares each candidate's prediction
+error with one fixed ``threshold``, set for the wrist of a body like one's own. Another person's stance and style
+put every prediction off by about as much from the first frame (a styled bow is 10-15 cm from every candidate at its
+onset on a 1.5 m body), so on real clips every candidate drops out and nothing is committed. With
+``dropout = "relative"`` the candidates race: a candidate drops out when its error exceeds ``ratio`` times the best
+living candidate's. What all candidates share (the stance, the body) cancels in the ratio; what tells them apart (the
+movement) does not. The ratio has no unit, so it holds for any body and skeleton; 1.5 means "half again as far off
+as the best", a clear lead and not a matter of noise. Two refinements follow from what the quantities mean:
+
+- errors under ``min_move`` count as ``min_move``: predictions that differ by less than the smallest displacement
+  that counts as a movement cannot be told apart, so a near-perfect best does not drop every other candidate;
+- ``ceiling``: a candidate whose error exceeds it drops out whatever the others do, so a demonstration that no edge
+  fits is still "unknown", not the least bad edge (0.15 m at Max's scale, three times the paper's 0.05 m: a part
+  predicted three wrists' thresholds away is somewhere else).
+
+Commitment is as in the paper (Fig. 3): when every living candidate stands for one movement (and ``min_progress``
+of it has been seen). With ``race`` the ratio compares each candidate's mean error since the onset rather than this
+frame's, so one frame does not decide. A demonstration that ends with several candidates still alive is answered
+with the best of them (the race's finish, :meth:`ForwardModel._leader`); every one of them is within the ceiling.
+
+Spread between takes (issue 18): a movement learned from several clips (``MotorCommandGraph.takes``) says how much
+its performances differ. With ``spread`` > 0 each such movement's candidates drop out beyond ``spread`` times its
+spread between takes (:meth:`ForwardModel.spreads`: the median over its takes of the take's mean prediction error
+under the nearest other take's commands), in place of ``threshold`` or ``ceiling``, as ``path-search``'s ``spread``
+does for its ``max_distance``. A movement people perform alike is held tight, one they perform in many ways loosely.
+
 Working memory: the matcher reads the segment from the
 :class:`~toolkit.watching.WorkingMemory` the watching loop gives it (root-relative,
 in the observer's parts, hidden parts held) and keeps no frames of its own; what it
@@ -562,7 +589,20 @@ class ForwardModel(Matcher):
         smooth = uniform_filter1d(observed, size=3, axis=0, mode="nearest") if len(observed) >= 3 else observed
         walked = np.concatenate([np.zeros((1, observed.shape[1])),
                                  np.cumsum(np.linalg.norm(np.diff(smooth, axis=0), axis=-1), axis=0)])
-        return np.array([self._error(track, path, walked[t], observed[t]) for t in range(1, len(observed))])
+        if track.hand or not len(path):  # a hand's fingers share one clock: frame by frame, as followed
+            return np.array([self._error(track, path, walked[t], observed[t]) for t in range(1, len(observed))])
+        # every frame at once: each part along its strokes of the whole path, laid end to end (what _predict does
+        # edge by edge: a part past the end of one edge's stroke goes on along the next, and stops at the last end)
+        edges = [self._edge(name) for name in path]
+        positions = np.concatenate([e.positions for e in edges], axis=1)  # (k, G, 3)
+        totals = np.stack([e.arcs[:, -1] for e in edges])  # (E, k)
+        starts = np.concatenate([np.zeros((1, totals.shape[1])), np.cumsum(totals, axis=0)[:-1]])
+        arcs = np.concatenate([e.arcs + starts[i][:, None] for i, e in enumerate(edges)], axis=1)  # (k, G)
+        along = walked[1:] + self._anchor(track, path[0])  # (T, k)
+        predicted = np.stack([np.stack([np.interp(along[:, p], arcs[p], positions[p, :, c]) for c in range(3)],
+                                       axis=-1) for p in range(len(arcs))], axis=1)  # (T, k, 3)
+        d = np.linalg.norm(predicted + self._onset_offset(track, path[0]) - observed[1:], axis=-1) * track.scale
+        return d.max(axis=1) if self.params["error"] == "max" else d.mean(axis=1)
 
     def _last_correct(self, track: Track, lengths: np.ndarray, memory: np.ndarray) -> None:
         """The node at which the demonstration last agreed with the committed path: the start of the edge it was on.
