@@ -227,3 +227,25 @@ def test_at_the_end_the_leader_of_the_race_is_the_answer_when_no_candidate_preva
     assert set(matcher.inspect()["candidates"]) == {(arms.out,), (aside,)}
     answer = matcher.conclude(demo)
     assert answer.movement == arms.out and answer.decided_at is None
+
+
+def test_a_candidate_worse_than_predicting_no_movement_drops_out_with_stillness(arms):
+    errors = {("a",): 0.03, ("b",): 0.05}  # still: 0.02, min_move 0.02: up to 0.04 explains something
+    assert use(arms, dropout="relative", ratio=2.0, stillness=True)._survivors(errors, None, 0.02) == {("a",): 0.03}
+    assert use(arms, dropout="relative", ratio=2.0, stillness=False)._survivors(errors) == errors
+
+
+def test_with_stillness_a_movement_no_edge_fits_is_unknown_as_soon_as_every_edge_is_worse_than_standing_still(arms):
+    """Inwards and down, 135 degrees from both edges: after a path L each prediction is 2 L sin(67.5°) ≈ 1.85 L off,
+    standing still L: both drop once 0.85 L > min_move (2 cm), L ≈ 2.4 cm, long before the ceiling (15 cm, L ≈ 8 cm)."""
+    demo = demonstration(arms, stroke_path(arms.motor.rest[2], [-0.25, -0.25, 0.0]))
+    moved = np.linalg.norm(demo.positions[:, 2] - demo.positions[0, 2], axis=1)
+    dropped = {}
+    for stillness in (True, False):
+        arms.motor.reset()
+        matcher = use(arms, dropout="relative", ratio=1.5, learn=False, stillness=stillness)
+        assert all(a is None for a in feed(matcher, demo))
+        assert matcher.conclude(demo).movement is None
+        dropped[stillness] = moved[matcher.inspect()["trace"][-1][0]]  # the frame both were last predicted
+    assert 0.02 < dropped[True] < 0.04
+    assert dropped[False] > 0.07

@@ -264,6 +264,9 @@ class ForwardModel(Matcher):
         Parameter("ceiling", float, 0.15, "With dropout = relative: prediction error (m) above which a candidate "
                   "drops out whatever the others do, so a demonstration no edge fits is unknown.", minimum=0.0,
                   length=True),
+        Parameter("stillness", bool, False, "Also drop a candidate whose prediction error exceeds, by more than "
+                  "min_move, that of predicting no movement at all (every part staying where it was at the onset): "
+                  "it explains nothing of what is seen. Meant with relative = true (both then compare displacements)."),
         Parameter("spread", float, 0.0, "A movement with several takes: its candidates drop out beyond this many "
                   "times its spread between takes (each take's mean prediction error under the nearest other take's "
                   "commands) instead of threshold (absolute) or ceiling (relative); 0: not used (the paper).",
@@ -480,7 +483,8 @@ class ForwardModel(Matcher):
             return None
         errors = {path: self._error(track, path, lengths, last) for path in self._extended(track, lengths)}
         track.trace.append((frame, errors))
-        alive = self._survivors(errors, self._evidence(track, errors))
+        still = self._distance(track, observed[0], last) if self.params["stillness"] else None
+        alive = self._survivors(errors, self._evidence(track, errors), still)
         if len(alive) > self.params["max_candidates"]:  # keep the best predictions
             alive = dict(sorted(alive.items(), key=lambda kv: kv[1])[: self.params["max_candidates"]])
         track.candidates = alive
@@ -505,8 +509,8 @@ class ForwardModel(Matcher):
     def _leader(self, track: Track, memory: np.ndarray) -> bool:
         """With ``dropout = relative``, at the end of a demonstration no candidate prevailed in alone: commit the
         subsystem to the best of those still alive (the lowest error, or with ``race`` the lowest mean error), as
-        the race's finish. Every one of them is within its ceiling, so this never turns an unknown movement into a
-        known one; the ceiling decides that. Whether it did."""
+        the race's finish. Every one of them is within its ceiling: what is unknown is decided by the ceiling, not
+        here. Returns whether it committed."""
         if self.params["dropout"] != "relative" or track.committed is not None or not track.candidates:
             return False
         score = ({p: t / n for p, (t, n) in track.sums.items() if p in track.candidates} if self.params["race"]
@@ -520,7 +524,8 @@ class ForwardModel(Matcher):
     # -- drop-out (K&G §4.4, Fig. 3) ----------------------------------------------------------------
 
     def _survivors(self, errors: Mapping[tuple[str, ...], float],
-                   evidence: Mapping[tuple[str, ...], float] | None = None) -> dict[tuple[str, ...], float]:
+                   evidence: Mapping[tuple[str, ...], float] | None = None,
+                   still: float | None = None) -> dict[tuple[str, ...], float]:
         """The candidates (paths and their prediction errors this frame) that do not drop out.
 
         ``absolute`` (the paper): those within their limit (:meth:`_limit`: ``threshold``, or ``spread`` times
@@ -528,8 +533,13 @@ class ForwardModel(Matcher):
         spread's) whose ``evidence`` (this frame's errors, or with ``race`` their means since the onset) is within
         ``ratio`` times the best of them, errors under ``min_move`` counted as ``min_move`` (two predictions closer
         than the smallest displacement that counts as a movement are not told apart).
+
+        ``still`` (with ``stillness``): the error of predicting no movement at all (every part where it was at the
+        onset); a candidate more than ``min_move`` worse than that explains nothing of what is seen and drops out.
         """
         alive = {path: error for path, error in errors.items() if error <= self._limit(path)}
+        if still is not None:
+            alive = {path: error for path, error in alive.items() if error <= still + self.params["min_move"]}
         if self.params["dropout"] == "relative" and alive:
             score = errors if evidence is None else evidence
             bar = self.params["ratio"] * max(min(score[p] for p in alive), self.params["min_move"])
