@@ -50,6 +50,12 @@ as the best", a clear lead and not a matter of noise. Two refinements follow fro
   fits is still "unknown", not the least bad edge (0.15 m at Max's scale, three times the paper's 0.05 m: a part
   predicted three wrists' thresholds away is somewhere else).
 
+With ``stillness`` a candidate also drops out when it predicts worse, by more than ``min_move``, than predicting
+no movement at all (every part staying where it was seen at the onset): it explains nothing of what is seen. This
+needs no length of its own and holds for any body; it is meant with ``relative = true``, where candidates and
+stillness alike compare displacements since the onset (with positions, a stance unlike one's own puts every
+candidate behind stillness from the first frame).
+
 Commitment is as in the paper (Fig. 3): when every living candidate stands for one movement (and ``min_progress``
 of it has been seen). With ``race`` the ratio compares each candidate's mean error since the onset rather than this
 frame's, so one frame does not decide. A demonstration that ends with several candidates still alive is answered
