@@ -589,7 +589,7 @@ class ForwardModel(Matcher):
                 for i, (_, subsystem, observed, _) in enumerate(examples):
                     others = [tuple(edges) for j, (edges, *_) in enumerate(examples) if j != i]
                     errors = [self.take_errors(subsystem, observed, path) for path in others]
-                    distances.append(min(float(np.mean(e)) for e in errors if len(e)))
+                    distances.append(min((float(np.mean(e)) for e in errors if len(e)), default=float("nan")))
                 finite = [d for d in distances if np.isfinite(d)]
                 if len(finite) >= 2:
                     self._spreads[movement] = float(np.median(finite))
