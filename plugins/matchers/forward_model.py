@@ -34,6 +34,39 @@ stroke becomes a guiding stroke by the inverse model, and the strokes become new
 edges and nodes leading from the active node (ending in the hub when the
 demonstration returns there).
 
+Drop-out relative to the other candidates (issue 18; not in the paper, which leaves the correspondence problem
+open, §6): the paper's drop-out (``dropout = "absolute"``, the default) compares each candidate's prediction
+error with one fixed ``threshold``, set for the wrist of a body like one's own. Another person's stance and style
+put every prediction off by about as much from the first frame (a styled bow is 10-15 cm from every candidate at its
+onset on a 1.5 m body), so on real clips every candidate drops out and nothing is committed. With
+``dropout = "relative"`` the candidates race: a candidate drops out when its error exceeds ``ratio`` times the best
+living candidate's. What all candidates share (the stance, the body) cancels in the ratio; what tells them apart (the
+movement) does not. The ratio has no unit, so it holds for any body and skeleton; 1.5 means "half again as far off
+as the best", a clear lead and not a matter of noise. Two refinements follow from what the quantities mean:
+
+- errors under ``min_move`` count as ``min_move``: predictions that differ by less than the smallest displacement
+  that counts as a movement cannot be told apart, so a near-perfect best does not drop every other candidate;
+- ``ceiling``: a candidate whose error exceeds it drops out whatever the others do, so a demonstration that no edge
+  fits is still "unknown", not the least bad edge (0.15 m at Max's scale, three times the paper's 0.05 m: a part
+  predicted three wrists' thresholds away is somewhere else).
+
+With ``stillness`` a candidate also drops out when it predicts worse, by more than ``min_move``, than predicting
+no movement at all (every part staying where it was seen at the onset): it explains nothing of what is seen. This
+needs no length of its own and holds for any body; it is meant with ``relative = true``, where candidates and
+stillness alike compare displacements since the onset (with positions, a stance unlike one's own puts every
+candidate behind stillness from the first frame).
+
+Commitment is as in the paper (Fig. 3): when every living candidate stands for one movement (and ``min_progress``
+of it has been seen). With ``race`` the ratio compares each candidate's mean error since the onset rather than this
+frame's, so one frame does not decide. A demonstration that ends with several candidates still alive is answered
+with the best of them (the race's finish, :meth:`ForwardModel._leader`); every one of them is within the ceiling.
+
+Spread between takes (issue 18): a movement learned from several clips (``MotorCommandGraph.takes``) says how much
+its performances differ. With ``spread`` > 0 each such movement's candidates drop out beyond ``spread`` times its
+spread between takes (:meth:`ForwardModel.spreads`: the median over its takes of the take's mean prediction error
+under the nearest other take's commands), in place of ``threshold`` or ``ceiling``, as ``path-search``'s ``spread``
+does for its ``max_distance``. A movement people perform alike is held tight, one they perform in many ways loosely.
+
 Working memory: the matcher reads the segment from the
 :class:`~toolkit.watching.WorkingMemory` the watching loop gives it (root-relative,
 in the observer's parts, hidden parts held) and keeps no frames of its own; what it
@@ -171,6 +204,11 @@ class Track:
     committed_at: int | None = None
     deviated_at: int | None = None
     anchors: dict[str, np.ndarray] = field(default_factory=dict)
+    first: np.ndarray | None = None
+    """The subsystem's parts as seen at the onset (k, 3); ``None``: read from working memory."""
+    sums: dict[tuple[str, ...], tuple[float, int]] = field(default_factory=dict)
+    """Per candidate path, its summed prediction errors and the frames summed (a path extended from another
+    inherits its sums): the race of ``race``."""
 
 
 @dataclass(frozen=True)
@@ -220,6 +258,25 @@ class ForwardModel(Matcher):
         Parameter("angle_scale", float, 0.25, "Metres one radian of finger joint angle counts as when a hand "
                   "subsystem's errors and movement are compared with threshold, deviation and min_move "
                   "(0.25: the 0.05 m threshold is 0.2 rad, 11 degrees).", minimum=1e-6, length=True),
+        Parameter("dropout", str, "absolute", "How a candidate drops out (K&G §4.4): 'absolute', the paper's, when "
+                  "its prediction error exceeds threshold; 'relative', when it exceeds ratio times the best living "
+                  "candidate's, or the absolute ceiling (see the module).", choices=("absolute", "relative")),
+        Parameter("ratio", float, 1.5, "With dropout = relative: a candidate drops out when its prediction error "
+                  "exceeds this many times the best living candidate's (errors under min_move count as min_move).",
+                  minimum=1.0),
+        Parameter("race", bool, False, "With dropout = relative: compare each candidate's mean prediction error "
+                  "since the onset, not this frame's, with the best's (evidence accumulates; one frame does not "
+                  "decide); the ceiling still applies to this frame's."),
+        Parameter("ceiling", float, 0.15, "With dropout = relative: prediction error (m) above which a candidate "
+                  "drops out whatever the others do, so a demonstration no edge fits is unknown.", minimum=0.0,
+                  length=True),
+        Parameter("stillness", bool, False, "Also drop a candidate whose prediction error exceeds, by more than "
+                  "min_move, that of predicting no movement at all (every part staying where it was at the onset): "
+                  "it explains nothing of what is seen. Meant with relative = true (both then compare displacements)."),
+        Parameter("spread", float, 0.0, "A movement with several takes: its candidates drop out beyond this many "
+                  "times its spread between takes (each take's mean prediction error under the nearest other take's "
+                  "commands) instead of threshold (absolute) or ceiling (relative); 0: not used (the paper).",
+                  minimum=0.0),
         Parameter("max_candidates", int, 24, "Most candidate command paths followed at once (the best predictions).", minimum=1),
         Parameter("error", str, "max", "How the prediction errors of a subsystem's parts combine: the largest "
                   "(a wrist subsystem, §4.4) or the mean (eq. 1 of B&B 2005, for whole-body subsystems).",
@@ -247,6 +304,7 @@ class ForwardModel(Matcher):
         self._tables: dict[int, tuple] = {}
         self._edges: dict[str, _EdgeTable] = {}
         self._memory: WorkingMemory | None = None
+        self._spreads: dict[str, float] | None = None
         self.tracks: dict[str, Track] = {}
         self.reported = False
 
@@ -431,7 +489,8 @@ class ForwardModel(Matcher):
             return None
         errors = {path: self._error(track, path, lengths, last) for path in self._extended(track, lengths)}
         track.trace.append((frame, errors))
-        alive = {path: error for path, error in errors.items() if error <= self.params["threshold"]}
+        still = self._distance(track, observed[0], last) if self.params["stillness"] else None
+        alive = self._survivors(errors, self._evidence(track, errors), still)
         if len(alive) > self.params["max_candidates"]:  # keep the best predictions
             alive = dict(sorted(alive.items(), key=lambda kv: kv[1])[: self.params["max_candidates"]])
         track.candidates = alive
@@ -440,13 +499,126 @@ class ForwardModel(Matcher):
             along = self._along(track, path[0], lengths)
             progress = self._progress(path[0], along)
             if progress >= self.params["min_progress"] or len(path) > 1:
-                track.committed_path = self._known_continuation(path)
-                track.committed = self.motor.add_sequence(list(track.committed_path))
-                track.committed_at = self._memory.n
-                track.speed = self._speed(path[0], along, self._anchor(track, path[0]), len(observed))
-                track.progress = progress
-                track.confidence = float(np.exp(-alive[path] / self.params["threshold"]))
+                self._commit(track, path, along, progress, len(observed), alive[path])
         return None
+
+    def _commit(self, track: Track, path: tuple[str, ...], along: np.ndarray, progress: float, n_observed: int,
+                error: float) -> None:
+        """Commit a subsystem to candidate ``path`` (the whole learned sequence it begins), at the speed seen."""
+        track.committed_path = self._known_continuation(path)
+        track.committed = self.motor.add_sequence(list(track.committed_path))
+        track.committed_at = self._memory.n
+        track.speed = self._speed(path[0], along, self._anchor(track, path[0]), n_observed)
+        track.progress = progress
+        track.confidence = float(np.exp(-error / self._limit(path)))
+
+    def _leader(self, track: Track, memory: np.ndarray) -> bool:
+        """With ``dropout = relative``, at the end of a demonstration no candidate prevailed in alone: commit the
+        subsystem to the best of those still alive (the lowest error, or with ``race`` the lowest mean error), as
+        the race's finish. Every one of them is within its ceiling: what is unknown is decided by the ceiling, not
+        here. Returns whether it committed."""
+        if self.params["dropout"] != "relative" or track.committed is not None or not track.candidates:
+            return False
+        score = ({p: t / n for p, (t, n) in track.sums.items() if p in track.candidates} if self.params["race"]
+                 else {}) or track.candidates
+        path = min(score, key=score.get)
+        observed = self._observed(track, memory)
+        along = self._along(track, path[0], _lengths(observed))
+        self._commit(track, path, along, self._progress(path[0], along), len(observed), track.candidates[path])
+        return True
+
+    # -- drop-out (K&G §4.4, Fig. 3) ----------------------------------------------------------------
+
+    def _survivors(self, errors: Mapping[tuple[str, ...], float],
+                   evidence: Mapping[tuple[str, ...], float] | None = None,
+                   still: float | None = None) -> dict[tuple[str, ...], float]:
+        """The candidates (paths and their prediction errors this frame) that do not drop out.
+
+        ``absolute`` (the paper): those within their limit (:meth:`_limit`: ``threshold``, or ``spread`` times
+        their movement's spread between takes). ``relative``: those within their limit (``ceiling``, or the
+        spread's) whose ``evidence`` (this frame's errors, or with ``race`` their means since the onset) is within
+        ``ratio`` times the best of them, errors under ``min_move`` counted as ``min_move`` (two predictions closer
+        than the smallest displacement that counts as a movement are not told apart).
+
+        ``still`` (with ``stillness``): the error of predicting no movement at all (every part where it was at the
+        onset); a candidate more than ``min_move`` worse than that explains nothing of what is seen and drops out.
+        """
+        alive = {path: error for path, error in errors.items() if error <= self._limit(path)}
+        if still is not None:
+            alive = {path: error for path, error in alive.items() if error <= still + self.params["min_move"]}
+        if self.params["dropout"] == "relative" and alive:
+            score = errors if evidence is None else evidence
+            bar = self.params["ratio"] * max(min(score[p] for p in alive), self.params["min_move"])
+            alive = {path: error for path, error in alive.items() if score[path] <= bar}
+        return alive
+
+    def _evidence(self, track: Track, errors: Mapping[tuple[str, ...], float]) -> Mapping[tuple[str, ...], float]:
+        """What the relative drop-out compares: this frame's errors, or with ``race`` each candidate's mean error
+        since the onset (its sums updated here; a path extended this frame inherits its parent's)."""
+        if not self.params["race"]:
+            return errors
+        sums = {}
+        for path, error in errors.items():
+            total, n = track.sums.get(path) or track.sums.get(path[:-1]) or (0.0, 0)
+            sums[path] = (total + error, n + 1)
+        track.sums = sums
+        return {path: total / n for path, (total, n) in sums.items()}
+
+    def _limit(self, path: tuple[str, ...]) -> float:
+        """The prediction error above which candidate ``path`` drops out whatever the others do: ``spread`` times
+        its movement's spread between takes (``spread`` > 0 and a movement of several takes), else ``threshold``
+        (``absolute``) or ``ceiling`` (``relative``)."""
+        if self.params["spread"] > 0:
+            spread = self.spreads().get(self._movement_key(path))
+            if spread is not None:
+                return self.params["spread"] * spread
+        return self.params["threshold" if self.params["dropout"] == "absolute" else "ceiling"]
+
+    def spreads(self) -> dict[str, float]:
+        """Each movement's spread between takes (issue 18; not in the paper), for movements of several takes
+        (``MotorCommandGraph.takes``): the median over its takes of the take's mean prediction error (over its
+        frames, as ``error`` combines the parts) under the nearest other take's commands, as the forward model
+        would predict the take from them (:meth:`take_errors`). Computed once, when first needed."""
+        if self._spreads is None:
+            takes = self.motor.takes() if hasattr(self.motor, "takes") else {}
+            self._spreads = {}
+            for movement, examples in takes.items():
+                if len(examples) < 2:
+                    continue
+                distances = []
+                for i, (_, subsystem, observed, _) in enumerate(examples):
+                    others = [tuple(edges) for j, (edges, *_) in enumerate(examples) if j != i]
+                    errors = [self.take_errors(subsystem, observed, path) for path in others]
+                    distances.append(min((float(np.mean(e)) for e in errors if len(e)), default=float("nan")))
+                finite = [d for d in distances if np.isfinite(d)]
+                if len(finite) >= 2:
+                    self._spreads[movement] = float(np.median(finite))
+        return self._spreads
+
+    def take_errors(self, subsystem: str, observed: np.ndarray, path: tuple[str, ...]) -> np.ndarray:
+        """The prediction error, frame by frame, of command path ``path`` on a subsystem's observed movement
+        ``observed`` (n, k, 3) followed from its first frame: the forward model's own prediction (:meth:`_error`,
+        anchors and ``relative`` included) with the observed path lengths up to each frame (the positions
+        averaged over three frames, as :func:`_lengths` does, over the whole take at once)."""
+        track = Track(subsystem, self._scale_of(subsystem), self.motor.is_hand(subsystem), "hub", 0, {}, [],
+                      first=observed[0])
+        smooth = uniform_filter1d(observed, size=3, axis=0, mode="nearest") if len(observed) >= 3 else observed
+        walked = np.concatenate([np.zeros((1, observed.shape[1])),
+                                 np.cumsum(np.linalg.norm(np.diff(smooth, axis=0), axis=-1), axis=0)])
+        if track.hand or not len(path):  # a hand's fingers share one clock: frame by frame, as followed
+            return np.array([self._error(track, path, walked[t], observed[t]) for t in range(1, len(observed))])
+        # every frame at once: each part along its strokes of the whole path, laid end to end (what _predict does
+        # edge by edge: a part past the end of one edge's stroke goes on along the next, and stops at the last end)
+        edges = [self._edge(name) for name in path]
+        positions = np.concatenate([e.positions for e in edges], axis=1)  # (k, G, 3)
+        totals = np.stack([e.arcs[:, -1] for e in edges])  # (E, k)
+        starts = np.concatenate([np.zeros((1, totals.shape[1])), np.cumsum(totals, axis=0)[:-1]])
+        arcs = np.concatenate([e.arcs + starts[i][:, None] for i, e in enumerate(edges)], axis=1)  # (k, G)
+        along = walked[1:] + self._anchor(track, path[0])  # (T, k)
+        predicted = np.stack([np.stack([np.interp(along[:, p], arcs[p], positions[p, :, c]) for c in range(3)],
+                                       axis=-1) for p in range(len(arcs))], axis=1)  # (T, k, 3)
+        d = np.linalg.norm(predicted + self._onset_offset(track, path[0]) - observed[1:], axis=-1) * track.scale
+        return d.max(axis=1) if self.params["error"] == "max" else d.mean(axis=1)
 
     def _last_correct(self, track: Track, lengths: np.ndarray, memory: np.ndarray) -> None:
         """The node at which the demonstration last agreed with the committed path: the start of the edge it was on.
@@ -599,7 +771,7 @@ class ForwardModel(Matcher):
             edge = self._edge(name)
             anchor = np.zeros(len(edge.arcs))
             if not (self.params["relative"] or track.hand):
-                first = self._at(track.onset)[self.motor.subsystems[track.subsystem]]
+                first = self._first(track)
                 far = np.linalg.norm(edge.positions - first[:, None], axis=-1)
                 far[edge.arcs > 0.5 * edge.arcs[:, -1:]] = np.inf  # the first half of each stroke
                 anchor = edge.arcs[np.arange(len(far)), np.argmin(far, axis=1)]
@@ -611,7 +783,13 @@ class ForwardModel(Matcher):
         if not self.params["relative"]:
             return 0.0
         start = self._edge(name).positions[:, 0]
-        return self._at(track.onset)[self.motor.subsystems[track.subsystem]] - start
+        return self._first(track) - start
+
+    def _first(self, track: Track) -> np.ndarray:
+        """The subsystem's parts where they were seen at the track's onset (k, 3)."""
+        if track.first is not None:
+            return track.first
+        return self._at(track.onset)[self.motor.subsystems[track.subsystem]]
 
     def _distance(self, track: Track, predicted: np.ndarray, observed: np.ndarray) -> float:
         """Per-part distances (k, 3 each) combined as ``error`` says: the largest or the mean (radians of a hand scaled)."""
@@ -657,6 +835,11 @@ class ForwardModel(Matcher):
         first_from, first_to = None, None
         for track in self.tracks.values():
             idx = self.motor.subsystems[track.subsystem]
+            if self._leader(track, memory):  # the race's finish (relative drop-out)
+                self.motor.move_to(track.subsystem, self.motor.edge(track.committed_path[-1]).target, posture=False)
+                perform.append(track.committed)
+                paths.extend(track.committed_path)
+                continue
             if track.committed is not None and not track.deviated:
                 end = self.motor.edge(track.committed_path[-1]).target
                 expected = self.motor.state(track.subsystem, end) + self._onset_offset(track, track.committed_path[0])

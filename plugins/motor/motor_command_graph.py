@@ -172,6 +172,7 @@ class MotorCommandGraph(MotorSystem):
         self._counter = 0
         self._state = self.rest.copy()
         self.labels: dict[str, str] = {}  # sequence name -> movement, for sequences learned from labelled clips
+        self._takes: dict[str, list[tuple[tuple[str, ...], str, np.ndarray, float]]] = {}  # movement -> its clips
         if clips is not None:
             self._learn_clips(clips)
 
@@ -188,7 +189,16 @@ class MotorCommandGraph(MotorSystem):
                 continue
             n = sum(1 for label in self.labels.values() if label == clip.movement)
             self.add_sequence(names, name=example_name(clip.movement, n), label=clip.movement)
+            self._takes.setdefault(clip.movement, []).append((tuple(names), subsystem, observed, m.fps))
             self.move_to(subsystem, "hub")
+
+    def takes(self) -> dict[str, list[tuple[tuple[str, ...], str, np.ndarray, float]]]:
+        """The takes of each movement learned from labelled clips (issue 18; not in the paper): per movement, one
+        ``(edges, subsystem, observed, fps)`` per clip: the chain of edges (names) the clip became, the
+        subsystem it moves, and the clip's own positions of that subsystem's parts (n, k, 3), as the inverse model
+        was given them. Several takes of one movement say what varies between its performances and what does not:
+        the forward model measures each take against the others' commands (``forward-model``'s ``spread``)."""
+        return {movement: list(takes) for movement, takes in self._takes.items()}
 
     def examples(self, fps: float = 30.0) -> list[tuple[str, Motion]]:
         """The clips the graphs were learned from, by movement; else one performance of each movement."""
