@@ -299,13 +299,13 @@ class PathSearch(Matcher):
         stays = np.zeros(len(paths), dtype=int) if stays is None else stays
         for t in frames:
             ends = paths[:, -1] if append else paths[:, 0]
-            reach = [table[e] for e in ends]
-            beam = np.repeat(np.arange(len(reach)), [len(r) for r in reach])
-            cand = np.concatenate(reach)
+            beam, cand = _gather(table, ends)
             stay = np.where(cand == ends[beam], stays[beam] + 1, 0)
             seen = vis[t]
-            if seen.any():  # eq. 1 over the parts seen in this sample: the mask is the same for every candidate, so
-                # the seen parts are taken first and pose_distance needs no mask (the hot loop of the search)
+            if seen.all():  # the hot loop of the search: every part seen, no mask
+                step = pose_distance(nodes[cand], obs[t], None, weights)
+            elif seen.any():  # eq. 1 over the parts seen in this sample: the mask is the same for every candidate,
+                # so the seen parts are taken first and pose_distance needs no mask
                 step = pose_distance(nodes[cand][:, seen], obs[t, seen], None,
                                      None if weights is None else weights[seen])
             else:
@@ -344,8 +344,9 @@ class PathSearch(Matcher):
         return Match(name, 1.0, None, tuple(path), {"learned": True, **details})
 
 
-def _reach(graph, nodes, index, max_skip: int, *, forward: bool) -> list[np.ndarray]:
-    """For every node, the nodes reachable in 0..max_skip steps along (or against) the edges."""
+def _reach(graph, nodes, index, max_skip: int, *, forward: bool) -> tuple[np.ndarray, np.ndarray]:
+    """For every node, the nodes reachable in 0..max_skip steps along (or against) the edges, as a compressed
+    table: node ``i`` reaches ``indices[indptr[i]:indptr[i + 1]]`` (sorted)."""
     step = graph.successors if forward else graph.predecessors
     out = []
     for node in nodes:
@@ -354,7 +355,17 @@ def _reach(graph, nodes, index, max_skip: int, *, forward: bool) -> list[np.ndar
             frontier = {m for f in frontier for m in step(f)}
             found |= frontier
         out.append(np.array(sorted(index[m] for m in found), dtype=np.intp))
-    return out
+    indptr = np.concatenate([[0], np.cumsum([len(r) for r in out])]).astype(np.intp)
+    return indptr, np.concatenate(out) if out else np.zeros(0, dtype=np.intp)
+
+
+def _gather(table: tuple[np.ndarray, np.ndarray], ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The candidates reachable from each end node of a beam: (beam index of each candidate, candidate node)."""
+    indptr, indices = table
+    counts = indptr[ends + 1] - indptr[ends]
+    beam = np.repeat(np.arange(len(ends)), counts)
+    within = np.arange(len(beam)) - np.repeat(np.cumsum(counts) - counts, counts)
+    return beam, indices[indptr[ends][beam] + within]
 
 
 @hookimpl
