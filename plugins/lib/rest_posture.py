@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.signal import lfilter
 
-__all__ = ["RestPosture", "dwell_weights"]
+__all__ = ["RestPosture", "DwellingRest", "dwell_weights"]
 
 
 def dwell_weights(speed: np.ndarray, dwell_speed: float) -> np.ndarray:
@@ -101,3 +101,92 @@ def _moving_mean(x: np.ndarray, taps: int) -> np.ndarray:
     lo = np.maximum(0, i - taps)
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(k[i] - k[lo] > 0, (c[i] - c[lo]) / np.maximum(k[i] - k[lo], 1), np.nan)
+
+
+class DwellingRest:
+    """The demonstrator's rest posture, re-anchored wherever they *stand*: every part stays put for a while.
+
+    :class:`RestPosture` forgets slowly (tens of seconds) and so follows a change of stance only after a long
+    dwell. This estimator is for segmentation (B&B §5.1: a movement leaves the hub and returns to it; K&G §4.1: a
+    movement is bounded by rests): the rest is one's own hub (``prior``) until the demonstrator has been seen
+    standing, then the mean pose of the latest stretch of standing, replaced as soon as they stand somewhere else.
+    A stooped, wide-legged or proud stance then reads as rest after ``dwell`` seconds of it, whatever came before.
+
+    *Standing* at frame ``t``: over the last ``dwell`` seconds (``t`` included) every part with a position stayed
+    within ``radius`` of its own mean there (the root-mean-square deviation of each part, the largest over the
+    parts; hidden parts are held, so they do not move). ``radius`` (m) is given per frame by the caller, so it can
+    be relative to the body and to the sway seen (:meth:`spreads` gives the measure it is compared with). A
+    stroke's turning point is slow for an instant and its parts travel on either side of it, so it is not
+    standing; a pose *held* longer than ``dwell`` is (the price of following a new stance quickly).
+
+    Everything is causal and the result does not depend on how the frames are packed into blocks.
+    """
+
+    def __init__(self, n_parts: int, fps: float, *, dwell: float, prior: np.ndarray,
+                 positions: np.ndarray | None = None) -> None:
+        self.fps = float(fps)
+        self.taps = max(2, int(round(dwell * self.fps)))
+        self.positions = np.ones(n_parts, dtype=bool) if positions is None else np.asarray(positions, dtype=bool)
+        self.rest = np.asarray(prior, dtype=float).reshape(n_parts, 3).copy()
+        self._tail = np.zeros((0, n_parts, 3))  # the last taps - 1 poses
+        self._run_sum: np.ndarray | None = None  # the poses summed over the standing stretch under way
+        self._run_count = 0
+        self.anchored = False  # has the demonstrator been seen standing yet?
+
+    def spreads(self, poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """For each frame of a block (n, P, 3): the largest root-mean-square deviation of a part from its mean over
+        the last ``dwell`` seconds (m), ``inf`` until that many frames have been seen; and the size
+        (:func:`plugins.lib.body_size.body_scale`) of that mean pose (m). Does not change the state."""
+        poses = np.asarray(poses, dtype=float)[:, self.positions]
+        tail = self._tail[:, self.positions]
+        x = np.concatenate([tail, poses])
+        n, k = len(poses), self.taps
+        if not n:
+            return np.zeros(0), np.zeros(0)
+        x = np.where(np.isfinite(x), x, 0.0)  # never seen: no evidence of movement either
+        c1 = np.concatenate([np.zeros((1,) + x.shape[1:]), np.cumsum(x, axis=0)])
+        c2 = np.concatenate([np.zeros((1,) + x.shape[1:]), np.cumsum(x * x, axis=0)])
+        end = np.arange(len(tail) + 1, len(x) + 1)  # exclusive ends of the windows of the block's frames
+        begin = end - k
+        ok = begin >= 0
+        b = np.maximum(begin, 0)
+        mean = (c1[end] - c1[b]) / k
+        var = np.maximum((c2[end] - c2[b]) / k - mean * mean, 0.0).sum(axis=-1)  # (n, P')
+        out = np.sqrt(var.max(axis=-1)) if var.shape[-1] else np.zeros(n)
+        centred = mean - mean.mean(axis=1, keepdims=True)
+        size = np.sqrt((centred * centred).sum(axis=-1).mean(axis=-1)) if mean.shape[1] >= 2 else np.zeros(n)
+        return np.where(ok, out, np.inf), size
+
+    def update(self, poses: np.ndarray, radius: float, *, relative: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """The rest after each frame of a block (n, P, 3), and where a new standing stretch began (n,): the index,
+        relative to this block, of the first pose of the stretch (it may be negative: in an earlier block); the
+        smallest int64 where none began. ``radius``: in metres, or with ``relative`` in body sizes (of the mean pose
+        over the last ``dwell`` seconds)."""
+        poses = np.asarray(poses, dtype=float)
+        n = len(poses)
+        rests = np.empty_like(poses)
+        began = np.full(n, np.iinfo(np.int64).min, dtype=np.int64)
+        if not n:
+            return rests, began
+        spread, size = self.spreads(poses)
+        standing = spread <= (radius * size if relative else radius)
+        x = np.concatenate([self._tail, poses])
+        held = np.where(np.isfinite(x), x, 0.0)
+        offset = len(self._tail)
+        for i in range(n):
+            if standing[i]:
+                if self._run_sum is None:  # a new stretch: the whole window counts
+                    self._run_sum = held[offset + i - self.taps + 1 : offset + i + 1].sum(axis=0)
+                    self._run_count = self.taps
+                    began[i] = i - self.taps + 1
+                else:
+                    self._run_sum = self._run_sum + held[offset + i]
+                    self._run_count += 1
+                rest = self._run_sum / self._run_count
+                self.rest = np.where(np.isfinite(poses[i]), rest, self.rest)
+                self.anchored = True
+            else:
+                self._run_sum, self._run_count = None, 0
+            rests[i] = self.rest
+        self._tail = x[-(self.taps - 1):].copy()
+        return rests, began

@@ -23,6 +23,28 @@ Additions a real stream needs, each a parameter:
   ``floor`` seconds, so the same threshold works for clean and noisy input.
   (A stream that starts in the middle of a movement is then not segmented
   until the body has once been at rest.)
+
+Two more, for real people (the correspondence problem, B&B §7.1, K&G §6), each off by default so the paper's
+observer is what a character gets unless it asks:
+
+- ``reference = "rest"``: the distance is measured from *the demonstrator's own rest posture*, not from the
+  observer's hub. It is estimated online and causally (:class:`plugins.lib.rest_posture.DwellingRest`): one's own
+  hub until the demonstrator is seen *standing* (every part stays within ``stillness`` times the start threshold of
+  its mean for ``dwell`` seconds), then the mean pose of the latest stretch of standing. A stooped, wide-legged or
+  proud stance thus reads as rest half a second after they take it, and a stance that changes after a movement is
+  followed at once. When they start standing while a segment is under way, the segment ends where the standing
+  began (they have come to rest, if somewhere else: B&B's movements end in a hub, K&G §4.1's at a rest).
+  ``dwell = 0.5`` s: a stroke's turning point is slow for about a tenth of a second (K&G §4.1's sensory memory),
+  people pause between gestures for half a second or more; a pose *held* longer than ``dwell`` in the middle of a
+  gesture is taken for rest (the gesture is cut there). ``stillness = 0.25``: with the start threshold at 0.1 body
+  sizes, every part stays within about a centimetre of where it was on a standing adult (0.45 m body size):
+  standing sway (1-2 cm/s) and marker noise over half a second, far below a gesture's tens of cm/s.
+- ``units = "body"``: the distance is measured in the demonstrator's body sizes
+  (:func:`plugins.lib.body_size.body_scale` of the reference pose: the root-mean-square distance of the parts from
+  their centroid, about 0.45 m for a standing adult, 0.20 m for Max) and compared with ``body_threshold``. The
+  default 0.1 is the paper's 0.02 m on Max (0.02 / 0.20), so Max watching Morris is unchanged, and the same file
+  holds for a mouse, a humanoid or a Kinect skeleton whatever units its recordings are in (a Kinect's noise is
+  the ``floor``'s to absorb).
 """
 
 from __future__ import annotations
@@ -35,7 +57,9 @@ import numpy as np
 from scipy.ndimage import minimum_filter1d
 from scipy.signal import butter, lfilter, lfilter_zi
 
+from plugins.lib.body_size import body_scale
 from plugins.lib.pose_distance import pose_distance
+from plugins.lib.rest_posture import DwellingRest
 from toolkit import ConfigError, Motion, Parameter, Segment, Segmenter, hookimpl
 from toolkit.components import provides
 
@@ -63,6 +87,19 @@ class HubThreshold(Segmenter):
         Parameter("floor", float, 10.0, "Seconds over which the running minimum of the filtered distance is "
                   "taken as the noise floor and subtracted (0: no floor, the paper's plain threshold).", minimum=0.0),
         Parameter("hub", str, "", "The hub pose to compare with (default: the observer's rest pose)."),
+        Parameter("reference", str, "hub", "What the distance is measured from: the observer's own hub (the paper) "
+                  "or the demonstrator's own rest, re-anchored wherever they stand still for `dwell` seconds.",
+                  choices=("hub", "rest")),
+        Parameter("dwell", float, 0.5, "With reference = rest: seconds every part must stay put to count as "
+                  "standing (a new rest). Shorter follows a new stance sooner and cuts gestures at shorter holds.",
+                  minimum=0.05),
+        Parameter("stillness", float, 0.25, "With reference = rest: standing means every part stays within this "
+                  "share of the start threshold of its mean pose over `dwell`.", minimum=0.0, maximum=1.0),
+        Parameter("units", str, "metres", "Distances in metres against `threshold` (the paper), or in the "
+                  "demonstrator's body sizes against `body_threshold`.", choices=("metres", "body")),
+        Parameter("body_threshold", float, 0.1, "With units = body: the start threshold in body sizes (the root-mean-"
+                  "square distance of the parts from their centroid in the reference pose; 0.1 = the paper's "
+                  "0.02 m on Max).", minimum=0.0),
     )
 
     def attach(self, owner: Any) -> None:
@@ -83,6 +120,8 @@ class HubThreshold(Segmenter):
         self.templates = hubs - hubs[:, root : root + 1]  # every hub: the distance is to the nearest one
         self.template = self.templates[0]
         self.template_parts = owner.body.parts
+        self._positions = ~np.asarray(getattr(owner.body, "angle_mask", np.zeros(len(self.template), bool)), bool)
+        self._hub_size = body_scale(self.template, self._positions)
 
     # -- streaming ---------------------------------------------------------------------
 
@@ -104,6 +143,14 @@ class HubThreshold(Segmenter):
         self._start: int | None = None
         self._below = 0
         self._on, self._off = self.thresholds
+        self._rest = DwellingRest(len(self.template), self._fps, dwell=self.params["dwell"], prior=self.template,
+                                  positions=self._positions) if self.params["reference"] == "rest" else None
+
+    @property
+    def rest(self) -> np.ndarray:
+        """The pose distances are measured from now (P, 3): the demonstrator's rest as estimated so far with
+        ``reference = "rest"`` (one's own hub until they have been seen standing), else one's own hub."""
+        return self.template.copy() if self._rest is None else self._rest.rest.copy()
 
     @property
     def active_since(self) -> int | None:
@@ -124,20 +171,52 @@ class HubThreshold(Segmenter):
     def push_block(self, poses: np.ndarray, visible: np.ndarray) -> tuple[list[tuple[int, Segment]], np.ndarray]:
         """A block of frames: the distances and the low-pass filter for all of them at once, then the
         thresholds frame by frame (the same as one push per frame)."""
-        raw = _hold(np.concatenate([[self._last], self.distances(poses, visible)]))[1:]  # no evidence: hold
-        if not len(raw):
-            return [], np.zeros(0, dtype=int)
-        self._last = float(raw[-1])
-        if self._zi is None:
-            self._zi = lfilter_zi(self._b, self._a) * raw[0]
-        filtered, self._zi = lfilter(self._b, self._a, raw, zi=self._zi)
+        raw, filtered, began = self._evidence(poses, visible)
         closed: list[tuple[int, Segment]] = []
         since = np.empty(len(raw), dtype=int)
         for i, value in enumerate(filtered.tolist()):
             self._frame += 1
+            if began[i] >= 0 and self._start is not None:  # they came to rest: the movement ended there
+                closed.extend((i, segment) for segment in self._close(max(self._start + 1, int(began[i]))))
             closed.extend((i, segment) for segment in self._step(value))
             since[i] = -1 if self._start is None else self._start
         return closed, since
+
+    def _evidence(self, poses: np.ndarray, visible: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The distance from the reference of each frame of a block (held where nothing is seen), low-pass filtered,
+        and the stream frame where a new stretch of standing began at each frame (-1: none). With reference = rest
+        the filter restarts at the distance from the new rest where one begins (the old rest no longer counts)."""
+        poses = np.asarray(poses, dtype=float)
+        visible = np.asarray(visible, dtype=bool)
+        n = len(poses)
+        began = np.full(n, -1, dtype=np.int64)
+        body = self.params["units"] == "body"
+        if self._rest is None:
+            dist = self.distances(poses, visible)
+            if body:
+                dist = dist / max(self._hub_size, 1e-12)
+        else:
+            radius = self.params["stillness"] * (self.params["body_threshold"] if body else self.params["threshold"])
+            rests, new = self._rest.update(poses, radius, relative=body)
+            dist = pose_distance(poses, rests, visible)
+            if body:
+                centred = rests[:, self._positions] - rests[:, self._positions].mean(axis=1, keepdims=True)
+                size = np.sqrt((centred * centred).sum(axis=-1).mean(axis=-1))
+                dist = dist / np.maximum(size, 1e-12)
+            at = np.flatnonzero(new > np.iinfo(np.int64).min)
+            began[at] = np.maximum(0, self._frame + 1 + new[at])
+        raw = _hold(np.concatenate([[self._last], dist]))[1:]  # no evidence: hold
+        if not n:
+            return raw, raw, began
+        self._last = float(raw[-1])
+        cuts = [0, *[int(i) for i in np.flatnonzero(began >= 0) if i > 0], n]
+        pieces = []
+        for a, b in zip(cuts, cuts[1:]):
+            if self._zi is None or (a < n and began[a] >= 0):
+                self._zi = lfilter_zi(self._b, self._a) * raw[a]
+            piece, self._zi = lfilter(self._b, self._a, raw[a:b], zi=self._zi)
+            pieces.append(piece)
+        return raw, np.concatenate(pieces), began
 
     def _above_floor(self, value: float) -> float:
         """``value`` minus the running minimum of the last ``floor`` seconds (itself if there is no floor)."""
@@ -187,10 +266,10 @@ class HubThreshold(Segmenter):
         distance itself without a floor). Frames with nothing visible hold the last value.
         """
         self.reset(motion.parts, motion.fps)
-        raw = _hold(self.distances(motion.positions, motion.visible))
+        raw, filtered, _ = self._evidence(motion.positions, motion.visible)
+        self.reset(motion.parts, motion.fps)
         if raw.size == 0:
             return raw, raw, raw
-        filtered, _ = lfilter(self._b, self._a, raw, zi=lfilter_zi(self._b, self._a) * raw[0])
         if not self._window:
             return raw, filtered, filtered
         w = self._window  # the running minimum of the last w frames, this one included (trailing window)
@@ -198,8 +277,10 @@ class HubThreshold(Segmenter):
 
     @property
     def thresholds(self) -> tuple[float, float]:
-        """The level at which a movement begins and the level below which it ends (hysteresis)."""
-        return self.params["threshold"], self.params["threshold"] * self.params["release"]
+        """The level at which a movement begins and the level below which it ends (hysteresis): metres, or body
+        sizes with units = body."""
+        on = self.params["body_threshold"] if self.params["units"] == "body" else self.params["threshold"]
+        return on, on * self.params["release"]
 
     def segment(self, motion: Motion) -> list[Segment]:
         self.reset(motion.parts, motion.fps)
