@@ -105,25 +105,26 @@ def test_a_styled_stance_that_changes_reads_as_rest():
     motion, gestures, shifts = stream(STANCES)
     assert gestures_found(segmenter(floor=0.0), motion, gestures, shifts)[0] < 0.5
     assert gestures_found(segmenter(), motion, gestures, shifts)[0] < 0.9
-    for units in ("metres", "body"):
-        seg = segmenter(reference="rest", units=units)
+    for units, stance_ in (("metres", "returned"), ("body", "returned"), ("metres", "held"), ("body", "held")):
+        seg = segmenter(reference="rest", units=units, stance=stance_)
         f1, error = gestures_found(seg, motion, gestures, shifts)
         assert f1 == 1.0 and error <= 10, (units, seg.segment(motion), gestures)  # a third of a gesture
     # the rest it ends with is the last stance, not one's own hub
     assert np.abs(seg.rest - stance(*STANCES[-1])).max() < 0.01
 
 
-def test_a_hold_shorter_than_dwell_is_not_rest_but_a_longer_one_is():
-    """A gesture that holds its extreme pose: for less than `dwell` it is one movement; held longer, the hold
-    reads as a new rest and cuts it (the price of following a new stance within `dwell`)."""
+def test_a_hold_is_not_rest_unless_held_for_settle():
+    """A gesture that holds its extreme pose and returns to the rest: with stance = returned one movement unless the
+    hold outlasts `settle` (2 s); with stance = held, a hold longer than `dwell` reads as a new rest and cuts it."""
     rest = stance(0.1, 0.0, 0.0)
-    for hold, pieces in ((0.1, 1), (1.0, 2)):
+    for hold, stance_, pieces in ((0.1, "returned", 1), (1.0, "returned", 1), (2.5, "returned", 2), (0.1, "held", 1),
+                                  (1.0, "held", 2)):
         up, down = np.split(gesture(rest, seconds=1.6), 2)
         held = np.repeat(up[-1:], int(round(hold * FPS)), axis=0)
         still = np.repeat(rest[None], 30, axis=0)
         motion = Motion(np.concatenate([still, up, held, down, still]), FPS, PARTS)
-        found = segmenter(reference="rest", dwell=0.5).segment(motion)
-        assert len(found) == pieces, (hold, found)
+        found = segmenter(reference="rest", stance=stance_).segment(motion)
+        assert len(found) == pieces, (hold, stance_, found)
 
 
 def test_the_papers_behaviour_is_the_default():
@@ -176,25 +177,43 @@ def test_dwelling_rest_is_the_mean_of_the_standing_stretch():
     est = DwellingRest(1, 30.0, dwell=0.1, prior=prior)
     x = np.array([0.0, 1.0, 1.0, 1.0, 1.0, 1.2, 2.0, 2.0])
     poses = np.stack([x, np.zeros_like(x), np.zeros_like(x)], axis=1)[:, None, :]
-    rests, began = est.update(poses, radius=0.11)
+    rests, events = est.update(poses, radius=0.11)
     # windows ending at 3 ([1, 1, 1]) and 4 stand; at 5 ([1, 1, 1.2]) the spread is 0.094 < 0.11: still standing
     assert rests[:3, 0, 0] == pytest.approx([0.0, 0.0, 0.0])
     assert rests[3:6, 0, 0] == pytest.approx([1.0, 1.0, (1.0 * 4 + 1.2) / 5])
     assert rests[6:, 0, 0] == pytest.approx([(1.0 * 4 + 1.2) / 5] * 2)  # [1, 1.2, 2] and [1.2, 2, 2] move
-    assert list(np.flatnonzero(began > np.iinfo(np.int64).min)) == [3] and began[3] == 1
+    assert list(np.flatnonzero(events[:, 0] >= 0)) == [3] and events[3].tolist() == [1, -1, -1]
+
+
+def test_a_new_stance_is_a_candidate_until_returned_to():
+    """With confirm: after the first rest (x = 0), standing at x = 1 is a candidate (the rest stays); standing at
+    0 again drops it (a hold); standing at 2 then moving and standing at 2 again makes 2 the rest, reported as
+    (candidate began, left, stood again)."""
+    est = DwellingRest(1, 30.0, dwell=0.1, prior=np.zeros((1, 3)), confirm=True)
+    x = [0, 0, 0, 1, 1, 1, 0, 0, 0, 2, 2, 2, 3, 2, 2, 2]
+    poses = np.array([[[v, 0.0, 0.0]] for v in x], dtype=float)
+    rests, events = est.update(poses, radius=0.01, near=0.5)
+    assert rests[:, 0, 0].tolist() == [0.0] * 15 + [2.0]
+    assert [tuple(e) for e in events.tolist() if e[0] >= 0] == [(0, -1, -1), (6, -1, -1), (9, 12, 13)]
+    assert est.candidate is None
+    settled = DwellingRest(1, 30.0, dwell=0.1, prior=np.zeros((1, 3)), confirm=True, settle=0.2)  # 6 frames
+    rests, events = settled.update(np.array([[[v, 0.0, 0.0]] for v in [0, 0, 0] + [1] * 6], dtype=float),
+                                   radius=0.01, near=0.5)
+    assert rests[:, 0, 0].tolist() == [0.0] * 8 + [1.0]
+    assert events[8].tolist() == [3, -1, -1]
 
 
 @settings(max_examples=25, deadline=None)
 @given(st.lists(st.integers(1, 60), min_size=1, max_size=30), st.sampled_from(["metres", "body"]),
-       st.integers(0, 3))
-def test_blocks_and_frames_give_the_same_segments(sizes, units, seed):
+       st.sampled_from(["returned", "held"]), st.integers(0, 3))
+def test_blocks_and_frames_give_the_same_segments(sizes, units, stance_, seed):
     """Block-wise and frame-by-frame feeding give the same segments at the same frames, and the same rest."""
     motion, _, _ = stream(STANCES[seed:seed + 3], seed=seed)
-    whole = segmenter(reference="rest", units=units)
+    whole = segmenter(reference="rest", units=units, stance=stance_)
     whole.reset(motion.parts, motion.fps)
     one = [(f, s) for f in range(motion.n_frames) for s in whole.push(motion.positions[f], motion.visible[f])]
     one += [(motion.n_frames, s) for s in whole.flush()]
-    blocks = segmenter(reference="rest", units=units)
+    blocks = segmenter(reference="rest", units=units, stance=stance_)
     blocks.reset(motion.parts, motion.fps)
     got, at, k = [], 0, 0
     while at < motion.n_frames:

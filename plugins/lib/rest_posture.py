@@ -104,34 +104,56 @@ def _moving_mean(x: np.ndarray, taps: int) -> np.ndarray:
 
 
 class DwellingRest:
-    """The demonstrator's rest posture, re-anchored wherever they *stand*: every part stays put for a while.
+    """The demonstrator's rest posture, re-anchored where they *stand* (every part stays put for a while) and return.
 
     :class:`RestPosture` forgets slowly (tens of seconds) and so follows a change of stance only after a long
-    dwell. This estimator is for segmentation (B&B §5.1: a movement leaves the hub and returns to it; K&G §4.1: a
-    movement is bounded by rests): the rest is one's own hub (``prior``) until the demonstrator has been seen
-    standing, then the mean pose of the latest stretch of standing, replaced as soon as they stand somewhere else.
-    A stooped, wide-legged or proud stance then reads as rest after ``dwell`` seconds of it, whatever came before.
+    dwell. This estimator is for segmentation (B&B §4.1, §5.1: movements leave a hub and return to it; K&G §4.1: a
+    movement is bounded by rests). The rest is one's own hub (``prior``) until the demonstrator is first seen
+    standing, then the mean pose of that stretch of standing; a stooped, wide-legged or proud stance thus reads as
+    rest ``dwell`` seconds after they are first seen in it.
 
     *Standing* at frame ``t``: over the last ``dwell`` seconds (``t`` included) every part with a position stayed
-    within ``radius`` of its own mean there (the root-mean-square deviation of each part, the largest over the
-    parts; hidden parts are held, so they do not move). ``radius`` (m) is given per frame by the caller, so it can
-    be relative to the body and to the sway seen (:meth:`spreads` gives the measure it is compared with). A
-    stroke's turning point is slow for an instant and its parts travel on either side of it, so it is not
-    standing; a pose *held* longer than ``dwell`` is (the price of following a new stance quickly).
+    within ``radius`` of its own mean there (its root-mean-square deviation, the largest over the parts; hidden
+    parts are held, so they do not move). A stroke's turning point is slow for an instant and its parts travel on
+    either side of it, so it is not standing.
 
+    Later stretches of standing:
+
+    - *near* the rest (their mean within ``near`` of it, eq. 1): they are the rest (it follows sway and drift);
+    - *elsewhere*: with ``confirm`` off, they are the new rest at once. With ``confirm`` on, such a stretch is only a
+      *candidate*: a gesture may hold a pose as long as any stance (a bow, a pointing hand), and what tells a new
+      stance from a hold is that movements *return* to it, as to a hub. The candidate becomes the rest when the
+      demonstrator stands near it again after moving (the rest "returned to"), or when they have stood in it for
+      ``settle`` seconds; a stretch near the old rest drops it (it was a hold); a stretch elsewhere replaces it.
+
+    :meth:`update` reports, frame by frame, the rest and where it changed: ``(b, -1, -1)`` when a stretch that began
+    at frame ``b`` became the rest there, ``(c, l, b)`` when a candidate that began at ``c`` and was left at ``l`` was
+    returned to by a stretch that began at ``b`` (frames count from the first frame given since construction).
     Everything is causal and the result does not depend on how the frames are packed into blocks.
     """
 
     def __init__(self, n_parts: int, fps: float, *, dwell: float, prior: np.ndarray,
-                 positions: np.ndarray | None = None) -> None:
+                 positions: np.ndarray | None = None, confirm: bool = False, settle: float = 0.0) -> None:
         self.fps = float(fps)
         self.taps = max(2, int(round(dwell * self.fps)))
+        self.settle = int(round(settle * self.fps)) if settle > 0 else 0
+        self.confirm = bool(confirm)
         self.positions = np.ones(n_parts, dtype=bool) if positions is None else np.asarray(positions, dtype=bool)
         self.rest = np.asarray(prior, dtype=float).reshape(n_parts, 3).copy()
         self._tail = np.zeros((0, n_parts, 3))  # the last taps - 1 poses
+        self._frame = -1
         self._run_sum: np.ndarray | None = None  # the poses summed over the standing stretch under way
         self._run_count = 0
+        self._run_began = -1
+        self._role = ""  # what the stretch under way is: "rest" or "candidate"
+        self._candidate: np.ndarray | None = None
+        self._candidate_began = self._candidate_left = -1
         self.anchored = False  # has the demonstrator been seen standing yet?
+
+    @property
+    def candidate(self) -> np.ndarray | None:
+        """A stance seen held elsewhere than the rest, not yet returned to (P, 3); ``None`` without one."""
+        return None if self._candidate is None else self._candidate.copy()
 
     def spreads(self, poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """For each frame of a block (n, P, 3): the largest root-mean-square deviation of a part from its mean over
@@ -157,36 +179,70 @@ class DwellingRest:
         size = np.sqrt((centred * centred).sum(axis=-1).mean(axis=-1)) if mean.shape[1] >= 2 else np.zeros(n)
         return np.where(ok, out, np.inf), size
 
-    def update(self, poses: np.ndarray, radius: float, *, relative: bool = False) -> tuple[np.ndarray, np.ndarray]:
-        """The rest after each frame of a block (n, P, 3), and where a new standing stretch began (n,): the index,
-        relative to this block, of the first pose of the stretch (it may be negative: in an earlier block); the
-        smallest int64 where none began. ``radius``: in metres, or with ``relative`` in body sizes (of the mean pose
-        over the last ``dwell`` seconds)."""
+    def _near(self, a: np.ndarray, b: np.ndarray, near: float, relative: bool) -> bool:
+        """eq. 1 between two poses (position parts seen in both) below ``near`` (m, or body sizes of ``b``)."""
+        a, b = a[self.positions], b[self.positions]
+        ok = np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1)
+        if not ok.any():
+            return False
+        d = float(np.linalg.norm(a[ok] - b[ok], axis=1).mean())
+        if relative:
+            c = b[ok] - b[ok].mean(axis=0)
+            near = near * float(np.sqrt((c * c).sum(axis=1).mean()))
+        return d < near
+
+    def update(self, poses: np.ndarray, radius: float, *, near: float = np.inf,
+               relative: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """The rest after each frame of a block (n, P, 3), and where it changed (n, 3) (see the class; ``-1``
+        rows where it did not). ``radius`` and ``near`` are in metres, or with ``relative`` in body sizes (of the
+        mean pose over the last ``dwell`` seconds, and of the rest)."""
         poses = np.asarray(poses, dtype=float)
         n = len(poses)
         rests = np.empty_like(poses)
-        began = np.full(n, np.iinfo(np.int64).min, dtype=np.int64)
+        events = np.full((n, 3), -1, dtype=np.int64)
         if not n:
-            return rests, began
+            return rests, events
         spread, size = self.spreads(poses)
         standing = spread <= (radius * size if relative else radius)
         x = np.concatenate([self._tail, poses])
         held = np.where(np.isfinite(x), x, 0.0)
         offset = len(self._tail)
         for i in range(n):
-            if standing[i]:
-                if self._run_sum is None:  # a new stretch: the whole window counts
-                    self._run_sum = held[offset + i - self.taps + 1 : offset + i + 1].sum(axis=0)
-                    self._run_count = self.taps
-                    began[i] = i - self.taps + 1
+            self._frame += 1
+            f = self._frame
+            if not standing[i]:
+                if self._role == "candidate":
+                    self._candidate_left = f  # the stance is left: the body moves again
+                self._run_sum, self._run_count, self._role = None, 0, ""
+                rests[i] = self.rest
+                continue
+            if self._run_sum is None:  # a new stretch: the whole window counts
+                self._run_sum = held[offset + i - self.taps + 1 : offset + i + 1].sum(axis=0)
+                self._run_count = self.taps
+                self._run_began = f - self.taps + 1
+                mean = np.where(np.isfinite(poses[i]), self._run_sum / self._run_count, np.nan)
+                if not self.confirm or not self.anchored or self._near(mean, self.rest, near, relative):
+                    self._role, self._candidate = "rest", None
+                    events[i] = (self._run_began, -1, -1)
+                elif self._candidate is not None and self._near(mean, self._candidate, near, relative):
+                    self._role = "rest"  # returned to: the candidate was a stance
+                    events[i] = (self._candidate_began, self._candidate_left, self._run_began)
+                    self._candidate = None
                 else:
-                    self._run_sum = self._run_sum + held[offset + i]
-                    self._run_count += 1
-                rest = self._run_sum / self._run_count
-                self.rest = np.where(np.isfinite(poses[i]), rest, self.rest)
+                    self._role = "candidate"
+                    self._candidate_began, self._candidate_left = self._run_began, -1
+            else:
+                self._run_sum = self._run_sum + held[offset + i]
+                self._run_count += 1
+                if self._role == "candidate" and self.settle and self._run_count >= self.settle:
+                    self._role, self._candidate = "rest", None  # stood in long enough: a stance
+                    events[i] = (self._run_began, -1, -1)
+            mean = self._run_sum / self._run_count
+            if self._role == "rest":
+                self.rest = np.where(np.isfinite(poses[i]), mean, self.rest)
                 self.anchored = True
             else:
-                self._run_sum, self._run_count = None, 0
+                self._candidate = np.where(np.isfinite(poses[i]), mean, np.nan)
             rests[i] = self.rest
         self._tail = x[-(self.taps - 1):].copy()
-        return rests, began
+        return rests, events

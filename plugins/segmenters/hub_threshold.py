@@ -29,16 +29,23 @@ observer is what a character gets unless it asks:
 
 - ``reference = "rest"``: the distance is measured from *the demonstrator's own rest posture*, not from the
   observer's hub. It is estimated online and causally (:class:`plugins.lib.rest_posture.DwellingRest`): one's own
-  hub until the demonstrator is seen *standing* (every part stays within ``stillness`` times the start threshold of
-  its mean for ``dwell`` seconds), then the mean pose of the latest stretch of standing. A stooped, wide-legged or
-  proud stance thus reads as rest half a second after they take it, and a stance that changes after a movement is
-  followed at once. When they start standing while a segment is under way, the segment ends where the standing
-  began (they have come to rest, if somewhere else: B&B's movements end in a hub, K&G §4.1's at a rest).
+  hub until the demonstrator is first seen *standing* (every part stays within ``stillness`` times the start
+  threshold of its mean for ``dwell`` seconds), then the mean pose of that stretch of standing. A stooped,
+  wide-legged or proud stance thus reads as rest half a second after they are first seen in it. When they
+  stand near their rest while a segment is under way, the segment ends where the standing began.
+  A new stance taken later (``stance = "returned"``, the default) must also be *returned to*, as B&B's hubs are
+  the poses movements leave and come back to: a pose held elsewhere is a candidate; when the demonstrator, after
+  moving, stands near it again, it becomes the rest and the segment under way is cut in two, the movement into the
+  stance (up to where they first stood in it) and the movement from it back to it (from where they left it); if
+  they return to the old rest instead, it was a hold and nothing is cut. Standing in it for ``settle`` seconds
+  makes it the rest too (the segment then ends where they first stood in it). ``stance = "held"`` takes any held
+  pose as the new rest at once (quicker, and a gesture's hold longer than ``dwell`` cuts it).
   ``dwell = 0.5`` s: a stroke's turning point is slow for about a tenth of a second (K&G §4.1's sensory memory),
-  people pause between gestures for half a second or more; a pose *held* longer than ``dwell`` in the middle of a
-  gesture is taken for rest (the gesture is cut there). ``stillness = 0.25``: with the start threshold at 0.1 body
-  sizes, every part stays within about a centimetre of where it was on a standing adult (0.45 m body size):
-  standing sway (1-2 cm/s) and marker noise over half a second, far below a gesture's tens of cm/s.
+  people pause between gestures for half a second or more. ``settle = 2`` s: longer than a gesture holds a pose
+  (a bow, a pointing hand: about a second), short enough for a live observer. ``stillness = 0.25``: with the start
+  threshold at 0.1 body sizes, every part stays within about a centimetre of where it was on a standing adult
+  (0.45 m body size): standing sway (1-2 cm/s) and marker noise over half a second, far below a gesture's tens of
+  cm/s.
 - ``units = "body"``: the distance is measured in the demonstrator's body sizes
   (:func:`plugins.lib.body_size.body_scale` of the reference pose: the root-mean-square distance of the parts from
   their centroid, about 0.45 m for a standing adult, 0.20 m for Max) and compared with ``body_threshold``. The
@@ -93,6 +100,11 @@ class HubThreshold(Segmenter):
         Parameter("dwell", float, 0.5, "With reference = rest: seconds every part must stay put to count as "
                   "standing (a new rest). Shorter follows a new stance sooner and cuts gestures at shorter holds.",
                   minimum=0.05),
+        Parameter("stance", str, "returned", "With reference = rest: a pose held away from the rest becomes the new "
+                  "rest once a movement returns to it (or it is held for `settle`), or at once when held.",
+                  choices=("returned", "held")),
+        Parameter("settle", float, 2.0, "With stance = returned: seconds of standing in a new stance after which it "
+                  "is the rest without a return (0: only a return).", minimum=0.0),
         Parameter("stillness", float, 0.25, "With reference = rest: standing means every part stays within this "
                   "share of the start threshold of its mean pose over `dwell`.", minimum=0.0, maximum=1.0),
         Parameter("units", str, "metres", "Distances in metres against `threshold` (the paper), or in the "
@@ -144,7 +156,8 @@ class HubThreshold(Segmenter):
         self._below = 0
         self._on, self._off = self.thresholds
         self._rest = DwellingRest(len(self.template), self._fps, dwell=self.params["dwell"], prior=self.template,
-                                  positions=self._positions) if self.params["reference"] == "rest" else None
+                                  positions=self._positions, confirm=self.params["stance"] == "returned",
+                                  settle=self.params["settle"]) if self.params["reference"] == "rest" else None
 
     @property
     def rest(self) -> np.ndarray:
@@ -171,52 +184,65 @@ class HubThreshold(Segmenter):
     def push_block(self, poses: np.ndarray, visible: np.ndarray) -> tuple[list[tuple[int, Segment]], np.ndarray]:
         """A block of frames: the distances and the low-pass filter for all of them at once, then the
         thresholds frame by frame (the same as one push per frame)."""
-        raw, filtered, began = self._evidence(poses, visible)
+        raw, filtered, events = self._evidence(poses, visible)
         closed: list[tuple[int, Segment]] = []
         since = np.empty(len(raw), dtype=int)
         for i, value in enumerate(filtered.tolist()):
             self._frame += 1
-            if began[i] >= 0 and self._start is not None:  # they came to rest: the movement ended there
-                closed.extend((i, segment) for segment in self._close(max(self._start + 1, int(began[i]))))
+            if events[i, 0] >= 0 and self._start is not None:
+                closed.extend((i, segment) for segment in self._rested(*events[i].tolist()))
             closed.extend((i, segment) for segment in self._step(value))
             since[i] = -1 if self._start is None else self._start
         return closed, since
 
+    def _rested(self, began: int, left: int, back: int) -> list[Segment]:
+        """The demonstrator came to rest (reference = rest) while a segment was under way: it ends where they began
+        to stand (``began``). When they came back to a stance they had stood in from ``began`` and left at ``left``
+        (``back``: where they stood in it again), the segment is the movement into it and then the one from it back
+        to it."""
+        start = self._start
+        if left < 0:
+            return self._close(max(start + 1, began))
+        out = self._close(began) if began > start else []
+        self._start = max(start, left)
+        return out + self._close(max(self._start + 1, back))
+
     def _evidence(self, poses: np.ndarray, visible: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The distance from the reference of each frame of a block (held where nothing is seen), low-pass filtered,
-        and the stream frame where a new stretch of standing began at each frame (-1: none). With reference = rest
-        the filter restarts at the distance from the new rest where one begins (the old rest no longer counts)."""
+        and where the rest changed at each frame (n, 3) (:meth:`DwellingRest.update`; -1: it did not). With
+        reference = rest the filter restarts at the distance from the new rest where it changes (the old rest no
+        longer counts)."""
         poses = np.asarray(poses, dtype=float)
         visible = np.asarray(visible, dtype=bool)
         n = len(poses)
-        began = np.full(n, -1, dtype=np.int64)
+        events = np.full((n, 3), -1, dtype=np.int64)
         body = self.params["units"] == "body"
         if self._rest is None:
             dist = self.distances(poses, visible)
             if body:
                 dist = dist / max(self._hub_size, 1e-12)
         else:
-            radius = self.params["stillness"] * (self.params["body_threshold"] if body else self.params["threshold"])
-            rests, new = self._rest.update(poses, radius, relative=body)
+            on = self.params["body_threshold"] if body else self.params["threshold"]
+            rests, events = self._rest.update(poses, self.params["stillness"] * on, near=on, relative=body)
             dist = pose_distance(poses, rests, visible)
             if body:
                 centred = rests[:, self._positions] - rests[:, self._positions].mean(axis=1, keepdims=True)
                 size = np.sqrt((centred * centred).sum(axis=-1).mean(axis=-1))
                 dist = dist / np.maximum(size, 1e-12)
-            at = np.flatnonzero(new > np.iinfo(np.int64).min)
-            began[at] = np.maximum(0, self._frame + 1 + new[at])
+            events = np.where(events >= 0, np.maximum(events, 0), -1)
         raw = _hold(np.concatenate([[self._last], dist]))[1:]  # no evidence: hold
         if not n:
-            return raw, raw, began
+            return raw, raw, events
         self._last = float(raw[-1])
-        cuts = [0, *[int(i) for i in np.flatnonzero(began >= 0) if i > 0], n]
+        changed = events[:, 0] >= 0
+        cuts = [0, *[int(i) for i in np.flatnonzero(changed) if i > 0], n]
         pieces = []
         for a, b in zip(cuts, cuts[1:]):
-            if self._zi is None or (a < n and began[a] >= 0):
+            if self._zi is None or changed[a]:
                 self._zi = lfilter_zi(self._b, self._a) * raw[a]
             piece, self._zi = lfilter(self._b, self._a, raw[a:b], zi=self._zi)
             pieces.append(piece)
-        return raw, np.concatenate(pieces), began
+        return raw, np.concatenate(pieces), events
 
     def _above_floor(self, value: float) -> float:
         """``value`` minus the running minimum of the last ``floor`` seconds (itself if there is no floor)."""
