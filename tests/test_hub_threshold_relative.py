@@ -22,10 +22,11 @@ HUB = np.array([[0.0, 0.0, 0.0], [0.0, 0.35, 0.0], [0.0, 0.65, 0.0], [-0.25, -0.
                 [-0.12, -0.95, 0.0], [0.12, -0.95, 0.0]])
 
 
-def segmenter(**params) -> HubThreshold:
+def segmenter(scale: float = 1.0, **params) -> HubThreshold:
+    """hub-threshold of an observer with HUB as its hub, ``scale`` times as large."""
     seg = HubThreshold(**params)
     body = SimpleNamespace(parts=PARTS, root_index=0, angle_mask=np.zeros(len(PARTS), bool))
-    seg.attach(SimpleNamespace(body=body, motor=SimpleNamespace(hub_poses=lambda: HUB[None])))
+    seg.attach(SimpleNamespace(body=body, motor=SimpleNamespace(hub_poses=lambda: scale * HUB[None])))
     return seg
 
 
@@ -136,14 +137,14 @@ def test_the_papers_behaviour_is_the_default():
 
 
 def test_body_units_scale_with_the_body():
-    """The same stream ten times as large: in metres the paper's threshold finds noise or nothing alike; in body
-    sizes the same segments."""
+    """The same stream and observer ten times as large: in body sizes the same segments; in metres the paper's
+    threshold (0.02 m) finds other ones."""
     motion, gestures, shifts = stream(STANCES[:3], noise=0.0)
     big = Motion(motion.positions * 10.0, FPS, PARTS)
     small = segmenter(reference="rest", units="body").segment(motion)
-    large = segmenter(reference="rest", units="body").segment(big)
+    large = segmenter(10.0, reference="rest", units="body").segment(big)
     assert small == large and len(small) >= len(gestures)
-    assert segmenter(reference="rest").segment(big) != small
+    assert segmenter(10.0, reference="rest").segment(big) != small
 
 
 def test_body_threshold_is_the_papers_threshold_on_max():
@@ -224,3 +225,21 @@ def test_blocks_and_frames_give_the_same_segments(sizes, units, stance_, seed):
     got += [(motion.n_frames, s) for s in blocks.flush()]
     assert got == one
     assert np.allclose(whole.rest, blocks.rest)
+
+
+def test_a_noisy_tracker_still_shows_standing():
+    """Tracker noise of 3 mm per axis moves every part more than `stillness` times the 0.02 m threshold (5 mm)
+    when nobody moves: without `noise` no one is ever seen standing (the paper's hub stays, and the stances merge
+    the gestures); with noise = 2 the radius follows the spread seen at rest and every gesture is found."""
+    motion, gestures, shifts = stream(STANCES, noise=0.003)
+    assert gestures_found(segmenter(reference="rest", noise=0.0), motion, gestures, shifts)[0] < 0.5
+    assert gestures_found(segmenter(reference="rest"), motion, gestures, shifts)[0] == 1.0
+
+
+def test_the_noise_floor_is_the_smallest_spread_of_the_last_seconds():
+    """A running minimum over `floor` seconds (3 frames at 30 fps for 0.1 s), across blocks."""
+    est = DwellingRest(1, 30.0, dwell=0.1, prior=np.zeros((1, 3)))
+    first = est.noise_floor(np.array([5.0, 4.0, 6.0, 7.0]), 0.1)
+    second = est.noise_floor(np.array([8.0, 1.0, 9.0, 9.0, 9.0]), 0.1)
+    assert first.tolist() == [5.0, 4.0, 4.0, 4.0]
+    assert second.tolist() == [6.0, 1.0, 1.0, 1.0, 9.0]

@@ -21,6 +21,7 @@ same setting holds for a mouse and a giant.
 from __future__ import annotations
 
 import numpy as np
+from scipy.ndimage import minimum_filter1d
 from scipy.signal import lfilter
 
 __all__ = ["RestPosture", "DwellingRest", "dwell_weights"]
@@ -108,9 +109,8 @@ class DwellingRest:
 
     :class:`RestPosture` forgets slowly (tens of seconds) and so follows a change of stance only after a long
     dwell. This estimator is for segmentation (B&B §4.1, §5.1: movements leave a hub and return to it; K&G §4.1: a
-    movement is bounded by rests). The rest is one's own hub (``prior``) until the demonstrator is first seen
-    standing, then the mean pose of that stretch of standing; a stooped, wide-legged or proud stance thus reads as
-    rest ``dwell`` seconds after they are first seen in it.
+    movement is bounded by rests). The rest is one's own hub (``prior``) until the demonstrator is seen standing,
+    then the mean pose of where they stand.
 
     *Standing* at frame ``t``: over the last ``dwell`` seconds (``t`` included) every part with a position stayed
     within ``radius`` of its own mean there (its root-mean-square deviation, the largest over the parts; hidden
@@ -120,8 +120,9 @@ class DwellingRest:
     Later stretches of standing:
 
     - *near* the rest (their mean within ``near`` of it, eq. 1): they are the rest (it follows sway and drift);
-    - *elsewhere*: with ``confirm`` off, they are the new rest at once. With ``confirm`` on, such a stretch is only a
-      *candidate*: a gesture may hold a pose as long as any stance (a bow, a pointing hand), and what tells a new
+    - *elsewhere* (the first stance of a stooped, wide-legged or proud demonstrator too): with ``confirm`` off, they
+      are the new rest at once (``dwell`` seconds after they are first seen in it). With ``confirm`` on, such a
+      stretch is only a *candidate*: a gesture may hold a pose as long as any stance (a bow, a pointing hand), and what tells a new
       stance from a hold is that movements *return* to it, as to a hub. The candidate becomes the rest when the
       demonstrator stands near it again after moving (the rest "returned to"), or when they have stood in it for
       ``settle`` seconds; a stretch near the old rest drops it (it was a hold); a stretch elsewhere replaces it.
@@ -141,6 +142,7 @@ class DwellingRest:
         self.positions = np.ones(n_parts, dtype=bool) if positions is None else np.asarray(positions, dtype=bool)
         self.rest = np.asarray(prior, dtype=float).reshape(n_parts, 3).copy()
         self._tail = np.zeros((0, n_parts, 3))  # the last taps - 1 poses
+        self._spreads = np.zeros(0)  # the last spreads, for the noise floor
         self._frame = -1
         self._run_sum: np.ndarray | None = None  # the poses summed over the standing stretch under way
         self._run_count = 0
@@ -179,6 +181,16 @@ class DwellingRest:
         size = np.sqrt((centred * centred).sum(axis=-1).mean(axis=-1)) if mean.shape[1] >= 2 else np.zeros(n)
         return np.where(ok, out, np.inf), size
 
+    def noise_floor(self, spreads: np.ndarray, floor: float) -> np.ndarray:
+        """The smallest of the spreads (n,) over the last ``floor`` seconds up to each frame (this block's and the
+        ones before: causal, whatever the blocks)."""
+        window = max(1, int(round(floor * self.fps)))
+        x = np.concatenate([self._spreads, np.asarray(spreads, dtype=float)])
+        x = np.where(np.isfinite(x), x, np.inf)
+        out = minimum_filter1d(x, window, mode="constant", cval=np.inf, origin=(window - 1) // 2)
+        self._spreads = x[-(window - 1):] if window > 1 else x[:0]
+        return out[len(x) - len(spreads):]
+
     def _near(self, a: np.ndarray, b: np.ndarray, near: float, relative: bool) -> bool:
         """eq. 1 between two poses (position parts seen in both) below ``near`` (m, or body sizes of ``b``)."""
         a, b = a[self.positions], b[self.positions]
@@ -191,11 +203,15 @@ class DwellingRest:
             near = near * float(np.sqrt((c * c).sum(axis=1).mean()))
         return d < near
 
-    def update(self, poses: np.ndarray, radius: float, *, near: float = np.inf,
-               relative: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    def update(self, poses: np.ndarray, radius: float, *, near: float = np.inf, relative: bool = False,
+               noise: float = 0.0, cap: float = np.inf, floor: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """The rest after each frame of a block (n, P, 3), and where it changed (n, 3) (see the class; ``-1``
-        rows where it did not). ``radius`` and ``near`` are in metres, or with ``relative`` in body sizes (of the
-        mean pose over the last ``dwell`` seconds, and of the rest)."""
+        rows where it did not). ``radius``, ``cap`` and ``near`` are in metres, or with ``relative`` in body sizes
+        (of the mean pose over the last ``dwell`` seconds, and of the rest).
+
+        With ``noise = k > 0`` the radius is at least ``k`` times the smallest spread seen over the last ``floor``
+        seconds (:meth:`noise_floor`: the sway and the tracker's noise of this demonstrator when they stand), and at
+        most ``cap``: a tracker noisier than that never shows anyone standing, and the rest stays where it was."""
         poses = np.asarray(poses, dtype=float)
         n = len(poses)
         rests = np.empty_like(poses)
@@ -203,7 +219,13 @@ class DwellingRest:
         if not n:
             return rests, events
         spread, size = self.spreads(poses)
-        standing = spread <= (radius * size if relative else radius)
+        scale = size if relative else np.ones(n)
+        limit = radius * scale
+        if noise > 0 and floor > 0:
+            with np.errstate(invalid="ignore", divide="ignore"):
+                level = self.noise_floor(np.where(scale > 0, spread / np.where(scale > 0, scale, 1.0), np.inf), floor)
+            limit = np.maximum(limit, np.minimum(noise * level, cap) * scale)
+        standing = spread <= limit
         x = np.concatenate([self._tail, poses])
         held = np.where(np.isfinite(x), x, 0.0)
         offset = len(self._tail)
@@ -221,7 +243,7 @@ class DwellingRest:
                 self._run_count = self.taps
                 self._run_began = f - self.taps + 1
                 mean = np.where(np.isfinite(poses[i]), self._run_sum / self._run_count, np.nan)
-                if not self.confirm or not self.anchored or self._near(mean, self.rest, near, relative):
+                if not self.confirm or self._near(mean, self.rest, near, relative):
                     self._role, self._candidate = "rest", None
                     events[i] = (self._run_began, -1, -1)
                 elif self._candidate is not None and self._near(mean, self._candidate, near, relative):

@@ -29,12 +29,11 @@ observer is what a character gets unless it asks:
 
 - ``reference = "rest"``: the distance is measured from *the demonstrator's own rest posture*, not from the
   observer's hub. It is estimated online and causally (:class:`plugins.lib.rest_posture.DwellingRest`): one's own
-  hub until the demonstrator is first seen *standing* (every part stays within ``stillness`` times the start
-  threshold of its mean for ``dwell`` seconds), then the mean pose of that stretch of standing. A stooped,
-  wide-legged or proud stance thus reads as rest half a second after they are first seen in it. When they
-  stand near their rest while a segment is under way, the segment ends where the standing began.
-  A new stance taken later (``stance = "returned"``, the default) must also be *returned to*, as B&B's hubs are
-  the poses movements leave and come back to: a pose held elsewhere is a candidate; when the demonstrator, after
+  hub until the demonstrator is seen *standing* (every part stays within ``stillness`` times the start threshold
+  of its mean for ``dwell`` seconds) somewhere else, then the mean pose of where they stand. When they stand near
+  their rest while a segment is under way, the segment ends where the standing began. A stance away from the
+  rest (a stooped, wide-legged or proud one, or a new one) must (``stance = "returned"``, the default) also be
+  *returned to*, as B&B's hubs are the poses movements leave and come back to: a pose held elsewhere is a candidate; when the demonstrator, after
   moving, stands near it again, it becomes the rest and the segment under way is cut in two, the movement into the
   stance (up to where they first stood in it) and the movement from it back to it (from where they left it); if
   they return to the old rest instead, it was a hold and nothing is cut. Standing in it for ``settle`` seconds
@@ -45,7 +44,11 @@ observer is what a character gets unless it asks:
   (a bow, a pointing hand: about a second), short enough for a live observer. ``stillness = 0.25``: with the start
   threshold at 0.1 body sizes, every part stays within about a centimetre of where it was on a standing adult
   (0.45 m body size): standing sway (1-2 cm/s) and marker noise over half a second, far below a gesture's tens of
-  cm/s.
+  cm/s. A noisier tracker (a Kinect) moves every part more than that when nobody moves, so the radius is at least
+  ``noise = 2`` times the smallest spread seen over the last ``floor`` seconds (what this demonstrator and this
+  tracker show when they stand; the spread of a still body fluctuates around its level, a gesture's is many times
+  larger), up to half the start threshold (noisier than that, no one is ever seen standing and the rest stays
+  one's own hub, the paper's).
 - ``units = "body"``: the distance is measured in the demonstrator's body sizes
   (:func:`plugins.lib.body_size.body_scale` of the reference pose: the root-mean-square distance of the parts from
   their centroid, about 0.45 m for a standing adult, 0.20 m for Max) and compared with ``body_threshold``. The
@@ -107,6 +110,10 @@ class HubThreshold(Segmenter):
                   "is the rest without a return (0: only a return).", minimum=0.0),
         Parameter("stillness", float, 0.25, "With reference = rest: standing means every part stays within this "
                   "share of the start threshold of its mean pose over `dwell`.", minimum=0.0, maximum=1.0),
+        Parameter("noise", float, 2.0, "With reference = rest: the standing radius is at least this many times the "
+                  "smallest spread of the demonstrator's parts over `dwell` seen in the last `floor` seconds (their "
+                  "sway and the tracker's noise), up to half the start threshold (0: `stillness` alone).",
+                  minimum=0.0),
         Parameter("units", str, "metres", "Distances in metres against `threshold` (the paper), or in the "
                   "demonstrator's body sizes against `body_threshold`.", choices=("metres", "body")),
         Parameter("body_threshold", float, 0.1, "With units = body: the start threshold in body sizes (the root-mean-"
@@ -223,7 +230,8 @@ class HubThreshold(Segmenter):
                 dist = dist / max(self._hub_size, 1e-12)
         else:
             on = self.params["body_threshold"] if body else self.params["threshold"]
-            rests, events = self._rest.update(poses, self.params["stillness"] * on, near=on, relative=body)
+            rests, events = self._rest.update(poses, self.params["stillness"] * on, near=on, relative=body,
+                                              noise=self.params["noise"], cap=0.5 * on, floor=self.params["floor"])
             dist = pose_distance(poses, rests, visible)
             if body:
                 centred = rests[:, self._positions] - rests[:, self._positions].mean(axis=1, keepdims=True)
