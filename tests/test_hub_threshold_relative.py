@@ -227,13 +227,19 @@ def test_blocks_and_frames_give_the_same_segments(sizes, units, stance_, seed):
     assert np.allclose(whole.rest, blocks.rest)
 
 
-def test_a_noisy_tracker_still_shows_standing():
-    """Tracker noise of 3 mm per axis moves every part more than `stillness` times the 0.02 m threshold (5 mm)
-    when nobody moves: without `noise` no one is ever seen standing (the paper's hub stays, and the stances merge
-    the gestures); with noise = 2 the radius follows the spread seen at rest and every gesture is found."""
-    motion, gestures, shifts = stream(STANCES, noise=0.003)
-    assert gestures_found(segmenter(reference="rest", noise=0.0), motion, gestures, shifts)[0] < 0.5
-    assert gestures_found(segmenter(reference="rest"), motion, gestures, shifts)[0] == 1.0
+def test_a_noisy_tracker_still_shows_standing_up_to_a_point():
+    """Tracker noise of 2.8 mm per axis moves some part more than `stillness` times the 0.02 m threshold (5 mm)
+    when nobody moves: without `noise` standing is seen only now and then and gestures merge; with noise = 2 the
+    radius follows the spread seen at rest and every gesture is found. At 4 mm twice that spread is above half the
+    threshold: standing cannot be told from noise, nobody is seen standing, and the rest stays one's own hub (the
+    paper's segments)."""
+    for seed in range(3):
+        motion, gestures, shifts = stream(STANCES, noise=0.0028, seed=seed)
+        assert gestures_found(segmenter(reference="rest", noise=0.0), motion, gestures, shifts)[0] < 0.95
+        assert gestures_found(segmenter(reference="rest"), motion, gestures, shifts)[0] == 1.0
+    motion, gestures, shifts = stream(STANCES, noise=0.004)
+    noisy = segmenter(reference="rest")
+    assert noisy.segment(motion) == segmenter().segment(motion) and np.array_equal(noisy.rest, HUB)
 
 
 def test_the_noise_floor_is_the_smallest_spread_of_the_last_seconds():

@@ -210,8 +210,9 @@ class DwellingRest:
         (of the mean pose over the last ``dwell`` seconds, and of the rest).
 
         With ``noise = k > 0`` the radius is at least ``k`` times the smallest spread seen over the last ``floor``
-        seconds (:meth:`noise_floor`: the sway and the tracker's noise of this demonstrator when they stand), and at
-        most ``cap``: a tracker noisier than that never shows anyone standing, and the rest stays where it was."""
+        seconds (:meth:`noise_floor`: the sway and the tracker's noise of this demonstrator when they stand). Where
+        that is more than ``cap``, nobody is seen standing: standing cannot be told from the tracker's noise, and
+        the rest stays where it was."""
         poses = np.asarray(poses, dtype=float)
         n = len(poses)
         rests = np.empty_like(poses)
@@ -224,7 +225,9 @@ class DwellingRest:
         if noise > 0 and floor > 0:
             with np.errstate(invalid="ignore", divide="ignore"):
                 level = self.noise_floor(np.where(scale > 0, spread / np.where(scale > 0, scale, 1.0), np.inf), floor)
-            limit = np.maximum(limit, np.minimum(noise * level, cap) * scale)
+            wide = noise * level
+            # noisier than the cap: standing cannot be told from noise, and a lucky window is no evidence
+            limit = np.where(wide <= cap, np.maximum(limit, wide * scale), -np.inf)
         standing = spread <= limit
         x = np.concatenate([self._tail, poses])
         held = np.where(np.isfinite(x), x, 0.0)

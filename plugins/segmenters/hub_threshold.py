@@ -47,8 +47,8 @@ observer is what a character gets unless it asks:
   cm/s. A noisier tracker (a Kinect) moves every part more than that when nobody moves, so the radius is at least
   ``noise = 2`` times the smallest spread seen over the last ``floor`` seconds (what this demonstrator and this
   tracker show when they stand; the spread of a still body fluctuates around its level, a gesture's is many times
-  larger), up to half the start threshold (noisier than that, no one is ever seen standing and the rest stays
-  one's own hub, the paper's).
+  larger). Where that is more than half the start threshold, standing cannot be told from noise and nobody is
+  seen standing: the rest stays where it was (one's own hub, the paper's, if it never moved).
 - ``units = "body"``: the distance is measured in the demonstrator's body sizes
   (:func:`plugins.lib.body_size.body_scale` of the reference pose: the root-mean-square distance of the parts from
   their centroid, about 0.45 m for a standing adult, 0.20 m for Max) and compared with ``body_threshold``. The
@@ -112,7 +112,8 @@ class HubThreshold(Segmenter):
                   "share of the start threshold of its mean pose over `dwell`.", minimum=0.0, maximum=1.0),
         Parameter("noise", float, 2.0, "With reference = rest: the standing radius is at least this many times the "
                   "smallest spread of the demonstrator's parts over `dwell` seen in the last `floor` seconds (their "
-                  "sway and the tracker's noise), up to half the start threshold (0: `stillness` alone).",
+                  "sway and the tracker's noise); above half the start threshold nobody is seen standing "
+                  "(0: `stillness` alone).",
                   minimum=0.0),
         Parameter("units", str, "metres", "Distances in metres against `threshold` (the paper), or in the "
                   "demonstrator's body sizes against `body_threshold`.", choices=("metres", "body")),
