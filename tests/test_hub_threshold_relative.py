@@ -116,7 +116,8 @@ def test_a_styled_stance_that_changes_reads_as_rest():
 
 def test_a_hold_is_not_rest_unless_held_for_settle():
     """A gesture that holds its extreme pose and returns to the rest: with stance = returned one movement unless the
-    hold outlasts `settle` (2 s); with stance = held, a hold longer than `dwell` reads as a new rest and cuts it."""
+    hold outlasts `settle` (2 s); with stance = held, a hold longer than `stand_time` reads as a new rest and cuts
+    it."""
     rest = stance(0.1, 0.0, 0.0)
     for hold, stance_, pieces in ((0.1, "returned", 1), (1.0, "returned", 1), (2.5, "returned", 2), (0.1, "held", 1),
                                   (1.0, "held", 2)):
@@ -147,7 +148,7 @@ def test_body_units_scale_with_the_body():
     assert segmenter(10.0, reference="rest").segment(big) != small
 
 
-def test_body_threshold_is_the_papers_threshold_on_max():
+def test_size_threshold_is_the_papers_threshold_on_max():
     """0.1 body sizes: Max's body size times 0.1 is the paper's 0.02 m within 2%."""
     from tests.conftest import CHARACTERS  # noqa: F401  (the character path)
     from toolkit import create_plugin_manager, load_character

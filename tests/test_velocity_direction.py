@@ -169,7 +169,7 @@ def test_the_rest_speed_in_body_sizes_and_above_the_noise_by_hand():
     """Two parts 1 m apart: body size 0.5 m, so 0.1 body sizes/s is 0.05 m/s. Still for the first frames (speed 0),
     then moving 0.3 m/s: with noise = 2 the rest speed stays 0.05 (twice the slowest, 0, is less); a body whose
     slowest speed over the floor is 0.3 m/s (sway and noise) rests below 0.6 m/s."""
-    seg = VelocityDirection(units="body", body_rest_speed=0.1, noise=2.0, memory=0.1)
+    seg = VelocityDirection(units="body", size_rest_speed=0.1, noise=2.0, memory=0.1)
     seg.reset(("root", "wrist"), FPS)
     pose = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
     assert seg._rest_speed(pose, 0.0) == pytest.approx(0.05)

@@ -122,10 +122,11 @@ class DwellingRest:
     - *near* the rest (their mean within ``near`` of it, eq. 1): they are the rest (it follows sway and drift);
     - *elsewhere* (the first stance of a stooped, wide-legged or proud demonstrator too): with ``confirm`` off, they
       are the new rest at once (``dwell`` seconds after they are first seen in it). With ``confirm`` on, such a
-      stretch is only a *candidate*: a gesture may hold a pose as long as any stance (a bow, a pointing hand), and what tells a new
-      stance from a hold is that movements *return* to it, as to a hub. The candidate becomes the rest when the
-      demonstrator stands near it again after moving (the rest "returned to"), or when they have stood in it for
-      ``settle`` seconds; a stretch near the old rest drops it (it was a hold); a stretch elsewhere replaces it.
+      stretch is only a *candidate*: a gesture may hold a pose as long as any stance (a bow, a pointing hand), and
+      what tells a new stance from a hold is that movements *return* to it, as to a hub. The candidate becomes the
+      rest when the demonstrator stands near it again after moving (the rest "returned to"), or when they have stood
+      in it for ``settle`` seconds; a stretch near the old rest drops it (it was a hold); a stretch elsewhere
+      replaces it.
 
     :meth:`update` reports, frame by frame, the rest and where it changed: ``(b, -1, -1)`` when a stretch that began
     at frame ``b`` became the rest there, ``(c, l, b)`` when a candidate that began at ``c`` and was left at ``l`` was

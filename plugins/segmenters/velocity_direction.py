@@ -32,7 +32,7 @@ move; a part not seen yet carries no evidence.
 Real people (the correspondence problem, K&G §6): the paper's rest is an absolute speed, which a noisy tracker
 never falls below and a large body's sway may exceed. Each of these is a parameter, off by default (the paper):
 
-- ``units = "body"``: the rest speed is ``body_rest_speed`` of the demonstrator's own body sizes per second
+- ``units = "body"``: the rest speed is ``size_rest_speed`` of the demonstrator's own body sizes per second
   (:func:`plugins.lib.body_size.body_scale` of the poses seen, a running mean: about 0.45 m for a standing adult,
   0.20 m for Max). 0.1 body sizes/s (4.5 cm/s on an adult) lies between standing sway (1-2 cm/s) and a gesture
   (tens of cm/s).
@@ -92,8 +92,8 @@ class VelocityDirection(Segmenter):
         Parameter("level", str, "stroke", "Report strokes (break points) or whole movements (onset to end).",
                   choices=("stroke", "movement")),
         Parameter("units", str, "metres", "The rest speed in m/s (`rest_speed`, the paper) or in the demonstrator's "
-                  "body sizes per second (`body_rest_speed`).", choices=("metres", "body")),
-        Parameter("body_rest_speed", float, 0.1, "With units = body: the rest speed in body sizes per second (the "
+                  "body sizes per second (`size_rest_speed`).", choices=("metres", "body")),
+        Parameter("size_rest_speed", float, 0.1, "With units = body: the rest speed in body sizes per second (the "
                   "root-mean-square distance of the parts from their centroid, running mean over the poses seen).",
                   minimum=0.0),
         Parameter("noise", float, 0.0, "The rest speed is at least this many times the slowest the demonstrator "
@@ -183,7 +183,7 @@ class VelocityDirection(Segmenter):
         return []
 
     def _rest_speed(self, pose: np.ndarray, speed: float) -> float:
-        """The speed below which the parts are at rest now: ``rest_speed`` (m/s), or ``body_rest_speed`` body sizes
+        """The speed below which the parts are at rest now: ``rest_speed`` (m/s), or ``size_rest_speed`` body sizes
         per second; at least ``noise`` times the slowest (mean over ``pause``) speed of the last ``floor`` seconds.
         Records this frame's speed and size first."""
         p = self.params
@@ -192,7 +192,7 @@ class VelocityDirection(Segmenter):
                 size = body_scale(pose, self._positions) if len(self._positions) == len(pose) else body_scale(pose)
                 if size > 0:
                     self._size_sum, self._size_n = self._size_sum + size, self._size_n + 1
-            rest = p["body_rest_speed"] * (self._size_sum / self._size_n if self._size_n else 0.0)
+            rest = p["size_rest_speed"] * (self._size_sum / self._size_n if self._size_n else 0.0)
         else:
             rest = p["rest_speed"]
         if not np.isnan(speed):
