@@ -132,3 +132,74 @@ def test_noise_at_rest_and_minima_at_the_ends_are_no_breaks():
     assert speed_breaks(flicker, 0.5, 0.08) == []
     assert speed_breaks(np.array([0.42, 0.06, 0.31, 0.61, 1.05, 1.41, 1.59, 1.47, 1.23, 1.03, 0.54, 0.17, 0.04, 0.15]),
                         0.5) == []  # the first and last two samples bracket nothing
+
+
+# -- real people: rests relative to the body and to the demonstrator's own speed (K&G §4.1, §6) -------------------
+
+
+def movements_with_rests(rng, n_movements, noise, rest_s=0.8):
+    """Movements of two or three strokes each that flow into each other (no stop inside a movement, only velocity
+    minima), separated by real rests of ``rest_s`` seconds; positions with tracker noise (m). The truth is the
+    movements."""
+    chunks, truth, at = [], [], 0
+    p = np.array([0.0, 1.0, 0.3])
+    hold = int(round(rest_s * FPS))
+    chunks.append(np.repeat([p], hold, 0))
+    at += hold
+    for _ in range(n_movements):
+        begin = at
+        for _ in range(int(rng.integers(2, 4))):
+            target = p + rng.uniform(-0.3, 0.3, 3)
+            while np.linalg.norm(target - p) < 0.2:
+                target = p + rng.uniform(-0.3, 0.3, 3)
+            stroke = GuidingStroke(p, target, rng.uniform(0.4, 0.7), 0.5, 0.4, "linear", rng.normal(size=3), 0.0,
+                                   0.5, 0.0)
+            path = stroke.trajectory(FPS)[:-1]
+            chunks.append(path)
+            at += len(path)
+            p = target
+        truth.append((begin, at))
+        chunks.append(np.repeat([p], hold, 0))
+        at += hold
+    path = np.concatenate(chunks) + rng.normal(0.0, noise, (at, 3))
+    return Motion(np.stack([np.zeros_like(path), path], 1), FPS, ("root", "wrist")), truth
+
+
+def test_the_rest_speed_in_body_sizes_and_above_the_noise_by_hand():
+    """Two parts 1 m apart: body size 0.5 m, so 0.1 body sizes/s is 0.05 m/s. Still for the first frames (speed 0),
+    then moving 0.3 m/s: with noise = 2 the rest speed stays 0.05 (twice the slowest, 0, is less); a body whose
+    slowest speed over the floor is 0.3 m/s (sway and noise) rests below 0.6 m/s."""
+    seg = VelocityDirection(units="body", size_rest_speed=0.1, noise=2.0, memory=0.1)
+    seg.reset(("root", "wrist"), FPS)
+    pose = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    assert seg._rest_speed(pose, 0.0) == pytest.approx(0.05)
+    assert seg._rest_speed(pose, 0.3) == pytest.approx(0.05)
+    seg.reset(("root", "wrist"), FPS)
+    for _ in range(5):
+        level = seg._rest_speed(pose, 0.3)
+    assert level == pytest.approx(0.6)
+    assert VelocityDirection()._rest_speed.__doc__  # the formula is documented where it is computed
+
+
+def test_movements_between_real_rests_under_noise():
+    """A tracker 6 mm noisy: the paper's absolute rest speed (0.08 m/s over 0.1 s) is never reached, so the whole
+    stream is one movement; relative to the demonstrator's own slowest speed and averaged over a pause of 0.3 s, the
+    movements are found and the velocity minima between their strokes cut nothing."""
+    rng = np.random.default_rng(11)
+    scores = {"paper": [], "relative": []}
+    for _ in range(6):
+        motion, truth = movements_with_rests(rng, 4, noise=0.006)
+        for name, params in (("paper", {}), ("relative", {"units": "body", "noise": 2.0, "pause": 0.3})):
+            found = VelocityDirection(parts=["wrist"], level="movement", **params).segment(motion)
+            scores[name].append(segmentation_scores([(s.start, s.end) for s in found], truth)["f1"])
+    assert np.mean(scores["paper"]) < 0.5
+    assert np.mean(scores["relative"]) >= 0.95, scores
+
+
+def test_the_papers_rest_is_the_default():
+    rng = np.random.default_rng(2)
+    motion, truth = movements_with_rests(rng, 3, noise=0.001)
+    plain = VelocityDirection(parts=["wrist"], level="movement")
+    assert plain.params["units"] == "metres" and plain.params["noise"] == 0 and plain.params["pause"] == 0
+    explicit = VelocityDirection(parts=["wrist"], level="movement", units="metres", noise=0.0, pause=0.0)
+    assert plain.segment(motion) == explicit.segment(motion)

@@ -23,6 +23,38 @@ Additions a real stream needs, each a parameter:
   ``floor`` seconds, so the same threshold works for clean and noisy input.
   (A stream that starts in the middle of a movement is then not segmented
   until the body has once been at rest.)
+
+Two more, for real people (the correspondence problem, B&B §7.1, K&G §6), each off by default so the paper's
+observer is what a character gets unless it asks:
+
+- ``reference = "rest"``: the distance is measured from *the demonstrator's own rest posture*, not from the observer's
+  hub. It is estimated online and causally (:class:`plugins.lib.rest_posture.DwellingRest`): one's own hub until the
+  demonstrator is seen *standing* (every part stays within ``stillness`` times the start threshold of its mean for
+  ``stand_time`` seconds) somewhere else, then the mean pose of where they stand. When they stand near their rest
+  while a segment is under way, the segment ends where the standing began. A stance away from the rest (a stooped,
+  wide-legged or proud one, or a new one) must (``stance = "returned"``, the default) also be *returned to*, as B&B's
+  hubs are the poses movements leave and come back to: a pose held elsewhere is a candidate; when the demonstrator,
+  after moving, stands near it again, it becomes the rest and the segment under way is cut in two, the movement into
+  the stance (up to where they first stood in it) and the movement from it back to it (from where they left it); if
+  they return to the old rest instead, it was a hold and nothing is cut. Standing in it for ``settle`` seconds makes
+  it the rest too (the segment then ends where they first stood in it). ``stance = "held"`` takes any held pose as the
+  new rest at once (quicker, and a gesture's hold longer than ``stand_time`` cuts it). ``stand_time = 0.5`` s: a
+  stroke's turning point is slow for about a tenth of a second (K&G §4.1's sensory memory), people pause between
+  gestures for half a second or more. ``settle = 2`` s: longer than a gesture holds a pose (a bow, a pointing hand:
+  about a second), short enough for a live observer. ``stillness = 0.25``: with the start threshold at 0.1 body sizes,
+  every part stays within about a centimetre of where it was on a standing adult (0.45 m body size): standing sway
+  (1-2 cm/s) and marker noise over half a second, far below a gesture's tens of cm/s. A noisier tracker (a Kinect)
+  moves every part more than that when nobody moves, so the radius is at least ``noise = 2`` times the smallest spread
+  seen over the last ``floor`` seconds (what this demonstrator and this tracker show when they stand; the spread of a
+  still body fluctuates around its level, a gesture's is many times larger). Where that is more than half the start
+  threshold, standing cannot be told from noise and nobody is seen standing: the rest stays where it was (one's own
+  hub, the paper's, if it never moved).
+- ``units = "body"``: the distance is measured in the demonstrator's body sizes
+  (:func:`plugins.lib.body_size.body_scale` of the reference pose: the root-mean-square distance of the parts from
+  their centroid, about 0.45 m for a standing adult, 0.20 m for Max) and compared with ``size_threshold``. The
+  default 0.1 is the paper's 0.02 m on Max (0.02 / 0.20), so Max watching Morris is unchanged, and the same file
+  holds for a mouse, a humanoid or a Kinect skeleton whatever units its recordings are in (a Kinect's noise is
+  the ``floor``'s to absorb).
 """
 
 from __future__ import annotations
@@ -35,7 +67,9 @@ import numpy as np
 from scipy.ndimage import minimum_filter1d
 from scipy.signal import butter, lfilter, lfilter_zi
 
+from plugins.lib.body_size import body_scale
 from plugins.lib.pose_distance import pose_distance
+from plugins.lib.rest_posture import DwellingRest
 from toolkit import ConfigError, Motion, Parameter, Segment, Segmenter, hookimpl
 from toolkit.components import provides
 
@@ -63,6 +97,29 @@ class HubThreshold(Segmenter):
         Parameter("floor", float, 10.0, "Seconds over which the running minimum of the filtered distance is "
                   "taken as the noise floor and subtracted (0: no floor, the paper's plain threshold).", minimum=0.0),
         Parameter("hub", str, "", "The hub pose to compare with (default: the observer's rest pose)."),
+        Parameter("reference", str, "hub", "What the distance is measured from: the observer's own hub (the paper) "
+                  "or the demonstrator's own rest, re-anchored wherever they stand still for `stand_time` seconds.",
+                  choices=("hub", "rest")),
+        Parameter("stand_time", float, 0.5, "With reference = rest: seconds every part must stay put to count as "
+                  "standing (a new rest). Shorter follows a new stance sooner and cuts gestures at shorter holds.",
+                  minimum=0.05),
+        Parameter("stance", str, "returned", "With reference = rest: a pose held away from the rest becomes the new "
+                  "rest once a movement returns to it (or it is held for `settle`), or at once when held.",
+                  choices=("returned", "held")),
+        Parameter("settle", float, 2.0, "With stance = returned: seconds of standing in a new stance after which it "
+                  "is the rest without a return (0: only a return).", minimum=0.0),
+        Parameter("stillness", float, 0.25, "With reference = rest: standing means every part stays within this "
+                  "share of the start threshold of its mean pose over `stand_time`.", minimum=0.0, maximum=1.0),
+        Parameter("noise", float, 2.0, "With reference = rest: the standing radius is at least this many times the "
+                  "smallest spread of the demonstrator's parts over `stand_time` seen in the last `floor` seconds "
+                  "(their sway and the tracker's noise); above half the start threshold nobody is seen standing "
+                  "(0: `stillness` alone).",
+                  minimum=0.0),
+        Parameter("units", str, "metres", "Distances in metres against `threshold` (the paper), or in the "
+                  "demonstrator's body sizes against `size_threshold`.", choices=("metres", "body")),
+        Parameter("size_threshold", float, 0.1, "With units = body: the start threshold in body sizes (the root-mean-"
+                  "square distance of the parts from their centroid in the reference pose; 0.1 = the paper's "
+                  "0.02 m on Max).", minimum=0.0),
     )
 
     def attach(self, owner: Any) -> None:
@@ -83,6 +140,8 @@ class HubThreshold(Segmenter):
         self.templates = hubs - hubs[:, root : root + 1]  # every hub: the distance is to the nearest one
         self.template = self.templates[0]
         self.template_parts = owner.body.parts
+        self._positions = ~np.asarray(getattr(owner.body, "angle_mask", np.zeros(len(self.template), bool)), bool)
+        self._hub_size = body_scale(self.template, self._positions)
 
     # -- streaming ---------------------------------------------------------------------
 
@@ -104,6 +163,16 @@ class HubThreshold(Segmenter):
         self._start: int | None = None
         self._below = 0
         self._on, self._off = self.thresholds
+        self._rest = DwellingRest(len(self.template), self._fps, dwell=self.params["stand_time"],
+                                  prior=self.template,
+                                  positions=self._positions, confirm=self.params["stance"] == "returned",
+                                  settle=self.params["settle"]) if self.params["reference"] == "rest" else None
+
+    @property
+    def rest(self) -> np.ndarray:
+        """The pose distances are measured from now (P, 3): the demonstrator's rest as estimated so far with
+        ``reference = "rest"`` (one's own hub until they have been seen standing), else one's own hub."""
+        return self.template.copy() if self._rest is None else self._rest.rest.copy()
 
     @property
     def active_since(self) -> int | None:
@@ -124,20 +193,66 @@ class HubThreshold(Segmenter):
     def push_block(self, poses: np.ndarray, visible: np.ndarray) -> tuple[list[tuple[int, Segment]], np.ndarray]:
         """A block of frames: the distances and the low-pass filter for all of them at once, then the
         thresholds frame by frame (the same as one push per frame)."""
-        raw = _hold(np.concatenate([[self._last], self.distances(poses, visible)]))[1:]  # no evidence: hold
-        if not len(raw):
-            return [], np.zeros(0, dtype=int)
-        self._last = float(raw[-1])
-        if self._zi is None:
-            self._zi = lfilter_zi(self._b, self._a) * raw[0]
-        filtered, self._zi = lfilter(self._b, self._a, raw, zi=self._zi)
+        raw, filtered, events = self._evidence(poses, visible)
         closed: list[tuple[int, Segment]] = []
         since = np.empty(len(raw), dtype=int)
         for i, value in enumerate(filtered.tolist()):
             self._frame += 1
+            if events[i, 0] >= 0 and self._start is not None:
+                closed.extend((i, segment) for segment in self._rested(*events[i].tolist()))
             closed.extend((i, segment) for segment in self._step(value))
             since[i] = -1 if self._start is None else self._start
         return closed, since
+
+    def _rested(self, began: int, left: int, back: int) -> list[Segment]:
+        """The demonstrator came to rest (reference = rest) while a segment was under way: it ends where they began
+        to stand (``began``). When they came back to a stance they had stood in from ``began`` and left at ``left``
+        (``back``: where they stood in it again), the segment is the movement into it and then the one from it back
+        to it."""
+        start = self._start
+        if left < 0:
+            return self._close(max(start + 1, began))
+        out = self._close(began) if began > start else []
+        self._start = max(start, left)
+        return out + self._close(max(self._start + 1, back))
+
+    def _evidence(self, poses: np.ndarray, visible: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The distance from the reference of each frame of a block (held where nothing is seen), low-pass filtered,
+        and where the rest changed at each frame (n, 3) (:meth:`DwellingRest.update`; -1: it did not). With
+        reference = rest the filter restarts at the distance from the new rest where it changes (the old rest no
+        longer counts)."""
+        poses = np.asarray(poses, dtype=float)
+        visible = np.asarray(visible, dtype=bool)
+        n = len(poses)
+        events = np.full((n, 3), -1, dtype=np.int64)
+        body = self.params["units"] == "body"
+        if self._rest is None:
+            dist = self.distances(poses, visible)
+            if body:
+                dist = dist / max(self._hub_size, 1e-12)
+        else:
+            on = self.params["size_threshold"] if body else self.params["threshold"]
+            rests, events = self._rest.update(poses, self.params["stillness"] * on, near=on, relative=body,
+                                              noise=self.params["noise"], cap=0.5 * on, floor=self.params["floor"])
+            dist = pose_distance(poses, rests, visible)
+            if body:
+                centred = rests[:, self._positions] - rests[:, self._positions].mean(axis=1, keepdims=True)
+                size = np.sqrt((centred * centred).sum(axis=-1).mean(axis=-1))
+                dist = dist / np.maximum(size, 1e-12)
+            events = np.where(events >= 0, np.maximum(events, 0), -1)
+        raw = _hold(np.concatenate([[self._last], dist]))[1:]  # no evidence: hold
+        if not n:
+            return raw, raw, events
+        self._last = float(raw[-1])
+        changed = events[:, 0] >= 0
+        cuts = [0, *[int(i) for i in np.flatnonzero(changed) if i > 0], n]
+        pieces = []
+        for a, b in zip(cuts, cuts[1:]):
+            if self._zi is None or changed[a]:
+                self._zi = lfilter_zi(self._b, self._a) * raw[a]
+            piece, self._zi = lfilter(self._b, self._a, raw[a:b], zi=self._zi)
+            pieces.append(piece)
+        return raw, np.concatenate(pieces), events
 
     def _above_floor(self, value: float) -> float:
         """``value`` minus the running minimum of the last ``floor`` seconds (itself if there is no floor)."""
@@ -187,10 +302,10 @@ class HubThreshold(Segmenter):
         distance itself without a floor). Frames with nothing visible hold the last value.
         """
         self.reset(motion.parts, motion.fps)
-        raw = _hold(self.distances(motion.positions, motion.visible))
+        raw, filtered, _ = self._evidence(motion.positions, motion.visible)
+        self.reset(motion.parts, motion.fps)
         if raw.size == 0:
             return raw, raw, raw
-        filtered, _ = lfilter(self._b, self._a, raw, zi=lfilter_zi(self._b, self._a) * raw[0])
         if not self._window:
             return raw, filtered, filtered
         w = self._window  # the running minimum of the last w frames, this one included (trailing window)
@@ -198,8 +313,10 @@ class HubThreshold(Segmenter):
 
     @property
     def thresholds(self) -> tuple[float, float]:
-        """The level at which a movement begins and the level below which it ends (hysteresis)."""
-        return self.params["threshold"], self.params["threshold"] * self.params["release"]
+        """The level at which a movement begins and the level below which it ends (hysteresis): metres, or body
+        sizes with units = body."""
+        on = self.params["size_threshold"] if self.params["units"] == "body" else self.params["threshold"]
+        return on, on * self.params["release"]
 
     def segment(self, motion: Motion) -> list[Segment]:
         self.reset(motion.parts, motion.fps)

@@ -29,6 +29,22 @@ used (the wrists and fingers for Max and Moritz; all parts when empty). Hidden
 parts hold their last seen position (``docs/conventions.md``), so they do not
 move; a part not seen yet carries no evidence.
 
+Real people (the correspondence problem, K&G §6): the paper's rest is an absolute speed, which a noisy tracker
+never falls below and a large body's sway may exceed. Each of these is a parameter, off by default (the paper):
+
+- ``units = "body"``: the rest speed is ``size_rest_speed`` of the demonstrator's own body sizes per second
+  (:func:`plugins.lib.body_size.body_scale` of the poses seen, a running mean: about 0.45 m for a standing adult,
+  0.20 m for Max). 0.1 body sizes/s (4.5 cm/s on an adult) lies between standing sway (1-2 cm/s) and a gesture
+  (tens of cm/s).
+- ``noise = k > 0``: the rest speed is at least ``k`` times the slowest the demonstrator has been over the last
+  ``floor`` seconds (their own speed distribution: sway plus the tracker's noise, whatever their units). ``k = 2``:
+  the speed of a body at rest fluctuates around its level, so twice the lowest is still rest, and a gesture is
+  many times faster.
+- ``pause = p > 0``: the speed is averaged over the last ``p`` seconds before it is compared with the rest speed,
+  so a movement begins and ends only at a *real rest* of about ``p`` seconds: a velocity minimum between two
+  strokes lasts about a tenth of a second (the sensory memory, §4.1) and no longer ends the movement. ``p = 0.3``
+  s: three sensory memories, shorter than the pauses people make between gestures.
+
 Hands (§4.3): a finger of the observer's body (an angle part, whose values
 are joint angles) moves at an *angular* velocity. Its angles are multiplied by
 ``angle_scale`` (metres per radian) as they enter the memories, so one rest
@@ -46,6 +62,7 @@ from typing import Any
 
 import numpy as np
 
+from plugins.lib.body_size import body_scale
 from plugins.lib.strokes import StrokeAnalysis, StrokeCriteria, analyse
 from toolkit import ConfigError, Parameter, Segment, Segmenter, hookimpl
 
@@ -74,6 +91,17 @@ class VelocityDirection(Segmenter):
                   "turning at 0.6 rad/s moves as fast as a wrist at 0.15 m/s).", minimum=0.0, length=True),
         Parameter("level", str, "stroke", "Report strokes (break points) or whole movements (onset to end).",
                   choices=("stroke", "movement")),
+        Parameter("units", str, "metres", "The rest speed in m/s (`rest_speed`, the paper) or in the demonstrator's "
+                  "body sizes per second (`size_rest_speed`).", choices=("metres", "body")),
+        Parameter("size_rest_speed", float, 0.1, "With units = body: the rest speed in body sizes per second (the "
+                  "root-mean-square distance of the parts from their centroid, running mean over the poses seen).",
+                  minimum=0.0),
+        Parameter("noise", float, 0.0, "The rest speed is at least this many times the slowest the demonstrator "
+                  "has been over the last `floor` seconds (0: off, the paper).", minimum=0.0),
+        Parameter("floor", float, 10.0, "Seconds over which the slowest speed is taken for `noise`.", minimum=0.1),
+        Parameter("pause", float, 0.0, "Seconds the speed is averaged over before it is compared with the rest "
+                  "speed: a movement begins and ends at a rest of about this long (0: the sensory memory, the "
+                  "paper).", minimum=0.0),
     )
 
     def attach(self, owner: Any) -> None:
@@ -108,6 +136,12 @@ class VelocityDirection(Segmenter):
         self._history: deque[np.ndarray] = deque(maxlen=2 * self._memory + 2)  # the sensory memory
         self._last: tuple[int, int, np.ndarray] | None = None  # the last movement closed: start, end, working memory
         self._analysis: StrokeAnalysis | None = None
+        self._pause = max(self._memory, int(round(self.params["pause"] * self._fps))) if self.params["pause"] > 0 else 0
+        self._speeds: deque[float] = deque(maxlen=max(1, self._pause))  # for the mean over `pause`
+        self._slowest: deque[tuple[int, float]] = deque()  # monotonic queue: the running minimum over `floor`
+        self._floor = max(1, int(round(self.params["floor"] * self._fps)))
+        self._positions = ~np.array([p in angles for p in parts]) if parts else np.zeros(0, bool)
+        self._size_sum, self._size_n = 0.0, 0
 
     @property
     def active_since(self) -> int | None:
@@ -127,20 +161,52 @@ class VelocityDirection(Segmenter):
             speed = float(step.max()) * self._fps / self._memory if step.size else np.nan
         if self._start is not None:
             self._buffer.append(points.ravel())
+        rest = self._rest_speed(pose, speed)
+        if self._pause:
+            if np.isnan(speed) or len(self._speeds) < self._pause:
+                return []
+            speed = sum(self._speeds) / len(self._speeds)
         if np.isnan(speed):
             return []
-        if speed > self.params["rest_speed"]:
+        if speed > rest:
             self._moving += 1
             self._resting = 0
             if self._start is None and self._moving >= self._memory:
-                self._start = max(0, self._frame - 2 * self._memory)
+                self._start = max(0, self._frame - 2 * self._memory - self._pause // 2)
                 self._buffer = list(self._history)[-(self._frame - self._start + 1):]
         else:
             self._resting += 1
             self._moving = 0
-            if self._start is not None and self._resting >= self._memory:
-                return self._close(max(self._start + 1, self._frame - self._resting + 1 - self._memory // 2))
+            if self._start is not None and self._resting >= max(self._memory, self._pause):
+                lag = self._memory // 2 + self._pause // 2
+                return self._close(max(self._start + 1, self._frame - self._resting + 1 - lag))
         return []
+
+    def _rest_speed(self, pose: np.ndarray, speed: float) -> float:
+        """The speed below which the parts are at rest now: ``rest_speed`` (m/s), or ``size_rest_speed`` body sizes
+        per second; at least ``noise`` times the slowest (mean over ``pause``) speed of the last ``floor`` seconds.
+        Records this frame's speed and size first."""
+        p = self.params
+        if p["units"] == "body":
+            if not self._size_n or self._frame % self._memory == 0:  # the size changes with the pose, slowly
+                size = body_scale(pose, self._positions) if len(self._positions) == len(pose) else body_scale(pose)
+                if size > 0:
+                    self._size_sum, self._size_n = self._size_sum + size, self._size_n + 1
+            rest = p["size_rest_speed"] * (self._size_sum / self._size_n if self._size_n else 0.0)
+        else:
+            rest = p["rest_speed"]
+        if not np.isnan(speed):
+            self._speeds.append(speed)
+        if p["noise"] > 0 and not np.isnan(speed) and len(self._speeds) >= max(1, self._pause):
+            level = sum(self._speeds) / len(self._speeds)
+            while self._slowest and self._slowest[-1][1] >= level:
+                self._slowest.pop()
+            self._slowest.append((self._frame, level))
+        while self._slowest and self._slowest[0][0] <= self._frame - self._floor:
+            self._slowest.popleft()
+        if self._slowest:
+            rest = max(rest, p["noise"] * self._slowest[0][1])
+        return rest
 
     def flush(self) -> list[Segment]:
         if self._start is None:
