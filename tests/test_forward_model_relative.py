@@ -13,21 +13,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from scipy.ndimage import uniform_filter1d
 
-from tests.test_forward_model import ARMS, FPS, demonstration, stroke_path
+from tests.test_forward_model import FPS, arms, demonstration, stroke_path  # noqa: F401 (arms: the fixture)
 from plugins.lib.guiding_stroke import GuidingStroke
-from toolkit import load_character
 from toolkit.watching import feed
-
-
-@pytest.fixture
-def arms(write, pm):
-    character = load_character(write("arms.toml", ARMS), pm)
-    motor = character.motor
-    left, right = motor.rest[2], motor.rest[3]
-    hold = GuidingStroke(right, right, 1.0)
-    character.out = motor.learn("wrists", "hub", [GuidingStroke(left, left + [0.3, 0.0, 0.0], 1.0), hold])
-    character.up = motor.learn("wrists", "hub", [GuidingStroke(left, left + [0.0, 0.3, 0.0], 1.0), hold])
-    return character
 
 
 def use(character, **params):
