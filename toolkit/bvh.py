@@ -154,21 +154,58 @@ class BVH:
 # -- reading ----------------------------------------------------------------------------------------
 
 _TOKEN = re.compile(r"\S+")
+# the line boundaries of str.splitlines, so that line numbers are the same as reading the file line by line
+_BREAK = re.compile("\r\n|[\n\r\v\f\x1c\x1d\x1e\x85\u2028\u2029]")
+
+
+def _lines(text: str):
+    """(line number, line, offset in ``text`` after the line and its break), lazily, as ``text.splitlines()``."""
+    start, number = 0, 0
+    for m in _BREAK.finditer(text):
+        number += 1
+        yield number, text[start:m.start()], m.end()
+        start = m.end()
+    if start < len(text):
+        yield number + 1, text[start:], len(text)
 
 
 class _Tokens:
-    """Whitespace-separated tokens with their line and column, for messages."""
+    """Whitespace-separated tokens with their line and column, for messages.
+
+    Lines are tokenized on demand: the header is read token by token, and the
+    MOTION block's numbers can be taken as one array (:meth:`rest`) without a
+    tuple per number.
+    """
 
     def __init__(self, text: str, source: str) -> None:
         self.source = source
+        self.text = text
         self.items: list[tuple[str, int, int]] = []
-        for number, line in enumerate(text.splitlines(), 1):
+        self._lines = _lines(text)
+        self.offset = 0  # where the first line not yet tokenized starts in ``text``
+        self.pos = 0
+
+    def _fill(self, i: float) -> None:
+        """Tokenize lines until there is a token ``i`` or the text ends."""
+        while len(self.items) <= i:
+            try:
+                number, line, self.offset = next(self._lines)
+            except StopIteration:
+                self.offset = len(self.text)
+                return
             for m in _TOKEN.finditer(line):
                 self.items.append((m.group(), number, m.start() + 1))
-        self.pos = 0
+
+    def fill_all(self) -> None:
+        self._fill(float("inf"))
+
+    def rest(self) -> list[str]:
+        """The tokens from ``pos`` to the end, without line and column (not consuming them)."""
+        return [t for t, _, _ in self.items[self.pos:]] + self.text[self.offset:].split()
 
     def error(self, problem: str, expected: str | None = None, at: int | None = None) -> ConfigError:
         i = self.pos if at is None else at
+        self._fill(i)
         if i < len(self.items):
             _, line, column = self.items[i]
         else:
@@ -177,9 +214,11 @@ class _Tokens:
         return ConfigError(problem, file=self.source, line=line, column=column, expected=expected)
 
     def peek(self) -> str | None:
+        self._fill(self.pos)
         return self.items[self.pos][0] if self.pos < len(self.items) else None
 
     def take(self, expected: str) -> str:
+        self._fill(self.pos)
         if self.pos >= len(self.items):
             raise self.error("unexpected end of file", expected)
         token = self.items[self.pos][0]
@@ -214,6 +253,11 @@ class _Tokens:
 
 def parse_bvh(text: str, source: str = "<bvh>") -> BVH:
     """Parse the text of a BVH file; ``source`` names it in error messages."""
+    return _parse(text, source)
+
+
+def _parse(text: str, source: str, fast: bool = True) -> BVH:
+    """``parse_bvh``; ``fast=False`` reads the MOTION block token by token (the reference for the fast path)."""
     tokens = _Tokens(text, source)
     tokens.expect("HIERARCHY")
     joints: list[Joint] = []
@@ -232,6 +276,24 @@ def parse_bvh(text: str, source: str = "<bvh>") -> BVH:
     if frame_time <= 0:
         raise tokens.error(f"frame time {frame_time}", "a positive number of seconds", at=at)
     n_channels = sum(len(j.channels) for j in joints)
+    if fast:
+        # the MOTION block as one array; any problem (a count, a token, a value) is located token by token below
+        rest, values = tokens.rest(), None
+        if len(rest) == n_frames * n_channels:
+            try:
+                values = np.array(rest, dtype=float).reshape(n_frames, n_channels)
+            except ValueError:
+                pass
+        del rest
+        if values is not None and np.isfinite(values).all():
+            return BVH(joints, frame_time, values, source)
+    tokens.fill_all()
+    return BVH(joints, frame_time, _motion_values(tokens, n_frames, n_channels), source)
+
+
+def _motion_values(tokens: _Tokens, n_frames: int, n_channels: int) -> np.ndarray:
+    """The MOTION block's values from the tokens after ``Frame Time``, with the line and column of any problem."""
+    source = tokens.source
     first = tokens.pos
     rest = tokens.items[first:]
     if len(rest) != n_frames * n_channels:
@@ -260,7 +322,7 @@ def parse_bvh(text: str, source: str = "<bvh>") -> BVH:
         k = int(np.flatnonzero(bad.reshape(-1))[0])
         token, line, column = rest[k]
         raise ConfigError(f"found {token!r}", file=source, line=line, column=column, expected="a finite channel value")
-    return BVH(joints, frame_time, values, source)
+    return values
 
 
 def _parse_joint(tokens: _Tokens, joints: list[Joint], parent: int) -> None:

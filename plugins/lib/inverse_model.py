@@ -37,14 +37,16 @@ graph's (:meth:`plugins.motor.motor_command_graph.MotorCommandGraph.learn_observ
 from __future__ import annotations
 
 import numpy as np
-from scipy.integrate import trapezoid
-from scipy.optimize import least_squares, minimize_scalar
-from scipy.signal import savgol_filter
+
+# scipy.signal, scipy.optimize and scipy.integrate are imported where they are used: importing them costs every
+# command that loads the plugins, most of which never run the inverse model
 
 from plugins.lib.guiding_stroke import GuidingStroke, progress
 from plugins.lib.hand_transition import HandTransition
 
 __all__ = ["stroke_from_segment", "transitions_from_segment", "trajectory_error", "commands_from_segment"]
+
+STRAIGHT = 0.03  # the default largest sideways deviation, as a share of the chord, of a straight stroke
 
 
 def trajectory_error(stroke: GuidingStroke | HandTransition, positions: np.ndarray, fps: float) -> float:
@@ -54,18 +56,47 @@ def trajectory_error(stroke: GuidingStroke | HandTransition, positions: np.ndarr
     return float(np.linalg.norm(stroke.position(t) - positions, axis=1).max())
 
 
-def _closed_form(p: np.ndarray, fps: float, straight: float, family: str | None = None) -> dict:
+def _timing(p: np.ndarray, fps: float) -> tuple[float, float]:
+    """The moment of peak velocity and the end gain, from the (smoothed) speed profile of positions ``p``."""
+    return _timings([p], fps)[0]
+
+
+def _timings(parts: list[np.ndarray], fps: float) -> list[tuple[float, float]]:
+    """:func:`_timing` of several parts' positions of one length, their speed profiles smoothed in one call.
+
+    The Savitzky-Golay filter works along the time axis, column by column (a convolution, and a least-squares
+    polynomial at each end), so filtering the parts' speeds side by side gives each part's own filtered speed;
+    ``tests/test_inverse_model_once.py`` checks it bit for bit.
+    """
+    speeds = np.stack([np.linalg.norm(np.diff(p, axis=0), axis=1) * fps for p in parts], axis=1)
+    if len(speeds) >= 7:
+        from scipy.signal import savgol_filter
+
+        if speeds.shape[1] == 1:  # one part: filtered as a 1-D profile, as it always was
+            speeds = savgol_filter(speeds[:, 0], 7, 2, mode="interp")[:, None]
+        else:
+            speeds = savgol_filter(speeds, 7, 2, axis=0, mode="interp")
+    out = []
+    for j in range(speeds.shape[1]):
+        speed = speeds[:, j]
+        peak = float(np.clip((np.argmax(speed) + 0.5) / max(len(speed), 1), 0.1, 0.9))
+        end_gain = float(np.clip(speed[-1] / max(speed.max(), 1e-12), 0.0, 0.9))
+        out.append((peak, end_gain))
+    return out
+
+
+def _closed_form(p: np.ndarray, fps: float, straight: float, family: str | None = None,
+                 timing: tuple[float, float] | None = None) -> dict:
+    """The closed-form estimates; ``timing`` is :func:`_timing` of the same ``p`` when already computed."""
+    from scipy.integrate import trapezoid
+
     start, target = p[0], p[-1]
     chord = target - start
     length = float(np.linalg.norm(chord))
     axis = chord / max(length, 1e-12)
     s = np.clip((p - start) @ axis / max(length, 1e-12), 0.0, 1.0)
     residual = p - (start + s[:, None] * chord)
-    speed = np.linalg.norm(np.diff(p, axis=0), axis=1) * fps
-    if len(speed) >= 7:
-        speed = savgol_filter(speed, 7 if len(speed) >= 7 else len(speed) | 1, 2, mode="interp")
-    peak = float(np.clip((np.argmax(speed) + 0.5) / max(len(speed), 1), 0.1, 0.9))
-    end_gain = float(np.clip(speed[-1] / max(speed.max(), 1e-12), 0.0, 0.9))
+    peak, end_gain = _timing(p, fps) if timing is None else timing
     est = {"start": start, "target": target, "duration": (len(p) - 1) / fps, "peak": peak, "end_gain": end_gain}
     size = np.linalg.norm(residual, axis=1)
     if length < 1e-6 or size.max() < straight * length:
@@ -101,7 +132,7 @@ def _closed_form(p: np.ndarray, fps: float, straight: float, family: str | None 
             "roundness": roundness, "skewness": skewness}
 
 
-def stroke_from_segment(positions: np.ndarray, fps: float, *, straight: float = 0.03, refine: bool = True) -> GuidingStroke:
+def stroke_from_segment(positions: np.ndarray, fps: float, *, straight: float = STRAIGHT, refine: bool = True) -> GuidingStroke:
     """The guiding stroke that reproduces a segment of wrist positions (N, 3) sampled at ``fps`` (N >= 2).
 
     Parameters
@@ -114,22 +145,34 @@ def stroke_from_segment(positions: np.ndarray, fps: float, *, straight: float = 
     refine : bool
         Refine the closed-form estimates by least squares.
     """
+    p = _checked(positions)
+    return _stroke(p, fps, straight, refine, _timing(p, fps))
+
+
+def _checked(positions: np.ndarray) -> np.ndarray:
     p = np.asarray(positions, dtype=float)
     if p.ndim != 2 or p.shape[1] != 3 or len(p) < 2 or not np.isfinite(p).all():
         raise ValueError("the inverse model needs two or more finite positions (N, 3)")
-    est = _closed_form(p, fps, straight)
+    return p
+
+
+def _stroke(p: np.ndarray, fps: float, straight: float, refine: bool, timing: tuple[float, float]) -> GuidingStroke:
+    """:func:`stroke_from_segment` of checked positions ``p`` whose :func:`_timing` is ``timing``."""
+    est = _closed_form(p, fps, straight, timing=timing)
     if not refine:
         return GuidingStroke(**est)
     if est["shape"] == "linear":
         return _refined(est, p, fps)
     # C or S: observation noise at the ends can make a C's residual change sides; both families are fitted and
-    # the one that reproduces the observation better is kept
-    fits = [_refined(_closed_form(p, fps, straight, family), p, fps) for family in ("c", "s")]
+    # the one that reproduces the observation better is kept (the speed profile is the same: filtered once)
+    fits = [_refined(_closed_form(p, fps, straight, family, timing), p, fps) for family in ("c", "s")]
     return min(fits, key=lambda stroke: (trajectory_error(stroke, p, fps), stroke.shape != est["shape"]))
 
 
 def _refined(est: dict, p: np.ndarray, fps: float) -> GuidingStroke:
     """The closed-form stroke ``est`` refined by bounded least squares against positions ``p``; the better of the two."""
+    from scipy.optimize import least_squares
+
     stroke = GuidingStroke(**est)
     t = np.arange(len(p)) / fps
     curved = stroke.shape != "linear"
@@ -158,6 +201,8 @@ def transitions_from_segment(angles: np.ndarray, fps: float, breaks: list[int] |
     breaks : list of int
         Frames of the via postures (the angular-velocity minima and direction changes found by the segmenter).
     """
+    from scipy.optimize import minimize_scalar
+
     a = np.asarray(angles, dtype=float)
     if a.ndim != 3 or a.shape[2] != 3 or len(a) < 2 or not np.isfinite(a).all():
         raise ValueError("the hand inverse model needs two or more finite configurations (N, k, 3)")
@@ -209,6 +254,8 @@ def commands_from_segment(observed: np.ndarray, fps: float, breaks: list[int] | 
     for i, (a, b) in enumerate(zip(cuts, cuts[1:])):
         if b - a < 2:
             continue
-        pieces.append(([stroke_from_segment(observed[a : b + 1, j], fps, refine=refine) for j in range(k)],
+        parts = [_checked(observed[a : b + 1, j]) for j in range(k)]
+        timings = _timings(parts, fps)  # the k parts' speed profiles filtered in one call
+        pieces.append(([_stroke(p, fps, STRAIGHT, refine, timing) for p, timing in zip(parts, timings)],
                        i == len(cuts) - 2))
     return pieces
