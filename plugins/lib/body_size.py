@@ -127,16 +127,21 @@ def retarget(poses: np.ndarray, tree: np.ndarray, ratio: np.ndarray, root: int) 
     return out
 
 
-def body_scale(pose: np.ndarray, parts: np.ndarray | None = None) -> float:
+def body_scale(pose: np.ndarray, parts: np.ndarray | None = None) -> float | np.ndarray:
     """A body's size from one pose: the root-mean-square distance of its parts from their centroid (m).
 
     The scale that relative thresholds are measured in: it needs no skeleton (any parts will do), is about 0.45 m
-    for a standing adult and grows with the body. ``parts`` (bool (P,)) selects the parts (position parts).
+    for a standing adult and grows with the body. ``parts`` (bool (P,)) selects the parts (position parts). Parts
+    with a coordinate that is not finite are left out; fewer than two parts left: 0. A pose (P, 3) gives a number;
+    poses (..., P, 3) give one per pose.
     """
     pose = np.asarray(pose, dtype=float)
     if parts is not None:
-        pose = pose[np.asarray(parts, dtype=bool)]
-    pose = pose[np.isfinite(pose).all(axis=1)]
-    if len(pose) < 2:
-        return 0.0
-    return float(np.sqrt(((pose - pose.mean(axis=0)) ** 2).sum(axis=1).mean()))
+        pose = pose[..., np.asarray(parts, dtype=bool), :]
+    ok = np.isfinite(pose).all(axis=-1)
+    count = ok.sum(axis=-1)
+    safe = np.where(ok[..., None], pose, 0.0)
+    centre = safe.sum(axis=-2) / np.maximum(count, 1)[..., None]
+    spread = np.where(ok, ((safe - centre[..., None, :]) ** 2).sum(axis=-1), 0.0).sum(axis=-1)
+    size = np.where(count >= 2, np.sqrt(spread / np.maximum(count, 1)), 0.0)
+    return float(size) if size.ndim == 0 else size

@@ -36,14 +36,15 @@ def frame_rotation(world: np.ndarray, local: np.ndarray, visible: np.ndarray, ro
     """
     world = np.asarray(world, dtype=float)
     local = np.asarray(local, dtype=float)
-    seen = np.asarray(visible, dtype=bool) & np.asarray(visible, dtype=bool)[:, root : root + 1]
+    visible = np.asarray(visible, dtype=bool)
+    seen = visible & visible[:, root : root + 1]
     seen[:, root] = False
     a = world - world[:, root : root + 1]
     b = local - local[:, root : root + 1]
     ca = a[..., 0] + 1j * a[..., 2]
     cb = b[..., 0] + 1j * b[..., 2]
     ok = seen & np.isfinite(ca) & np.isfinite(cb)
-    s = np.where(ok, np.conj(np.where(ok, ca, 0)) * np.where(ok, cb, 0), 0).sum(axis=1)
+    s = (np.conj(np.where(ok, ca, 0)) * np.where(ok, cb, 0)).sum(axis=1)
     out = np.angle(s)
     out[np.abs(s) < 1e-12] = np.nan
     return out

@@ -50,7 +50,7 @@ class Posegraph(MotorSystem):
         Parameter("cycles", bool, True, "A clip that ends where it began (within hub_radius), away from every hub "
                   "(one cycle of a walk or a run, cropped from a longer recording), loops: an edge leads from its "
                   "last pose back to its first, so a path can follow the movement for as many cycles as it is seen "
-                  "(false: every path leaves through a hub, the paper's posegraph).", ),
+                  "(false: every path leaves through a hub, the paper's posegraph)."),
         Parameter("node_rate", float, 10.0, "Pose nodes per second of movement: the graph's resolution. Higher "
                   "recognises finer timing at the cost of search time.", minimum=1.0, maximum=120.0),
     )
@@ -107,7 +107,8 @@ class Posegraph(MotorSystem):
         t = np.arange(motion.n_frames) / motion.fps
         keep = np.unique(np.clip(np.round(np.arange(0.0, t[-1] + 1e-9, 1.0 / rate) * motion.fps), 0,
                                  motion.n_frames - 1).astype(int))
-        sampled = motion.filled(default=self.rest_pose()).positions[keep]  # hidden parts held (docs/conventions.md)
+        filled = motion.filled(default=self.rest_pose()).positions  # hidden parts held (docs/conventions.md)
+        sampled = filled[keep]
         hub_rel = self.key_poses.array - self.key_poses.array[:, self.body.root_index : self.body.root_index + 1]
         root = self.body.root_index
         end_rel = [sampled[i] - sampled[i, root] for i in (0, -1)]
@@ -120,8 +121,7 @@ class Posegraph(MotorSystem):
                                                    motion.fps)[keep])
         name = example_name(movement, n)
         self._add_path(name, ends[0], sampled[1:-1], ends[1], poses, travel, velocity[1:-1], label=movement)
-        whole = motion.filled(default=self.rest_pose()).positions[[0, -1]]
-        whole = whole - whole[:, root : root + 1]
+        whole = filled[[0, -1]] - filled[[0, -1], root : root + 1]
         cycle = float(pose_distance(whole[0], whole[1], True))  # its very first and last frames
         radius = self.params["hub_radius"]
         if (self.params["cycles"] and len(sampled) > 3 and cycle <= radius

@@ -236,9 +236,7 @@ class HubThreshold(Segmenter):
                                               noise=self.params["noise"], cap=0.5 * on, floor=self.params["floor"])
             dist = pose_distance(poses, rests, visible)
             if body:
-                centred = rests[:, self._positions] - rests[:, self._positions].mean(axis=1, keepdims=True)
-                size = np.sqrt((centred * centred).sum(axis=-1).mean(axis=-1))
-                dist = dist / np.maximum(size, 1e-12)
+                dist = dist / np.maximum(body_scale(rests, self._positions), 1e-12)
             events = np.where(events >= 0, np.maximum(events, 0), -1)
         raw = _hold(np.concatenate([[self._last], dist]))[1:]  # no evidence: hold
         if not n:
