@@ -54,7 +54,7 @@ MAX_LINE_CHARS = 1 << 20
 TIME_TOLERANCE = 0.25
 """How far a step of a CSV time column may differ from the median step, as a fraction of the median step."""
 
-_BLOCK_CHARS = 1 << 23  # a CSV block ends after this many characters even if it has fewer than ``frames`` rows
+_BLOCK_CHARS = 1 << 20  # a CSV block ends after about this many characters even if it has fewer than ``frames`` rows
 _FPS_HINT = "a frame rate: give `fps` in the profile's [profile] table or --fps"
 _AXES = "xyz"
 _COORDINATE = re.compile(r"^(?P<joint>.+)[_.](?P<axis>[xyzXYZ])$")
@@ -131,7 +131,7 @@ def iter_position_blocks(path: str | Path, *, names: Sequence[str] | None = None
     path, names, fps
         As for :func:`read_positions`.
     frames : int
-        The most frames per block (a CSV block also ends after about 8 Mi characters).
+        The most frames per block (a CSV block also ends after about 1 Mi characters of text).
 
     Returns
     -------
@@ -447,13 +447,15 @@ def _row_blocks(layout: _Layout, columns: Sequence[int], frames: int,
             yield values, (np.array(numbers, dtype=np.int64) if lines else None)
 
 
-def _empty_field(delimiter: str) -> re.Pattern[str]:
-    d = re.escape(delimiter)
-    space = "[ \\t\\f\\v]" if delimiter != "\t" else "[ \\f\\v]"
-    return re.compile(f"(?:^|(?<={d})){space}*(?={d}|\n)", re.MULTILINE)  # every row ends with a line break
-
-
-_EMPTY = {d: _empty_field(d) for d in (",", ";", "\t")}
+def _fill_empty(text: str, d: str) -> str:
+    """``text`` (lines each ending in a line break) with ``nan`` in every empty field; a field of only spaces is left
+    for :func:`_parse_slow`."""
+    if text.startswith(d):
+        text = "nan" + text
+    twice = d + d
+    while twice in text:  # twice: in ",,," the second empty field starts where the first replacement ended
+        text = text.replace(twice, d + "nan" + d)
+    return text.replace("\n" + d, "\nnan" + d).replace(d + "\n", d + "nan\n")
 
 
 def _parse_fast(rows: list[str], layout: _Layout, columns: Sequence[int]) -> np.ndarray | None:
@@ -467,7 +469,7 @@ def _parse_fast(rows: list[str], layout: _Layout, columns: Sequence[int]) -> np.
         text += "\n"
     if '"' in text:
         return None
-    text = _EMPTY[d].sub("nan", text)
+    text = _fill_empty(text, d)
     try:
         return np.loadtxt(io.StringIO(text), delimiter=d, usecols=columns, dtype=float, comments=None, ndmin=2,
                           quotechar=None)
@@ -496,5 +498,6 @@ def _parse_slow(rows: list[str], numbers: list[int], layout: _Layout, columns: S
             except ValueError:
                 raise ConfigError(f"found {cell!r} in column {layout.column_name(c)!r}", file=path, line=number,
                                   column=_field_starts(row, d)[c],
-                                  expected="a number, or an empty cell or nan for a missing value") from None
+                                  expected="a time in seconds" if c == layout.time else
+                                  "a number, or an empty cell or nan for a missing value") from None
     return out
