@@ -252,6 +252,50 @@ def test_bounds_on_lines_columns_and_joints(tmp_path, monkeypatch):
         read_positions(tmp_path / "wide.csv", fps=30)
 
 
+CELL = st.text(alphabet=st.sampled_from(list("0123456789.eE+-_ naifNIFx\"")), max_size=8)
+
+
+@settings(max_examples=300, deadline=None)
+@given(rows=st.lists(st.lists(CELL, min_size=3, max_size=3), min_size=1, max_size=4))
+def test_numpy_reads_a_block_as_the_field_by_field_reader_does(rows):
+    """Whenever numpy.loadtxt reads a block, the reference reader reads the same values from it."""
+    layout = pos._Layout(pos.Path("f.csv"), "a_x,a_y,a_z\n", ",", ("a_x", "a_y", "a_z"), ("a",), (0, 1, 2), None)
+    lines = [",".join(r) + "\n" for r in rows]
+    fast = pos._parse_fast(lines, layout, layout.columns)
+    try:
+        slow = pos._parse_slow(lines, list(range(2, 2 + len(lines))), layout, layout.columns)
+    except ConfigError:
+        assert fast is None
+    else:
+        assert fast is None or same(fast, slow)
+
+
+TOKENS = st.sampled_from(["a_x", "a_y", "b.X", "time", "1", "-2.5e3", "nan", "", " ", "x", '"', ",", ";", "\t",
+                          "\n", "\r\n", "\ufeff", "0.1", "1e-9", "inf", "\x00", "\xe9"])
+BASE = "time,a_x,a_y,a_z,b.X,b.Y,b.Z,note\n" + "".join(f"{k / 30!r},1,2,3,,5,6e0,n\n" for k in range(6))
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(edits=st.lists(st.tuples(st.floats(0, 1), st.integers(0, 3), TOKENS), max_size=6),
+       fps=st.sampled_from([None, 30.0]), frames=st.integers(1, 4))
+def test_mutated_csv_is_read_or_a_config_error(tmp_path, edits, fps, frames):
+    """A valid CSV with tokens inserted or characters replaced: every outcome is a JointPositions or a ConfigError
+    (never another exception), and the blocks agree with the whole read."""
+    text = BASE
+    for where, cut, token in edits:
+        at = int(where * len(text))
+        text = text[:at] + token + text[at + cut:]
+    path = write(tmp_path / "fuzz.csv", text)
+    try:
+        got = read_positions(path, fps=fps)
+    except ConfigError:
+        return
+    assert got.positions.shape[1:] == (len(got.names), 3) and 0 < got.fps <= MAX_FPS
+    header, blocks = iter_position_blocks(path, fps=fps, frames=frames)
+    parts = list(blocks)
+    assert same(np.concatenate(parts) if parts else header.positions, got.positions)
+
+
 # -- .npy -------------------------------------------------------------------------------------------
 
 

@@ -187,6 +187,8 @@ def _check_names(names: Sequence[str] | None, path: Path) -> tuple[str, ...] | N
         return None
     if isinstance(names, str) or not isinstance(names, Sequence):
         raise ConfigError(f"joint names {names!r}", file=path, expected="a list of joint names")
+    if not names:
+        raise ConfigError("no joint names", file=path, expected="a list of joint names")
     if len(names) > MAX_JOINTS:
         raise ConfigError(f"{len(names)} joint names", file=path, expected=f"at most {MAX_JOINTS} joints")
     seen: set[str] = set()
@@ -219,8 +221,8 @@ def _npy(path: Path, names: tuple[str, ...] | None, fps: float | None,
     if array.ndim != 3 or array.shape[2] != 3:
         raise ConfigError(f"array of shape {array.shape}", file=path, expected=expected)
     n_frames, n_joints = int(array.shape[0]), int(array.shape[1])
-    if n_joints > MAX_JOINTS:
-        raise ConfigError(f"{n_joints} joints", file=path, expected=f"at most {MAX_JOINTS} joints")
+    if not 0 < n_joints <= MAX_JOINTS:
+        raise ConfigError(f"{n_joints} joints", file=path, expected=f"between 1 and {MAX_JOINTS} joints")
     if names is None:
         raise ConfigError("a .npy file has no joint names", file=path,
                           expected=f"the names of its {n_joints} joints (the profile's joint list)")
