@@ -145,12 +145,19 @@ def test_byte_order_mark_tab_delimiter_and_blank_lines(tmp_path):
     assert same(got.positions, np.array([[[1.0, 2, 3]], [[4.0, 5, 6]]]))
 
 
-def test_time_column_gives_the_rate_from_the_median_step_and_wins_over_fps(tmp_path):
-    steps = [0.01, 0.0105, 0.0095, 0.01, 0.011]  # jitter within TIME_TOLERANCE
+def test_time_column_gives_the_rate_from_the_span_and_wins_over_fps(tmp_path):
+    steps = [0.01, 0.0105, 0.0095, 0.01, 0.012]  # jitter within TIME_TOLERANCE of the median
     times = np.concatenate([[0.0], np.cumsum(steps)])
     text = "time,j_x,j_y,j_z\n" + "".join(f"{float(t)!r},0,0,0\n" for t in times)
     got = read_positions(write(tmp_path / "t.csv", text), fps=30)
-    assert got.fps == pytest.approx(1 / np.median(np.diff(times)))
+    assert got.fps == pytest.approx(5 / 0.052)
+
+
+@pytest.mark.parametrize("fmt", ["%.6g", "%.3f"])
+def test_rounded_times_give_the_true_rate(tmp_path, fmt):
+    """Times of a 120 fps recording rounded to 1 ms: steps of 8 and 9 ms (a median step would say 125 fps)."""
+    text = "time,j_x,j_y,j_z\n" + "".join(f"{fmt % (100 + k / 120)},0,0,0\n" for k in range(1201))
+    assert read_positions(write(tmp_path / "t.csv", text)).fps == pytest.approx(120, rel=1e-4)
 
 
 def test_header_only_gives_no_frames(tmp_path):

@@ -382,7 +382,8 @@ def _csv(path: Path, names: tuple[str, ...] | None, fps: float | None,
 
 
 def _rate_from_time(layout: _Layout, frames: int) -> float | None:
-    """Frames per second from the time column (1 / the median step), or None with fewer than two rows."""
+    """Frames per second from the time column (steps within TIME_TOLERANCE of the median step; the rate is the number
+    of steps over the time they span), or None with fewer than two rows."""
     path, name = layout.source, layout.column_name(layout.time)
     chunks = list(_row_blocks(layout, (layout.time,), frames, lines=True))
     times = np.concatenate([v[:, 0] for v, _ in chunks]) if chunks else np.empty(0)
@@ -410,7 +411,9 @@ def _rate_from_time(layout: _Layout, frames: int) -> float | None:
                           line=int(lines[k]), column=column,
                           expected=f"steps of {step:.6g} s (the median) within {TIME_TOLERANCE:.0%}; "
                                    "for a recording with dropped frames, drop the time column and give fps")
-    rate = 1.0 / step
+    # the rate from the mean step (the span over the steps), not the median: with times rounded to a few digits the
+    # median is one of the rounded steps (%.6g times at 120 fps: steps of 0.008 and 0.009 s, median 0.008 s, 125 fps)
+    rate = (times.size - 1) / float(times[-1] - times[0])
     if not rate <= MAX_FPS:
         raise ConfigError(f"the time column's median step of {step:.6g} s is {rate:.6g} frames per second",
                           file=path, line=int(lines[1]), column=column,
