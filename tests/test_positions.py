@@ -411,3 +411,10 @@ def test_peak_memory_is_a_small_multiple_of_the_positions(tmp_path, suffix):
         tracemalloc.stop()
     assert same(got.positions, positions)
     assert peak < 2 * positions.nbytes + 8e6, f"peak {peak / 1e6:.1f} MB"
+
+
+def test_the_documented_bounds_are_the_module_constants():
+    doc = (pos.Path(__file__).resolve().parent.parent / "docs" / "formats.md").read_text()
+    assert f"`MAX_FPS` = {MAX_FPS:,.0f}" in doc
+    assert f"`MAX_COLUMNS` ({pos.MAX_COLUMNS:,})" in doc and f"`MAX_JOINTS` ({pos.MAX_JOINTS:,})" in doc
+    assert f"`TIME_TOLERANCE` ({pos.TIME_TOLERANCE:.0%})" in doc and pos.MAX_LINE_CHARS == 1 << 20
