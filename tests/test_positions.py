@@ -277,6 +277,20 @@ def test_numpy_reads_a_block_as_the_field_by_field_reader_does(rows):
         assert fast is None or same(fast, slow)
 
 
+@settings(max_examples=500, deadline=None)
+@given(line=st.text(alphabet=st.sampled_from(list('ab1 ,;"\t')), max_size=20), delimiter=st.sampled_from([",", ";"]))
+def test_error_columns_are_where_the_csv_module_starts_each_field(line, delimiter):
+    try:
+        fields = pos._split(line, delimiter, pos.Path("f.csv"), 1)
+    except ConfigError:
+        return
+    starts = pos._field_starts(line, delimiter)
+    assert len(starts) == max(len(fields), 1)
+    for start, field in zip(starts, fields):
+        raw = line[start - 1:]
+        assert raw.startswith(field) or raw.startswith('"')
+
+
 TOKENS = st.sampled_from(["a_x", "a_y", "b.X", "time", "1", "-2.5e3", "nan", "", " ", "x", '"', ",", ";", "\t",
                           "\n", "\r\n", "\ufeff", "0.1", "1e-9", "inf", "\x00", "\xe9"])
 BASE = "time,a_x,a_y,a_z,b.X,b.Y,b.Z,note\n" + "".join(f"{k / 30!r},1,2,3,,5,6e0,n\n" for k in range(6))

@@ -298,13 +298,22 @@ def _delimiter_name(delimiter: str) -> str:
 
 
 def _field_starts(line: str, delimiter: str) -> list[int]:
-    """The 1-based character column where each field of ``line`` starts (quotes respected)."""
-    starts, quoted = [1], False
-    for i, c in enumerate(line):
-        if c == '"':
-            quoted = not quoted
-        elif c == delimiter and not quoted:
+    """The 1-based character column where each field of ``line`` starts, as the csv module splits it (a double quote
+    opens a quoted field only as the field's first character; ``""`` inside one is a quote)."""
+    starts, quoted, i = [1], False, 0
+    while i < len(line):
+        c = line[i]
+        if quoted:
+            if c == '"':
+                if line.startswith('"', i + 1):
+                    i += 1
+                else:
+                    quoted = False
+        elif c == '"' and i == starts[-1] - 1:
+            quoted = True
+        elif c == delimiter:
             starts.append(i + 2)
+        i += 1
     return starts
 
 
