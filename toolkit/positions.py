@@ -174,7 +174,8 @@ def _check_regular(path: Path) -> None:
 
 def _check_fps(fps: object, path: Path, what: str) -> float:
     if isinstance(fps, bool) or not isinstance(fps, Real):
-        raise ConfigError(f"{what} is {fps!r}", file=path, expected=f"a number of frames per second in (0, {MAX_FPS:g}]")
+        raise ConfigError(f"{what} is {fps!r}", file=path,
+                          expected=f"a number of frames per second in (0, {MAX_FPS:g}]")
     value = float(fps)
     if not (0.0 < value <= MAX_FPS):  # NaN fails too
         raise ConfigError(f"{what} is {value:g} frames per second", file=path,
@@ -499,7 +500,8 @@ def _parse_slow(rows: list[str], numbers: list[int], layout: _Layout, columns: S
         fields = _split(row, d, path, number)
         if len(fields) != len(layout.cells):
             raise ConfigError(f"{len(fields)} fields", file=path, line=number, column=1,
-                              expected=f"{len(layout.cells)} fields separated by {_delimiter_name(d)}, as in the header")
+                              expected=f"{len(layout.cells)} fields separated by {_delimiter_name(d)}, "
+                                       "as in the header")
         for k, c in enumerate(columns):
             cell = fields[c].strip()
             if not cell:
