@@ -9,6 +9,7 @@ fails the same way as a bad TOML value.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -97,8 +98,17 @@ class Parameter:
         return text
 
     def coerce(self, value: Any) -> Any:
-        """Return the checked value (ints widened to float) or raise :class:`ConfigError`."""
+        """Return the checked value (ints widened to float) or raise :class:`ConfigError`.
+
+        A NaN or infinite number anywhere in the value (in an array or table too) is refused: every number a
+        parameter takes is finite.
+        """
         value = _check_type(value, self.type, self.name, self._expected())
+        where = _non_finite(value)
+        if where is not None:
+            path, number = where
+            raise ConfigError(f"value {number!r} is not a finite number", key=(self.name, *path),
+                              expected=self._expected() if not path else "finite numbers")
         if self.items is not None:
             value = [_check_type(v, self.items, i, self._expected()) for i, v in enumerate(value)]
         if self.type in (int, float):
@@ -119,6 +129,20 @@ class Parameter:
 
     def _expected(self) -> str:
         return self.describe(article=True)
+
+
+def _non_finite(value: Any) -> tuple[tuple[str | int, ...], float] | None:
+    """The key path (relative to ``value``) and value of its first NaN or infinite number, or ``None``."""
+    stack: list[tuple[tuple[str | int, ...], Any]] = [((), value)]
+    while stack:
+        path, item = stack.pop()
+        if isinstance(item, float) and not math.isfinite(item):
+            return path, item
+        if isinstance(item, Mapping):
+            stack.extend(((*path, k), v) for k, v in reversed(list(item.items())))
+        elif isinstance(item, (list, tuple)):
+            stack.extend(((*path, i), v) for i, v in reversed(list(enumerate(item))))
+    return None
 
 
 def _check_type(value: Any, kind: type, key: str | int, expected: str) -> Any:

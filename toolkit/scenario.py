@@ -146,7 +146,7 @@ def _build(table: Mapping[str, Any], path: Path, pm: PluginManager, seed: int | 
         if not isinstance(override, Mapping):
             raise ConfigError("not a table", key=(*key, "override"), expected="tables to merge over the character's")
         override = _seeded(override, seed, char_path, pm)
-        character = load_character(char_path, pm, override=override)
+        character = load_character(char_path, pm, override=override, override_at=(path, (*key, "override")))
         heading = math.radians(_number(spec.get("heading", 0.0), (*key, "heading"), "degrees"))
         position = _vector(spec.get("position", [0.0, 0.0, 0.0]), (*key, "position"))
         actor_id = spec.get("id", re.sub(r"[^a-z0-9]+", "-", character.name.lower()).strip("-"))
