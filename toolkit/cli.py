@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import re
 import sys
 from collections.abc import Sequence
@@ -39,13 +40,122 @@ class _Parser(argparse.ArgumentParser):
         self.exit(1, f"likeme: error: {message} (see '{self.prog} --help')\n")
 
 
+# -- argument types and output paths: checked where they enter, before any work ------------------------
+
+
+def seed_type(text: str) -> int:
+    """``--seed``: an integer in [0, 2**63 - 1] (numpy's generators take no negative seed)."""
+    from toolkit.scenario import MAX_SEED
+
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid int value: {text!r}") from None
+    if not 0 <= value <= MAX_SEED:
+        raise argparse.ArgumentTypeError(f"invalid seed {value}: expected an integer in [0, {MAX_SEED}]")
+    return value
+
+
+def number_type(low: float, high: float, what: str = "a number") -> Any:
+    """An argument type: a finite number in [low, high] (NaN and infinities refused)."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"invalid number: {text!r}") from None
+        if not (math.isfinite(value) and low <= value <= high):
+            raise argparse.ArgumentTypeError(f"invalid value {text!r}: expected {what} in [{low:g}, {high:g}]")
+        return value
+
+    parse.__name__ = "number"
+    return parse
+
+
+def count_type(low: int, high: int) -> Any:
+    """An argument type: an integer in [low, high]."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"invalid int value: {text!r}") from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"invalid value {value}: expected an integer in [{low}, {high}]")
+        return value
+
+    parse.__name__ = "count"
+    return parse
+
+
+OUTPUT_FILES = ("json", "csv", "plot", "out")
+"""Options naming a file a command writes (a string value; ``likeme run --json`` is a flag and is left alone)."""
+OUTPUT_DIRS = ("render",)
+"""Options naming a folder a command writes into (created if missing)."""
+
+
+def _probe(folder: Path, path: Path, option: str, expected: str) -> None:
+    """Create and remove a temporary file in ``folder``: the only sure test that the command can write there."""
+    import tempfile
+
+    try:
+        with tempfile.NamedTemporaryFile(dir=folder, prefix=".likeme-probe-"):
+            pass
+    except OSError as exc:
+        raise ConfigError(f"cannot write there ({exc.strerror or exc})", file=path, key=(f"--{option}",),
+                          expected=expected) from None
+
+
+def check_output_file(path: str | Path, option: str) -> Path:
+    """A file a command will write: its folder must exist and be writable, and it must not be a folder itself."""
+    path = Path(path)
+    folder = path.parent
+    key = (f"--{option}",)
+    if path.is_dir():
+        raise ConfigError("is a folder", file=path, key=key, expected="the path of a file to write")
+    if path.exists() and not path.is_file():
+        raise ConfigError("not a regular file", file=path, key=key, expected="the path of a file to write")
+    if not folder.is_dir():
+        raise ConfigError("no such folder", file=folder, key=key, expected="a file in an existing folder")
+    _probe(folder, path, option, "a file in a folder this user can write")
+    return path
+
+
+def check_output_dir(path: str | Path, option: str) -> Path:
+    """A folder a command will write into: an existing writable folder, or a missing one, created here (with its
+    missing parents)."""
+    path = Path(path)
+    key = (f"--{option}",)
+    if path.exists() and not path.is_dir():
+        raise ConfigError("not a folder", file=path, key=key, expected="a folder to write into (created if missing)")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError(f"cannot create the folder ({exc.strerror or exc})", file=path, key=key,
+                          expected="a folder to write into (created if missing)") from None
+    _probe(path, path, option, "a folder this user can write into")
+    return path
+
+
+def check_outputs(args: argparse.Namespace) -> None:
+    """Every output path a command was given (:data:`OUTPUT_FILES`, :data:`OUTPUT_DIRS`), checked before it runs."""
+    for option in OUTPUT_FILES:
+        value = getattr(args, option, None)
+        if isinstance(value, str):
+            check_output_file(value, option)
+    for option in OUTPUT_DIRS:
+        value = getattr(args, option, None)
+        if isinstance(value, str):
+            check_output_dir(value, option)
+
+
 def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     parser = _Parser(prog="likeme", description="Characters that understand others by simulating them with their own bodies.")
     parser.add_argument("--version", action="version", version=f"likeme {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
 
     p = sub.add_parser("demo", help="run the built-in scenario and report what each character did and saw")
-    p.add_argument("--seed", type=int, default=None, help="seed for random choices (default: the scenario's)")
+    p.add_argument("--seed", type=seed_type, default=None, help="seed for random choices (default: the scenario's)")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.add_argument("--keep-going", action="store_true", help="go on without a plugin that fails (default: stop)")
     p.add_argument("--scenario", action="append", metavar="NAME",
@@ -54,8 +164,9 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
 
     p = sub.add_parser("run", help="run a scenario file")
     p.add_argument("scenario", help="scenario TOML file, or the name of a built-in scenario")
-    p.add_argument("--seed", type=int, default=None, help="seed for random choices (default: the scenario's)")
-    p.add_argument("--duration", type=float, default=None, help="seconds to run (default: the scenario's)")
+    p.add_argument("--seed", type=seed_type, default=None, help="seed for random choices (default: the scenario's)")
+    p.add_argument("--duration", type=number_type(0.0, 3600.0, "seconds"), default=None,
+                   help="seconds to run, at most 3600 (default: the scenario's)")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.add_argument("--keep-going", action="store_true", help="go on without a plugin that fails (default: stop)")
     p.add_argument("--load", metavar="STATE", help="restore what the characters learned from a state file first")
@@ -126,6 +237,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if not getattr(args, "handler", None):
             parser.print_help()
             return 1
+        check_outputs(args)
         return int(args.handler(args, pm) or 0)
     except LikemeError as err:
         print(f"likeme: error: {err}", file=sys.stderr)
@@ -161,7 +273,9 @@ def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dic
 
     scenario = load_scenario(path, pm, seed=args.seed, on_plugin_error="skip" if args.keep_going else "stop")
     if getattr(args, "duration", None) is not None:
-        scenario.duration = args.duration
+        from toolkit.scenario import check_duration
+
+        scenario.duration = check_duration(args.duration, scenario.world.fps, ("--duration",))
     if getattr(args, "load", None):
         from toolkit.state import load_state
 

@@ -11,7 +11,9 @@ from importlib import import_module
 from pathlib import Path
 from typing import Any
 
+from plugins.action.script import MAX_RANDOM
 from toolkit import hookimpl
+from toolkit.cli import count_type, number_type, seed_type
 
 MATCHERS = ("path-search", "forward-model", "dtw")
 """The matchers ``likeme bench recognition`` and ``stream`` compare when none is named."""
@@ -77,13 +79,13 @@ def _motion_capture_commands(sub: Any) -> None:
 
     p = sub.add_parser("make-data", help="write repertoire, demos, streams and a profile from the built-in characters")
     p.add_argument("dest", metavar="DIR")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=seed_type, default=0)
     p.set_defaults(handler=_handler("data", "cmd_make_data"))
 
     p = sub.add_parser("bandai", help="build benchmark folders from the Bandai-Namco clips (links; nothing copied)")
     p.add_argument("src", metavar="BANDAI_DIR")
     p.add_argument("dest", metavar="DIR")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=seed_type, default=0)
     p.add_argument("--profile", default=str(Path(__file__).resolve().parents[2] / "characters" / "profiles"
                                             / "bandai-namco.toml"), help="the body profile to put beside the data")
     p.set_defaults(handler=_handler("data", "cmd_bandai"))
@@ -98,10 +100,13 @@ def likeme_register_commands(subparsers):
     p = sub.add_parser("watch", help="an observer watches a demonstrator's random movements (B&B §5)")
     p.add_argument("--observer", default="max", help="observer character (default: max)")
     p.add_argument("--demonstrator", default="morris", help="demonstrator character (default: morris)")
-    p.add_argument("--movements", type=int, default=200, help="number of random movements (default: 200)")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--noise", type=float, default=0.005, help="vision noise, metres (default: 0.005)")
-    p.add_argument("--dropout", type=float, default=0.05, help="per-part dropout probability (default: 0.05)")
+    p.add_argument("--movements", type=count_type(1, MAX_RANDOM), default=200,
+                   help=f"number of random movements, at most {MAX_RANDOM} (default: 200)")
+    p.add_argument("--seed", type=seed_type, default=0)
+    p.add_argument("--noise", type=number_type(0.0, 1.0, "metres"), default=0.005,
+                   help="vision noise, metres (default: 0.005)")
+    p.add_argument("--dropout", type=number_type(0.0, 1.0, "a probability"), default=0.05,
+                   help="per-part dropout probability (default: 0.05)")
     p.add_argument("--no-occlusion", action="store_true", help="switch occlusion off")
     p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
                    help="override an observer parameter, e.g. --set segmenter.floor=0 (repeatable)")
@@ -117,14 +122,14 @@ def likeme_register_commands(subparsers):
                    "demonstrations (default: 0.3; 0: arms only)")
     p.add_argument("--angle-noise", type=float, default=0.005, help="observation noise on finger joint angles, radians "
                    "(default: 0.005)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=seed_type, default=0)
     p.add_argument("--json", metavar="FILE", help="also write the results as JSON")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(handler=_handler("facilitation", "cmd_facilitation"))
 
     p = sub.add_parser("behaviour", help="an observer identifies the behaviour, motivation and object of a demonstrator (B&B §6)")
     p.add_argument("--episodes", type=int, default=100, help="random episodes per condition (default: 100)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=seed_type, default=0)
     p.add_argument("--json", metavar="FILE", help="also write the results (every episode) as JSON")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(handler=_handler("behaviour", "cmd_behaviour"))
