@@ -16,7 +16,7 @@ from typing import Any
 
 from toolkit.errors import ConfigError
 
-__all__ = ["Parameter", "REQUIRED", "validate_params"]
+__all__ = ["Parameter", "REQUIRED", "validate_params", "parse_settings", "check_settings"]
 
 
 class _Required:
@@ -230,3 +230,54 @@ def parse_settings(items: list[str], *, tables: bool = True) -> dict[str, Any]:
             parsed = value  # a bare word is a string
         (out.setdefault(table, {}) if tables else out)[name] = parsed
     return out
+
+
+def check_settings(settings: Mapping[str, Mapping[str, Any]], pm: Any, plugins: Mapping[str, Sequence[str]], *,
+                   option: str = "--set") -> None:
+    """Check command-line settings (``TABLE.KEY=VALUE`` as parsed by :func:`parse_settings`) before any work.
+
+    Every table must be a component table; every key a parameter, and every value valid, for each plugin the
+    table's settings will reach: ``plugins[TABLE]`` (a benchmark that compares several matchers checks
+    ``matcher.KEY`` against each of them), or the plugin the settings themselves name with ``TABLE.plugin=NAME``.
+
+    Raises
+    ------
+    ConfigError
+        Keyed ``OPTION.TABLE.KEY``, listing the component tables, or the plugin's parameters.
+    """
+    from toolkit.character import COMPONENT_TABLES
+    from toolkit.components import KINDS
+
+    for table, values in settings.items():
+        if table not in COMPONENT_TABLES:
+            raise ConfigError(f"unknown table {table!r}", key=(option, table), expected=f"{option} TABLE.KEY=VALUE "
+                              "with TABLE a component table", available=list(COMPONENT_TABLES))
+        named = values.get("plugin")
+        names = [named] if named is not None else list(plugins.get(table, ()))
+        if not names:
+            raise ConfigError(f"no [{table}] component to set", key=(option, table),
+                              expected=f"a table the observer has, or {table}.plugin=NAME with it",
+                              available=[t for t in COMPONENT_TABLES if plugins.get(t)])
+        for name in names:
+            if not isinstance(name, str):
+                raise ConfigError(f"invalid plugin name {name!r}", key=(option, table, "plugin"),
+                                  expected=f"the name of a registered {KINDS[table].kind}",
+                                  available=pm.registry.names(table))
+            try:
+                cls = pm.registry.get(table, name)
+            except ConfigError as err:
+                raise err.within(prefix=(option, table, "plugin")) from None
+            owner = f"{KINDS[table].kind} {name!r}"
+            known = {p.name: p for p in cls.parameters}
+            for key, value in values.items():
+                if key == "plugin":
+                    continue
+                if key not in known:
+                    raise ConfigError(f"unknown parameter {key!r} for {owner}", key=(option, table, key),
+                                      expected=f"a parameter of {owner}", available=sorted(known))
+                try:
+                    known[key].coerce(value)
+                except ConfigError as err:
+                    rest = (key, *err.key[1:]) if err.key[:1] == ("",) else err.key
+                    raise ConfigError(f"{err.problem} for {owner}", key=(option, table, *rest),
+                                      expected=err.expected, available=err.available) from None
