@@ -366,7 +366,9 @@ def plugins_table(pm: PluginManager, *, params: bool = False) -> dict[str, Any]:
             }
         )
     skipped = [{"name": i.name, "distribution": i.distribution} for i in pm.skipped]
-    return {"components": components, "plugins": plugins, "skipped": skipped}
+    failed = [{"name": i.name, "module": i.module, "distribution": i.distribution, "version": i.version,
+               "error": str(e)} for i, e in pm.failed]
+    return {"components": components, "plugins": plugins, "skipped": skipped, "failed": failed}
 
 
 def components_markdown(pm: PluginManager) -> str:
@@ -417,6 +419,9 @@ def cmd_plugins(args: argparse.Namespace, pm: PluginManager) -> int:
         print(f"  {p['name']} ({p['module']}, {dist}): {', '.join(p['hooks'])}")
     for s in table["skipped"]:
         print(f"  {s['name']} ({s['distribution']}): skipped, LIKEME_DISABLE_PLUGIN_AUTOLOAD is set")
+    for f in table["failed"]:
+        print(f"  {f['name']} ({f['module']}, {f['distribution']} {f['version']}): failed to load, left out: "
+              f"{f['error']}")
     return 0
 
 
