@@ -271,6 +271,9 @@ def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dic
     from toolkit.report import summarise
     from toolkit.scenario import load_scenario
 
+    if getattr(args, "set", None) and not getattr(args, "render", None):  # the view's settings: nothing to apply them to
+        raise ConfigError("--set without --render", key=("--set",),
+                          expected="--render DIR with the settings of the view that draws the run")
     scenario = load_scenario(path, pm, seed=args.seed, on_plugin_error="skip" if args.keep_going else "stop")
     if getattr(args, "duration", None) is not None:
         from toolkit.scenario import check_duration
@@ -429,6 +432,10 @@ def cmd_show(args: argparse.Namespace, pm: PluginManager) -> int:
     from toolkit.character import load_character
     from toolkit.report import describe_character
 
+    for option, value in (("--set", args.set), ("--out", args.out)):
+        if value and not args.view:  # a view's settings and picture: nothing to apply them to
+            raise ConfigError(f"{option} without --view", key=(option,),
+                              expected="--view NAME with the view's settings and where it writes its picture")
     if args.after:
         from toolkit.scenario import load_scenario
 
