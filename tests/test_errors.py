@@ -182,6 +182,8 @@ CASES = [
     ("bench-dropout", "bench watch --dropout 2", {}, ["bench", "watch", "--dropout", "2"], ["argument --dropout: invalid value '2'", "expected a probability in [0, 1]"]),
     ("set-table-typo", "--set with a misspelt table", {}, ["bench", "watch", "--movements", "1", "--set", "matchr.k=3"], ["key --set.matchr", "unknown table 'matchr'", "available: motor, perception, correspondence, segmenter, matcher, action"]),
     ("set-key-unknown", "--set with a key of no named matcher", {"p.toml": PROFILE}, ["bench", "recognition", "--body", "p.toml", "--repertoire", ".", "--matcher", "path-search", "--matcher", "dtw", "--set", "matcher.spread=2"], ["key --set.matcher.spread", "unknown parameter 'spread' for matcher 'dtw'", "available: max_distance, stride, window"]),
+    ("scenario-radius", "an object of negative radius", {"s.toml": SCENE + '[[objects]]\nname = "c"\nkind = "food"\nradius = -1\n'}, ["validate", "s.toml"], ["key objects[0].radius", "invalid value -1", "expected a positive number of metres"]),
+    ("bench-lengths-nan", "bench --lengths-for-height nan", {"p.toml": PROFILE}, ["bench", "recognition", "--body", "p.toml", "--repertoire", ".", "--lengths-for-height", "nan"], ["argument --lengths-for-height: invalid value 'nan'", "expected metres in [0, 1000]"]),
     ("set-value-nan", "--set with a NaN value", {}, ["bench", "watch", "--movements", "1", "--set", "perception.noise=nan"], ["key --set.perception.noise", "value nan is not a finite number for perception 'synthetic-vision'"]),
 ]
 

@@ -279,7 +279,8 @@ def _load_chain(path: Path, pm: PluginManager | None, stack: tuple[Path, ...] = 
     """The merged table of ``path`` and everything it extends, and the files involved (outermost first)."""
     path = path.resolve()
     if len(stack) >= MAX_EXTENDS:
-        raise ConfigError(f"extends chain longer than {MAX_EXTENDS} files", file=stack[-1], key=("character", "extends"),
+        raise ConfigError(f"extends chain longer than {MAX_EXTENDS} files", file=stack[-1],
+                          key=("character", "extends"),
                           expected=f"at most {MAX_EXTENDS} files, each extending the next")
     if path in stack:
         cycle = " -> ".join(p.name for p in (*stack, path))

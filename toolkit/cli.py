@@ -271,7 +271,7 @@ def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dic
     from toolkit.report import summarise
     from toolkit.scenario import load_scenario
 
-    if getattr(args, "set", None) and not getattr(args, "render", None):  # the view's settings: nothing to apply them to
+    if getattr(args, "set", None) and not getattr(args, "render", None):  # a view's settings, and no view
         raise ConfigError("--set without --render", key=("--set",),
                           expected="--render DIR with the settings of the view that draws the run")
     scenario = load_scenario(path, pm, seed=args.seed, on_plugin_error="skip" if args.keep_going else "stop")

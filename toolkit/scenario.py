@@ -119,6 +119,13 @@ def _number(value: Any, key: tuple, expected: str = "a number") -> float:
     return float(value)
 
 
+def _radius(value: Any, key: tuple) -> float:
+    radius = _number(value, key, "a positive number of metres")
+    if radius <= 0:
+        raise ConfigError(f"invalid value {value!r}", key=key, expected="a positive number of metres")
+    return radius
+
+
 def _vector(value: Any, key: tuple) -> list[float]:
     if not isinstance(value, list) or len(value) != 3:
         raise ConfigError(f"invalid value {value!r}", key=key, expected="[x, y, z] in metres")
@@ -230,7 +237,7 @@ def _build(table: Mapping[str, Any], path: Path, pm: PluginManager, seed: int | 
             name=spec["name"],
             kind=spec["kind"],
             position=_vector(spec.get("position", [0.0, 0.0, 0.0]), (*key, "position")),
-            radius=_number(spec.get("radius", 0.05), (*key, "radius")),
+            radius=_radius(spec.get("radius", 0.05), (*key, "radius")),
             colour=colour,
             held_by=held_by,
             properties=dict(properties),

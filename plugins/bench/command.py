@@ -79,7 +79,8 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--body", required=True, metavar="PROFILE", help="body profile TOML of the files")
     p.add_argument("--correspondence", metavar="NAME", default="", help="correspondence (default: the observer "
                    "template's; none: the papers' plain observer)")
-    p.add_argument("--lengths-for-height", type=float, default=None, metavar="M", dest="lengths_for_height",
+    p.add_argument("--lengths-for-height", type=number_type(0.0, 1000.0, "metres"), default=None, metavar="M",
+                   dest="lengths_for_height",
                    help="the height (m) the length parameters were written for, scaled to the observer's own height "
                    "(default: the observer template's; 0: metres as written, the papers)")
     p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
