@@ -215,6 +215,8 @@ def parse_settings(items: list[str], *, tables: bool = True) -> dict[str, Any]:
     """
     import tomllib
 
+    from toolkit.character import MAX_DEPTH, _too_deep
+
     out: dict[str, Any] = {}
     for item in items:
         key, sep, value = item.partition("=")
@@ -228,6 +230,11 @@ def parse_settings(items: list[str], *, tables: bool = True) -> dict[str, Any]:
             parsed = tomllib.loads(f"v = {value}")["v"]
         except tomllib.TOMLDecodeError:
             parsed = value  # a bare word is a string
+        except RecursionError:
+            parsed = None
+        if parsed is None or _too_deep({"v": parsed}):
+            raise ConfigError(f"value of {key.strip()!r} nested more than {MAX_DEPTH} levels deep", key=("--set",),
+                              expected=f"arrays and tables nested at most {MAX_DEPTH} levels deep")
         (out.setdefault(table, {}) if tables else out)[name] = parsed
     return out
 
