@@ -169,21 +169,21 @@ def test_output_file_checks(tmp_path):
     from toolkit import ConfigError
     from toolkit.cli import check_output_file
 
-    assert check_output_file(tmp_path / "new.json", "json") == tmp_path / "new.json"
+    assert check_output_file(tmp_path / "new.json", "--json") == tmp_path / "new.json"
     assert not (tmp_path / "new.json").exists() and list(tmp_path.iterdir()) == []  # the probe leaves nothing
     with pytest.raises(ConfigError, match="key --json: is a folder"):
-        check_output_file(tmp_path, "json")
+        check_output_file(tmp_path, "--json")
     with pytest.raises(ConfigError, match="key --csv: no such folder"):
-        check_output_file(tmp_path / "missing" / "x.csv", "csv")
+        check_output_file(tmp_path / "missing" / "x.csv", "--csv")
     with pytest.raises(ConfigError, match="key --out: not a regular file"):
-        check_output_file("/dev/null", "out")
+        check_output_file("/dev/null", "--out")
 
 
 def test_render_folder_is_created_before_the_run(tmp_path):
     from toolkit.cli import check_output_dir
 
     folder = tmp_path / "a" / "b"
-    assert check_output_dir(folder, "render") == folder and folder.is_dir() and list(folder.iterdir()) == []
+    assert check_output_dir(folder, "--render") == folder and folder.is_dir() and list(folder.iterdir()) == []
 
 
 def test_view_settings_without_a_view_are_refused():

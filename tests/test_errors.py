@@ -179,6 +179,7 @@ CASES = [
     ("cli-json-folder", "--json into a folder that does not exist", {}, ["bench", "watch", "--movements", "1", "--json", "/nonexistent/x.json"], ["/nonexistent: key --json", "no such folder", "expected a file in an existing folder"]),
     ("cli-render-file", "--render to a file, not a folder", {"f.txt": "x\n"}, ["run", "demo", "--render", "f.txt"], ["f.txt: key --render", "not a folder"]),
     ("cli-render-unwritable", "--render below a file", {"f.txt": "x\n"}, ["run", "demo", "--render", "f.txt/frames"], ["f.txt/frames: key --render", "cannot create the folder"]),
+    ("bench-data-file", "bench make-data into a file", {"f.txt": "x\n"}, ["bench", "make-data", "f.txt"], ["f.txt: key DIR", "not a folder"]),
     ("bench-dropout", "bench watch --dropout 2", {}, ["bench", "watch", "--dropout", "2"], ["argument --dropout: invalid value '2'", "expected a probability in [0, 1]"]),
     ("set-table-typo", "--set with a misspelt table", {}, ["bench", "watch", "--movements", "1", "--set", "matchr.k=3"], ["key --set.matchr", "unknown table 'matchr'", "available: motor, perception, correspondence, segmenter, matcher, action"]),
     ("set-key-unknown", "--set with a key of no named matcher", {"p.toml": PROFILE}, ["bench", "recognition", "--body", "p.toml", "--repertoire", ".", "--matcher", "path-search", "--matcher", "dtw", "--set", "matcher.spread=2"], ["key --set.matcher.spread", "unknown parameter 'spread' for matcher 'dtw'", "available: max_distance, stride, window"]),

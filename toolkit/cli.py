@@ -88,10 +88,11 @@ def count_type(low: int, high: int) -> Any:
     return parse
 
 
-OUTPUT_FILES = ("json", "csv", "plot", "out")
-"""Options naming a file a command writes (a string value; ``likeme run --json`` is a flag and is left alone)."""
-OUTPUT_DIRS = ("render",)
-"""Options naming a folder a command writes into (created if missing)."""
+OUTPUT_FILES = {"json": "--json", "csv": "--csv", "plot": "--plot", "out": "--out"}
+"""Arguments naming a file a command writes, and how they are named in messages (a string value only: ``likeme run
+--json`` is a flag and is left alone)."""
+OUTPUT_DIRS = {"render": "--render", "dest": "DIR"}
+"""Arguments naming a folder a command writes into (created if missing): ``run --render``, ``bench make-data DIR``."""
 
 
 def _probe(folder: Path, path: Path, option: str, expected: str) -> None:
@@ -102,15 +103,16 @@ def _probe(folder: Path, path: Path, option: str, expected: str) -> None:
         with tempfile.NamedTemporaryFile(dir=folder, prefix=".likeme-probe-"):
             pass
     except OSError as exc:
-        raise ConfigError(f"cannot write there ({exc.strerror or exc})", file=path, key=(f"--{option}",),
+        raise ConfigError(f"cannot write there ({exc.strerror or exc})", file=path, key=(option,),
                           expected=expected) from None
 
 
 def check_output_file(path: str | Path, option: str) -> Path:
-    """A file a command will write: its folder must exist and be writable, and it must not be a folder itself."""
+    """A file a command will write (``option`` names it in messages, ``--json``): its folder must exist and be
+    writable, and it must not be a folder, a device or a FIFO."""
     path = Path(path)
     folder = path.parent
-    key = (f"--{option}",)
+    key = (option,)
     if path.is_dir():
         raise ConfigError("is a folder", file=path, key=key, expected="the path of a file to write")
     if path.exists() and not path.is_file():
@@ -122,10 +124,10 @@ def check_output_file(path: str | Path, option: str) -> Path:
 
 
 def check_output_dir(path: str | Path, option: str) -> Path:
-    """A folder a command will write into: an existing writable folder, or a missing one, created here (with its
-    missing parents)."""
+    """A folder a command will write into (``option`` names it in messages, ``--render``): an existing writable
+    folder, or a missing one, created here (with its missing parents)."""
     path = Path(path)
-    key = (f"--{option}",)
+    key = (option,)
     if path.exists() and not path.is_dir():
         raise ConfigError("not a folder", file=path, key=key, expected="a folder to write into (created if missing)")
     try:
@@ -139,12 +141,12 @@ def check_output_dir(path: str | Path, option: str) -> Path:
 
 def check_outputs(args: argparse.Namespace) -> None:
     """Every output path a command was given (:data:`OUTPUT_FILES`, :data:`OUTPUT_DIRS`), checked before it runs."""
-    for option in OUTPUT_FILES:
-        value = getattr(args, option, None)
+    for name, option in OUTPUT_FILES.items():
+        value = getattr(args, name, None)
         if isinstance(value, str):
             check_output_file(value, option)
-    for option in OUTPUT_DIRS:
-        value = getattr(args, option, None)
+    for name, option in OUTPUT_DIRS.items():
+        value = getattr(args, name, None)
         if isinstance(value, str):
             check_output_dir(value, option)
 
