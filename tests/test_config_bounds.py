@@ -205,3 +205,18 @@ def test_a_movement_folder_named_like_an_example_is_refused(tmp_path):
     (tmp_path / "bow#2" / "take.bvh").unlink()
     (tmp_path / "bow#2").rmdir()
     assert list(clip_files(tmp_path)) == ["bow"]
+
+
+def test_the_scenario_view_checks_object_colours_before_the_run(pm):
+    """An object made in Python with a colour the renderer cannot draw fails when recording starts, not after."""
+    from toolkit import load_scenario
+
+    scenario = load_scenario("cheese_or_ball", pm)
+    cheese = scenario.world.objects["cheese"]
+    view = pm.registry.get("view", "scenario")()
+    cheese.colour = "purplish"
+    with pytest.raises(ConfigError, match="key objects.cheese.colour: unknown colour 'purplish' of object 'cheese'"):
+        view.start(scenario.world)
+    assert scenario.world.frame == 0
+    cheese.colour = "red"  # a name the renderer knows
+    view.stop(view.start(scenario.world))
