@@ -265,3 +265,26 @@ def test_a_perception_that_raises_is_named(data, profile, pm_, monkeypatch):
     with pytest.raises(PluginError, match=r"plugin 'motion-capture' failed in MotionCapture.perceive_poses: "
                                           r"KeyError: 'left_hand'"):
         observer.push(np.zeros((len(profile.body.parts), 3)))
+
+
+@pytest.mark.parametrize("args, expected", [
+    (["segmentation", "--segmenter", "raising-segmenter"], "likeme: error: plugin 'raising-segmenter' failed in "
+                                                           "RaisingSegmenter.push_block: RuntimeError: the segmenter "
+                                                           "broke"),
+    (["stream", "--segmenter", "overlapping-segments", "--matcher", "dtw", "--repertoire", "REPERTOIRE"],
+     "likeme: error: plugin 'overlapping-segments' failed in OverlappingSegments.flush: returned a segment 10..30"),
+    (["recognition", "--matcher", "stranger", "--repertoire", "REPERTOIRE", "--demos", "DEMOS"],
+     "likeme: error: plugin 'stranger' failed in Stranger.conclude: returned movement 'teleport'"),
+])
+def test_bench_reports_a_misbehaving_plugin_as_one_line(data, misbehaving, capsys, args, expected):
+    from toolkit.cli import main
+
+    args = [str(data / "repertoire") if a == "REPERTOIRE" else str(data / "demos") if a == "DEMOS" else a
+            for a in args]
+    streams = [] if args[0] == "recognition" else ["--streams", str(data / "streams")]
+    code = main(["bench", *args, "--body", str(data / "profile.toml"), *streams, "--quiet"])
+    out = capsys.readouterr()
+    assert code == 1
+    lines = out.err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(expected), out.err
+    assert "Traceback" not in out.err + out.out
