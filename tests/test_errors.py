@@ -152,6 +152,11 @@ CASES = [
     ("view-unknown", "unknown view", {}, ["show", "max", "--view", "graph"], ["unknown view 'graph'", "available:", "hub-signal"]),
     ("view-segmenter", "a signal view of a segmenter the character does not have", {}, ["show", "max", "--view", "speed-profile"], ["key --view", "Max has no velocity-direction segmenter (its segmenter is 'hub-threshold')", "expected a character whose [segmenter] plugin is velocity-direction"]),
     ("view-movement", "a view asked to perform an unknown movement", {}, ["show", "max", "--view", "hub-signal", "--set", 'movements=["fly"]'], ["key movements", "unknown movement 'fly'", "available:", "wave"]),
+    # -- watching: bounded working memory and the memory benchmark
+    ("bench-memory-minutes", "memory benchmark for nan minutes", {}, ["bench", "memory", "--minutes", "nan"], ["key --minutes", "value nan", "expected a finite number > 0"]),
+    ("bench-memory-block", "memory benchmark with packets of 0 frames", {}, ["bench", "memory", "--block", "0"], ["key --block", "value 0", "expected a whole number >= 1"]),
+    ("observe-ruptures-window", "ruptures with a negative window", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "ruptures", "--set", "segmenter.window=-1", "m.bvh"], ["key segmenter.window", "value -1.0 out of range", "expected a number in [0, inf]"]),
+    ("observe-max-movement", "velocity-direction with a negative max_movement", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "velocity-direction", "--set", "segmenter.max_movement=-5", "m.bvh"], ["key segmenter.max_movement", "value -5.0 out of range"]),
 ]
 
 

@@ -191,12 +191,12 @@ def cmd_memory(args: Any, pm: Any) -> int:
     for name in ("minutes", "fps", "every", "limit"):
         value = getattr(args, name)
         if not np.isfinite(value) or value <= 0:
-            raise ConfigError(f"--{name} {value}", expected="a finite number > 0")
+            raise ConfigError(f"value {value}", key=(f"--{name}",), expected="a finite number > 0")
     if args.block < 1:
-        raise ConfigError(f"--block {args.block}", expected="a whole number >= 1")
+        raise ConfigError(f"value {args.block}", key=("--block",), expected="a whole number >= 1")
     for value in args.observe_minutes or ():
         if not np.isfinite(value) or value <= 0:
-            raise ConfigError(f"--observe-minutes {value}", expected="a finite number > 0")
+            raise ConfigError(f"value {value}", key=("--observe-minutes",), expected="a finite number > 0")
     with tempfile.TemporaryDirectory(prefix="likeme-memory-") as tmp:
         data = _data(pm, Path(tmp) / "data")
         if not args.no_live:
