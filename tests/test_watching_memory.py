@@ -288,3 +288,33 @@ def test_bench_reports_a_misbehaving_plugin_as_one_line(data, misbehaving, capsy
     lines = out.err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith(expected), out.err
     assert "Traceback" not in out.err + out.out
+
+
+# -- the memory benchmark --------------------------------------------------------------------------------------
+
+
+def test_the_memory_benchmark_prints_flat_rows_held_and_observes_a_written_stream(capsys):
+    """``likeme bench memory``: a line per simulated interval whose rows held stop growing once the stream is longer
+    than what working memory keeps, and a ``likeme observe`` subprocess on a written stream that exits cleanly."""
+    from toolkit.cli import main
+
+    assert main(["bench", "memory", "--minutes", "2", "--every", "0.5", "--fps", "30", "--block", "45",
+                 "--observe-minutes", "0.2"]) == 0
+    out = capsys.readouterr().out
+    lines = out.splitlines()
+    table = [line.split() for line in lines[2:6]]
+    assert [float(r[0]) for r in table] == [0.5, 1.0, 1.5, 2.0]
+    assert [int(r[1]) for r in table] == [900, 1800, 2700, 3600]
+    held = [int(r[3]) for r in table]
+    assert held[-1] < 3600 // 2 and max(held) <= ObservationLog.slack + 10 * 30  # what is let go unused, and keep
+    observed = next(line for line in lines if line.strip().startswith("0.2 "))
+    assert observed.split()[4] == "0"  # the subprocess's exit status
+
+
+def test_a_written_stream_is_read_back_at_its_length_and_rate(tmp_path, pm_, data, profile):
+    from plugins.bench.memory import write_stream
+
+    path = write_stream(pm_, tmp_path / "s.bvh", minutes=0.25, fps=60.0, seed=1)
+    motion = profile.read(path)
+    assert motion.n_frames == 900 and motion.fps == pytest.approx(60.0)
+    assert np.isfinite(motion.positions).all()

@@ -143,6 +143,11 @@ def likeme_register_commands(subparsers):
     p.add_argument("--limit", type=float, default=4.0, help="address space cap of the observe subprocess, GB "
                    "(default: 4)")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--segmenter", metavar="NAME", help="the live observer's segmenter (default: the observer "
+                   "template's)")
+    p.add_argument("--matcher", metavar="NAME", help="the live observer's matcher (default: the template's)")
+    p.add_argument("--correspondence", metavar="NAME", default="", help="the live observer's correspondence "
+                   "(default: the template's; none: none)")
     p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
                    help="override an observer parameter (repeatable)")
     p.set_defaults(handler=_handler("memory", "cmd_memory"))

@@ -83,14 +83,18 @@ def _data(pm: Any, folder: Path) -> Path:
 
 
 def live_memory(pm: Any, data: Path, *, minutes: float, fps: float, every: float, block: int, seed: int = 0,
-                trace: bool = False, settings: dict[str, Any] | None = None, out: Any = sys.stdout) -> list[dict]:
+                trace: bool = False, settings: dict[str, Any] | None = None, segmenter: str | None = None,
+                matcher: str | None = None, correspondence: str = "", out: Any = None) -> list[dict]:
     """Feed a live observer ``minutes`` of stream at ``fps`` and print a line every ``every`` minutes (see the
-    module); returns the lines as dicts."""
+    module; ``segmenter``, ``matcher``, ``correspondence``: plugins replacing the observer template's); returns the
+    lines as dicts."""
     from toolkit.observe import Observer, compose_observer
     from toolkit.profile import load_profile
 
+    out = sys.stdout if out is None else out
     profile = load_profile(data / "profile.toml")
-    character = compose_observer(pm, profile, data / "repertoire", settings=settings)
+    character = compose_observer(pm, profile, data / "repertoire", settings=settings, segmenter=segmenter,
+                                 matcher=matcher or "", correspondence=correspondence)
     observer = Observer(character, profile.body, fps)
     total, step = int(round(minutes * 60 * fps)), max(1, int(round(every * 60 * fps)))
     rows: list[dict] = []
@@ -186,7 +190,9 @@ def observe_memory(data: Path, path: Path, *, limit: float = 4.0, extra: tuple[s
 def cmd_memory(args: Any, pm: Any) -> int:
     """``likeme bench memory``."""
     from toolkit.errors import ConfigError
+    from toolkit.observe import compose_observer
     from toolkit.params import parse_settings
+    from toolkit.profile import load_profile
 
     for name in ("minutes", "fps", "every", "limit"):
         value = getattr(args, name)
@@ -200,10 +206,14 @@ def cmd_memory(args: Any, pm: Any) -> int:
     with tempfile.TemporaryDirectory(prefix="likeme-memory-") as tmp:
         data = _data(pm, Path(tmp) / "data")
         if not args.no_live:
+            names = {k: c.name for k, c in compose_observer(pm, load_profile(data / "profile.toml"), data / "repertoire",
+                     segmenter=args.segmenter, matcher=args.matcher or "", correspondence=args.correspondence,
+                     settings=parse_settings(list(args.set))).components().items() if k != "action"}
             print(f"live observer: {args.minutes:g} simulated minutes at {args.fps:g} fps, {args.block} frames a "
-                  f"packet")
+                  f"packet; " + ", ".join(f"{k} {v}" for k, v in names.items()))
             live_memory(pm, data, minutes=args.minutes, fps=args.fps, every=args.every, block=args.block,
-                        seed=args.seed, trace=args.tracemalloc, settings=parse_settings(list(args.set)))
+                        seed=args.seed, trace=args.tracemalloc, settings=parse_settings(list(args.set)),
+                        segmenter=args.segmenter, matcher=args.matcher, correspondence=args.correspondence)
         if args.observe_minutes:
             print(f"\nlikeme observe (a subprocess; address space capped at {args.limit:g} GB)")
             print(f"{'minutes':>8} {'file MB':>8} {'peak RSS MB':>11} {'wall s':>7} {'status':>6}  measured by")
