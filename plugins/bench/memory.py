@@ -206,9 +206,10 @@ def cmd_memory(args: Any, pm: Any) -> int:
     with tempfile.TemporaryDirectory(prefix="likeme-memory-") as tmp:
         data = _data(pm, Path(tmp) / "data")
         if not args.no_live:
-            names = {k: c.name for k, c in compose_observer(pm, load_profile(data / "profile.toml"), data / "repertoire",
-                     segmenter=args.segmenter, matcher=args.matcher or "", correspondence=args.correspondence,
-                     settings=parse_settings(list(args.set))).components().items() if k != "action"}
+            character = compose_observer(pm, load_profile(data / "profile.toml"), data / "repertoire",
+                                         segmenter=args.segmenter, matcher=args.matcher or "",
+                                         correspondence=args.correspondence, settings=parse_settings(list(args.set)))
+            names = {k: c.name for k, c in character.components().items() if k != "action"}
             print(f"live observer: {args.minutes:g} simulated minutes at {args.fps:g} fps, {args.block} frames a "
                   f"packet; " + ", ".join(f"{k} {v}" for k, v in names.items()))
             live_memory(pm, data, minutes=args.minutes, fps=args.fps, every=args.every, block=args.block,
