@@ -186,6 +186,11 @@ CASES = [
     ("scenario-radius", "an object of negative radius", {"s.toml": SCENE + '[[objects]]\nname = "c"\nkind = "food"\nradius = -1\n'}, ["validate", "s.toml"], ["key objects[0].radius", "invalid value -1", "expected a positive number of metres"]),
     ("bench-lengths-nan", "bench --lengths-for-height nan", {"p.toml": PROFILE}, ["bench", "recognition", "--body", "p.toml", "--repertoire", ".", "--lengths-for-height", "nan"], ["argument --lengths-for-height: invalid value 'nan'", "expected metres in [0, 1000]"]),
     ("set-value-nan", "--set with a NaN value", {}, ["bench", "watch", "--movements", "1", "--set", "perception.noise=nan"], ["key --set.perception.noise", "value nan is not a finite number for perception 'synthetic-vision'"]),
+    # -- watching: bounded working memory and the memory benchmark
+    ("bench-memory-minutes", "memory benchmark for nan minutes", {}, ["bench", "memory", "--minutes", "nan"], ["key --minutes", "value nan", "expected a finite number > 0"]),
+    ("bench-memory-block", "memory benchmark with packets of 0 frames", {}, ["bench", "memory", "--block", "0"], ["key --block", "value 0", "expected a whole number >= 1"]),
+    ("observe-ruptures-window", "ruptures with a negative window", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "ruptures", "--set", "segmenter.window=-1", "m.bvh"], ["key segmenter.window", "value -1.0 out of range", "expected a number in [0, inf]"]),
+    ("observe-max-movement", "velocity-direction with a negative max_movement", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "velocity-direction", "--set", "segmenter.max_movement=-5", "m.bvh"], ["key segmenter.max_movement", "value -5.0 out of range"]),
 ]
 
 

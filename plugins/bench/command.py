@@ -180,6 +180,29 @@ def likeme_register_commands(subparsers):
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(handler=_handler("behaviour", "cmd_behaviour"))
 
+    p = sub.add_parser("memory", help="the observer's memory against stream length: a live observer fed for "
+                       "--minutes, and likeme observe on generated BVH streams")
+    p.add_argument("--minutes", type=float, default=60.0, help="simulated minutes fed to the live observer "
+                   "(default: 60)")
+    p.add_argument("--every", type=float, default=10.0, help="print a line every this many minutes (default: 10)")
+    p.add_argument("--fps", type=float, default=120.0, help="frames per second of the streams (default: 120)")
+    p.add_argument("--block", type=int, default=120, help="frames a packet for the live observer (default: 120)")
+    p.add_argument("--tracemalloc", action="store_true", help="also trace Python allocations (slower)")
+    p.add_argument("--no-live", action="store_true", help="skip the live observer")
+    p.add_argument("--observe-minutes", type=float, action="append", metavar="MIN", help="also run likeme "
+                   "observe on a generated stream this long (repeatable; e.g. 1 and 60)")
+    p.add_argument("--limit", type=float, default=4.0, help="address space cap of the observe subprocess, GB "
+                   "(default: 4)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--segmenter", metavar="NAME", help="the live observer's segmenter (default: the observer "
+                   "template's)")
+    p.add_argument("--matcher", metavar="NAME", help="the live observer's matcher (default: the template's)")
+    p.add_argument("--correspondence", metavar="NAME", default="", help="the live observer's correspondence "
+                   "(default: the template's; none: none)")
+    p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
+                   help="override an observer parameter (repeatable)")
+    p.set_defaults(handler=_handler("memory", "cmd_memory"))
+
     p = sub.add_parser("vision", help="rendered-vision against synthetic-vision on the same frames: agreement, "
                        "position difference, milliseconds per frame")
     p.add_argument("--scenario", default="jump_then_cover_face", help="scenario to watch (default: jump_then_cover_face)")

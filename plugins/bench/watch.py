@@ -26,6 +26,7 @@ from toolkit import World, load_character
 from toolkit.character import merge_tables
 from toolkit.params import parse_settings
 from toolkit.state import write_atomic
+from toolkit.watching import call_component, check_match
 
 __all__ = ["watch_benchmark", "render_watch", "cmd_watch"]
 
@@ -96,7 +97,7 @@ def watch_benchmark(
     correct = 0
     confusions: dict[str, int] = {}
     for (s, e), label in zip(truth, labels):
-        match = obs.matcher.match(watcher.memory.motion(s, e))
+        match = check_match(obs, call_component(obs, "matcher", "match", watcher.memory.motion(s, e)), "match")
         got = match.movement or "unknown"
         correct += got == label
         if got != label:
