@@ -179,12 +179,17 @@ MAX_DEPTH = 256
 """The deepest nesting of joints read (real skeletons are under 30 deep, fingers included)."""
 MAX_CHANNELS = len(CHANNEL_NAMES)
 """The most channels one joint can have (each channel name once)."""
-_CHUNK = 1 << 20  # characters of text taken at a time
+_CHUNK = 1 << 18  # characters of text taken at a time
 _HISTORY = 64  # header tokens kept for messages about a token already taken
 
 _TOKEN = re.compile(r"\S+")
 # the line boundaries of str.splitlines, so that line numbers are the same as reading the file line by line
 _BREAK = re.compile("\r\n|[\n\r\v\f\x1c\x1d\x1e\x85\u2028\u2029]")
+
+
+def _shown(token: str | None) -> str:
+    """A token as a message shows it: quoted, cut to 40 characters."""
+    return repr(token) if token is None or len(token) <= 40 else repr(token[:40]) + "..."
 
 
 def _text_chunks(text: str) -> Iterator[str]:
@@ -293,6 +298,7 @@ class _Tokens:
             del self.items[k]
 
     def error(self, problem: str, expected: str | None = None, at: int | None = None) -> ConfigError:
+        """The error at token ``at`` (default: the next one), or on the line after the last token at the end."""
         i = self.pos if at is None else at
         self._fill(i)
         if i < self.count:
@@ -317,7 +323,7 @@ class _Tokens:
         token = self.take(repr(word))
         if token != word:
             self.pos -= 1
-            raise self.error(f"found {token!r}", repr(word))
+            raise self.error(f"found {_shown(token)}", repr(word))
 
     def number(self, what: str) -> float:
         token = self.take(what)
@@ -325,10 +331,10 @@ class _Tokens:
             value = float(token)
         except ValueError:
             self.pos -= 1
-            raise self.error(f"found {token!r}", what) from None
+            raise self.error(f"found {_shown(token)}", what) from None
         if not np.isfinite(value):
             self.pos -= 1
-            raise self.error(f"found {token!r}", f"a finite {what}")
+            raise self.error(f"found {_shown(token)}", f"a finite {what}")
         return value
 
     def integer(self, what: str, most: int) -> int:
@@ -336,7 +342,7 @@ class _Tokens:
         token = self.take(what)
         if not (token.isascii() and token.isdigit()) or len(token) > 18 or int(token) > most:
             self.pos -= 1
-            raise self.error(f"found {token!r}", f"{what} (ASCII digits, at most {most})")
+            raise self.error(f"found {_shown(token)}", f"{what} (ASCII digits, at most {most})")
         return int(token)
 
 
@@ -381,10 +387,10 @@ def _parse_header(tokens: _Tokens) -> _Header:
                 tokens.take("}")
                 open_joints.pop()
             else:
-                raise tokens.error(f"found {token!r}" if token else "unexpected end of file",
-                                   f"'JOINT', 'End Site' or '}}' closing joint {name!r}")
+                raise tokens.error(f"found {_shown(token)}" if token else "unexpected end of file",
+                                   f"'JOINT', 'End Site' or '}}' closing joint {_shown(name)}")
     if not joints:
-        raise tokens.error(f"found {tokens.peek()!r}" if tokens.peek() else "unexpected end of file", "'ROOT'")
+        raise tokens.error(f"found {_shown(tokens.peek())}" if tokens.peek() else "unexpected end of file", "'ROOT'")
     if not any(j.channels for j in joints):
         tokens.peek()
         raise tokens.error("no channels in the hierarchy", "at least one joint with CHANNELS (a motion to read)")
@@ -410,9 +416,9 @@ def _parse_joint_head(tokens: _Tokens, joints: list[Joint], names: set[str], par
     at = tokens.pos
     name = tokens.take("a joint name")
     if name in ("{", "}", "OFFSET", "CHANNELS"):
-        raise tokens.error(f"found {name!r}", "a joint name", at=at)
+        raise tokens.error(f"found {_shown(name)}", "a joint name", at=at)
     if name in names:
-        raise tokens.error(f"duplicate joint name {name!r}", "unique joint names", at=at)
+        raise tokens.error(f"duplicate joint name {_shown(name)}", "unique joint names", at=at)
     tokens.expect("{")
     tokens.expect("OFFSET")
     offset = tuple(tokens.number("an OFFSET coordinate") for _ in range(3))
@@ -423,9 +429,9 @@ def _parse_joint_head(tokens: _Tokens, joints: list[Joint], names: set[str], par
         at = tokens.pos
         c = tokens.take("a channel name")
         if c not in CHANNEL_NAMES:
-            raise tokens.error(f"found {c!r}", "a channel name (" + ", ".join(CHANNEL_NAMES) + ")", at=at)
+            raise tokens.error(f"found {_shown(c)}", "a channel name (" + ", ".join(CHANNEL_NAMES) + ")", at=at)
         if c in channels:
-            raise tokens.error(f"channel {c!r} listed twice for joint {name!r}", "each channel once", at=at)
+            raise tokens.error(f"channel {c!r} listed twice for joint {_shown(name)}", "each channel once", at=at)
         channels.append(c)
     names.add(name)
     joints.append(Joint(name, parent, offset, tuple(channels)))
@@ -481,11 +487,11 @@ def _locate(header: _Header, lines: Iterator[tuple[int, str]], n_channels: int, 
                            expected=f"{n_frames} frame lines")
     if bad_token is not None:
         token, number, column = bad_token
-        return ConfigError(f"found {token!r}", file=source, line=number, column=column,
+        return ConfigError(f"found {_shown(token)}", file=source, line=number, column=column,
                            expected="a number (a channel value)")
     if not_finite is not None:
         token, number, column = not_finite
-        return ConfigError(f"found {token!r}", file=source, line=number, column=column,
+        return ConfigError(f"found {_shown(token)}", file=source, line=number, column=column,
                            expected="a finite channel value")
     return ConfigError("the MOTION block does not read as numbers", file=source, line=header.line,
                        expected="channel values")  # pragma: no cover - the block read as an array after all
@@ -629,7 +635,7 @@ class BVHStream:
             raise self._fail()
         values = np.empty((self.n_frames, self.n_channels))
         f = 0
-        for block in self.blocks(max(1, (1 << 17) // self.n_channels)):
+        for block in self.blocks(max(1, (1 << 15) // self.n_channels)):
             values[f : f + len(block)] = block
             f += len(block)
         return BVH(self.joints, self.header.frame_time, values, self.source)
@@ -707,13 +713,13 @@ def _reference_values(head: _Header, lines: Iterator[tuple[int, str]], n_channel
                           column=column, expected=f"{n_frames} frame lines")
     for token, line, column in rest:
         if not _is_number(token):
-            raise ConfigError(f"found {token!r}", file=source, line=line, column=column,
+            raise ConfigError(f"found {_shown(token)}", file=source, line=line, column=column,
                               expected="a number (a channel value)")
     values = np.array([t for t, _, _ in rest], dtype=float).reshape(n_frames, n_channels)
     bad = ~np.isfinite(values)
     if bad.any():
         token, line, column = rest[int(np.flatnonzero(bad.reshape(-1))[0])]
-        raise ConfigError(f"found {token!r}", file=source, line=line, column=column, expected="a finite channel value")
+        raise ConfigError(f"found {_shown(token)}", file=source, line=line, column=column, expected="a finite channel value")
     return values
 
 

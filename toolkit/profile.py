@@ -36,7 +36,8 @@ from typing import Any
 import numpy as np
 
 from toolkit.body import Body
-from toolkit.bvh import BLOCK, BVH, BVHStream, open_bvh, read_bvh
+import toolkit.bvh as bvh_module
+from toolkit.bvh import BVH, BVHStream, open_bvh, read_bvh
 from toolkit.errors import ConfigError
 from toolkit.files import check_regular_file
 from toolkit.motion import Motion
@@ -118,10 +119,10 @@ class BodyProfile:
         """Read a BVH file and return its motion through this profile."""
         return self.motion(read_bvh(path))
 
-    def stream(self, path: str | Path, block: int = BLOCK) -> MotionStream:
+    def stream(self, path: str | Path, block: int | None = None) -> MotionStream:
         """A BVH file's motion through this profile, ``block`` frames at a time (:class:`MotionStream`).
 
-        The header is read and checked against the profile at once; the frames follow as they are iterated, with
+        ``block`` defaults to :data:`toolkit.bvh.BLOCK`. The header is read and checked against the profile at once; the frames follow as they are iterated, with
         forward kinematics run per block, so the memory does not grow with the file. The blocks are
         ``profile.read(path)`` sliced, bit for bit, and a bad value raises the error ``read`` raises.
         """
@@ -131,7 +132,7 @@ class BodyProfile:
         except BaseException:
             bvh.close()
             raise
-        return MotionStream(self, bvh, block)
+        return MotionStream(self, bvh, bvh_module.BLOCK if block is None else block)
 
 
 class MotionStream:
