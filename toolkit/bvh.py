@@ -294,8 +294,9 @@ class _Tokens:
                 return
             self.line_number, self.line_text = item
             self._matches = _TOKEN.finditer(self.line_text)
-        for k in [k for k in self.items if k < self.pos - _HISTORY]:
-            del self.items[k]
+        if len(self.items) > 4 * _HISTORY:
+            for k in [k for k in self.items if k < self.pos - _HISTORY]:
+                del self.items[k]
 
     def error(self, problem: str, expected: str | None = None, at: int | None = None) -> ConfigError:
         """The error at token ``at`` (default: the next one), or on the line after the last token at the end."""

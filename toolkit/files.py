@@ -57,8 +57,8 @@ def _check_stat(st: os.stat_result, path: Path, what: str, kind: str) -> None:
     limit = max_bytes(kind)
     if st.st_size > limit:
         variable = LIMITS[kind][0]
-        raise ConfigError(f"{what} of {st.st_size / 2**20:.1f} MB is larger than the cap of {limit / 2**20:g} MB",
-                          file=path, expected=f"a smaller file, or a higher cap in the environment variable {variable}")
+        raise ConfigError(f"{what} of {st.st_size:,} bytes is larger than the cap of {limit:,} bytes", file=path,
+                          expected=f"a smaller file, or a higher cap in megabytes in the environment variable {variable}")
 
 
 def check_regular_file(path: str | Path, what: str = "file", kind: str = "config") -> Path:
