@@ -349,11 +349,14 @@ def cmd_show(args: argparse.Namespace, pm: PluginManager) -> int:
 def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
     import json
 
+    from toolkit.files import check_regular_file
     from toolkit.observe import NO_CORRESPONDENCE, Observer, compose_observer
     from toolkit.params import parse_settings
     from toolkit.profile import load_profile
 
     profile = load_profile(args.body)
+    for path in args.files:  # a FIFO, a device, a directory or a missing file fails before any work
+        check_regular_file(path, "BVH file", "motion")
     for name, kind in ((args.segmenter, "segmenter"), (args.matcher, "matcher"), (args.correspondence, "correspondence")):
         if name is not None and name != NO_CORRESPONDENCE:
             pm.registry.get(kind, name)  # an unknown name fails here, listing the registered ones
