@@ -180,6 +180,7 @@ MAX_DEPTH = 256
 MAX_CHANNELS = len(CHANNEL_NAMES)
 """The most channels one joint can have (each channel name once)."""
 _CHUNK = 1 << 18  # characters of text taken at a time
+_PIECE = 1 << 15  # values converted from text at a time
 _HISTORY = 64  # header tokens kept for messages about a token already taken
 
 _TOKEN = re.compile(r"\S+")
@@ -518,21 +519,33 @@ def _motion_blocks(chunks: Iterator[str], n_frames: int, n_channels: int, frames
                    fail: Callable[[], ConfigError]) -> Iterator[np.ndarray]:
     """The MOTION block's values as arrays of ``frames`` frames (the last one shorter); ``fail`` gives the error.
 
-    The text is split into tokens a chunk at a time and converted a block at a time; the line and column of a
-    problem are found only when there is one (``fail``, a second pass over the block).
+    The text is split into tokens a chunk at a time and converted ``_PIECE`` values at a time into the block being
+    filled; the line and column of a problem are found only when there is one (``fail``, a second pass).
     """
-    total, size = n_frames * n_channels, max(1, frames) * n_channels
+    total, frames = n_frames * n_channels, max(1, frames)
+    piece = max(1, _PIECE // n_channels)  # frames converted at a time: a list of strings this long is alive
     pending: list[str] = []
-    done, carry = 0, ""
+    done, carry, yielded = 0, "", 0  # values converted, a token cut by the chunk's end, frames given
+    block, filled = None, 0
 
-    def convert(words: list[str]) -> np.ndarray:
+    def room() -> int:
+        """Frames still to fill in the block (a new one holds ``frames`` or the frames left)."""
+        return min(frames, n_frames - yielded) if block is None else len(block) - filled
+
+    def convert(k: int) -> None:
+        nonlocal block, filled, done
+        if block is None:
+            block, filled = np.empty((min(frames, n_frames - yielded), n_channels)), 0
+        words = pending[: k * n_channels]
         try:
-            values = np.array(words, dtype=float)
+            block[filled : filled + k] = np.array(words, dtype=float).reshape(k, n_channels)
         except ValueError:
             raise fail() from None
-        if not np.isfinite(values).all():
+        if not np.isfinite(block[filled : filled + k]).all():
             raise fail()
-        return values.reshape(-1, n_channels)
+        del pending[: k * n_channels]
+        filled += k
+        done += k * n_channels
 
     for chunk in chunks:
         if not chunk:
@@ -543,16 +556,24 @@ def _motion_blocks(chunks: Iterator[str], n_frames: int, n_channels: int, frames
         if done + len(pending) + len(words) > total:
             raise fail()
         pending += words
-        while len(pending) >= size:
-            yield convert(pending[:size])
-            del pending[:size]
-            done += size
+        while len(pending) >= piece * n_channels:
+            convert(min(piece, room()))
+            if filled == len(block):
+                yield block
+                yielded += filled
+                block = None
     if carry:
         pending.append(carry)
     if done + len(pending) != total:
         raise fail()
-    if pending:
-        yield convert(pending)
+    while pending:
+        convert(min(len(pending) // n_channels, room()))
+        if filled == len(block):
+            yield block
+            yielded += filled
+            block = None
+    if block is not None and filled:  # pragma: no cover - a block is given as soon as it is full
+        yield block[:filled]
 
 
 class BVHStream:
@@ -636,7 +657,7 @@ class BVHStream:
             raise self._fail()
         values = np.empty((self.n_frames, self.n_channels))
         f = 0
-        for block in self.blocks(max(1, (1 << 15) // self.n_channels)):
+        for block in self.blocks(max(1, _PIECE // self.n_channels)):
             values[f : f + len(block)] = block
             f += len(block)
         return BVH(self.joints, self.header.frame_time, values, self.source)
