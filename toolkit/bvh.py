@@ -457,6 +457,31 @@ def _locate(header: _Header, lines: Iterator[tuple[int, str]], n_channels: int, 
     expected = n_frames * n_channels
     total, k, last_line = 0, 0, header.line
     bad_count = beyond = bad_token = not_finite = None
+    batch: list[tuple[int, str, list[str]]] = []  # lines whose values are converted together
+    held = 0
+
+    def check() -> None:
+        """Look for the first value that is not a number (and the first not finite) in the lines of ``batch``."""
+        nonlocal bad_token, not_finite
+        if bad_token is not None:
+            return
+        try:
+            values = np.array([w for _, _, words in batch for w in words], dtype=float)
+        except ValueError:
+            values = None
+        if values is not None and (not_finite is not None or np.isfinite(values).all()):
+            return
+        for number, line, words in batch:  # line by line, only in a batch with a problem
+            try:
+                values = np.array(words, dtype=float)
+            except ValueError:
+                j = next(j for j, w in enumerate(words) if not _is_number(w))
+                bad_token = (words[j], number, _column(line, j))
+                return
+            if not_finite is None and not np.isfinite(values).all():
+                j = int(np.flatnonzero(~np.isfinite(values))[0])
+                not_finite = (words[j], number, _column(line, j))
+
     for number, line in _motion_lines(header, lines):
         words = line.split()
         if not words:
@@ -470,15 +495,12 @@ def _locate(header: _Header, lines: Iterator[tuple[int, str]], n_channels: int, 
         total += count
         last_line = number
         if bad_token is None:
-            try:
-                values = np.array(words, dtype=float)
-            except ValueError:
-                j = next(j for j, w in enumerate(words) if not _is_number(w))
-                bad_token = (words[j], number, _column(line, j))
-            else:
-                if not_finite is None and not np.isfinite(values).all():
-                    j = int(np.flatnonzero(~np.isfinite(values))[0])
-                    not_finite = (words[j], number, _column(line, j))
+            batch.append((number, line, words))
+            held += count
+            if held >= _PIECE:
+                check()
+                batch, held = [], 0
+    check()
     if total != expected:
         if bad_count is not None:
             i, number, count = bad_count
