@@ -106,3 +106,7 @@ def test_real_clips_read_bit_for_bit_the_same_both_ways():
         text = path.read_text(encoding="utf-8", errors="replace")
         fast = read_bvh(path)
         _same(fast, _parse(text, str(path), fast=False))
+        for frames in (1, 50):
+            with open_bvh(path) as stream:
+                _same(fast, BVH(stream.joints, stream.header.frame_time, np.concatenate(list(stream.blocks(frames))),
+                                str(path)))
