@@ -7,11 +7,15 @@ import tracemalloc
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import toolkit.bvh as bvh_module
 
 from tests.test_bvh import SMALL
 from toolkit import ConfigError
-from toolkit.bvh import (MAX_DEPTH, MAX_FPS, MIN_FPS, BVH, Joint, format_bvh, iter_bvh_blocks, parse_bvh, read_bvh,
-                         write_bvh)
+from toolkit.bvh import (MAX_DEPTH, MAX_FPS, MIN_FPS, BVH, BVHStream, Joint, format_bvh, iter_bvh_blocks, parse_bvh,
+                         read_bvh, write_bvh)
 from toolkit.files import check_regular_file, max_bytes
 from toolkit.profile import load_profile
 
@@ -114,11 +118,12 @@ def test_a_fifo_a_device_or_a_directory_fails_at_once(tmp_path, reader):
 def test_the_size_cap_has_a_default_and_an_environment_variable(tmp_path, monkeypatch):
     path = write_bvh(parse_bvh(SMALL), tmp_path / "s.bvh")
     monkeypatch.delenv("LIKEME_MAX_MOTION_MB", raising=False)
+    monkeypatch.delenv("LIKEME_MAX_CONFIG_MB", raising=False)
     assert max_bytes("motion") == 4096 * 2**20 and max_bytes("config") == 16 * 2**20
     monkeypatch.setenv("LIKEME_MAX_MOTION_MB", "0.0001")  # 104 bytes
-    with pytest.raises(ConfigError, match="s.bvh: BVH file of [0-9,]+ bytes is larger than the cap of 104 bytes; expected a "
-                                          "smaller file, or a higher cap in megabytes in the environment variable "
-                                          "LIKEME_MAX_MOTION_MB"):
+    with pytest.raises(ConfigError, match="s.bvh: BVH file of [0-9,]+ bytes is larger than the cap of 104 bytes; "
+                                          "expected a smaller file, or a higher cap in megabytes in the environment "
+                                          "variable LIKEME_MAX_MOTION_MB"):
         read_bvh(path)
     monkeypatch.setenv("LIKEME_MAX_MOTION_MB", "nan")
     with pytest.raises(ConfigError, match="key LIKEME_MAX_MOTION_MB: invalid size cap 'nan'"):
@@ -130,3 +135,43 @@ def test_the_size_cap_has_a_default_and_an_environment_variable(tmp_path, monkey
     profile.write_text('[parts]\nroot = "hips"\n' + "# padding\n" * 10)
     with pytest.raises(ConfigError, match="p.toml: body profile of .* is larger than the cap"):
         load_profile(profile)
+
+
+_WORDS = ["HIERARCHY", "ROOT", "JOINT", "End", "Site", "{", "}", "OFFSET", "CHANNELS", "MOTION", "Frames:", "Frame",
+          "Time:", "Xrotation", "Yposition", "0", "1", "6", "7", "²", "-1", "1e-7", "1e999", "nan", "x",
+          "1000000000000", "\ufeff", "\r\n", "\n", "\r", "\t", " ", "\v", "\u2028", "\x00"]
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.tuples(st.integers(0, 10**6), st.integers(0, 3), st.sampled_from(_WORDS)), min_size=1, max_size=4),
+       st.integers(1, 3), st.sampled_from([5, 64, 1 << 18]))
+def test_mutated_files_read_or_fail_with_a_config_error_the_same_whole_and_streamed(edits, frames, chunk):
+    text = SMALL
+    for at, how, word in edits:  # insert, replace a token, delete a token, or cut the file
+        i = at % (len(text) + 1)
+        if how == 0:
+            text = text[:i] + word + text[i:]
+        elif how in (1, 2):
+            j = i + len(text[i:].split(maxsplit=1)[0]) if text[i:].strip() else i
+            text = text[:i] + (word if how == 1 else "") + text[j:]
+        else:
+            text = text[:i]
+    results = []
+    for read in (lambda: parse_bvh(text, "m.bvh").values,
+                 lambda: bvh_module._parse(text, "m.bvh", fast=False).values,
+                 lambda: _stream_text(text, frames, chunk)):
+        try:
+            results.append(read().tobytes())
+        except ConfigError as exc:
+            results.append(str(exc))
+    assert results[0] == results[1] == results[2]
+
+
+def _stream_text(text: str, frames: int, chunk: int) -> np.ndarray:
+    """The values of ``text`` streamed in blocks of ``frames`` frames from chunks of ``chunk`` characters."""
+    saved, bvh_module._CHUNK = bvh_module._CHUNK, chunk
+    try:
+        stream = BVHStream(lambda: bvh_module._text_chunks(text), "m.bvh", len(text))
+        return np.concatenate([np.empty((0, stream.n_channels)), *stream.blocks(frames)])
+    finally:
+        bvh_module._CHUNK = saved

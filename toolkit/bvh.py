@@ -37,8 +37,8 @@ from scipy.spatial.transform import Rotation
 from toolkit.errors import ConfigError
 from toolkit.files import check_regular_file, open_regular
 
-__all__ = ["Joint", "BVH", "BVHStream", "read_bvh", "open_bvh", "iter_bvh_blocks", "parse_bvh", "write_bvh", "format_bvh",
-           "from_joint_positions", "CHANNEL_NAMES", "MAX_FPS", "MIN_FPS", "MAX_DEPTH", "BLOCK"]
+__all__ = ["Joint", "BVH", "BVHStream", "read_bvh", "open_bvh", "iter_bvh_blocks", "parse_bvh", "write_bvh",
+           "format_bvh", "from_joint_positions", "CHANNEL_NAMES", "MAX_FPS", "MIN_FPS", "MAX_DEPTH", "BLOCK"]
 
 CHANNEL_NAMES = ("Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zrotation")
 BLOCK = 4096
@@ -763,7 +763,8 @@ def _reference_values(head: _Header, lines: Iterator[tuple[int, str]], n_channel
     bad = ~np.isfinite(values)
     if bad.any():
         token, line, column = rest[int(np.flatnonzero(bad.reshape(-1))[0])]
-        raise ConfigError(f"found {_shown(token)}", file=source, line=line, column=column, expected="a finite channel value")
+        raise ConfigError(f"found {_shown(token)}", file=source, line=line, column=column,
+                          expected="a finite channel value")
     return values
 
 

@@ -58,7 +58,8 @@ def _check_stat(st: os.stat_result, path: Path, what: str, kind: str) -> None:
     if st.st_size > limit:
         variable = LIMITS[kind][0]
         raise ConfigError(f"{what} of {st.st_size:,} bytes is larger than the cap of {limit:,} bytes", file=path,
-                          expected=f"a smaller file, or a higher cap in megabytes in the environment variable {variable}")
+                          expected="a smaller file, or a higher cap in megabytes in the environment variable "
+                                   f"{variable}")
 
 
 def check_regular_file(path: str | Path, what: str = "file", kind: str = "config") -> Path:

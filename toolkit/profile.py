@@ -122,9 +122,10 @@ class BodyProfile:
     def stream(self, path: str | Path, block: int | None = None) -> MotionStream:
         """A BVH file's motion through this profile, ``block`` frames at a time (:class:`MotionStream`).
 
-        ``block`` defaults to :data:`toolkit.bvh.BLOCK`. The header is read and checked against the profile at once; the frames follow as they are iterated, with
-        forward kinematics run per block, so the memory does not grow with the file. The blocks are
-        ``profile.read(path)`` sliced, bit for bit, and a bad value raises the error ``read`` raises.
+        ``block`` defaults to :data:`toolkit.bvh.BLOCK`. The header is read and checked against the profile at
+        once; the frames follow as they are iterated, with forward kinematics run per block, so the memory does not
+        grow with the file. The blocks are ``profile.read(path)`` sliced, bit for bit, and a bad value raises the
+        error ``read`` raises.
         """
         bvh = open_bvh(path)
         try:
