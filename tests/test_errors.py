@@ -46,6 +46,10 @@ Frame Time: 0.0333333
 0 90 0 0 0 0 0 0 0
 0 91 0 0 0 0 0 0 0
 """
+DEEP_BVH = ("HIERARCHY\nROOT j0\n{\nOFFSET 0 0 0\nCHANNELS 3 Xrotation Yrotation Zrotation\n"
+            + "".join(f"JOINT j{i}\n{{\nOFFSET 0 1 0\nCHANNELS 3 Xrotation Yrotation Zrotation\n" for i in range(1, 1000))
+            + "}\n" * 1000 + "MOTION\nFrames: 1\nFrame Time: 0.03\n" + " ".join(["0"] * 3000) + "\n")
+"""A BVH file whose joints are nested 1,000 deep."""
 PROFILE = '[profile]\nname = "p"\nunits = "cm"\n[parts]\nroot = "hips"\nhead = "head"\nnose = "head_end"\n[facing]\nleft = "head"\nright = "nose"\n'
 
 
@@ -191,6 +195,17 @@ CASES = [
     ("bench-memory-block", "memory benchmark with packets of 0 frames", {}, ["bench", "memory", "--block", "0"], ["key --block", "value 0", "expected a whole number >= 1"]),
     ("observe-ruptures-window", "ruptures with a negative window", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "ruptures", "--set", "segmenter.window=-1", "m.bvh"], ["key segmenter.window", "value -1.0 out of range", "expected a number in [0, inf]"]),
     ("observe-max-movement", "velocity-direction with a negative max_movement", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "velocity-direction", "--set", "segmenter.max_movement=-5", "m.bvh"], ["key segmenter.max_movement", "value -5.0 out of range"]),
+    # -- reading: bounded, streaming BVH and profile reading (issue 21)
+    ("bvh-frame-rate", "a frame time of 0.1 microseconds (10 MHz)", {"m.bvh": BVH.replace("Frame Time: 0.0333333", "Frame Time: 1e-7")}, ["validate", "m.bvh"], ["m.bvh:18:13", "frame time 1e-07 s (1e+07 frames per second)", "expected a frame time of 0.0001 to 60 seconds"]),
+    ("bvh-nesting", "joints nested 1,000 deep", {"m.bvh": DEEP_BVH}, ["validate", "m.bvh"], ["m.bvh:1026:1", "joints nested deeper than 256", "expected at most 256 levels of JOINT"]),
+    ("bvh-no-channels", "no channels in the whole file", {"m.bvh": BVH.replace("CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation", "CHANNELS 0").replace("CHANNELS 3 Zrotation Xrotation Yrotation", "CHANNELS 0")}, ["validate", "m.bvh"], ["m.bvh:16:1", "no channels in the hierarchy", "expected at least one joint with CHANNELS"]),
+    ("bvh-channel-digit", "a channel count in superscript digits", {"m.bvh": BVH.replace("CHANNELS 3", "CHANNELS \u00b2")}, ["validate", "m.bvh"], ["m.bvh:9:14", "found '\u00b2'", "expected the number of channels (ASCII digits, at most 6)"]),
+    ("bvh-frames-huge", "Frames: 10**12 with two frame lines", {"m.bvh": BVH.replace("Frames: 2", "Frames: 1000000000000")}, ["validate", "m.bvh"], ["m.bvh:21:1", "2 frame lines after 'Frames: 1000000000000'", "expected 1000000000000 frame lines"]),
+    ("bvh-dev-zero", "a device given as a clip", {"p.toml": PROFILE}, ["observe", "--body", "p.toml", "--repertoire", ".", "/dev/zero"], ["/dev/zero: is a character device, not a file", "expected a regular file (BVH file)"]),
+    ("bvh-directory", "a directory given as a clip", {"p.toml": PROFILE}, ["observe", "--body", "p.toml", "--repertoire", ".", "."], [".: is a directory, not a file", "expected a regular file (BVH file)"]),
+    ("profile-dev-zero", "a device given as a body profile", {"m.bvh": BVH}, ["observe", "--body", "/dev/zero", "--repertoire", ".", "m.bvh"], ["/dev/zero: is a character device, not a file", "expected a regular file (body profile)"]),
+    ("validate-dev-zero", "a device given to validate", {}, ["validate", "/dev/zero"], ["/dev/zero: is a character device, not a file", "expected a regular file (TOML file)"]),
+    ("validate-directory", "a directory given to validate", {}, ["validate", "."], [".: is a directory, not a file", "expected a regular file (TOML file)"]),
 ]
 
 

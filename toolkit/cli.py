@@ -477,11 +477,14 @@ def cmd_show(args: argparse.Namespace, pm: PluginManager) -> int:
 def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
     import json
 
+    from toolkit.files import check_regular_file
     from toolkit.observe import NO_CORRESPONDENCE, Observer, compose_observer
     from toolkit.params import parse_settings
     from toolkit.profile import load_profile
 
     profile = load_profile(args.body)
+    for path in args.files:  # a FIFO, a device, a directory or a missing file fails before any work
+        check_regular_file(path, "BVH file", "motion")
     for name, kind in ((args.segmenter, "segmenter"), (args.matcher, "matcher"), (args.correspondence, "correspondence")):
         if name is not None and name != NO_CORRESPONDENCE:
             pm.registry.get(kind, name)  # an unknown name fails here, listing the registered ones
@@ -491,9 +494,14 @@ def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
                                  settings=parse_settings(list(args.set)))
     report = []
     for path in args.files:
-        motion = profile.read(path)
-        observer = Observer(character, profile.body, motion.fps)
-        found = observer.watch(motion)
+        # the file streamed a block of frames at a time (header first), so reading memory does not grow with it
+        with profile.stream(path) as motion:
+            observer = Observer(character, profile.body, motion.fps)
+            observer.reset()
+            found = []
+            for positions, visible in motion:
+                found.extend(observer.push_block(positions, visible))
+            found.extend(observer.flush())
         report.append({"file": str(path), "frames": motion.n_frames, "fps": round(motion.fps, 3), "segments": [
             {"start_frame": o.segment.start, "end_frame": o.segment.end, "start_s": round(o.segment.start_time, 3),
              "end_s": round(o.segment.end_time, 3), "movement": o.movement or "unknown",
@@ -542,8 +550,9 @@ def _why_text(seg: dict[str, Any]) -> str:
 
 
 def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
-    from toolkit.bvh import read_bvh
+    from toolkit.bvh import open_bvh
     from toolkit.character import load_character, read_toml
+    from toolkit.files import check_regular_file
     from toolkit.observe import check_observer_template, is_observer_template
     from toolkit.profile import is_profile, load_profile
     from toolkit.report import describe_character
@@ -558,14 +567,16 @@ def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
     for path in args.files:
         try:
             if str(path).lower().endswith(".bvh"):
-                bvh = read_bvh(path)
+                with open_bvh(path) as bvh:  # every frame read and checked, a block at a time
+                    for _ in bvh.blocks():
+                        pass
                 line = f"ok    {path}: BVH: {len(bvh.names)} joints, {bvh.n_frames} frames at {bvh.fps:g} fps"
                 if profile is not None:
-                    unmapped = profile.check(bvh)
+                    unmapped = profile.check(bvh.header)
                     line += f"; profile {profile.name!r} maps {len(profile.joints)}, leaves {len(unmapped)} unmapped"
                 print(line)
                 continue
-            table = read_toml(path)
+            table = read_toml(check_regular_file(path, "TOML file", "config"))
             if is_scenario(table):
                 scenario = load_scenario(path, pm)
                 world = scenario.world
