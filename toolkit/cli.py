@@ -213,7 +213,8 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p.add_argument("--matcher", metavar="NAME", help="matcher (default: the observer template's)")
     p.add_argument("--correspondence", metavar="NAME", help="correspondence (default: the observer template's; "
                    "none: the papers' plain observer)")
-    p.add_argument("--lengths-for-height", type=float, default=None, metavar="M", dest="lengths_for_height",
+    p.add_argument("--lengths-for-height", type=number_type(0.0, 1000.0, "metres"), default=None, metavar="M",
+                   dest="lengths_for_height",
                    help="the height (m) the length parameters were written for, scaled to the observer's own height "
                    "(default: the observer template's; 0: metres as written, the papers)")
     p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
@@ -478,8 +479,8 @@ def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
     import json
 
     from toolkit.files import check_regular_file
-    from toolkit.observe import NO_CORRESPONDENCE, Observer, compose_observer
-    from toolkit.params import parse_settings
+    from toolkit.observe import NO_CORRESPONDENCE, Observer, compose_observer, observer_plugins
+    from toolkit.params import check_settings, parse_settings
     from toolkit.profile import load_profile
 
     profile = load_profile(args.body)
@@ -488,10 +489,14 @@ def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
     for name, kind in ((args.segmenter, "segmenter"), (args.matcher, "matcher"), (args.correspondence, "correspondence")):
         if name is not None and name != NO_CORRESPONDENCE:
             pm.registry.get(kind, name)  # an unknown name fails here, listing the registered ones
+    settings = parse_settings(list(args.set))
+    check_settings(settings, pm, observer_plugins(pm, segmenters=[args.segmenter] if args.segmenter else (),
+                                                  matchers=[args.matcher] if args.matcher else (),
+                                                  correspondence=args.correspondence or ""))
     character = compose_observer(pm, profile, args.repertoire, segmenter=args.segmenter, matcher=args.matcher or "",
                                  correspondence=args.correspondence or "",
                                  lengths_for_height="" if args.lengths_for_height is None else args.lengths_for_height,
-                                 settings=parse_settings(list(args.set)))
+                                 settings=settings)
     report = []
     for path in args.files:
         # the file streamed a block of frames at a time (header first), so reading memory does not grow with it
