@@ -159,18 +159,20 @@ def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dic
     from toolkit.report import summarise
     from toolkit.scenario import load_scenario
 
+    from toolkit.state import Checkpoint, StateFile, apply_state, read_state
+
+    # the --save target and the --load file are checked before any work (the target first: its version is the one
+    # this run may overwrite); the loaded state is applied, all or nothing, once the world is composed
+    target = StateFile(args.save) if getattr(args, "save", None) else None
+    loaded = read_state(args.load) if getattr(args, "load", None) else None
     scenario = load_scenario(path, pm, seed=args.seed, on_plugin_error="skip" if args.keep_going else "stop")
     if getattr(args, "duration", None) is not None:
         scenario.duration = args.duration
-    if getattr(args, "load", None):
-        from toolkit.state import load_state
-
-        load_state(scenario.world, args.load)
+    if loaded is not None:
+        apply_state(scenario.world, loaded, args.load)
     checkpoint = None
-    if getattr(args, "save", None):
-        from toolkit.state import Checkpoint
-
-        checkpoint = Checkpoint(scenario.world, args.save)
+    if target is not None:
+        checkpoint = Checkpoint(scenario.world, target)
         pm.register(checkpoint, name="checkpoint")
     view = _view(pm, args.view, "scenario", args.set) if getattr(args, "render", None) else None
     files = []
@@ -184,7 +186,7 @@ def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dic
             pm.unregister(checkpoint)
     world = scenario.world
     if checkpoint is not None:
-        checkpoint.save()
+        checkpoint.finish()  # ConfigError if the last save fails or had to go to a conflict file
     if view is not None:
         print(f"wrote {len(files)} file(s) to {args.render}: " + ", ".join(
             sorted({f.suffix.lstrip('.') for f in files})), file=sys.stderr)
