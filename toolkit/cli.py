@@ -163,7 +163,7 @@ def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dic
 
     # the --save target and the --load file are checked before any work (the target first: its version is the one
     # this run may overwrite); the loaded state is applied, all or nothing, once the world is composed
-    target = StateFile(args.save) if getattr(args, "save", None) else None
+    target = StateFile(args.save, loaded=getattr(args, "load", None)) if getattr(args, "save", None) else None
     loaded = read_state(args.load) if getattr(args, "load", None) else None
     scenario = load_scenario(path, pm, seed=args.seed, on_plugin_error="skip" if args.keep_going else "stop")
     if getattr(args, "duration", None) is not None:

@@ -226,11 +226,22 @@ def check_save_target(path: str | Path) -> Path:
         path = path.resolve()
     folder = path.parent if str(path.parent) else Path(".")
     ancestor = folder
-    while not ancestor.exists() and ancestor != ancestor.parent:
-        ancestor = ancestor.parent
-    if ancestor.exists() and not ancestor.is_dir():
+    while True:  # the nearest ancestor that exists says why the folder cannot be used
+        try:
+            info = ancestor.stat()
+            break
+        except FileNotFoundError:
+            if ancestor == ancestor.parent:
+                break
+            ancestor = ancestor.parent
+        except NotADirectoryError:
+            ancestor = ancestor.parent
+        except OSError as exc:
+            raise ConfigError(f"cannot reach the folder {ancestor}: {_reason(exc)}", file=path,
+                              expected="--save into a folder this user can write") from None
+    if ancestor.exists() and not stat.S_ISDIR(info.st_mode):
         raise ConfigError(f"{ancestor} is a file, not a folder", file=path, expected="--save into an existing folder")
-    if not folder.is_dir():
+    if ancestor != folder:
         raise ConfigError(f"the folder {folder} does not exist", file=path, expected="--save into an existing folder")
     if path.is_dir():
         raise ConfigError("is a folder, not a file", file=path, expected="--save FILE (a state file to write)")
@@ -261,15 +272,27 @@ class StateFile:
     ----------
     path : path
         The ``--save`` target; :func:`check_save_target` is called on it.
+    loaded : path, optional
+        The state file the run loaded (``--load``). If the target holds a state and is not that file, ``report``
+        is told at once that the run will replace it (a run that means to add to a state loads it first).
     report : callable, optional
         Told (one line) when a save goes to a conflict file instead; default: a warning on standard error.
     """
 
-    def __init__(self, path: str | Path, *, report: Callable[[str], None] | None = None) -> None:
+    def __init__(self, path: str | Path, *, loaded: str | Path | None = None,
+                 report: Callable[[str], None] | None = None) -> None:
         self.path = check_save_target(path)
         self.known = _digest(self.path)  # the version this process has seen: overwriting it loses nothing
         self.diverted: Path | None = None
         self.report = report or _warn
+        if self.path.is_file() and self.path.stat().st_size:
+            try:
+                same = loaded is not None and os.path.samefile(loaded, self.path)
+            except OSError:
+                same = False
+            if not same:
+                self.report(f"{self.path} holds a saved state this run did not load (--load {self.path} adds to it); "
+                            f"what this run learns will replace it")
 
     @property
     def conflict_path(self) -> Path:

@@ -529,6 +529,9 @@ class MotorCommandGraph(MotorSystem):
                     built = tuple(command_from_dict(c) for c in commands)
                 except (TypeError, ValueError, KeyError, OverflowError) as exc:
                     raise bad(f"invalid edge ({exc})"[:300], key, "an edge written by get_state") from None
+                values = [v for c in built for k, v in c.to_dict(arrays=True).items() if k != "shape"]
+                if not all(np.isfinite(np.asarray(v, dtype=float)).all() and np.abs(v).max() < 1e6 for v in values):
+                    raise bad("invalid edge (a number that is not finite, or beyond 1e6)", key, "an edge written by get_state")
                 if not all(0 < c.duration <= 3600 for c in built):
                     raise bad("invalid edge (a command longer than an hour)", key, "an edge written by get_state")
                 edges[e["name"]] = (Edge(e["name"], name, e["from"], e["to"], built, "loaded"), int(number))
