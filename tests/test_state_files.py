@@ -479,3 +479,34 @@ def test_hostile_json_is_refused(tmp_path, text, message):
     path.write_text(text)
     with pytest.raises(ConfigError, match=message):
         read_state(path)
+
+
+def test_a_component_without_a_check_is_restored_from_its_snapshot(real_states, tmp_path):
+    """Components whose set_state takes no ``check`` (third-party plugins written before it) are applied first, with a
+    snapshot; when a later one fails, the earlier ones are restored from their snapshots."""
+    from plugins.action.hierarchical import Hierarchical
+    from plugins.motor.posegraph import Posegraph
+
+    data = json.loads(dict(real_states)["learn_windmill"])
+    data["actors"]["max"]["components"]["action"]["state"]["beliefs"] = {"pear": "toy"}
+    data["actors"]["max"]["components"]["motor"]["state"]["learned"]["learned-1"]["poses"] = [[[0, 0]]]
+    data["checksum"] = checksum(data)
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps(data))
+    world = windmill()[1].world
+    max_ = world.actors["max"].character
+    calls = []
+
+    def action_set_state(state):  # an old-style set_state: no check keyword
+        calls.append(dict(state))
+        Hierarchical.set_state(max_.action, state)
+
+    def motor_set_state(state):
+        Posegraph.set_state(max_.motor, state)
+
+    max_.action.set_state, max_.motor.set_state = action_set_state, motor_set_state
+    before = character_state(max_)
+    with pytest.raises(ConfigError, match=r"key actors.max.components.motor.state.learned.learned-1.poses: invalid poses"):
+        load_state(world, path)
+    assert calls[0]["beliefs"] == {"pear": "toy"} and len(calls) == 2  # applied, then restored
+    assert character_state(max_) == before

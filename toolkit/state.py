@@ -357,7 +357,7 @@ def _walk(value: Any, key: tuple, path: Path) -> None:
     while stack:
         value, key = stack.pop()
         if len(key) > MAX_DEPTH:
-            raise ConfigError(f"nested more than {MAX_DEPTH} deep", file=path, key=key[:MAX_DEPTH],
+            raise ConfigError(f"nested more than {MAX_DEPTH} deep below here", file=path, key=key[:4],
                               expected="a state file written by likeme")
         if isinstance(value, bool) or value is None:
             continue
