@@ -510,3 +510,23 @@ def test_a_component_without_a_check_is_restored_from_its_snapshot(real_states, 
         load_state(world, path)
     assert calls[0]["beliefs"] == {"pear": "toy"} and len(calls) == 2  # applied, then restored
     assert character_state(max_) == before
+
+
+def test_a_save_sweeps_away_what_a_killed_writer_left(tmp_path):
+    stale = tmp_path / ".s.json.k1l2l3.tmp"
+    stale.write_text('{"half": ')
+    other = tmp_path / ".t.json.abc.tmp"  # another file's: not ours to remove
+    other.write_text("x")
+    StateFile(tmp_path / "s.json").save('{"format": "likeme-state"}\n')
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".s.json.lock", ".t.json.abc.tmp", "s.json"]
+
+
+def test_a_component_that_returns_nan_is_named_when_saving(tmp_path):
+    from toolkit import PluginError
+
+    world = windmill()[1].world
+    max_ = world.actors["max"].character
+    max_.action.drives["hunger"].level = float("nan")
+    with pytest.raises(PluginError, match=r"plugin 'hierarchical' failed in get_state: returned a number that is not finite"):
+        save_state(world, tmp_path / "s.json")
+    assert not (tmp_path / "s.json").exists()

@@ -50,6 +50,7 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
+import glob
 import hashlib
 import inspect
 import json
@@ -63,7 +64,7 @@ from pathlib import Path
 from typing import Any
 
 from toolkit.character import Character
-from toolkit.errors import ConfigError
+from toolkit.errors import ConfigError, PluginError
 from toolkit.hookspecs import hookimpl
 
 __all__ = ["FORMAT", "VERSION", "READS", "MAX_BYTES", "MAX_DEPTH", "MAX_INT", "MAX_STRING", "write_atomic",
@@ -158,7 +159,17 @@ def state_text(target: Any) -> str:
         data = {"format": FORMAT, "version": VERSION, "actors": {target.name.lower(): character_state(target)}}
     else:
         data = world_state(target)
-    data["checksum"] = checksum(data)
+    try:
+        data["checksum"] = checksum(data)
+    except ValueError:  # NaN or infinity: a file no likeme could load again
+        characters = [target] if isinstance(target, Character) else [a.character for a in target.actors.values()]
+        for character in characters:
+            for component in character.components().values():
+                try:
+                    canonical(component.get_state())
+                except ValueError:
+                    raise PluginError(component.name, "get_state", "returned a number that is not finite") from None
+        raise
     return json.dumps(data, indent=1, sort_keys=True, allow_nan=False) + "\n"
 
 
@@ -183,6 +194,14 @@ def _digest(path: Path) -> str | None:
         return None
 
 
+def _sweep(path: Path) -> None:
+    """Remove the temporary files ``.NAME.*.tmp`` a killed writer left beside ``path`` (call under its lock: no
+    likeme process is writing one then)."""
+    for stale in path.parent.glob(f".{glob.escape(path.name)}.*.tmp"):
+        with contextlib.suppress(OSError):
+            stale.unlink()
+
+
 def _reason(exc: OSError) -> str:
     return exc.strerror or str(exc)
 
@@ -205,7 +224,7 @@ def _probe_folder(folder: Path, name: str, path: Path) -> None:
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".tmp", dir=folder)
         os.close(fd)
-        os.unlink(tmp)
+        Path(tmp).unlink(missing_ok=True)  # (a saving process may have swept it away already)
     except OSError as exc:
         raise ConfigError(f"cannot write in the folder {folder}: {_reason(exc)}", file=path,
                           expected="--save into a folder this user can write") from None
@@ -302,6 +321,7 @@ class StateFile:
     def save(self, text: str) -> Path:
         """Write ``text``; returns where it went (:attr:`path`, or the conflict file). Raises :class:`OSError`."""
         with _locked(self.path):
+            _sweep(self.path)
             if self.diverted is None:
                 current = _digest(self.path)
                 if current is not None and current != self.known:
