@@ -166,6 +166,7 @@ CASES = [
     ("state-not-table", "a component's state that is not a table", {"st.json": state(actors={"max": {"character": "Max", "components": {"action": {"plugin": "hierarchical", "state": 5}}}})}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["key actors.max.components.action.state: int instead of a table"]),
     ("state-deep", "nesting 40 deep", {"st.json": state(frame=[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[0]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]])}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["nested more than 32 deep"]),
     ("state-huge-int", "a huge integer", {"st.json": state(frame=10**40)}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["st.json: key frame: integer too large (41 digits)"]),
+    ("state-load-device", "--load of a device", {}, ["run", "demo", "--load", "/dev/zero"], ["/dev/zero: not a regular file; expected a state file written by --save"]),
     ("state-nan", "NaN in a state file", {"st.json": state(time=float("nan"))}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["not JSON likeme reads: NaN is not a finite number"]),
 ]
 

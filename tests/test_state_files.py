@@ -314,7 +314,7 @@ def real_states(tmp_path_factory):
     """State files written by scenarios that learn: (scenario, file text)."""
     folder = tmp_path_factory.mktemp("real")
     out = []
-    for name in ("learn_windmill", "imitation_games"):
+    for name in ("learn_windmill", "imitation_games", "hand_arm_games"):  # a posegraph; wrist and hand command graphs
         pm = create_plugin_manager(autoload=False)
         world = load_scenario(CHARACTERS / "scenarios" / f"{name}.toml", pm).run()
         out.append((name, _save(world, folder / f"{name}.json").read_text()))
