@@ -158,7 +158,6 @@ def _view(pm: PluginManager, name: str, subject: str, settings: list[str]) -> An
 def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dict[str, Any]:
     from toolkit.report import summarise
     from toolkit.scenario import load_scenario
-
     from toolkit.state import Checkpoint, StateFile, apply_state, read_state
 
     # the --save target and the --load file are checked before any work (the target first: its version is the one

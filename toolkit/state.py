@@ -469,7 +469,8 @@ def read_state(path: str | Path) -> dict[str, Any]:
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
-        raise ConfigError(f"not UTF-8 text (byte {exc.start})", file=path, expected="a JSON state file written by likeme") from None
+        raise ConfigError(f"not UTF-8 text (byte {exc.start})", file=path,
+                          expected="a JSON state file written by likeme") from None
     try:
         data = json.loads(text, parse_constant=_no_constant)
     except json.JSONDecodeError as exc:
@@ -479,7 +480,8 @@ def read_state(path: str | Path) -> dict[str, Any]:
         raise ConfigError("not JSON likeme reads: nested too deeply", file=path,
                           expected=f"at most {MAX_DEPTH} levels of nesting") from None
     except ValueError as exc:  # NaN, Infinity; an integer of more than 4300 digits
-        raise ConfigError(f"not JSON likeme reads: {exc}", file=path, expected="finite numbers of sensible size") from None
+        raise ConfigError(f"not JSON likeme reads: {exc}", file=path,
+                          expected="finite numbers of sensible size") from None
     return check_state_data(data, path)
 
 
@@ -498,7 +500,7 @@ def _call(component: Any, state: dict, path: Path, prefix: tuple, **kwargs: Any)
         component.set_state(state, **kwargs)
     except ConfigError as err:
         raise err.within(file=path, prefix=prefix) from None
-    except Exception as exc:  # a component's set_state that does not check its input itself
+    except Exception as exc:  # noqa: BLE001 - a set_state that does not check its input itself
         raise ConfigError(f"{component.kind} {component.name!r} cannot use this state ({type(exc).__name__}: {exc})",
                           file=path, key=prefix, expected="a state written by the same plugin") from None
 
@@ -638,7 +640,8 @@ class Checkpoint:
     def finish(self) -> None:
         """The last save of a run: :class:`ConfigError` if it fails, or if the state had to go to a conflict file."""
         if not self.save():
-            fallback = Path(tempfile.gettempdir()) / f"{self.path.stem}.unsaved-{os.getpid()}{self.path.suffix or '.json'}"
+            name = f"{self.path.stem}.unsaved-{os.getpid()}{self.path.suffix or '.json'}"
+            fallback = Path(tempfile.gettempdir()) / name
             try:
                 write_atomic(fallback, state_text(self.world))
                 where = f"what this run learned is saved in {fallback} instead"

@@ -272,7 +272,8 @@ class Hierarchical(ActionSystem):
         correspondence: dict[str, Counter] = {}
         for movement, counts in table("correspondence", "a table of movement = {path = count}").items():
             if not isinstance(counts, dict):
-                raise ConfigError("invalid correspondence", key=("correspondence", movement), expected="a table of path = count")
+                raise ConfigError("invalid correspondence", key=("correspondence", movement),
+                                  expected="a table of path = count")
             for text, n in counts.items():
                 path = tuple(p.strip() for p in text.split(">"))
                 if path[-1] not in self.hierarchy.tuples or path not in self.hierarchy.paths_to(path[-1]):
@@ -282,7 +283,8 @@ class Hierarchical(ActionSystem):
         transitions: Counter = Counter()
         items = state.get("transitions", [])
         if not isinstance(items, list):
-            raise ConfigError("invalid transitions", key=("transitions",), expected="a list of [from_leaf, to_leaf, count]")
+            raise ConfigError("invalid transitions", key=("transitions",),
+                              expected="a list of [from_leaf, to_leaf, count]")
         for i, item in enumerate(items):
             if not (isinstance(item, list) and len(item) == 3 and all(isinstance(x, str) and x in self.hierarchy.tuples
                                                                      for x in item[:2])):

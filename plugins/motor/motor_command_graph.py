@@ -490,7 +490,8 @@ class MotorCommandGraph(MotorSystem):
                 raise bad("invalid subsystem state", (name,), "a table of " + ", ".join(keys))
             for k in entry:
                 if k not in keys:
-                    raise ConfigError(f"unknown key {k!r}", key=(name, k), expected="a subsystem state key", available=keys)
+                    raise ConfigError(f"unknown key {k!r}", key=(name, k), expected="a subsystem state key",
+                                      available=keys)
             table = entry.get("nodes", {})
             if not isinstance(table, dict):
                 raise bad("invalid nodes", (name, "nodes"), "a table of node = state")
@@ -520,8 +521,8 @@ class MotorCommandGraph(MotorSystem):
                     raise bad(f"edge {e['name']!r} twice", (*key, "name"), "each edge once")
                 for end in ("from", "to"):
                     if e[end] not in known_nodes:
-                        raise ConfigError(f"unknown node {e[end]!r}", key=(*key, end), expected="a node of the subsystem",
-                                          available=sorted(known_nodes))
+                        raise ConfigError(f"unknown node {e[end]!r}", key=(*key, end),
+                                          expected="a node of the subsystem", available=sorted(known_nodes))
                 commands = e.get("commands", e.get("strokes"))
                 if not isinstance(commands, list) or not commands or not all(isinstance(c, dict) for c in commands):
                     raise bad("invalid commands", key, "a non-empty list of commands written by get_state")
@@ -531,7 +532,8 @@ class MotorCommandGraph(MotorSystem):
                     raise bad(f"invalid edge ({exc})"[:300], key, "an edge written by get_state") from None
                 values = [v for c in built for k, v in c.to_dict(arrays=True).items() if k != "shape"]
                 if not all(np.isfinite(np.asarray(v, dtype=float)).all() and np.abs(v).max() < 1e6 for v in values):
-                    raise bad("invalid edge (a number that is not finite, or beyond 1e6)", key, "an edge written by get_state")
+                    raise bad("invalid edge (a number that is not finite, or beyond 1e6)", key,
+                              "an edge written by get_state")
                 if not all(0 < c.duration <= 3600 for c in built):
                     raise bad("invalid edge (a command longer than an hour)", key, "an edge written by get_state")
                 edges[e["name"]] = (Edge(e["name"], name, e["from"], e["to"], built, "loaded"), int(number))

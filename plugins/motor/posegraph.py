@@ -270,7 +270,8 @@ class Posegraph(MotorSystem):
                 raise ConfigError(f"unknown key {key!r}", key=(key,), expected="a posegraph state key", available=["learned"])
         learned = state.get("learned", {})
         if not isinstance(learned, dict):
-            raise ConfigError("invalid learned movements", key=("learned",), expected="a table of learned movements by name")
+            raise ConfigError("invalid learned movements", key=("learned",),
+                              expected="a table of learned movements by name")
         root = self.body.root_index
         shape = f"an array of shape (nodes >= 1, {self.body.n_parts}, 3) of finite numbers (metres, below 1e6)"
         known = set(self.paths) | set(self.movements())
@@ -281,7 +282,8 @@ class Posegraph(MotorSystem):
                 raise ConfigError(f"movement {name!r} already exists" if name else "empty movement name", key=key,
                                   expected="a movement the character does not know yet", available=sorted(known))
             if not isinstance(entry, dict) or not isinstance(entry.get("source", ""), str):
-                raise ConfigError(f"invalid learned movement {name!r}", key=key, expected="{source = text, poses = ...}")
+                raise ConfigError(f"invalid learned movement {name!r}", key=key,
+                                  expected="{source = text, poses = ...}")
             for k in entry:
                 if k not in ("source", "poses"):
                     raise ConfigError(f"unknown key {k!r}", key=(*key, k), expected="a learned movement's key",
