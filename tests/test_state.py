@@ -16,7 +16,8 @@ from hypothesis import strategies as st
 
 from tests.conftest import CHARACTERS, ROOT
 from toolkit import ConfigError, create_plugin_manager, load_character, load_scenario
-from toolkit.state import Checkpoint, character_state, checksum, load_state, read_state, save_state, write_atomic
+from toolkit.state import (Checkpoint, StateFile, character_state, checksum, load_state, read_state, save_state,
+                           write_atomic)
 
 
 @pytest.fixture(scope="module")
@@ -202,3 +203,6 @@ learn = true
     assert loaded > 0
     # a write cut short leaves at most a temporary file beside the state file, never a broken state file
     assert {p.name for p in tmp_path.iterdir() if not p.name.startswith(".s.json.")} == {"s.json", "long.toml"}
+    # and the next save sweeps such leftovers away
+    StateFile(state, loaded=state).save(state.read_text())
+    assert {p.name for p in tmp_path.iterdir()} == {"s.json", "long.toml", ".s.json.lock"}
