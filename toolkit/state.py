@@ -39,7 +39,8 @@ beside the file, held only while saving) and, under it, compares the file with t
 (its SHA-256 when the run started, or as this process last wrote it). If another process wrote the file since, it
 is not overwritten: this run's state goes to ``NAME.conflict-PID.json`` beside it (and every later save of the
 run too), a warning says so, and the run ends with an error naming both files, so neither run's learning is lost.
-A run's ``--save`` target is checked before the run starts (:func:`check_save_target`).
+A run's ``--save`` target is checked before the run starts (:func:`check_save_target`); a run that will replace a
+state file it did not ``--load`` says so at the start.
 
 :class:`Checkpoint` is a plugin that saves after every step in which something was learned. A save that fails
 (a full disk) is reported once, keeps what was learned in memory and is tried again; the final save's failure is
