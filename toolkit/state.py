@@ -599,7 +599,8 @@ class Checkpoint:
         self.every = every
         self.dirty = False
         self.saves = 0
-        self.error: str | None = None
+        self.error: str | None = None  # the last save's failure, while it lasts
+        self.reason = ""  # the operating system's reason for it
         self._last = world.frame
         self._retry = world.frame
 
@@ -624,7 +625,8 @@ class Checkpoint:
         try:
             self.file.save(state_text(self.world))
         except OSError as exc:
-            error = f"{self.path}: could not save state: {_reason(exc)}"
+            self.reason = _reason(exc)
+            error = f"{self.path}: could not save state: {self.reason}"
             if error != self.error:
                 self.report(f"{error}; what was learned is kept and saved again at the next checkpoint")
             self.error = error
@@ -648,7 +650,7 @@ class Checkpoint:
                 where = f"what this run learned is saved in {fallback} instead"
             except OSError:
                 where = "what this run learned could not be saved anywhere"
-            raise ConfigError(f"could not save state: {self.error.split(': could not save state: ', 1)[-1]}; {where}",
+            raise ConfigError(f"could not save state: {self.reason}; {where}",
                               file=self.path, expected="a folder with space this user can write")
         if self.file.diverted is not None:
             raise self.file.conflict_error()
