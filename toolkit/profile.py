@@ -125,7 +125,7 @@ def is_profile(table: Mapping[str, Any]) -> bool:
 
 def load_profile(path: str | Path) -> BodyProfile:
     """Read a body profile TOML file; every problem is a :class:`ConfigError` naming the file, key and line."""
-    from toolkit.character import find_key_line, read_toml
+    from toolkit.character import check_body, find_key_line, read_toml
 
     path = Path(path)
     table = read_toml(path)
@@ -148,12 +148,16 @@ def load_profile(path: str | Path) -> BodyProfile:
             raise fail(f"unknown units {units!r}", ("profile", "units"), expected="a unit name or metres per unit",
                        available=UNITS)
         scale = UNITS[units]
-    elif isinstance(units, int | float) and not isinstance(units, bool) and units > 0:
+    elif isinstance(units, int | float) and not isinstance(units, bool) and np.isfinite(units) and units > 0:
         scale = float(units)
     else:
-        raise fail(f"invalid units {units!r}", ("profile", "units"), expected="a unit name or a positive number")
+        raise fail(f"invalid units {units!r}", ("profile", "units"),
+                   expected="a unit name or a positive number (finite: metres per unit)")
     up = head.get("up", "+y")
-    if not isinstance(up, str) or up not in UP_AXES:
+    if not isinstance(up, str):
+        raise fail(f"wrong type {type(up).__name__} (value {up!r})", ("profile", "up"),
+                   expected='one axis as a string, like up = "+z"', available=UP_AXES)
+    if up not in UP_AXES:
         raise fail(f"unknown up axis {up!r}", ("profile", "up"), expected="an axis", available=UP_AXES)
     parts = table.get("parts")
     if not isinstance(parts, Mapping) or not parts:
@@ -172,7 +176,7 @@ def load_profile(path: str | Path) -> BodyProfile:
     body_table = {"parts": list(parts), "root": root, "facing": facing,
                   "bones": table.get("bones", []), "colours": table.get("colours", {})}
     try:
-        body = Body.from_config(body_table)
+        body = check_body(Body.from_config(body_table))
     except ConfigError as exc:
         key = exc.key if exc.key and exc.key[0] in ("bones", "colours") else ("facing", *exc.key[1:]) if exc.key and \
             exc.key[0] in ("facing", "root") else exc.key
