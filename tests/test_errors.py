@@ -207,6 +207,22 @@ CASES = [
     ("profile-dev-zero", "a device given as a body profile", {"m.bvh": BVH}, ["observe", "--body", "/dev/zero", "--repertoire", ".", "m.bvh"], ["/dev/zero: is a character device, not a file", "expected a regular file (body profile)"]),
     ("validate-dev-zero", "a device given to validate", {}, ["validate", "/dev/zero"], ["/dev/zero: is a character device, not a file", "expected a regular file (TOML file)"]),
     ("validate-directory", "a directory given to validate", {}, ["validate", "."], [".: is a directory, not a file", "expected a regular file (TOML file)"]),
+    # -- state files: saving and loading (issue 21)
+    ("state-save-folder", "--save into a folder that does not exist", {}, ["run", "demo", "--save", "missing/st.json"], ["missing/st.json: the folder missing does not exist", "expected --save into an existing folder"]),
+    ("state-save-parent-file", "--save below a file", {"f.txt": "x"}, ["run", "demo", "--save", "f.txt/st.json"], ["f.txt/st.json: f.txt is a file, not a folder"]),
+    ("state-save-directory", "--save to a folder", {}, ["run", "demo", "--save", "/usr"], ["/usr: is a folder, not a file"]),
+    ("state-save-not-state", "--save over a file that is not a state file", {"notes.txt": "my notes"}, ["run", "demo", "--save", "notes.txt"], ["notes.txt: exists and is not a likeme state file; refusing to overwrite it"]),
+    ("state-checksum", "a state file changed after likeme wrote it", {"st.json": state(version=2, checksum="sha256:00")}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["st.json: key checksum: checksum does not match the content"]),
+    ("state-no-checksum", "a version-2 state file without a checksum", {"st.json": state(version=2)}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["st.json: key checksum: missing checksum"]),
+    ("state-character", "a state saved from another character", {"st.json": state(actors={"max": {"character": "Moritz", "components": {}}})}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["key actors.max.character: state saved from Moritz, but actor 'max' is Max", "available: max (Moritz)"]),
+    ("state-learned-list", "learned movements as a list", {"st.json": state(actors={"max": {"character": "Max", "components": {"motor": {"plugin": "posegraph", "state": {"learned": []}}}}})}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["key actors.max.components.motor.state.learned: invalid learned movements"]),
+    ("state-count", "a count that is not a number", {"st.json": state(actors={"max": {"character": "Max", "components": {"action": {"plugin": "hierarchical", "state": {"transitions": [["reach", "eat", "abc"]]}}}}})}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["key actors.max.components.action.state.transitions[0][2]: invalid count 'abc'"]),
+    ("state-list-name", "a list where a name belongs", {"st.json": state(actors={"max": {"character": "Max", "components": {"action": {"plugin": "hierarchical", "state": {"transitions": [[["reach"], "eat", 1]]}}}}})}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["invalid transition [['reach'], 'eat', 1]"]),
+    ("state-not-table", "a component's state that is not a table", {"st.json": state(actors={"max": {"character": "Max", "components": {"action": {"plugin": "hierarchical", "state": 5}}}})}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["key actors.max.components.action.state: int instead of a table"]),
+    ("state-deep", "nesting 40 deep", {"st.json": state(frame=[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[0]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]])}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["nested more than 32 deep"]),
+    ("state-huge-int", "a huge integer", {"st.json": state(frame=10**40)}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["st.json: key frame: integer too large (41 digits)"]),
+    ("state-load-device", "--load of a device", {}, ["run", "demo", "--load", "/dev/zero"], ["/dev/zero: is a character device, not a file; expected a regular file (state file written by --save)"]),
+    ("state-nan", "NaN in a state file", {"st.json": state(time=float("nan"))}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["not JSON likeme reads: NaN is not a finite number"]),
 ]
 
 

@@ -273,24 +273,25 @@ def _view(pm: PluginManager, name: str, subject: str, settings: list[str]) -> An
 def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dict[str, Any]:
     from toolkit.report import summarise
     from toolkit.scenario import load_scenario
+    from toolkit.state import Checkpoint, StateFile, apply_state, read_state
 
     if getattr(args, "set", None) and not getattr(args, "render", None):  # a view's settings, and no view
         raise ConfigError("--set without --render", key=("--set",),
                           expected="--render DIR with the settings of the view that draws the run")
+    # the --save target and the --load file are checked before any work (the target first: its version is the one
+    # this run may overwrite); the loaded state is applied, all or nothing, once the world is composed
+    target = StateFile(args.save, loaded=getattr(args, "load", None)) if getattr(args, "save", None) else None
+    loaded = read_state(args.load) if getattr(args, "load", None) else None
     scenario = load_scenario(path, pm, seed=args.seed, on_plugin_error="skip" if args.keep_going else "stop")
     if getattr(args, "duration", None) is not None:
         from toolkit.scenario import check_duration
 
         scenario.duration = check_duration(args.duration, scenario.world.fps, ("--duration",))
-    if getattr(args, "load", None):
-        from toolkit.state import load_state
-
-        load_state(scenario.world, args.load)
+    if loaded is not None:
+        apply_state(scenario.world, loaded, args.load)
     checkpoint = None
-    if getattr(args, "save", None):
-        from toolkit.state import Checkpoint
-
-        checkpoint = Checkpoint(scenario.world, args.save)
+    if target is not None:
+        checkpoint = Checkpoint(scenario.world, target)
         pm.register(checkpoint, name="checkpoint")
     view = _view(pm, args.view, "scenario", args.set) if getattr(args, "render", None) else None
     files = []
@@ -304,7 +305,7 @@ def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dic
             pm.unregister(checkpoint)
     world = scenario.world
     if checkpoint is not None:
-        checkpoint.save()
+        checkpoint.finish()  # ConfigError if the last save fails or had to go to a conflict file
     if view is not None:
         print(f"wrote {len(files)} file(s) to {args.render}: " + ", ".join(
             sorted({f.suffix.lstrip('.') for f in files})), file=sys.stderr)

@@ -10,7 +10,7 @@ The size caps (``docs/conventions.md``) have defaults a user can raise with envi
 - motion files (BVH): ``LIKEME_MAX_MOTION_MB``, default 4096 (a 60-minute 120 fps capture of 60 joints with six
   channels each is about 2 GB of text);
 - configuration files (TOML: characters, profiles, scenarios): ``LIKEME_MAX_CONFIG_MB``, default 16;
-- state files (JSON written by ``--save``: what characters learned): ``LIKEME_MAX_STATE_MB``, default 256.
+- state files (JSON written by ``--save``: what characters learned): ``LIKEME_MAX_STATE_MB``, default 64.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from toolkit.errors import ConfigError
 __all__ = ["check_regular_file", "open_regular", "max_bytes", "LIMITS"]
 
 LIMITS: dict[str, tuple[str, int]] = {"motion": ("LIKEME_MAX_MOTION_MB", 4096), "config": ("LIKEME_MAX_CONFIG_MB", 16),
-                                      "state": ("LIKEME_MAX_STATE_MB", 256)}
+                                      "state": ("LIKEME_MAX_STATE_MB", 64)}
 """The size cap of each kind of file: (environment variable in MB, default MB)."""
 
 
