@@ -94,8 +94,8 @@ class _ObserverEstimator(BaseEstimator):
 
     def _compose(self, repertoire: Any) -> Any:
         args = self._observer_args()
-        return compose_observer(_plugin_manager(), self._profile(), repertoire, lengths_for_height=self.lengths_for_height,
-                                **args)
+        return compose_observer(_plugin_manager(), self._profile(), repertoire,
+                                lengths_for_height=self.lengths_for_height, **args)
 
     def _repertoire(self, motions: Sequence[Motion], labels: Sequence[str]) -> Any:
         """The clips as a repertoire in memory, its hubs found with the motor system's settings."""
@@ -111,7 +111,8 @@ class _ObserverEstimator(BaseEstimator):
 
     def get_params(self, deep: bool = True) -> dict[str, Any]:
         """The constructor's arguments; with ``deep``, also ``TABLE__KEY`` for every parameter of each component
-        table's plugin (its value as the observer will have it: given, the template's, or the default)."""
+        table's plugin (its value as written for the observer: given, the template's, or the default; a length
+        parameter is scaled to the body's height when composed, as ``lengths_for_height`` says)."""
         params = super().get_params(deep=False)
         if deep:
             available = self._plugin_parameters()
