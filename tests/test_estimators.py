@@ -92,7 +92,7 @@ def test_memory_repertoire_and_clips_folder_together_is_an_error(data):
                          settings={"motor": {"clips": str(dest / "repertoire")}})
 
 
-@pytest.mark.parametrize("matcher", ["path-search", "dtw"])
+@pytest.mark.parametrize("matcher", ["path-search", "dtw", "forward-model"])
 def test_classifier_answers_as_bench_recognition(data, matcher):
     """fit on the repertoire folder's clips, predict the demos: the answers and the accuracy of
     ``likeme bench recognition`` on the same folders, item by item."""
@@ -148,6 +148,18 @@ def test_segmenter_with_a_repertoire_given(data):
     a = MovementSegmenter(profile, repertoire=(X, y)).fit(streams).predict(streams)
     b = MovementSegmenter(profile, repertoire=clip_repertoire(X, y, profile)).fit(streams).predict(streams)
     assert a == b and all(a)
+
+
+def test_grid_search_over_a_segmenter_parameter(data):
+    """A threshold above every movement's distance from the hub finds nothing (F1 0); the search keeps the other.
+    (The template's hub-threshold measures in body sizes: its ``size_threshold``.)"""
+    dest, profile = data
+    streams, truth = load_streams(dest / "streams", profile)
+    search = GridSearchCV(MovementSegmenter(profile), {"segmenter__size_threshold": [0.1, 50.0]}, cv=2)
+    search.fit(streams, truth)
+    assert search.best_params_ == {"segmenter__size_threshold": 0.1}
+    assert list(search.cv_results_["mean_test_score"]) == [1.0, 0.0]
+    assert search.best_estimator_.predict(streams[:1])[0]
 
 
 @settings(max_examples=40, deadline=None)
@@ -221,6 +233,21 @@ def test_get_set_params_round_trip(data, params):
     plugin = {k: v for k, v in got.items() if k != "settings"}
     assert {k: v for k, v in again.get_params().items() if k != "settings"} == plugin
     assert clone(clf).get_params() == got
+
+
+SEGMENTER_PARAMS = {"segmenter__threshold": st.floats(0.0, 1.0), "segmenter__min_duration": st.floats(0.0, 2.0),
+                    "segmenter__release": st.floats(0.0, 1.0), "segmenter": st.just("hub-threshold")}
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(st.dictionaries(st.sampled_from(sorted(SEGMENTER_PARAMS)), st.none()).flatmap(
+    lambda keys: st.fixed_dictionaries({k: SEGMENTER_PARAMS[k] for k in keys})))
+def test_segmenter_get_set_params_round_trip(data, params):
+    _, profile = data
+    seg = MovementSegmenter(profile).set_params(**params)
+    got = seg.get_params()
+    assert {k: got[k] for k in params} == params
+    assert clone(seg).get_params() == got
 
 
 def test_plugin_parameters_follow_the_plugin(data):
