@@ -124,6 +124,22 @@ def test_arrays_are_motions_at_fps(data):
     assert (a == np.array(y[:6], dtype=object)).all()
 
 
+def test_labels_that_are_numbers_come_back_as_numbers(data):
+    dest, profile = data
+    X, y, _ = load_recordings(dest / "repertoire", profile)
+    names = sorted(set(y))
+    numbers = np.array([names.index(label) for label in y])
+    clf = MovementClassifier(profile, unknown=-1).fit(X, numbers)
+    assert clf.classes_.tolist() == list(range(len(names)))
+    predicted = clf.predict(X[:5])
+    assert predicted.tolist() == numbers[:5].tolist() and predicted.dtype.kind == "i"
+    assert clf.score(X[:5], numbers[:5]) == 1.0
+    rejecting = clone(clf).set_params(matcher__max_distance=0.0, matcher__spread=0.0).fit(X, numbers)
+    assert rejecting.predict(X[:3]).tolist() == [-1, -1, -1]
+    with pytest.raises(EstimatorInputError, match="the label -1"):
+        clf.fit(X[:2], [0, -1])
+
+
 def test_segmenter_scores_as_bench_segmentation(data):
     dest, profile = data
     bench = segmentation(create_plugin_manager(), profile, dest / "streams", ["hub-threshold"])
@@ -275,6 +291,8 @@ def test_errors(data):
         clf.fit(X[0], y[:1])
     with pytest.raises(EstimatorInputError, match="the label 'unknown'"):
         clf.fit(X[:2], ["bow", UNKNOWN])
+    with pytest.raises(EstimatorInputError, match="without '#'"):
+        clf.fit(X[:2], ["bow", "bow#2"])
     with pytest.raises(EstimatorInputError) as err:
         clf.set_params(matcher__kk=3)
     assert "unknown parameter 'matcher__kk' of matcher plugin 'path-search'" in str(err.value)

@@ -211,11 +211,15 @@ class MovementClassifier(ClassifierMixin, _ObserverEstimator):
         Plugin parameters per table, ``{"matcher": {"k": 4}}``; ``set_params(matcher__k=4)`` writes here.
     fps : float
         The frame rate of motions given as arrays.
+    unknown : object
+        What :meth:`predict` answers for a motion the matcher rejects (:data:`UNKNOWN`); with labels that are not
+        strings, give one of their kind (``-1``) so that answers and labels compare.
 
     Attributes
     ----------
-    classes_ : ndarray of str
-        The movement labels fitted, sorted (``"unknown"`` is never one).
+    classes_ : ndarray
+        The movement labels fitted, sorted (``"unknown"`` is never one); labels that are not strings (numbers)
+        name the movements by their text and come back from :meth:`predict` as they were given.
     character_ : Character
         The observer composed by :meth:`fit`.
     repertoire_ : ClipRepertoire
@@ -225,7 +229,8 @@ class MovementClassifier(ClassifierMixin, _ObserverEstimator):
     def __init__(self, profile: Any, matcher: str = "path-search", *, motor: str | None = None,
                  segmenter: str | None = None, correspondence: str | None = "",
                  lengths_for_height: float | None | str = "", template: str | Path = OBSERVER_TEMPLATE,
-                 settings: Mapping[str, Mapping[str, Any]] | None = None, fps: float = 30.0) -> None:
+                 settings: Mapping[str, Mapping[str, Any]] | None = None, fps: float = 30.0,
+                 unknown: Any = UNKNOWN) -> None:
         self.profile = profile
         self.matcher = matcher
         self.motor = motor
@@ -235,14 +240,16 @@ class MovementClassifier(ClassifierMixin, _ObserverEstimator):
         self.template = template
         self.settings = settings
         self.fps = fps
+        self.unknown = unknown
 
     def fit(self, X: Any, y: Any) -> MovementClassifier:
         """Build the repertoire from the motions ``X`` labelled ``y`` and compose the observer."""
         motions = self._motions(X)
-        labels = _labels(y, len(motions))
+        labels = _labels(y, len(motions), unknown=self.unknown)
         self.repertoire_ = self._repertoire(motions, labels)
         self.character_ = self._compose(self.repertoire_)
-        self.classes_ = np.array(sorted(set(labels)))
+        self.classes_ = np.unique(np.asarray(y))
+        self._label_of = {str(c): c for c in self.classes_}  # a movement's name -> the label it was given as
         return self
 
     def observe(self, X: Any) -> list[Observation]:
@@ -253,8 +260,9 @@ class MovementClassifier(ClassifierMixin, _ObserverEstimator):
         return [Observer(self.character_, body, m.fps).classify(m) for m in self._motions(X)]
 
     def predict(self, X: Any) -> np.ndarray:
-        """The movement of each motion, or :data:`UNKNOWN` where the matcher rejects it."""
-        return np.array([obs.movement or UNKNOWN for obs in self.observe(X)], dtype=object)
+        """The label of each motion's movement, or ``unknown`` (:data:`UNKNOWN`) where the matcher rejects it."""
+        return np.asarray([self._label_of[obs.movement] if obs.movement in self._label_of else self.unknown
+                           for obs in self.observe(X)])
 
     def decision_function(self, X: Any) -> np.ndarray:
         """The matcher's confidence in [0, 1] in the movement it recognised, 0 for every other class.
@@ -268,7 +276,7 @@ class MovementClassifier(ClassifierMixin, _ObserverEstimator):
         """
         observations = self.observe(X)
         scores = np.zeros((len(observations), len(self.classes_)))
-        index = {c: i for i, c in enumerate(self.classes_)}
+        index = {str(c): i for i, c in enumerate(self.classes_)}
         for row, obs in enumerate(observations):
             if obs.movement in index and obs.match is not None:
                 scores[row, index[obs.movement]] = obs.match.confidence
@@ -382,7 +390,7 @@ def to_breakpoints(segments: Sequence[tuple[int, int]], n_frames: int) -> list[i
     return sorted(cuts) + [int(n_frames)]
 
 
-def _labels(y: Any, n: int, what: str = "y") -> list[str]:
+def _labels(y: Any, n: int, what: str = "y", *, unknown: Any = UNKNOWN) -> list[str]:
     if isinstance(y, (str, bytes)):
         raise EstimatorInputError(f"{what} is one string", key=(what,), expected="one movement label per motion")
     labels = [str(v) for v in np.asarray(y, dtype=object).ravel()] if np.ndim(y) <= 1 else None
@@ -391,9 +399,13 @@ def _labels(y: Any, n: int, what: str = "y") -> list[str]:
     if len(labels) != n:
         raise EstimatorInputError(f"{n} motions and {len(labels)} labels", key=(what,),
                                   expected="one movement label per motion")
-    if UNKNOWN in labels:
-        raise EstimatorInputError(f"the label {UNKNOWN!r}", key=(what,),
-                                  expected=f"movement labels ({UNKNOWN!r} is what predict answers for none)")
+    if str(unknown) in labels or UNKNOWN in labels:
+        raise EstimatorInputError(f"the label {unknown if str(unknown) in labels else UNKNOWN!r}", key=(what,),
+                                  expected=f"movement labels ({unknown!r} is what predict answers for none)")
+    odd = sorted({label for label in labels if "#" in label or not label.strip()})
+    if odd:
+        raise EstimatorInputError(f"labels {odd}", key=(what,), expected="non-empty movement labels without '#' "
+                                  "(a movement's second take is named bow#2)")
     return labels
 
 
