@@ -137,3 +137,62 @@ def test_bench_behaviour_runs(tmp_path):
     data = json.loads(out.read_text())
     assert set(data["conditions"]) == {"line-of-sight", "no-line-of-sight", "close-together"}
     assert data["conditions"]["line-of-sight"]["path"] >= 2 / 3
+
+
+# -- arguments and output paths checked where they enter (issue 21) -----------------------------------------
+
+
+def test_seed_bounds():
+    import argparse
+
+    from toolkit.cli import seed_type
+
+    assert seed_type("0") == 0 and seed_type(str(2**63 - 1)) == 2**63 - 1
+    for text in ("-1", str(2**63), "x", "1.5"):
+        with pytest.raises(argparse.ArgumentTypeError):
+            seed_type(text)
+
+
+@pytest.mark.parametrize("text", ["nan", "inf", "-inf", "-0.5", "3600.5"])
+def test_duration_refuses_non_finite_and_out_of_range(text):
+    import argparse
+
+    from toolkit.cli import number_type
+
+    parse = number_type(0.0, 3600.0, "seconds")
+    assert parse("0") == 0.0 and parse("3600") == 3600.0
+    with pytest.raises(argparse.ArgumentTypeError, match=r"expected seconds in \[0, 3600\]"):
+        parse(text)
+
+
+def test_output_file_checks(tmp_path):
+    from toolkit import ConfigError
+    from toolkit.cli import check_output_file
+
+    assert check_output_file(tmp_path / "new.json", "--json") == tmp_path / "new.json"
+    assert not (tmp_path / "new.json").exists() and list(tmp_path.iterdir()) == []  # the probe leaves nothing
+    with pytest.raises(ConfigError, match="key --json: is a folder"):
+        check_output_file(tmp_path, "--json")
+    with pytest.raises(ConfigError, match="key --csv: no such folder"):
+        check_output_file(tmp_path / "missing" / "x.csv", "--csv")
+    with pytest.raises(ConfigError, match="key --out: not a regular file"):
+        check_output_file("/dev/null", "--out")
+
+
+def test_render_folder_is_created_before_the_run(tmp_path):
+    from toolkit.cli import check_output_dir
+
+    folder = tmp_path / "a" / "b"
+    assert check_output_dir(folder, "--render") == folder and folder.is_dir() and list(folder.iterdir()) == []
+
+
+def test_view_settings_without_a_view_are_refused():
+    assert_one_line_error(likeme("run", "demo", "--set", "every=2"), "key --set: --set without --render")
+    assert_one_line_error(likeme("show", "max", "--set", "keys=4"), "key --set: --set without --view")
+    assert_one_line_error(likeme("show", "max", "--out", "x.png"), "key --out: --out without --view")
+
+
+def test_bad_output_fails_before_any_work(tmp_path):
+    """A bench that would run for minutes stops at once on an output it could not write."""
+    result = likeme("bench", "watch", "--movements", "200", "--json", tmp_path / "missing" / "w.json")
+    assert_one_line_error(result, "key --json: no such folder")

@@ -46,6 +46,10 @@ Frame Time: 0.0333333
 0 90 0 0 0 0 0 0 0
 0 91 0 0 0 0 0 0 0
 """
+DEEP_BVH = ("HIERARCHY\nROOT j0\n{\nOFFSET 0 0 0\nCHANNELS 3 Xrotation Yrotation Zrotation\n"
+            + "".join(f"JOINT j{i}\n{{\nOFFSET 0 1 0\nCHANNELS 3 Xrotation Yrotation Zrotation\n" for i in range(1, 1000))
+            + "}\n" * 1000 + "MOTION\nFrames: 1\nFrame Time: 0.03\n" + " ".join(["0"] * 3000) + "\n")
+"""A BVH file whose joints are nested 1,000 deep."""
 PROFILE = '[profile]\nname = "p"\nunits = "cm"\n[parts]\nroot = "hips"\nhead = "head"\nnose = "head_end"\n[facing]\nleft = "head"\nright = "nose"\n'
 
 
@@ -152,6 +156,56 @@ CASES = [
     ("view-unknown", "unknown view", {}, ["show", "max", "--view", "graph"], ["unknown view 'graph'", "available:", "hub-signal"]),
     ("view-segmenter", "a signal view of a segmenter the character does not have", {}, ["show", "max", "--view", "speed-profile"], ["key --view", "Max has no velocity-direction segmenter (its segmenter is 'hub-threshold')", "expected a character whose [segmenter] plugin is velocity-direction"]),
     ("view-movement", "a view asked to perform an unknown movement", {}, ["show", "max", "--view", "hub-signal", "--set", 'movements=["fly"]'], ["key movements", "unknown movement 'fly'", "available:", "wave"]),
+    # -- config: every file, parameter and argument bounded and checked where it enters (issue 21)
+    ("param-nan", "a NaN parameter", {"c.toml": CHILD + "[perception]\nnoise = nan\n"}, ["validate", "c.toml"], ["c.toml:5: key perception.noise", "value nan is not a finite number"]),
+    ("param-inf-nested", "an infinite number inside a table parameter", {"c.toml": CHILD + "[motor.poses.stand]\nhead = [0, inf, 0]\n"}, ["validate", "c.toml"], ["key motor.poses.stand.head[1]", "value inf is not a finite number", "expected finite numbers"]),
+    ("toml-deep", "TOML nested 10,000 deep", {"c.toml": "x = " + "[" * 10000 + "]" * 10000 + "\n"}, ["validate", "c.toml"], ["c.toml", "TOML nested more than 32 levels deep"]),
+    ("toml-deep-tables", "inline tables nested 10,000 deep", {"c.toml": "x = " + "{a=" * 10000 + "1" + "}" * 10000 + "\n"}, ["validate", "c.toml"], ["c.toml", "TOML nested more than 32 levels deep"]),
+    ("extends-chain", "an extends chain of 1,200 files", {f"c{i}.toml": f'[character]\nname = "C{i}"\nextends = "c{i + 1}.toml"\n' for i in range(1200)}, ["validate", "c0.toml"], ["c63.toml", "key character.extends", "extends chain longer than 64 files"]),
+    ("facing-same-part", "facing left and right the same part", {"c.toml": BODY.replace('right = "rk"', 'right = "lk"')}, ["validate", "c.toml"], ["key body.facing.right", "left and right are the same part 'lk'", "available: root, head, rk"]),
+    ("bone-to-itself", "a bone from a part to itself", {"c.toml": BODY.replace("facing =", 'bones = [["root", "head"], ["head", "head"]]\nfacing =')}, ["validate", "c.toml"], ["key body.bones[1]", "a bone from part 'head' to itself"]),
+    ("profile-units-inf", "infinite units in a profile", {"p.toml": PROFILE.replace('"cm"', "inf")}, ["validate", "p.toml"], ["p.toml:3: key profile.units", "invalid units inf"]),
+    ("profile-up-list", "up given as a list", {"p.toml": PROFILE.replace('units = "cm"', 'units = "cm"\nup = ["+y"]')}, ["validate", "p.toml"], ["key profile.up", "wrong type list", 'expected one axis as a string, like up = "+z"']),
+    ("profile-facing-same", "a profile facing left and right the same part", {"p.toml": PROFILE.replace('right = "nose"', 'right = "head"')}, ["validate", "p.toml"], ["p.toml:10: key facing.right", "left and right are the same part 'head'"]),
+    ("profile-bone-self", "a profile bone from a part to itself", {"p.toml": 'bones = [["head", "head"]]\n' + PROFILE}, ["validate", "p.toml"], ["p.toml:1: key bones[0]", "a bone from part 'head' to itself"]),
+    ("scenario-properties", "object properties not a table", {"s.toml": SCENE + '[[objects]]\nname = "c"\nkind = "food"\nproperties = "abc"\n'}, ["validate", "s.toml"], ["key objects[0].properties", "wrong type str", "expected a table of properties"]),
+    ("scenario-held-by-list", "held_by given as a list", {"s.toml": SCENE + '[[objects]]\nname = "c"\nkind = "food"\nheld_by = ["max"]\n'}, ["validate", "s.toml"], ["key objects[0].held_by", "wrong type list", "expected the id of one actor, as a string", "available: max"]),
+    ("scenario-colour", "an object colour that is not #rrggbb", {"s.toml": SCENE + '[[objects]]\nname = "c"\nkind = "food"\ncolour = "purplish"\n'}, ["run", "s.toml", "--render", "out"], ["key objects[0].colour", "invalid colour 'purplish'", 'expected a colour "#rrggbb"']),
+    ("scenario-tail", "a tail of 1e300 seconds", {"s.toml": SCENE.replace('name = "s"', 'name = "s"\ntail = 1e300')}, ["validate", "s.toml"], ["key scenario.tail", "invalid value 1e+300", "expected seconds in [0, 3600]"]),
+    ("scenario-fps-high", "a frame rate of a million", {"s.toml": SCENE.replace('name = "s"', 'name = "s"\nfps = 1e6')}, ["validate", "s.toml"], ["key scenario.fps", "invalid value 1000000.0", "at most 1000"]),
+    ("scenario-frames", "a run of more frames than bounded", {"s.toml": SCENE.replace('name = "s"', 'name = "s"\nfps = 1000\nduration = 3600')}, ["validate", "s.toml"], ["key scenario.duration", "duration 3600 s at 1000 fps is 3600000 frames", "expected at most 432000 frames"]),
+    ("scenario-seed", "a negative seed in a scenario", {"s.toml": SCENE.replace('name = "s"', 'name = "s"\nseed = -1')}, ["validate", "s.toml"], ["key scenario.seed", "invalid seed -1", "expected an integer in [0, "]),
+    ("script-random", "a script drawing 100,000,000 movements", {"s.toml": SCENE + '[actors.override.action]\nplugin = "script"\nrandom = 100000000\n'}, ["validate", "s.toml"], ["s.toml:8: key actors[0].override.action.random", "value 100000000 out of range", "expected an integer in [0, 100000]"]),
+    ("override-typo", "a scenario override's typo (reported in the scenario)", {"s.toml": SCENE + '[actors.override.segmenter]\ntreshold = 0.1\n'}, ["validate", "s.toml"], ["s.toml:7: key actors[0].override.segmenter.treshold", "unknown parameter 'treshold' for segmenter 'hub-threshold'"]),
+    ("cli-duration-nan", "--duration nan", {}, ["run", "demo", "--duration", "nan"], ["argument --duration: invalid value 'nan'", "expected seconds in [0, 3600]"]),
+    ("cli-duration-inf", "--duration inf", {}, ["run", "demo", "--duration", "inf"], ["argument --duration: invalid value 'inf'"]),
+    ("cli-seed-negative", "--seed -1", {}, ["run", "demo", "--seed", "-1"], ["argument --seed: invalid seed -1", "expected an integer in [0, 9223372036854775807]"]),
+    ("cli-json-folder", "--json into a folder that does not exist", {}, ["bench", "watch", "--movements", "1", "--json", "/nonexistent/x.json"], ["/nonexistent: key --json", "no such folder", "expected a file in an existing folder"]),
+    ("cli-render-file", "--render to a file, not a folder", {"f.txt": "x\n"}, ["run", "demo", "--render", "f.txt"], ["f.txt: key --render", "not a folder"]),
+    ("cli-render-unwritable", "--render below a file", {"f.txt": "x\n"}, ["run", "demo", "--render", "f.txt/frames"], ["f.txt/frames: key --render", "cannot create the folder"]),
+    ("bench-data-file", "bench make-data into a file", {"f.txt": "x\n"}, ["bench", "make-data", "f.txt"], ["f.txt: key DIR", "not a folder"]),
+    ("bench-dropout", "bench watch --dropout 2", {}, ["bench", "watch", "--dropout", "2"], ["argument --dropout: invalid value '2'", "expected a probability in [0, 1]"]),
+    ("set-table-typo", "--set with a misspelt table", {}, ["bench", "watch", "--movements", "1", "--set", "matchr.k=3"], ["key --set.matchr", "unknown table 'matchr'", "available: motor, perception, correspondence, segmenter, matcher, action"]),
+    ("set-key-unknown", "--set with a key of no named matcher", {"p.toml": PROFILE}, ["bench", "recognition", "--body", "p.toml", "--repertoire", ".", "--matcher", "path-search", "--matcher", "dtw", "--set", "matcher.spread=2"], ["key --set.matcher.spread", "unknown parameter 'spread' for matcher 'dtw'", "available: max_distance, stride, window"]),
+    ("scenario-radius", "an object of negative radius", {"s.toml": SCENE + '[[objects]]\nname = "c"\nkind = "food"\nradius = -1\n'}, ["validate", "s.toml"], ["key objects[0].radius", "invalid value -1", "expected a positive number of metres"]),
+    ("bench-lengths-nan", "bench --lengths-for-height nan", {"p.toml": PROFILE}, ["bench", "recognition", "--body", "p.toml", "--repertoire", ".", "--lengths-for-height", "nan"], ["argument --lengths-for-height: invalid value 'nan'", "expected metres in [0, 1000]"]),
+    ("set-value-nan", "--set with a NaN value", {}, ["bench", "watch", "--movements", "1", "--set", "perception.noise=nan"], ["key --set.perception.noise", "value nan is not a finite number for perception 'synthetic-vision'"]),
+    # -- watching: bounded working memory and the memory benchmark
+    ("bench-memory-minutes", "memory benchmark for nan minutes", {}, ["bench", "memory", "--minutes", "nan"], ["key --minutes", "value nan", "expected a finite number > 0"]),
+    ("bench-memory-block", "memory benchmark with packets of 0 frames", {}, ["bench", "memory", "--block", "0"], ["key --block", "value 0", "expected a whole number >= 1"]),
+    ("observe-ruptures-window", "ruptures with a negative window", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "ruptures", "--set", "segmenter.window=-1", "m.bvh"], ["key segmenter.window", "value -1.0 out of range", "expected a number in [0, inf]"]),
+    ("observe-max-movement", "velocity-direction with a negative max_movement", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "velocity-direction", "--set", "segmenter.max_movement=-5", "m.bvh"], ["key segmenter.max_movement", "value -5.0 out of range"]),
+    # -- reading: bounded, streaming BVH and profile reading (issue 21)
+    ("bvh-frame-rate", "a frame time of 0.1 microseconds (10 MHz)", {"m.bvh": BVH.replace("Frame Time: 0.0333333", "Frame Time: 1e-7")}, ["validate", "m.bvh"], ["m.bvh:18:13", "frame time 1e-07 s (1e+07 frames per second)", "expected a frame time of 0.0001 to 60 seconds"]),
+    ("bvh-nesting", "joints nested 1,000 deep", {"m.bvh": DEEP_BVH}, ["validate", "m.bvh"], ["m.bvh:1026:1", "joints nested deeper than 256", "expected at most 256 levels of JOINT"]),
+    ("bvh-no-channels", "no channels in the whole file", {"m.bvh": BVH.replace("CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation", "CHANNELS 0").replace("CHANNELS 3 Zrotation Xrotation Yrotation", "CHANNELS 0")}, ["validate", "m.bvh"], ["m.bvh:16:1", "no channels in the hierarchy", "expected at least one joint with CHANNELS"]),
+    ("bvh-channel-digit", "a channel count in superscript digits", {"m.bvh": BVH.replace("CHANNELS 3", "CHANNELS \u00b2")}, ["validate", "m.bvh"], ["m.bvh:9:14", "found '\u00b2'", "expected the number of channels (ASCII digits, at most 6)"]),
+    ("bvh-frames-huge", "Frames: 10**12 with two frame lines", {"m.bvh": BVH.replace("Frames: 2", "Frames: 1000000000000")}, ["validate", "m.bvh"], ["m.bvh:21:1", "2 frame lines after 'Frames: 1000000000000'", "expected 1000000000000 frame lines"]),
+    ("bvh-dev-zero", "a device given as a clip", {"p.toml": PROFILE}, ["observe", "--body", "p.toml", "--repertoire", ".", "/dev/zero"], ["/dev/zero: is a character device, not a file", "expected a regular file (BVH file)"]),
+    ("bvh-directory", "a directory given as a clip", {"p.toml": PROFILE}, ["observe", "--body", "p.toml", "--repertoire", ".", "."], [".: is a directory, not a file", "expected a regular file (BVH file)"]),
+    ("profile-dev-zero", "a device given as a body profile", {"m.bvh": BVH}, ["observe", "--body", "/dev/zero", "--repertoire", ".", "m.bvh"], ["/dev/zero: is a character device, not a file", "expected a regular file (body profile)"]),
+    ("validate-dev-zero", "a device given to validate", {}, ["validate", "/dev/zero"], ["/dev/zero: is a character device, not a file", "expected a regular file (TOML file)"]),
+    ("validate-directory", "a directory given to validate", {}, ["validate", "."], [".: is a directory, not a file", "expected a regular file (TOML file)"]),
 ]
 
 

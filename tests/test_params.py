@@ -50,3 +50,25 @@ def test_describe_is_readable():
     assert PARAMS[1].describe() == "integer in [1, 100], default 5"
     assert PARAMS[4].describe() == "table, required"
     assert PARAMS[3].describe() == "array of strings, default []"
+
+
+@pytest.mark.parametrize("value", ["nan", "inf", "-inf"])
+def test_non_finite_numbers_are_refused_with_the_key(value):
+    from toolkit.params import parse_settings
+
+    settings = parse_settings([f"matcher.k={value}", f"segmenter.floor={value}"])
+    with pytest.raises(ConfigError, match=rf"key floor: value -?{value.lstrip('-')} is not a finite number"):
+        validate_params("segmenter 'x'", [Parameter("floor", float, 0.0, minimum=0.0)], settings["segmenter"])
+
+
+def test_a_setting_nested_too_deep_is_refused():
+    from toolkit.params import parse_settings
+
+    value = parse_settings(["keys=" + "[" * 31 + "]" * 31], tables=False)["keys"]  # with its table: 32 levels
+    depth = 0
+    while isinstance(value, list):
+        depth, value = depth + 1, value[0] if value else None
+    assert depth == 31
+    for depth in (33, 5000):
+        with pytest.raises(ConfigError, match="key --set: value of 'keys' nested more than 32 levels deep"):
+            parse_settings([f"keys={'[' * depth}{']' * depth}"], tables=False)

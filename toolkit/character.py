@@ -45,6 +45,7 @@ __all__ = [
     "character_paths",
     "merge_tables",
     "COMPONENT_TABLES",
+    "check_body",
 ]
 
 COMPONENT_TABLES: dict[str, bool] = {
@@ -145,11 +146,28 @@ class Character:
 # -- reading files -------------------------------------------------------------------
 
 
-def read_text(path: str | Path, what: str) -> str:
-    """A UTF-8 text file's content; a missing or unreadable file is a :class:`ConfigError` expecting ``what``."""
+MAX_TEXT_BYTES = 16 * 1024 * 1024
+"""The largest declaration file read (bytes): a character, scenario or profile is a few kilobytes."""
+MAX_DEPTH = 32
+"""The deepest nesting of arrays and tables a declaration may have."""
+MAX_EXTENDS = 64
+"""The longest ``extends`` chain a character file may start."""
+
+
+def read_text(path: str | Path, what: str, *, limit: int | None = None) -> str:
+    """A UTF-8 text file's content (a byte-order mark at its start is dropped); a missing, unreadable or not
+    regular file (a device, a FIFO), or one larger than ``limit`` bytes, is a :class:`ConfigError` expecting
+    ``what``."""
     path = Path(path)
     try:
-        return path.read_text(encoding="utf-8")
+        if path.exists() and not path.is_file():
+            raise ConfigError("not a regular file", file=path, expected=f"a {what}")
+        with path.open("rb") as handle:
+            data = handle.read() if limit is None else handle.read(limit + 1)
+        if limit is not None and len(data) > limit:
+            raise ConfigError(f"file larger than {limit} bytes", file=path,
+                              expected=f"a {what} (a declaration of a few kilobytes)")
+        return data.decode("utf-8-sig")
     except FileNotFoundError:
         raise ConfigError("file not found", file=path, expected=f"an existing {what}") from None
     except (OSError, UnicodeDecodeError) as exc:
@@ -159,15 +177,33 @@ def read_text(path: str | Path, what: str) -> str:
 def read_toml(path: str | Path) -> dict[str, Any]:
     """Parse a TOML file; syntax errors become a :class:`ConfigError` with line and column."""
     path = Path(path)
-    text = read_text(path, "TOML file")
+    text = read_text(path, "TOML file", limit=MAX_TEXT_BYTES)
     try:
-        return tomllib.loads(text)
+        table = tomllib.loads(text)
+    except RecursionError:
+        table = None
     except tomllib.TOMLDecodeError as exc:
         msg = str(exc)
         m = re.search(r"\(at line (\d+), column (\d+)\)", msg)
         line, col = (int(m.group(1)), int(m.group(2))) if m else (None, None)
         problem = re.sub(r"\s*\(at (line \d+, column \d+|end of document)\)", "", msg)
         return _raise(ConfigError(f"TOML syntax error: {problem}", file=path, line=line, column=col))
+    if table is None or _too_deep(table):
+        return _raise(ConfigError(f"TOML nested more than {MAX_DEPTH} levels deep", file=path,
+                                  expected=f"arrays and tables nested at most {MAX_DEPTH} levels deep"))
+    return table
+
+
+def _too_deep(table: Mapping[str, Any]) -> bool:
+    """Whether arrays and tables nest deeper than :data:`MAX_DEPTH` (walked without recursion)."""
+    stack: list[tuple[Any, int]] = [(table, 1)]
+    while stack:
+        value, depth = stack.pop()
+        if depth > MAX_DEPTH:
+            return True
+        children = value.values() if isinstance(value, Mapping) else value
+        stack.extend((v, depth + 1) for v in children if isinstance(v, (Mapping, list)))
+    return False
 
 
 def _raise(err: Exception) -> Any:
@@ -247,6 +283,10 @@ def merge_tables(base: Mapping[str, Any], over: Mapping[str, Any]) -> dict[str, 
 def _load_chain(path: Path, pm: PluginManager | None, stack: tuple[Path, ...] = ()) -> tuple[dict[str, Any], tuple[Path, ...]]:
     """The merged table of ``path`` and everything it extends, and the files involved (outermost first)."""
     path = path.resolve()
+    if len(stack) >= MAX_EXTENDS:
+        raise ConfigError(f"extends chain longer than {MAX_EXTENDS} files", file=stack[-1],
+                          key=("character", "extends"),
+                          expected=f"at most {MAX_EXTENDS} files, each extending the next")
     if path in stack:
         cycle = " -> ".join(p.name for p in (*stack, path))
         raise ConfigError(f"extends cycle: {cycle}", file=stack[-1], key=("character", "extends"), expected="no cycle")
@@ -269,7 +309,8 @@ def _load_chain(path: Path, pm: PluginManager | None, stack: tuple[Path, ...] = 
 
 
 def load_character(
-    path: str | Path, pm: PluginManager | None = None, *, override: Mapping[str, Any] | None = None
+    path: str | Path, pm: PluginManager | None = None, *, override: Mapping[str, Any] | None = None,
+    override_at: tuple[str | Path | None, tuple[str | int, ...]] | None = None,
 ) -> Character:
     """Load, merge, validate and compose the character declared in ``path``.
 
@@ -281,6 +322,9 @@ def load_character(
         Where components are looked up; a new one is created if omitted.
     override : mapping, optional
         Tables merged over the file's (a scenario's per-actor overrides).
+    override_at : (file, key prefix), optional
+        Where ``override`` was written (a scenario file and ``("actors", 0, "override")``; ``(None, ("--set",))``
+        for the command line): an error in a key the override gives is reported there, not in the character file.
     """
     if pm is None:
         from toolkit.manager import create_plugin_manager
@@ -295,7 +339,26 @@ def load_character(
     try:
         return compose_character(table, pm, files=files)
     except ConfigError as err:
+        if override and override_at is not None and err.file is None and _gives(override, err.key):
+            file, prefix = override_at
+            key = (*prefix, *err.key)
+            line = find_key_line(Path(file), key) if file is not None else None
+            raise ConfigError(err.problem, file=file, key=key, line=line, expected=err.expected,
+                              available=err.available) from None
         raise _locate(err, files) from None
+
+
+def _gives(override: Mapping[str, Any], key: tuple) -> bool:
+    """Whether the key path ``key`` leads to a value that ``override`` gives (a table of it, a key, an element)."""
+    value: Any = override
+    for part in key:
+        if isinstance(value, Mapping) and isinstance(part, str) and part in value:
+            value = value[part]
+        elif isinstance(value, list) and isinstance(part, int) and 0 <= part < len(value):
+            value = value[part]
+        else:
+            return False
+    return bool(key)
 
 
 def compose_character(table: Mapping[str, Any], pm: PluginManager, *, files: tuple[Path, ...] = (),
@@ -328,7 +391,7 @@ def compose_character(table: Mapping[str, Any], pm: PluginManager, *, files: tup
                           expected="a positive number: the standing height (m) the length parameters were written for")
     body_table = _table(table, "body", required=True)
     try:
-        body = Body.from_config(body_table)
+        body = check_body(Body.from_config(body_table))
     except ConfigError as err:
         raise err.within(prefix=("body",)) from None
 
@@ -360,6 +423,21 @@ def compose_character(table: Mapping[str, Any], pm: PluginManager, *, files: tup
         _guard(component, key, "attach", lambda c=component: c.attach(character))
     pm.hook.likeme_character_composed(character=character)  # a failing plugin is named by the plugin manager
     return character
+
+
+def check_body(body: Body) -> Body:
+    """``body`` if its facing and bones are usable, else a :class:`ConfigError` keyed relative to its table: the
+    facing's left and right parts must differ (their difference is the facing direction) and a bone joins two
+    different parts. Character files and body profiles both go through it."""
+    if body.facing.left == body.facing.right:
+        raise ConfigError(f"left and right are the same part {body.facing.left!r}", key=("facing", "right"),
+                          expected="two different parts (the facing direction is their difference)",
+                          available=[p for p in body.parts if p != body.facing.left])
+    for i, (a, b) in enumerate(body.bones):
+        if a == b:
+            raise ConfigError(f"a bone from part {a!r} to itself", key=("bones", i),
+                              expected="a pair of two different parts")
+    return body
 
 
 def _length_scale(character: Character) -> float:

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import re
 import sys
 from collections.abc import Sequence
@@ -39,13 +40,124 @@ class _Parser(argparse.ArgumentParser):
         self.exit(1, f"likeme: error: {message} (see '{self.prog} --help')\n")
 
 
+# -- argument types and output paths: checked where they enter, before any work ------------------------
+
+
+def seed_type(text: str) -> int:
+    """``--seed``: an integer in [0, 2**63 - 1] (numpy's generators take no negative seed)."""
+    from toolkit.scenario import MAX_SEED
+
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid int value: {text!r}") from None
+    if not 0 <= value <= MAX_SEED:
+        raise argparse.ArgumentTypeError(f"invalid seed {value}: expected an integer in [0, {MAX_SEED}]")
+    return value
+
+
+def number_type(low: float, high: float, what: str = "a number") -> Any:
+    """An argument type: a finite number in [low, high] (NaN and infinities refused)."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"invalid number: {text!r}") from None
+        if not (math.isfinite(value) and low <= value <= high):
+            raise argparse.ArgumentTypeError(f"invalid value {text!r}: expected {what} in [{low:g}, {high:g}]")
+        return value
+
+    parse.__name__ = "number"
+    return parse
+
+
+def count_type(low: int, high: int) -> Any:
+    """An argument type: an integer in [low, high]."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"invalid int value: {text!r}") from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"invalid value {value}: expected an integer in [{low}, {high}]")
+        return value
+
+    parse.__name__ = "count"
+    return parse
+
+
+OUTPUT_FILES = {"json": "--json", "csv": "--csv", "plot": "--plot", "out": "--out"}
+"""Arguments naming a file a command writes, and how they are named in messages (a string value only: ``likeme run
+--json`` is a flag and is left alone)."""
+OUTPUT_DIRS = {"render": "--render", "dest": "DIR"}
+"""Arguments naming a folder a command writes into (created if missing): ``run --render``, ``bench make-data DIR``."""
+
+
+def _probe(folder: Path, path: Path, option: str, expected: str) -> None:
+    """Create and remove a temporary file in ``folder``: the only sure test that the command can write there."""
+    import tempfile
+
+    try:
+        with tempfile.NamedTemporaryFile(dir=folder, prefix=".likeme-probe-"):
+            pass
+    except OSError as exc:
+        raise ConfigError(f"cannot write there ({exc.strerror or exc})", file=path, key=(option,),
+                          expected=expected) from None
+
+
+def check_output_file(path: str | Path, option: str) -> Path:
+    """A file a command will write (``option`` names it in messages, ``--json``): its folder must exist and be
+    writable, and it must not be a folder, a device or a FIFO."""
+    path = Path(path)
+    folder = path.parent
+    key = (option,)
+    if path.is_dir():
+        raise ConfigError("is a folder", file=path, key=key, expected="the path of a file to write")
+    if path.exists() and not path.is_file():
+        raise ConfigError("not a regular file", file=path, key=key, expected="the path of a file to write")
+    if not folder.is_dir():
+        raise ConfigError("no such folder", file=folder, key=key, expected="a file in an existing folder")
+    _probe(folder, path, option, "a file in a folder this user can write")
+    return path
+
+
+def check_output_dir(path: str | Path, option: str) -> Path:
+    """A folder a command will write into (``option`` names it in messages, ``--render``): an existing writable
+    folder, or a missing one, created here (with its missing parents)."""
+    path = Path(path)
+    key = (option,)
+    if path.exists() and not path.is_dir():
+        raise ConfigError("not a folder", file=path, key=key, expected="a folder to write into (created if missing)")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError(f"cannot create the folder ({exc.strerror or exc})", file=path, key=key,
+                          expected="a folder to write into (created if missing)") from None
+    _probe(path, path, option, "a folder this user can write into")
+    return path
+
+
+def check_outputs(args: argparse.Namespace) -> None:
+    """Every output path a command was given (:data:`OUTPUT_FILES`, :data:`OUTPUT_DIRS`), checked before it runs."""
+    for name, option in OUTPUT_FILES.items():
+        value = getattr(args, name, None)
+        if isinstance(value, str):
+            check_output_file(value, option)
+    for name, option in OUTPUT_DIRS.items():
+        value = getattr(args, name, None)
+        if isinstance(value, str):
+            check_output_dir(value, option)
+
+
 def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     parser = _Parser(prog="likeme", description="Characters that understand others by simulating them with their own bodies.")
     parser.add_argument("--version", action="version", version=f"likeme {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
 
     p = sub.add_parser("demo", help="run the built-in scenario and report what each character did and saw")
-    p.add_argument("--seed", type=int, default=None, help="seed for random choices (default: the scenario's)")
+    p.add_argument("--seed", type=seed_type, default=None, help="seed for random choices (default: the scenario's)")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.add_argument("--keep-going", action="store_true", help="go on without a plugin that fails (default: stop)")
     p.add_argument("--scenario", action="append", metavar="NAME",
@@ -54,8 +166,9 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
 
     p = sub.add_parser("run", help="run a scenario file")
     p.add_argument("scenario", help="scenario TOML file, or the name of a built-in scenario")
-    p.add_argument("--seed", type=int, default=None, help="seed for random choices (default: the scenario's)")
-    p.add_argument("--duration", type=float, default=None, help="seconds to run (default: the scenario's)")
+    p.add_argument("--seed", type=seed_type, default=None, help="seed for random choices (default: the scenario's)")
+    p.add_argument("--duration", type=number_type(0.0, 3600.0, "seconds"), default=None,
+                   help="seconds to run, at most 3600 (default: the scenario's)")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.add_argument("--keep-going", action="store_true", help="go on without a plugin that fails (default: stop)")
     p.add_argument("--load", metavar="STATE", help="restore what the characters learned from a state file first")
@@ -126,6 +239,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if not getattr(args, "handler", None):
             parser.print_help()
             return 1
+        check_outputs(args)
         return int(args.handler(args, pm) or 0)
     except LikemeError as err:
         print(f"likeme: error: {err}", file=sys.stderr)
@@ -159,9 +273,14 @@ def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dic
     from toolkit.report import summarise
     from toolkit.scenario import load_scenario
 
+    if getattr(args, "set", None) and not getattr(args, "render", None):  # a view's settings, and no view
+        raise ConfigError("--set without --render", key=("--set",),
+                          expected="--render DIR with the settings of the view that draws the run")
     scenario = load_scenario(path, pm, seed=args.seed, on_plugin_error="skip" if args.keep_going else "stop")
     if getattr(args, "duration", None) is not None:
-        scenario.duration = args.duration
+        from toolkit.scenario import check_duration
+
+        scenario.duration = check_duration(args.duration, scenario.world.fps, ("--duration",))
     if getattr(args, "load", None):
         from toolkit.state import load_state
 
@@ -252,7 +371,9 @@ def plugins_table(pm: PluginManager, *, params: bool = False) -> dict[str, Any]:
             }
         )
     skipped = [{"name": i.name, "distribution": i.distribution} for i in pm.skipped]
-    return {"components": components, "plugins": plugins, "skipped": skipped}
+    failed = [{"name": i.name, "module": i.module, "distribution": i.distribution, "version": i.version,
+               "error": str(e)} for i, e in pm.failed]
+    return {"components": components, "plugins": plugins, "skipped": skipped, "failed": failed}
 
 
 def components_markdown(pm: PluginManager) -> str:
@@ -303,6 +424,9 @@ def cmd_plugins(args: argparse.Namespace, pm: PluginManager) -> int:
         print(f"  {p['name']} ({p['module']}, {dist}): {', '.join(p['hooks'])}")
     for s in table["skipped"]:
         print(f"  {s['name']} ({s['distribution']}): skipped, LIKEME_DISABLE_PLUGIN_AUTOLOAD is set")
+    for f in table["failed"]:
+        print(f"  {f['name']} ({f['module']}, {f['distribution']} {f['version']}): failed to load, left out: "
+              f"{f['error']}")
     return 0
 
 
@@ -310,6 +434,10 @@ def cmd_show(args: argparse.Namespace, pm: PluginManager) -> int:
     from toolkit.character import load_character
     from toolkit.report import describe_character
 
+    for option, value in (("--set", args.set), ("--out", args.out)):
+        if value and not args.view:  # a view's settings and picture: nothing to apply them to
+            raise ConfigError(f"{option} without --view", key=(option,),
+                              expected="--view NAME with the view's settings and where it writes its picture")
     if args.after:
         from toolkit.scenario import load_scenario
 
@@ -349,11 +477,14 @@ def cmd_show(args: argparse.Namespace, pm: PluginManager) -> int:
 def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
     import json
 
+    from toolkit.files import check_regular_file
     from toolkit.observe import NO_CORRESPONDENCE, Observer, compose_observer
     from toolkit.params import parse_settings
     from toolkit.profile import load_profile
 
     profile = load_profile(args.body)
+    for path in args.files:  # a FIFO, a device, a directory or a missing file fails before any work
+        check_regular_file(path, "BVH file", "motion")
     for name, kind in ((args.segmenter, "segmenter"), (args.matcher, "matcher"), (args.correspondence, "correspondence")):
         if name is not None and name != NO_CORRESPONDENCE:
             pm.registry.get(kind, name)  # an unknown name fails here, listing the registered ones
@@ -363,9 +494,14 @@ def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
                                  settings=parse_settings(list(args.set)))
     report = []
     for path in args.files:
-        motion = profile.read(path)
-        observer = Observer(character, profile.body, motion.fps)
-        found = observer.watch(motion)
+        # the file streamed a block of frames at a time (header first), so reading memory does not grow with it
+        with profile.stream(path) as motion:
+            observer = Observer(character, profile.body, motion.fps)
+            observer.reset()
+            found = []
+            for positions, visible in motion:
+                found.extend(observer.push_block(positions, visible))
+            found.extend(observer.flush())
         report.append({"file": str(path), "frames": motion.n_frames, "fps": round(motion.fps, 3), "segments": [
             {"start_frame": o.segment.start, "end_frame": o.segment.end, "start_s": round(o.segment.start_time, 3),
              "end_s": round(o.segment.end_time, 3), "movement": o.movement or "unknown",
@@ -414,8 +550,9 @@ def _why_text(seg: dict[str, Any]) -> str:
 
 
 def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
-    from toolkit.bvh import read_bvh
+    from toolkit.bvh import open_bvh
     from toolkit.character import load_character, read_toml
+    from toolkit.files import check_regular_file
     from toolkit.observe import check_observer_template, is_observer_template
     from toolkit.profile import is_profile, load_profile
     from toolkit.report import describe_character
@@ -430,14 +567,16 @@ def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
     for path in args.files:
         try:
             if str(path).lower().endswith(".bvh"):
-                bvh = read_bvh(path)
+                with open_bvh(path) as bvh:  # every frame read and checked, a block at a time
+                    for _ in bvh.blocks():
+                        pass
                 line = f"ok    {path}: BVH: {len(bvh.names)} joints, {bvh.n_frames} frames at {bvh.fps:g} fps"
                 if profile is not None:
-                    unmapped = profile.check(bvh)
+                    unmapped = profile.check(bvh.header)
                     line += f"; profile {profile.name!r} maps {len(profile.joints)}, leaves {len(unmapped)} unmapped"
                 print(line)
                 continue
-            table = read_toml(path)
+            table = read_toml(check_regular_file(path, "TOML file", "config"))
             if is_scenario(table):
                 scenario = load_scenario(path, pm)
                 world = scenario.world

@@ -9,6 +9,12 @@ Environment variables:
 ``LIKEME_DISABLE_PLUGIN_AUTOLOAD=1``
     Load only the entries of the ``likeme`` distribution itself (the built-ins);
     third-party entries are skipped.
+
+A third-party entry point that fails to import or to register does not stop likeme: it is left out, recorded in
+:attr:`PluginManager.failed`, and one warning line on standard error names the entry point, its distribution,
+the error, and ``LIKEME_DISABLE_PLUGIN_AUTOLOAD=1``. Every command goes on without it (``validate`` included);
+only a component it would have registered is missing, and naming one is the usual "unknown ..." error, which then
+also names the plugin that failed. ``likeme plugins`` lists it as failed. A built-in that fails is an error.
 ``LIKEME_TRACE_HOOKS=1``
     Print every hook call and its result to standard error.
 
@@ -89,9 +95,13 @@ class ComponentInfo:
 
 
 class Registry:
-    """Components by kind and name, collected from the ``likeme_register_*`` hooks."""
+    """Components by kind and name, collected from the ``likeme_register_*`` hooks.
 
-    def __init__(self, components: Iterable[ComponentInfo]) -> None:
+    ``failed``: third-party plugins that failed to load; an unknown name's error mentions them.
+    """
+
+    def __init__(self, components: Iterable[ComponentInfo], failed: Sequence[PluginInfo] = ()) -> None:
+        self.failed = tuple(failed)
         self._by_kind: dict[str, dict[str, ComponentInfo]] = {kind: {} for kind in KINDS}
         for info in components:
             self._by_kind[info.kind][info.name] = info
@@ -109,9 +119,11 @@ class Registry:
             return self._by_kind[kind][name].cls
         except KeyError:
             label = KINDS[kind].kind
-            raise ConfigError(
-                f"unknown {label} {name!r}", expected=f"the name of a registered {label}", available=self.names(kind)
-            ) from None
+            expected = f"the name of a registered {label}"
+            if self.failed:
+                expected += " (" + ", ".join(f"plugin {i.name!r} of {i.distribution} failed to load"
+                                             for i in self.failed) + ")"
+            raise ConfigError(f"unknown {label} {name!r}", expected=expected, available=self.names(kind)) from None
 
     def info(self, kind: str, name: str) -> ComponentInfo:
         self.get(kind, name)
@@ -133,6 +145,7 @@ class PluginManager(pluggy.PluginManager):
         self.add_hookspecs(hookspecs)
         self.plugin_infos: dict[str, PluginInfo] = {}
         self.skipped: list[PluginInfo] = []
+        self.failed: list[tuple[PluginInfo, PluginError]] = []
         self._registry: Registry | None = None
         self._policies: list[tuple[str, Failed | None]] = []
         self.tracing = False
@@ -205,11 +218,29 @@ class PluginManager(pluggy.PluginManager):
             if not third_party and _normalise(dist) != DISTRIBUTION:
                 self.skipped.append(info)
                 continue
+            builtin = _normalise(dist) == DISTRIBUTION
             try:
                 module = ep.load()
-            except Exception as exc:  # a broken third-party import must name itself
-                raise PluginError(ep.name, f"import of {ep.value} ({dist})", f"{type(exc).__name__}: {exc}") from exc
-            self.register_plugin(module, info)
+            except Exception as exc:  # a broken import must name itself
+                error = PluginError(ep.name, f"import of {ep.value} ({dist})", f"{type(exc).__name__}: {exc}")
+                if builtin:
+                    raise error from exc
+                self._fail(info, error)
+                continue
+            try:
+                self.register_plugin(module, info)
+            except PluginError as error:
+                if builtin:
+                    raise
+                self._fail(info, error)
+
+    def _fail(self, info: PluginInfo, error: PluginError) -> None:
+        """A third-party entry point that failed: left out, recorded and announced on one warning line."""
+        self.failed.append((info, error))
+        self._registry = None
+        sys.stderr.write(f"likeme: warning: {error}; going on without plugin {info.name!r} of distribution "
+                         f"{info.distribution} {info.version} (entry point {info.name} = {info.module}); set "
+                         f"{ENV_DISABLE_AUTOLOAD}=1 to load only the built-in plugins\n")
 
     def register_plugin(self, plugin: ModuleType | object, info: PluginInfo) -> None:
         """Register one plugin object under ``info.name`` (used for entry points and by tests)."""
@@ -238,7 +269,7 @@ class PluginManager(pluggy.PluginManager):
     def registry(self) -> Registry:
         """Every component registered by the loaded plugins (collected once, then cached)."""
         if self._registry is None:
-            self._registry = Registry(self._collect())
+            self._registry = Registry(self._collect(), [info for info, _ in self.failed])
         return self._registry
 
     def _collect(self) -> list[ComponentInfo]:

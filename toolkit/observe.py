@@ -29,10 +29,10 @@ import numpy as np
 
 from toolkit.character import COMPONENT_TABLES, Character, compose_character, read_toml, resolve_file
 from toolkit.components import Perception
-from toolkit.errors import ConfigError
+from toolkit.errors import ConfigError, PluginError
 from toolkit.motion import Motion
 from toolkit.profile import BodyProfile
-from toolkit.watching import Observation, WatchingLoop
+from toolkit.watching import KEEP_SECONDS, MAX_SEGMENT_SECONDS, Observation, WatchingLoop, guarded
 
 __all__ = ["Observation", "Observer", "compose_observer", "observer_tables", "OBSERVER_TEMPLATE", "NO_CORRESPONDENCE",
            "is_observer_template", "check_observer_template"]
@@ -55,9 +55,17 @@ class Observer:
     as a tracker delivers a packet or a file is read). Both give the same observations at the same frames: a block
     is perceived and segmented at once where the plugins can do so (``Perception.perceive_poses``,
     ``Segmenter.push_block``), then a streaming matcher is fed frame by frame.
+
+    Working memory is bounded (:mod:`toolkit.watching`): it holds the segment under way and the last ``keep``
+    seconds (default :data:`~toolkit.watching.KEEP_SECONDS`), and a segment still open after ``max_segment``
+    seconds (default :data:`~toolkit.watching.MAX_SEGMENT_SECONDS`) is cut there, so an observer fed for hours
+    stays the same size; ``keep=None`` keeps every row. :meth:`watch`, given a whole motion, keeps every row of it
+    (``poses`` is then its whole perception). Every call into a plugin (the perception's included) is guarded: a
+    failure is a :class:`~toolkit.errors.PluginError` naming it, and what it returns is checked.
     """
 
-    def __init__(self, character: Character, body: Any, fps: float, *, perception: Perception | None = None) -> None:
+    def __init__(self, character: Character, body: Any, fps: float, *, perception: Perception | None = None,
+                 keep: float | None = KEEP_SECONDS, max_segment: float | None = MAX_SEGMENT_SECONDS) -> None:
         perception = perception if perception is not None else character.perception
         if perception is None or character.segmenter is None:
             raise ConfigError(f"character {character.name} cannot observe", expected="a perception and a segmenter")
@@ -69,15 +77,15 @@ class Observer:
                               key=("perception", "plugin"), expected="a perception that implements perceive_pose",
                               available=able)
         self.character, self.body, self.fps, self.perception = character, body, float(fps), perception
-        self.loop = WatchingLoop(character)
+        self.loop = WatchingLoop(character, keep=keep, max_segment=max_segment)
         self.reset()
 
     def reset(self) -> None:
         """Start a new stream: frame numbering, memory, perception and segmenter restart; the motor system stands
         at rest."""
         if self.character.motor is not None:
-            self.character.motor.reset()
-        self.perception.reset(self.fps)
+            guarded(self.character.motor, "reset")
+        guarded(self.perception, "reset", self.fps)
         self.loop.reset(self.body.parts, self.fps, capacity=256)
 
     @property
@@ -91,19 +99,33 @@ class Observer:
 
     @property
     def poses(self) -> np.ndarray:
-        """The root-relative poses perceived so far (frames, P, 3): the working memory, hidden parts held."""
+        """The root-relative poses perceived so far (frames, P, 3): the working memory, hidden parts held (with
+        bounded working memory, the rows it holds: from frame ``memory.offset``)."""
         return self.loop.memory.positions
 
     @property
     def visible(self) -> np.ndarray:
-        """Which parts were seen in each frame so far (frames, P)."""
+        """Which parts were seen in each frame so far (frames, P) (the rows working memory holds)."""
         return self.loop.memory.visible
 
     def _perceive(self, positions: np.ndarray, visible: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+        """The perception's root-relative poses (n, S, 3) and visibility (n, S) of world positions (n, S, 3),
+        guarded and checked."""
         positions = np.asarray(positions, dtype=float)
         visible = None if visible is None else np.asarray(visible, dtype=bool)
         times = (self.loop.memory.n + np.arange(len(positions))) / self.fps
-        return self.perception.perceive_poses(positions, visible, self.body, times)
+        result = guarded(self.perception, "perceive_poses", positions, visible, self.body, times)
+        where = f"{type(self.perception).__name__}.perceive_poses"
+        try:
+            poses, seen = result
+            poses, seen = np.asarray(poses, dtype=float), np.asarray(seen, dtype=bool)
+        except (TypeError, ValueError):
+            raise PluginError(self.perception.name, where, f"returned {type(result).__name__}, expected (poses, "
+                              f"visible)") from None
+        if poses.shape != positions.shape or seen.shape != positions.shape[:2]:
+            raise PluginError(self.perception.name, where, f"returned poses {poses.shape} and visible {seen.shape}, "
+                              f"expected {positions.shape} and {positions.shape[:2]}")
+        return poses, seen
 
     def push(self, positions: np.ndarray, visible: np.ndarray | None = None) -> list[Observation]:
         """One frame of world positions (P, 3); returns the observations of segments that closed here."""
@@ -120,14 +142,19 @@ class Observer:
         """Stream a whole motion of world positions (reset first, flushed at the end).
 
         ``block``: frames delivered at a time (0: the whole motion as one block); the observations do not
-        depend on it.
+        depend on it. Every row is kept (``poses`` is the whole motion's perception) and no segment is cut.
         """
-        self.reset()
-        step = block if block > 0 else max(1, motion.n_frames)
-        out: list[Observation] = []
-        for f in range(0, motion.n_frames, step):
-            out.extend(self.push_block(motion.positions[f : f + step], motion.visible[f : f + step]))
-        out.extend(self.flush())
+        bound = self.loop.keep
+        self.loop.keep = None  # the motion is whole in memory already: its perception is kept whole too
+        try:
+            self.reset()
+            step = block if block > 0 else max(1, motion.n_frames)
+            out: list[Observation] = []
+            for f in range(0, motion.n_frames, step):
+                out.extend(self.push_block(motion.positions[f : f + step], motion.visible[f : f + step]))
+            out.extend(self.flush())
+        finally:
+            self.loop.keep = bound
         return out
 
     def classify(self, motion: Motion) -> Observation:

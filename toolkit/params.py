@@ -9,13 +9,14 @@ fails the same way as a bad TOML value.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 from toolkit.errors import ConfigError
 
-__all__ = ["Parameter", "REQUIRED", "validate_params"]
+__all__ = ["Parameter", "REQUIRED", "validate_params", "parse_settings", "check_settings"]
 
 
 class _Required:
@@ -97,8 +98,17 @@ class Parameter:
         return text
 
     def coerce(self, value: Any) -> Any:
-        """Return the checked value (ints widened to float) or raise :class:`ConfigError`."""
+        """Return the checked value (ints widened to float) or raise :class:`ConfigError`.
+
+        A NaN or infinite number anywhere in the value (in an array or table too) is refused: every number a
+        parameter takes is finite.
+        """
         value = _check_type(value, self.type, self.name, self._expected())
+        where = _non_finite(value)
+        if where is not None:
+            path, number = where
+            raise ConfigError(f"value {number!r} is not a finite number", key=(self.name, *path),
+                              expected=self._expected() if not path else "finite numbers")
         if self.items is not None:
             value = [_check_type(v, self.items, i, self._expected()) for i, v in enumerate(value)]
         if self.type in (int, float):
@@ -119,6 +129,20 @@ class Parameter:
 
     def _expected(self) -> str:
         return self.describe(article=True)
+
+
+def _non_finite(value: Any) -> tuple[tuple[str | int, ...], float] | None:
+    """The key path (relative to ``value``) and value of its first NaN or infinite number, or ``None``."""
+    stack: list[tuple[tuple[str | int, ...], Any]] = [((), value)]
+    while stack:
+        path, item = stack.pop()
+        if isinstance(item, float) and not math.isfinite(item):
+            return path, item
+        if isinstance(item, Mapping):
+            stack.extend(((*path, k), v) for k, v in reversed(list(item.items())))
+        elif isinstance(item, (list, tuple)):
+            stack.extend(((*path, i), v) for i, v in reversed(list(enumerate(item))))
+    return None
 
 
 def _check_type(value: Any, kind: type, key: str | int, expected: str) -> Any:
@@ -191,6 +215,8 @@ def parse_settings(items: list[str], *, tables: bool = True) -> dict[str, Any]:
     """
     import tomllib
 
+    from toolkit.character import MAX_DEPTH, _too_deep
+
     out: dict[str, Any] = {}
     for item in items:
         key, sep, value = item.partition("=")
@@ -204,5 +230,61 @@ def parse_settings(items: list[str], *, tables: bool = True) -> dict[str, Any]:
             parsed = tomllib.loads(f"v = {value}")["v"]
         except tomllib.TOMLDecodeError:
             parsed = value  # a bare word is a string
+        except RecursionError:
+            parsed = None
+        if parsed is None or _too_deep({"v": parsed}):
+            raise ConfigError(f"value of {key.strip()!r} nested more than {MAX_DEPTH} levels deep", key=("--set",),
+                              expected=f"arrays and tables nested at most {MAX_DEPTH} levels deep")
         (out.setdefault(table, {}) if tables else out)[name] = parsed
     return out
+
+
+def check_settings(settings: Mapping[str, Mapping[str, Any]], pm: Any, plugins: Mapping[str, Sequence[str]], *,
+                   option: str = "--set") -> None:
+    """Check command-line settings (``TABLE.KEY=VALUE`` as parsed by :func:`parse_settings`) before any work.
+
+    Every table must be a component table; every key a parameter, and every value valid, for each plugin the
+    table's settings will reach: ``plugins[TABLE]`` (a benchmark that compares several matchers checks
+    ``matcher.KEY`` against each of them), or the plugin the settings themselves name with ``TABLE.plugin=NAME``.
+
+    Raises
+    ------
+    ConfigError
+        Keyed ``OPTION.TABLE.KEY``, listing the component tables, or the plugin's parameters.
+    """
+    from toolkit.character import COMPONENT_TABLES
+    from toolkit.components import KINDS
+
+    for table, values in settings.items():
+        if table not in COMPONENT_TABLES:
+            raise ConfigError(f"unknown table {table!r}", key=(option, table), expected=f"{option} TABLE.KEY=VALUE "
+                              "with TABLE a component table", available=list(COMPONENT_TABLES))
+        named = values.get("plugin")
+        names = [named] if named is not None else list(plugins.get(table, ()))
+        if not names:
+            raise ConfigError(f"no [{table}] component to set", key=(option, table),
+                              expected=f"a table the observer has, or {table}.plugin=NAME with it",
+                              available=[t for t in COMPONENT_TABLES if plugins.get(t)])
+        for name in names:
+            if not isinstance(name, str):
+                raise ConfigError(f"invalid plugin name {name!r}", key=(option, table, "plugin"),
+                                  expected=f"the name of a registered {KINDS[table].kind}",
+                                  available=pm.registry.names(table))
+            try:
+                cls = pm.registry.get(table, name)
+            except ConfigError as err:
+                raise err.within(prefix=(option, table, "plugin")) from None
+            owner = f"{KINDS[table].kind} {name!r}"
+            known = {p.name: p for p in cls.parameters}
+            for key, value in values.items():
+                if key == "plugin":
+                    continue
+                if key not in known:
+                    raise ConfigError(f"unknown parameter {key!r} for {owner}", key=(option, table, key),
+                                      expected=f"a parameter of {owner}", available=sorted(known))
+                try:
+                    known[key].coerce(value)
+                except ConfigError as err:
+                    rest = (key, *err.key[1:]) if err.key[:1] == ("",) else err.key
+                    raise ConfigError(f"{err.problem} for {owner}", key=(option, table, *rest),
+                                      expected=err.expected, available=err.available) from None

@@ -337,6 +337,14 @@ class _Reports(Listener):
         self.actor.stop_imitation(self.actor.target, str(match.details.get("reason", "deviation")))
 
 
+MAX_FPS = 1000.0
+"""The highest frame rate a world runs at (frames per second)."""
+MAX_SECONDS = 3600.0
+"""The longest run, and the longest tail of a run until idle (seconds)."""
+MAX_FRAMES = 432_000
+"""The most frames one run steps (an hour at 120 fps): a duration times the frame rate above it is refused."""
+
+
 class World:
     """Actors and objects stepping together at a fixed frame rate.
 
@@ -358,8 +366,8 @@ class World:
     """
 
     def __init__(self, fps: float = 30.0, pm: Any = None, on_plugin_error: str = "stop") -> None:
-        if not fps > 0:
-            raise ValueError("fps must be positive")
+        if not 0 < fps <= MAX_FPS:
+            raise ValueError(f"fps must be positive and at most {MAX_FPS:g}")
         if on_plugin_error not in ("stop", "skip"):
             raise ValueError("on_plugin_error is 'stop' or 'skip'")
         self.on_plugin_error = on_plugin_error
@@ -492,7 +500,12 @@ class World:
         """
         if duration is None and not until_idle:
             raise ValueError("give a duration or until_idle=True")
-        limit = int(round((duration if duration is not None else max_duration) * self.fps))
+        for name, value in (("duration", duration), ("tail", tail), ("max_duration", max_duration)):
+            if value is not None and not 0 <= value <= MAX_SECONDS:
+                raise ValueError(f"{name} must be in [0, {MAX_SECONDS:g}] seconds, not {value!r}")
+        limit = min(int(round((duration if duration is not None else max_duration) * self.fps)), MAX_FRAMES)
+        if duration is not None and duration * self.fps > MAX_FRAMES:
+            raise ValueError(f"{duration:g} s at {self.fps:g} fps is more than {MAX_FRAMES} frames")
         settle = int(round(tail * self.fps))
         quiet = 0
         for _ in range(limit):

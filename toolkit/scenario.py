@@ -38,9 +38,9 @@ from typing import Any
 from toolkit.character import load_character, merge_tables, read_toml, resolve_file
 from toolkit.errors import ConfigError
 from toolkit.manager import PluginManager
-from toolkit.runtime import World, WorldObject
+from toolkit.runtime import MAX_FPS, MAX_FRAMES, MAX_SECONDS, World, WorldObject
 
-__all__ = ["Scenario", "load_scenario", "is_scenario"]
+__all__ = ["Scenario", "load_scenario", "is_scenario", "check_duration", "check_seed"]
 
 SCENARIO_KEYS = ("name", "description", "fps", "duration", "tail", "seed")
 ACTOR_KEYS = ("id", "character", "position", "heading", "watch", "override")
@@ -90,10 +90,40 @@ def load_scenario(path: str | Path, pm: PluginManager, *, seed: int | None = Non
         raise err.within(file=path) from None
 
 
+MAX_SEED = 2**63 - 1
+"""The largest seed: components hand it to numpy's random generators (which take no negative seed)."""
+
+
+def check_seed(seed: Any, key: tuple) -> int:
+    """``seed`` if it is an integer in [0, :data:`MAX_SEED`], else a :class:`ConfigError` at ``key``."""
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= MAX_SEED:
+        raise ConfigError(f"invalid seed {seed!r}", key=key, expected=f"an integer in [0, {MAX_SEED}]")
+    return seed
+
+
+def check_duration(duration: Any, fps: float, key: tuple) -> float:
+    """``duration`` (seconds) if it is a finite number in [0, :data:`MAX_SECONDS`] whose frames at ``fps`` are at
+    most :data:`MAX_FRAMES`, else a :class:`ConfigError` at ``key``."""
+    if isinstance(duration, bool) or not isinstance(duration, (int, float)) or not 0 <= duration <= MAX_SECONDS:
+        raise ConfigError(f"invalid duration {duration!r}", key=key,
+                          expected=f"a finite number of seconds in [0, {MAX_SECONDS:g}]")
+    if duration * fps > MAX_FRAMES:
+        raise ConfigError(f"duration {duration:g} s at {fps:g} fps is {duration * fps:.0f} frames", key=key,
+                          expected=f"at most {MAX_FRAMES} frames in a run")
+    return float(duration)
+
+
 def _number(value: Any, key: tuple, expected: str = "a number") -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise ConfigError(f"invalid value {value!r}", key=key, expected=expected)
     return float(value)
+
+
+def _radius(value: Any, key: tuple) -> float:
+    radius = _number(value, key, "a positive number of metres")
+    if radius <= 0:
+        raise ConfigError(f"invalid value {value!r}", key=key, expected="a positive number of metres")
+    return radius
 
 
 def _vector(value: Any, key: tuple) -> list[float]:
@@ -119,14 +149,20 @@ def _build(table: Mapping[str, Any], path: Path, pm: PluginManager, seed: int | 
     fps = _number(head.get("fps", 30.0), ("scenario", "fps"))
     if fps <= 0:
         raise ConfigError(f"invalid value {fps!r}", key=("scenario", "fps"), expected="a positive number")
+    if fps > MAX_FPS:
+        raise ConfigError(f"invalid value {fps!r}", key=("scenario", "fps"),
+                          expected=f"a positive number of frames per second, at most {MAX_FPS:g}")
     duration = head.get("duration")
     if duration is not None:
-        duration = _number(duration, ("scenario", "duration"))
+        duration = check_duration(_number(duration, ("scenario", "duration")), fps, ("scenario", "duration"))
     tail = _number(head.get("tail", 1.0), ("scenario", "tail"))
+    if not 0 <= tail <= MAX_SECONDS:
+        raise ConfigError(f"invalid value {tail!r}", key=("scenario", "tail"),
+                          expected=f"seconds in [0, {MAX_SECONDS:g}]")
     file_seed = head.get("seed", 0)
     if isinstance(file_seed, bool) or not isinstance(file_seed, int):
         raise ConfigError(f"invalid value {file_seed!r}", key=("scenario", "seed"), expected="an integer")
-    seed = file_seed if seed is None else seed
+    seed = check_seed(file_seed, ("scenario", "seed")) if seed is None else check_seed(seed, ("--seed",))
 
     world = World(fps=fps, pm=pm, on_plugin_error=on_plugin_error)
     actors = table.get("actors", [])
@@ -146,7 +182,7 @@ def _build(table: Mapping[str, Any], path: Path, pm: PluginManager, seed: int | 
         if not isinstance(override, Mapping):
             raise ConfigError("not a table", key=(*key, "override"), expected="tables to merge over the character's")
         override = _seeded(override, seed, char_path, pm)
-        character = load_character(char_path, pm, override=override)
+        character = load_character(char_path, pm, override=override, override_at=(path, (*key, "override")))
         heading = math.radians(_number(spec.get("heading", 0.0), (*key, "heading"), "degrees"))
         position = _vector(spec.get("position", [0.0, 0.0, 0.0]), (*key, "position"))
         actor_id = spec.get("id", re.sub(r"[^a-z0-9]+", "-", character.name.lower()).strip("-"))
@@ -185,16 +221,26 @@ def _build(table: Mapping[str, Any], path: Path, pm: PluginManager, seed: int | 
             if not isinstance(spec.get(req), str):
                 raise ConfigError("missing or invalid", key=(*key, req), expected="a string")
         held_by = spec.get("held_by")
+        if held_by is not None and not isinstance(held_by, str):
+            raise ConfigError(f"wrong type {type(held_by).__name__} (value {held_by!r})", key=(*key, "held_by"),
+                              expected="the id of one actor, as a string", available=list(world.actors))
         if held_by is not None and held_by not in world.actors:
             raise ConfigError(f"unknown actor {held_by!r}", key=(*key, "held_by"), expected="an actor id", available=list(world.actors))
+        properties = spec.get("properties", {})
+        if not isinstance(properties, Mapping):
+            raise ConfigError(f"wrong type {type(properties).__name__} (value {properties!r})",
+                              key=(*key, "properties"), expected="a table of properties, like { tasty = 0.8 }")
+        colour = spec.get("colour", "#c0c0c0")
+        if not _is_colour(colour):
+            raise ConfigError(f"invalid colour {colour!r}", key=(*key, "colour"), expected='a colour "#rrggbb"')
         obj = WorldObject(
             name=spec["name"],
             kind=spec["kind"],
             position=_vector(spec.get("position", [0.0, 0.0, 0.0]), (*key, "position")),
-            radius=_number(spec.get("radius", 0.05), (*key, "radius")),
-            colour=str(spec.get("colour", "#c0c0c0")),
+            radius=_radius(spec.get("radius", 0.05), (*key, "radius")),
+            colour=colour,
             held_by=held_by,
-            properties=dict(spec.get("properties", {})),
+            properties=dict(properties),
         )
         try:
             world.add_object(obj)
@@ -209,6 +255,10 @@ def _build(table: Mapping[str, Any], path: Path, pm: PluginManager, seed: int | 
         tail=tail,
         seed=seed,
     )
+
+
+def _is_colour(value: Any) -> bool:
+    return isinstance(value, str) and re.fullmatch(r"#[0-9a-fA-F]{6}", value) is not None
 
 
 def _seeded(override: Mapping[str, Any], seed: int, char_path: Path, pm: PluginManager) -> dict[str, Any]:

@@ -26,6 +26,24 @@ policy (:func:`call_component` names the failing plugin; a world in skip mode dr
 Working memory rows count from the first frame of the stream (``reset``); a :class:`Segment`'s frames are rows.
 A matcher reads the segment it follows through a :class:`WorkingMemory`, a view of the rows it has been given so
 far: it keeps no frames of its own.
+
+Bounded working memory (a live observer that watches for hours): a loop made with ``keep`` (seconds) holds only the
+rows still needed, the segment under way from its onset, the rows a segmenter says it may still report
+(``holds_since``) and the last ``keep`` seconds; older rows are dropped and the log's ``offset`` says where the rows
+it holds begin, so row numbers still count from the stream's first frame and segments, working memory views and
+matchers read the same rows as before. A segment that never closes (a demonstrator who never comes back to rest)
+is cut every ``max_segment`` seconds: the loop closes the piece under way (an :class:`Observation` with ``cut``
+set, answered by the matcher on its frames) and follows the rest from there; when the segmenter closes the segment
+at last, it is reported from the last cut. A segment the segmenter reports that begins before the first row
+working memory still holds is reported from that row. Memory is then bounded whatever the input: working memory
+by ``max_segment`` plus ``keep`` seconds, a matcher by the ``max_segment`` seconds it follows. Without ``keep``
+(the default, an actor in a world and :meth:`Observer.watch <toolkit.observe.Observer.watch>`, which is given the
+whole motion) every row is kept and nothing is cut.
+
+What plugins return is checked here, for every watcher alike: segments lie inside the stream, are ordered, disjoint
+and non-empty; a match names a movement of the observer's own repertoire (its motor system's) or none (unknown),
+with a finite confidence in [0, 1]. Anything else is a :class:`~toolkit.errors.PluginError` naming the plugin, the
+method, what it returned and what was expected.
 """
 
 from __future__ import annotations
@@ -43,8 +61,17 @@ from toolkit.motion import Motion, fill_hidden, part_index
 if TYPE_CHECKING:  # pragma: no cover
     from toolkit.character import Character
 
-__all__ = ["ObservationLog", "WorkingMemory", "Observation", "Listener", "WatchingLoop", "call_component", "feed",
-           "follow"]
+__all__ = ["ObservationLog", "WorkingMemory", "Observation", "Listener", "WatchingLoop", "call_component", "guarded",
+           "check_match", "feed", "follow", "KEEP_SECONDS", "MAX_SEGMENT_SECONDS"]
+
+KEEP_SECONDS = 10.0
+"""Seconds of the newest rows a bounded working memory keeps beyond what open segments need (a live observer's
+default, :class:`toolkit.observe.Observer`): room for a look back (a view, a gaze) without growing."""
+
+MAX_SEGMENT_SECONDS = 60.0
+"""Seconds after which a bounded loop cuts a segment that has not closed: about ten times the longest movement of
+the papers' repertoires (a bow, a dance: seconds), so a real movement is never cut, and a minute of working memory
+(7,200 frames at 120 fps) is small."""
 
 
 class ObservationLog:
@@ -54,7 +81,15 @@ class ObservationLog:
     ``world`` (F, P, 3), the parts' world positions. Hidden parts follow the one rule of
     :func:`toolkit.motion.fill_hidden`, kept up as frames arrive: a hidden part holds its last seen value; when a
     part is seen for the first time, the rows before are set to that sighting; a part not seen yet is NaN.
+
+    Rows no longer needed may be dropped (:meth:`forget`): the log then holds rows ``offset`` to ``n`` (exclusive);
+    ``n`` still counts every frame since watching began, and ``positions``, ``visible`` and ``world`` are the rows
+    held (all of them while nothing was forgotten).
     """
+
+    slack = 1024
+    """Rows :meth:`forget` lets go unused before it moves the rows held to the front (at least as many as it holds:
+    each row is then moved about once)."""
 
     def __init__(self, parts: Sequence[str], fps: float, capacity: int = 1024) -> None:
         self.parts = tuple(parts)
@@ -66,6 +101,7 @@ class ObservationLog:
         self._seen = np.zeros(p, dtype=bool)  # seen at least once
         self._all_seen = False
         self.n = 0
+        self.offset = 0  # the row number of the first row held (self._pos[0])
 
     def append(self, pose: np.ndarray, visible: np.ndarray, world: np.ndarray | None = None) -> None:
         """One frame: root-relative pose (P, 3), visible (P,), world positions (P, 3) if known."""
@@ -79,7 +115,7 @@ class ObservationLog:
         k = len(poses)
         if k == 0:
             return
-        start, end = self.n, self.n + k
+        start, end = self.n - self.offset, self.n - self.offset + k  # in the arrays
         if end > len(self._pos):
             self._reserve(end)
         self._vis[start:end] = visible
@@ -93,18 +129,44 @@ class ObservationLog:
                 self._world[:start, first] = self._world[start:end][np.argmax(visible[:, first], axis=0), first]
             self._seen |= visible.any(axis=0)
             self._all_seen = bool(self._seen.all())
-        self.n = end
+        self.n += k
 
     def _held(self, store: np.ndarray, values: np.ndarray, visible: np.ndarray) -> np.ndarray:
         """``values`` with hidden parts filled by the rule, continuing from the row before (the last seen values)."""
         if visible.all():
             return values
+        last = self.n - self.offset - 1
         if self.n and len(values) == 1 and self._all_seen:  # one frame, every part seen before: hold the last row
-            return np.where(visible[..., None], values, store[self.n - 1])
+            return np.where(visible[..., None], values, store[last])
         if self.n:
-            before = store[self.n - 1][None]
+            before = store[last][None]
             return fill_hidden(np.concatenate([before, values]), np.concatenate([self._seen[None], visible]))[1:]
         return fill_hidden(values, visible)
+
+    def forget(self, before: int) -> None:
+        """Rows before row ``before`` are no longer needed: they may be dropped, all but the newest (the log drops
+        them once they are as many as the rows it would keep, and at least :attr:`slack`, so a row is moved about
+        once; memory stays about twice what is needed at most)."""
+        before = min(int(before), self.n - 1)  # the newest row stays: hidden parts hold its values
+        dead = before - self.offset
+        if dead <= 0 or dead < max(self.slack, self.n - before):
+            return
+        held = self.n - before
+        size = max(2 * held, self.slack, 16)  # new arrays: a view a plugin kept of the old rows stays as it was
+        pos, world = np.full((size, *self._pos.shape[1:]), np.nan), np.full((size, *self._world.shape[1:]), np.nan)
+        vis = np.zeros((size, self._vis.shape[1]), dtype=bool)
+        pos[:held], world[:held], vis[:held] = self._pos[dead : dead + held], self._world[dead : dead + held], \
+            self._vis[dead : dead + held]
+        self._pos, self._world, self._vis = pos, world, vis
+        self.offset = before
+
+    def _rows(self, start: int, stop: int | None = None) -> slice:
+        """Rows ``start`` to ``stop`` (row numbers since watching began) as a slice of the arrays; a row that was
+        dropped is a ``ValueError`` (a caller that needs it should have kept it)."""
+        stop = self.n if stop is None else min(int(stop), self.n)
+        if start < self.offset:
+            raise ValueError(f"rows from {start} were dropped: working memory holds rows {self.offset}..{self.n}")
+        return slice(start - self.offset, max(start, stop) - self.offset)
 
     def _reserve(self, size: int) -> None:
         """Room for ``size`` frames (the arrays double when full)."""
@@ -117,24 +179,25 @@ class ObservationLog:
 
     @property
     def positions(self) -> np.ndarray:
-        """Root-relative positions (F, P, 3), hidden parts held (a view: do not write)."""
-        return self._pos[: self.n]
+        """Root-relative positions of the rows held (F, P, 3), hidden parts held (a view: do not write)."""
+        return self._pos[: self.n - self.offset]
 
     @property
     def visible(self) -> np.ndarray:
-        """Which parts were seen in each frame (F, P)."""
-        return self._vis[: self.n]
+        """Which parts were seen in each row held (F, P)."""
+        return self._vis[: self.n - self.offset]
 
     @property
     def world(self) -> np.ndarray:
-        """World positions (F, P, 3) as perceived, hidden parts held; NaN where never seen or not given."""
-        return self._world[: self.n]
+        """World positions of the rows held (F, P, 3) as perceived, hidden parts held; NaN where never seen or not
+        given."""
+        return self._world[: self.n - self.offset]
 
-    def motion(self, start: int = 0, stop: int | None = None) -> Motion:
-        """Rows ``start`` to ``stop`` as a root-relative :class:`Motion` (a copy), with their world positions."""
-        stop = self.n if stop is None else min(stop, self.n)
-        return Motion(self._pos[start:stop].copy(), self.fps, self.parts, self._vis[start:stop],
-                      self._world[start:stop].copy())
+    def motion(self, start: int | None = None, stop: int | None = None) -> Motion:
+        """Rows ``start`` (default: the first held) to ``stop`` as a root-relative :class:`Motion` (a copy), with
+        their world positions."""
+        rows = self._rows(self.offset if start is None else start, stop)
+        return Motion(self._pos[rows].copy(), self.fps, self.parts, self._vis[rows].copy(), self._world[rows].copy())
 
     def since(self, start: int) -> WorkingMemory:
         """A :class:`WorkingMemory` of the rows from ``start``, holding none of them yet (the loop feeds them)."""
@@ -180,17 +243,17 @@ class WorkingMemory:
     @property
     def positions(self) -> np.ndarray:
         """Root-relative positions (n, P, 3) of the frames given so far (a view: do not write)."""
-        return self._log._pos[self.start : self._stop]
+        return self._log._pos[self._log._rows(self.start, self._stop)]
 
     @property
     def visible(self) -> np.ndarray:
         """Which parts were seen (n, P)."""
-        return self._log._vis[self.start : self._stop]
+        return self._log._vis[self._log._rows(self.start, self._stop)]
 
     @property
     def world(self) -> np.ndarray:
         """World positions (n, P, 3) as perceived."""
-        return self._log._world[self.start : self._stop]
+        return self._log._world[self._log._rows(self.start, self._stop)]
 
     def motion(self) -> Motion:
         """The frames given so far as a root-relative :class:`Motion` (a copy)."""
@@ -205,12 +268,14 @@ class Observation:
     """One segment found in the stream and what the matcher made of it.
 
     ``decided_at`` is the number of frames into the segment at which the matcher committed (``None``: at its
-    end); ``match`` is ``None`` without a matcher.
+    end); ``match`` is ``None`` without a matcher. ``cut``: the segment had not closed after ``max_segment``
+    seconds and the watching loop cut it there (see the module); the rest is followed as a segment of its own.
     """
 
     segment: Segment
     match: Match | None
     decided_at: int | None
+    cut: bool = False
 
     @property
     def movement(self) -> str | None:
@@ -246,19 +311,39 @@ def call_component(character: Character, key: str, method: str, *args: Any, **kw
     component = getattr(character, key)
     if component is None:
         return None
+    return guarded(component, method, *args, **kwargs)
+
+
+def guarded(component: Any, method: str, *args: Any, **kwargs: Any) -> Any:
+    """Call ``component.<method>(...)``; anything but a likeme error becomes a :class:`PluginError` naming the
+    component and the method (as :func:`call_component`, for a component that is not one of a character's)."""
     try:
         return getattr(component, method)(*args, **kwargs)
     except LikemeError:
         raise
     except Exception as exc:
-        raise PluginError(component.name, f"{type(component).__name__}.{method}", f"{type(exc).__name__}: {exc}") from exc
+        raise PluginError(getattr(component, "name", type(component).__name__), f"{type(component).__name__}.{method}",
+                          f"{type(exc).__name__}: {exc}") from exc
 
 
-def _answer(segment: Segment, early: Match | None, late: Match | None) -> Observation:
+def _answer(segment: Segment, early: Match | None, late: Match | None, cut: bool = False) -> Observation:
     """The matcher's answer for a segment: what it concluded at the end, else what it committed to early."""
     if late is None and early is not None:
-        return Observation(segment, early, early.decided_at)
-    return Observation(segment, late if late is not None else Match.unknown(), None)
+        return Observation(segment, early, early.decided_at, cut)
+    return Observation(segment, late if late is not None else Match.unknown(), None, cut)
+
+
+def _seconds(value: float | None, name: str) -> float | None:
+    """A bound in seconds: ``None`` or a finite number >= 0 (else a :class:`ConfigError`)."""
+    if value is None:
+        return None
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        value = float("nan")
+    if not np.isfinite(value) or value < 0:
+        raise ConfigError(f"{name} = {value!r}", key=(name,), expected="a finite number of seconds >= 0, or none")
+    return value
 
 
 class WatchingLoop:
@@ -274,13 +359,25 @@ class WatchingLoop:
         (default: :func:`call_component`).
     listener : Listener, optional
         Told of segments, recognitions and deviations as they happen.
+    keep : float, optional
+        Bounded working memory (see the module): seconds of the newest rows kept beyond what the segment under way
+        and the segmenter need (:data:`KEEP_SECONDS` for a live observer). ``None`` (the default): every row is
+        kept and nothing is cut.
+    max_segment : float, optional
+        With ``keep``: seconds after which a segment that has not closed is cut (:data:`MAX_SEGMENT_SECONDS`;
+        ``None``: never, and a segment under way holds its rows however long it lasts).
     """
 
     def __init__(self, character: Character, *, call: Callable[..., Any] | None = None,
-                 listener: Listener | None = None) -> None:
+                 listener: Listener | None = None, keep: float | None = None,
+                 max_segment: float | None = MAX_SEGMENT_SECONDS) -> None:
         self.character = character
         self._call = call or (lambda key, method, *a, **k: call_component(character, key, method, *a, **k))
         self.listener = listener or Listener()
+        self.keep = _seconds(keep, "keep")
+        self.max_segment = _seconds(max_segment, "max_segment")
+        if self.max_segment == 0:
+            raise ConfigError("max_segment = 0", key=("max_segment",), expected="more than 0 seconds, or none")
         self.memory = ObservationLog(character.body.parts, 30.0, capacity=1)
         self.perceived: ObservationLog | None = None  # before correspondence (only with one)
         self._index = np.arange(len(character.body.parts))
@@ -288,6 +385,12 @@ class WatchingLoop:
         self._open: int | None = None  # start row of the segment the matcher follows
         self._view: WorkingMemory | None = None
         self._early: Match | None = None
+        self._since = -1  # the onset of the segment under way, from the last cut (-1: none)
+        self._floor = 0  # no segment is reported from before this row (the last cut)
+        self._last_end = 0  # the end of the last segment the segmenter closed (they are ordered and disjoint)
+        self._known: set[str] = set()  # movements found in the motor system's repertoire
+        self._keep_frames: int | None = None
+        self._max_frames: int | None = None
 
     # -- the stream ----------------------------------------------------------------------------------------
 
@@ -303,6 +406,10 @@ class WatchingLoop:
         self.memory = ObservationLog(own, fps, capacity=capacity)
         self.perceived = ObservationLog(own, fps, capacity=capacity) if self.character.correspondence else None
         self._open, self._view, self._early = None, None, None
+        self._since, self._floor, self._last_end, self._known = -1, 0, 0, set()
+        bounded = self.keep is not None
+        self._keep_frames = int(round(self.keep * float(fps))) if bounded else None
+        self._max_frames = max(1, int(round(self.max_segment * float(fps)))) if bounded and self.max_segment else None
         self._call("correspondence", "reset", own, float(fps))
         self._call("segmenter", "reset", own, float(fps))
 
@@ -324,13 +431,17 @@ class WatchingLoop:
         world = None if world is None else self._onto(world, np.nan)
         if self.perceived is not None and self.character.correspondence is not None:
             self.perceived.extend(poses, visible, world)
-            held, seen = self.perceived.positions[first:], self.perceived.visible[first:]
+            rows = self.perceived._rows(first)
+            held, seen = self.perceived._pos[rows], self.perceived._vis[rows]
             mapped = self._call("correspondence", "map_block", held, seen)
             if self.character.correspondence is not None:  # not dropped under a skip policy
-                mapped = np.asarray(mapped, dtype=float)
+                try:
+                    mapped = np.asarray(mapped, dtype=float)
+                except (TypeError, ValueError):
+                    mapped = np.asarray(None)
                 if mapped.shape != held.shape:
                     raise PluginError(self.character.correspondence.name, "Correspondence.map_block",
-                                      f"returned an array of shape {mapped.shape}, expected {held.shape}")
+                                      f"returned {_shown(mapped)}, expected an array of shape {held.shape}")
                 poses, visible = mapped, seen
         self.memory.extend(poses, visible, world)
         return first
@@ -343,11 +454,13 @@ class WatchingLoop:
         n = self.memory.n - first
         segmenter = self.character.segmenter
         if n == 0 or segmenter is None:
+            self._forget()
             return []
-        result = self._call("segmenter", "push_block", self.memory.positions[first:], self.memory.visible[first:])
+        new = WorkingMemory(self.memory, first, self.memory.n)
+        result = self._call("segmenter", "push_block", new.positions, new.visible)
         if self.character.segmenter is None:  # dropped (skip policy)
             return []
-        closed, since = self._checked_block(result, n)
+        closed, since = self._checked_block(result, n, first)
         out: list[Observation] = []
         k = 0
         for i in range(n):
@@ -355,8 +468,18 @@ class WatchingLoop:
             while k < len(closed) and closed[k][0] == i:
                 here.append(closed[k][1])
                 k += 1
+            here = self._clipped(here)
             out.extend(self._close(s, split=len(here) > 1) for s in here)
-            self._follow(int(since[i]), first + i)
+            row = first + i
+            onset = int(since[i])
+            if onset >= 0:
+                onset = max(onset, self._floor, self.memory.offset)
+                if self._max_frames is not None and row - onset >= self._max_frames:  # never closed: cut it here
+                    out.append(self._close(Segment(onset, row, self.memory.fps), cut=True))
+                    self._floor = onset = row
+            self._since = onset
+            self._follow(onset, row)
+        self._forget()
         return out
 
     def flush(self) -> list[Observation]:
@@ -366,7 +489,8 @@ class WatchingLoop:
         closed = self._call("segmenter", "flush")
         if self.character.segmenter is None:
             return []
-        segments = self._checked_segments(closed or [], "flush")
+        segments = self._clipped(self._checked_segments(closed or [], "flush", self.memory.n))
+        self._since = -1
         return [self._close(s, split=len(segments) > 1) for s in segments]
 
     def classify(self, poses: np.ndarray, visible: np.ndarray, world: np.ndarray | None = None) -> Observation:
@@ -375,6 +499,34 @@ class WatchingLoop:
         first = self._remember(poses, visible, world)
         segment = Segment(first, max(first + 1, self.memory.n), self.memory.fps)
         return self._close(segment, announce=False)
+
+    # -- bounded working memory -------------------------------------------------------------------------------
+
+    def _clipped(self, segments: list[Segment]) -> list[Segment]:
+        """Segments the segmenter closed, each from the last cut or the first row still held at the earliest (a
+        segment wholly before them was answered already, as the pieces it was cut into)."""
+        low = max(self._floor, self.memory.offset)
+        if not segments or segments[0].start >= low:
+            return segments
+        return [s if s.start >= low else Segment(low, s.end, s.fps) for s in segments if s.end > low]
+
+    def _forget(self) -> None:
+        """Bounded working memory: rows before the segment under way, before what the segmenter may still report
+        (its ``holds_since``, at most ``max_segment`` back) and before the last ``keep`` seconds may go."""
+        if self._keep_frames is None:
+            return
+        n = self.memory.n
+        need = n - self._keep_frames
+        if self._since >= 0:
+            need = min(need, self._since)
+        if self._open is not None:
+            need = min(need, self._open)
+        holds = getattr(self.character.segmenter, "holds_since", None)
+        if isinstance(holds, (int, np.integer)) and holds >= 0:
+            need = min(need, max(int(holds), self._floor, n - self._max_frames if self._max_frames else 0))
+        self.memory.forget(need)
+        if self.perceived is not None:
+            self.perceived.forget(need)
 
     # -- following a segment ----------------------------------------------------------------------------------
 
@@ -407,7 +559,7 @@ class WatchingLoop:
             return
         self._view.feed(row + 1)
         match = self._call("matcher", "observe", self._view)
-        if match is None:
+        if match is None or self.character.matcher is None:
             return
         self._check_match(match, "observe")
         if match.details.get("stop"):
@@ -416,7 +568,7 @@ class WatchingLoop:
             self._early = match
             self.listener.recognised(None, match)
 
-    def _close(self, segment: Segment, *, announce: bool = True, split: bool = False) -> Observation:
+    def _close(self, segment: Segment, *, announce: bool = True, split: bool = False, cut: bool = False) -> Observation:
         """A segment ended: its answer.
 
         A streaming matcher concludes what it followed. It is fed the segment's own frames first when it did not
@@ -429,7 +581,7 @@ class WatchingLoop:
         matcher = self.character.matcher
         if matcher is None:
             self._open, self._view, self._early = None, None, None
-            return Observation(segment, None, None)
+            return Observation(segment, None, None, cut)
         followed = self._open == segment.start and self._view is not None
         if matcher.streaming and (not followed or (split and self._early is None)):
             self._begin(segment.start)  # matched on its own frames, fed one by one
@@ -437,47 +589,144 @@ class WatchingLoop:
                 self._feed(r)
         early = self._early if self._open == segment.start else None
         late = self._call("matcher", "conclude", self.memory.motion(segment.start, segment.end))
-        if late is not None:
+        if late is not None and self.character.matcher is not None:
             self._check_match(late, "conclude")
             if late != early:
                 self.listener.recognised(segment, late)
         self._open, self._view, self._early = None, None, None
-        return _answer(segment, early, late)
+        return _answer(segment, early, late, cut)
 
     # -- what plugins return ----------------------------------------------------------------------------------
 
-    def _checked_block(self, result: Any, n: int) -> tuple[list[tuple[int, Segment]], np.ndarray]:
-        name = self._name("segmenter")
+    def _checked_block(self, result: Any, n: int, first: int) -> tuple[list[tuple[int, Segment]], np.ndarray]:
+        """``push_block``'s answer for a block of ``n`` rows from row ``first``, checked: each segment closed at a
+        frame of the block, ending by that frame, ordered and disjoint; an onset (or -1) per frame, none after it."""
+        name, where = self._name("segmenter"), f"{self._type('segmenter')}.push_block"
         try:
             closed, since = result
-            since = np.asarray(since, dtype=int).reshape(n)
+            since = np.asarray(since)
+            if since.dtype.kind not in "iu" and not (since.dtype.kind == "f" and np.isfinite(since).all()
+                                                     and (since == np.round(since)).all()):
+                raise TypeError
+            since = since.astype(np.int64).reshape(n)
             pairs = [(int(i), s) for i, s in closed]
-        except (TypeError, ValueError):
-            raise PluginError(name, "Segmenter.push_block", f"returned {result!r}, expected ([(frame in block, "
-                              f"Segment), ...], onsets ({n},))") from None
+        except (TypeError, ValueError, OverflowError):
+            raise PluginError(name, where, f"returned {_shown(result)}, expected ([(frame in block, Segment), ...], "
+                              f"onsets ({n},))") from None
+        rows = first + np.arange(n)
+        bad = np.flatnonzero((since > rows) | (since < -1))
+        if len(bad):
+            i = int(bad[0])
+            raise PluginError(name, where, f"said a segment under way began at frame {int(since[i])} after frame "
+                              f"{first + i}, expected a frame from 0 up to {first + i}, or -1 for none")
         for i, segment in pairs:
             if not 0 <= i < n:
-                raise PluginError(name, "Segmenter.push_block", f"closed a segment at frame {i} of a block of {n}")
-        self._checked_segments([s for _, s in pairs], "push_block")
-        return sorted(pairs, key=lambda p: p[0]), since
+                raise PluginError(name, where, f"closed a segment at frame {i} of a block of {n}, expected 0..{n - 1}")
+        pairs = sorted(pairs, key=lambda p: p[0])
+        for i, segment in pairs:
+            self._checked_segments([segment], "push_block", first + i + 1)
+        return pairs, since
 
-    def _checked_segments(self, segments: Any, method: str) -> list[Segment]:
+    def _checked_segments(self, segments: Any, method: str, frames: int) -> list[Segment]:
+        """Segments the segmenter returned, checked: inside the ``frames`` seen so far, ordered and disjoint
+        (from every segment it closed before), non-empty."""
+        name, where = self._name("segmenter"), f"{self._type('segmenter')}.{method}"
+        try:
+            segments = list(segments)
+        except TypeError:
+            raise PluginError(name, where, f"returned {_shown(segments)}, expected a list of Segments") from None
         for segment in segments:
             if not isinstance(segment, Segment):
-                raise PluginError(self._name("segmenter"), f"Segmenter.{method}",
-                                  f"returned {segment!r}, expected Segment objects")
-            if segment.end > self.memory.n:
-                raise PluginError(self._name("segmenter"), f"Segmenter.{method}",
-                                  f"returned {segment!r}, which ends after the {self.memory.n} frames seen")
-        return list(segments)
+                raise PluginError(name, where, f"returned {_shown(segment)}, expected Segment objects")
+            start, end = segment.start, segment.end
+            if not (isinstance(start, (int, np.integer)) and isinstance(end, (int, np.integer))):
+                raise PluginError(name, where, f"returned {_shown(segment)}, expected whole frame numbers")
+            if not 0 <= start < end:
+                raise PluginError(name, where, f"returned an empty segment {start}..{end}, expected 0 <= start < end")
+            if end > frames:
+                raise PluginError(name, where, f"returned a segment {start}..{end}, which ends after the {frames} "
+                                  f"frames seen, expected segments inside the stream")
+            if start < self._last_end:
+                raise PluginError(name, where, f"returned a segment {start}..{end} that begins before the end of the "
+                                  f"segment before it ({self._last_end}), expected ordered, disjoint segments")
+            self._last_end = int(end)
+        return segments
 
     def _check_match(self, match: Any, method: str) -> None:
-        if not isinstance(match, Match):
-            raise PluginError(self._name("matcher"), f"Matcher.{method}", f"returned {match!r}, expected a Match")
+        check_match(self.character, match, method, self._known)
 
     def _name(self, key: str) -> str:
         component = getattr(self.character, key)
         return component.name if component is not None else key
+
+    def _type(self, key: str) -> str:
+        component = getattr(self.character, key)
+        return type(component).__name__ if component is not None else key.capitalize()
+
+
+def check_match(character: Character, match: Any, method: str, known: set[str] | None = None) -> Match:
+    """``character``'s matcher's answer from ``method``, checked: a :class:`Match` naming a movement of the
+    character's repertoire (its motor system's) or none (unknown), with a finite confidence in [0, 1]; else a
+    :class:`PluginError` naming the matcher, the method, what it returned and what was expected. ``known``: names
+    found in the repertoire already (a cache the caller keeps)."""
+    component = character.matcher
+    name = component.name if component is not None else "matcher"
+    where = f"{type(component).__name__ if component is not None else 'Matcher'}.{method}"
+    known = set() if known is None else known
+    if not isinstance(match, Match):
+        raise PluginError(name, where, f"returned {_shown(match)}, expected a Match or None")
+    try:
+        confidence = float(match.confidence)
+    except (TypeError, ValueError):
+        confidence = float("nan")
+    if not (np.isfinite(confidence) and 0.0 <= confidence <= 1.0):
+        raise PluginError(name, where, f"returned confidence {match.confidence!r} for {match.movement!r}, "
+                          f"expected a finite number in [0, 1]")
+    movement = match.movement
+    if movement is None or movement in known:
+        return match
+    motor = character.motor
+    if not isinstance(movement, str):
+        raise PluginError(name, where, f"returned movement {movement!r}, expected a movement name or None")
+    if motor is None or _knows(motor, movement):
+        known.add(movement)
+        return match
+    names = list(motor.movements())
+    raise PluginError(name, where, f"returned movement {movement!r}, expected a movement of the observer's "
+                      f"repertoire or None (unknown); available: {', '.join(map(str, names[:20]))}"
+                      + (f" and {len(names) - 20} more" if len(names) > 20 else ""))
+
+
+def _knows(motor: Any, movement: str) -> bool:
+    """Whether ``movement`` is one the motor system can name: one of its ``movements()``, a performable name of one
+    (``label``), one it says it ``knows`` (an optional method), else one of the names a motor command graph gives
+    what it learns without a label (its ``sequences``, ``together`` movements and ``edge`` names)."""
+    known = set(motor.movements())
+    if movement in known or motor.label(movement) in known:
+        return True
+    knows = getattr(motor, "knows", None)
+    if callable(knows):
+        return bool(knows(movement))
+    names = (*getattr(motor, "sequences", {}), *getattr(motor, "together", {}))
+    if movement in names:
+        return True
+    edge = getattr(motor, "edge", None)
+    if callable(edge):
+        try:
+            edge(movement)
+            return True
+        except (KeyError, LikemeError):
+            return False
+    return False
+
+
+def _shown(value: Any, limit: int = 120) -> str:
+    """``repr(value)``, shortened to ``limit`` characters."""
+    try:
+        text = repr(value)
+    except Exception:  # a plugin's object whose repr fails
+        text = f"<{type(value).__name__}>"
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def feed(matcher: Any, motion: Motion) -> Iterator[Match | None]:

@@ -14,19 +14,26 @@ import numpy as np
 from toolkit import ActionSystem, ConfigError, MovementRequest, Parameter, hookimpl
 
 
+MAX_RANDOM = 100_000
+"""The most movements a script draws at random (they are drawn when it is attached)."""
+
+
 class Script(ActionSystem):
     """Performs the listed movements in order, then `random` movements drawn with `seed`."""
 
     name = "script"
     parameters = (
         Parameter("movements", list, [], "Movements to perform first, in order.", items=str),
-        Parameter("random", int, 0, "How many movements to draw at random from the repertoire afterwards.", minimum=0),
+        Parameter("random", int, 0, "How many movements to draw at random from the repertoire afterwards.", minimum=0,
+                  maximum=MAX_RANDOM),
         Parameter("exclude", list, [], "Movements never drawn at random.", items=str),
         Parameter("no_repeat", bool, True, "Never draw the same movement twice in a row."),
-        Parameter("pause", float, 0.5, "Seconds of standing in the hub between movements.", minimum=0.0),
-        Parameter("start", float, 0.5, "Seconds before the first movement.", minimum=0.0),
-        Parameter("speed", float, 1.0, "Playback speed of every movement (2 is twice as fast).", minimum=0.01),
-        Parameter("seed", int, 0, "Seed of the random draws."),
+        Parameter("pause", float, 0.5, "Seconds of standing in the hub between movements.", minimum=0.0,
+                  maximum=3600.0),
+        Parameter("start", float, 0.5, "Seconds before the first movement.", minimum=0.0, maximum=3600.0),
+        Parameter("speed", float, 1.0, "Playback speed of every movement (2 is twice as fast).", minimum=0.01,
+                  maximum=100.0),
+        Parameter("seed", int, 0, "Seed of the random draws.", minimum=0, maximum=2**63 - 1),
     )
 
     def attach(self, owner: Any) -> None:

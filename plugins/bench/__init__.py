@@ -2,6 +2,6 @@
 
 ``command`` registers the command and its sub-commands; each other module is one benchmark (``watch``,
 ``behaviour``, ``facilitation``, ``vision``, ``mocap`` for recognition, segmentation and streams of motion-capture
-files), ``data`` writes and reads the folders the motion-capture benchmarks run on, and ``metrics`` holds the
+files, ``memory`` for the observer's memory against stream length), ``data`` writes and reads the folders the motion-capture benchmarks run on, and ``metrics`` holds the
 scores. ``docs/benchmarks.md`` has every table with the command that printed it.
 """

@@ -11,7 +11,10 @@ from importlib import import_module
 from pathlib import Path
 from typing import Any
 
+from plugins.action.script import MAX_RANDOM
 from toolkit import hookimpl
+from toolkit.errors import ConfigError
+from toolkit.cli import count_type, number_type, seed_type
 
 MATCHERS = ("path-search", "forward-model", "dtw")
 """The matchers ``likeme bench recognition`` and ``stream`` compare when none is named."""
@@ -20,19 +23,64 @@ SEGMENTERS = ("hub-threshold", "velocity-direction", "ruptures")
 
 
 def _handler(module: str, function: str, *extra: Any):
-    """A handler that imports ``plugins.bench.MODULE`` when it runs and calls ``FUNCTION(*extra, args, pm)``."""
+    """A handler that imports ``plugins.bench.MODULE`` when it runs and calls ``FUNCTION(*extra, args, pm)``; its
+    ``--set`` settings are checked first against every plugin they will reach (:func:`_check_set`)."""
 
     def run(args: argparse.Namespace, pm: Any) -> int:
+        if getattr(args, "set", None):
+            _check_set(args, pm)
         return getattr(import_module(f"plugins.bench.{module}"), function)(*extra, args, pm)
 
     return run
+
+
+def _check_set(args: argparse.Namespace, pm: Any) -> None:
+    """``--set TABLE.KEY=VALUE`` checked before anything runs: against the observer's component of each table, and
+    against every segmenter and matcher the benchmark compares (a key one of them lacks fails at once, not after
+    the others ran)."""
+    from toolkit.character import _load_chain, merge_tables, read_toml, resolve_file
+    from toolkit.params import check_settings, parse_settings
+
+    settings = parse_settings(list(args.set))
+    if args.benchmark == "watch":  # a character watching through synthetic vision (plugins/bench/watch.py)
+        path = resolve_file(args.observer, None, pm, key=("--observer",))
+        base = merge_tables(_load_chain(path, pm)[0], {"perception": {"plugin": "synthetic-vision"}})
+    else:  # an observer composed from the observer template (toolkit.observe.compose_observer)
+        from toolkit.observe import OBSERVER_TEMPLATE
+
+        base = read_toml(resolve_file(OBSERVER_TEMPLATE, None, pm))
+    plugins: dict[str, list[str]] = {k: [v["plugin"]] for k, v in base.items()
+                                     if isinstance(v, dict) and isinstance(v.get("plugin"), str)}
+    if args.benchmark in ("recognition", "stream"):
+        plugins["matcher"] = list(args.matcher or MATCHERS)
+    if args.benchmark == "segmentation":
+        plugins["segmenter"] = list(args.segmenter or SEGMENTERS)
+    elif args.benchmark == "stream":
+        plugins["segmenter"] = list(args.segmenter or SEGMENTERS[:2])
+    correspondence = getattr(args, "correspondence", "")
+    if correspondence == "none":
+        plugins.pop("correspondence", None)
+    elif correspondence:
+        plugins["correspondence"] = [correspondence]
+    motors = set(plugins.get("motor", []))
+    for name in plugins.get("matcher", []) if args.benchmark != "watch" else []:
+        try:
+            wanted = pm.registry.get("matcher", name).motor_systems
+        except ConfigError as err:  # an unknown matcher is named here, listing the registered ones
+            raise err.within(prefix=("--matcher",)) from None
+        if wanted and not motors & set(wanted):
+            motors.add(wanted[0])
+    if motors:
+        plugins["motor"] = sorted(motors)
+    check_settings(settings, pm, plugins)
 
 
 def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--body", required=True, metavar="PROFILE", help="body profile TOML of the files")
     p.add_argument("--correspondence", metavar="NAME", default="", help="correspondence (default: the observer "
                    "template's; none: the papers' plain observer)")
-    p.add_argument("--lengths-for-height", type=float, default=None, metavar="M", dest="lengths_for_height",
+    p.add_argument("--lengths-for-height", type=number_type(0.0, 1000.0, "metres"), default=None, metavar="M",
+                   dest="lengths_for_height",
                    help="the height (m) the length parameters were written for, scaled to the observer's own height "
                    "(default: the observer template's; 0: metres as written, the papers)")
     p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
@@ -77,13 +125,13 @@ def _motion_capture_commands(sub: Any) -> None:
 
     p = sub.add_parser("make-data", help="write repertoire, demos, streams and a profile from the built-in characters")
     p.add_argument("dest", metavar="DIR")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=seed_type, default=0)
     p.set_defaults(handler=_handler("data", "cmd_make_data"))
 
     p = sub.add_parser("bandai", help="build benchmark folders from the Bandai-Namco clips (links; nothing copied)")
     p.add_argument("src", metavar="BANDAI_DIR")
     p.add_argument("dest", metavar="DIR")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=seed_type, default=0)
     p.add_argument("--profile", default=str(Path(__file__).resolve().parents[2] / "characters" / "profiles"
                                             / "bandai-namco.toml"), help="the body profile to put beside the data")
     p.set_defaults(handler=_handler("data", "cmd_bandai"))
@@ -98,10 +146,13 @@ def likeme_register_commands(subparsers):
     p = sub.add_parser("watch", help="an observer watches a demonstrator's random movements (B&B §5)")
     p.add_argument("--observer", default="max", help="observer character (default: max)")
     p.add_argument("--demonstrator", default="morris", help="demonstrator character (default: morris)")
-    p.add_argument("--movements", type=int, default=200, help="number of random movements (default: 200)")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--noise", type=float, default=0.005, help="vision noise, metres (default: 0.005)")
-    p.add_argument("--dropout", type=float, default=0.05, help="per-part dropout probability (default: 0.05)")
+    p.add_argument("--movements", type=count_type(1, MAX_RANDOM), default=200,
+                   help=f"number of random movements, at most {MAX_RANDOM} (default: 200)")
+    p.add_argument("--seed", type=seed_type, default=0)
+    p.add_argument("--noise", type=number_type(0.0, 1.0, "metres"), default=0.005,
+                   help="vision noise, metres (default: 0.005)")
+    p.add_argument("--dropout", type=number_type(0.0, 1.0, "a probability"), default=0.05,
+                   help="per-part dropout probability (default: 0.05)")
     p.add_argument("--no-occlusion", action="store_true", help="switch occlusion off")
     p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
                    help="override an observer parameter, e.g. --set segmenter.floor=0 (repeatable)")
@@ -117,17 +168,40 @@ def likeme_register_commands(subparsers):
                    "demonstrations (default: 0.3; 0: arms only)")
     p.add_argument("--angle-noise", type=float, default=0.005, help="observation noise on finger joint angles, radians "
                    "(default: 0.005)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=seed_type, default=0)
     p.add_argument("--json", metavar="FILE", help="also write the results as JSON")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(handler=_handler("facilitation", "cmd_facilitation"))
 
     p = sub.add_parser("behaviour", help="an observer identifies the behaviour, motivation and object of a demonstrator (B&B §6)")
     p.add_argument("--episodes", type=int, default=100, help="random episodes per condition (default: 100)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=seed_type, default=0)
     p.add_argument("--json", metavar="FILE", help="also write the results (every episode) as JSON")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(handler=_handler("behaviour", "cmd_behaviour"))
+
+    p = sub.add_parser("memory", help="the observer's memory against stream length: a live observer fed for "
+                       "--minutes, and likeme observe on generated BVH streams")
+    p.add_argument("--minutes", type=float, default=60.0, help="simulated minutes fed to the live observer "
+                   "(default: 60)")
+    p.add_argument("--every", type=float, default=10.0, help="print a line every this many minutes (default: 10)")
+    p.add_argument("--fps", type=float, default=120.0, help="frames per second of the streams (default: 120)")
+    p.add_argument("--block", type=int, default=120, help="frames a packet for the live observer (default: 120)")
+    p.add_argument("--tracemalloc", action="store_true", help="also trace Python allocations (slower)")
+    p.add_argument("--no-live", action="store_true", help="skip the live observer")
+    p.add_argument("--observe-minutes", type=float, action="append", metavar="MIN", help="also run likeme "
+                   "observe on a generated stream this long (repeatable; e.g. 1 and 60)")
+    p.add_argument("--limit", type=float, default=4.0, help="address space cap of the observe subprocess, GB "
+                   "(default: 4)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--segmenter", metavar="NAME", help="the live observer's segmenter (default: the observer "
+                   "template's)")
+    p.add_argument("--matcher", metavar="NAME", help="the live observer's matcher (default: the template's)")
+    p.add_argument("--correspondence", metavar="NAME", default="", help="the live observer's correspondence "
+                   "(default: the template's; none: none)")
+    p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
+                   help="override an observer parameter (repeatable)")
+    p.set_defaults(handler=_handler("memory", "cmd_memory"))
 
     p = sub.add_parser("vision", help="rendered-vision against synthetic-vision on the same frames: agreement, "
                        "position difference, milliseconds per frame")

@@ -22,6 +22,7 @@ def vision_benchmark(pm: Any, scenario: str, observer: str, resolutions: list[in
     from plugins.perception.rendered_vision import RenderedVision
     from plugins.perception.synthetic_vision import SyntheticVision
     from toolkit.scenario import load_scenario
+    from toolkit.watching import guarded
 
     world = load_scenario(scenario, pm).world
     actor = world.actors[observer]
@@ -43,12 +44,12 @@ def vision_benchmark(pm: Any, scenario: str, observer: str, resolutions: list[in
         for _ in range(frames):
             world.step()
             t0 = time.perf_counter()
-            truth_p, truth_s, _ = geometric.look(actor, target, world)
+            truth_p, truth_s, _ = guarded(geometric, "look", actor, target, world)
             geometric_time += time.perf_counter() - t0
             for r, v in rendered.items():
                 row = stats[r]
                 t0 = time.perf_counter()
-                p, s, _ = v.look(actor, target, world)
+                p, s, _ = guarded(v, "look", actor, target, world)
                 row["time"] += time.perf_counter() - t0
                 row["agree"] += int((s == truth_s).sum())
                 row["n"] += len(s)

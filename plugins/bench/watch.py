@@ -26,6 +26,7 @@ from toolkit import World, load_character
 from toolkit.character import merge_tables
 from toolkit.params import parse_settings
 from toolkit.state import write_atomic
+from toolkit.watching import call_component, check_match
 
 __all__ = ["watch_benchmark", "render_watch", "cmd_watch"]
 
@@ -50,12 +51,14 @@ def watch_benchmark(
 
     ``settings`` are tables merged over the observer's character (``{"segmenter": {"floor": 0.0}}``).
     """
+    _check_arguments(movements=movements, seed=seed, noise=noise, dropout=dropout)
     demo = load_character(demonstrator, pm, override={
         "action": {"plugin": "script", "random": movements, "exclude": ["stand", *exclude], "seed": seed, "pause": 0.5}
     })
     obs_override = {"perception": {"plugin": "synthetic-vision", "noise": noise, "dropout": dropout,
                                    "occlusion": occlusion, "seed": seed + 1}}
-    obs = load_character(observer, pm, override=merge_tables(obs_override, settings or {}))
+    obs = load_character(observer, pm, override=merge_tables(obs_override, settings or {}),
+                         override_at=(None, ("--set",)))  # the arguments are checked above: the rest is --set
     obs.action = None  # watch only: the benchmark measures perception, segmentation and recognition
     world = World(fps=30.0, pm=pm)
     target = world.add_actor(demo, "demonstrator", (0.0, 0.0, 1.6), np.pi)
@@ -94,7 +97,7 @@ def watch_benchmark(
     correct = 0
     confusions: dict[str, int] = {}
     for (s, e), label in zip(truth, labels):
-        match = obs.matcher.match(watcher.memory.motion(s, e))
+        match = check_match(obs, call_component(obs, "matcher", "match", watcher.memory.motion(s, e)), "match")
         got = match.movement or "unknown"
         correct += got == label
         if got != label:
@@ -125,6 +128,21 @@ def watch_benchmark(
         "python": platform.python_version(),
         "numpy": np.__version__,
     }
+
+
+def _check_arguments(*, movements: int, seed: int, noise: float, dropout: float) -> None:
+    """The benchmark's own arguments, each reported under its option (not as a key of the characters they reach)."""
+    from plugins.action.script import MAX_RANDOM
+    from toolkit.errors import ConfigError
+    from toolkit.scenario import check_seed
+
+    check_seed(seed, ("--seed",))
+    if isinstance(movements, bool) or not isinstance(movements, int) or not 1 <= movements <= MAX_RANDOM:
+        raise ConfigError(f"invalid value {movements!r}", key=("--movements",),
+                          expected=f"an integer in [1, {MAX_RANDOM}]")
+    for option, value, high, what in (("--noise", noise, 1.0, "metres"), ("--dropout", dropout, 1.0, "a probability")):
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value <= high:
+            raise ConfigError(f"invalid value {value!r}", key=(option,), expected=f"{what} in [0, {high:g}]")
 
 
 def render_watch(r: dict[str, Any]) -> str:

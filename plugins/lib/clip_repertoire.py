@@ -94,9 +94,13 @@ def root_relative_motion(world: Motion, profile: BodyProfile, facing_window: flo
     return Motion(pose, world.fps, world.parts, mask, world.positions).filled()
 
 
+EXAMPLE_MARK = "#"
+"""What joins a movement's name and the number of its further examples (``bow#2``): never in a movement's name."""
+
+
 def example_name(movement: str, earlier: int) -> str:
     """The name of a movement's next example clip, after ``earlier`` ones: ``bow``, ``bow#2``, ``bow#3``..."""
-    return movement if earlier == 0 else f"{movement}#{earlier + 1}"
+    return movement if earlier == 0 else f"{movement}{EXAMPLE_MARK}{earlier + 1}"
 
 
 def clip_files(folder: Path) -> dict[str, list[Path]]:
@@ -112,6 +116,12 @@ def clip_files(folder: Path) -> dict[str, list[Path]]:
     if not out:  # a flat folder of recordings: each file on its own (its ends still give hubs)
         for path in sorted(p for p in folder.iterdir() if p.suffix.lower() in CLIP_SUFFIXES):
             out[path.stem] = [path]
+    for movement, files in out.items():
+        if EXAMPLE_MARK in movement:  # bow#2 is the name of bow's second example: it would replace that one
+            raise ConfigError(f"movement name {movement!r} contains {EXAMPLE_MARK!r}", file=files[0].parent
+                              if files[0].parent != folder else files[0],
+                              expected=f"movement names without {EXAMPLE_MARK!r} (it names a movement's further "
+                              f"examples: {example_name('bow', 1)}, {example_name('bow', 2)}...); rename the folder")
     if not out:
         raise ConfigError("no clips found", file=folder,
                           expected="sub-folders named after movements holding .bvh clips (walk/take1.bvh ...)",

@@ -6,9 +6,17 @@ distribution count), with the number of change points chosen by a penalty
 rather than given. Every stretch between two change points that is at least
 ``min_length`` seconds long is a segment.
 
-Change-point detection over a whole recording is offline: pushing frames only
-stores them, and the segments come out when the stream is flushed (so this
-segmenter cannot drive response facilitation).
+Change-point detection is offline: pushing frames stores them, and the segments
+come out when ``window`` seconds of stream are held, and when the stream is
+flushed (so this segmenter cannot drive response facilitation). Memory is
+bounded by the window: when it is full, its change points are found, the
+stretches before its last change point are reported, and the frames from that
+change point on are kept for the next window (a last change point in the first
+half of the window, or none, reports the window whole: every search moves on by
+half a window at least, and no segment is longer than the window). A stream no
+longer than the window is searched whole, as before; ``window = 0`` holds the
+whole stream until it ends. :attr:`RupturesSegmenter.holds_since` tells the
+watching loop the first frame it may still report.
 
 The RBF kernel's bandwidth is ruptures' own median heuristic (``gamma`` = 1 /
 the median squared distance between frames), computed on at most
@@ -59,48 +67,84 @@ class RupturesSegmenter(Segmenter):
         Parameter("kernel", str, "rbf", "The kernel of the cost.", choices=("rbf", "linear", "cosine")),
         Parameter("min_length", float, 0.5, "Shortest segment in seconds.", minimum=0.0),
         Parameter("stride", int, 2, "Use every n-th frame (KernelCPD is quadratic in length).", minimum=1),
+        Parameter("window", float, 60.0, "Seconds of stream held and searched at once (memory is bounded by it; "
+                  "no segment is longer); 0: the whole stream, held until it ends.", minimum=0.0),
     )
 
     def reset(self, parts: Sequence[str], fps: float) -> None:
         self._fps = float(fps)
         self._frames: list[np.ndarray] = []
         self._visible: list[np.ndarray] = []
+        self._offset = 0  # the frame number of self._frames[0]
+        self._window = int(round(self.params["window"] * self._fps)) if self.params["window"] > 0 else 0
 
     @property
     def active_since(self) -> int | None:
         return None
 
+    @property
+    def holds_since(self) -> int | None:
+        """The first frame a segment still to be reported may begin at (the first frame held), ``None`` if none."""
+        return self._offset if self._frames else None
+
     def push(self, pose: np.ndarray, visible: np.ndarray) -> list[Segment]:
-        self._frames.append(np.asarray(pose, dtype=float))
-        self._visible.append(np.asarray(visible, dtype=bool))
+        self._frames.append(np.array(pose, dtype=float))  # copies: the poses given are views of working memory
+        self._visible.append(np.array(visible, dtype=bool))
+        if self._window and len(self._frames) >= max(self._window, 2):
+            return self._advance()
         return []
 
     def flush(self) -> list[Segment]:
         if not self._frames:
             return []
-        out = self._detect(np.array(self._frames), np.array(self._visible))
+        poses, visible = np.array(self._frames), np.array(self._visible)
+        out = self._segments(self._bounds(poses, visible), visible.any(axis=1), self._offset)
+        self._offset += len(self._frames)
         self._frames, self._visible = [], []
+        return out
+
+    def _advance(self) -> list[Segment]:
+        """A full window: the stretches before its last change point (all of it when that is in its first half),
+        the frames from there kept."""
+        poses, visible = np.array(self._frames), np.array(self._visible)
+        n = len(poses)
+        bounds = self._bounds(poses, visible)
+        last = bounds[-2] if len(bounds) > 2 and bounds[-2] >= n // 2 else n
+        out = self._segments([b for b in bounds if b <= last], visible.any(axis=1), self._offset)
+        self._frames, self._visible = self._frames[last:], self._visible[last:]
+        self._offset += last
         return out
 
     def segment(self, motion: Motion) -> list[Segment]:
         self.reset(motion.parts, motion.fps)
-        return self._detect(motion.positions, motion.visible)
+        if not self._window or motion.n_frames < self._window:
+            return self._segments(self._bounds(motion.positions, motion.visible), motion.visible.any(axis=1), 0)
+        closed, _ = self.push_block(motion.positions, motion.visible)
+        return [s for _, s in closed] + self.flush()
 
-    def _detect(self, poses: np.ndarray, visible: np.ndarray) -> list[Segment]:
+    def _bounds(self, poses: np.ndarray, visible: np.ndarray) -> list[int]:
+        """0, the change points of ``poses`` (frames, not strided), ``len(poses)``; just the ends when fewer than
+        two frames are seen or the stretch is too short to be cut."""
         n, stride = len(poses), self.params["stride"]
         seen = visible.any(axis=1)
         if seen.sum() < 2:
-            return []
+            return [0, n]
         x = fill_hidden(poses, visible, default=np.zeros(poses.shape[1:])).reshape(n, -1)  # docs/conventions.md
         x = np.nan_to_num(x - np.nanmean(x, axis=0))[::stride]
         min_size = max(2, int(round(self.params["min_length"] * self._fps / stride)))
         if len(x) < 2 * min_size:
-            return [Segment(0, n, self._fps)] if n / self._fps >= self.params["min_length"] else []
+            return [0, n]
         kernel = self.params["kernel"]
         params = {"gamma": rbf_gamma(x)} if kernel == "rbf" else None
         ends = rpt.KernelCPD(kernel=kernel, min_size=min_size, params=params).fit(x).predict(pen=self.params["penalty"])
-        bounds = [0, *[min(n, int(e) * stride) for e in ends[:-1]], n]
-        return [Segment(a, b, self._fps) for a, b in zip(bounds, bounds[1:])
+        return [0, *[min(n, int(e) * stride) for e in ends[:-1]], n]
+
+    def _segments(self, bounds: list[int], seen: np.ndarray, offset: int) -> list[Segment]:
+        """The stretches between successive ``bounds`` at least ``min_length`` long with a frame seen, numbered
+        from ``offset``."""
+        if seen.sum() < 2:
+            return []
+        return [Segment(offset + a, offset + b, self._fps) for a, b in zip(bounds, bounds[1:])
                 if b > a and (b - a) / self._fps >= self.params["min_length"] and seen[a:b].any()]
 
 

@@ -45,6 +45,11 @@ never falls below and a large body's sway may exceed. Each of these is a paramet
   strokes lasts about a tenth of a second (the sensory memory, §4.1) and no longer ends the movement. ``p = 0.3``
   s: three sensory memories, shorter than the pauses people make between gestures.
 
+Memory: the visual working memory holds the movement under way, so a movement that never ends (a demonstrator who
+never comes to rest) is closed after ``max_movement`` seconds, where it is, and the next one begins at once there:
+the segmenter's memory is bounded whatever the stream. The default, 60 s, is the watching loop's own bound
+(:data:`toolkit.watching.MAX_SEGMENT_SECONDS`), ten times the longest of the papers' movements.
+
 Hands (§4.3): a finger of the observer's body (an angle part, whose values
 are joint angles) moves at an *angular* velocity. Its angles are multiplied by
 ``angle_scale`` (metres per radian) as they enter the memories, so one rest
@@ -102,6 +107,8 @@ class VelocityDirection(Segmenter):
         Parameter("pause", float, 0.0, "Seconds the speed is averaged over before it is compared with the rest "
                   "speed: a movement begins and ends at a rest of about this long (0: the sensory memory, the "
                   "paper).", minimum=0.0),
+        Parameter("max_movement", float, 60.0, "Seconds after which a movement that has not ended is closed there and "
+                  "the next begins at once (the working memory's bound; 0: none).", minimum=0.0),
     )
 
     def attach(self, owner: Any) -> None:
@@ -151,6 +158,7 @@ class VelocityDirection(Segmenter):
         self._frame += 1
         points = pose[self._idx] * self._scale  # hidden parts are held where last seen; never seen: NaN
         seen = np.isfinite(points).all(axis=1)
+        cut: list[Segment] = []
         self._history.append(points.ravel())
         speed = np.nan
         if len(self._history) > self._memory and seen.any():
@@ -160,14 +168,18 @@ class VelocityDirection(Segmenter):
             step = step[np.isfinite(step)]
             speed = float(step.max()) * self._fps / self._memory if step.size else np.nan
         if self._start is not None:
+            longest = int(round(self.params["max_movement"] * self._fps))
+            if longest and self._frame - self._start >= max(longest, 2):  # never ended: closed, the next one begun
+                cut = self._close(self._frame)
+                self._start, self._buffer = self._frame, []
             self._buffer.append(points.ravel())
         rest = self._rest_speed(pose, speed)
         if self._pause:
             if np.isnan(speed) or len(self._speeds) < self._pause:
-                return []
+                return cut
             speed = sum(self._speeds) / len(self._speeds)
         if np.isnan(speed):
-            return []
+            return cut
         if speed > rest:
             self._moving += 1
             self._resting = 0
@@ -179,8 +191,8 @@ class VelocityDirection(Segmenter):
             self._moving = 0
             if self._start is not None and self._resting >= max(self._memory, self._pause):
                 lag = self._memory // 2 + self._pause // 2
-                return self._close(max(self._start + 1, self._frame - self._resting + 1 - lag))
-        return []
+                return cut + self._close(max(self._start + 1, self._frame - self._resting + 1 - lag))
+        return cut
 
     def _rest_speed(self, pose: np.ndarray, speed: float) -> float:
         """The speed below which the parts are at rest now: ``rest_speed`` (m/s), or ``size_rest_speed`` body sizes

@@ -30,6 +30,21 @@ from toolkit.motion import facing_vector
 __all__ = ["ScenarioView", "Recorder"]
 
 
+def _check_colours(world: Any) -> None:
+    """Every object's colour is one the renderer draws: checked before the run, not found after it."""
+    import pyvista as pv
+
+    from toolkit import ConfigError
+
+    for name, obj in world.objects.items():
+        if obj.colour:
+            try:
+                pv.Color(obj.colour)
+            except ValueError:
+                raise ConfigError(f"unknown colour {obj.colour!r} of object {name!r}", key=("objects", name, "colour"),
+                                  expected='a colour "#rrggbb" (or a colour name the renderer knows)') from None
+
+
 @dataclass
 class Recorder:
     """What a run showed, frame by frame; registered as a plugin while the world runs."""
@@ -105,6 +120,7 @@ class ScenarioView(View):
 
             raise ConfigError(f"unknown format {unknown[0]!r}", key=("formats",), expected="image formats",
                               available=["png", "gif", "mp4"])
+        _check_colours(world)
         recorder = Recorder(world, every=self.params["every"], fps=world.fps)
         world.pm.register(recorder, name="scenario-view-recorder")
         return recorder
