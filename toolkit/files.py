@@ -9,7 +9,8 @@ The size caps (``docs/conventions.md``) have defaults a user can raise with envi
 
 - motion files (BVH): ``LIKEME_MAX_MOTION_MB``, default 4096 (a 60-minute 120 fps capture of 60 joints with six
   channels each is about 2 GB of text);
-- configuration files (TOML: characters, profiles, scenarios): ``LIKEME_MAX_CONFIG_MB``, default 16.
+- configuration files (TOML: characters, profiles, scenarios): ``LIKEME_MAX_CONFIG_MB``, default 16;
+- state files (JSON written by ``--save``: what characters learned): ``LIKEME_MAX_STATE_MB``, default 64.
 """
 
 from __future__ import annotations
@@ -23,12 +24,13 @@ from toolkit.errors import ConfigError
 
 __all__ = ["check_regular_file", "open_regular", "max_bytes", "LIMITS"]
 
-LIMITS: dict[str, tuple[str, int]] = {"motion": ("LIKEME_MAX_MOTION_MB", 4096), "config": ("LIKEME_MAX_CONFIG_MB", 16)}
+LIMITS: dict[str, tuple[str, int]] = {"motion": ("LIKEME_MAX_MOTION_MB", 4096), "config": ("LIKEME_MAX_CONFIG_MB", 16),
+                                      "state": ("LIKEME_MAX_STATE_MB", 64)}
 """The size cap of each kind of file: (environment variable in MB, default MB)."""
 
 
 def max_bytes(kind: str = "config") -> int:
-    """The size cap in bytes of a kind of file (``"motion"`` or ``"config"``), from its environment variable."""
+    """The size cap in bytes of a kind of file (a key of :data:`LIMITS`), from its environment variable."""
     variable, default = LIMITS[kind]
     raw = os.environ.get(variable, "")
     if not raw.strip():
@@ -70,7 +72,7 @@ def check_regular_file(path: str | Path, what: str = "file", kind: str = "config
     path : str or Path
     what : str
         What the file should be, for the message ("BVH file", "body profile").
-    kind : {"config", "motion"}
+    kind : {"config", "motion", "state"}
         Which size cap applies (:data:`LIMITS`).
 
     Raises
