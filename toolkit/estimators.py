@@ -470,7 +470,8 @@ def load_streams(folder: str | Path, profile: str | Path | BodyProfile) -> tuple
     from plugins.lib.clip_repertoire import CLIP_SUFFIXES
 
     profile = profile if isinstance(profile, BodyProfile) else load_profile(profile)
-    files = sorted(p for p in Path(folder).iterdir() if p.suffix.lower() in CLIP_SUFFIXES)
+    files = sorted(p for p in Path(folder).iterdir()
+                   if p.suffix.lower() in CLIP_SUFFIXES and not p.name.endswith(".segments.csv"))
     if not files:
         raise EstimatorInputError("no streams found", file=folder,
                                   expected="NAME.bvh files with NAME.segments.csv beside them")
