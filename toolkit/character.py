@@ -82,6 +82,10 @@ class Character:
         The merged declaration.
     pm : PluginManager or None
         The plugin manager it was composed with; components announce events through ``pm.hook``.
+    repertoire : object or None
+        A repertoire given in memory when it was composed (:func:`compose_character`'s ``repertoire``), which its
+        motor system builds from instead of a folder named in its table (a
+        :class:`plugins.lib.clip_repertoire.ClipRepertoire` for ``posegraph`` and ``motor-command-graph``).
     """
 
     name: str
@@ -97,6 +101,7 @@ class Character:
     lengths_for_height: float | None = None
     config: dict[str, Any] = field(default_factory=dict)
     pm: PluginManager | None = field(default=None, repr=False)
+    repertoire: Any = field(default=None, repr=False)
 
     @property
     def file(self) -> Path | None:
@@ -350,8 +355,12 @@ def _gives(override: Mapping[str, Any], key: tuple) -> bool:
     return bool(key)
 
 
-def compose_character(table: Mapping[str, Any], pm: PluginManager, *, files: tuple[Path, ...] = ()) -> Character:
+def compose_character(table: Mapping[str, Any], pm: PluginManager, *, files: tuple[Path, ...] = (),
+                      repertoire: Any = None) -> Character:
     """Validate a merged character table and build its components.
+
+    ``repertoire``: a repertoire in memory for the motor system (:attr:`Character.repertoire`), read when it is
+    attached, instead of a folder its table names (``[motor] clips``).
 
     Raises :class:`ConfigError` with the key path (file placement is done by
     :func:`load_character`) or :class:`PluginError` if a component fails to build.
@@ -398,6 +407,7 @@ def compose_character(table: Mapping[str, Any], pm: PluginManager, *, files: tup
         lengths_for_height=None if lengths_for is None else float(lengths_for),
         config=dict(table),
         pm=pm,
+        repertoire=repertoire,
     )
     scale = None  # known once the motor system is attached (its rest pose gives the height)
     for key, component in character.components().items():  # motor first: the others read it
