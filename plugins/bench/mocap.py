@@ -37,6 +37,7 @@ import numpy as np
 from plugins.bench.command import MATCHERS, SEGMENTERS
 from plugins.bench.data import read_segments
 from plugins.bench.metrics import confusion_matrix, macro_f1, movement_error_rate, segmentation_scores
+from plugins.bench.tables import text_table
 from plugins.lib.clip_repertoire import clip_files
 from toolkit import ConfigError
 from toolkit.observe import Observer, compose_observer
@@ -396,7 +397,7 @@ def run(kind: str, args: Any, pm: Any) -> int:
     if kind == "recognition":
         for row in result["plugins"]:
             print(f"\n{row['plugin']} confusion (rows true, columns recognised): {', '.join(row['labels'])}")
-            for label, counts in zip(row["labels"], row["confusion"]):
-                print(f"  {label:>12} " + " ".join(f"{c:3d}" for c in counts))
+            print(text_table([[label, *counts] for label, counts in zip(row["labels"], row["confusion"])],
+                             [("", "right")] * (len(row["labels"]) + 1), header=False))
     write_outputs(result, args)
     return 0
