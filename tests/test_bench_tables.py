@@ -7,7 +7,7 @@ import string
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from plugins.bench.tables import text_table
+from plugins.bench import text_table
 
 
 def reference_table(rows, columns, header=True, indent=2):
@@ -26,7 +26,8 @@ cell = st.text(alphabet=string.ascii_letters + string.digits + string.punctuatio
 @settings(max_examples=200, deadline=None)
 @given(st.integers(1, 6).flatmap(lambda n: st.tuples(
     st.lists(st.tuples(cell, st.sampled_from(["left", "right"])), min_size=n, max_size=n),
-    st.lists(st.lists(st.one_of(st.just(""), cell), min_size=n, max_size=n), min_size=1, max_size=8), st.booleans(), st.integers(0, 4))))
+    st.lists(st.lists(st.one_of(st.just(""), cell), min_size=n, max_size=n), min_size=1, max_size=8),
+    st.booleans(), st.integers(0, 4))))
 def test_a_table_is_the_hand_padded_text(case):
     columns, rows, header, indent = case
     assert text_table(rows, columns, header=header, indent=indent) == reference_table(rows, columns, header, indent)

@@ -104,7 +104,7 @@ def behaviour_benchmark(pm: Any, *, episodes: int = 100, seed: int = 0, progress
 
 
 def render_behaviour(r: dict[str, Any]) -> str:
-    from plugins.bench.tables import text_table
+    from plugins.bench import text_table
 
     head = (f"likeme bench behaviour: Max identifies what Morris does (seed {r['seed']}, {r['episodes_per_condition']} "
             f"episodes per condition, {r['seconds']:.0f} s)")

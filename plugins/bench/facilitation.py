@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from plugins.bench.tables import text_table
+from plugins.bench import text_table
 from toolkit import World, load_character
 from toolkit.state import write_atomic
 

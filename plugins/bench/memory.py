@@ -103,7 +103,7 @@ def live_memory(pm: Any, data: Path, *, minutes: float, fps: float, every: float
     began = time.perf_counter()
     if trace:
         tracemalloc.start()
-    # hand-padded, not plugins.bench.tables: each row is printed as it is measured, minutes apart, not at the end
+    # hand-padded, not plugins.bench.text_table: each row is printed as it is measured, minutes apart, not at the end
     print(f"{'minutes':>8} {'frames':>9} {'segments':>8} {'rows held':>9} {'RSS MB':>8} {'peak RSS MB':>11}"
           + (f" {'traced peak MB':>14}" if trace else "") + f" {'wall s':>7}", file=out, flush=True)
     for positions in random_stream(pm, fps, seed=seed, block=block):

@@ -34,10 +34,10 @@ from typing import Any
 
 import numpy as np
 
+from plugins.bench import text_table
 from plugins.bench.command import MATCHERS, SEGMENTERS
 from plugins.bench.data import read_segments
 from plugins.bench.metrics import confusion_matrix, macro_f1, movement_error_rate, segmentation_scores
-from plugins.bench.tables import text_table
 from plugins.lib.clip_repertoire import clip_files
 from toolkit import ConfigError
 from toolkit.observe import Observer, compose_observer

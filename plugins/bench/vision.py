@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from plugins.bench.tables import text_table
+from plugins.bench import text_table
 from toolkit import ConfigError
 
 __all__ = ["vision_benchmark", "cmd_vision"]

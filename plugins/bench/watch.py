@@ -21,8 +21,8 @@ from typing import Any
 
 import numpy as np
 
+from plugins.bench import text_table
 from plugins.bench.metrics import match_segments, movement_error_rate, segmentation_scores
-from plugins.bench.tables import text_table
 from toolkit import World, load_character
 from toolkit.character import merge_tables
 from toolkit.params import parse_settings
