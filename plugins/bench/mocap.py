@@ -34,9 +34,10 @@ from typing import Any
 
 import numpy as np
 
+from plugins.bench import text_table
 from plugins.bench.command import MATCHERS, SEGMENTERS
 from plugins.bench.data import read_segments
-from plugins.bench.metrics import movement_error_rate, segmentation_scores
+from plugins.bench.metrics import confusion_matrix, macro_f1, movement_error_rate, segmentation_scores
 from plugins.lib.clip_repertoire import clip_files
 from toolkit import ConfigError
 from toolkit.observe import Observer, compose_observer
@@ -155,16 +156,14 @@ def recognition(pm, profile, repertoire: Path, demos: Path | None, matchers: Seq
                                  "decision_fraction": round(obs.decision_fraction, 4), "frames": motion.n_frames})
                 frames, seconds = frames + clock.frames, seconds + clock.seconds
         labels = sorted(set(truth) | set(predicted))
-        confusion = np.zeros((len(labels), len(labels)), dtype=int)
-        for t, p in zip(truth, predicted):
-            confusion[labels.index(t), labels.index(p)] += 1
+        confusion = confusion_matrix(truth, predicted, labels)
         right = [t == p for t, p in zip(truth, predicted)]
         seen = [r for r, t in zip(right, truth) if t != UNKNOWN]
         unseen = [r for r, t in zip(right, truth) if t == UNKNOWN]
         plugins.append({"plugin": name, "accuracy": float(np.mean(right)),
                         "known_accuracy": float(np.mean(seen)) if seen else float("nan"),
                         "rejection": float(np.mean(unseen)) if unseen else float("nan"),
-                        "macro_f1": _macro_f1(truth, predicted), "decision_median": float(np.median(fractions)),
+                        "macro_f1": macro_f1(truth, predicted), "decision_median": float(np.median(fractions)),
                         "decision_p90": float(np.percentile(fractions, 90)), "fps": frames / max(seconds, 1e-9),
                         "items": len(truth), "labels": labels, "confusion": confusion.tolist()})
     return {"benchmark": "recognition", "protocol": protocol, "plugins": plugins, "items": rows}
@@ -243,16 +242,6 @@ def _repertoire_without(folder: Path, movement: str | None, files: frozenset[Pat
             for f in kept:
                 (Path(tmp) / name / f.name).symlink_to(f.resolve())
         yield Path(tmp)
-
-
-def _macro_f1(truth: Sequence[str], predicted: Sequence[str]) -> float:
-    scores = []
-    for label in sorted(set(truth)):
-        tp = sum(t == label and p == label for t, p in zip(truth, predicted))
-        fp = sum(t != label and p == label for t, p in zip(truth, predicted))
-        fn = sum(t == label and p != label for t, p in zip(truth, predicted))
-        scores.append(2 * tp / (2 * tp + fp + fn) if tp else 0.0)
-    return float(np.mean(scores)) if scores else 0.0
 
 
 def segmentation(pm, profile, streams: Path, segmenters: Sequence[str], *, repertoire: Path | None = None,
@@ -408,7 +397,7 @@ def run(kind: str, args: Any, pm: Any) -> int:
     if kind == "recognition":
         for row in result["plugins"]:
             print(f"\n{row['plugin']} confusion (rows true, columns recognised): {', '.join(row['labels'])}")
-            for label, counts in zip(row["labels"], row["confusion"]):
-                print(f"  {label:>12} " + " ".join(f"{c:3d}" for c in counts))
+            print(text_table([[label, *counts] for label, counts in zip(row["labels"], row["confusion"])],
+                             [("", "right")] * (len(row["labels"]) + 1), header=False))
     write_outputs(result, args)
     return 0
