@@ -71,8 +71,10 @@ BANDAI = [  # joint, parent, our point (None: an end site at its parent, as in t
     ("Chest", "Spine", "chest"), ("Neck", "Chest", "neck"), ("Head", "Neck", "head"), ("Head_end", "Head", None),
 ]
 for _s, _side in (("L", "l"), ("R", "r")):
-    BANDAI += [(f"Shoulder_{_s}", "Chest", f"{_side}_clavicle"), (f"UpperArm_{_s}", f"Shoulder_{_s}", f"{_side}_shoulder"),
-               (f"LowerArm_{_s}", f"UpperArm_{_s}", f"{_side}_elbow"), (f"Hand_{_s}", f"LowerArm_{_s}", f"{_side}_wrist"),
+    BANDAI += [(f"Shoulder_{_s}", "Chest", f"{_side}_clavicle"),
+               (f"UpperArm_{_s}", f"Shoulder_{_s}", f"{_side}_shoulder"),
+               (f"LowerArm_{_s}", f"UpperArm_{_s}", f"{_side}_elbow"),
+               (f"Hand_{_s}", f"LowerArm_{_s}", f"{_side}_wrist"),
                (f"Hand_{_s}_end", f"Hand_{_s}", None)]
 for _s, _side in (("L", "l"), ("R", "r")):
     BANDAI += [(f"UpperLeg_{_s}", "Hips", f"{_side}_hip"), (f"LowerLeg_{_s}", f"UpperLeg_{_s}", f"{_side}_knee"),
@@ -82,7 +84,8 @@ for _s, _side in (("L", "l"), ("R", "r")):
 KINECT = [("SpineBase", None, "hips"), ("SpineMid", "SpineBase", "spine"), ("SpineShoulder", "SpineMid", "chest"),
           ("Neck", "SpineShoulder", "neck"), ("Head", "Neck", "head")]
 for _s, _side in (("Left", "l"), ("Right", "r")):
-    KINECT += [(f"Shoulder{_s}", "SpineShoulder", f"{_side}_shoulder"), (f"Elbow{_s}", f"Shoulder{_s}", f"{_side}_elbow"),
+    KINECT += [(f"Shoulder{_s}", "SpineShoulder", f"{_side}_shoulder"),
+               (f"Elbow{_s}", f"Shoulder{_s}", f"{_side}_elbow"),
                (f"Wrist{_s}", f"Elbow{_s}", f"{_side}_wrist"), (f"Hip{_s}", "SpineBase", f"{_side}_hip"),
                (f"Knee{_s}", f"Hip{_s}", f"{_side}_knee"), (f"Ankle{_s}", f"Knee{_s}", f"{_side}_ankle"),
                (f"Foot{_s}", f"Ankle{_s}", f"{_side}_toes")]

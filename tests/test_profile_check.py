@@ -275,7 +275,8 @@ def _keypoints(tmp_path, scheme_names):
 
 def test_profile_maps_coco_and_mediapipe_keypoints_and_says_the_root_is_a_choice(tmp_path, capsys):
     coco = [("nose", "head"), ("left_shoulder", "l_shoulder"), ("right_shoulder", "r_shoulder"),
-            ("left_elbow", "l_elbow"), ("right_elbow", "r_elbow"), ("left_wrist", "l_wrist"), ("right_wrist", "r_wrist"),
+            ("left_elbow", "l_elbow"), ("right_elbow", "r_elbow"), ("left_wrist", "l_wrist"),
+            ("right_wrist", "r_wrist"),
             ("left_hip", "l_hip"), ("right_hip", "r_hip"), ("left_knee", "l_knee"), ("right_knee", "r_knee"),
             ("left_ankle", "l_ankle"), ("right_ankle", "r_ankle")]
     for names in (coco, [(n.upper(), p) for n, p in coco]):  # COCO's names, MediaPipe's
@@ -345,3 +346,28 @@ def test_the_proposal_for_a_real_bandai_namco_clip_is_the_shipped_profile(tmp_pa
                                                                      shipped.body.facing.right)
     status, _, err = run(capsys, "validate", "--body", profile.file, *sorted(BANDAI.glob("*.bvh")))  # every clip
     assert status == 0 and warnings_of(err) == [], err
+
+
+def test_a_joint_never_seen_and_gaps_leave_the_facing_to_a_pair_that_is_seen(tmp_path):
+    """A Kinect CSV whose left hip is never tracked and whose every 7th frame is empty: the shoulders give the facing."""
+    import warnings
+
+    take = write_skeleton_csv(tmp_path / "kinect.csv", KINECT, performance(["bow"]), scale=1000.0, up="+z")
+    lines = take.read_text().splitlines()
+    header = lines[0].split(",")
+    rows = [lines[0]]
+    for i, line in enumerate(lines[1:]):
+        values = line.split(",")
+        rows.append(",".join("" if h.startswith("HipLeft") or (i % 7 == 0 and h != "time") else v
+                             for h, v in zip(header, values)))
+    take.write_text("\n".join(rows) + "\n")
+    recording = read_positions(take)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no RuntimeWarning from a slice that is all NaN
+        proposal = propose_profile(recording.names, recording.positions, source=take.name, fps=recording.fps)
+    (tmp_path / "p.toml").write_text(proposal.text)
+    profile = load_profile(tmp_path / "p.toml")
+    assert (profile.scale, profile.up) == (0.001, "+z")
+    assert (profile.body.facing.left, profile.body.facing.right) == ("left_shoulder", "right_shoulder")
+    positions = profile.convert(recording.positions, list(recording.names))
+    assert recording_warnings(profile, [(positions, np.isfinite(positions).all(axis=-1))]) == []

@@ -273,8 +273,6 @@ def recording_warnings(profile, blocks: Iterable[tuple[np.ndarray, np.ndarray]])
 
 # -- proposals ----------------------------------------------------------------------------------------------------
 
-_SIDES = {"left": ("Left", "_L", "L", "l", "left", "LEFT", "L_"), "right": ("Right", "_R", "R", "r", "right", "RIGHT", "R_")}
-
 SCHEMES: dict[str, dict[str, tuple[str, ...]]] = {
     # likeme part: the scheme's joints that can be it, in order of preference; {S} is the side in the scheme's way
     "Bandai-Namco": {
@@ -287,7 +285,8 @@ SCHEMES: dict[str, dict[str, tuple[str, ...]]] = {
         "root": ("mixamorig:Hips",), "chest": ("mixamorig:Spine2", "mixamorig:Spine1"), "neck": ("mixamorig:Neck",),
         "head": ("mixamorig:Head",), "head_top": ("mixamorig:HeadTop_End", "mixamorig:Head_end"),
         "left_shoulder": ("mixamorig:LeftArm",), "left_elbow": ("mixamorig:LeftForeArm",),
-        "left_wrist": ("mixamorig:LeftHand",), "left_hip": ("mixamorig:LeftUpLeg",), "left_knee": ("mixamorig:LeftLeg",),
+        "left_wrist": ("mixamorig:LeftHand",), "left_hip": ("mixamorig:LeftUpLeg",),
+        "left_knee": ("mixamorig:LeftLeg",),
         "left_foot": ("mixamorig:LeftFoot",), "left_toes": ("mixamorig:LeftToeBase",),
         "left_toe_tip": ("mixamorig:LeftToe_End", "mixamorig:LeftToeBase_end"),
     },
@@ -511,8 +510,16 @@ def propose_profile(names: Sequence[str], positions: np.ndarray, *, parents: Seq
 
     # facing: a left/right pair across the body, and a forward marker that is in front of it in every frame
     facing_note = ""
-    pair = next(((a, b) for a, b in (("left_hip", "right_hip"), ("left_shoulder", "right_shoulder"))
-                 if a in mapping and b in mapping), None) or _side_pair(parts, joints)
+    pairs = [(a, b) for a, b in (("left_hip", "right_hip"), ("left_shoulder", "right_shoulder"),
+                                 ("left_knee", "right_knee")) if a in mapping and b in mapping]
+    pairs += [p for p in [_side_pair(parts, joints)] if p is not None and p not in pairs]
+    both = [float((seen[:, parts.index(a)] & seen[:, parts.index(b)]).mean()) if len(seen) else 0.0 for a, b in pairs]
+    pair = next((p for p, f in zip(pairs, both) if f >= 0.5), None)  # seen together in most frames
+    if pair is None and pairs:
+        pair = pairs[int(np.argmax(both))]
+        todo.append(f"the facing pair {pair[0]!r}, {pair[1]!r} is seen together in only {max(both):.0%} of the "
+                    "frames")
+        facing_note = f"TODO: {todo[-1]}"
     if pair is None:
         pair = (parts[0], parts[min(1, len(parts) - 1)])
         todo.append("no left/right pair of joints found for the facing")
