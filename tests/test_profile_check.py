@@ -106,6 +106,7 @@ def test_two_parts_mapping_one_joint_are_a_warning(tmp_path, capsys, bandai_like
     assert status == 0
     assert warnings_of(err) == [f"likeme: warning: {profile}: parts 'chest' and 'neck' both map joint 'Chest': they "
                                 "are one point"]
+    assert run(capsys, "validate", "--strict", profile)[2][-1] == warnings_of(err)[0]  # the profile alone too
 
 
 # -- warnings of validate --body ---------------------------------------------------------------------------------

@@ -605,6 +605,7 @@ def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
             elif is_profile(table):
                 prof = load_profile(path)
                 print(f"ok    {path}: body profile {prof.name!r}: {len(prof.joints)} parts, units {prof.scale:g} m, up {prof.up}")
+                warned += _warn(path, _profile_warnings(prof))
             else:
                 c = describe_character(load_character(path, pm))
                 comps = ", ".join(f"{k} {c[k]['plugin']}" for k in ("motor", "perception", "segmenter", "matcher", "action") if k in c)

@@ -274,7 +274,7 @@ def recording_warnings(profile, blocks: Iterable[tuple[np.ndarray, np.ndarray]])
 # -- proposals ----------------------------------------------------------------------------------------------------
 
 SCHEMES: dict[str, dict[str, tuple[str, ...]]] = {
-    # likeme part: the scheme's joints that can be it, in order of preference; {S} is the side in the scheme's way
+    # likeme part: the joints of the scheme that can be it, in order of preference (the left side only)
     "Bandai-Namco": {
         "root": ("Hips",), "chest": ("Chest",), "neck": ("Neck",), "head": ("Head",), "head_top": ("Head_end",),
         "left_shoulder": ("UpperArm_L",), "left_elbow": ("LowerArm_L",), "left_wrist": ("Hand_L",),
