@@ -364,7 +364,7 @@ def _parse_header(tokens: _Tokens) -> _Header:
     """HIERARCHY to the frame time, with every bound checked where it is read (iteratively: no recursion)."""
     tokens.expect("HIERARCHY")
     joints: list[Joint] = []
-    names: set[str] = set()
+    names: dict[str, str] = {}  # every name so far (joints and end sites), with where it was given, for messages
     while tokens.peek() == "ROOT":
         tokens.take("ROOT")
         open_joints = [_parse_joint_head(tokens, joints, names, parent=-1)]
@@ -378,13 +378,20 @@ def _parse_header(tokens: _Tokens) -> _Header:
                 tokens.take("JOINT")
                 open_joints.append(_parse_joint_head(tokens, joints, names, parent=index))
             elif token == "End":
+                at = tokens.pos
                 tokens.take("End")
                 tokens.expect("Site")
+                end_name = f"{name}_end"  # an end site is named after its parent: it must not shadow another point
+                if end_name in names:
+                    raise tokens.error(f"the end site of joint {_shown(name)} is named {_shown(end_name)}, like "
+                                       f"{names[end_name]}", "unique joint names (end sites are named <parent>_end: "
+                                       "rename the joint)", at=at)
+                names[end_name] = f"the end site of joint {_shown(name)} at line {tokens.items[at][1]}"
                 tokens.expect("{")
                 tokens.expect("OFFSET")
                 end = tuple(tokens.number("an OFFSET coordinate") for _ in range(3))
                 tokens.expect("}")
-                joints.append(Joint(f"{name}_end", index, end, (), end_site=True))
+                joints.append(Joint(end_name, index, end, (), end_site=True))
             elif token == "}":
                 tokens.take("}")
                 open_joints.pop()
@@ -413,14 +420,15 @@ def _parse_header(tokens: _Tokens) -> _Header:
     return _Header(joints, frame_time, n_frames, line, column - 1 + len(token), tokens.line_text)
 
 
-def _parse_joint_head(tokens: _Tokens, joints: list[Joint], names: set[str], parent: int) -> int:
+def _parse_joint_head(tokens: _Tokens, joints: list[Joint], names: dict[str, str], parent: int) -> int:
     """A joint's name, OFFSET and CHANNELS (its children come after); returns its index."""
-    at = tokens.pos
+    at = name_at = tokens.pos
     name = tokens.take("a joint name")
     if name in ("{", "}", "OFFSET", "CHANNELS"):
         raise tokens.error(f"found {_shown(name)}", "a joint name", at=at)
     if name in names:
-        raise tokens.error(f"duplicate joint name {_shown(name)}", "unique joint names", at=at)
+        raise tokens.error(f"duplicate joint name {_shown(name)}" + ("" if names[name].startswith("the joint") else
+                           f", the name of {names[name]}"), "unique joint names", at=at)
     tokens.expect("{")
     tokens.expect("OFFSET")
     offset = tuple(tokens.number("an OFFSET coordinate") for _ in range(3))
@@ -435,7 +443,7 @@ def _parse_joint_head(tokens: _Tokens, joints: list[Joint], names: set[str], par
         if c in channels:
             raise tokens.error(f"channel {c!r} listed twice for joint {_shown(name)}", "each channel once", at=at)
         channels.append(c)
-    names.add(name)
+    names[name] = f"the joint at line {tokens.items[name_at][1]}"
     joints.append(Joint(name, parent, offset, tuple(channels)))
     return len(joints) - 1
 

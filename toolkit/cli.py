@@ -224,8 +224,15 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
 
     p = sub.add_parser("validate", help="check character, scenario and body-profile files and BVH motion files")
     p.add_argument("files", nargs="+", metavar="FILE", help="character, scenario or profile TOML files, or BVH files")
-    p.add_argument("--body", metavar="PROFILE", help="also check that each BVH file has the joints this profile maps")
+    p.add_argument("--body", metavar="PROFILE", help="also check that each BVH file has the joints this profile maps, "
+                   "and warn where the profile is probably wrong for it (units, up axis, facing)")
+    p.add_argument("--strict", action="store_true", help="exit with status 1 on a warning too")
     p.set_defaults(handler=cmd_validate)
+
+    p = sub.add_parser("profile", help="propose a body profile for a recording (BVH, or CSV joint positions)")
+    p.add_argument("file", metavar="FILE", help="a BVH file, or a CSV of joint positions (JOINT_x, JOINT_y, JOINT_z)")
+    p.add_argument("--out", metavar="PROFILE.toml", help="write the profile there (default: print it)")
+    p.set_defaults(handler=cmd_profile)
 
     pm.hook.likeme_register_commands(subparsers=sub)
     return parser
@@ -564,12 +571,15 @@ def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
     from toolkit.report import describe_character
     from toolkit.scenario import is_scenario, load_scenario
 
-    failed = 0
+    failed = warned = 0
     try:
         profile = load_profile(args.body) if args.body else None
     except LikemeError as err:
         print(f"likeme: error: {err}", file=sys.stderr)
         return 1
+    flips: list[tuple[str, Any, int]] = []  # where the facing flips in each recording, counted over them all
+    if profile is not None:
+        warned += _warn(args.body, _profile_warnings(profile))
     for path in args.files:
         try:
             if str(path).lower().endswith(".bvh"):
@@ -581,6 +591,8 @@ def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
                     unmapped = profile.check(bvh.header)
                     line += f"; profile {profile.name!r} maps {len(profile.joints)}, leaves {len(unmapped)} unmapped"
                 print(line)
+                if profile is not None:  # where the profile is probably wrong for this file (plugins/lib/profile_check)
+                    warned += _warn(path, _recording_warnings(profile, path, flips))
                 continue
             table = read_toml(check_regular_file(path, "TOML file", "config"))
             if is_scenario(table):
@@ -594,6 +606,7 @@ def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
             elif is_profile(table):
                 prof = load_profile(path)
                 print(f"ok    {path}: body profile {prof.name!r}: {len(prof.joints)} parts, units {prof.scale:g} m, up {prof.up}")
+                warned += _warn(path, _profile_warnings(prof))
             else:
                 c = describe_character(load_character(path, pm))
                 comps = ", ".join(f"{k} {c[k]['plugin']}" for k in ("motor", "perception", "segmenter", "matcher", "action") if k in c)
@@ -602,7 +615,121 @@ def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
         except LikemeError as err:
             failed += 1
             print(f"likeme: error: {err}", file=sys.stderr)
-    return 1 if failed else 0
+    if flips:
+        from plugins.lib.profile_check import facing_warnings
+
+        warned += sum(_warn(path, [text]) for path, text in facing_warnings(flips))
+    return 1 if failed or (warned and args.strict) else 0
+
+
+def _warn(source: str | Path, warnings: list[str]) -> int:
+    """Print each warning as ``likeme: warning: SOURCE: ...`` on standard error; return how many."""
+    for text in warnings:
+        print(f"likeme: warning: {source}: {text}", file=sys.stderr)
+    return len(warnings)
+
+
+def _profile_warnings(profile: Any) -> list[str]:
+    from plugins.lib.profile_check import profile_warnings
+
+    return profile_warnings(profile)
+
+
+def _recording_warnings(profile: Any, path: str | Path, flips: list[tuple[str, Any, int]]) -> list[str]:
+    """Where ``profile`` is probably wrong for the recording ``path`` (units, up axis), read a block at a time; the
+    frames where its facing flips are added to ``flips``, to be counted over every recording."""
+    from plugins.lib.profile_check import RecordingCheck
+
+    check = RecordingCheck(profile)
+    with profile.stream(path) as blocks:
+        for positions, visible in blocks:
+            check.update(positions, visible)
+    flips.append((str(path), *check.flips()))
+    return check.warnings(facing=False)
+
+
+PROFILE_FRAMES = 20_000
+"""The frames of a recording ``likeme profile`` reads (from its start): enough to see a body's size, up and facing."""
+
+
+def _read_recording(path: str) -> tuple[list[str], Any, list[int] | None, float | None, int]:
+    """A recording's joint names, positions (F, J, 3) in its own units and axes (at most :data:`PROFILE_FRAMES`),
+    hierarchy (BVH) or None, frame rate (None: the file does not tell) and number of frames."""
+    import numpy as np
+
+    suffix = Path(path).suffix.lower()
+    if suffix == ".bvh":
+        from toolkit.bvh import open_bvh
+
+        with open_bvh(path) as bvh:
+            header, kept, count = bvh.header, [], 0
+            for values in bvh.blocks():
+                kept.append(header._kinematics(values[: PROFILE_FRAMES - count])[0])
+                count += len(kept[-1])
+                if count >= PROFILE_FRAMES:
+                    break
+            positions = np.concatenate(kept) if kept else np.zeros((0, len(bvh.names), 3))
+            return list(bvh.names), positions, [j.parent for j in bvh.joints], bvh.fps, bvh.n_frames
+    if suffix == ".csv":
+        from toolkit.positions import iter_position_blocks
+
+        fps: float | None = None
+        try:
+            header, blocks = iter_position_blocks(path)
+            fps = header.fps
+        except ConfigError as err:
+            if "frame rate" not in str(err):
+                raise
+            header, blocks = iter_position_blocks(path, fps=1.0)  # no time column: the proposal needs no frame rate
+        kept, count = [], 0
+        for block in blocks:
+            kept.append(block[: PROFILE_FRAMES - count])
+            count += len(kept[-1])
+            if count >= PROFILE_FRAMES:
+                break
+        positions = np.concatenate(kept) if kept else header.positions
+        return list(header.names), positions, None, fps, len(positions)
+    raise ConfigError(f"cannot propose a profile for a {suffix or 'suffix-less'} file", file=path, key=("FILE",),
+                      expected="a BVH file or a CSV of joint positions (a .npy array has no joint names)",
+                      available=(".bvh", ".csv"))
+
+
+def cmd_profile(args: argparse.Namespace, pm: PluginManager) -> int:
+    """Propose a body profile for a recording (``plugins.lib.profile_check.propose_profile``), check it on the same
+    recording, and print it or write it to ``--out``; what it could not decide is marked ``# TODO``."""
+    import tempfile
+
+    import numpy as np
+
+    from plugins.lib.profile_check import propose_profile, recording_warnings
+    from toolkit.files import check_regular_file
+    from toolkit.profile import load_profile
+    from toolkit.state import write_atomic
+
+    check_regular_file(args.file, "recording", "motion")
+    names, positions, parents, fps, frames = _read_recording(args.file)
+    if len(positions) == 0:
+        raise ConfigError("no frames", file=args.file, expected="a recording with at least one frame")
+    stem = re.sub(r"[^A-Za-z0-9_-]+", "-", Path(args.out or args.file).stem).strip("-") or "proposed"
+    proposal = propose_profile(names, positions, parents=parents, name=stem, source=Path(args.file).name, fps=fps)
+    with tempfile.TemporaryDirectory() as tmp:  # the proposal must load and pass its own checks on this recording
+        draft = Path(tmp) / f"{stem}.toml"
+        draft.write_text(proposal.text, encoding="utf-8")
+        profile = load_profile(draft)
+    converted = profile.convert(positions, names)
+    warnings = recording_warnings(profile, [(converted, np.isfinite(converted).all(axis=-1))])
+    if args.out:
+        write_atomic(args.out, proposal.text)
+        print(f"wrote {args.out}", file=sys.stderr)
+    else:
+        print(proposal.text, end="")
+    if len(positions) < frames:
+        print(f"likeme: note: {args.file}: proposed from the first {len(positions)} of {frames} frames",
+              file=sys.stderr)
+    for text in proposal.todo:
+        print(f"likeme: note: {args.file}: TODO: {text}", file=sys.stderr)
+    _warn(args.file, warnings)
+    return 0
 
 
 if __name__ == "__main__":  # pragma: no cover
