@@ -196,7 +196,7 @@ def worker():
     w = fuzz.Worker(memory_mb=1024)
     w.start()
     yield w
-    w.stop()
+    w.close()
 
 
 def _call(worker, name, timeout=20.0):
@@ -213,7 +213,8 @@ def test_the_harness_classifies_planted_outcomes(worker):
     assert fuzz.classify(_call(worker, "plant_memory")) == "memory"
     restarts = worker.restarts
     started = time.monotonic()
-    assert fuzz.classify(_call(worker, "plant_hang", timeout=1.0)) == "hang"
+    hang = _call(worker, "plant_hang", timeout=1.0)
+    assert fuzz.classify(hang) == "hang" and hang["where"].startswith("tests/test_fuzz.py:")  # located by a stack dump
     assert time.monotonic() - started < 10 and worker.restarts == restarts + 1
     assert fuzz.classify(_call(worker, "plant_documented")) == "documented"  # a fresh worker after the hang
 

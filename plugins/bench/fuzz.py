@@ -31,6 +31,7 @@ import contextlib
 import io
 import json
 import os
+import re
 import select
 import shutil
 import signal
@@ -118,8 +119,6 @@ def _bandai_bvh(rng: np.random.Generator) -> str:
 
 def _absolute_refs(text: str, folder: Path) -> str:
     """A built-in TOML file's relative references (``"../max.toml"``) made absolute, so a copy elsewhere loads."""
-    import re
-
     return re.sub(r'"(\.\./[^"]+\.toml)"', lambda m: json.dumps((folder / m.group(1)).resolve().as_posix()), text)
 
 
@@ -165,6 +164,7 @@ def make_seeds(dest: Path, pm: Any, *, seed: int = 0) -> dict[str, list[dict[str
     seeds["bvh"] = [{"path": hand},
                     {"path": bandai, "profile": bandai_profile},
                     {"path": stream, "profile": max_profile, "repertoire": repertoire}]
+    seeds["bvh"].append(seeds["bvh"][-1])  # the stream twice: the only seed that is also observed
     seeds["profile"] = [{"path": bandai_profile, "bvh": bandai},
                         {"path": max_profile, "bvh": stream, "repertoire": repertoire}]
 
@@ -240,8 +240,8 @@ def _command(target: str, seed: dict[str, Any], rng: np.random.Generator) -> lis
         options = [["validate", f]]
         if "profile" in seed:
             options.append(["validate", "--body", str(seed["profile"]), f])
-        if "repertoire" in seed:
-            options.append(["observe", "--body", str(seed["profile"]), "--repertoire", str(seed["repertoire"]), f])
+        if "repertoire" in seed:  # observing sizes filters from the frame rate: as often as both validates
+            options += [["observe", "--body", str(seed["profile"]), "--repertoire", str(seed["repertoire"]), f]] * 2
         return options[int(rng.integers(len(options)))]
     if target == "profile":
         options = [["validate", f], ["validate", "--body", f, str(seed["bvh"])]]
@@ -249,10 +249,18 @@ def _command(target: str, seed: dict[str, Any], rng: np.random.Generator) -> lis
             options.append(["observe", "--body", f, "--repertoire", str(seed["repertoire"]), str(seed["bvh"])])
         return options[int(rng.integers(len(options)))]
     if target == "scenario":
-        return ["run", f, "--duration", "1"] if rng.random() < 0.75 else ["validate", f]
+        return ["run", f, "--duration", _duration(rng)] if rng.random() < 0.75 else ["validate", f]
     if target == "state":
-        return ["run", "learn_windmill", "--load", f, "--duration", "1"]
+        return ["run", "learn_windmill", "--load", f, "--duration", _duration(rng)]
     return ["validate", f]
+
+
+HOSTILE_DURATIONS = ("nan", "inf", "-1", "0", "1e300", "1e-9")
+"""What ``--duration`` is, in one case in ten of the scenario and state targets (else 1 second)."""
+
+
+def _duration(rng: np.random.Generator) -> str:
+    return HOSTILE_DURATIONS[int(rng.integers(len(HOSTILE_DURATIONS)))] if rng.random() < 0.1 else "1"
 
 
 def make_case(index: int, target: str, seeds: dict[str, list[dict[str, Any]]], seed: int) -> Case:
@@ -325,10 +333,16 @@ def run_one(request: dict[str, Any]) -> dict[str, Any]:
     return result
 
 
-def _worker_main(memory_mb: int, warm: list[list[str]]) -> None:
-    """The worker process: read one JSON request a line, answer one JSON line on the protocol descriptor."""
+def _worker_main(memory_mb: int, warm: list[list[str]], stacks: str = "") -> None:
+    """The worker process: read one JSON request a line, answer one JSON line on the protocol descriptor.
+
+    With ``stacks``, ``SIGUSR1`` writes the worker's Python stack to that file (how a hang is located).
+    """
+    import faulthandler
     import resource
 
+    if stacks:
+        faulthandler.register(signal.SIGUSR1, file=open(stacks, "a", encoding="utf-8"), all_threads=False)  # noqa: SIM115
     proto = os.fdopen(os.dup(1), "w", buffering=1, encoding="utf-8")
     requests = os.fdopen(os.dup(0), "r", encoding="utf-8")
     devnull = os.open(os.devnull, os.O_RDWR)
@@ -357,6 +371,8 @@ class Worker:
     """A long-lived ``python -m plugins.bench.fuzz --worker`` process, restarted after a timeout or a crash."""
 
     def __init__(self, memory_mb: int, warm: list[list[str]] | None = None, *, start_timeout: float = 120.0) -> None:
+        self._stacks = tempfile.NamedTemporaryFile(prefix="likeme-fuzz-stacks-", suffix=".txt", delete=False)  # noqa: SIM115
+        self._stacks.close()
         self.memory_mb = memory_mb
         self.warm = warm or []
         self.start_timeout = start_timeout
@@ -368,7 +384,7 @@ class Worker:
                    MALLOC_ARENA_MAX="2", PYTHONHASHSEED="0", MPLBACKEND="Agg")
         env["PYTHONPATH"] = os.pathsep.join([str(ROOT), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
         self.proc = subprocess.Popen([sys.executable, "-m", "plugins.bench.fuzz", "--worker", str(self.memory_mb),
-                                      json.dumps(self.warm)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                      json.dumps(self.warm), self._stacks.name], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                      stderr=subprocess.DEVNULL, env=env, cwd=str(ROOT), start_new_session=True)
         answer = self._read(self.start_timeout)
         if not isinstance(answer, dict) or not answer.get("ready"):
@@ -394,6 +410,34 @@ class Worker:
             buf += chunk
             if buf.endswith(b"\n"):
                 return json.loads(buf)
+
+    def close(self) -> None:
+        """Stop the worker for good."""
+        self.stop()
+        Path(self._stacks.name).unlink(missing_ok=True)
+
+    def _stack(self) -> str:
+        """The innermost frame of the project's code where the (hung) worker is now, from its stack dump."""
+        assert self.proc is not None
+        path = Path(self._stacks.name)
+        before = path.stat().st_size
+        try:
+            os.kill(self.proc.pid, signal.SIGUSR1)
+        except ProcessLookupError:
+            return ""
+        deadline = time.monotonic() + 2.0
+        while path.stat().st_size == before and time.monotonic() < deadline:
+            time.sleep(0.05)
+        time.sleep(0.1)
+        with path.open(encoding="utf-8", errors="replace") as handle:
+            handle.seek(before)
+            dump = handle.read()
+        here = Path(__file__).resolve()
+        for file, line, function in re.findall(r'File "([^"]+)", line (\d+) in (\S+)', dump):  # innermost first
+            p = Path(file).resolve()
+            if p != here and ROOT in p.parents:
+                return f"{p.relative_to(ROOT).as_posix()}:{line} in {function}"
+        return ""
 
     def stop(self) -> None:
         if self.proc is None:
@@ -430,10 +474,11 @@ class Worker:
             name = signal.Signals(-code).name if code is not None and code < 0 else f"exit status {code}"
             return {"rc": None, "died": name, "exception": None, "message": "", "where": "",
                     "stderr": f"the worker died ({name})"}
+        where = self._stack()
         self.stop()
         self.restarts += 1
-        return {"rc": None, "timeout": True, "exception": None, "message": "", "where": "",
-                "stderr": f"no answer within {timeout:g} s (killed)"}
+        return {"rc": None, "timeout": True, "exception": None, "message": "", "where": where,
+                "stderr": f"no answer within {timeout:g} s (killed); it was at {where or 'an unknown place'}"}
 
 
 def classify(result: dict[str, Any]) -> str:
@@ -468,7 +513,7 @@ class Result:
         """What groups equal failures: the exception and where it was raised, or the kind of failure."""
         a = self.answer
         if self.outcome == "hang":
-            return "hang"
+            return f"hang at {a.get('where') or '?'}"
         if a.get("died"):
             return f"worker died ({a['died']})"
         if a.get("exception"):
@@ -509,7 +554,7 @@ def run_fuzz(pm: Any, *, n: int = 2000, seed: int = 0, targets: tuple[str, ...] 
             Path(out).mkdir(parents=True, exist_ok=True)
             shutil.rmtree(Path(out) / "seeds", ignore_errors=True)
         seeds = make_seeds((Path(out).resolve() if out is not None else tmp) / "seeds", pm, seed=seed)
-        stream = seeds["bvh"][2]
+        stream = seeds["bvh"][-1]
         warm = [["validate", str(CHARACTERS / "max.toml")],
                 ["observe", "--body", str(stream["profile"]), "--repertoire", str(stream["repertoire"]),
                  str(stream["path"])],
@@ -533,7 +578,7 @@ def run_fuzz(pm: Any, *, n: int = 2000, seed: int = 0, targets: tuple[str, ...] 
                 if progress is not None:
                     progress(result)
         finally:
-            worker.stop()
+            worker.close()
     return results
 
 
@@ -616,4 +661,5 @@ def cmd_fuzz(args: Any, pm: Any) -> int:
 
 
 if __name__ == "__main__" and len(sys.argv) >= 3 and sys.argv[1] == "--worker":
-    _worker_main(int(sys.argv[2]), json.loads(sys.argv[3]) if len(sys.argv) > 3 else [])
+    _worker_main(int(sys.argv[2]), json.loads(sys.argv[3]) if len(sys.argv) > 3 else [],
+                 sys.argv[4] if len(sys.argv) > 4 else "")

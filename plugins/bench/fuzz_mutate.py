@@ -201,9 +201,15 @@ def _sub_line(data: bytes, pattern: bytes, repl: Callable[[re.Match], bytes]) ->
     return re.sub(pattern, repl, data, count=1, flags=re.M)
 
 
+FRAME_TIMES = ("1e-7", "1e-6", "1e-9", "0.00001", "1e-320", "0", "-0.0333333", "nan", "inf", "1e300", "\u00b2", "",
+               "0.0333333 0.1", "1/30")
+"""What ``Frame Time:`` becomes: tiny above all (filters are sized as seconds x fps), then zero, negative, not
+finite, huge, not a number."""
+
+
 def bvh_frame_time(data: bytes, rng: np.random.Generator) -> bytes:
-    """A hostile ``Frame Time:`` (1e-7, 0, negative, NaN, inf, superscripts...)."""
-    value = _pick(rng, HOSTILE_NUMBERS + ("1e-6", "0.00001", "1e-9"))
+    """A hostile ``Frame Time:`` (:data:`FRAME_TIMES`)."""
+    value = _pick(rng, FRAME_TIMES)
     return _sub_line(data, rb"^(\s*Frame Time:)[^\r\n]*", lambda m: m.group(1) + b" " + value.encode())
 
 
@@ -324,6 +330,39 @@ def toml_value(data: bytes, rng: np.random.Generator) -> bytes:
     return data[: m.start(2)] + _pick(rng, HOSTILE_TOML_VALUES).encode() + data[m.end(2):]
 
 
+SIZING_NUMBERS = ("1e300", "1e9", "1e6", "100000000", "2147483648", "9223372036854775807", "nan", "inf", "-inf", "-1",
+                  "0", "-0.0", "1e-7", "1e-300")
+"""What a number that may size memory or time (a frame rate, a duration, a count) is replaced with."""
+
+
+def toml_number(data: bytes, rng: np.random.Generator) -> bytes:
+    """Replace one number of a value (``fps = 30.0``, ``tail = 1.5``, ``random = 12``, a key time) with a size that
+    is huge, tiny, negative, zero or not finite (:data:`SIZING_NUMBERS`)."""
+    spans = []
+    for m in _TOML_ASSIGN.finditer(data):
+        value = m.group(2).split(b"#")[0]
+        spans += [(m.start(2) + n.start(), m.start(2) + n.end()) for n in _NUMBER.finditer(value)
+                  if not value[:n.start()].count(b'"') % 2]  # not inside a string
+    if not spans:
+        return data
+    a, b = spans[int(rng.integers(len(spans)))]
+    return data[:a] + _pick(rng, SIZING_NUMBERS).encode() + data[b:]
+
+
+_TOML_SCALAR = re.compile(rb"^([ \t]*[A-Za-z0-9_\-]+[ \t]*=[ \t]*)([-+]?[0-9][0-9_.eE+\-]*)[ \t]*(?:#[^\r\n]*)?$", re.M)
+
+
+def toml_scalar(data: bytes, rng: np.random.Generator) -> bytes:
+    """Replace a whole numeric value (``fps = 30.0``, ``tail = 1.5``, ``random = 12``, ``seed = 3``) with a size that
+    is huge, tiny, negative, zero or not finite (:data:`SIZING_NUMBERS`): where a scenario's or a component's time
+    and memory come from."""
+    lines = list(_TOML_SCALAR.finditer(data))
+    if not lines:
+        return toml_number(data, rng)
+    m = _pick(rng, lines)
+    return data[: m.start(2)] + _pick(rng, SIZING_NUMBERS).encode() + data[m.end(2):]
+
+
 def toml_wrap(data: bytes, rng: np.random.Generator) -> bytes:
     """Wrap one value in a list (``held_by = ["max"]``, ``up = ["+y"]``) or an inline table."""
     lines = [m for m in _TOML_ASSIGN.finditer(data) if m.group(2).strip() and not m.group(2).strip().startswith(b"[")]
@@ -372,14 +411,15 @@ def toml_tables(data: bytes, rng: np.random.Generator) -> bytes:
 def toml_extends(data: bytes, rng: np.random.Generator) -> bytes:
     """``extends`` / ``character`` pointing at itself, at a folder, at a device, at nothing, or not a string."""
     target = _pick(rng, (b'"."', b'"/dev/null"', b'"/"', b'""', b'"max"', b"3", b'["max"]', b'"../../../../etc/passwd"',
-                         b'"nobody"'))
+                         b'"nobody"', b'"/dev/zero"', b'"/proc/self/status"'))
     m = re.search(rb"^([ \t]*(?:extends|character)[ \t]*=[ \t]*)([^\r\n]*)", data, flags=re.M)
     if not m:
         return data.replace(b"[character]\n", b"[character]\nextends = " + target + b"\n", 1)
     return data[: m.start(2)] + target + data[m.end(2):]
 
 
-TOML_MUTATIONS: dict[str, Mutation] = {f.__name__: f for f in (toml_value, toml_wrap, toml_deep, toml_tables, toml_extends)}
+TOML_MUTATIONS: dict[str, Mutation] = {f.__name__: f for f in (
+    toml_value, toml_number, toml_scalar, toml_wrap, toml_deep, toml_tables, toml_extends)}
 
 
 # -- JSON (state files) ----------------------------------------------------------------------------------------------
