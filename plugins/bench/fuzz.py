@@ -281,15 +281,25 @@ def make_case(index: int, target: str, seeds: dict[str, list[dict[str, Any]]], s
 # -- the worker ------------------------------------------------------------------------------------------------------
 
 
+OWN_CODE = ("toolkit", "plugins", "tests")
+"""The folders of the project's own code: where a failure is located (not the libraries, not this harness)."""
+
+
+def _own(filename: str) -> str:
+    """``filename`` relative to the project if it is the project's own code (not this harness), else ''."""
+    path = Path(filename).resolve()
+    if path == Path(__file__).resolve() or ROOT not in path.parents:
+        return ""
+    rel = path.relative_to(ROOT)
+    return rel.as_posix() if rel.parts[0] in OWN_CODE else ""
+
+
 def _where(tb: Any) -> str:
     """The innermost frame of the traceback in the project's own code (``toolkit/x.py:12 in f``)."""
-    here = Path(__file__).resolve()
     found = ""
     for frame in traceback.extract_tb(tb):
-        path = Path(frame.filename).resolve()
-        if path == here or ROOT not in path.parents:
-            continue
-        found = f"{path.relative_to(ROOT).as_posix()}:{frame.lineno} in {frame.name}"
+        if own := _own(frame.filename):
+            found = f"{own}:{frame.lineno} in {frame.name}"
     return found
 
 
@@ -432,11 +442,9 @@ class Worker:
         with path.open(encoding="utf-8", errors="replace") as handle:
             handle.seek(before)
             dump = handle.read()
-        here = Path(__file__).resolve()
         for file, line, function in re.findall(r'File "([^"]+)", line (\d+) in (\S+)', dump):  # innermost first
-            p = Path(file).resolve()
-            if p != here and ROOT in p.parents:
-                return f"{p.relative_to(ROOT).as_posix()}:{line} in {function}"
+            if own := _own(file):
+                return f"{own}:{line} in {function}"
         return ""
 
     def stop(self) -> None:

@@ -560,11 +560,11 @@ def mutation_names(fmt: str) -> list[str]:
 
 
 def mutate(data: bytes, fmt: str, rng: np.random.Generator) -> tuple[bytes, list[str]]:
-    """Apply one to three mutations to ``data`` (half of them format-aware); return the bytes and their names."""
+    """Apply one to three mutations to ``data`` (two in three format-aware); return the bytes and their names."""
     aware = MUTATIONS.get(fmt, {})
     applied = []
     for _ in range(int(rng.choice([1, 1, 2, 3]))):
-        pool = aware if aware and rng.random() < 0.5 else GENERIC
+        pool = aware if aware and rng.random() < 2 / 3 else GENERIC
         name = _pick(rng, sorted(pool))
         data = pool[name](data, rng)
         applied.append(name)
