@@ -211,11 +211,12 @@ def test_the_harness_classifies_planted_outcomes(worker):
     assert fuzz.classify(_call(worker, "plant_documented")) == "documented"
     assert fuzz.classify(_call(worker, "plant_ok")) == "ok"
     assert fuzz.classify(_call(worker, "plant_memory")) == "memory"
+    assert fuzz.classify(_call(worker, "plant_ok")) == "ok"  # a fresh worker after a MemoryError, this module imported
     restarts = worker.restarts
     started = time.monotonic()
-    hang = _call(worker, "plant_hang", timeout=1.0)
+    hang = _call(worker, "plant_hang", timeout=2.0)
     assert fuzz.classify(hang) == "hang" and hang["where"].startswith("tests/test_fuzz.py:")  # located by a stack dump
-    assert time.monotonic() - started < 10 and worker.restarts == restarts + 1
+    assert time.monotonic() - started < 15 and worker.restarts == restarts + 1
     assert fuzz.classify(_call(worker, "plant_documented")) == "documented"  # a fresh worker after the hang
 
 
