@@ -265,7 +265,8 @@ def test_bench_fuzz_reports_and_fails_on_findings(tmp_path, capsys):
     from toolkit.cli import main
 
     status = main(["bench", "fuzz", "--n", "12", "--targets", "state,bvh", "--seed", "3", "--timeout", "20",
-                   "--out", str(tmp_path), "--quiet"])
+                   "--out", str(tmp_path / "cases"), "--quiet"])
+    tmp_path = tmp_path / "cases"  # created by the command
     out = capsys.readouterr().out
     closing = out.strip().splitlines()[-1]
     m = re.fullmatch(r"fuzz: 12 inputs, (\d+) tracebacks, (\d+) hangs, (\d+) over memory", closing)
@@ -276,6 +277,15 @@ def test_bench_fuzz_reports_and_fails_on_findings(tmp_path, capsys):
     for kept in tmp_path.glob("case*.stderr"):
         assert "# replay (in this folder): likeme " in kept.read_text()
     assert "state" in out and "bvh" in out
+
+
+def test_bench_fuzz_refuses_an_out_that_is_a_file(tmp_path, capsys):
+    from toolkit.cli import main
+
+    (tmp_path / "f").write_text("x")
+    assert main(["bench", "fuzz", "--n", "1", "--out", str(tmp_path / "f")]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "key --out: not a folder" in err[0]
 
 
 def test_bench_fuzz_refuses_unknown_targets(capsys):

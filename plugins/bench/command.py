@@ -146,6 +146,7 @@ def likeme_register_commands(subparsers):
                    "profile, scenario, state, csv (default: all)")
     p.add_argument("--timeout", type=float, default=10.0, help="seconds a case may take (default: 10)")
     p.add_argument("--memory", type=int, default=1024, help="address-space limit of the worker, MB (default: 1024)")
-    p.add_argument("--out", metavar="DIR", help="write every failing input and its stderr here, to replay")
+    p.add_argument("--out", metavar="DIR", dest="out_dir", help="write every failing input and its stderr into this "
+                   "folder (created if missing), to replay")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(handler=_handler("fuzz", "cmd_fuzz"))

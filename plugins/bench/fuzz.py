@@ -619,6 +619,26 @@ def failures(results: list[Result]) -> list[tuple[str, str, list[Result]]]:
     return sorted(((t, k, rs) for (t, k), rs in groups.items()), key=lambda g: (g[0], -len(g[2]), g[1]))
 
 
+def _out_dir(value: str | None) -> Path | None:
+    """``--out DIR``: a folder to write into, created if missing, checked before the run."""
+    from toolkit.errors import ConfigError
+
+    if not value:
+        return None
+    path = Path(value)
+    expected = "a folder to write the failing cases into (created if missing)"
+    if path.exists() and not path.is_dir():
+        raise ConfigError("not a folder", file=path, key=("--out",), expected=expected)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=path, prefix=".likeme-probe-"):
+            pass
+    except OSError as exc:
+        raise ConfigError(f"cannot write there ({exc.strerror or exc})", file=path, key=("--out",),
+                          expected=expected) from None
+    return path
+
+
 def cmd_fuzz(args: Any, pm: Any) -> int:
     """``likeme bench fuzz``: print a table of outcomes per target, the failures by place, and the closing line."""
     from rich.console import Console
@@ -636,12 +656,13 @@ def cmd_fuzz(args: Any, pm: Any) -> int:
         raise ConfigError(f"--n {args.n}, --timeout {args.timeout}, --memory {args.memory}",
                           key=("--n" if args.n < 1 else "--timeout" if not 0 < args.timeout < float("inf") else "--memory",),
                           expected="--n >= 1, a finite --timeout > 0 (seconds), --memory >= 0 (MB, 0: no limit)")
+    out_dir = _out_dir(getattr(args, "out_dir", None))
     console = Console(stderr=True)
     notes: list[str] = []
     with Progress(console=console, transient=True, disable=args.quiet) as bar:
         task = bar.add_task("fuzz", total=args.n)
         results = run_fuzz(pm, n=args.n, seed=args.seed, targets=targets, timeout=args.timeout,
-                           memory_mb=args.memory, out=Path(args.out) if args.out else None, notes=notes,
+                           memory_mb=args.memory, out=out_dir, notes=notes,
                            progress=lambda r: bar.advance(task))
     out = Console()
     table = Table(title=f"likeme bench fuzz --n {args.n} --seed {args.seed}")
@@ -663,8 +684,8 @@ def cmd_fuzz(args: Any, pm: Any) -> int:
                   f"{first.case.command()}")
     for note in notes:
         print(f"note: {note}")
-    if args.out:
-        print(f"failing inputs, their stderr and the seeds they came from: {args.out}")
+    if out_dir is not None:
+        print(f"failing inputs, their stderr and the seeds they came from: {out_dir}")
     print(summary_line(results))
     return 1 if any(r.outcome in BAD for r in results) else 0
 
