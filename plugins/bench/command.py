@@ -192,3 +192,16 @@ def likeme_register_commands(subparsers):
                    "(default: 240, 480, 960)")
     p.add_argument("--frames", type=int, default=240, help="frames to compare (default: 240)")
     p.set_defaults(handler=_handler("vision", "cmd_vision"))
+
+    p = sub.add_parser("fuzz", help="mutated real-looking inputs through the commands a user runs: only documented "
+                       "errors allowed (docs/robustness.md)")
+    p.add_argument("--n", type=int, default=2000, help="number of mutated inputs (default: 2000)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the mutations (default: 0)")
+    p.add_argument("--targets", default="bvh,toml,profile,scenario,state,csv", help="comma-separated: bvh, toml, "
+                   "profile, scenario, state, csv (default: all)")
+    p.add_argument("--timeout", type=float, default=10.0, help="seconds a case may take (default: 10)")
+    p.add_argument("--memory", type=int, default=1024, help="address-space limit of the worker, MB (default: 1024)")
+    p.add_argument("--out", metavar="DIR", dest="out_dir", help="write every failing input and its stderr into this "
+                   "folder (created if missing), to replay")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(handler=_handler("fuzz", "cmd_fuzz"))
