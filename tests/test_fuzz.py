@@ -83,12 +83,6 @@ def _edit_header(text: str, edits: list[tuple[str, int, str]]) -> str:
     return "".join(tokens) + text[end:]
 
 
-KNOWN_BVH = pytest.mark.xfail(strict=True, reason="main (5f5286e) raises tracebacks on hostile BVH headers "
-                              "(CHANNELS with a superscript count, deep nesting...: issue 21, the 'reading' branch "
-                              "fixes them). Strict: remove this marker once that branch is merged.")
-
-
-@KNOWN_BVH
 @settings(max_examples=150, deadline=None, derandomize=True)
 @given(edits=EDITS, seed=st.sampled_from(["hand", "bandai"]))
 def test_mutated_bvh_headers_give_documented_errors_only(edits, seed):
@@ -96,7 +90,6 @@ def test_mutated_bvh_headers_give_documented_errors_only(edits, seed):
     _read_bvh_checked(text.encode("utf-8", "surrogatepass"))
 
 
-@KNOWN_BVH
 @settings(max_examples=150, deadline=None, derandomize=True)
 @given(case=st.integers(0, 2 ** 32 - 1), seed=st.sampled_from(["hand", "bandai"]))
 def test_structurally_mutated_bvh_files_give_documented_errors_only(case, seed):

@@ -35,6 +35,7 @@ from toolkit.body import Body
 from toolkit.components import ActionSystem, Component, Correspondence, Matcher, MotorSystem, Perception, Segmenter
 from toolkit.errors import ConfigError, LikemeError, PluginError
 from toolkit.manager import PluginManager
+from toolkit.params import finite_number
 
 __all__ = [
     "Character",
@@ -243,11 +244,14 @@ def resolve_file(ref: str, base: Path | None, pm: PluginManager | None, *, key: 
     searched = character_paths(pm)
     candidates.extend(p / name for p in searched)
     for c in candidates:
-        if c.is_file():
-            return c.resolve()
+        try:
+            if c.is_file():
+                return c.resolve()
+        except OSError:  # a name too long for the file system, a loop of links: not a file that can be found
+            continue
     known = sorted({f.stem for p in searched for f in p.glob("*.toml")})
     raise ConfigError(
-        f"cannot find {ref!r}",
+        f"cannot find {ref[:80]!r}" + (f" ({len(ref)} characters)" if len(ref) > 80 else ""),
         file=file,
         key=key,
         expected="a path relative to this file or the name of a character on the search path",
@@ -379,8 +383,7 @@ def compose_character(table: Mapping[str, Any], pm: PluginManager, *, files: tup
     if not isinstance(description, str):
         raise ConfigError("wrong type", key=("character", "description"), expected="a string")
     lengths_for = head.get("lengths_for_height")
-    if lengths_for is not None and (isinstance(lengths_for, bool) or not isinstance(lengths_for, (int, float))
-                                    or not np.isfinite(lengths_for) or lengths_for <= 0):
+    if lengths_for is not None and (finite_number(lengths_for) or 0.0) <= 0:
         raise ConfigError(f"invalid value {lengths_for!r}", key=("character", "lengths_for_height"),
                           expected="a positive number: the standing height (m) the length parameters were written for")
     body_table = _table(table, "body", required=True)

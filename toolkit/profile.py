@@ -41,6 +41,7 @@ from toolkit.bvh import BVH, BVHStream, open_bvh, read_bvh
 from toolkit.errors import ConfigError
 from toolkit.files import check_regular_file
 from toolkit.motion import Motion
+from toolkit.params import finite_number
 
 __all__ = ["BodyProfile", "MotionStream", "is_profile", "load_profile", "UNITS", "UP_AXES"]
 
@@ -205,10 +206,10 @@ def load_profile(path: str | Path) -> BodyProfile:
             raise fail(f"unknown units {units!r}", ("profile", "units"), expected="a unit name or metres per unit",
                        available=UNITS)
         scale = UNITS[units]
-    elif isinstance(units, int | float) and not isinstance(units, bool) and np.isfinite(units) and units > 0:
+    elif (finite_number(units) or 0.0) > 0:
         scale = float(units)
     else:
-        raise fail(f"invalid units {units!r}", ("profile", "units"),
+        raise fail(f"invalid units {repr(units)[:40]}", ("profile", "units"),
                    expected="a unit name or a positive number (finite: metres per unit)")
     up = head.get("up", "+y")
     if not isinstance(up, str):
