@@ -17,7 +17,8 @@ from typing import Any
 
 from toolkit import Parameter
 
-__all__ = ["DEMONSTRATION", "PALETTE", "blank", "figure", "save_figure", "timeline", "demonstrate"]
+__all__ = ["DEMONSTRATION", "PALETTE", "blank", "colours", "figure", "fit_labels", "save_figure", "span_label", "timeline",
+           "demonstrate"]
 
 PALETTE = ("#4363d8", "#e6194b", "#3cb44b", "#f58231", "#911eb4", "#42d4f4", "#f032e6", "#9a6324", "#469990",
            "#800000", "#808000", "#000075")
@@ -37,10 +38,13 @@ DEMONSTRATION = (
 """The parameters every signal view shares: what is demonstrated, and the picture's size."""
 
 
-def demonstrate(view: Any, character: Any) -> Any:
-    """The :class:`~plugins.views.demonstration.Demonstration` a signal view's parameters ask for."""
+def demonstrate(view: Any, character: Any, recording: Any = None) -> Any:
+    """The :class:`~plugins.views.demonstration.Demonstration` a signal view's parameters ask for, or ``recording``
+    (one made by :func:`~plugins.views.demonstration.recording`) when there is one."""
     from plugins.views.demonstration import perform_sequence
 
+    if recording is not None:
+        return recording
     p = view.params
     return perform_sequence(character, p["demonstrator"], p["movements"], "movements", speed=p["speed"],
                             rest=p["rest"], noise=p["noise"], seed=p["seed"])
@@ -48,10 +52,13 @@ def demonstrate(view: Any, character: Any) -> Any:
 
 def blank(width: int, height: int) -> Any:
     """An empty figure of ``width`` x ``height`` pixels (constrained layout, Agg canvas)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     dpi = 100
-    return Figure(figsize=(width / dpi, height / dpi), dpi=dpi, layout="constrained")
+    fig = Figure(figsize=(width / dpi, height / dpi), dpi=dpi, layout="constrained")
+    FigureCanvasAgg(fig)  # a canvas that can measure text before the picture is written
+    return fig
 
 
 def figure(width: int, height: int, rows: Sequence[float]) -> tuple[Any, list[Any]]:
@@ -61,14 +68,91 @@ def figure(width: int, height: int, rows: Sequence[float]) -> tuple[Any, list[An
     return fig, list(axes)
 
 
+SPAN_LABEL = "likeme-span-label"
+"""The ``gid`` of a label that belongs inside a span of the x axis (:func:`span_label`): fitted before saving."""
+
+ELLIPSIS = "\u2026"
+
+
+def span_label(ax: Any, x0: float, x1: float, y: float, text: str, **kwargs: Any) -> Any:
+    """A label centred in the span ``x0``..``x1`` (data) at height ``y`` (axes fraction), fitted to the span when the
+    figure is saved (:func:`fit_labels`): shortened with an ellipsis where it is wider, hidden where not one letter
+    fits, so labels of neighbouring spans never overlap and none runs past the axes."""
+    kwargs.setdefault("fontsize", 8)
+    label = ax.text((x0 + x1) / 2, y, text, ha="center", va="center", transform=ax.get_xaxis_transform(),
+                    gid=SPAN_LABEL, clip_on=False, **kwargs)
+    label.likeme_span = (float(x0), float(x1))
+    label.likeme_text = text
+    return label
+
+
+def _shorten(label: Any, text: str, width: float, renderer: Any, smallest: float | None = None) -> bool:
+    """Set the longest prefix of ``text`` (with an ellipsis when cut) whose width is within ``width`` pixels, after
+    trying the font down to ``smallest`` points; whether anything of it is left."""
+    label.set_text(text)
+    size = label.get_fontsize()
+    while label.get_window_extent(renderer).width > width and smallest is not None and size > smallest:
+        size = max(smallest, size - 0.5)
+        label.set_fontsize(size)
+    if label.get_window_extent(renderer).width <= width:
+        return True
+    lo, hi = 0, len(text) - 1  # the longest prefix that fits, by bisection
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        label.set_text(text[:mid].rstrip() + ELLIPSIS)
+        if label.get_window_extent(renderer).width <= width:
+            lo = mid
+        else:
+            hi = mid - 1
+    label.set_text(text[:lo].rstrip() + ELLIPSIS)
+    return lo > 0
+
+
+def fit_labels(fig: Any, pad: float = 3.0) -> int:
+    """Fit every :func:`span_label` of ``fig`` to the visible part of its span and every axes title to the figure's
+    width, after the layout is done; the layout is then kept as it is. Returns how many labels were shortened or
+    hidden."""
+    fig.canvas.draw()  # the layout, and a renderer that measures text
+    renderer = fig.canvas.get_renderer()
+    fig.set_layout_engine("none")  # what is measured now is where things stay
+    changed = 0
+    right = fig.bbox.x1 - pad
+    for ax in fig.axes:
+        lo, hi = sorted(ax.get_xlim())
+        for label in ax.texts:
+            if label.get_gid() != SPAN_LABEL:
+                continue
+            x0, x1 = max(label.likeme_span[0], lo), min(label.likeme_span[1], hi)
+            if x1 <= x0:
+                label.set_visible(False)
+                changed += 1
+                continue
+            label.set_x((x0 + x1) / 2)
+            (px0, _), (px1, _) = ax.transData.transform([(x0, 0.0), (x1, 0.0)])
+            fits = _shorten(label, label.likeme_text, abs(px1 - px0) - 2 * pad, renderer,
+                            smallest=min(6.5, label.get_fontsize()))
+            label.set_visible(fits)
+            changed += label.get_text() != label.likeme_text or not fits
+        for title in (ax.title, ax._left_title, ax._right_title):
+            text = title.get_text()
+            if text and title.get_window_extent(renderer).x1 > right:
+                start = title.get_window_extent(renderer).x0
+                _shorten(title, text, right - max(start, pad), renderer)
+                changed += 1
+    return changed
+
+
 def save_figure(fig: Any, out: str | Path) -> Path:
-    """Write ``fig`` to ``out`` as PNG atomically (a temporary file in the same folder, then a rename)."""
+    """Fit the labels (:func:`fit_labels`), then write ``fig`` to ``out`` as PNG atomically (a temporary file in the
+    same folder, then a rename)."""
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
+    fit_labels(fig)
     fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".png", dir=out.parent)
     os.close(fd)
     try:
         fig.savefig(tmp, format="png")
+        os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, out)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
@@ -76,28 +160,49 @@ def save_figure(fig: Any, out: str | Path) -> Path:
     return out
 
 
-def timeline(ax: Any, demo: Any, observations: Sequence[Any], fps: float) -> None:
-    """The strip above a signal: true movements (top row) and found segments (bottom row) over time.
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
 
-    Each found segment is labelled with what was recognised; a black tick marks the moment the matcher committed
-    when it did so before the segment ended.
+
+UNKNOWN_COLOUR = "#a0a0a0"
+"""The colour of a segment recognised as no movement."""
+
+
+def colours(names: Sequence[str]) -> dict[str, str]:
+    """A colour per movement name (sorted, so the same names get the same colours in every picture)."""
+    return {m: PALETTE[i % len(PALETTE)] for i, m in enumerate(sorted(set(names)))}
+
+
+def timeline(ax: Any, demo: Any, observations: Sequence[Any], fps: float, *, recognised: bool = True) -> None:
+    """The strip above a signal: true movements (top row, when they are known) and found segments (bottom row).
+
+    A found segment is coloured and labelled by what was recognised (grey: unknown; ``recognised=False``, with no
+    matcher: alternating greys, unlabelled); a black tick marks the moment the matcher committed when it did so
+    before the segment ended. Labels are fitted to their spans when the figure is saved.
     """
-    names = sorted({m for _, _, m in demo.truth})
-    colour = {m: PALETTE[i % len(PALETTE)] for i, m in enumerate(names)}
+    found = [o.movement or "unknown" for o in observations] if recognised else []
+    colour = colours([m for _, _, m in demo.truth] + [m for m in found if m != "unknown"])
+    colour["unknown"] = UNKNOWN_COLOUR
+    rows = {"found": (0.05, 0.45), "performed": (0.55, 0.95)} if demo.truth else {"found": (0.25, 0.75)}
+    lo, hi = rows["found"]
     for start, end, movement in demo.truth:
-        ax.axvspan(start / fps, end / fps, ymin=0.55, ymax=0.95, color=colour[movement], alpha=0.35, lw=0)
-        ax.text((start + end) / 2 / fps, 0.75, movement, ha="center", va="center", fontsize=8, clip_on=True)
+        a, b = rows["performed"]
+        ax.axvspan(start / fps, end / fps, ymin=a, ymax=b, facecolor=colour[movement], alpha=0.35, lw=1,
+                   edgecolor="white")
+        span_label(ax, start / fps, end / fps, (a + b) / 2, movement)
     for k, o in enumerate(observations):
         s = o.segment
-        ax.axvspan(s.start_time, s.end_time, ymin=0.05, ymax=0.45, color="#606060" if k % 2 else "#909090",
-                   alpha=0.5, lw=0)
-        label = o.movement or "unknown"
-        ax.text((s.start_time + s.end_time) / 2, 0.25, label, ha="center", va="center", fontsize=8, clip_on=True,
-                color="black")
+        fill = colour[found[k]] if recognised else ("#606060" if k % 2 else "#909090")
+        ax.axvspan(s.start_time, s.end_time, ymin=lo, ymax=hi, facecolor=fill, alpha=0.5, lw=1, edgecolor="white")
+        if recognised:
+            span_label(ax, s.start_time, s.end_time, (lo + hi) / 2, found[k])
         if o.decided_at is not None:
             t = (s.start + o.decided_at) / fps
-            ax.plot([t, t], [0.05, 0.45], color="black", lw=2)
+            ax.plot([t, t], [lo, hi], color="black", lw=2, transform=ax.get_xaxis_transform())
     ax.set_ylim(0, 1)
-    ax.set_yticks([0.25, 0.75], ["found", "performed"])
+    ax.set_yticks([(a + b) / 2 for a, b in rows.values()], list(rows))
     ax.tick_params(axis="y", length=0)
-    ax.set_title(f"{demo.who}: {', '.join(m for _, _, m in demo.truth)}", fontsize=10, loc="left")
+    what = ", ".join(m for _, _, m in demo.truth)
+    ax.set_title(f"{demo.who}: {what}" if what else demo.who, fontsize=10, loc="left")

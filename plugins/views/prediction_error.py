@@ -38,18 +38,24 @@ class PredictionErrorView(View):
 
     name = "prediction-error"
     parameters = DEMONSTRATION
+    needs = {"matcher": "forward-model"}
+    """What the character must have; ``likeme show --body PROFILE FILE`` composes an observer with it."""
+    recordings = "each"
+    """``likeme show --body PROFILE FILE ...`` draws one picture per recording (``draw(..., recording=...)``)."""
 
-    def draw(self, subject: Any, out: Path) -> list[Path]:
+    def draw(self, subject: Any, out: Path, recording: Any = None) -> list[Path]:
+        """Draw ``subject`` watching a demonstration (the parameters') or ``recording`` (a
+        :func:`~plugins.views.demonstration.recording`) to the PNG file ``out``."""
         character = subject
         matcher = require(character, "matcher", "forward-model")
-        demo = demonstrate(self, character)
+        demo = demonstrate(self, character, recording)
         segments: list[dict[str, Any]] = []
         observer, found = watch(character, demo, each=lambda o: segments.append({"observation": o,
                                                                                **matcher.inspect()}))
         fps = observer.fps
         threshold, deviation = matcher.params["threshold"], matcher.params["deviation"]
         fig, (top, ax) = figure(self.params["width"], self.params["height"], (1, 4))
-        timeline(top, demo, found, fps)
+        timeline(top, demo, found, fps, recognised=character.matcher is not None)
         colour: dict[str, str] = {}
         highest = 2.0 * max(threshold, deviation)
         for seg in segments:
