@@ -101,7 +101,7 @@ class BodyView(View):
             labels.append(label)
             points.append([x - cell * 0.1, y + height * 0.5, 0.0])
         width = self.params["width"]
-        lower = (0.0, -(n_rows + 1) * row)
+        lower = (0.0, -n_rows * row - height * 0.5)  # the feet of the last row, and a margin
         upper = (columns * strip, row * 0.1 + height * 1.8)
         size = (width, self.params["height"] or int(width * (upper[1] - lower[1]) / (upper[0] - lower[0])))
         return [poses_png(out, body, np.stack(poses), np.array(points), labels, lower=lower, upper=upper, size=size,

@@ -171,8 +171,15 @@ UNKNOWN_COLOUR = "#a0a0a0"
 
 
 def colours(names: Sequence[str]) -> dict[str, str]:
-    """A colour per movement name (sorted, so the same names get the same colours in every picture)."""
-    return {m: PALETTE[i % len(PALETTE)] for i, m in enumerate(sorted(set(names)))}
+    """A colour per movement name (sorted, so the same names get the same colours in every picture): the palette,
+    or for more names than it has, hues a golden angle apart in two strengths (strong, distinct neighbours)."""
+    names = sorted(set(names))
+    if len(names) <= len(PALETTE):
+        return {m: PALETTE[i] for i, m in enumerate(names)}
+    from matplotlib.colors import hsv_to_rgb, to_hex
+
+    return {m: to_hex(hsv_to_rgb((0.61803398875 * i % 1.0, 0.75, 0.9 if i % 2 else 0.65)))
+            for i, m in enumerate(names)}
 
 
 def timeline(ax: Any, demo: Any, observations: Sequence[Any], fps: float, *, recognised: bool = True) -> None:
