@@ -191,6 +191,11 @@ CASES = [
     ("bench-memory-block", "memory benchmark with packets of 0 frames", {}, ["bench", "memory", "--block", "0"], ["key --block", "value 0", "expected a whole number >= 1"]),
     ("observe-ruptures-window", "ruptures with a negative window", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "ruptures", "--set", "segmenter.window=-1", "m.bvh"], ["key segmenter.window", "value -1.0 out of range", "expected a number in [0, inf]"]),
     ("observe-max-movement", "velocity-direction with a negative max_movement", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "velocity-direction", "--set", "segmenter.max_movement=-5", "m.bvh"], ["key segmenter.max_movement", "value -5.0 out of range"]),
+    # -- views of your own recordings (likeme show --body PROFILE FILE ... --view NAME)
+    ("show-recording-no-view", "recordings to show without a view", {"p.toml": PROFILE, "m.bvh": BVH}, ["show", "--body", "p.toml", "m.bvh"], ["key --view", "recordings without --view", "available:", "hub-signal"]),
+    ("show-recording-view", "recordings shown by a view that draws none", {"p.toml": PROFILE, "m.bvh": BVH}, ["show", "--body", "p.toml", "m.bvh", "--view", "posegraph"], ["key --view", "view 'posegraph' does not draw recordings", "available:", "speed-profile"]),
+    ("show-recording-no-body", "a recording shown without its body profile", {"m.bvh": BVH}, ["show", "m.bvh", "--view", "body"], ["key character", "cannot show m.bvh", "with --body PROFILE recordings"]),
+    ("show-recordings-one-png", "two recordings' pictures to one file", {"p.toml": PROFILE, "m.bvh": BVH}, ["show", "--body", "p.toml", "m.bvh", "m.bvh", "--view", "hub-signal", "--out", "x.png"], ["x.png: key --out", "one file for several pictures", "expected a folder"]),
 ]
 
 

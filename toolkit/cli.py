@@ -531,6 +531,10 @@ def _show_recordings(args: argparse.Namespace, pm: PluginManager, template: str 
         raise ConfigError(f"view {args.view!r} does not draw recordings", key=("--view",),
                           expected="a view of recordings", available=_recording_views(pm))
     needs = dict(getattr(view, "needs", {}))
+    if each == "all":
+        outs = [_show_out(args.out_path, Path(files[0]).stem if len(files) == 1 else "recordings", args.view)]
+    else:
+        outs = [_show_out(args.out_path, Path(f).stem, args.view, several=len(files) > 1) for f in files]
     profile = load_profile(args.body)
     demos = [recording(profile, f) for f in files]  # each read (and checked) before anything is composed
     segmenter = args.segmenter or needs.get("segmenter")
@@ -540,18 +544,16 @@ def _show_recordings(args: argparse.Namespace, pm: PluginManager, template: str 
         if not repertoire:  # the recordings themselves, a movement each: their hub poses, their paths
             repertoire = Path(tmp)
             for k, f in enumerate(files):
-                folder = repertoire / (Path(f).stem if k == files.index(f) else f"{Path(f).stem}_{k}")
-                folder.mkdir(exist_ok=True)
+                folder = repertoire / f"{k:03d}-{Path(f).stem}"  # one movement per file, the same file twice too
+                folder.mkdir()
                 (folder / Path(f).name).symlink_to(Path(f).resolve())
         character = compose_observer(pm, profile, repertoire, template=template or OBSERVER_TEMPLATE,
                                      segmenter=segmenter, matcher=matcher, correspondence=args.correspondence or "")
         if each == "all":
-            stem = Path(files[0]).stem if len(files) == 1 else "recordings"
-            written = view.draw(character, _show_out(args.out_path, stem, args.view), recordings=demos)
+            written = view.draw(character, outs[0], recordings=demos)
         else:
             written = []
-            for f, demo in zip(files, demos):
-                out = _show_out(args.out_path, Path(f).stem, args.view, several=len(files) > 1)
+            for out, demo in zip(outs, demos):
                 written += view.draw(character, out, recording=demo)
     for path in written:
         print(f"wrote {path}")

@@ -81,6 +81,7 @@ def span_label(ax: Any, x0: float, x1: float, y: float, text: str, **kwargs: Any
     kwargs.setdefault("fontsize", 8)
     label = ax.text((x0 + x1) / 2, y, text, ha="center", va="center", transform=ax.get_xaxis_transform(),
                     gid=SPAN_LABEL, clip_on=False, **kwargs)
+    label.set_in_layout(False)  # fitted after the layout, not a reason to shrink the axes
     label.likeme_span = (float(x0), float(x1))
     label.likeme_text = text
     return label
@@ -109,14 +110,27 @@ def _shorten(label: Any, text: str, width: float, renderer: Any, smallest: float
 
 
 def fit_labels(fig: Any, pad: float = 3.0) -> int:
-    """Fit every :func:`span_label` of ``fig`` to the visible part of its span and every axes title to the figure's
-    width, after the layout is done; the layout is then kept as it is. Returns how many labels were shortened or
-    hidden."""
-    fig.canvas.draw()  # the layout, and a renderer that measures text
-    renderer = fig.canvas.get_renderer()
-    fig.set_layout_engine("none")  # what is measured now is where things stay
+    """Fit every axes title to the figure's width and every :func:`span_label` of ``fig`` to the visible part of its
+    span, after the layout is done (twice: the titles first, as they take part in the layout, then the labels); the
+    layout is then kept as it is. Returns how many labels and titles were shortened or hidden."""
     changed = 0
-    right = fig.bbox.x1 - pad
+    left, right = fig.bbox.x0 + pad, fig.bbox.x1 - pad
+    for _ in range(3):  # a shorter title changes the layout, which may move another title
+        fig.canvas.draw()  # the layout, and a renderer that measures text
+        renderer = fig.canvas.get_renderer()
+        shortened = 0
+        for ax in fig.axes:
+            for title in (ax.title, ax._left_title, ax._right_title):
+                box = title.get_window_extent(renderer)
+                if title.get_text() and (box.x1 > right + 0.5 or box.x0 < left - 0.5):
+                    room = {"left": right - max(box.x0, left), "right": min(box.x1, right) - left,
+                            "center": 2 * min((box.x0 + box.x1) / 2 - left, right - (box.x0 + box.x1) / 2)}
+                    _shorten(title, title.get_text(), room[title.get_horizontalalignment()], renderer)
+                    shortened += 1
+        changed += shortened
+        if not shortened:
+            break
+    fig.set_layout_engine("none")  # what is measured now is where things stay
     for ax in fig.axes:
         lo, hi = sorted(ax.get_xlim())
         for label in ax.texts:
@@ -133,12 +147,6 @@ def fit_labels(fig: Any, pad: float = 3.0) -> int:
                             smallest=min(6.5, label.get_fontsize()))
             label.set_visible(fits)
             changed += label.get_text() != label.likeme_text or not fits
-        for title in (ax.title, ax._left_title, ax._right_title):
-            text = title.get_text()
-            if text and title.get_window_extent(renderer).x1 > right:
-                start = title.get_window_extent(renderer).x0
-                _shorten(title, text, right - max(start, pad), renderer)
-                changed += 1
     return changed
 
 

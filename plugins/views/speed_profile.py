@@ -119,7 +119,7 @@ class SpeedProfileView(View):
                 tax.set_xlim((x0 + x1) / 2 - 0.05, (x0 + x1) / 2 + 0.05)
                 tax.set_ylim((y0 + y1) / 2 - 0.05, (y0 + y1) / 2 + 0.05)
             tax.set_aspect("equal", adjustable="box")
-            tax.set_title(f"{chosen[j]} (x, y, m): clusters and breaks", fontsize=8)
+            tax.set_title(f"{chosen[j]}: x, y (m)", fontsize=8)
             tax.tick_params(labelsize=7)
             tax.xaxis.set_major_locator(MaxNLocator(nbins=2))  # a narrow panel: few ticks, none overlapping
         ax.plot([], [], color="#e6194b", label=f"speed break points ({n_speed})")
