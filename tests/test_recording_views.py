@@ -57,6 +57,8 @@ def _labels(ax):
 def _assert_readable(fig):
     """No two span labels of an axis overlap, each lies inside its axes and its span; tick labels and titles lie
     inside the figure."""
+    from plugins.views.plotting import FREE_LABEL
+
     renderer = fig.canvas.get_renderer()
     page = fig.bbox
     for ax in fig.axes:
@@ -68,6 +70,10 @@ def _assert_readable(fig):
             for other, obox in labels[k + 1 :]:
                 apart = box.x1 <= obox.x0 + 0.5 or obox.x1 <= box.x0 + 0.5 or box.y1 <= obox.y0 or obox.y1 <= box.y0
                 assert apart, f"{text.get_text()!r} overlaps {other.get_text()!r}"
+        free = [t.get_window_extent(renderer) for t in ax.texts if t.get_gid() == FREE_LABEL and t.get_visible()]
+        for k, box in enumerate(free):
+            assert ax.bbox.x0 <= box.x0 and box.x1 <= ax.bbox.x1 and ax.bbox.y0 <= box.y0 and box.y1 <= ax.bbox.y1
+            assert not any(box.overlaps(other) for other in free[k + 1 :])
         (x0, x1), (y0, y1) = sorted(ax.get_xlim()), sorted(ax.get_ylim())
         drawn = [t for t in ax.get_xticklabels() if x0 - 1e-9 <= t.get_position()[0] <= x1 + 1e-9]  # in view
         drawn += [t for t in ax.get_yticklabels() if y0 - 1e-9 <= t.get_position()[1] <= y1 + 1e-9]
@@ -160,6 +166,23 @@ def test_a_recording_without_a_repertoire_is_segmented_by_the_view_s_segmenter_a
                         if t.get_text() and lo <= t.get_position()[0] <= hi), key=lambda b: b.x0)
         assert all(a.x1 <= b.x0 for a, b in zip(boxes, boxes[1:]))
     assert out.stat().st_size > 1000
+
+
+def test_the_prediction_error_of_a_recording_marks_each_commitment_and_keeps_its_notes_apart(data, tmp_path,
+                                                                                              figures, capsys):
+    stream = data / "streams" / "stream_1.bvh"
+    assert main(["show", "--body", str(data / "profile.toml"), str(stream), "--repertoire", str(data / "repertoire"),
+                 "--view", "prediction-error", "--out", str(tmp_path), "--set", "width=1000", "--set", "height=500"]) == 0
+    assert capsys.readouterr().out.strip() == f"wrote {tmp_path / 'stream_1-prediction-error.png'}"
+    fig, = figures
+    top, ax = fig.axes
+    ticks = [line for line in top.lines if line.get_color() == "black"]  # a commitment before the segment ended
+    commits = [line for line in ax.lines if line.get_color() == "black" and line.get_linestyle() == "-"
+               and len(line.get_xdata()) == 2 and line.get_xdata()[0] == line.get_xdata()[1]]
+    assert len(commits) == len(ticks) >= 1
+    renderer = fig.canvas.get_renderer()
+    assert ax.get_legend().get_window_extent(renderer).x0 >= ax.bbox.x1  # beside the plot, not over it
+    _assert_readable(fig)
 
 
 def test_show_draws_the_key_poses_of_several_recordings_in_one_picture(data, tmp_path, capsys):

@@ -17,8 +17,8 @@ from typing import Any
 
 from toolkit import Parameter
 
-__all__ = ["DEMONSTRATION", "PALETTE", "blank", "colours", "figure", "fit_labels", "save_figure", "span_label", "timeline",
-           "demonstrate"]
+__all__ = ["DEMONSTRATION", "FREE_LABEL", "PALETTE", "blank", "colours", "figure", "fit_labels", "save_figure",
+           "span_label", "timeline", "demonstrate"]
 
 PALETTE = ("#4363d8", "#e6194b", "#3cb44b", "#f58231", "#911eb4", "#42d4f4", "#f032e6", "#9a6324", "#469990",
            "#800000", "#808000", "#000075")
@@ -70,6 +70,10 @@ def figure(width: int, height: int, rows: Sequence[float]) -> tuple[Any, list[An
 
 SPAN_LABEL = "likeme-span-label"
 """The ``gid`` of a label that belongs inside a span of the x axis (:func:`span_label`): fitted before saving."""
+
+FREE_LABEL = "likeme-free-label"
+"""The ``gid`` of a label placed where its data is (the end of a line, a moment): before saving, one that would
+overlap a label of higher ``zorder`` or drawn before it, or run past its axes, is hidden (:func:`fit_labels`)."""
 
 ELLIPSIS = "\u2026"
 
@@ -147,6 +151,20 @@ def fit_labels(fig: Any, pad: float = 3.0) -> int:
                             smallest=min(6.5, label.get_fontsize()))
             label.set_visible(fits)
             changed += label.get_text() != label.likeme_text or not fits
+        kept: list[Any] = []
+        free = [t for t in ax.texts if t.get_gid() == FREE_LABEL and t.get_visible()]
+        for label in sorted(free, key=lambda t: -t.get_zorder()):  # the higher first, then in the order drawn
+            box = label.get_window_extent(renderer)
+            if box.x1 > ax.bbox.x1 and label.get_horizontalalignment() == "left":  # past the right edge: to the left
+                label.set_horizontalalignment("right")
+                label.set_text(label.get_text().strip() + " ")
+                box = label.get_window_extent(renderer)
+            inside = ax.bbox.x0 <= box.x0 and box.x1 <= ax.bbox.x1 and ax.bbox.y0 <= box.y0 and box.y1 <= ax.bbox.y1
+            if inside and not any(box.overlaps(other) for other in kept):
+                kept.append(box)
+            else:
+                label.set_visible(False)
+                changed += 1
     return changed
 
 

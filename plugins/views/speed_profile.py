@@ -126,11 +126,11 @@ class SpeedProfileView(View):
         ax.plot([], [], color="#4363d8", ls="--", label=f"direction break points ({n_direction})")
         ax.scatter([], [], marker="v", color="black", label=f"breaks kept ({n_kept})")
         ax.set_xlabel("time (s)")
-        ax.set_ylabel("speed (m/s; fingers: rad/s x angle_scale)" if character.body.angle_mask[idx].any() else "speed (m/s)")
+        fingers = int(character.body.angle_mask[idx].sum())
+        ax.set_ylabel("speed (m/s; fingers: rad/s x angle_scale)" if fingers else "speed (m/s)")
         ax.set_xlim(0, demo.motion.duration)
         ax.set_ylim(bottom=0)
         ax.legend(loc="upper right", fontsize=8)
-        fingers = int(character.body.angle_mask[idx].sum())
         watched = (", ".join(chosen[j] for j in placed) if len(chosen) - fingers <= TRAJECTORIES else
                    f"{len(chosen) - fingers} parts") + (f" and {fingers} fingers" if fingers else "")
         ax.set_title(f"{character.name} watching {watched}: {len(movements)} movement(s) in working memory, "
