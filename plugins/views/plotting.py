@@ -159,6 +159,12 @@ def fit_labels(fig: Any, pad: float = 3.0) -> int:
                 label.set_horizontalalignment("right")
                 label.set_text(label.get_text().strip() + " ")
                 box = label.get_window_extent(renderer)
+            shift = max(0.0, ax.bbox.y0 - box.y0) - max(0.0, box.y1 - ax.bbox.y1)  # a line's end at the floor: up
+            if shift and abs(shift) < box.height:  # moved inside when its anchor is (the rest would be clipped)
+                transform = label.get_transform()
+                anchor = transform.transform(label.get_position())
+                label.set_position(transform.inverted().transform(anchor + [0.0, shift]))
+                box = label.get_window_extent(renderer)
             inside = ax.bbox.x0 <= box.x0 and box.x1 <= ax.bbox.x1 and ax.bbox.y0 <= box.y0 and box.y1 <= ax.bbox.y1
             if inside and not any(box.overlaps(other) for other in kept):
                 kept.append(box)
