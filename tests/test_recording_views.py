@@ -268,3 +268,50 @@ def test_the_confusion_matrix_picture_writes_every_count_with_labels_and_a_colou
     fit_labels(fig)
     _assert_readable(fig)
     assert plot_result(result, tmp_path / "r.png").stat().st_size > 1000
+
+
+def test_the_stream_picture_labels_each_found_segment_and_marks_the_wrong_ones():
+    from plugins.bench.plots import FALSE, timeline_figure
+    from plugins.views.plotting import fit_labels
+
+    result = {"benchmark": "stream", "plugins": [{"plugin": "hub-threshold+dtw", "error_rate": 0.5}], "timelines": [
+        {"item": "s.bvh", "frames": 300, "fps": 30.0, "truth": [[30, 120, "wave"], [150, 270, "bow"]],
+         "found": {"hub-threshold+dtw": [[35, 115, "wave"], [155, 260, "clap"], [275, 290, "unknown"]]}}]}
+    fig = timeline_figure(result)
+    fit_labels(fig)
+    _, ax = fig.axes
+    labels = {t.likeme_text: t.get_color() for t in ax.texts if t.get_gid()}
+    assert labels == {"wave": "black", "bow": "black", "clap": FALSE, "unknown": FALSE}
+    assert [t.get_text() for t in ax.get_yticklabels()] == ["true", "hub-threshold+dtw"]
+    assert not any(p.get_hatch() for p in ax.patches)  # every found segment is named: coloured, not hatched
+    _assert_readable(fig)
+
+
+def test_show_out_names_a_folder_or_a_file_and_the_picture_honours_the_umask(tmp_path, capsys):
+    import os
+
+    args = ["show", "max", "--view", "body", "--set", "keys=1", "--set", 'movements=["jump"]', "--set", "width=200"]
+    old = os.umask(0o022)
+    try:
+        assert main([*args, "--out", str(tmp_path / "pictures")]) == 0
+        assert main([*args, "--out", str(tmp_path / "max.png")]) == 0
+    finally:
+        os.umask(old)
+    folder = tmp_path / "pictures" / "max-body.png"
+    assert capsys.readouterr().out.split() == ["wrote", str(folder), "wrote", str(tmp_path / "max.png")]
+    assert folder.is_file() and (tmp_path / "max.png").is_file()
+
+
+def test_a_signal_picture_is_written_with_the_mode_the_umask_allows(tmp_path):
+    import os
+
+    from plugins.views.plotting import blank, save_figure
+
+    fig = blank(200, 200)
+    fig.subplots().plot([0, 1], [0, 1])
+    old = os.umask(0o022)
+    try:
+        path = save_figure(fig, tmp_path / "p.png")
+    finally:
+        os.umask(old)
+    assert path.stat().st_mode & 0o777 == 0o644
