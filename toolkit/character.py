@@ -141,30 +141,24 @@ class Character:
 # -- reading files -------------------------------------------------------------------
 
 
-MAX_TEXT_BYTES = 16 * 1024 * 1024
-"""The largest declaration file read (bytes): a character, scenario or profile is a few kilobytes."""
 MAX_DEPTH = 32
 """The deepest nesting of arrays and tables a declaration may have."""
 MAX_EXTENDS = 64
 """The longest ``extends`` chain a character file may start."""
 
 
-def read_text(path: str | Path, what: str, *, limit: int | None = None) -> str:
+def read_text(path: str | Path, what: str, *, kind: str = "config") -> str:
     """A UTF-8 text file's content (a byte-order mark at its start is dropped); a missing, unreadable or not
-    regular file (a device, a FIFO), or one larger than ``limit`` bytes, is a :class:`ConfigError` expecting
-    ``what``."""
+    regular file (a device, a FIFO, a directory), or one larger than the size cap of ``kind``
+    (:data:`toolkit.files.LIMITS`), is a :class:`ConfigError` expecting ``what``."""
+    from toolkit.files import open_regular
+
     path = Path(path)
+    if not path.exists() and not path.is_symlink():
+        raise ConfigError("file not found", file=path, expected=f"an existing {what}")
     try:
-        if path.exists() and not path.is_file():
-            raise ConfigError("not a regular file", file=path, expected=f"a {what}")
-        with path.open("rb") as handle:
-            data = handle.read() if limit is None else handle.read(limit + 1)
-        if limit is not None and len(data) > limit:
-            raise ConfigError(f"file larger than {limit} bytes", file=path,
-                              expected=f"a {what} (a declaration of a few kilobytes)")
-        return data.decode("utf-8-sig")
-    except FileNotFoundError:
-        raise ConfigError("file not found", file=path, expected=f"an existing {what}") from None
+        with open_regular(path, what, kind) as handle:
+            return handle.read().decode("utf-8-sig")
     except (OSError, UnicodeDecodeError) as exc:
         raise ConfigError(f"cannot read file ({exc})", file=path, expected=f"a readable UTF-8 {what}") from None
 
@@ -172,7 +166,7 @@ def read_text(path: str | Path, what: str, *, limit: int | None = None) -> str:
 def read_toml(path: str | Path) -> dict[str, Any]:
     """Parse a TOML file; syntax errors become a :class:`ConfigError` with line and column."""
     path = Path(path)
-    text = read_text(path, "TOML file", limit=MAX_TEXT_BYTES)
+    text = read_text(path, "TOML file")
     try:
         table = tomllib.loads(text)
     except RecursionError:

@@ -225,7 +225,8 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p.add_argument("--matcher", metavar="NAME", help="matcher (default: the observer template's)")
     p.add_argument("--correspondence", metavar="NAME", help="correspondence (default: the observer template's; "
                    "none: the papers' plain observer)")
-    p.add_argument("--lengths-for-height", type=float, default=None, metavar="M", dest="lengths_for_height",
+    p.add_argument("--lengths-for-height", type=number_type(0.0, 1000.0, "metres"), default=None, metavar="M",
+                   dest="lengths_for_height",
                    help="the height (m) the length parameters were written for, scaled to the observer's own height "
                    "(default: the observer template's; 0: metres as written, the papers)")
     p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
@@ -284,24 +285,25 @@ def _view(pm: PluginManager, name: str, subject: str, settings: list[str]) -> An
 def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dict[str, Any]:
     from toolkit.report import summarise
     from toolkit.scenario import load_scenario
+    from toolkit.state import Checkpoint, StateFile, apply_state, read_state
 
     if getattr(args, "set", None) and not getattr(args, "render", None):  # a view's settings, and no view
         raise ConfigError("--set without --render", key=("--set",),
                           expected="--render DIR with the settings of the view that draws the run")
+    # the --save target and the --load file are checked before any work (the target first: its version is the one
+    # this run may overwrite); the loaded state is applied, all or nothing, once the world is composed
+    target = StateFile(args.save, loaded=getattr(args, "load", None)) if getattr(args, "save", None) else None
+    loaded = read_state(args.load) if getattr(args, "load", None) else None
     scenario = load_scenario(path, pm, seed=args.seed, on_plugin_error="skip" if args.keep_going else "stop")
     if getattr(args, "duration", None) is not None:
         from toolkit.scenario import check_duration
 
         scenario.duration = check_duration(args.duration, scenario.world.fps, ("--duration",))
-    if getattr(args, "load", None):
-        from toolkit.state import load_state
-
-        load_state(scenario.world, args.load)
+    if loaded is not None:
+        apply_state(scenario.world, loaded, args.load)
     checkpoint = None
-    if getattr(args, "save", None):
-        from toolkit.state import Checkpoint
-
-        checkpoint = Checkpoint(scenario.world, args.save)
+    if target is not None:
+        checkpoint = Checkpoint(scenario.world, target)
         pm.register(checkpoint, name="checkpoint")
     view = _view(pm, args.view, "scenario", args.set) if getattr(args, "render", None) else None
     files = []
@@ -315,7 +317,7 @@ def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dic
             pm.unregister(checkpoint)
     world = scenario.world
     if checkpoint is not None:
-        checkpoint.save()
+        checkpoint.finish()  # ConfigError if the last save fails or had to go to a conflict file
     if view is not None:
         print(f"wrote {len(files)} file(s) to {args.render}: " + ", ".join(
             sorted({f.suffix.lstrip('.') for f in files})), file=sys.stderr)
@@ -567,23 +569,35 @@ def _recording_views(pm: PluginManager) -> list[str]:
 def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
     import json
 
-    from toolkit.observe import NO_CORRESPONDENCE, Observer, compose_observer
-    from toolkit.params import parse_settings
+    from toolkit.files import check_regular_file
+    from toolkit.observe import NO_CORRESPONDENCE, Observer, compose_observer, observer_plugins
+    from toolkit.params import check_settings, parse_settings
     from toolkit.profile import load_profile
 
     profile = load_profile(args.body)
+    for path in args.files:  # a FIFO, a device, a directory or a missing file fails before any work
+        check_regular_file(path, "BVH file", "motion")
     for name, kind in ((args.segmenter, "segmenter"), (args.matcher, "matcher"), (args.correspondence, "correspondence")):
         if name is not None and name != NO_CORRESPONDENCE:
             pm.registry.get(kind, name)  # an unknown name fails here, listing the registered ones
+    settings = parse_settings(list(args.set))
+    check_settings(settings, pm, observer_plugins(pm, segmenters=[args.segmenter] if args.segmenter else (),
+                                                  matchers=[args.matcher] if args.matcher else (),
+                                                  correspondence=args.correspondence or ""))
     character = compose_observer(pm, profile, args.repertoire, segmenter=args.segmenter, matcher=args.matcher or "",
                                  correspondence=args.correspondence or "",
                                  lengths_for_height="" if args.lengths_for_height is None else args.lengths_for_height,
-                                 settings=parse_settings(list(args.set)))
+                                 settings=settings)
     report = []
     for path in args.files:
-        motion = profile.read(path)
-        observer = Observer(character, profile.body, motion.fps)
-        found = observer.watch(motion)
+        # the file streamed a block of frames at a time (header first), so reading memory does not grow with it
+        with profile.stream(path) as motion:
+            observer = Observer(character, profile.body, motion.fps)
+            observer.reset()
+            found = []
+            for positions, visible in motion:
+                found.extend(observer.push_block(positions, visible))
+            found.extend(observer.flush())
         report.append({"file": str(path), "frames": motion.n_frames, "fps": round(motion.fps, 3), "segments": [
             {"start_frame": o.segment.start, "end_frame": o.segment.end, "start_s": round(o.segment.start_time, 3),
              "end_s": round(o.segment.end_time, 3), "movement": o.movement or "unknown",
@@ -632,8 +646,9 @@ def _why_text(seg: dict[str, Any]) -> str:
 
 
 def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
-    from toolkit.bvh import read_bvh
+    from toolkit.bvh import open_bvh
     from toolkit.character import load_character, read_toml
+    from toolkit.files import check_regular_file
     from toolkit.observe import check_observer_template, is_observer_template
     from toolkit.profile import is_profile, load_profile
     from toolkit.report import describe_character
@@ -648,14 +663,16 @@ def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
     for path in args.files:
         try:
             if str(path).lower().endswith(".bvh"):
-                bvh = read_bvh(path)
+                with open_bvh(path) as bvh:  # every frame read and checked, a block at a time
+                    for _ in bvh.blocks():
+                        pass
                 line = f"ok    {path}: BVH: {len(bvh.names)} joints, {bvh.n_frames} frames at {bvh.fps:g} fps"
                 if profile is not None:
-                    unmapped = profile.check(bvh)
+                    unmapped = profile.check(bvh.header)
                     line += f"; profile {profile.name!r} maps {len(profile.joints)}, leaves {len(unmapped)} unmapped"
                 print(line)
                 continue
-            table = read_toml(path)
+            table = read_toml(check_regular_file(path, "TOML file", "config"))
             if is_scenario(table):
                 scenario = load_scenario(path, pm)
                 world = scenario.world

@@ -21,7 +21,7 @@ system's rest state (:meth:`MotorSystem.reset`).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -35,7 +35,7 @@ from toolkit.profile import BodyProfile
 from toolkit.watching import KEEP_SECONDS, MAX_SEGMENT_SECONDS, Observation, WatchingLoop, guarded
 
 __all__ = ["Observation", "Observer", "compose_observer", "OBSERVER_TEMPLATE", "NO_CORRESPONDENCE", "is_observer_template",
-           "check_observer_template"]
+           "check_observer_template", "observer_plugins"]
 
 NO_CORRESPONDENCE = "none"
 """The correspondence name that means none (``--correspondence none``): the papers' plain observer."""
@@ -245,6 +245,36 @@ def compose_observer(pm: Any, profile: BodyProfile, repertoire: str | Path, *, s
     table["motor"] = {**table.get("motor", {}), "clips": str(Path(repertoire).resolve()),
                       "profile": str(profile.file.resolve()) if profile.file else ""}
     return compose_character(table, pm)
+
+
+def observer_plugins(pm: Any, *, segmenters: Sequence[str] = (), matchers: Sequence[str] = (),
+                     correspondence: str | None = "", template: str | Path = OBSERVER_TEMPLATE) -> dict[str, list[str]]:
+    """The plugins each component table of an observer composed from ``template`` may have, by table: the template's,
+    with the ``segmenters``, ``matchers`` and ``correspondence`` named instead of its own, and the motor system each
+    of those matchers needs. What ``--set TABLE.KEY=VALUE`` is checked against before any work
+    (:func:`toolkit.params.check_settings`)."""
+    path = Path(template) if Path(template).is_file() else resolve_file(str(template), None, pm)
+    plugins: dict[str, list[str]] = {k: [v["plugin"]] for k, v in read_toml(path).items()
+                                     if isinstance(v, Mapping) and isinstance(v.get("plugin"), str)}
+    if segmenters:
+        plugins["segmenter"] = list(segmenters)
+    if matchers:
+        plugins["matcher"] = list(matchers)
+    if correspondence is None or correspondence == NO_CORRESPONDENCE:
+        plugins.pop("correspondence", None)
+    elif correspondence:
+        plugins["correspondence"] = [correspondence]
+    motors = set(plugins.get("motor", []))
+    for name in plugins.get("matcher", []):
+        try:
+            wanted = pm.registry.get("matcher", name).motor_systems
+        except ConfigError as err:  # an unknown matcher is named here, listing the registered ones
+            raise err.within(prefix=("--matcher",)) from None
+        if wanted and not motors & set(wanted):
+            motors.add(wanted[0])
+    if motors:
+        plugins["motor"] = sorted(motors)
+    return plugins
 
 
 OBSERVER_KEYS = ("name", "description", "lengths_for_height")
