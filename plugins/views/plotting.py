@@ -218,8 +218,8 @@ def timeline(ax: Any, demo: Any, observations: Sequence[Any], fps: float, *, rec
     """The strip above a signal: true movements (top row, when they are known) and found segments (bottom row).
 
     A found segment is coloured and labelled by what was recognised (grey: unknown; ``recognised=False``, with no
-    matcher: alternating greys, unlabelled); a black tick marks the moment the matcher committed when it did so
-    before the segment ended. Labels are fitted to their spans when the figure is saved.
+    matcher: alternating greys, unlabelled); a black tick up from the foot of the lane marks the moment the matcher
+    committed when it did so before the segment ended. Labels are fitted to their spans when the figure is saved.
     """
     found = [o.movement or "unknown" for o in observations] if recognised else []
     colour = colours([m for _, _, m in demo.truth] + [m for m in found if m != "unknown"])
@@ -237,9 +237,9 @@ def timeline(ax: Any, demo: Any, observations: Sequence[Any], fps: float, *, rec
         ax.axvspan(s.start_time, s.end_time, ymin=lo, ymax=hi, facecolor=fill, alpha=0.5, lw=1, edgecolor="white")
         if recognised:
             span_label(ax, s.start_time, s.end_time, (lo + hi) / 2, found[k])
-        if o.decided_at is not None:
+        if o.decided_at is not None:  # a black tick up from the lane's foot, below its label
             t = (s.start + o.decided_at) / fps
-            ax.plot([t, t], [lo, hi], color="black", lw=2, transform=ax.get_xaxis_transform())
+            ax.plot([t, t], [lo, lo + 0.3 * (hi - lo)], color="black", lw=2.5, transform=ax.get_xaxis_transform())
     ax.set_ylim(0, 1)
     ax.set_yticks([(a + b) / 2 for a, b in rows.values()], list(rows))
     ax.tick_params(axis="y", length=0)
