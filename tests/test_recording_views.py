@@ -172,7 +172,8 @@ def test_the_prediction_error_of_a_recording_marks_each_commitment_and_keeps_its
                                                                                               figures, capsys):
     stream = data / "streams" / "stream_1.bvh"
     assert main(["show", "--body", str(data / "profile.toml"), str(stream), "--repertoire", str(data / "repertoire"),
-                 "--view", "prediction-error", "--out", str(tmp_path), "--set", "width=1000", "--set", "height=500"]) == 0
+                 "--view", "prediction-error", "--out", str(tmp_path), "--set", "width=1000",
+                 "--set", "height=500"]) == 0
     assert capsys.readouterr().out.strip() == f"wrote {tmp_path / 'stream_1-prediction-error.png'}"
     fig, = figures
     top, ax = fig.axes
