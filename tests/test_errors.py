@@ -233,6 +233,11 @@ CASES = [
     ("profile-missing", "likeme profile of a missing file", {}, ["profile", "take.bvh"], ["take.bvh: cannot read (No such file or directory)", "expected a readable recording"]),
     ("profile-out-folder", "likeme profile --out into a missing folder", {"m.bvh": BVH}, ["profile", "m.bvh", "--out", "no/p.toml"], ["no: key --out", "no such folder"]),
     ("profile-csv-header", "likeme profile of a CSV without joint columns", {"k.csv": "time,a,b\n0,1,2\n"}, ["profile", "k.csv"], ["k.csv:1: no joint columns in the header", "available: time, a, b"]),
+    # -- views of your own recordings (likeme show --body PROFILE FILE ... --view NAME)
+    ("show-recording-no-view", "recordings to show without a view", {"p.toml": PROFILE, "m.bvh": BVH}, ["show", "--body", "p.toml", "m.bvh"], ["key --view", "recordings without --view", "available:", "hub-signal"]),
+    ("show-recording-view", "recordings shown by a view that draws none", {"p.toml": PROFILE, "m.bvh": BVH}, ["show", "--body", "p.toml", "m.bvh", "--view", "posegraph"], ["key --view", "view 'posegraph' does not draw recordings", "available:", "speed-profile"]),
+    ("show-recording-no-body", "a recording shown without its body profile", {"m.bvh": BVH}, ["show", "m.bvh", "--view", "body"], ["key character", "cannot show m.bvh", "with --body PROFILE recordings"]),
+    ("show-recordings-one-png", "two recordings' pictures to one file", {"p.toml": PROFILE, "m.bvh": BVH}, ["show", "--body", "p.toml", "m.bvh", "m.bvh", "--view", "hub-signal", "--out", "x.png"], ["x.png: key --out", "one file for several pictures", "expected a folder"]),
 ]
 
 
