@@ -12,6 +12,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from plugins.bench.data import make_data, write_positions
 from toolkit import ConfigError
@@ -167,3 +169,33 @@ def test_the_rate_comes_from_the_fps_given_else_the_first_step(data):
 def test_docs_pipe_example_is_the_command_the_tests_run():
     text = (ROOT / "docs" / "formats.md").read_text()
     assert "cat rec.csv | likeme observe --body profile.toml --repertoire repertoire --fps 30 -" in text
+
+
+PROFILE_3 = '[profile]\nname = "three"\nfps = 25\n[parts]\nroot = "b"\nhead = "a"\nnose = "c"\n' \
+    '[facing]\nleft = "head"\nright = "nose"\n'
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(frames=st.integers(1, 12), joints=st.permutations(["a", "b", "c", "d"]),
+       values=st.lists(st.one_of(st.floats(-1e6, 1e6, allow_nan=False), st.just(float("nan"))), min_size=144,
+                       max_size=144))
+def test_csv_npy_and_piped_lines_give_the_same_motion(tmp_path, frames, joints, values):
+    """Random positions with missing values, written as CSV, .npy, CSV lines and JSON lines: the same parts' positions
+    through a profile, NaN (not visible) where a value is missing."""
+    positions = np.array(values[: frames * 12]).reshape(frames, 4, 3)
+    profile_path = tmp_path / "p.toml"
+    profile_path.write_text(PROFILE_3.replace("fps = 25", f"fps = 25\njoints = {json.dumps(list(joints))}"))
+    profile = load_profile(profile_path)
+    write_positions(tmp_path / "m.csv", list(joints), positions)
+    write_positions(tmp_path / "m.npy", list(joints), positions)
+    expected = positions[:, [joints.index(j) for j in ("b", "a", "c")]]
+    expected[~np.isfinite(expected).all(axis=-1)] = np.nan  # a part with a missing coordinate is not visible at all
+    for name in ("m.csv", "m.npy"):
+        motion = profile.read(tmp_path / name)
+        np.testing.assert_array_equal(motion.positions, expected)
+        np.testing.assert_array_equal(motion.visible, np.isfinite(expected).all(axis=-1))
+    piped = np.array(list(LiveInput(io.BytesIO((tmp_path / "m.csv").read_bytes()), profile, 25.0)))
+    np.testing.assert_array_equal(piped, expected)
+    lines = "".join(json.dumps({j: [None if np.isnan(v) else v for v in p.tolist()] for j, p in zip(joints, pose)})
+                    + "\n" for pose in positions)
+    np.testing.assert_array_equal(np.array(list(LiveInput(io.BytesIO(lines.encode()), profile, 25.0))), expected)

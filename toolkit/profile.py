@@ -3,10 +3,13 @@
 A profile is a TOML file (``docs/conventions.md`` has the format) saying which
 source joints are the tracked body parts, which part is the root, which parts
 give the facing (a left/right pair and an optional forward marker, like the
-paper's knees and nose), the source's up axis and its units. Reading a BVH file
+paper's knees and nose), the source's up axis and its units. Reading a recording
 through a profile gives a :class:`~toolkit.motion.Motion` of world positions in
 metres with ``+y`` up, one column per tracked part, and the :class:`Body` to
-perceive it with.
+perceive it with. Recordings are read by their suffix (:data:`RECORDING_SUFFIXES`,
+``docs/formats.md``): BVH files, CSV joint positions and ``.npy`` arrays
+(:mod:`toolkit.positions`); the optional ``fps`` key gives the frame rate of
+files without one of their own, ``joints`` the joint names of a ``.npy`` array.
 
 Example (the Bandai-Namco skeleton, ``characters/profiles/bandai-namco.toml``)::
 

@@ -11,7 +11,8 @@ through a body profile (:mod:`toolkit.profile`) and watches them with
   against the whole repertoire), ``open`` (leave one movement out: only "unknown" is right) and ``groups`` (leave
   one group out: the repertoire folder's clips whose file names share a group, a style or a performer, are the
   demos of a repertoire made of all the other clips).
-- ``segmentation``: each stream ``NAME.bvh`` (or ``.csv``, ``.npy``) has ``NAME.segments.csv`` (:func:`plugins.bench.data.read_segments`).
+- ``segmentation``: each stream ``NAME.bvh`` (or ``.csv``, ``.npy``) has ``NAME.segments.csv``
+  (:func:`plugins.bench.data.read_segments`).
   Precision, recall, F1 and boundary error (:mod:`plugins.bench.metrics`) per segmenter.
 - ``stream``: segment and recognise end to end for every pairing; the movement error rate (edit distance over the
   true count).
