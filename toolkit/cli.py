@@ -222,12 +222,12 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
                        "piped in): segments, recognised movements, decisions")
     p.add_argument("files", nargs="+", metavar="FILE", help="recordings (.bvh, .csv, .npy; see docs/formats.md), or "
                    "'-' alone: CSV or JSON lines on standard input, each observation printed as its segment closes")
+    p.add_argument("--body", required=True, metavar="PROFILE", help="body profile TOML of the files")
+    p.add_argument("--repertoire", required=True, metavar="DIR", help="labelled clips: one folder per movement")
     p.add_argument("--fps", type=fps_type, default=None, metavar="HZ",
                    help="frame rate of recordings without one of their own (a CSV without a time column, a .npy "
                    "array, standard input); wins over the profile's fps; a BVH's Frame Time and a CSV's time column "
                    "win over it")
-    p.add_argument("--body", required=True, metavar="PROFILE", help="body profile TOML of the files")
-    p.add_argument("--repertoire", required=True, metavar="DIR", help="labelled clips: one folder per movement")
     p.add_argument("--segmenter", metavar="NAME", help="segmenter (default: the observer template's, "
                    "characters/observers/recordings.toml)")
     p.add_argument("--matcher", metavar="NAME", help="matcher (default: the observer template's)")
@@ -519,9 +519,9 @@ def _segment_text(seg: dict[str, Any]) -> str:
 
 
 def _file_error(err: LikemeError, path: str) -> str:
-    """An error while reading or watching ``path``, as one line naming the file."""
+    """An error while reading or watching ``path``, as one line naming the file (a plugin's failure: at the end)."""
     text = str(err)
-    return text if path in text else f"{path}: {text}"
+    return text if path in text else f"{text} (watching {path})"
 
 
 def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
