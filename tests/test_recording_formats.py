@@ -75,12 +75,12 @@ def _table(text: str) -> list[list[str]]:
     return rows
 
 
-@pytest.mark.parametrize("benchmark", ["recognition", "stream"])
+@pytest.mark.parametrize("benchmark", ["recognition", "segmentation", "stream"])
 def test_bench_gives_the_same_table_for_every_format(data, capsys, benchmark):
     def run(name: str) -> list[list[str]]:
         folder = data / name
         args = ["bench", benchmark, "--body", str(folder / "profile.toml"), "--repertoire", str(folder / "repertoire"),
-                "--matcher", "path-search", "--quiet"]
+                "--quiet"] + (["--matcher", "path-search"] if benchmark != "segmentation" else [])
         args += ["--demos", str(folder / "demos")] if benchmark == "recognition" else \
             ["--streams", str(folder / "streams"), "--segmenter", "hub-threshold"]
         assert main(args) == 0
@@ -207,3 +207,17 @@ def test_validate_reads_csv_and_npy_with_and_without_a_profile(data, capsys):
     assert all("profile 'max' maps 11, leaves 0 unmapped" in line for line in out)
     assert main(["validate", str(npy_file)]) == 1  # no frame rate without --fps or a profile
     assert "a .npy file has no frame rate" in capsys.readouterr().err
+
+
+def test_a_streams_folder_of_csv_is_its_own_repertoire_without_its_segment_files(data, capsys):
+    """bench segmentation without --repertoire finds hubs from the streams' ends: NAME.segments.csv is not a clip."""
+    from plugins.lib.clip_repertoire import clip_files
+
+    assert list(clip_files(data / "csv" / "streams")) == ["stream_1", "stream_2"]
+    tables = []
+    for name in ("bvh", "csv"):
+        folder = data / name
+        assert main(["bench", "segmentation", "--body", str(folder / "profile.toml"), "--streams",
+                     str(folder / "streams"), "--segmenter", "hub-threshold", "--quiet"]) == 0
+        tables.append(_table(capsys.readouterr().out))
+    assert tables[0] == tables[1]
