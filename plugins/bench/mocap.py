@@ -36,6 +36,7 @@ from typing import Any
 
 import numpy as np
 
+from plugins.bench import progress as progress_bar
 from plugins.bench import text_table
 from plugins.bench.command import MATCHERS, SEGMENTERS
 from plugins.bench.data import read_segments
@@ -113,9 +114,7 @@ class _Clock:
 def _progress(items: list, label: str, quiet: bool):
     if quiet:
         return items
-    from rich.progress import track
-
-    return track(items, description=label, transient=True)
+    return progress_bar(items, label)
 
 
 PROTOCOLS = ("closed", "open", "groups")
