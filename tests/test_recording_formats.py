@@ -221,3 +221,24 @@ def test_a_streams_folder_of_csv_is_its_own_repertoire_without_its_segment_files
                      str(folder / "streams"), "--segmenter", "hub-threshold", "--quiet"]) == 0
         tables.append(_table(capsys.readouterr().out))
     assert tables[0] == tables[1]
+
+
+def test_a_piped_benchmark_starts_with_its_table_and_its_files_are_0644_under_umask_022(data, tmp_path):
+    """Progress on standard error, the table first on standard output (``likeme bench recognition ... | head -n 3``),
+    and what it writes readable by others as the umask allows (not mkstemp's 0600)."""
+    import os
+    import subprocess
+    import sys
+
+    folder = data / "bvh"
+    out_json, out_png = tmp_path / "r.json", tmp_path / "r.png"
+    command = [sys.executable, "-m", "toolkit.cli", "bench", "recognition", "--body", str(folder / "profile.toml"),
+               "--repertoire", str(folder / "repertoire"), "--demos", str(folder / "demos"), "--matcher", "dtw",
+               "--json", str(out_json), "--plot", str(out_png)]
+    done = subprocess.run(command, capture_output=True, text=True, timeout=600,
+                          preexec_fn=lambda: os.umask(0o022), cwd=Path(__file__).resolve().parent.parent)
+    assert done.returncode == 0, done.stderr
+    head = done.stdout.splitlines()[:3]
+    assert head[0].startswith("| plugin |") and head[1].startswith("|---") and head[2].startswith("| dtw |")
+    for path in (out_json, out_png):
+        assert (path.stat().st_mode & 0o777) == 0o644, oct(path.stat().st_mode)
