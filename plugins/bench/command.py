@@ -111,8 +111,8 @@ def _motion_capture_commands(sub: Any) -> None:
     p = sub.add_parser("make-data", help="write repertoire, demos, streams and a profile from the built-in characters")
     p.add_argument("dest", metavar="DIR")
     p.add_argument("--seed", type=seed_type, default=0)
-    p.add_argument("--format", choices=("bvh", "csv", "npy"), default="bvh",
-                   help="the recordings' format: BVH, CSV joint positions or .npy arrays (default: bvh)")
+    p.add_argument("--format", choices=("bvh", "csv", "npy", "c3d"), default="bvh",  # plugins.bench.data.FORMATS
+                   help="the recordings' format: BVH, CSV joint positions, .npy arrays or C3D markers (default: bvh)")
     p.set_defaults(handler=_handler("data", "cmd_make_data"))
 
     p = sub.add_parser("bandai", help="build benchmark folders from the Bandai-Namco clips (links; nothing copied)")
