@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import argparse
 from importlib import import_module
-from pathlib import Path
 from typing import Any
 
 from plugins.action.script import MAX_RANDOM
@@ -119,8 +118,8 @@ def _motion_capture_commands(sub: Any) -> None:
     p.add_argument("src", metavar="BANDAI_DIR")
     p.add_argument("dest", metavar="DIR")
     p.add_argument("--seed", type=seed_type, default=0)
-    p.add_argument("--profile", default=str(Path(__file__).resolve().parents[2] / "characters" / "profiles"
-                                            / "bandai-namco.toml"), help="the body profile to put beside the data")
+    p.add_argument("--profile", default=None, help="the body profile to put beside the data (default: the built-in "
+                   "profiles/bandai-namco.toml, from the source tree or the installed copy)")
     p.set_defaults(handler=_handler("data", "cmd_bandai"))
 
 

@@ -244,5 +244,9 @@ def cmd_make_data(args, pm) -> int:
 
 def cmd_bandai(args, pm) -> int:
     """``likeme bench bandai SRC DIR``."""
-    print(bandai(Path(args.src), Path(args.dest), Path(args.profile), seed=args.seed))
+    from toolkit.character import resolve_file
+
+    profile = Path(args.profile) if args.profile else resolve_file("profiles/bandai-namco.toml", None, pm,
+                                                                   key=("--profile",))
+    print(bandai(Path(args.src), Path(args.dest), profile, seed=args.seed))
     return 0
