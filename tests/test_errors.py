@@ -229,7 +229,7 @@ CASES = [
     ("state-nan", "NaN in a state file", {"st.json": state(time=float("nan"))}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["not JSON likeme reads: NaN is not a finite number"]),
     # -- profiling: profiles that check themselves (issue 20)
     ("bvh-end-site-name", "a joint named like an end site", {"m.bvh": BVH.replace("  }\n}\nMOTION", "  }\n  JOINT head_end\n  {\n    OFFSET 0 1 0\n    CHANNELS 0\n  }\n}\nMOTION")}, ["validate", "m.bvh"], ["m.bvh:15:9", "duplicate joint name 'head_end', the name of the end site of joint 'head' at line 10", "expected unique joint names"]),
-    ("profile-npy", "likeme profile of a .npy array", {"a.npy": "x"}, ["profile", "a.npy"], ["a.npy: key FILE", "cannot propose a profile for a .npy file", "expected a BVH file or a CSV of joint positions (a .npy array has no joint names)"]),
+    ("profile-npy", "likeme profile of a .npy array", {"a.npy": "x"}, ["profile", "a.npy"], ["a.npy: key FILE", "cannot propose a profile for a .npy file", "expected a BVH file, a CSV of joint positions or a C3D file (a .npy array has no joint names)"]),
     ("profile-missing", "likeme profile of a missing file", {}, ["profile", "take.bvh"], ["take.bvh: cannot read (No such file or directory)", "expected a readable recording"]),
     ("profile-out-folder", "likeme profile --out into a missing folder", {"m.bvh": BVH}, ["profile", "m.bvh", "--out", "no/p.toml"], ["no: key --out", "no such folder"]),
     ("profile-csv-header", "likeme profile of a CSV without joint columns", {"k.csv": "time,a,b\n0,1,2\n"}, ["profile", "k.csv"], ["k.csv:1: no joint columns in the header", "available: time, a, b"]),
