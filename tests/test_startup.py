@@ -1,0 +1,109 @@
+"""Start-up: ``likeme --version`` loads nothing, ``--help`` only the plugins that add commands, a command all of them.
+
+Speed itself is measured by ``likeme bench startup`` (figures in docs/benchmarks.md), not by a timed test; these
+tests check what is imported, and that a lazy plugin manager ends up the same as an eager one.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from tests.conftest import ROOT
+from toolkit.manager import create_plugin_manager
+
+HEAVY = ("numpy", "scipy", "networkx", "pyvista", "matplotlib", "rich", "dtaidistance", "ruptures", "imageio")
+
+
+def _modules_after(*args: str) -> set[str]:
+    """The modules imported by ``likeme ARGS`` run in a fresh interpreter (the built-ins only)."""
+    code = ("import sys, json\nfrom toolkit.cli import main\ntry:\n    main(sys.argv[1:])\nexcept SystemExit:\n    pass\n"
+            "sys.stderr.write('\\nMODULES ' + json.dumps(sorted(sys.modules)))\n")
+    env = {"PYTHONPATH": str(ROOT), "LIKEME_DISABLE_PLUGIN_AUTOLOAD": "1", "PATH": "/usr/bin:/bin"}
+    result = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True, env=env, timeout=120)
+    assert "MODULES " in result.stderr, result.stderr
+    return set(json.loads(result.stderr.rsplit("MODULES ", 1)[1]))
+
+
+def _top(modules: set[str]) -> set[str]:
+    return {m.split(".")[0] for m in modules}
+
+
+def test_version_loads_no_plugin_manager_and_no_library():
+    modules = _modules_after("--version")
+    assert not {"pluggy", "toolkit.manager", "importlib.metadata", *HEAVY} & (modules | _top(modules))
+    assert not any(m.startswith("plugins") for m in modules)
+
+
+def test_help_imports_only_the_plugins_that_add_commands():
+    modules = _modules_after("--help")
+    assert "plugins.bench.command" in modules  # declared in the likeme.commands group: bench is in --help
+    assert not set(HEAVY) & _top(modules)
+    component_modules = {m for m in modules if m.startswith("plugins.") and m.count(".") == 2} - {"plugins.bench.command"}
+    assert component_modules == set()
+
+
+def test_a_command_loads_every_plugin():
+    modules = _modules_after("plugins")
+    assert {"plugins.segmenters.hub_threshold", "plugins.views.body", "plugins.bench.command", "numpy"} <= modules
+
+
+def _order(pm) -> list[str]:
+    return [name for name, _ in pm.list_name_plugin()]
+
+
+def test_a_lazy_manager_loads_the_same_plugins_in_the_same_order_as_an_eager_one():
+    eager = create_plugin_manager(autoload=False, trace=False)
+    lazy = create_plugin_manager(autoload=False, trace=False, lazy=True)
+    assert _order(lazy) == []
+    lazy.load_command_plugins()
+    assert _order(lazy) == ["benchmark"]
+    lazy.load_all()
+    assert _order(lazy) == _order(eager)
+    assert len(_order(eager)) > 20
+    for hook in ("likeme_register_segmenters", "likeme_register_commands", "likeme_world_stepped"):
+        assert ([i.plugin_name for i in getattr(lazy.hook, hook).get_hookimpls()]
+                == [i.plugin_name for i in getattr(eager.hook, hook).get_hookimpls()])
+    assert lazy.plugin_infos == eager.plugin_infos
+    lazy.load_all()  # nothing more to do
+    assert _order(lazy) == _order(eager)
+
+
+def test_a_lazy_managers_registry_has_every_component():
+    lazy = create_plugin_manager(autoload=False, trace=False, lazy=True)
+    eager = create_plugin_manager(autoload=False, trace=False)
+    assert lazy.registry.names("segmenter") == eager.registry.names("segmenter") != []
+    assert lazy.registry.names("view") == eager.registry.names("view") != []
+
+
+def test_plugins_given_in_python_are_registered_after_the_entry_points():
+    from tests.conftest import make_plugin
+
+    extra = make_plugin(likeme_world_stepped=lambda world: None)
+    lazy = create_plugin_manager(autoload=False, trace=False, lazy=True, plugins=[("extra", extra)])
+    assert lazy.get_plugin("extra") is None
+    lazy.load_all()
+    assert _order(lazy)[-1] == "extra"
+
+
+def test_the_bench_help_names_the_scripts_limit():
+    from plugins.action.script import MAX_RANDOM
+    from plugins.bench.command import SCRIPT_MAX_RANDOM
+
+    assert SCRIPT_MAX_RANDOM == MAX_RANDOM
+
+
+def test_the_toolkit_package_exports_its_names_when_used():
+    import toolkit
+
+    for name in toolkit.__all__:
+        assert getattr(toolkit, name) is not None
+    assert set(toolkit.__all__) <= set(dir(toolkit))
+    with pytest.raises(AttributeError, match="no attribute 'Nothing'"):
+        toolkit.Nothing  # noqa: B018
+    namespace: dict = {}
+    exec("from toolkit import *", namespace)
+    assert namespace["Motion"] is toolkit.Motion and namespace["create_plugin_manager"] is create_plugin_manager
