@@ -29,7 +29,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from toolkit.errors import ConfigError
 
@@ -120,6 +119,8 @@ class BVH:
         one replaces the matching OFFSET component), else its OFFSET; its
         rotation is the intrinsic product of its rotation channels in order.
         """
+        from scipy.spatial.transform import Rotation
+
         n = self.n_frames
         positions = np.empty((n, len(self.joints), 3))
         rotations = np.empty((n, len(self.joints), 3, 3))
