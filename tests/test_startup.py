@@ -107,3 +107,25 @@ def test_the_toolkit_package_exports_its_names_when_used():
     namespace: dict = {}
     exec("from toolkit import *", namespace)
     assert namespace["Motion"] is toolkit.Motion and namespace["create_plugin_manager"] is create_plugin_manager
+
+
+def test_bench_startup_times_each_command_in_a_fresh_process(tmp_path, capsys):
+    from toolkit.cli import main
+
+    out = tmp_path / "startup.json"
+    assert main(["bench", "startup", "--runs", "2", "--json", str(out)]) == 0
+    rows = json.loads(out.read_text())["rows"]
+    assert [r["command"] for r in rows] == ["likeme --version", "likeme --help", "likeme plugins"]
+    for r in rows:
+        assert r["runs"] == 2 and 0 < r["min_s"] <= r["median_s"] <= r["max_s"]
+    text = capsys.readouterr().out
+    assert "2 runs each" in text and "likeme plugins" in text.splitlines()[-1]
+
+
+def test_bench_startup_names_a_command_that_fails():
+    from plugins.bench.startup import time_commands
+    from toolkit.errors import LikemeError
+
+    failing = [sys.executable, "-c", "import sys; sys.stderr.write('no such thing'); sys.exit(3)"]
+    with pytest.raises(LikemeError, match=r"'likeme --version' exited with status 3: no such thing"):
+        time_commands(1, failing)

@@ -214,6 +214,12 @@ def likeme_register_commands(subparsers):
                    help="override an observer parameter (repeatable)")
     p.set_defaults(handler=_handler("memory", "cmd_memory"))
 
+    p = sub.add_parser("startup", help="how long likeme takes to start: the medians of likeme --version, --help "
+                       "and plugins, each run in a fresh process")
+    p.add_argument("--runs", type=count_type(1, 1000), default=20, help="runs of each command (default: 20)")
+    p.add_argument("--json", metavar="FILE", help="also write the times as JSON")
+    p.set_defaults(handler=_handler("startup", "cmd_startup"))
+
     p = sub.add_parser("vision", help="rendered-vision against synthetic-vision on the same frames: agreement, "
                        "position difference, milliseconds per frame")
     p.add_argument("--scenario", default="jump_then_cover_face", help="scenario to watch (default: jump_then_cover_face)")
