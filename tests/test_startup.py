@@ -46,9 +46,11 @@ def test_help_imports_only_the_plugins_that_add_commands():
     assert component_modules == set()
 
 
-def test_a_command_loads_every_plugin():
+def test_a_command_loads_every_plugin_but_only_the_libraries_their_modules_need():
     modules = _modules_after("plugins")
     assert {"plugins.segmenters.hub_threshold", "plugins.views.body", "plugins.bench.command", "numpy"} <= modules
+    # pyvista and matplotlib (views), dtaidistance (dtw), ruptures, imageio and rich: imported when first used
+    assert not {"pyvista", "vtkmodules", "matplotlib", "dtaidistance", "ruptures", "imageio", "rich"} & _top(modules)
 
 
 def _order(pm) -> list[str]:

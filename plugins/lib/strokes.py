@@ -24,7 +24,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import argrelextrema, savgol_filter
 
 __all__ = ["StrokeCriteria", "StrokeAnalysis", "analyse", "breaks", "speed_breaks", "direction_clusters",
            "direction_breaks"]
@@ -57,6 +56,8 @@ def speed_breaks(speed: np.ndarray, drop: float, moving: float = 0.0) -> list[in
     starts or ends at full speed still brackets its minima; both sides must rise above ``moving``, so a dip
     between two flickers of noise at rest separates no strokes.
     """
+    from scipy.signal import argrelextrema
+
     speed = np.asarray(speed, dtype=float)
     n = len(speed)
     if n < 3:
@@ -146,6 +147,8 @@ def analyse(window: np.ndarray, fps: float, criteria: StrokeCriteria = StrokeCri
     Speed minima below ``drop`` of their neighbouring maxima cut; direction-cluster changes cut where the
     direction turns sharply at a dip of the speed (see the module). Pieces shorter than ``min_stroke`` merge.
     """
+    from scipy.signal import savgol_filter
+
     c = criteria
     n = len(window)
     empty = np.zeros(max(0, n - 1))
