@@ -80,8 +80,6 @@ def pytest_sessionfinish(session, exitstatus):
         return
     if not _WORKERS or not all(whole for whole, _ in _WORKERS):
         return
-    from _pytest.reports import TestReport
-
     from tests.test_docs import HOOKS
 
     called = set().union(*(hooks for _, hooks in _WORKERS))
@@ -90,7 +88,7 @@ def pytest_sessionfinish(session, exitstatus):
         test = f"{HOOK_CHECK}[{name}]"
         ok = name in called
         failed += not ok
-        report = TestReport(f"tests/test_docs.py::{test}", ("tests/test_docs.py", 0, test), {},
+        report = pytest.TestReport(f"tests/test_docs.py::{test}", ("tests/test_docs.py", 0, test), {},
                             "passed" if ok else "failed",
                             None if ok else f"no test made the toolkit call {name} with an implementation registered "
                                             "(on any xdist worker)", "call")
