@@ -131,3 +131,44 @@ def test_bench_startup_names_a_command_that_fails():
     failing = [sys.executable, "-c", "import sys; sys.stderr.write('no such thing'); sys.exit(3)"]
     with pytest.raises(LikemeError, match=r"'likeme --version' exited with status 3: no such thing"):
         time_commands(1, failing)
+
+
+def _distribution(root, commands: str | None) -> None:
+    """A third-party distribution ``likeme-fake`` installed into ``root`` (its dist-info, as pip writes it): plugin
+    ``fake-a`` adds the command ``fake``, plugin ``fake-b`` a run-event hook; ``commands``: its likeme.commands."""
+    info = root / "likeme_fake-1.0.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: likeme-fake\nVersion: 1.0\n")
+    groups = "[likeme]\nfake-a = likeme_fake_a\nfake-b = likeme_fake_b\n"
+    if commands is not None:
+        groups += f"\n[likeme.commands]\n{commands} = likeme_fake_a\n"
+    (info / "entry_points.txt").write_text(groups)
+    (root / "likeme_fake_a.py").write_text(
+        "from toolkit import hookimpl\n\n@hookimpl\ndef likeme_register_commands(subparsers):\n"
+        "    subparsers.add_parser('fake', help='a third-party command').set_defaults(handler=lambda a, pm: 0)\n")
+    (root / "likeme_fake_b.py").write_text("from toolkit import hookimpl\n\n@hookimpl\ndef likeme_world_stepped(world):\n"
+                                           "    pass\n")
+
+
+@pytest.mark.parametrize("commands, early", [(None, ["fake-a", "fake-b"]), ("fake-a", ["fake-a"])])
+def test_a_third_party_distribution_declares_its_command_plugins_or_has_all_imported(tmp_path, monkeypatch,
+                                                                                      commands, early):
+    import importlib
+
+    from toolkit.cli import build_parser
+
+    _distribution(tmp_path, commands)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    importlib.invalidate_caches()
+    for module in ("likeme_fake_a", "likeme_fake_b"):
+        monkeypatch.delitem(sys.modules, module, raising=False)
+    lazy = create_plugin_manager(autoload=True, trace=False, lazy=True)
+    parser = build_parser(lazy)
+    assert [n for n in _order(lazy) if n in ("benchmark", "fake-a", "fake-b")] == ["benchmark", *early]
+    assert "hub-threshold" not in _order(lazy)
+    assert ("likeme_fake_b" in sys.modules) == ("fake-b" in early)
+    assert parser.parse_args(["fake"]).handler(None, lazy) == 0
+    lazy.load_all()
+    eager = create_plugin_manager(autoload=True, trace=False)
+    assert _order(lazy) == _order(eager) and _order(eager).index("fake-b") > _order(eager).index("hub-threshold")
+    assert lazy.plugin_infos["fake-b"].distribution == "likeme-fake"
