@@ -133,7 +133,7 @@ def test_bench_startup_names_a_command_that_fails():
         time_commands(1, failing)
 
 
-def _distribution(root, commands: str | None) -> None:
+def _fake_distribution(root, commands: str | None) -> None:
     """A third-party distribution ``likeme-fake`` installed into ``root`` (its dist-info, as pip writes it): plugin
     ``fake-a`` adds the command ``fake``, plugin ``fake-b`` a run-event hook; ``commands``: its likeme.commands."""
     info = root / "likeme_fake-1.0.dist-info"
@@ -157,7 +157,7 @@ def test_a_third_party_distribution_declares_its_command_plugins_or_has_all_impo
 
     from toolkit.cli import build_parser
 
-    _distribution(tmp_path, commands)
+    _fake_distribution(tmp_path, commands)
     monkeypatch.syspath_prepend(str(tmp_path))
     importlib.invalidate_caches()
     for module in ("likeme_fake_a", "likeme_fake_b"):

@@ -229,8 +229,10 @@ class PluginManager(pluggy.PluginManager):
         self._third_party = third_party
         seen: dict[str, PluginInfo] = {}
         entries = []
-        for ep in sorted(metadata.entry_points(group=ENTRY_POINT_GROUP), key=_builtin_first):
-            dist, version = _distribution(ep)
+        found = metadata.entry_points(group=ENTRY_POINT_GROUP)
+        known: dict[int, tuple[str, str]] = {}  # the distributions of ``found``, alive while it is
+        for ep in sorted(found, key=lambda ep: _builtin_first(ep, known)):
+            dist, version = _distribution(ep, known)
             info = PluginInfo(ep.name, ep.value, dist, version)
             if info.name in seen:
                 if seen[info.name].module == info.module:  # the same distribution found twice on sys.path
@@ -272,8 +274,10 @@ class PluginManager(pluggy.PluginManager):
         if self._entries is None or self._loaded:
             return
         declared: dict[str, set[str]] = {}
-        for ep in metadata.entry_points(group=COMMANDS_GROUP):
-            dist = _normalise(_distribution(ep)[0])
+        found = metadata.entry_points(group=COMMANDS_GROUP)
+        known: dict[int, tuple[str, str]] = {}
+        for ep in found:
+            dist = _normalise(_distribution(ep, known)[0])
             declared.setdefault(dist, set()).add(ep.name)
         for info, ep in self._entries:
             names = declared.get(_normalise(info.distribution))
@@ -461,24 +465,24 @@ def _normalise(name: str) -> str:
     return re.sub(r"[-_.]+", "-", name).lower()
 
 
-_DISTRIBUTIONS: dict[int, tuple[object, tuple[str, str]]] = {}
-
-
-def _distribution(ep: metadata.EntryPoint) -> tuple[str, str]:
-    """The name and version of an entry point's distribution; its metadata is parsed once per distribution (every
-    entry point of one distribution shares its ``dist``), not once per entry point."""
+def _distribution(ep: metadata.EntryPoint, known: dict[int, tuple[str, str]] | None = None) -> tuple[str, str]:
+    """The name and version of an entry point's distribution. ``known`` (distribution id -> name and version, kept
+    by the caller while the entry points live) parses each distribution's metadata once, not once per entry point:
+    every entry point of one distribution shares its ``dist``."""
     dist = ep.dist
     if dist is None:
         return "(unknown)", "?"
-    cached = _DISTRIBUTIONS.get(id(dist))
-    if cached is None or cached[0] is not dist:
-        meta = dist.metadata
-        cached = _DISTRIBUTIONS[id(dist)] = (dist, (meta["Name"], meta["Version"]))
-    return cached[1]
+    if known is not None and id(dist) in known:
+        return known[id(dist)]
+    meta = dist.metadata
+    found = (meta["Name"], meta["Version"])
+    if known is not None:
+        known[id(dist)] = found
+    return found
 
 
-def _builtin_first(ep: metadata.EntryPoint) -> tuple[int, str]:
-    dist = _distribution(ep)[0] if ep.dist is not None else ""
+def _builtin_first(ep: metadata.EntryPoint, known: dict[int, tuple[str, str]] | None = None) -> tuple[int, str]:
+    dist = _distribution(ep, known)[0] if ep.dist is not None else ""
     return (0 if _normalise(dist) == DISTRIBUTION else 1, ep.name)
 
 
