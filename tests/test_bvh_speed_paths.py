@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import tempfile
+from pathlib import Path
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -10,17 +13,30 @@ from hypothesis import strategies as st
 from tests.conftest import BANDAI
 from tests.test_bvh import SMALL, bvh_files
 from toolkit import ConfigError
-from toolkit.bvh import _parse, format_bvh, from_joint_positions, read_bvh, write_bvh
+from toolkit.bvh import BVH, _parse, format_bvh, from_joint_positions, open_bvh, read_bvh, write_bvh
 
 
 def _both(text: str, source: str = "x.bvh"):
-    """(fast result or error text, token-by-token result or error text)."""
+    """(fast result or error text, token-by-token result or error text); the file streamed in blocks of 1 and 2
+    frames is checked against the fast result on the way."""
     out = []
     for fast in (True, False):
         try:
             out.append(_parse(text, source, fast=fast))
         except ConfigError as exc:
             out.append(str(exc))
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder, source)
+        with open(path, "w", encoding="utf-8", newline="") as f:
+            f.write(text)
+        for frames in (1, 2):
+            try:
+                with open_bvh(path) as stream:
+                    streamed = BVH(stream.joints, stream.header.frame_time,
+                                   np.concatenate([np.empty((0, stream.n_channels)), *stream.blocks(frames)]), source)
+            except ConfigError as exc:
+                streamed = str(exc).replace(folder + "/", "")
+            _same(out[0], streamed)
     return out
 
 
@@ -64,6 +80,13 @@ MALFORMED = [
     lambda t: t.replace("\r\n", "\n"),
     lambda t: t.replace("\r\n", "\r"),
     lambda t: t.replace("Frame Time: 0.0333333", "Frame Time: 0.0333333 5"),
+    lambda t: t.replace("Frame Time: 0.0333333", "Frame Time: 1e-7"),
+    lambda t: t.replace("Frames: 2", "Frames: 1000000000000"),
+    lambda t: t.replace("Frames: 2", "Frames: 0"),
+    lambda t: t.replace("CHANNELS 3", "CHANNELS \u00b2"),
+    lambda t: "\ufeff" + t,
+    lambda t: t.replace("1 90 0 90 0 0  0 0 0  5 0 0 0 0 0\r\n", "1 90 0 90 0 0  0 0 0\r\n5 0 0 0 0 0\r\n"),
+    lambda t: t.replace("0 90 0 0", "0 x 0 0").replace("Frames: 2", "Frames: 3"),
 ]
 
 
@@ -83,3 +106,7 @@ def test_real_clips_read_bit_for_bit_the_same_both_ways():
         text = path.read_text(encoding="utf-8", errors="replace")
         fast = read_bvh(path)
         _same(fast, _parse(text, str(path), fast=False))
+        for frames in (1, 50):
+            with open_bvh(path) as stream:
+                _same(fast, BVH(stream.joints, stream.header.frame_time, np.concatenate(list(stream.blocks(frames))),
+                                str(path)))

@@ -46,6 +46,10 @@ Frame Time: 0.0333333
 0 90 0 0 0 0 0 0 0
 0 91 0 0 0 0 0 0 0
 """
+DEEP_BVH = ("HIERARCHY\nROOT j0\n{\nOFFSET 0 0 0\nCHANNELS 3 Xrotation Yrotation Zrotation\n"
+            + "".join(f"JOINT j{i}\n{{\nOFFSET 0 1 0\nCHANNELS 3 Xrotation Yrotation Zrotation\n" for i in range(1, 1000))
+            + "}\n" * 1000 + "MOTION\nFrames: 1\nFrame Time: 0.03\n" + " ".join(["0"] * 3000) + "\n")
+"""A BVH file whose joints are nested 1,000 deep."""
 PROFILE = '[profile]\nname = "p"\nunits = "cm"\n[parts]\nroot = "hips"\nhead = "head"\nnose = "head_end"\n[facing]\nleft = "head"\nright = "nose"\n'
 
 
@@ -181,16 +185,59 @@ CASES = [
     ("cli-render-unwritable", "--render below a file", {"f.txt": "x\n"}, ["run", "demo", "--render", "f.txt/frames"], ["f.txt/frames: key --render", "cannot create the folder"]),
     ("bench-data-file", "bench make-data into a file", {"f.txt": "x\n"}, ["bench", "make-data", "f.txt"], ["f.txt: key DIR", "not a folder"]),
     ("bench-dropout", "bench watch --dropout 2", {}, ["bench", "watch", "--dropout", "2"], ["argument --dropout: invalid value '2'", "expected a probability in [0, 1]"]),
+    ("observe-set-typo", "observe --set with a misspelt key", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--set", "matcher.kk=3", "m.bvh"], ["key --set.matcher.kk", "unknown parameter 'kk'", "available:"]),
     ("set-table-typo", "--set with a misspelt table", {}, ["bench", "watch", "--movements", "1", "--set", "matchr.k=3"], ["key --set.matchr", "unknown table 'matchr'", "available: motor, perception, correspondence, segmenter, matcher, action"]),
     ("set-key-unknown", "--set with a key of no named matcher", {"p.toml": PROFILE}, ["bench", "recognition", "--body", "p.toml", "--repertoire", ".", "--matcher", "path-search", "--matcher", "dtw", "--set", "matcher.spread=2"], ["key --set.matcher.spread", "unknown parameter 'spread' for matcher 'dtw'", "available: max_distance, stride, window"]),
     ("scenario-radius", "an object of negative radius", {"s.toml": SCENE + '[[objects]]\nname = "c"\nkind = "food"\nradius = -1\n'}, ["validate", "s.toml"], ["key objects[0].radius", "invalid value -1", "expected a positive number of metres"]),
     ("bench-lengths-nan", "bench --lengths-for-height nan", {"p.toml": PROFILE}, ["bench", "recognition", "--body", "p.toml", "--repertoire", ".", "--lengths-for-height", "nan"], ["argument --lengths-for-height: invalid value 'nan'", "expected metres in [0, 1000]"]),
+    ("profile-units-huge", "units an integer too large for a float", {"p.toml": PROFILE.replace('"cm"', "9" * 400)}, ["validate", "p.toml"], ["key profile.units", "invalid units", "expected a unit name or a positive number"]),
+    ("param-int-huge", "an integer parameter beyond 64 bits", {"c.toml": CHILD + "[matcher]\nk = " + "9" * 30 + "\n"}, ["validate", "c.toml"], ["key matcher.k", "integer too large"]),
+    ("param-float-huge", "a float parameter given as a 400-digit integer", {"c.toml": CHILD + "[perception]\nnoise = " + "9" * 400 + "\n"}, ["validate", "c.toml"], ["key perception.noise", "number too large"]),
+    ("character-name-long", "a character reference of 5,000 characters", {"s.toml": SCENE.replace(MAX, "x" * 5000)}, ["validate", "s.toml"], ["key actors[0].character", "(5000 characters)", "available:"]),
     ("set-value-nan", "--set with a NaN value", {}, ["bench", "watch", "--movements", "1", "--set", "perception.noise=nan"], ["key --set.perception.noise", "value nan is not a finite number for perception 'synthetic-vision'"]),
     # -- watching: bounded working memory and the memory benchmark
     ("bench-memory-minutes", "memory benchmark for nan minutes", {}, ["bench", "memory", "--minutes", "nan"], ["key --minutes", "value nan", "expected a finite number > 0"]),
     ("bench-memory-block", "memory benchmark with packets of 0 frames", {}, ["bench", "memory", "--block", "0"], ["key --block", "value 0", "expected a whole number >= 1"]),
-    ("observe-ruptures-window", "ruptures with a negative window", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "ruptures", "--set", "segmenter.window=-1", "m.bvh"], ["key segmenter.window", "value -1.0 out of range", "expected a number in [0, inf]"]),
-    ("observe-max-movement", "velocity-direction with a negative max_movement", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "velocity-direction", "--set", "segmenter.max_movement=-5", "m.bvh"], ["key segmenter.max_movement", "value -5.0 out of range"]),
+    ("observe-ruptures-window", "ruptures with a negative window", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "ruptures", "--set", "segmenter.window=-1", "m.bvh"], ["key --set.segmenter.window", "value -1.0 out of range", "expected a number in [0, inf]"]),
+    ("observe-max-movement", "velocity-direction with a negative max_movement", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "velocity-direction", "--set", "segmenter.max_movement=-5", "m.bvh"], ["key --set.segmenter.max_movement", "value -5.0 out of range"]),
+    # -- reading: bounded, streaming BVH and profile reading (issue 21)
+    ("bvh-frame-rate", "a frame time of 0.1 microseconds (10 MHz)", {"m.bvh": BVH.replace("Frame Time: 0.0333333", "Frame Time: 1e-7")}, ["validate", "m.bvh"], ["m.bvh:18:13", "frame time 1e-07 s (1e+07 frames per second)", "expected a frame time of 0.0001 to 60 seconds"]),
+    ("bvh-nesting", "joints nested 1,000 deep", {"m.bvh": DEEP_BVH}, ["validate", "m.bvh"], ["m.bvh:1026:1", "joints nested deeper than 256", "expected at most 256 levels of JOINT"]),
+    ("bvh-no-channels", "no channels in the whole file", {"m.bvh": BVH.replace("CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation", "CHANNELS 0").replace("CHANNELS 3 Zrotation Xrotation Yrotation", "CHANNELS 0")}, ["validate", "m.bvh"], ["m.bvh:16:1", "no channels in the hierarchy", "expected at least one joint with CHANNELS"]),
+    ("bvh-channel-digit", "a channel count in superscript digits", {"m.bvh": BVH.replace("CHANNELS 3", "CHANNELS \u00b2")}, ["validate", "m.bvh"], ["m.bvh:9:14", "found '\u00b2'", "expected the number of channels (ASCII digits, at most 6)"]),
+    ("bvh-frames-huge", "Frames: 10**12 with two frame lines", {"m.bvh": BVH.replace("Frames: 2", "Frames: 1000000000000")}, ["validate", "m.bvh"], ["m.bvh:21:1", "2 frame lines after 'Frames: 1000000000000'", "expected 1000000000000 frame lines"]),
+    ("bvh-dev-zero", "a device given as a clip", {"p.toml": PROFILE}, ["observe", "--body", "p.toml", "--repertoire", ".", "/dev/zero"], ["/dev/zero: is a character device, not a file", "expected a regular file (BVH file)"]),
+    ("bvh-directory", "a directory given as a clip", {"p.toml": PROFILE}, ["observe", "--body", "p.toml", "--repertoire", ".", "."], [".: is a directory, not a file", "expected a regular file (BVH file)"]),
+    ("profile-dev-zero", "a device given as a body profile", {"m.bvh": BVH}, ["observe", "--body", "/dev/zero", "--repertoire", ".", "m.bvh"], ["/dev/zero: is a character device, not a file", "expected a regular file (body profile)"]),
+    ("validate-dev-zero", "a device given to validate", {}, ["validate", "/dev/zero"], ["/dev/zero: is a character device, not a file", "expected a regular file (TOML file)"]),
+    ("validate-directory", "a directory given to validate", {}, ["validate", "."], [".: is a directory, not a file", "expected a regular file (TOML file)"]),
+    # -- state files: saving and loading (issue 21)
+    ("state-save-folder", "--save into a folder that does not exist", {}, ["run", "demo", "--save", "missing/st.json"], ["missing/st.json: the folder missing does not exist", "expected --save into an existing folder"]),
+    ("state-save-parent-file", "--save below a file", {"f.txt": "x"}, ["run", "demo", "--save", "f.txt/st.json"], ["f.txt/st.json: f.txt is a file, not a folder"]),
+    ("state-save-directory", "--save to a folder", {}, ["run", "demo", "--save", "/usr"], ["/usr: is a folder, not a file"]),
+    ("state-save-not-state", "--save over a file that is not a state file", {"notes.txt": "my notes"}, ["run", "demo", "--save", "notes.txt"], ["notes.txt: exists and is not a likeme state file; refusing to overwrite it"]),
+    ("state-checksum", "a state file changed after likeme wrote it", {"st.json": state(version=2, checksum="sha256:00")}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["st.json: key checksum: checksum does not match the content"]),
+    ("state-no-checksum", "a version-2 state file without a checksum", {"st.json": state(version=2)}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["st.json: key checksum: missing checksum"]),
+    ("state-character", "a state saved from another character", {"st.json": state(actors={"max": {"character": "Moritz", "components": {}}})}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["key actors.max.character: state saved from Moritz, but actor 'max' is Max", "available: max (Moritz)"]),
+    ("state-learned-list", "learned movements as a list", {"st.json": state(actors={"max": {"character": "Max", "components": {"motor": {"plugin": "posegraph", "state": {"learned": []}}}}})}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["key actors.max.components.motor.state.learned: invalid learned movements"]),
+    ("state-count", "a count that is not a number", {"st.json": state(actors={"max": {"character": "Max", "components": {"action": {"plugin": "hierarchical", "state": {"transitions": [["reach", "eat", "abc"]]}}}}})}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["key actors.max.components.action.state.transitions[0][2]: invalid count 'abc'"]),
+    ("state-list-name", "a list where a name belongs", {"st.json": state(actors={"max": {"character": "Max", "components": {"action": {"plugin": "hierarchical", "state": {"transitions": [[["reach"], "eat", 1]]}}}}})}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["invalid transition [['reach'], 'eat', 1]"]),
+    ("state-not-table", "a component's state that is not a table", {"st.json": state(actors={"max": {"character": "Max", "components": {"action": {"plugin": "hierarchical", "state": 5}}}})}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["key actors.max.components.action.state: int instead of a table"]),
+    ("state-deep", "nesting 40 deep", {"st.json": state(frame=[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[0]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]])}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["nested more than 32 deep"]),
+    ("state-huge-int", "a huge integer", {"st.json": state(frame=10**40)}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["st.json: key frame: integer too large (41 digits)"]),
+    ("state-load-device", "--load of a device", {}, ["run", "demo", "--load", "/dev/zero"], ["/dev/zero: is a character device, not a file; expected a regular file (state file written by --save)"]),
+    ("state-nan", "NaN in a state file", {"st.json": state(time=float("nan"))}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["not JSON likeme reads: NaN is not a finite number"]),
+    # -- profiling: profiles that check themselves (issue 20)
+    ("bvh-end-site-name", "a joint named like an end site", {"m.bvh": BVH.replace("  }\n}\nMOTION", "  }\n  JOINT head_end\n  {\n    OFFSET 0 1 0\n    CHANNELS 0\n  }\n}\nMOTION")}, ["validate", "m.bvh"], ["m.bvh:15:9", "duplicate joint name 'head_end', the name of the end site of joint 'head' at line 10", "expected unique joint names"]),
+    ("profile-npy", "likeme profile of a .npy array", {"a.npy": "x"}, ["profile", "a.npy"], ["a.npy: key FILE", "cannot propose a profile for a .npy file", "expected a BVH file or a CSV of joint positions (a .npy array has no joint names)"]),
+    ("profile-missing", "likeme profile of a missing file", {}, ["profile", "take.bvh"], ["take.bvh: cannot read (No such file or directory)", "expected a readable recording"]),
+    ("profile-out-folder", "likeme profile --out into a missing folder", {"m.bvh": BVH}, ["profile", "m.bvh", "--out", "no/p.toml"], ["no: key --out", "no such folder"]),
+    ("profile-csv-header", "likeme profile of a CSV without joint columns", {"k.csv": "time,a,b\n0,1,2\n"}, ["profile", "k.csv"], ["k.csv:1: no joint columns in the header", "available: time, a, b"]),
+    # -- views of your own recordings (likeme show --body PROFILE FILE ... --view NAME)
+    ("show-recording-no-view", "recordings to show without a view", {"p.toml": PROFILE, "m.bvh": BVH}, ["show", "--body", "p.toml", "m.bvh"], ["key --view", "recordings without --view", "available:", "hub-signal"]),
+    ("show-recording-view", "recordings shown by a view that draws none", {"p.toml": PROFILE, "m.bvh": BVH}, ["show", "--body", "p.toml", "m.bvh", "--view", "posegraph"], ["key --view", "view 'posegraph' does not draw recordings", "available:", "speed-profile"]),
+    ("show-recording-no-body", "a recording shown without its body profile", {"m.bvh": BVH}, ["show", "m.bvh", "--view", "body"], ["key character", "cannot show m.bvh", "with --body PROFILE recordings"]),
+    ("show-recordings-one-png", "two recordings' pictures to one file", {"p.toml": PROFILE, "m.bvh": BVH}, ["show", "--body", "p.toml", "m.bvh", "m.bvh", "--view", "hub-signal", "--out", "x.png"], ["x.png: key --out", "one file for several pictures", "expected a folder"]),
 ]
 
 

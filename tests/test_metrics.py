@@ -1,13 +1,18 @@
-"""Benchmark scores: the one-to-one segment rule and the movement error rate."""
+"""Benchmark scores: the one-to-one segment rule, the movement error rate, macro F1 and the confusion matrix.
+
+The edit distance, macro F1 and confusion matrix come from rapidfuzz and scikit-learn; the hand-written functions
+they replaced are kept here as references, and hypothesis checks the libraries give exactly their results."""
 
 from __future__ import annotations
 
 import json
 
-from hypothesis import given
+import numpy as np
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from plugins.bench.metrics import edit_distance, match_segments, movement_error_rate, segmentation_scores
+from plugins.bench.metrics import (confusion_matrix, edit_distance, macro_f1, match_segments, movement_error_rate,
+                                   segmentation_scores)
 from tests.test_cli import likeme
 
 
@@ -45,6 +50,74 @@ def test_edit_distance_is_a_metric(a, b):
     assert d == edit_distance(b, a)
     assert (d == 0) == (a == b)
     assert abs(len(a) - len(b)) <= d <= max(len(a), len(b))
+
+
+def reference_edit_distance(a, b):
+    """The hand-written Levenshtein distance that rapidfuzz replaced."""
+    prev = np.arange(len(b) + 1)
+    for i, x in enumerate(a, 1):
+        cur = np.empty_like(prev)
+        cur[0] = i
+        for j, y in enumerate(b, 1):
+            cur[j] = min(prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (x != y))
+        prev = cur
+    return int(prev[-1])
+
+
+def reference_macro_f1(truth, predicted):
+    """The hand-written macro F1 that scikit-learn's f1_score replaced."""
+    scores = []
+    for label in sorted(set(truth)):
+        tp = sum(t == label and p == label for t, p in zip(truth, predicted))
+        fp = sum(t != label and p == label for t, p in zip(truth, predicted))
+        fn = sum(t == label and p != label for t, p in zip(truth, predicted))
+        scores.append(2 * tp / (2 * tp + fp + fn) if tp else 0.0)
+    return float(np.mean(scores)) if scores else 0.0
+
+
+def reference_confusion(truth, predicted, labels):
+    """The hand-written confusion matrix that scikit-learn's confusion_matrix replaced."""
+    confusion = np.zeros((len(labels), len(labels)), dtype=int)
+    for t, p in zip(truth, predicted):
+        confusion[labels.index(t), labels.index(p)] += 1
+    return confusion
+
+
+labels = st.sampled_from(["jump", "wave", "reach", "sit", "unknown", "Jump", "jump ", "", "1"])
+long_words = st.lists(labels, max_size=40)
+
+
+@settings(max_examples=300, deadline=None)
+@given(long_words, long_words)
+def test_edit_distance_equals_the_hand_written_one(a, b):
+    assert edit_distance(a, b) == reference_edit_distance(a, b)
+    assert movement_error_rate(a, b) == reference_edit_distance(a, b) / max(len(b), 1)
+
+
+@given(st.lists(st.one_of(st.integers(-3, 3), st.text(max_size=2), st.tuples(st.integers(0, 2))), max_size=12),
+       st.lists(st.one_of(st.integers(-3, 3), st.text(max_size=2), st.tuples(st.integers(0, 2))), max_size=12))
+def test_edit_distance_of_any_hashable_labels(a, b):
+    assert edit_distance(a, b) == reference_edit_distance(a, b)
+
+
+pairs = st.lists(st.tuples(labels, labels), max_size=60)
+
+
+@settings(max_examples=300, deadline=None)  # the first call imports scikit-learn
+@given(pairs)
+def test_macro_f1_and_confusion_equal_the_hand_written_ones(items):
+    truth, predicted = [t for t, _ in items], [p for _, p in items]
+    assert macro_f1(truth, predicted) == reference_macro_f1(truth, predicted)  # bit for bit
+    names = sorted(set(truth) | set(predicted))
+    m = confusion_matrix(truth, predicted, names)
+    assert m.dtype == int and m.tolist() == reference_confusion(truth, predicted, names).tolist()
+
+
+def test_macro_f1_counts_true_labels_only():
+    # "unknown" is only predicted: it costs "jump" a miss and has no F1 of its own
+    assert macro_f1(["jump", "jump", "sit"], ["jump", "unknown", "sit"]) == (2 / 3 + 1.0) / 2
+    assert macro_f1([], []) == 0.0
+    assert confusion_matrix(["a", "b"], ["b", "b"], ["a", "b"]).tolist() == [[0, 1], [0, 1]]
 
 
 def test_movement_error_rate():

@@ -6,9 +6,13 @@ A stick figure of five parts whose hand either rises (``raise``) or goes forward
 
 from __future__ import annotations
 
+import networkx as nx
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
+from plugins.matchers.path_search import _reach
 from toolkit import Motion, load_character
 
 STICK = """
@@ -147,3 +151,35 @@ def test_per_movement_keeps_a_hypothesis_for_a_movement_the_k_nearest_start_pose
     stick.matcher.params = {**stick.matcher.params, "per_movement": True}
     match = stick.matcher.match(glitched)
     assert match.movement == "raise" and set(match.details["votes"]) == {"raise"}
+
+
+def reference_reach(graph, nodes, index, max_skip, *, forward):
+    """The hand-written bounded reach that networkx's bounded breadth-first search replaced."""
+    step = graph.successors if forward else graph.predecessors
+    out = []
+    for node in nodes:
+        frontier, found = {node}, {node}
+        for _ in range(max_skip):
+            frontier = {m for f in frontier for m in step(f)}
+            found |= frontier
+        out.append(np.array(sorted(index[m] for m in found), dtype=np.intp))
+    indptr = np.concatenate([[0], np.cumsum([len(r) for r in out])]).astype(np.intp)
+    return indptr, np.concatenate(out) if out else np.zeros(0, dtype=np.intp)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 30).flatmap(lambda n: st.tuples(
+    st.just(n), st.lists(st.tuples(st.integers(0, max(n - 1, 0)), st.integers(0, max(n - 1, 0))), max_size=3 * n),
+    st.permutations(range(n)), st.integers(1, 5), st.booleans())))
+def test_reach_tables_equal_the_hand_written_ones(case):
+    """Random directed graphs (cycles, self-loops, hubs), nodes in any order: the same compressed tables."""
+    n, edges, order, max_skip, forward = case
+    graph = nx.DiGraph()
+    graph.add_nodes_from(f"n{i}" for i in range(n))
+    graph.add_edges_from((f"n{a}", f"n{b}") for a, b in edges)
+    nodes = [f"n{i}" for i in order]
+    index = {node: i for i, node in enumerate(nodes)}
+    got = _reach(graph, nodes, index, max_skip, forward=forward)
+    want = reference_reach(graph, nodes, index, max_skip, forward=forward)
+    for g, w in zip(got, want):
+        assert g.dtype == w.dtype and g.tolist() == w.tolist()

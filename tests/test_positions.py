@@ -387,13 +387,13 @@ def test_npy_errors(tmp_path):
 
 def test_only_regular_files_are_read(tmp_path):
     (tmp_path / "dir.csv").mkdir()
-    with pytest.raises(ConfigError, match=r"dir.csv: cannot read a directory; expected a regular file"):
+    with pytest.raises(ConfigError, match=r"dir.csv: is a directory, not a file; expected a regular file"):
         read_positions(tmp_path / "dir.csv", fps=30)
     os.mkfifo(tmp_path / "fifo.csv")  # opening it would block until a writer comes: it must not be opened
-    with pytest.raises(ConfigError, match=r"fifo.csv: cannot read a FIFO; expected a regular file"):
+    with pytest.raises(ConfigError, match=r"fifo.csv: is a FIFO \(named pipe\), not a file; expected a regular file"):
         iter_position_blocks(tmp_path / "fifo.csv", fps=30)
     (tmp_path / "zero.npy").symlink_to("/dev/zero")
-    with pytest.raises(ConfigError, match=r"zero.npy: cannot read a device; expected a regular file"):
+    with pytest.raises(ConfigError, match=r"zero.npy: is a character device, not a file; expected a regular file"):
         read_positions(tmp_path / "zero.npy", names=["a"], fps=30)
     with pytest.raises(ConfigError, match=r"missing.csv: cannot read \(No such file or directory\)"):
         read_positions(tmp_path / "missing.csv", fps=30)

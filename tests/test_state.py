@@ -16,7 +16,8 @@ from hypothesis import strategies as st
 
 from tests.conftest import CHARACTERS, ROOT
 from toolkit import ConfigError, create_plugin_manager, load_character, load_scenario
-from toolkit.state import Checkpoint, character_state, load_state, read_state, save_state, write_atomic
+from toolkit.state import (Checkpoint, StateFile, character_state, checksum, load_state, read_state, save_state,
+                           write_atomic)
 
 
 @pytest.fixture(scope="module")
@@ -53,16 +54,18 @@ def test_save_then_load_gives_the_same_learned_state(learned):
 def test_state_file_has_format_and_version(learned):
     _, path = learned
     data = json.loads(path.read_text())
-    assert data["format"] == "likeme-state" and data["version"] == 1
+    assert data["format"] == "likeme-state" and data["version"] == 2
+    assert data["checksum"] == checksum(data) and data["checksum"].startswith("sha256:")
     assert set(data["actors"]) == {"morris", "max"}
+    assert data["actors"]["max"]["character"] == "Max"
 
 
 @pytest.mark.parametrize(
     "edit, message",
     [
-        (lambda d: d.update(version=2), r"state.json: key version: unsupported state format version 2; expected a version this likeme reads; available: 1"),
+        (lambda d: d.update(version=3), r"state.json: key version: unsupported state format version 3; expected a version this likeme reads; available: 1, 2"),
         (lambda d: d.update(format="other"), r"key format: not a likeme state file"),
-        (lambda d: d["actors"].update(ghost={"components": {}}), r"key actors.ghost: unknown actor 'ghost'.*available: morris, max"),
+        (lambda d: d["actors"].update(ghost={"character": "Ghost", "components": {}}), r"key actors.ghost: unknown actor 'ghost'.*available: morris, max"),
         (lambda d: d["actors"]["max"]["components"]["motor"].update(plugin="keyframe"), r"key actors.max.components.motor.plugin: state saved for plugin 'keyframe'; expected state of 'posegraph'"),
         (lambda d: d["actors"]["max"]["components"]["action"]["state"]["drives"].update(thirst=0.5), r"key actors.max.components.action.state.drives.thirst: unknown drive 'thirst'"),
         (lambda d: d["actors"]["max"]["components"]["motor"]["state"]["learned"]["learned-1"].update(poses=[[1, 2]]), r"invalid poses of learned movement 'learned-1'"),
@@ -72,6 +75,7 @@ def test_bad_state_files_are_refused_with_a_clear_message(learned, tmp_path, edi
     _, path = learned
     data = json.loads(path.read_text())
     edit(data)
+    data["checksum"] = checksum(data)  # signed again: the checks behind the checksum
     bad = tmp_path / "state.json"
     bad.write_text(json.dumps(data))
     with pytest.raises(ConfigError, match=message):
@@ -199,3 +203,6 @@ learn = true
     assert loaded > 0
     # a write cut short leaves at most a temporary file beside the state file, never a broken state file
     assert {p.name for p in tmp_path.iterdir() if not p.name.startswith(".s.json.")} == {"s.json", "long.toml"}
+    # and the next save sweeps such leftovers away
+    StateFile(state, loaded=state).save(state.read_text())
+    assert {p.name for p in tmp_path.iterdir()} == {"s.json", "long.toml", ".s.json.lock"}

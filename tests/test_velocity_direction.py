@@ -126,6 +126,15 @@ def test_a_hold_inside_a_movement_is_one_break_even_when_the_movement_starts_at_
     assert slow[0] <= breaks[0] <= slow[-1]
 
 
+def test_minima_joined_by_a_rest_are_one_hold_at_its_middle():
+    """Two minima with nothing faster than the rest speed between them are one hold, cut once at its middle (the
+    rule that keeps speed_breaks hand-written: scipy.signal.find_peaks on the negated speed finds 3 and 5 here)."""
+    speed = np.array([1, 1, 1, 0.05, 0.07, 0.05, 1, 1, 1.0])
+    assert speed_breaks(speed, 0.5, 0.08) == [4]
+    speed[4] = 0.3  # faster than the rest speed between them: two holds, two breaks
+    assert speed_breaks(speed, 0.5, 0.08) == [3, 5]
+
+
 def test_noise_at_rest_and_minima_at_the_ends_are_no_breaks():
     rng = np.random.default_rng(1)
     flicker = np.r_[rng.uniform(0, 0.06, 12), np.linspace(0.1, 1.0, 10), np.linspace(1.0, 0.1, 10), rng.uniform(0, 0.06, 12)]

@@ -23,18 +23,25 @@ column, what was expected and what was found.
 
 from __future__ import annotations
 
+import codecs
+import itertools
+import os
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from toolkit.errors import ConfigError
+from toolkit.files import check_regular_file, open_regular
 
-__all__ = ["Joint", "BVH", "read_bvh", "parse_bvh", "write_bvh", "format_bvh", "from_joint_positions", "CHANNEL_NAMES"]
+__all__ = ["Joint", "BVH", "BVHStream", "read_bvh", "open_bvh", "iter_bvh_blocks", "parse_bvh", "write_bvh",
+           "format_bvh", "from_joint_positions", "CHANNEL_NAMES", "MAX_FPS", "MIN_FPS", "MAX_DEPTH", "BLOCK"]
 
 CHANNEL_NAMES = ("Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zrotation")
+BLOCK = 4096
+"""Frames per block when a file is streamed (:func:`iter_bvh_blocks`) and forward kinematics is run."""
 
 
 @dataclass(frozen=True)
@@ -119,9 +126,13 @@ class BVH:
         one replaces the matching OFFSET component), else its OFFSET; its
         rotation is the intrinsic product of its rotation channels in order.
         """
+        return self._kinematics(self.values)
+
+    def _kinematics(self, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`forward_kinematics` of channel values (n, C); each frame on its own (the same bits in any block)."""
         from scipy.spatial.transform import Rotation
 
-        n = self.n_frames
+        n = len(values)
         positions = np.empty((n, len(self.joints), 3))
         rotations = np.empty((n, len(self.joints), 3, 3))
         for j, joint in enumerate(self.joints):
@@ -130,10 +141,10 @@ class BVH:
             for c, column in zip(joint.channels, self._columns[j]):
                 axis = "XYZ".index(c[0])
                 if c.endswith("position"):
-                    local_t[:, axis] = self.values[:, column]
+                    local_t[:, axis] = values[:, column]
                 else:
                     order += c[0]
-                    angles.append(self.values[:, column])
+                    angles.append(values[:, column])
             if order:
                 local_r = Rotation.from_euler(order, np.stack(angles, axis=1), degrees=True).as_matrix()
             else:
@@ -147,80 +158,165 @@ class BVH:
                 rotations[:, j] = parent_r @ local_r
         return positions, rotations
 
-    def positions(self) -> np.ndarray:
-        """World positions (F, J, 3) of every joint and end site, in the file's units and axes."""
-        return self.forward_kinematics()[0]
+    def positions(self, block: int = BLOCK) -> np.ndarray:
+        """World positions (F, J, 3) of every joint and end site, in the file's units and axes.
+
+        Computed ``block`` frames at a time, so the rotations (frames x joints x 9 numbers) are never held for the
+        whole file; the same bits as :meth:`forward_kinematics`.
+        """
+        out = np.empty((self.n_frames, len(self.joints), 3))
+        for f in range(0, self.n_frames, max(1, block)):
+            out[f : f + block] = self._kinematics(self.values[f : f + block])[0]
+        return out
 
 
 # -- reading ----------------------------------------------------------------------------------------
+
+MAX_FPS = 10_000.0
+"""The highest frame rate read (``Frame Time`` of at least 0.1 ms): high-speed optical capture reaches a few kHz."""
+MIN_FPS = 1.0 / 60.0
+"""The lowest frame rate read (``Frame Time`` of at most 60 s)."""
+MAX_DEPTH = 256
+"""The deepest nesting of joints read (real skeletons are under 30 deep, fingers included)."""
+MAX_CHANNELS = len(CHANNEL_NAMES)
+"""The most channels one joint can have (each channel name once)."""
+_CHUNK = 1 << 18  # characters of text taken at a time
+_PIECE = 1 << 15  # values converted from text at a time
+_HISTORY = 64  # header tokens kept for messages about a token already taken
 
 _TOKEN = re.compile(r"\S+")
 # the line boundaries of str.splitlines, so that line numbers are the same as reading the file line by line
 _BREAK = re.compile("\r\n|[\n\r\v\f\x1c\x1d\x1e\x85\u2028\u2029]")
 
 
-def _lines(text: str):
-    """(line number, line, offset in ``text`` after the line and its break), lazily, as ``text.splitlines()``."""
-    start, number = 0, 0
-    for m in _BREAK.finditer(text):
-        number += 1
-        yield number, text[start:m.start()], m.end()
-        start = m.end()
-    if start < len(text):
-        yield number + 1, text[start:], len(text)
+def _shown(token: str | None) -> str:
+    """A token as a message shows it: quoted, cut to 40 characters."""
+    return repr(token) if token is None or len(token) <= 40 else repr(token[:40]) + "..."
+
+
+def _text_chunks(text: str) -> Iterator[str]:
+    """A text in pieces of ``_CHUNK`` characters, a leading byte-order mark dropped."""
+    start = 1 if text.startswith("\ufeff") else 0
+    for i in range(start, len(text), _CHUNK):
+        yield text[i : i + _CHUNK]
+
+
+def _file_chunks(path: Path) -> Iterator[str]:
+    """The decoded text of a regular file in pieces (UTF-8, a byte-order mark dropped, bad bytes replaced)."""
+    decoder = codecs.getincrementaldecoder("utf-8-sig")(errors="replace")
+    with open_regular(path, "BVH file", "motion") as f:
+        while True:
+            try:
+                raw = f.read(_CHUNK)
+            except OSError as exc:
+                raise ConfigError(f"cannot read ({exc.strerror or exc})", file=path,
+                                  expected="a readable BVH file") from None
+            if not raw:
+                break
+            yield decoder.decode(raw)
+    yield decoder.decode(b"", final=True)
+
+
+class _Lines:
+    """Lines of text arriving in chunks, numbered as ``str.splitlines`` numbers them; the rest taken as chunks."""
+
+    def __init__(self, chunks: Iterator[str]) -> None:
+        self._chunks = chunks
+        self._buf = ""
+        self._pos = 0
+        self._eof = False
+        self.number = 0
+
+    def _more(self) -> bool:
+        for chunk in self._chunks:
+            if chunk:
+                self._buf = self._buf[self._pos :] + chunk
+                self._pos = 0
+                return True
+        self._eof = True
+        return False
+
+    def next(self) -> tuple[int, str] | None:
+        """The next (line number, line) without its break, or None at the end."""
+        while True:
+            m = _BREAK.search(self._buf, self._pos)
+            # a '\r' at the end of what has arrived may be the first half of '\r\n'
+            if m is not None and (m.end() < len(self._buf) or m.group() != "\r" or self._eof):
+                line, self._pos = self._buf[self._pos : m.start()], m.end()
+                self.number += 1
+                return self.number, line
+            if not self._eof and self._more():
+                continue
+            if self._pos < len(self._buf):
+                line, self._pos = self._buf[self._pos :], len(self._buf)
+                self.number += 1
+                return self.number, line
+            return None
+
+    def __iter__(self) -> Iterator[tuple[int, str]]:
+        while (item := self.next()) is not None:
+            yield item
+
+    def rest(self) -> Iterator[str]:
+        """The text not yet taken as lines, in chunks."""
+        if self._pos < len(self._buf):
+            yield self._buf[self._pos :]
+        self._buf, self._pos = "", 0
+        yield from self._chunks
 
 
 class _Tokens:
-    """Whitespace-separated tokens with their line and column, for messages.
+    """The header's whitespace-separated tokens with their line and column, for messages.
 
-    Lines are tokenized on demand: the header is read token by token, and the
-    MOTION block's numbers can be taken as one array (:meth:`rest`) without a
-    tuple per number.
+    Lines are tokenized one at a time as tokens are taken; only the last few tokens are kept (a message names a
+    token taken a moment ago), so a long header costs no memory per token.
     """
 
-    def __init__(self, text: str, source: str) -> None:
+    def __init__(self, lines: _Lines, source: str) -> None:
         self.source = source
-        self.text = text
-        self.items: list[tuple[str, int, int]] = []
-        self._lines = _lines(text)
-        self.offset = 0  # where the first line not yet tokenized starts in ``text``
+        self.lines = lines
+        self.items: dict[int, tuple[str, int, int]] = {}
+        self.count = 0  # tokens tokenized so far
         self.pos = 0
+        self.last_line = 0  # the line of the last token tokenized
+        self.line_number, self.line_text = 0, ""
+        self._matches: Iterator[re.Match] | None = None
 
     def _fill(self, i: float) -> None:
-        """Tokenize lines until there is a token ``i`` or the text ends."""
-        while len(self.items) <= i:
-            try:
-                number, line, self.offset = next(self._lines)
-            except StopIteration:
-                self.offset = len(self.text)
+        """Tokenize until there is a token ``i`` or the text ends."""
+        while self.count <= i:
+            m = next(self._matches, None) if self._matches is not None else None
+            if m is not None:
+                self.items[self.count] = (m.group(), self.line_number, m.start() + 1)
+                self.last_line = self.line_number
+                self.count += 1
+                continue
+            item = self.lines.next()
+            if item is None:
                 return
-            for m in _TOKEN.finditer(line):
-                self.items.append((m.group(), number, m.start() + 1))
-
-    def fill_all(self) -> None:
-        self._fill(float("inf"))
-
-    def rest(self) -> list[str]:
-        """The tokens from ``pos`` to the end, without line and column (not consuming them)."""
-        return [t for t, _, _ in self.items[self.pos:]] + self.text[self.offset:].split()
+            self.line_number, self.line_text = item
+            self._matches = _TOKEN.finditer(self.line_text)
+        if len(self.items) > 4 * _HISTORY:
+            for k in [k for k in self.items if k < self.pos - _HISTORY]:
+                del self.items[k]
 
     def error(self, problem: str, expected: str | None = None, at: int | None = None) -> ConfigError:
+        """The error at token ``at`` (default: the next one), or on the line after the last token at the end."""
         i = self.pos if at is None else at
         self._fill(i)
-        if i < len(self.items):
+        if i < self.count:
             _, line, column = self.items[i]
         else:
-            line = (self.items[-1][1] if self.items else 0) + 1
-            column = 1
+            line, column = self.last_line + 1, 1
         return ConfigError(problem, file=self.source, line=line, column=column, expected=expected)
 
     def peek(self) -> str | None:
         self._fill(self.pos)
-        return self.items[self.pos][0] if self.pos < len(self.items) else None
+        return self.items[self.pos][0] if self.pos < self.count else None
 
     def take(self, expected: str) -> str:
         self._fill(self.pos)
-        if self.pos >= len(self.items):
+        if self.pos >= self.count:
             raise self.error("unexpected end of file", expected)
         token = self.items[self.pos][0]
         self.pos += 1
@@ -230,7 +326,7 @@ class _Tokens:
         token = self.take(repr(word))
         if token != word:
             self.pos -= 1
-            raise self.error(f"found {token!r}", repr(word))
+            raise self.error(f"found {_shown(token)}", repr(word))
 
     def number(self, what: str) -> float:
         token = self.take(what)
@@ -238,18 +334,395 @@ class _Tokens:
             value = float(token)
         except ValueError:
             self.pos -= 1
-            raise self.error(f"found {token!r}", what) from None
+            raise self.error(f"found {_shown(token)}", what) from None
         if not np.isfinite(value):
             self.pos -= 1
-            raise self.error(f"found {token!r}", f"a finite {what}")
+            raise self.error(f"found {_shown(token)}", f"a finite {what}")
         return value
 
-    def integer(self, what: str) -> int:
+    def integer(self, what: str, most: int) -> int:
+        """A count in ASCII digits (``str.isdigit`` would take '²'), at most ``most``."""
         token = self.take(what)
-        if not token.isdigit():
+        if not (token.isascii() and token.isdigit()) or len(token) > 18 or int(token) > most:
             self.pos -= 1
-            raise self.error(f"found {token!r}", what)
+            raise self.error(f"found {_shown(token)}", f"{what} (ASCII digits, at most {most})")
         return int(token)
+
+
+@dataclass
+class _Header:
+    """What comes before the MOTION block's values, and where they start."""
+
+    joints: list[Joint]
+    frame_time: float
+    n_frames: int
+    line: int  # the line of 'Frame Time', where the values may start
+    column: int  # the character after the frame time's number on that line (0-based)
+    first: str  # that line's text
+
+
+def _parse_header(tokens: _Tokens) -> _Header:
+    """HIERARCHY to the frame time, with every bound checked where it is read (iteratively: no recursion)."""
+    tokens.expect("HIERARCHY")
+    joints: list[Joint] = []
+    names: dict[str, str] = {}  # every name so far (joints and end sites), with where it was given, for messages
+    while tokens.peek() == "ROOT":
+        tokens.take("ROOT")
+        open_joints = [_parse_joint_head(tokens, joints, names, parent=-1)]
+        while open_joints:
+            index = open_joints[-1]
+            name = joints[index].name
+            token = tokens.peek()
+            if token == "JOINT":
+                if len(open_joints) >= MAX_DEPTH:
+                    raise tokens.error(f"joints nested deeper than {MAX_DEPTH}", f"at most {MAX_DEPTH} levels of JOINT")
+                tokens.take("JOINT")
+                open_joints.append(_parse_joint_head(tokens, joints, names, parent=index))
+            elif token == "End":
+                at = tokens.pos
+                tokens.take("End")
+                tokens.expect("Site")
+                end_name = f"{name}_end"  # an end site is named after its parent: it must not shadow another point
+                if end_name in names:
+                    raise tokens.error(f"the end site of joint {_shown(name)} is named {_shown(end_name)}, like "
+                                       f"{names[end_name]}", "unique joint names (end sites are named <parent>_end: "
+                                       "rename the joint)", at=at)
+                names[end_name] = f"the end site of joint {_shown(name)} at line {tokens.items[at][1]}"
+                tokens.expect("{")
+                tokens.expect("OFFSET")
+                end = tuple(tokens.number("an OFFSET coordinate") for _ in range(3))
+                tokens.expect("}")
+                joints.append(Joint(end_name, index, end, (), end_site=True))
+            elif token == "}":
+                tokens.take("}")
+                open_joints.pop()
+            else:
+                raise tokens.error(f"found {_shown(token)}" if token else "unexpected end of file",
+                                   f"'JOINT', 'End Site' or '}}' closing joint {_shown(name)}")
+    if not joints:
+        raise tokens.error(f"found {_shown(tokens.peek())}" if tokens.peek() else "unexpected end of file", "'ROOT'")
+    if not any(j.channels for j in joints):
+        tokens.peek()
+        raise tokens.error("no channels in the hierarchy", "at least one joint with CHANNELS (a motion to read)")
+    tokens.expect("MOTION")
+    tokens.expect("Frames:")
+    n_frames = tokens.integer("the number of frames", 10**15)
+    tokens.expect("Frame")
+    tokens.expect("Time:")
+    at = tokens.pos
+    frame_time = tokens.number("the frame time in seconds")
+    if frame_time <= 0:
+        raise tokens.error(f"frame time {frame_time}", "a positive number of seconds", at=at)
+    if not 1.0 / MAX_FPS <= frame_time <= 1.0 / MIN_FPS:
+        raise tokens.error(f"frame time {frame_time:g} s ({1.0 / frame_time:g} frames per second)",
+                           f"a frame time of {1.0 / MAX_FPS:g} to {1.0 / MIN_FPS:g} seconds (frame rates from 1/60 Hz "
+                           f"to {MAX_FPS / 1000:g} kHz)", at=at)
+    token, line, column = tokens.items[at]
+    return _Header(joints, frame_time, n_frames, line, column - 1 + len(token), tokens.line_text)
+
+
+def _parse_joint_head(tokens: _Tokens, joints: list[Joint], names: dict[str, str], parent: int) -> int:
+    """A joint's name, OFFSET and CHANNELS (its children come after); returns its index."""
+    at = name_at = tokens.pos
+    name = tokens.take("a joint name")
+    if name in ("{", "}", "OFFSET", "CHANNELS"):
+        raise tokens.error(f"found {_shown(name)}", "a joint name", at=at)
+    if name in names:
+        raise tokens.error(f"duplicate joint name {_shown(name)}" + ("" if names[name].startswith("the joint") else
+                           f", the name of {names[name]}"), "unique joint names", at=at)
+    tokens.expect("{")
+    tokens.expect("OFFSET")
+    offset = tuple(tokens.number("an OFFSET coordinate") for _ in range(3))
+    tokens.expect("CHANNELS")
+    count = tokens.integer("the number of channels", MAX_CHANNELS)
+    channels: list[str] = []
+    for _ in range(count):
+        at = tokens.pos
+        c = tokens.take("a channel name")
+        if c not in CHANNEL_NAMES:
+            raise tokens.error(f"found {_shown(c)}", "a channel name (" + ", ".join(CHANNEL_NAMES) + ")", at=at)
+        if c in channels:
+            raise tokens.error(f"channel {c!r} listed twice for joint {_shown(name)}", "each channel once", at=at)
+        channels.append(c)
+    names[name] = f"the joint at line {tokens.items[name_at][1]}"
+    joints.append(Joint(name, parent, offset, tuple(channels)))
+    return len(joints) - 1
+
+
+def _motion_lines(header: _Header, lines: Iterator[tuple[int, str]]) -> Iterator[tuple[int, str]]:
+    """The MOTION block's lines from the frame time's line on, what precedes the values blanked (columns kept)."""
+    yield header.line, " " * header.column + header.first[header.column :]
+    yield from lines
+
+
+def _locate(header: _Header, lines: Iterator[tuple[int, str]], n_channels: int, source: str) -> ConfigError:
+    """The error of a MOTION block that does not read as an array, with its line and column, in one pass.
+
+    In order: the number of values (the first frame line whose count is wrong, else the frame lines counted), then
+    the first value that is not a number, then the first that is not finite; line by line, so the memory is that
+    of the longest line.
+    """
+    n_frames = header.n_frames
+    expected = n_frames * n_channels
+    total, k, last_line = 0, 0, header.line
+    bad_count = beyond = bad_token = not_finite = None
+    batch: list[tuple[int, str, list[str]]] = []  # lines whose values are converted together
+    held = 0
+
+    def check() -> None:
+        """Look for the first value that is not a number (and the first not finite) in the lines of ``batch``."""
+        nonlocal bad_token, not_finite
+        if bad_token is not None:
+            return
+        try:
+            values = np.array([w for _, _, words in batch for w in words], dtype=float)
+        except ValueError:
+            values = None
+        if values is not None and (not_finite is not None or np.isfinite(values).all()):
+            return
+        for number, line, words in batch:  # line by line, only in a batch with a problem
+            try:
+                values = np.array(words, dtype=float)
+            except ValueError:
+                j = next(j for j, w in enumerate(words) if not _is_number(w))
+                bad_token = (words[j], number, _column(line, j))
+                return
+            if not_finite is None and not np.isfinite(values).all():
+                j = int(np.flatnonzero(~np.isfinite(values))[0])
+                not_finite = (words[j], number, _column(line, j))
+
+    for number, line in _motion_lines(header, lines):
+        words = line.split()
+        if not words:
+            continue
+        count = len(words)
+        if bad_count is None and count != n_channels:
+            bad_count = (k, number, count)
+        k += 1
+        if beyond is None and total + count > expected:
+            beyond = (number, _column(line, expected - total))
+        total += count
+        last_line = number
+        if bad_token is None:
+            batch.append((number, line, words))
+            held += count
+            if held >= _PIECE:
+                check()
+                batch, held = [], 0
+    check()
+    if total != expected:
+        if bad_count is not None:
+            i, number, count = bad_count
+            return ConfigError(f"frame {i + 1} has {count} values", file=source, line=number, column=1,
+                               expected=f"{n_channels} channel values per frame line")
+        number, column = (last_line + 1, 1) if k < n_frames else beyond
+        return ConfigError(f"{k} frame lines after 'Frames: {n_frames}'", file=source, line=number, column=column,
+                           expected=f"{n_frames} frame lines")
+    if bad_token is not None:
+        token, number, column = bad_token
+        return ConfigError(f"found {_shown(token)}", file=source, line=number, column=column,
+                           expected="a number (a channel value)")
+    if not_finite is not None:
+        token, number, column = not_finite
+        return ConfigError(f"found {_shown(token)}", file=source, line=number, column=column,
+                           expected="a finite channel value")
+    return ConfigError("the MOTION block does not read as numbers", file=source, line=header.line,
+                       expected="channel values")  # pragma: no cover - the block read as an array after all
+
+
+def _column(line: str, j: int) -> int:
+    """The column (1-based) of the ``j``-th token of a line."""
+    for i, m in enumerate(_TOKEN.finditer(line)):
+        if i == j:
+            return m.start() + 1
+    return len(line) + 1  # pragma: no cover
+
+
+def _is_number(word: str) -> bool:
+    try:
+        np.array([word], dtype=float)
+    except ValueError:
+        return False
+    return True
+
+
+def _motion_blocks(chunks: Iterator[str], n_frames: int, n_channels: int, frames: int,
+                   fail: Callable[[], ConfigError]) -> Iterator[np.ndarray]:
+    """The MOTION block's values as arrays of ``frames`` frames (the last one shorter); ``fail`` gives the error.
+
+    The text is split into tokens a chunk at a time and converted ``_PIECE`` values at a time into the block being
+    filled; the line and column of a problem are found only when there is one (``fail``, a second pass).
+    """
+    total, frames = n_frames * n_channels, max(1, frames)
+    piece = max(1, _PIECE // n_channels)  # frames converted at a time: a list of strings this long is alive
+    pending: list[str] = []
+    done, carry, yielded = 0, "", 0  # values converted, a token cut by the chunk's end, frames given
+    block, filled = None, 0
+
+    def room() -> int:
+        """Frames still to fill in the block (a new one holds ``frames`` or the frames left)."""
+        return min(frames, n_frames - yielded) if block is None else len(block) - filled
+
+    def convert(k: int) -> None:
+        nonlocal block, filled, done
+        if block is None:
+            block, filled = np.empty((min(frames, n_frames - yielded), n_channels)), 0
+        words = pending[: k * n_channels]
+        try:
+            block[filled : filled + k] = np.array(words, dtype=float).reshape(k, n_channels)
+        except ValueError:
+            raise fail() from None
+        if not np.isfinite(block[filled : filled + k]).all():
+            raise fail()
+        del pending[: k * n_channels]
+        filled += k
+        done += k * n_channels
+
+    for chunk in chunks:
+        if not chunk:
+            continue
+        text = carry + chunk
+        words = text.split()
+        carry = words.pop() if words and not text[-1].isspace() else ""
+        if done + len(pending) + len(words) > total:
+            raise fail()
+        pending += words
+        while len(pending) >= piece * n_channels:
+            convert(min(piece, room()))
+            if filled == len(block):
+                yield block
+                yielded += filled
+                block = None
+    if carry:
+        pending.append(carry)
+    if done + len(pending) != total:
+        raise fail()
+    while pending:
+        convert(min(len(pending) // n_channels, room()))
+        if filled == len(block):
+            yield block
+            yielded += filled
+            block = None
+    if block is not None and filled:  # pragma: no cover - a block is given as soon as it is full
+        yield block[:filled]
+
+
+class BVHStream:
+    """A BVH file whose header has been read and whose MOTION block is read in blocks of frames.
+
+    Made by :func:`open_bvh`. ``header`` is a :class:`BVH` with the joints and frame time and no frames;
+    :meth:`blocks` yields the channel values (k, C) block by block, with the same errors (file, line, column) as
+    reading the whole file. Use it as a context manager, or iterate :meth:`blocks` to the end, to close the file.
+    """
+
+    def __init__(self, open_chunks: Callable[[], Iterator[str]], source: str, size: int) -> None:
+        self._open, self.source = open_chunks, source
+        self._chunks = open_chunks()
+        self._lines = _Lines(self._chunks)
+        try:
+            self._head = _parse_header(_Tokens(self._lines, source))
+        except BaseException:
+            self.close()
+            raise
+        self.header = BVH(self._head.joints, self._head.frame_time, np.empty((0, 0)), source)
+        self._size = size  # an upper bound of the characters in the text
+        self._read = False
+
+    @property
+    def n_frames(self) -> int:
+        """The number of frames the header declares (the blocks are checked against it)."""
+        return self._head.n_frames
+
+    @property
+    def n_channels(self) -> int:
+        return self.header.n_channels
+
+    @property
+    def fps(self) -> float:
+        return self.header.fps
+
+    @property
+    def joints(self) -> list[Joint]:
+        return self.header.joints
+
+    @property
+    def names(self) -> list[str]:
+        return self.header.names
+
+    def _fail(self) -> ConfigError:
+        """The error of the MOTION block, found by reading the text again from the start."""
+        self.close()
+        lines = _Lines(self._open())
+        try:
+            for number, _ in lines:
+                if number == self._head.line:
+                    break
+            return _locate(self._head, iter(lines), self.n_channels, self.source)
+        finally:
+            close = getattr(lines._chunks, "close", None)
+            if close is not None:
+                close()
+
+    def _possible(self) -> bool:
+        """Whether the text can hold the declared frames (each value takes a character and a separator)."""
+        return self.n_frames * (2 * self.n_channels) - 1 <= self._size
+
+    def blocks(self, frames: int = BLOCK) -> Iterator[np.ndarray]:
+        """The channel values (k, C) of ``frames`` frames at a time (the last block shorter), once."""
+        if self._read:
+            raise RuntimeError("the MOTION block of a BVHStream is read once")
+        self._read = True
+        try:
+            if not self._possible():
+                raise self._fail()
+            head = self._head
+            chunks = itertools.chain([head.first[head.column :] + "\n"], self._lines.rest())
+            yield from _motion_blocks(chunks, self.n_frames, self.n_channels, frames, self._fail)
+        finally:
+            self.close()
+
+    def read(self) -> BVH:
+        """All the frames as one :class:`BVH` (the values in one array, filled block by block)."""
+        if not self._possible():
+            self.close()
+            raise self._fail()
+        values = np.empty((self.n_frames, self.n_channels))
+        f = 0
+        for block in self.blocks(max(1, _PIECE // self.n_channels)):
+            values[f : f + len(block)] = block
+            f += len(block)
+        return BVH(self.joints, self.header.frame_time, values, self.source)
+
+    def close(self) -> None:
+        close = getattr(self._chunks, "close", None)
+        if close is not None:
+            close()
+
+    def __enter__(self) -> BVHStream:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def open_bvh(path: str | Path) -> BVHStream:
+    """Open a BVH file and read its header; the MOTION block follows with :meth:`BVHStream.blocks`.
+
+    Only a regular file within the size cap is opened (:func:`toolkit.files.check_regular_file`).
+    """
+    path = check_regular_file(path, "BVH file", "motion")
+    size = os.stat(path).st_size
+    return BVHStream(lambda: _file_chunks(path), str(path), size)
+
+
+def iter_bvh_blocks(path: str | Path, frames: int = BLOCK) -> Iterator[np.ndarray]:
+    """The channel values of a BVH file in blocks of ``frames`` frames (k, C), as :func:`read_bvh` reads them.
+
+    ``np.concatenate(list(iter_bvh_blocks(path, n)))`` is ``read_bvh(path).values`` bit for bit, and a file that
+    :func:`read_bvh` refuses raises the same error (file, line, column) when the block holding the problem is read.
+    """
+    with open_bvh(path) as stream:
+        yield from stream.blocks(frames)
 
 
 def parse_bvh(text: str, source: str = "<bvh>") -> BVH:
@@ -258,126 +731,56 @@ def parse_bvh(text: str, source: str = "<bvh>") -> BVH:
 
 
 def _parse(text: str, source: str, fast: bool = True) -> BVH:
-    """``parse_bvh``; ``fast=False`` reads the MOTION block token by token (the reference for the fast path)."""
-    tokens = _Tokens(text, source)
-    tokens.expect("HIERARCHY")
-    joints: list[Joint] = []
-    while tokens.peek() == "ROOT":
-        tokens.take("ROOT")
-        _parse_joint(tokens, joints, parent=-1)
-    if not joints:
-        raise tokens.error(f"found {tokens.peek()!r}" if tokens.peek() else "unexpected end of file", "'ROOT'")
-    tokens.expect("MOTION")
-    tokens.expect("Frames:")
-    n_frames = tokens.integer("the number of frames")
-    tokens.expect("Frame")
-    tokens.expect("Time:")
-    at = tokens.pos
-    frame_time = tokens.number("the frame time in seconds")
-    if frame_time <= 0:
-        raise tokens.error(f"frame time {frame_time}", "a positive number of seconds", at=at)
-    n_channels = sum(len(j.channels) for j in joints)
+    """``parse_bvh``; ``fast=False`` reads the MOTION block token by token (the reference for the block reader)."""
+    stream = BVHStream(lambda: _text_chunks(text), source, len(text))
     if fast:
-        # the MOTION block as one array; any problem (a count, a token, a value) is located token by token below
-        rest, values = tokens.rest(), None
-        if len(rest) == n_frames * n_channels:
-            try:
-                values = np.array(rest, dtype=float).reshape(n_frames, n_channels)
-            except ValueError:
-                pass
-        del rest
-        if values is not None and np.isfinite(values).all():
-            return BVH(joints, frame_time, values, source)
-    tokens.fill_all()
-    return BVH(joints, frame_time, _motion_values(tokens, n_frames, n_channels), source)
+        return stream.read()
+    stream.close()
+    head = stream._head
+    lines = _Lines(_text_chunks(text))
+    for number, _ in lines:
+        if number == head.line:
+            break
+    values = _reference_values(head, iter(lines), stream.n_channels, source)
+    return BVH(head.joints, head.frame_time, values, source)
 
 
-def _motion_values(tokens: _Tokens, n_frames: int, n_channels: int) -> np.ndarray:
-    """The MOTION block's values from the tokens after ``Frame Time``, with the line and column of any problem."""
-    source = tokens.source
-    first = tokens.pos
-    rest = tokens.items[first:]
+def _reference_values(head: _Header, lines: Iterator[tuple[int, str]], n_channels: int, source: str) -> np.ndarray:
+    """The MOTION block's values from a token per value with its line and column: slow, the reference."""
+    rest = [(m.group(), number, m.start() + 1) for number, line in _motion_lines(head, lines)
+            for m in _TOKEN.finditer(line)]
+    n_frames = head.n_frames
     if len(rest) != n_frames * n_channels:
-        # find the line that is too short or too long, to name it
-        lines: dict[int, int] = {}
+        counts: dict[int, int] = {}
         for _, line, _ in rest:
-            lines[line] = lines.get(line, 0) + 1
-        for k, (line, count) in enumerate(sorted(lines.items())):
+            counts[line] = counts.get(line, 0) + 1
+        for k, (line, count) in enumerate(sorted(counts.items())):
             if count != n_channels:
                 raise ConfigError(f"frame {k + 1} has {count} values", file=source, line=line, column=1,
                                   expected=f"{n_channels} channel values per frame line")
-        raise tokens.error(f"{len(lines)} frame lines after 'Frames: {n_frames}'", f"{n_frames} frame lines",
-                           at=first + len(rest) if len(lines) < n_frames else first + n_frames * n_channels)
-    try:
-        values = np.array([t for t, _, _ in rest], dtype=float).reshape(n_frames, n_channels)
-    except ValueError:
-        for k, (token, line, column) in enumerate(rest):
-            try:
-                float(token)
-            except ValueError:
-                raise ConfigError(f"found {token!r}", file=source, line=line, column=column,
-                                  expected="a number (a channel value)") from None
-        raise
+        if len(counts) < n_frames:
+            line, column = (rest[-1][1] if rest else head.line) + 1, 1
+        else:
+            _, line, column = rest[n_frames * n_channels]
+        raise ConfigError(f"{len(counts)} frame lines after 'Frames: {n_frames}'", file=source, line=line,
+                          column=column, expected=f"{n_frames} frame lines")
+    for token, line, column in rest:
+        if not _is_number(token):
+            raise ConfigError(f"found {_shown(token)}", file=source, line=line, column=column,
+                              expected="a number (a channel value)")
+    values = np.array([t for t, _, _ in rest], dtype=float).reshape(n_frames, n_channels)
     bad = ~np.isfinite(values)
     if bad.any():
-        k = int(np.flatnonzero(bad.reshape(-1))[0])
-        token, line, column = rest[k]
-        raise ConfigError(f"found {token!r}", file=source, line=line, column=column, expected="a finite channel value")
+        token, line, column = rest[int(np.flatnonzero(bad.reshape(-1))[0])]
+        raise ConfigError(f"found {_shown(token)}", file=source, line=line, column=column,
+                          expected="a finite channel value")
     return values
 
 
-def _parse_joint(tokens: _Tokens, joints: list[Joint], parent: int) -> None:
-    at = tokens.pos
-    name = tokens.take("a joint name")
-    if name in ("{", "}", "OFFSET", "CHANNELS"):
-        raise tokens.error(f"found {name!r}", "a joint name", at=at)
-    if any(j.name == name for j in joints):
-        raise tokens.error(f"duplicate joint name {name!r}", "unique joint names", at=at)
-    tokens.expect("{")
-    tokens.expect("OFFSET")
-    offset = tuple(tokens.number("an OFFSET coordinate") for _ in range(3))
-    tokens.expect("CHANNELS")
-    count = tokens.integer("the number of channels")
-    channels = []
-    for _ in range(count):
-        at = tokens.pos
-        c = tokens.take("a channel name")
-        if c not in CHANNEL_NAMES:
-            raise tokens.error(f"found {c!r}", "a channel name (" + ", ".join(CHANNEL_NAMES) + ")", at=at)
-        if c in channels:
-            raise tokens.error(f"channel {c!r} listed twice for joint {name!r}", "each channel once", at=at)
-        channels.append(c)
-    index = len(joints)
-    joints.append(Joint(name, parent, offset, tuple(channels)))
-    while True:
-        token = tokens.peek()
-        if token == "JOINT":
-            tokens.take("JOINT")
-            _parse_joint(tokens, joints, index)
-        elif token == "End":
-            tokens.take("End")
-            tokens.expect("Site")
-            tokens.expect("{")
-            tokens.expect("OFFSET")
-            end = tuple(tokens.number("an OFFSET coordinate") for _ in range(3))
-            tokens.expect("}")
-            joints.append(Joint(f"{name}_end", index, end, (), end_site=True))
-        elif token == "}":
-            tokens.take("}")
-            return
-        else:
-            raise tokens.error(f"found {token!r}" if token else "unexpected end of file",
-                               f"'JOINT', 'End Site' or '}}' closing joint {name!r}")
-
-
 def read_bvh(path: str | Path) -> BVH:
-    """Read a BVH file; a missing, unreadable or malformed file is a :class:`ConfigError`."""
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8", errors="replace")
-    except OSError as exc:
-        raise ConfigError(f"cannot read ({exc.strerror or exc})", file=path, expected="a readable BVH file") from None
-    return parse_bvh(text, str(path))
+    """Read a BVH file; a missing, unreadable, special (a FIFO, a device), oversized or malformed file is a
+    :class:`ConfigError`."""
+    return open_bvh(path).read()
 
 
 # -- writing ----------------------------------------------------------------------------------------
@@ -394,22 +797,23 @@ def format_bvh(bvh: BVH, *, precision: int = 6) -> str:
         children.setdefault(j.parent, []).append(i)
     out = ["HIERARCHY"]
 
-    def emit(i: int, depth: int) -> None:
+    stack: list[tuple[int, int, bool]] = [(root, 0, False) for root in reversed(children.get(-1, []))]
+    while stack:  # depth first, without recursion (a hierarchy may be deep)
+        i, depth, closing = stack.pop()
         joint, pad = bvh.joints[i], "  " * depth
+        if closing:
+            out.append(f"{pad}}}")
+            continue
         off = " ".join(_number(v) for v in joint.offset)
         if joint.end_site:
             out.extend([f"{pad}End Site", f"{pad}{{", f"{pad}  OFFSET {off}", f"{pad}}}"])
-            return
+            continue
         out.append(f"{pad}{'ROOT' if joint.parent < 0 else 'JOINT'} {joint.name}")
         out.append(f"{pad}{{")
         out.append(f"{pad}  OFFSET {off}")
         out.append(f"{pad}  CHANNELS {len(joint.channels)} {' '.join(joint.channels)}".rstrip())
-        for c in children.get(i, []):
-            emit(c, depth + 1)
-        out.append(f"{pad}}}")
-
-    for root in children.get(-1, []):
-        emit(root, 0)
+        stack.append((i, depth, True))
+        stack.extend((c, depth + 1, False) for c in reversed(children.get(i, [])))
     out += ["MOTION", f"Frames: {bvh.n_frames}", f"Frame Time: {bvh.frame_time:.9g}"]
     fmt = f"%.{precision}g"
     out.extend(" ".join(fmt % v for v in row) for row in bvh.values)

@@ -35,6 +35,7 @@ from toolkit.body import Body
 from toolkit.components import ActionSystem, Component, Correspondence, Matcher, MotorSystem, Perception, Segmenter
 from toolkit.errors import ConfigError, LikemeError, PluginError
 from toolkit.manager import PluginManager
+from toolkit.params import finite_number
 
 __all__ = [
     "Character",
@@ -82,6 +83,10 @@ class Character:
         The merged declaration.
     pm : PluginManager or None
         The plugin manager it was composed with; components announce events through ``pm.hook``.
+    repertoire : object or None
+        A repertoire given in memory when it was composed (:func:`compose_character`'s ``repertoire``), which its
+        motor system builds from instead of a folder named in its table (a
+        :class:`plugins.lib.clip_repertoire.ClipRepertoire` for ``posegraph`` and ``motor-command-graph``).
     """
 
     name: str
@@ -97,6 +102,7 @@ class Character:
     lengths_for_height: float | None = None
     config: dict[str, Any] = field(default_factory=dict)
     pm: PluginManager | None = field(default=None, repr=False)
+    repertoire: Any = field(default=None, repr=False)
 
     @property
     def file(self) -> Path | None:
@@ -141,30 +147,24 @@ class Character:
 # -- reading files -------------------------------------------------------------------
 
 
-MAX_TEXT_BYTES = 16 * 1024 * 1024
-"""The largest declaration file read (bytes): a character, scenario or profile is a few kilobytes."""
 MAX_DEPTH = 32
 """The deepest nesting of arrays and tables a declaration may have."""
 MAX_EXTENDS = 64
 """The longest ``extends`` chain a character file may start."""
 
 
-def read_text(path: str | Path, what: str, *, limit: int | None = None) -> str:
+def read_text(path: str | Path, what: str, *, kind: str = "config") -> str:
     """A UTF-8 text file's content (a byte-order mark at its start is dropped); a missing, unreadable or not
-    regular file (a device, a FIFO), or one larger than ``limit`` bytes, is a :class:`ConfigError` expecting
-    ``what``."""
+    regular file (a device, a FIFO, a directory), or one larger than the size cap of ``kind``
+    (:data:`toolkit.files.LIMITS`), is a :class:`ConfigError` expecting ``what``."""
+    from toolkit.files import open_regular
+
     path = Path(path)
+    if not path.exists() and not path.is_symlink():
+        raise ConfigError("file not found", file=path, expected=f"an existing {what}")
     try:
-        if path.exists() and not path.is_file():
-            raise ConfigError("not a regular file", file=path, expected=f"a {what}")
-        with path.open("rb") as handle:
-            data = handle.read() if limit is None else handle.read(limit + 1)
-        if limit is not None and len(data) > limit:
-            raise ConfigError(f"file larger than {limit} bytes", file=path,
-                              expected=f"a {what} (a declaration of a few kilobytes)")
-        return data.decode("utf-8-sig")
-    except FileNotFoundError:
-        raise ConfigError("file not found", file=path, expected=f"an existing {what}") from None
+        with open_regular(path, what, kind) as handle:
+            return handle.read().decode("utf-8-sig")
     except (OSError, UnicodeDecodeError) as exc:
         raise ConfigError(f"cannot read file ({exc})", file=path, expected=f"a readable UTF-8 {what}") from None
 
@@ -172,7 +172,7 @@ def read_text(path: str | Path, what: str, *, limit: int | None = None) -> str:
 def read_toml(path: str | Path) -> dict[str, Any]:
     """Parse a TOML file; syntax errors become a :class:`ConfigError` with line and column."""
     path = Path(path)
-    text = read_text(path, "TOML file", limit=MAX_TEXT_BYTES)
+    text = read_text(path, "TOML file")
     try:
         table = tomllib.loads(text)
     except RecursionError:
@@ -244,11 +244,14 @@ def resolve_file(ref: str, base: Path | None, pm: PluginManager | None, *, key: 
     searched = character_paths(pm)
     candidates.extend(p / name for p in searched)
     for c in candidates:
-        if c.is_file():
-            return c.resolve()
+        try:
+            if c.is_file():
+                return c.resolve()
+        except OSError:  # a name too long for the file system, a loop of links: not a file that can be found
+            continue
     known = sorted({f.stem for p in searched for f in p.glob("*.toml")})
     raise ConfigError(
-        f"cannot find {ref!r}",
+        f"cannot find {ref[:80]!r}" + (f" ({len(ref)} characters)" if len(ref) > 80 else ""),
         file=file,
         key=key,
         expected="a path relative to this file or the name of a character on the search path",
@@ -356,8 +359,12 @@ def _gives(override: Mapping[str, Any], key: tuple) -> bool:
     return bool(key)
 
 
-def compose_character(table: Mapping[str, Any], pm: PluginManager, *, files: tuple[Path, ...] = ()) -> Character:
+def compose_character(table: Mapping[str, Any], pm: PluginManager, *, files: tuple[Path, ...] = (),
+                      repertoire: Any = None) -> Character:
     """Validate a merged character table and build its components.
+
+    ``repertoire``: a repertoire in memory for the motor system (:attr:`Character.repertoire`), read when it is
+    attached, instead of a folder its table names (``[motor] clips``).
 
     Raises :class:`ConfigError` with the key path (file placement is done by
     :func:`load_character`) or :class:`PluginError` if a component fails to build.
@@ -376,8 +383,7 @@ def compose_character(table: Mapping[str, Any], pm: PluginManager, *, files: tup
     if not isinstance(description, str):
         raise ConfigError("wrong type", key=("character", "description"), expected="a string")
     lengths_for = head.get("lengths_for_height")
-    if lengths_for is not None and (isinstance(lengths_for, bool) or not isinstance(lengths_for, (int, float))
-                                    or not np.isfinite(lengths_for) or lengths_for <= 0):
+    if lengths_for is not None and (finite_number(lengths_for) or 0.0) <= 0:
         raise ConfigError(f"invalid value {lengths_for!r}", key=("character", "lengths_for_height"),
                           expected="a positive number: the standing height (m) the length parameters were written for")
     body_table = _table(table, "body", required=True)
@@ -404,6 +410,7 @@ def compose_character(table: Mapping[str, Any], pm: PluginManager, *, files: tup
         lengths_for_height=None if lengths_for is None else float(lengths_for),
         config=dict(table),
         pm=pm,
+        repertoire=repertoire,
     )
     scale = None  # known once the motor system is attached (its rest pose gives the height)
     for key, component in character.components().items():  # motor first: the others read it

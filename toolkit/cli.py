@@ -187,20 +187,32 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p.add_argument("--markdown", action="store_true", help="print a Markdown reference of every component and its parameters")
     p.set_defaults(handler=cmd_plugins)
 
-    p = sub.add_parser("show", help="show a character's representations: as text, or drawn by a view to PNG")
-    p.add_argument("character", help="character TOML file or name (with --after: the id of an actor of the scenario)")
+    p = sub.add_parser("show", help="show a character's representations, or your own recordings, as text or drawn by a "
+                       "view to PNG")
+    p.add_argument("character", nargs="+", metavar="CHARACTER|FILE",
+                   help="character TOML file or name (with --after: the id of an actor of the scenario); with --body: "
+                   "the recordings to draw (.bvh and the other formats body profiles read), after an optional "
+                   "observer template (default observers/recordings)")
     p.add_argument("--after", metavar="SCENARIO", help="run this scenario first and show the actor as it is then "
                    "(what it learned included)")
     p.add_argument("--actions", action="store_true", help="print the action system (hierarchy, drives, beliefs, maps) as text")
     p.add_argument("--view", metavar="NAME", help="draw the character with this view (see 'likeme plugins'), "
-                   "e.g. body, posegraph, motor-command-graph")
-    p.add_argument("--out", metavar="FILE.png", help="where the view writes its picture (default: CHARACTER-VIEW.png)")
+                   "e.g. body, posegraph, motor-command-graph; of recordings: body, hub-signal, speed-profile, "
+                   "prediction-error")
+    p.add_argument("--out", metavar="FILE.png|DIR", dest="out_path",
+                   help="where the view writes its picture: a .png file, or a folder (created if missing) for "
+                   "NAME-VIEW.png files (default: NAME-VIEW.png here; NAME: the character's, or each recording's)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="a parameter of the view, e.g. --set keys=4 (repeatable)")
-    p.add_argument("--body", metavar="PROFILE", help="with --repertoire: show the observer of recordings of this "
-                   "body that the observer template CHARACTER composes (e.g. observers/recordings), as likeme observe "
-                   "does")
-    p.add_argument("--repertoire", metavar="DIR", help="with --body: the observer's labelled clips")
+    p.add_argument("--body", metavar="PROFILE", help="the body profile of the recordings: with FILEs, draw them as "
+                   "the observer composed from the template watches them; without, with --repertoire: show that "
+                   "observer, as likeme observe composes it")
+    p.add_argument("--repertoire", metavar="DIR", help="with --body: the observer's labelled clips (default with "
+                   "FILEs: the recordings themselves, a movement each, and no matcher unless the view needs one)")
+    p.add_argument("--segmenter", metavar="NAME", help="with --body: the observer's segmenter (default: the one the "
+                   "view needs, else the template's)")
+    p.add_argument("--matcher", metavar="NAME", help="with --body: the observer's matcher (default: the one the view "
+                   "needs, else the template's)")
     p.add_argument("--correspondence", metavar="NAME", help="with --body: the observer's correspondence (default: "
                    "the template's)")
     p.set_defaults(handler=cmd_show)
@@ -214,7 +226,8 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p.add_argument("--matcher", metavar="NAME", help="matcher (default: the observer template's)")
     p.add_argument("--correspondence", metavar="NAME", help="correspondence (default: the observer template's; "
                    "none: the papers' plain observer)")
-    p.add_argument("--lengths-for-height", type=float, default=None, metavar="M", dest="lengths_for_height",
+    p.add_argument("--lengths-for-height", type=number_type(0.0, 1000.0, "metres"), default=None, metavar="M",
+                   dest="lengths_for_height",
                    help="the height (m) the length parameters were written for, scaled to the observer's own height "
                    "(default: the observer template's; 0: metres as written, the papers)")
     p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
@@ -224,8 +237,15 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
 
     p = sub.add_parser("validate", help="check character, scenario and body-profile files and BVH motion files")
     p.add_argument("files", nargs="+", metavar="FILE", help="character, scenario or profile TOML files, or BVH files")
-    p.add_argument("--body", metavar="PROFILE", help="also check that each BVH file has the joints this profile maps")
+    p.add_argument("--body", metavar="PROFILE", help="also check that each BVH file has the joints this profile maps, "
+                   "and warn where the profile is probably wrong for it (units, up axis, facing)")
+    p.add_argument("--strict", action="store_true", help="exit with status 1 on a warning too")
     p.set_defaults(handler=cmd_validate)
+
+    p = sub.add_parser("profile", help="propose a body profile for a recording (BVH, or CSV joint positions)")
+    p.add_argument("file", metavar="FILE", help="a BVH file, or a CSV of joint positions (JOINT_x, JOINT_y, JOINT_z)")
+    p.add_argument("--out", metavar="PROFILE.toml", help="write the profile there (default: print it)")
+    p.set_defaults(handler=cmd_profile)
 
     pm.load_command_plugins()  # a lazy manager's plugins that add commands (none to do for a loaded one)
     pm.hook.likeme_register_commands(subparsers=sub)
@@ -290,24 +310,25 @@ def _view(pm: PluginManager, name: str, subject: str, settings: list[str]) -> An
 def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dict[str, Any]:
     from toolkit.report import summarise
     from toolkit.scenario import load_scenario
+    from toolkit.state import Checkpoint, StateFile, apply_state, read_state
 
     if getattr(args, "set", None) and not getattr(args, "render", None):  # a view's settings, and no view
         raise ConfigError("--set without --render", key=("--set",),
                           expected="--render DIR with the settings of the view that draws the run")
+    # the --save target and the --load file are checked before any work (the target first: its version is the one
+    # this run may overwrite); the loaded state is applied, all or nothing, once the world is composed
+    target = StateFile(args.save, loaded=getattr(args, "load", None)) if getattr(args, "save", None) else None
+    loaded = read_state(args.load) if getattr(args, "load", None) else None
     scenario = load_scenario(path, pm, seed=args.seed, on_plugin_error="skip" if args.keep_going else "stop")
     if getattr(args, "duration", None) is not None:
         from toolkit.scenario import check_duration
 
         scenario.duration = check_duration(args.duration, scenario.world.fps, ("--duration",))
-    if getattr(args, "load", None):
-        from toolkit.state import load_state
-
-        load_state(scenario.world, args.load)
+    if loaded is not None:
+        apply_state(scenario.world, loaded, args.load)
     checkpoint = None
-    if getattr(args, "save", None):
-        from toolkit.state import Checkpoint
-
-        checkpoint = Checkpoint(scenario.world, args.save)
+    if target is not None:
+        checkpoint = Checkpoint(scenario.world, target)
         pm.register(checkpoint, name="checkpoint")
     view = _view(pm, args.view, "scenario", args.set) if getattr(args, "render", None) else None
     files = []
@@ -321,7 +342,7 @@ def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dic
             pm.unregister(checkpoint)
     world = scenario.world
     if checkpoint is not None:
-        checkpoint.save()
+        checkpoint.finish()  # ConfigError if the last save fails or had to go to a conflict file
     if view is not None:
         print(f"wrote {len(files)} file(s) to {args.render}: " + ", ".join(
             sorted({f.suffix.lstrip('.') for f in files})), file=sys.stderr)
@@ -454,14 +475,27 @@ def cmd_plugins(args: argparse.Namespace, pm: PluginManager) -> int:
     return 0
 
 
+RECORDING_SUFFIXES = (".bvh", ".csv", ".npy", ".c3d")
+"""File names that ``likeme show --body PROFILE FILE ...`` takes for recordings, not for a character or template."""
+
+
 def cmd_show(args: argparse.Namespace, pm: PluginManager) -> int:
     from toolkit.character import load_character
     from toolkit.report import describe_character
 
-    for option, value in (("--set", args.set), ("--out", args.out)):
+    for option, value in (("--set", args.set), ("--out", args.out_path)):
         if value and not args.view:  # a view's settings and picture: nothing to apply them to
             raise ConfigError(f"{option} without --view", key=(option,),
                               expected="--view NAME with the view's settings and where it writes its picture")
+    files = [f for f in args.character if Path(f).suffix.lower() in RECORDING_SUFFIXES]
+    names = [f for f in args.character if f not in files]
+    if len(names) > 1 or (files and args.after) or (files and not args.body):
+        raise ConfigError(f"cannot show {' and '.join(names) if len(names) > 1 else ' '.join(args.character)}",
+                          key=("character",), expected="one character (or observer template), or with --body PROFILE "
+                          f"recordings ({', '.join(RECORDING_SUFFIXES)}) after an optional observer template")
+    if files:
+        return _show_recordings(args, pm, names[0] if names else None, files)
+    args.character = names[0]
     if args.after:
         from toolkit.scenario import load_scenario
 
@@ -476,15 +510,17 @@ def cmd_show(args: argparse.Namespace, pm: PluginManager) -> int:
 
         if not (args.body and args.repertoire):
             raise ConfigError("--body and --repertoire go together", key=("--repertoire" if args.body else "--body",),
-                              expected="both: the recordings' body profile and the observer's labelled clips")
+                              expected="both: the recordings' body profile and the observer's labelled clips "
+                              "(or --body with recordings to draw)")
         character = compose_observer(pm, load_profile(args.body), args.repertoire, template=args.character,
+                                     segmenter=args.segmenter, matcher=args.matcher or "",
                                      correspondence=args.correspondence or "")
     else:
         character = load_character(args.character, pm)
     if args.view:
         view = _view(pm, args.view, "character", args.set)
-        out = Path(args.out or f"{re.sub(r'[^a-z0-9]+', '-', character.name.lower()).strip('-')}-{args.view}.png")
-        for path in view.draw(character, out):
+        name = re.sub(r"[^a-z0-9]+", "-", character.name.lower()).strip("-")
+        for path in view.draw(character, _show_out(args.out_path, name, args.view)):
             print(f"wrote {path}")
         return 0
     if args.actions:
@@ -498,26 +534,101 @@ def cmd_show(args: argparse.Namespace, pm: PluginManager) -> int:
     return 0
 
 
+def _show_out(out: str | None, name: str, view: str, several: bool = False) -> Path:
+    """Where ``likeme show`` writes the picture of ``name``: ``--out`` when it names a .png file, else NAME-VIEW.png
+    in the folder ``--out`` names (created if missing) or here; ``several`` pictures need a folder."""
+    if out and Path(out).suffix.lower() == ".png" and not Path(out).is_dir():
+        if several:
+            raise ConfigError("one file for several pictures", file=out, key=("--out",),
+                              expected="a folder for one picture per recording (NAME-VIEW.png in it)")
+        return check_output_file(out, "--out")
+    folder = check_output_dir(out, "--out") if out else Path(".")
+    return folder / f"{name}-{view}.png"
+
+
+def _show_recordings(args: argparse.Namespace, pm: PluginManager, template: str | None, files: list[str]) -> int:
+    """``likeme show --body PROFILE FILE ... --view NAME``: the view's picture of the recordings, watched by the
+    observer composed from the template (and ``--repertoire``, or the recordings themselves), as observe does."""
+    import tempfile
+
+    from plugins.views.demonstration import recording
+    from toolkit.observe import OBSERVER_TEMPLATE, compose_observer
+    from toolkit.profile import load_profile
+
+    if not args.view:
+        raise ConfigError("recordings without --view", key=("--view",), expected="--view NAME: a view that draws "
+                          "recordings", available=_recording_views(pm))
+    view = _view(pm, args.view, "character", args.set)
+    each = getattr(view, "recordings", None)
+    if each not in ("each", "all"):
+        raise ConfigError(f"view {args.view!r} does not draw recordings", key=("--view",),
+                          expected="a view of recordings", available=_recording_views(pm))
+    needs = dict(getattr(view, "needs", {}))
+    if each == "all":
+        outs = [_show_out(args.out_path, Path(files[0]).stem if len(files) == 1 else "recordings", args.view)]
+    else:
+        outs = [_show_out(args.out_path, Path(f).stem, args.view, several=len(files) > 1) for f in files]
+    profile = load_profile(args.body)
+    demos = [recording(profile, f) for f in files]  # each read (and checked) before anything is composed
+    segmenter = args.segmenter or needs.get("segmenter")
+    matcher = args.matcher or needs.get("matcher") or ("" if args.repertoire else None)
+    with tempfile.TemporaryDirectory(prefix="likeme-show-") as tmp:
+        repertoire = args.repertoire
+        if not repertoire:  # the recordings themselves, a movement each: their hub poses, their paths
+            repertoire = Path(tmp)
+            for k, f in enumerate(files):
+                folder = repertoire / f"{k:03d}-{Path(f).stem}"  # one movement per file, the same file twice too
+                folder.mkdir()
+                (folder / Path(f).name).symlink_to(Path(f).resolve())
+        character = compose_observer(pm, profile, repertoire, template=template or OBSERVER_TEMPLATE,
+                                     segmenter=segmenter, matcher=matcher, correspondence=args.correspondence or "")
+        if each == "all":
+            written = view.draw(character, outs[0], recordings=demos)
+        else:
+            written = []
+            for out, demo in zip(outs, demos):
+                written += view.draw(character, out, recording=demo)
+    for path in written:
+        print(f"wrote {path}")
+    return 0
+
+
+def _recording_views(pm: PluginManager) -> list[str]:
+    return [n for n in pm.registry.names("view") if getattr(pm.registry.get("view", n), "recordings", None)]
+
+
 def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
     import json
 
-    from toolkit.observe import NO_CORRESPONDENCE, Observer, compose_observer
-    from toolkit.params import parse_settings
+    from toolkit.files import check_regular_file
+    from toolkit.observe import NO_CORRESPONDENCE, Observer, compose_observer, observer_plugins
+    from toolkit.params import check_settings, parse_settings
     from toolkit.profile import load_profile
 
     profile = load_profile(args.body)
+    for path in args.files:  # a FIFO, a device, a directory or a missing file fails before any work
+        check_regular_file(path, "BVH file", "motion")
     for name, kind in ((args.segmenter, "segmenter"), (args.matcher, "matcher"), (args.correspondence, "correspondence")):
         if name is not None and name != NO_CORRESPONDENCE:
             pm.registry.get(kind, name)  # an unknown name fails here, listing the registered ones
+    settings = parse_settings(list(args.set))
+    check_settings(settings, pm, observer_plugins(pm, segmenters=[args.segmenter] if args.segmenter else (),
+                                                  matchers=[args.matcher] if args.matcher else (),
+                                                  correspondence=args.correspondence or ""))
     character = compose_observer(pm, profile, args.repertoire, segmenter=args.segmenter, matcher=args.matcher or "",
                                  correspondence=args.correspondence or "",
                                  lengths_for_height="" if args.lengths_for_height is None else args.lengths_for_height,
-                                 settings=parse_settings(list(args.set)))
+                                 settings=settings)
     report = []
     for path in args.files:
-        motion = profile.read(path)
-        observer = Observer(character, profile.body, motion.fps)
-        found = observer.watch(motion)
+        # the file streamed a block of frames at a time (header first), so reading memory does not grow with it
+        with profile.stream(path) as motion:
+            observer = Observer(character, profile.body, motion.fps)
+            observer.reset()
+            found = []
+            for positions, visible in motion:
+                found.extend(observer.push_block(positions, visible))
+            found.extend(observer.flush())
         report.append({"file": str(path), "frames": motion.n_frames, "fps": round(motion.fps, 3), "segments": [
             {"start_frame": o.segment.start, "end_frame": o.segment.end, "start_s": round(o.segment.start_time, 3),
              "end_s": round(o.segment.end_time, 3), "movement": o.movement or "unknown",
@@ -566,30 +677,38 @@ def _why_text(seg: dict[str, Any]) -> str:
 
 
 def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
-    from toolkit.bvh import read_bvh
+    from toolkit.bvh import open_bvh
     from toolkit.character import load_character, read_toml
+    from toolkit.files import check_regular_file
     from toolkit.observe import check_observer_template, is_observer_template
     from toolkit.profile import is_profile, load_profile
     from toolkit.report import describe_character
     from toolkit.scenario import is_scenario, load_scenario
 
-    failed = 0
+    failed = warned = 0
     try:
         profile = load_profile(args.body) if args.body else None
     except LikemeError as err:
         print(f"likeme: error: {err}", file=sys.stderr)
         return 1
+    flips: list[tuple[str, Any, int]] = []  # where the facing flips in each recording, counted over them all
+    if profile is not None:
+        warned += _warn(args.body, _profile_warnings(profile))
     for path in args.files:
         try:
             if str(path).lower().endswith(".bvh"):
-                bvh = read_bvh(path)
+                with open_bvh(path) as bvh:  # every frame read and checked, a block at a time
+                    for _ in bvh.blocks():
+                        pass
                 line = f"ok    {path}: BVH: {len(bvh.names)} joints, {bvh.n_frames} frames at {bvh.fps:g} fps"
                 if profile is not None:
-                    unmapped = profile.check(bvh)
+                    unmapped = profile.check(bvh.header)
                     line += f"; profile {profile.name!r} maps {len(profile.joints)}, leaves {len(unmapped)} unmapped"
                 print(line)
+                if profile is not None:  # where the profile is probably wrong for this file (plugins/lib/profile_check)
+                    warned += _warn(path, _recording_warnings(profile, path, flips))
                 continue
-            table = read_toml(path)
+            table = read_toml(check_regular_file(path, "TOML file", "config"))
             if is_scenario(table):
                 scenario = load_scenario(path, pm)
                 world = scenario.world
@@ -601,6 +720,7 @@ def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
             elif is_profile(table):
                 prof = load_profile(path)
                 print(f"ok    {path}: body profile {prof.name!r}: {len(prof.joints)} parts, units {prof.scale:g} m, up {prof.up}")
+                warned += _warn(path, _profile_warnings(prof))
             else:
                 c = describe_character(load_character(path, pm))
                 comps = ", ".join(f"{k} {c[k]['plugin']}" for k in ("motor", "perception", "segmenter", "matcher", "action") if k in c)
@@ -609,7 +729,121 @@ def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
         except LikemeError as err:
             failed += 1
             print(f"likeme: error: {err}", file=sys.stderr)
-    return 1 if failed else 0
+    if flips:
+        from plugins.lib.profile_check import facing_warnings
+
+        warned += sum(_warn(path, [text]) for path, text in facing_warnings(flips))
+    return 1 if failed or (warned and args.strict) else 0
+
+
+def _warn(source: str | Path, warnings: list[str]) -> int:
+    """Print each warning as ``likeme: warning: SOURCE: ...`` on standard error; return how many."""
+    for text in warnings:
+        print(f"likeme: warning: {source}: {text}", file=sys.stderr)
+    return len(warnings)
+
+
+def _profile_warnings(profile: Any) -> list[str]:
+    from plugins.lib.profile_check import profile_warnings
+
+    return profile_warnings(profile)
+
+
+def _recording_warnings(profile: Any, path: str | Path, flips: list[tuple[str, Any, int]]) -> list[str]:
+    """Where ``profile`` is probably wrong for the recording ``path`` (units, up axis), read a block at a time; the
+    frames where its facing flips are added to ``flips``, to be counted over every recording."""
+    from plugins.lib.profile_check import RecordingCheck
+
+    check = RecordingCheck(profile)
+    with profile.stream(path) as blocks:
+        for positions, visible in blocks:
+            check.update(positions, visible)
+    flips.append((str(path), *check.flips()))
+    return check.warnings(facing=False)
+
+
+PROFILE_FRAMES = 20_000
+"""The frames of a recording ``likeme profile`` reads (from its start): enough to see a body's size, up and facing."""
+
+
+def _read_recording(path: str) -> tuple[list[str], Any, list[int] | None, float | None, int]:
+    """A recording's joint names, positions (F, J, 3) in its own units and axes (at most :data:`PROFILE_FRAMES`),
+    hierarchy (BVH) or None, frame rate (None: the file does not tell) and number of frames."""
+    import numpy as np
+
+    suffix = Path(path).suffix.lower()
+    if suffix == ".bvh":
+        from toolkit.bvh import open_bvh
+
+        with open_bvh(path) as bvh:
+            header, kept, count = bvh.header, [], 0
+            for values in bvh.blocks():
+                kept.append(header._kinematics(values[: PROFILE_FRAMES - count])[0])
+                count += len(kept[-1])
+                if count >= PROFILE_FRAMES:
+                    break
+            positions = np.concatenate(kept) if kept else np.zeros((0, len(bvh.names), 3))
+            return list(bvh.names), positions, [j.parent for j in bvh.joints], bvh.fps, bvh.n_frames
+    if suffix == ".csv":
+        from toolkit.positions import iter_position_blocks
+
+        fps: float | None = None
+        try:
+            header, blocks = iter_position_blocks(path)
+            fps = header.fps
+        except ConfigError as err:
+            if "frame rate" not in str(err):
+                raise
+            header, blocks = iter_position_blocks(path, fps=1.0)  # no time column: the proposal needs no frame rate
+        kept, count = [], 0
+        for block in blocks:
+            kept.append(block[: PROFILE_FRAMES - count])
+            count += len(kept[-1])
+            if count >= PROFILE_FRAMES:
+                break
+        positions = np.concatenate(kept) if kept else header.positions
+        return list(header.names), positions, None, fps, len(positions)
+    raise ConfigError(f"cannot propose a profile for a {suffix or 'suffix-less'} file", file=path, key=("FILE",),
+                      expected="a BVH file or a CSV of joint positions (a .npy array has no joint names)",
+                      available=(".bvh", ".csv"))
+
+
+def cmd_profile(args: argparse.Namespace, pm: PluginManager) -> int:
+    """Propose a body profile for a recording (``plugins.lib.profile_check.propose_profile``), check it on the same
+    recording, and print it or write it to ``--out``; what it could not decide is marked ``# TODO``."""
+    import tempfile
+
+    import numpy as np
+
+    from plugins.lib.profile_check import propose_profile, recording_warnings
+    from toolkit.files import check_regular_file
+    from toolkit.profile import load_profile
+    from toolkit.state import write_atomic
+
+    check_regular_file(args.file, "recording", "motion")
+    names, positions, parents, fps, frames = _read_recording(args.file)
+    if len(positions) == 0:
+        raise ConfigError("no frames", file=args.file, expected="a recording with at least one frame")
+    stem = re.sub(r"[^A-Za-z0-9_-]+", "-", Path(args.out or args.file).stem).strip("-") or "proposed"
+    proposal = propose_profile(names, positions, parents=parents, name=stem, source=Path(args.file).name, fps=fps)
+    with tempfile.TemporaryDirectory() as tmp:  # the proposal must load and pass its own checks on this recording
+        draft = Path(tmp) / f"{stem}.toml"
+        draft.write_text(proposal.text, encoding="utf-8")
+        profile = load_profile(draft)
+    converted = profile.convert(positions, names)
+    warnings = recording_warnings(profile, [(converted, np.isfinite(converted).all(axis=-1))])
+    if args.out:
+        write_atomic(args.out, proposal.text)
+        print(f"wrote {args.out}", file=sys.stderr)
+    else:
+        print(proposal.text, end="")
+    if len(positions) < frames:
+        print(f"likeme: note: {args.file}: proposed from the first {len(positions)} of {frames} frames",
+              file=sys.stderr)
+    for text in proposal.todo:
+        print(f"likeme: note: {args.file}: TODO: {text}", file=sys.stderr)
+    _warn(args.file, warnings)
+    return 0
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -305,10 +305,14 @@ class Component(ABC):
         """
         return {}
 
-    def set_state(self, state: dict[str, Any]) -> None:
+    def set_state(self, state: dict[str, Any], *, check: bool = False) -> None:
         """Restore what :meth:`get_state` returned (on a freshly composed component).
 
-        Raise :class:`~toolkit.errors.ConfigError` (keys relative to ``state``) for data it cannot use.
+        Raise :class:`~toolkit.errors.ConfigError` (keys relative to ``state``) for data it cannot use, before
+        changing anything: a state file is applied all or nothing. With ``check=True`` only check ``state`` (every
+        type, value and name, against the component as it is now) and change nothing: a later ``set_state(state)``
+        must then succeed. ``state`` comes from a file that passed the schema of :mod:`toolkit.state` (JSON values,
+        bounded depth, integers and strings, finite numbers) but may hold any JSON type anywhere.
         """
         if state:
             raise ConfigError(f"{self.kind} {self.name!r} keeps no state, but the file has some", expected="no state",

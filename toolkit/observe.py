@@ -21,7 +21,7 @@ system's rest state (:meth:`MotorSystem.reset`).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -34,8 +34,8 @@ from toolkit.motion import Motion
 from toolkit.profile import BodyProfile
 from toolkit.watching import KEEP_SECONDS, MAX_SEGMENT_SECONDS, Observation, WatchingLoop, guarded
 
-__all__ = ["Observation", "Observer", "compose_observer", "OBSERVER_TEMPLATE", "NO_CORRESPONDENCE", "is_observer_template",
-           "check_observer_template"]
+__all__ = ["Observation", "Observer", "compose_observer", "observer_tables", "OBSERVER_TEMPLATE", "NO_CORRESPONDENCE",
+           "is_observer_template", "check_observer_template", "observer_plugins"]
 
 NO_CORRESPONDENCE = "none"
 """The correspondence name that means none (``--correspondence none``): the papers' plain observer."""
@@ -174,7 +174,7 @@ class Observer:
         return self.loop.flush()
 
 
-def compose_observer(pm: Any, profile: BodyProfile, repertoire: str | Path, *, segmenter: str | None = None,
+def compose_observer(pm: Any, profile: BodyProfile, repertoire: Any, *, segmenter: str | None = None,
                      matcher: str | None = "", settings: Mapping[str, Mapping[str, Any]] | None = None,
                      motor: str | None = None, correspondence: str | None = "",
                      lengths_for_height: float | None | str = "",
@@ -185,6 +185,10 @@ def compose_observer(pm: Any, profile: BodyProfile, repertoire: str | Path, *, s
 
     Parameters
     ----------
+    repertoire : str, Path or ClipRepertoire
+        A folder of labelled clips read through ``profile``, or a repertoire built in memory
+        (:func:`plugins.lib.clip_repertoire.clip_repertoire`), which the motor system receives when it is attached
+        (:attr:`Character.repertoire`); both give the same character.
     segmenter, matcher, motor : str, optional
         Plugin names replacing the template's (the template's own plugin, named, keeps its parameters);
         ``matcher=None`` composes no matcher (segmentation only). The motor
@@ -198,6 +202,38 @@ def compose_observer(pm: Any, profile: BodyProfile, repertoire: str | Path, *, s
     settings : mapping, optional
         Extra parameters per table (``{"matcher": {"k": 4}}``; ``{"perception": {"plugin": ...}}`` replaces one).
     """
+    head, tables = observer_tables(pm, segmenter=segmenter, matcher=matcher, settings=settings, motor=motor,
+                                   correspondence=correspondence, template=template)
+    facing = {"left": profile.body.facing.left, "right": profile.body.facing.right}
+    if profile.body.facing.forward:
+        facing["forward"] = profile.body.facing.forward
+    if profile.body.facing.behind:
+        facing["behind"] = profile.body.facing.behind
+    character: dict[str, Any] = {"name": head.get("name", "observer"),
+                                 "description": f"watches {profile.name} motion" + (f": {head['description']}"
+                                                                                     if head.get("description") else "")}
+    lengths_for = head.get("lengths_for_height") if lengths_for_height == "" else lengths_for_height
+    if lengths_for:
+        character["lengths_for_height"] = lengths_for
+    table: dict[str, Any] = {
+        "character": character,
+        "body": {"parts": list(profile.body.parts), "root": profile.body.root, "facing": facing,
+                 "bones": [list(b) for b in profile.body.bones]},
+        **tables,
+    }
+    if not isinstance(repertoire, (str, Path)):  # in memory: handed to the motor system as it is attached
+        return compose_character(table, pm, repertoire=repertoire)
+    table["motor"] = {**table.get("motor", {}), "clips": str(Path(repertoire).resolve()),
+                      "profile": str(profile.file.resolve()) if profile.file else ""}
+    return compose_character(table, pm)
+
+
+def observer_tables(pm: Any, *, segmenter: str | None = None, matcher: str | None = "",
+                    settings: Mapping[str, Mapping[str, Any]] | None = None, motor: str | None = None,
+                    correspondence: str | None = "", template: str | Path = OBSERVER_TEMPLATE
+                    ) -> tuple[dict[str, Any], dict[str, dict[str, Any]]]:
+    """The ``[observer]`` table of ``template`` and the component tables (``plugin`` and parameters) an observer
+    composed with these arguments has, as :func:`compose_observer` takes them (its arguments, the same meaning)."""
     settings = {k: dict(v) for k, v in (settings or {}).items()}
     path = Path(template) if Path(template).is_file() else resolve_file(str(template), None, pm)
     check_observer_template(path, pm)
@@ -224,27 +260,37 @@ def compose_observer(pm: Any, profile: BodyProfile, repertoire: str | Path, *, s
         if key in tables and extra.get("plugin", tables[key].get("plugin")) != tables[key].get("plugin"):
             tables[key] = {}  # another plugin: none of the template's parameters apply
         tables[key] = {**tables.get(key, {}), **extra}
-    facing = {"left": profile.body.facing.left, "right": profile.body.facing.right}
-    if profile.body.facing.forward:
-        facing["forward"] = profile.body.facing.forward
-    if profile.body.facing.behind:
-        facing["behind"] = profile.body.facing.behind
-    head = dict(base["observer"])
-    character: dict[str, Any] = {"name": head.get("name", "observer"),
-                                 "description": f"watches {profile.name} motion" + (f": {head['description']}"
-                                                                                     if head.get("description") else "")}
-    lengths_for = head.get("lengths_for_height") if lengths_for_height == "" else lengths_for_height
-    if lengths_for:
-        character["lengths_for_height"] = lengths_for
-    table: dict[str, Any] = {
-        "character": character,
-        "body": {"parts": list(profile.body.parts), "root": profile.body.root, "facing": facing,
-                 "bones": [list(b) for b in profile.body.bones]},
-        **tables,
-    }
-    table["motor"] = {**table.get("motor", {}), "clips": str(Path(repertoire).resolve()),
-                      "profile": str(profile.file.resolve()) if profile.file else ""}
-    return compose_character(table, pm)
+    return dict(base["observer"]), tables
+
+
+def observer_plugins(pm: Any, *, segmenters: Sequence[str] = (), matchers: Sequence[str] = (),
+                     correspondence: str | None = "", template: str | Path = OBSERVER_TEMPLATE) -> dict[str, list[str]]:
+    """The plugins each component table of an observer composed from ``template`` may have, by table: the template's,
+    with the ``segmenters``, ``matchers`` and ``correspondence`` named instead of its own, and the motor system each
+    of those matchers needs. What ``--set TABLE.KEY=VALUE`` is checked against before any work
+    (:func:`toolkit.params.check_settings`)."""
+    path = Path(template) if Path(template).is_file() else resolve_file(str(template), None, pm)
+    plugins: dict[str, list[str]] = {k: [v["plugin"]] for k, v in read_toml(path).items()
+                                     if isinstance(v, Mapping) and isinstance(v.get("plugin"), str)}
+    if segmenters:
+        plugins["segmenter"] = list(segmenters)
+    if matchers:
+        plugins["matcher"] = list(matchers)
+    if correspondence is None or correspondence == NO_CORRESPONDENCE:
+        plugins.pop("correspondence", None)
+    elif correspondence:
+        plugins["correspondence"] = [correspondence]
+    motors = set(plugins.get("motor", []))
+    for name in plugins.get("matcher", []):
+        try:
+            wanted = pm.registry.get("matcher", name).motor_systems
+        except ConfigError as err:  # an unknown matcher is named here, listing the registered ones
+            raise err.within(prefix=("--matcher",)) from None
+        if wanted and not motors & set(wanted):
+            motors.add(wanted[0])
+    if motors:
+        plugins["motor"] = sorted(motors)
+    return plugins
 
 
 OBSERVER_KEYS = ("name", "description", "lengths_for_height")

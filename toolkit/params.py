@@ -131,6 +131,22 @@ class Parameter:
         return self.describe(article=True)
 
 
+MAX_INT = 2**63 - 1
+"""The largest integer a parameter takes (what numpy and the plugins can hold)."""
+
+
+def finite_number(value: Any) -> float | None:
+    """``value`` as a float if it is a number (not a bool) whose float is finite, else ``None``: NaN, infinities,
+    strings and integers too large for a float (``10**400``) all give ``None``, never an exception."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return None
+    try:
+        number = float(value)
+    except OverflowError:
+        return None
+    return number if math.isfinite(number) else None
+
+
 def _non_finite(value: Any) -> tuple[tuple[str | int, ...], float] | None:
     """The key path (relative to ``value``) and value of its first NaN or infinite number, or ``None``."""
     stack: list[tuple[tuple[str | int, ...], Any]] = [((), value)]
@@ -148,7 +164,13 @@ def _non_finite(value: Any) -> tuple[tuple[str | int, ...], float] | None:
 def _check_type(value: Any, kind: type, key: str | int, expected: str) -> Any:
     ok = isinstance(value, kind) and not (kind in (int, float) and isinstance(value, bool))
     if kind is float and isinstance(value, int) and not isinstance(value, bool):
+        if finite_number(value) is None:
+            raise ConfigError(f"number too large ({str(value)[:20]}...)", key=(key,) if isinstance(key, str) else
+                              ("", key), expected=expected)
         return float(value)
+    if kind is int and isinstance(value, int) and not isinstance(value, bool) and abs(value) > MAX_INT:
+        raise ConfigError(f"integer too large ({str(value)[:20]}...)", key=(key,) if isinstance(key, str) else ("", key),
+                          expected=f"{expected} (at most {MAX_INT} in size)")
     if kind is dict:
         ok = isinstance(value, Mapping)
     if not ok:

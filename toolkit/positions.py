@@ -21,9 +21,7 @@ from __future__ import annotations
 
 import csv
 import io
-import os
 import re
-import stat
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, replace
 from numbers import Real
@@ -32,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from toolkit.errors import ConfigError
+from toolkit.files import check_regular_file, open_regular
 
 __all__ = ["JointPositions", "read_positions", "iter_position_blocks", "SUFFIXES", "MAX_FPS", "MAX_JOINTS",
            "MAX_COLUMNS", "MAX_LINE_CHARS", "TIME_TOLERANCE"]
@@ -147,7 +146,7 @@ def iter_position_blocks(path: str | Path, *, names: Sequence[str] | None = None
     if suffix not in SUFFIXES:
         raise ConfigError(f"unknown file type {path.suffix or '(no suffix)'!r}", file=path,
                           expected="a joint-position file", available=SUFFIXES)
-    _check_regular(path)
+    check_regular_file(path, "recording of joint positions", "motion")
     if fps is not None:
         fps = _check_fps(fps, path, "the frame rate given")
     names = _check_names(names, path)
@@ -157,19 +156,6 @@ def iter_position_blocks(path: str | Path, *, names: Sequence[str] | None = None
 
 
 # -- shared checks ----------------------------------------------------------------------------------
-
-
-def _check_regular(path: Path) -> None:
-    """A :class:`ConfigError` unless ``path`` is a regular file (a directory, a device or a FIFO fails at once)."""
-    try:
-        mode = os.stat(path).st_mode
-    except OSError as exc:
-        raise ConfigError(f"cannot read ({exc.strerror or exc})", file=path, expected="a readable file") from None
-    if not stat.S_ISREG(mode):
-        kind = ("a directory" if stat.S_ISDIR(mode) else "a FIFO" if stat.S_ISFIFO(mode) else
-                "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) else "a socket" if stat.S_ISSOCK(mode) else
-                "not a regular file")
-        raise ConfigError(f"cannot read {kind}", file=path, expected="a regular file")
 
 
 def _check_fps(fps: object, path: Path, what: str) -> float:
@@ -272,11 +258,10 @@ def _read_line(f: io.TextIOBase, number: int, source: Path) -> str:
 
 
 def _open(path: Path) -> io.TextIOWrapper:
-    try:
-        # utf-8-sig drops a byte-order mark; undecodable bytes become U+FFFD and fail as a number where they matter
-        return open(path, encoding="utf-8-sig", errors="replace", newline=None)
-    except OSError as exc:
-        raise ConfigError(f"cannot read ({exc.strerror or exc})", file=path, expected="a readable file") from None
+    """The file as text, opened by :func:`toolkit.files.open_regular` (checked again on the open descriptor)."""
+    # utf-8-sig drops a byte-order mark; undecodable bytes become U+FFFD and fail as a number where they matter
+    return io.TextIOWrapper(open_regular(path, "recording of joint positions", "motion"), encoding="utf-8-sig",
+                            errors="replace", newline=None)
 
 
 def _detect_delimiter(line: str) -> str:

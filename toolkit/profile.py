@@ -28,7 +28,7 @@ Example (the Bandai-Namco skeleton, ``characters/profiles/bandai-namco.toml``)::
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -36,11 +36,14 @@ from typing import Any
 import numpy as np
 
 from toolkit.body import Body
-from toolkit.bvh import BVH, read_bvh
+import toolkit.bvh as bvh_module
+from toolkit.bvh import BVH, BVHStream, open_bvh, read_bvh
 from toolkit.errors import ConfigError
+from toolkit.files import check_regular_file
 from toolkit.motion import Motion
+from toolkit.params import finite_number
 
-__all__ = ["BodyProfile", "is_profile", "load_profile", "UNITS", "UP_AXES"]
+__all__ = ["BodyProfile", "MotionStream", "is_profile", "load_profile", "UNITS", "UP_AXES"]
 
 UNITS: dict[str, float] = {"metre": 1.0, "meter": 1.0, "m": 1.0, "centimetre": 0.01, "centimeter": 0.01, "cm": 0.01,
                            "millimetre": 0.001, "millimeter": 0.001, "mm": 0.001, "inch": 0.0254, "in": 0.0254,
@@ -117,6 +120,61 @@ class BodyProfile:
         """Read a BVH file and return its motion through this profile."""
         return self.motion(read_bvh(path))
 
+    def stream(self, path: str | Path, block: int | None = None) -> MotionStream:
+        """A BVH file's motion through this profile, ``block`` frames at a time (:class:`MotionStream`).
+
+        ``block`` defaults to :data:`toolkit.bvh.BLOCK`. The header is read and checked against the profile at
+        once; the frames follow as they are iterated, with forward kinematics run per block, so the memory does not
+        grow with the file. The blocks are ``profile.read(path)`` sliced, bit for bit, and a bad value raises the
+        error ``read`` raises.
+        """
+        bvh = open_bvh(path)
+        try:
+            self.check(bvh.header)
+        except BaseException:
+            bvh.close()
+            raise
+        return MotionStream(self, bvh, bvh_module.BLOCK if block is None else block)
+
+
+class MotionStream:
+    """The blocks of a motion file read through a profile (made by :meth:`BodyProfile.stream`).
+
+    ``fps``, ``n_frames`` and ``parts`` are known before the first block; iterating yields ``(positions, visible)``
+    blocks, positions (k, P, 3) in metres with +y up and visibility (k, P), as :meth:`BodyProfile.read` would give
+    them. A context manager: leaving it closes the file.
+    """
+
+    def __init__(self, profile: BodyProfile, bvh: BVHStream, block: int) -> None:
+        self.profile, self.bvh, self.block = profile, bvh, max(1, int(block))
+
+    @property
+    def fps(self) -> float:
+        return self.bvh.fps
+
+    @property
+    def n_frames(self) -> int:
+        return self.bvh.n_frames
+
+    @property
+    def parts(self) -> list[str]:
+        return list(self.profile.body.parts)
+
+    def __iter__(self) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+        header, names = self.bvh.header, self.bvh.names
+        for values in self.bvh.blocks(self.block):
+            positions = self.profile.convert(header._kinematics(values)[0], names)
+            yield positions, np.isfinite(positions).all(axis=-1)
+
+    def close(self) -> None:
+        self.bvh.close()
+
+    def __enter__(self) -> MotionStream:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
 
 def is_profile(table: Mapping[str, Any]) -> bool:
     """Whether a parsed TOML table is a body profile (it has a ``[profile]`` or ``[parts]`` table, no ``[character]``)."""
@@ -127,7 +185,7 @@ def load_profile(path: str | Path) -> BodyProfile:
     """Read a body profile TOML file; every problem is a :class:`ConfigError` naming the file, key and line."""
     from toolkit.character import check_body, find_key_line, read_toml
 
-    path = Path(path)
+    path = check_regular_file(path, "body profile", "config")  # not a FIFO or /dev/zero, not a huge file
     table = read_toml(path)
 
     def fail(problem: str, key: tuple, **kw: Any) -> ConfigError:
@@ -148,10 +206,10 @@ def load_profile(path: str | Path) -> BodyProfile:
             raise fail(f"unknown units {units!r}", ("profile", "units"), expected="a unit name or metres per unit",
                        available=UNITS)
         scale = UNITS[units]
-    elif isinstance(units, int | float) and not isinstance(units, bool) and np.isfinite(units) and units > 0:
+    elif (finite_number(units) or 0.0) > 0:
         scale = float(units)
     else:
-        raise fail(f"invalid units {units!r}", ("profile", "units"),
+        raise fail(f"invalid units {repr(units)[:40]}", ("profile", "units"),
                    expected="a unit name or a positive number (finite: metres per unit)")
     up = head.get("up", "+y")
     if not isinstance(up, str):

@@ -38,6 +38,7 @@ from typing import Any
 from toolkit.character import load_character, merge_tables, read_toml, resolve_file
 from toolkit.errors import ConfigError
 from toolkit.manager import PluginManager
+from toolkit.params import finite_number
 from toolkit.runtime import MAX_FPS, MAX_FRAMES, MAX_SECONDS, World, WorldObject
 
 __all__ = ["Scenario", "load_scenario", "is_scenario", "check_duration", "check_seed"]
@@ -114,9 +115,10 @@ def check_duration(duration: Any, fps: float, key: tuple) -> float:
 
 
 def _number(value: Any, key: tuple, expected: str = "a number") -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+    number = finite_number(value)
+    if number is None:
         raise ConfigError(f"invalid value {value!r}", key=key, expected=expected)
-    return float(value)
+    return number
 
 
 def _radius(value: Any, key: tuple) -> float:

@@ -239,34 +239,64 @@ class Hierarchical(ActionSystem):
             "transitions": [[a, b, n] for (a, b), n in self.transitions.items()],
         }
 
-    def set_state(self, state: dict[str, Any]) -> None:
+    def set_state(self, state: dict[str, Any], *, check: bool = False) -> None:
+        """Restore drives, beliefs and the two maps; every entry is checked before anything is changed."""
         known = ("drives", "beliefs", "correspondence", "transitions")
+        if not isinstance(state, dict):
+            raise ConfigError("invalid hierarchical state", expected="a table of " + ", ".join(known))
         for key in state:
             if key not in known:
                 raise ConfigError(f"unknown key {key!r}", key=(key,), expected="a hierarchical state key", available=known)
-        for name, level in state.get("drives", {}).items():
+
+        def table(key: str, what: str) -> dict:
+            value = state.get(key, {})
+            if not isinstance(value, dict):
+                raise ConfigError(f"invalid {key}", key=(key,), expected=what)
+            return value
+
+        def count(value: Any, key: tuple) -> int:
+            if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+                raise ConfigError(f"invalid count {value!r}", key=key, expected="a whole number >= 0")
+            return value
+
+        levels = {}
+        for name, level in table("drives", "a table of drive = level").items():
             if name not in self.drives:
                 raise ConfigError(f"unknown drive {name!r}", key=("drives", name), expected="a drive of this character", available=list(self.drives))
             if isinstance(level, bool) or not isinstance(level, (int, float)) or not 0 <= level <= 1:
                 raise ConfigError(f"invalid level {level!r}", key=("drives", name), expected="a number in [0, 1]")
-            self.drives[name].level = float(level)
-        beliefs = state.get("beliefs", {})
+            levels[name] = float(level)
+        beliefs = table("beliefs", "object types mapped to categories")
         if not all(isinstance(v, str) for v in beliefs.values()):
             raise ConfigError("invalid beliefs", key=("beliefs",), expected="object types mapped to categories")
-        self.beliefs = dict(beliefs)
-        self.correspondence = {}
-        for movement, counts in state.get("correspondence", {}).items():
+        correspondence: dict[str, Counter] = {}
+        for movement, counts in table("correspondence", "a table of movement = {path = count}").items():
+            if not isinstance(counts, dict):
+                raise ConfigError("invalid correspondence", key=("correspondence", movement),
+                                  expected="a table of path = count")
             for text, n in counts.items():
                 path = tuple(p.strip() for p in text.split(">"))
                 if path[-1] not in self.hierarchy.tuples or path not in self.hierarchy.paths_to(path[-1]):
                     raise ConfigError(f"not a path of the hierarchy: {text!r}", key=("correspondence", movement, text),
                                       expected="top > ... > leaf tuple names")
-                self.correspondence.setdefault(movement, Counter())[path] = int(n)
-        self.transitions = Counter()
-        for i, item in enumerate(state.get("transitions", [])):
-            if not (isinstance(item, list) and len(item) == 3 and all(x in self.hierarchy.tuples for x in item[:2])):
+                correspondence.setdefault(movement, Counter())[path] = count(n, ("correspondence", movement, text))
+        transitions: Counter = Counter()
+        items = state.get("transitions", [])
+        if not isinstance(items, list):
+            raise ConfigError("invalid transitions", key=("transitions",),
+                              expected="a list of [from_leaf, to_leaf, count]")
+        for i, item in enumerate(items):
+            if not (isinstance(item, list) and len(item) == 3 and all(isinstance(x, str) and x in self.hierarchy.tuples
+                                                                     for x in item[:2])):
                 raise ConfigError(f"invalid transition {item!r}", key=("transitions", i), expected="[from_leaf, to_leaf, count]")
-            self.transitions[(item[0], item[1])] = int(item[2])
+            transitions[(item[0], item[1])] = count(item[2], ("transitions", i, 2))
+        if check:
+            return
+        for name, level in levels.items():
+            self.drives[name].level = level
+        self.beliefs = dict(beliefs)
+        self.correspondence = correspondence
+        self.transitions = transitions
 
     def render(self) -> str:
         lines = ["action hierarchy (top level: motivational subsystems; children: the next level's action group):"]

@@ -104,12 +104,15 @@ def behaviour_benchmark(pm: Any, *, episodes: int = 100, seed: int = 0, progress
 
 
 def render_behaviour(r: dict[str, Any]) -> str:
-    lines = [f"likeme bench behaviour: Max identifies what Morris does (seed {r['seed']}, {r['episodes_per_condition']} "
-             f"episodes per condition, {r['seconds']:.0f} s)",
-             f"  {'condition':<18} {'episodes':>8} {'identified':>10} {'path':>6} {'motivation':>10} {'object':>6}"]
-    for c, t in r["conditions"].items():
-        lines.append(f"  {c:<18} {t['episodes']:>8} {t['identified']:>10.3f} {t['path']:>6.3f} {t['motivation']:>10.3f} {t['object']:>6.3f}")
-    return "\n".join(lines)
+    from plugins.bench import text_table
+
+    head = (f"likeme bench behaviour: Max identifies what Morris does (seed {r['seed']}, {r['episodes_per_condition']} "
+            f"episodes per condition, {r['seconds']:.0f} s)")
+    rows = [[c, t["episodes"], f"{t['identified']:.3f}", f"{t['path']:.3f}", f"{t['motivation']:.3f}",
+             f"{t['object']:.3f}"] for c, t in r["conditions"].items()]
+    columns = [("condition", "left")] + [(name, "right") for name in ("episodes", "identified", "path", "motivation",
+                                                                        "object")]
+    return "\n".join([head, text_table(rows, columns)])
 
 
 def cmd_behaviour(args: argparse.Namespace, pm: Any) -> int:

@@ -12,7 +12,6 @@ from pathlib import Path
 from typing import Any
 
 from toolkit import hookimpl
-from toolkit.errors import ConfigError
 from toolkit.cli import count_type, number_type, seed_type
 
 MATCHERS = ("path-search", "forward-model", "dtw")
@@ -49,40 +48,22 @@ def _check_set(args: argparse.Namespace, pm: Any) -> None:
     """``--set TABLE.KEY=VALUE`` checked before anything runs: against the observer's component of each table, and
     against every segmenter and matcher the benchmark compares (a key one of them lacks fails at once, not after
     the others ran)."""
-    from toolkit.character import _load_chain, merge_tables, read_toml, resolve_file
+    from toolkit.character import _load_chain, merge_tables, resolve_file
     from toolkit.params import check_settings, parse_settings
 
     settings = parse_settings(list(args.set))
     if args.benchmark == "watch":  # a character watching through synthetic vision (plugins/bench/watch.py)
         path = resolve_file(args.observer, None, pm, key=("--observer",))
         base = merge_tables(_load_chain(path, pm)[0], {"perception": {"plugin": "synthetic-vision"}})
+        plugins = {k: [v["plugin"]] for k, v in base.items() if isinstance(v, dict) and isinstance(v.get("plugin"), str)}
     else:  # an observer composed from the observer template (toolkit.observe.compose_observer)
-        from toolkit.observe import OBSERVER_TEMPLATE
+        from toolkit.observe import observer_plugins
 
-        base = read_toml(resolve_file(OBSERVER_TEMPLATE, None, pm))
-    plugins: dict[str, list[str]] = {k: [v["plugin"]] for k, v in base.items()
-                                     if isinstance(v, dict) and isinstance(v.get("plugin"), str)}
-    if args.benchmark in ("recognition", "stream"):
-        plugins["matcher"] = list(args.matcher or MATCHERS)
-    if args.benchmark == "segmentation":
-        plugins["segmenter"] = list(args.segmenter or SEGMENTERS)
-    elif args.benchmark == "stream":
-        plugins["segmenter"] = list(args.segmenter or SEGMENTERS[:2])
-    correspondence = getattr(args, "correspondence", "")
-    if correspondence == "none":
-        plugins.pop("correspondence", None)
-    elif correspondence:
-        plugins["correspondence"] = [correspondence]
-    motors = set(plugins.get("motor", []))
-    for name in plugins.get("matcher", []) if args.benchmark != "watch" else []:
-        try:
-            wanted = pm.registry.get("matcher", name).motor_systems
-        except ConfigError as err:  # an unknown matcher is named here, listing the registered ones
-            raise err.within(prefix=("--matcher",)) from None
-        if wanted and not motors & set(wanted):
-            motors.add(wanted[0])
-    if motors:
-        plugins["motor"] = sorted(motors)
+        segmenters = (list(args.segmenter or SEGMENTERS) if args.benchmark == "segmentation" else
+                      list(args.segmenter or SEGMENTERS[:2]) if args.benchmark == "stream" else ())
+        matchers = list(args.matcher or MATCHERS) if args.benchmark in ("recognition", "stream") else ()
+        plugins = observer_plugins(pm, segmenters=segmenters, matchers=matchers,
+                                   correspondence=getattr(args, "correspondence", ""))
     check_settings(settings, pm, plugins)
 
 
@@ -228,3 +209,16 @@ def likeme_register_commands(subparsers):
                    "(default: 240, 480, 960)")
     p.add_argument("--frames", type=int, default=240, help="frames to compare (default: 240)")
     p.set_defaults(handler=_handler("vision", "cmd_vision"))
+
+    p = sub.add_parser("fuzz", help="mutated real-looking inputs through the commands a user runs: only documented "
+                       "errors allowed (docs/robustness.md)")
+    p.add_argument("--n", type=int, default=2000, help="number of mutated inputs (default: 2000)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the mutations (default: 0)")
+    p.add_argument("--targets", default="bvh,toml,profile,scenario,state,csv", help="comma-separated: bvh, toml, "
+                   "profile, scenario, state, csv (default: all)")
+    p.add_argument("--timeout", type=float, default=10.0, help="seconds a case may take (default: 10)")
+    p.add_argument("--memory", type=int, default=1024, help="address-space limit of the worker, MB (default: 1024)")
+    p.add_argument("--out", metavar="DIR", dest="out_dir", help="write every failing input and its stderr into this "
+                   "folder (created if missing), to replay")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(handler=_handler("fuzz", "cmd_fuzz"))

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from plugins.bench import text_table
 from toolkit import World, load_character
 from toolkit.state import write_atomic
 
@@ -286,15 +287,11 @@ def render_facilitation(r: dict[str, Any]) -> str:
               "edges learned per novel movement (expected: strokes or 1 hand edge, + the return)",
               "imitation path error, mean / 90th percentile"]
     table = [cells(f, unit) for _, f, unit in columns]
-    width = max(len(a) for a in labels)
-    widths = [max(len(name), *(len(c) for c in col)) for (name, _, _), col in zip(columns, table)]
     head = (f"likeme bench facilitation: Max watches Moritz (seed {r['seed']}, {r['repertoire']} movements of each kind "
             f"learned first, noise {r['noise']} m and {r.get('angle_noise', 0.0)} rad)")
-    lines = [head, f"  {'':<{width}}  " + "  ".join(f"{name:>{w}}" for (name, _, _), w in zip(columns, widths))]
-    for i, label in enumerate(labels):
-        lines.append(f"  {label:<{width}}  " + "  ".join(f"{col[i]:>{w}}" for col, w in zip(table, widths)))
-    lines.append(f"  {'frames per second (world)':<{width}}  {r['frames_per_second']:.0f}")
-    return "\n".join(lines)
+    rows = [[label, *(col[i] for col in table)] for i, label in enumerate(labels)]
+    rows.append(["frames per second (world)", f"{r['frames_per_second']:.0f}", *([""] * (len(columns) - 1))])
+    return "\n".join([head, text_table(rows, [("", "left")] + [(name, "right") for name, _, _ in columns])])
 
 
 def cmd_facilitation(args: argparse.Namespace, pm: Any) -> int:

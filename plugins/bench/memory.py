@@ -103,6 +103,7 @@ def live_memory(pm: Any, data: Path, *, minutes: float, fps: float, every: float
     began = time.perf_counter()
     if trace:
         tracemalloc.start()
+    # hand-padded, not plugins.bench.text_table: each row is printed as it is measured, minutes apart, not at the end
     print(f"{'minutes':>8} {'frames':>9} {'segments':>8} {'rows held':>9} {'RSS MB':>8} {'peak RSS MB':>11}"
           + (f" {'traced peak MB':>14}" if trace else "") + f" {'wall s':>7}", file=out, flush=True)
     for positions in random_stream(pm, fps, seed=seed, block=block):
@@ -217,6 +218,7 @@ def cmd_memory(args: Any, pm: Any) -> int:
                         segmenter=args.segmenter, matcher=args.matcher, correspondence=args.correspondence)
         if args.observe_minutes:
             print(f"\nlikeme observe (a subprocess; address space capped at {args.limit:g} GB)")
+            # hand-padded as the live table above: a row as each subprocess ends
             print(f"{'minutes':>8} {'file MB':>8} {'peak RSS MB':>11} {'wall s':>7} {'status':>6}  measured by")
             for minutes in args.observe_minutes:
                 path = write_stream(pm, Path(tmp) / f"stream_{minutes:g}min.bvh", minutes=minutes, fps=args.fps,

@@ -6,16 +6,23 @@
   by the found segment that overlaps it most).
 - The movement error rate is the edit distance (insertions, deletions,
   substitutions) between the recognised and the true label sequences, divided by
-  the number of true movements.
+  the number of true movements (``rapidfuzz``'s Levenshtein distance).
+- Recognition: the macro F1 over the true labels and the confusion matrix
+  (``scikit-learn``'s ``f1_score`` and ``confusion_matrix``).
+
+The segment matching rule is this project's own (the benchmarks' definition of a found
+movement), so it stays written out here.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import warnings
+from collections.abc import Hashable, Sequence
 
 import numpy as np
 
-__all__ = ["match_segments", "segmentation_scores", "edit_distance", "movement_error_rate"]
+__all__ = ["match_segments", "segmentation_scores", "edit_distance", "movement_error_rate", "macro_f1",
+           "confusion_matrix"]
 
 Span = tuple[int, int]
 
@@ -57,18 +64,37 @@ def segmentation_scores(found: Sequence[Span], truth: Sequence[Span]) -> dict[st
     }
 
 
-def edit_distance(a: Sequence[str], b: Sequence[str]) -> int:
-    """Levenshtein distance between two label sequences."""
-    prev = np.arange(len(b) + 1)
-    for i, x in enumerate(a, 1):
-        cur = np.empty_like(prev)
-        cur[0] = i
-        for j, y in enumerate(b, 1):
-            cur[j] = min(prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (x != y))
-        prev = cur
-    return int(prev[-1])
+def edit_distance(a: Sequence[Hashable], b: Sequence[Hashable]) -> int:
+    """Levenshtein distance between two label sequences (insertions, deletions and substitutions cost 1)."""
+    from rapidfuzz.distance import Levenshtein
+
+    ids: dict[Hashable, int] = {}  # labels as integers: rapidfuzz compares other objects by their hash
+    return int(Levenshtein.distance([ids.setdefault(x, len(ids)) for x in a], [ids.setdefault(y, len(ids)) for y in b]))
 
 
 def movement_error_rate(recognised: Sequence[str], truth: Sequence[str]) -> float:
     """Edit distance between recognised and true sequences over the number of true movements."""
     return edit_distance(recognised, truth) / max(len(truth), 1)
+
+
+def macro_f1(truth: Sequence[str], predicted: Sequence[str]) -> float:
+    """The mean over the true labels of each label's F1 (2 tp / (2 tp + fp + fn)); 0 without items.
+
+    A label only predicted (``unknown`` for a known movement, say) costs its true label a miss and counts no F1
+    of its own."""
+    if not len(truth):
+        return 0.0
+    from sklearn.metrics import f1_score
+
+    return float(f1_score(list(truth), list(predicted), labels=sorted(set(truth)), average="macro", zero_division=0.0))
+
+
+def confusion_matrix(truth: Sequence[str], predicted: Sequence[str], labels: Sequence[str]) -> np.ndarray:
+    """Counts (len(labels), len(labels)): row the true label, column the predicted one."""
+    if not len(labels):
+        return np.zeros((0, 0), dtype=int)
+    from sklearn.metrics import confusion_matrix as counts
+
+    with warnings.catch_warnings():  # one label: the matrix is 1 x 1, as asked (its warning is for labels not given)
+        warnings.filterwarnings("ignore", "A single label was found", UserWarning)
+        return counts(list(truth), list(predicted), labels=list(labels)).astype(int)

@@ -34,9 +34,10 @@ from typing import Any
 
 import numpy as np
 
+from plugins.bench import text_table
 from plugins.bench.command import MATCHERS, SEGMENTERS
 from plugins.bench.data import read_segments
-from plugins.bench.metrics import movement_error_rate, segmentation_scores
+from plugins.bench.metrics import confusion_matrix, macro_f1, movement_error_rate, segmentation_scores
 from plugins.lib.clip_repertoire import clip_files
 from toolkit import ConfigError
 from toolkit.observe import Observer, compose_observer
@@ -155,16 +156,14 @@ def recognition(pm, profile, repertoire: Path, demos: Path | None, matchers: Seq
                                  "decision_fraction": round(obs.decision_fraction, 4), "frames": motion.n_frames})
                 frames, seconds = frames + clock.frames, seconds + clock.seconds
         labels = sorted(set(truth) | set(predicted))
-        confusion = np.zeros((len(labels), len(labels)), dtype=int)
-        for t, p in zip(truth, predicted):
-            confusion[labels.index(t), labels.index(p)] += 1
+        confusion = confusion_matrix(truth, predicted, labels)
         right = [t == p for t, p in zip(truth, predicted)]
         seen = [r for r, t in zip(right, truth) if t != UNKNOWN]
         unseen = [r for r, t in zip(right, truth) if t == UNKNOWN]
         plugins.append({"plugin": name, "accuracy": float(np.mean(right)),
                         "known_accuracy": float(np.mean(seen)) if seen else float("nan"),
                         "rejection": float(np.mean(unseen)) if unseen else float("nan"),
-                        "macro_f1": _macro_f1(truth, predicted), "decision_median": float(np.median(fractions)),
+                        "macro_f1": macro_f1(truth, predicted), "decision_median": float(np.median(fractions)),
                         "decision_p90": float(np.percentile(fractions, 90)), "fps": frames / max(seconds, 1e-9),
                         "items": len(truth), "labels": labels, "confusion": confusion.tolist()})
     return {"benchmark": "recognition", "protocol": protocol, "plugins": plugins, "items": rows}
@@ -245,21 +244,11 @@ def _repertoire_without(folder: Path, movement: str | None, files: frozenset[Pat
         yield Path(tmp)
 
 
-def _macro_f1(truth: Sequence[str], predicted: Sequence[str]) -> float:
-    scores = []
-    for label in sorted(set(truth)):
-        tp = sum(t == label and p == label for t, p in zip(truth, predicted))
-        fp = sum(t != label and p == label for t, p in zip(truth, predicted))
-        fn = sum(t == label and p != label for t, p in zip(truth, predicted))
-        scores.append(2 * tp / (2 * tp + fp + fn) if tp else 0.0)
-    return float(np.mean(scores)) if scores else 0.0
-
-
 def segmentation(pm, profile, streams: Path, segmenters: Sequence[str], *, repertoire: Path | None = None,
                  settings=None, quiet: bool = True, observer: dict[str, Any] | None = None) -> dict[str, Any]:
     """Segment every stream with every segmenter; precision, recall, F1, boundary error and speed."""
     data = [(path, truth, profile.read(path)) for path, truth in _streams(streams)]
-    plugins, rows = [], []
+    plugins, rows, timelines = [], [], _timelines(data)
     for name in segmenters:
         clock = _Clock(compose_observer(pm, profile, repertoire or streams, segmenter=name, matcher=None,
                                         settings=settings, **(observer or {})), profile)
@@ -267,6 +256,7 @@ def segmentation(pm, profile, streams: Path, segmenters: Sequence[str], *, reper
         errors = []
         for path, truth, motion in _progress(data, f"segmentation {name}", quiet):
             found = [o.segment for o in clock.run("watch", motion)]
+            timelines[path.name]["found"][name] = [[f.start, f.end] for f in found]
             s = segmentation_scores([(f.start, f.end) for f in found], [(a, b) for a, b, _ in truth])
             found_all, true_all, tp = found_all + s["found"], true_all + s["true"], tp + s["true_positives"]
             if s["true_positives"]:
@@ -279,21 +269,31 @@ def segmentation(pm, profile, streams: Path, segmenters: Sequence[str], *, reper
         boundary = sum(e * n for e, n in errors) / max(1, sum(n for _, n in errors))
         plugins.append({"plugin": name, "precision": precision, "recall": recall, "f1": f1,
                         "boundary_error": boundary, "fps": clock.fps, "items": len(data)})
-    return {"benchmark": "segmentation", "plugins": plugins, "items": rows}
+    return {"benchmark": "segmentation", "plugins": plugins, "items": rows, "timelines": list(timelines.values())}
+
+
+def _timelines(data) -> dict[str, dict[str, Any]]:
+    """Per stream, what its plot draws: its length, its true segments, and (filled in) the segments each plugin
+    found (``[start, end]``, end exclusive; with the movement recognised in ``stream``)."""
+    return {path.name: {"item": path.name, "frames": motion.n_frames, "fps": motion.fps,
+                        "truth": [[a, b, m] for a, b, m in truth], "found": {}} for path, truth, motion in data}
 
 
 def stream(pm, profile, repertoire: Path, streams: Path, segmenters: Sequence[str], matchers: Sequence[str], *,
            settings=None, quiet: bool = True, observer: dict[str, Any] | None = None) -> dict[str, Any]:
     """Segment and recognise every stream with every pairing; the movement error rate."""
     data = [(path, truth, profile.read(path)) for path, truth in _streams(streams)]
-    plugins, rows = [], []
+    plugins, rows, timelines = [], [], _timelines(data)
     for seg in segmenters:
         for mat in matchers:
             clock = _Clock(compose_observer(pm, profile, repertoire, segmenter=seg, matcher=mat, settings=settings,
                                             **(observer or {})), profile)
             errors, true_count = 0.0, 0
             for path, truth, motion in _progress(data, f"stream {seg} + {mat}", quiet):
-                recognised = [o.movement or "unknown" for o in clock.run("watch", motion)]
+                observed = clock.run("watch", motion)
+                recognised = [o.movement or "unknown" for o in observed]
+                timelines[path.name]["found"][f"{seg}+{mat}"] = [[o.segment.start, o.segment.end, m]
+                                                                 for o, m in zip(observed, recognised)]
                 labels = [label for _, _, label in truth]
                 rate = movement_error_rate(recognised, labels)
                 errors += rate * len(labels)
@@ -303,7 +303,7 @@ def stream(pm, profile, repertoire: Path, streams: Path, segmenters: Sequence[st
             plugins.append({"plugin": f"{seg}+{mat}", "segmenter": seg, "matcher": mat,
                             "error_rate": errors / max(true_count, 1), "fps": clock.fps,
                             "items": len(data)})
-    return {"benchmark": "stream", "plugins": plugins, "items": rows}
+    return {"benchmark": "stream", "plugins": plugins, "items": rows, "timelines": list(timelines.values())}
 
 
 COLUMNS = {
@@ -354,37 +354,11 @@ def write_outputs(result: dict[str, Any], args: Any) -> None:
 
 
 def plot(result: dict[str, Any], path: Path) -> Path:
-    """Draw a result to PNG: confusion matrices (recognition) or the main score per plugin."""
-    import matplotlib
+    """Draw a result to PNG (:func:`plugins.bench.plots.plot_result`): confusion matrices (recognition), timelines
+    of true and found segments per stream (segmentation, stream)."""
+    from plugins.bench.plots import plot_result
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    kind = result["benchmark"]
-    if kind == "recognition":
-        n = len(result["plugins"])
-        fig, axes = plt.subplots(1, n, figsize=(5.5 * n, 5), squeeze=False)
-        for ax, row in zip(axes[0], result["plugins"]):
-            m = np.array(row["confusion"])
-            ax.imshow(m, cmap="Blues")
-            ax.set_xticks(range(len(row["labels"])), row["labels"], rotation=90, fontsize=7)
-            ax.set_yticks(range(len(row["labels"])), row["labels"], fontsize=7)
-            ax.set_title(f"{row['plugin']}: accuracy {row['accuracy']:.2f}")
-            ax.set_xlabel("recognised")
-            ax.set_ylabel("true")
-    else:
-        key = "f1" if kind == "segmentation" else "error_rate"
-        fig, ax = plt.subplots(figsize=(1.2 + 1.1 * len(result["plugins"]), 4))
-        names = [r["plugin"] for r in result["plugins"]]
-        ax.bar(range(len(names)), [r[key] for r in result["plugins"]], color="#4878a8")
-        ax.set_xticks(range(len(names)), names, rotation=30, ha="right", fontsize=8)
-        ax.set_ylabel(key.replace("_", " "))
-        ax.set_title(f"{kind}: {key.replace('_', ' ')} per plugin")
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
-    return path
+    return plot_result(result, path)
 
 
 def run(kind: str, args: Any, pm: Any) -> int:
@@ -408,7 +382,7 @@ def run(kind: str, args: Any, pm: Any) -> int:
     if kind == "recognition":
         for row in result["plugins"]:
             print(f"\n{row['plugin']} confusion (rows true, columns recognised): {', '.join(row['labels'])}")
-            for label, counts in zip(row["labels"], row["confusion"]):
-                print(f"  {label:>12} " + " ".join(f"{c:3d}" for c in counts))
+            print(text_table([[label, *counts] for label, counts in zip(row["labels"], row["confusion"])],
+                             [("", "right")] * (len(row["labels"]) + 1), header=False))
     write_outputs(result, args)
     return 0

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from plugins.bench import text_table
 from toolkit import ConfigError
 
 __all__ = ["vision_benchmark", "cmd_vision"]
@@ -71,8 +72,8 @@ def vision_benchmark(pm: Any, scenario: str, observer: str, resolutions: list[in
 def cmd_vision(args: argparse.Namespace, pm: Any) -> int:
     rows = vision_benchmark(pm, args.scenario, args.observer, args.resolution or [240, 480, 960], args.frames)
     print(f"{args.observer} watching in {args.scenario}, {args.frames} frames")
-    print(f"{'perception':<26} {'ms/frame':>9} {'seen-agreement':>15} {'median mm':>10} {'p95 mm':>8}")
-    for r in rows:
-        print(f"{r['perception']:<26} {r['ms_per_frame']:9.2f} {r['agreement']:15.3f} {r['median_mm']:10.1f} "
-              f"{r['p95_mm']:8.1f}")
+    columns = [("perception", "left")] + [(name, "right") for name in ("ms/frame", "seen-agreement", "median mm",
+                                                                         "p95 mm")]
+    print(text_table([[r["perception"], f"{r['ms_per_frame']:.2f}", f"{r['agreement']:.3f}", f"{r['median_mm']:.1f}",
+                       f"{r['p95_mm']:.1f}"] for r in rows], columns, indent=0))
     return 0

@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from plugins.bench import text_table
 from plugins.bench.metrics import match_segments, movement_error_rate, segmentation_scores
 from toolkit import World, load_character
 from toolkit.character import merge_tables
@@ -162,8 +163,7 @@ def render_watch(r: dict[str, Any]) -> str:
     comps = ", ".join(f"{k} {v}" for k, v in r["components"].items())
     if r["settings"]:
         comps += "; " + ", ".join(f"{t}.{k} = {v!r}" for t, table in r["settings"].items() for k, v in table.items())
-    width = max(len(a) for a, _ in rows)
-    lines = [head, f"  {comps}"] + [f"  {a:<{width}}  {b}" for a, b in rows]
+    lines = [head, f"  {comps}", text_table(rows, [("", "left"), ("", "left")], header=False)]
     if r["unsegmented"]:
         lines.append("  movements without a matching segment: " + ", ".join(f"{k} ({v})" for k, v in list(r["unsegmented"].items())[:8]))
     if r["confusions"]:

@@ -17,10 +17,16 @@ still still get one.
 Poses are root-relative in the body's own frame (§5.1, :func:`plugins.lib.root_frame.root_relative` with the
 facing a centred running median over the clip), lifted to the median height of the root at the hubs, which is the
 local frame a motor system uses. Hidden parts follow ``docs/conventions.md`` (held where last seen).
+
+A repertoire can as well be built from labelled world-position motions in memory (:func:`clip_repertoire`, what
+reading a folder does once the files are read) and handed to a motor system when a character is composed
+(``compose_character(..., repertoire=...)``, ``compose_observer(pm, profile, repertoire)``): the motor system
+then builds from it instead of its ``clips`` folder, with the same hubs and the same frames.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -31,34 +37,50 @@ from plugins.lib.root_frame import root_relative, smooth_heading
 from toolkit import ConfigError, Motion, Parameter
 from toolkit.profile import BodyProfile, load_profile
 
-__all__ = ["Clip", "ClipRepertoire", "load_clip_repertoire", "find_hubs", "root_relative_motion", "clip_files", "example_name",
-           "CLIP_PARAMETERS", "repertoire_for"]
+__all__ = ["Clip", "ClipRepertoire", "load_clip_repertoire", "clip_repertoire", "find_hubs", "root_relative_motion",
+           "clip_files", "example_name", "CLIP_PARAMETERS", "repertoire_for"]
 
 CLIP_SUFFIXES = (".bvh",)
 
 
 @dataclass(frozen=True)
 class Clip:
-    """One example of a movement: its label, file and local-frame motion (root at hub height)."""
+    """One example of a movement: its label, file (or name, built in memory) and local-frame motion (root at hub
+    height; its world positions in :attr:`Motion.world`)."""
 
     movement: str
-    source: Path
+    source: Path | str
     motion: Motion
 
 
 @dataclass(frozen=True)
 class ClipRepertoire:
-    """Clips by movement, the hub poses found from them, and the profile they were read with."""
+    """Clips by movement, the hub poses found from them, and the profile they were read with.
+
+    ``folder`` is where the clips were read from (``None``: built in memory); ``hub_radius`` and ``hub_share``
+    the settings the hubs were found with.
+    """
 
     profile: BodyProfile
     clips: tuple[Clip, ...]
     hubs: np.ndarray  # (H, P, 3), local frame
-    folder: Path
+    folder: Path | None
+    hub_radius: float = 0.06
+    hub_share: float = 0.2
 
     @property
     def movements(self) -> list[str]:
         return sorted({c.movement for c in self.clips})
 
+    def with_hubs(self, hub_radius: float, hub_share: float) -> ClipRepertoire:
+        """This repertoire with hubs found with other settings (itself when they are its own): the same clips'
+        world positions built again."""
+        if (hub_radius, hub_share) == (self.hub_radius, self.hub_share):
+            return self
+        worlds = [Motion(c.motion.world, c.motion.fps, c.motion.parts, c.motion.visible) for c in self.clips]
+        return clip_repertoire(worlds, [c.movement for c in self.clips], self.profile,
+                               sources=[c.source for c in self.clips], hub_radius=hub_radius, hub_share=hub_share,
+                               folder=self.folder)
 
 
 def root_relative_motion(world: Motion, profile: BodyProfile, facing_window: float = 1.0) -> Motion:
@@ -133,21 +155,61 @@ def find_hubs(ends: np.ndarray, radius: float, share: float) -> np.ndarray:
 
 def load_clip_repertoire(folder: str | Path, profile: str | Path | BodyProfile, *, hub_radius: float = 0.06,
                          hub_share: float = 0.2) -> ClipRepertoire:
-    """Read every clip of ``folder`` through ``profile`` and find the hubs."""
+    """Read every clip of ``folder`` through ``profile`` and find the hubs (:func:`clip_repertoire`)."""
     profile = profile if isinstance(profile, BodyProfile) else load_profile(profile)
-    rel: list[tuple[str, Path, Motion]] = []
-    for movement, files in clip_files(Path(folder)).items():
-        for path in files:
-            motion = root_relative_motion(profile.read(path), profile)
-            if motion.n_frames < 2:
-                raise ConfigError(f"clip has {motion.n_frames} frame", file=path, expected="at least two frames")
-            rel.append((movement, path, motion))
+    labelled = [(movement, path) for movement, files in clip_files(Path(folder)).items() for path in files]
+    return clip_repertoire([profile.read(path) for _, path in labelled], [movement for movement, _ in labelled],
+                           profile, sources=[path for _, path in labelled], hub_radius=hub_radius,
+                           hub_share=hub_share, folder=Path(folder))
+
+
+def clip_repertoire(motions: Sequence[Motion], labels: Sequence[str], profile: str | Path | BodyProfile, *,
+                    sources: Sequence[Path | str] | None = None, hub_radius: float = 0.06, hub_share: float = 0.2,
+                    folder: Path | None = None) -> ClipRepertoire:
+    """A repertoire from labelled clips of world positions in ``profile``'s parts, the hubs found from them.
+
+    Parameters
+    ----------
+    motions : sequence of Motion
+        World positions (metres, +y up) of the profile's body parts, in its order, one clip each.
+    labels : sequence of str
+        The movement of each clip.
+    sources : sequence of Path or str, optional
+        Where each clip comes from (its file); by default its example name (``bow``, ``bow#2``...).
+    hub_radius, hub_share : float
+        As :func:`find_hubs`.
+    folder : Path, optional
+        The folder the clips were read from, if any.
+    """
+    profile = profile if isinstance(profile, BodyProfile) else load_profile(profile)
+    motions, labels = list(motions), [str(label) for label in labels]
+    if len(motions) != len(labels):
+        raise ConfigError(f"{len(motions)} clips and {len(labels)} labels", key=("labels",),
+                          expected="one movement label per clip")
+    if not motions:
+        raise ConfigError("no clips", key=("clips",), expected="at least one labelled clip")
+    if sources is None:
+        counts: dict[str, int] = {}
+        sources = []
+        for label in labels:
+            sources.append(example_name(label, counts.get(label, 0)))
+            counts[label] = counts.get(label, 0) + 1
+    rel: list[tuple[str, Path | str, Motion]] = []
+    for movement, source, world in zip(labels, sources, motions):
+        where = {"file": source} if isinstance(source, Path) else {"key": ("clips", str(source))}
+        if tuple(world.parts) != tuple(profile.body.parts):
+            raise ConfigError("the clip's parts are not the profile's parts", **where,
+                              expected=f"parts {list(profile.body.parts)}", available=list(world.parts))
+        motion = root_relative_motion(world, profile)
+        if motion.n_frames < 2:
+            raise ConfigError(f"clip has {motion.n_frames} frame", **where, expected="at least two frames")
+        rel.append((movement, source, motion))
     ends = np.stack([_filled(m, i) for _, _, m in rel for i in (0, -1)])
     hubs_rel = find_hubs(ends, hub_radius, hub_share)
     height = _root_height(rel)
     lift = np.array([0.0, height, 0.0])
-    clips = tuple(Clip(mv, path, Motion(m.positions + lift, m.fps, m.parts, m.visible, m.world)) for mv, path, m in rel)
-    return ClipRepertoire(profile, clips, hubs_rel + lift, Path(folder))
+    clips = tuple(Clip(mv, src, Motion(m.positions + lift, m.fps, m.parts, m.visible, m.world)) for mv, src, m in rel)
+    return ClipRepertoire(profile, clips, hubs_rel + lift, folder, hub_radius, hub_share)
 
 
 def _filled(motion: Motion, frame: int) -> np.ndarray:
@@ -155,7 +217,7 @@ def _filled(motion: Motion, frame: int) -> np.ndarray:
     return np.nan_to_num(motion.positions[frame])
 
 
-def _root_height(rel: list[tuple[str, Path, Motion]]) -> float:
+def _root_height(rel: list[tuple[str, Path | str, Motion]]) -> float:
     """Median height of the root above the lowest part at the clips' ends: the hub's standing height."""
     heights = []
     for _, _, m in rel:
@@ -185,7 +247,18 @@ def repertoire_for(params: dict, owner: object) -> ClipRepertoire | None:
     """The clip repertoire a motor system's ``clips`` and ``profile`` parameters name, or ``None`` without clips.
 
     Paths are relative to the owner's character file; a repertoire read once is shared (by path and settings).
+    A repertoire given in memory when the owner was composed (its ``repertoire``, a :class:`ClipRepertoire`) is
+    used instead of a folder, its hubs found with these parameters' ``hub_radius`` and ``hub_share``.
     """
+    given = getattr(owner, "repertoire", None)
+    if given is not None:
+        if params["clips"]:
+            raise ConfigError("clips given twice", key=("clips",),
+                              expected="either a clips folder or a repertoire in memory, not both")
+        if not isinstance(given, ClipRepertoire):
+            raise ConfigError(f"a repertoire of type {type(given).__name__}", key=("clips",),
+                              expected="a plugins.lib.clip_repertoire.ClipRepertoire")
+        return _same_parts(owner, given.with_hubs(params["hub_radius"], params["hub_share"]))
     if not params["clips"]:
         return None
     if not params["profile"]:
@@ -199,7 +272,11 @@ def repertoire_for(params: dict, owner: object) -> ClipRepertoire | None:
             _CACHE.clear()
         _CACHE[key] = load_clip_repertoire(folder, profile_path, hub_radius=params["hub_radius"],
                                            hub_share=params["hub_share"])
-    repertoire = _CACHE[key]
+    return _same_parts(owner, _CACHE[key])
+
+
+def _same_parts(owner: object, repertoire: ClipRepertoire) -> ClipRepertoire:
+    """The repertoire, or a :class:`ConfigError` when the owner's body parts are not its profile's parts."""
     body = getattr(owner, "body", None)
     if body is not None and tuple(body.parts) != tuple(repertoire.profile.body.parts):
         raise ConfigError("the body's parts are not the profile's parts", key=("profile",),

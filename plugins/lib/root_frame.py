@@ -94,6 +94,22 @@ def _circular_median(windows: np.ndarray) -> np.ndarray:
     return np.angle(np.exp(1j * out))
 
 
+_WINDOW_BUDGET = 1 << 20
+"""Numbers of windows gathered at a time by :func:`_windowed_median` (a window is as long as seconds x fps)."""
+
+
+def _windowed_median(view: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """:func:`_circular_median` of the rows ``rows`` of a sliding-window view, a bounded number of rows at a time.
+
+    Gathering every row at once would copy frames x window numbers (a whole recording times seconds x fps);
+    each row's median depends only on that row, so the result is the same bit for bit.
+    """
+    step = max(1, _WINDOW_BUDGET // max(1, view.shape[1]))
+    if len(rows) <= step:
+        return _circular_median(view[rows])
+    return np.concatenate([_circular_median(view[rows[i : i + step]]) for i in range(0, len(rows), step)])
+
+
 class HeadingFilter:
     """A running median of recent facing estimates, for a stream of frames.
 
@@ -142,8 +158,8 @@ class HeadingFilter:
         if not have.any():
             return out
         padded = np.concatenate([np.full(self.window - 1, np.nan), estimates])
-        windows = np.lib.stride_tricks.sliding_window_view(padded, self.window)[ends[have] - 1]  # last w to each frame
-        out[have] = _circular_median(windows)
+        windows = np.lib.stride_tricks.sliding_window_view(padded, self.window)  # a view: nothing copied yet
+        out[have] = _windowed_median(windows, ends[have] - 1)  # the last w estimates to each frame
         return out
 
 
@@ -163,8 +179,8 @@ def smooth_heading(heading: np.ndarray, window: int) -> np.ndarray:
     if n == 0 or window <= 1 or not np.isfinite(heading).any():
         return heading.copy()
     padded = np.pad(heading, half, constant_values=np.nan)  # near the ends the window shrinks: the facing stays
-    windows = np.lib.stride_tricks.sliding_window_view(padded, 2 * half + 1)[:n]  # continuous from frame to frame
-    return _circular_median(windows)
+    windows = np.lib.stride_tricks.sliding_window_view(padded, 2 * half + 1)  # continuous from frame to frame
+    return _windowed_median(windows, np.arange(n))
 
 
 def to_root_relative(

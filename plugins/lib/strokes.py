@@ -56,6 +56,9 @@ def speed_breaks(speed: np.ndarray, drop: float, moving: float = 0.0) -> list[in
     starts or ends at full speed still brackets its minima; both sides must rise above ``moving``, so a dip
     between two flickers of noise at rest separates no strokes.
     """
+    # Written out, not scipy.signal.find_peaks: K&G §4.3's criterion is a share of the neighbouring maxima (a ratio,
+    # where find_peaks's prominence is a difference to the lower base of higher peaks) and a hold joins minima with
+    # nothing faster than the rest speed between them, which no find_peaks option (plateau, distance, wlen) expresses.
     from scipy.signal import argrelextrema
 
     speed = np.asarray(speed, dtype=float)

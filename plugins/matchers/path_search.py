@@ -356,17 +356,21 @@ class PathSearch(Matcher):
 
 def _reach(graph, nodes, index, max_skip: int, *, forward: bool) -> tuple[np.ndarray, np.ndarray]:
     """For every node, the nodes reachable in 0..max_skip steps along (or against) the edges, as a compressed
-    table: node ``i`` reaches ``indices[indptr[i]:indptr[i + 1]]`` (sorted)."""
-    step = graph.successors if forward else graph.predecessors
-    out = []
-    for node in nodes:
-        frontier, found = {node}, {node}
-        for _ in range(max_skip):
-            frontier = {m for f in frontier for m in step(f)}
-            found |= frontier
-        out.append(np.array(sorted(index[m] for m in found), dtype=np.intp))
-    indptr = np.concatenate([[0], np.cumsum([len(r) for r in out])]).astype(np.intp)
-    return indptr, np.concatenate(out) if out else np.zeros(0, dtype=np.intp)
+    table: node ``i`` reaches ``indices[indptr[i]:indptr[i + 1]]`` (sorted). networkx's breadth-first search
+    bounded by ``cutoff`` finds each node's reach."""
+    g = graph if forward else graph.reverse(copy=False)
+    counts = np.empty(len(nodes), dtype=np.intp)
+    found: list[Any] = []
+    for i, node in enumerate(nodes):
+        reached = nx.single_source_shortest_path_length(g, node, cutoff=max_skip)
+        counts[i] = len(reached)
+        found.extend(reached)
+    indptr = np.zeros(len(nodes) + 1, dtype=np.intp)
+    np.cumsum(counts, out=indptr[1:])
+    # each row sorted at once: row i's indices offset by i * len(nodes), one sort, the offsets taken off again
+    offset = np.repeat(np.arange(len(nodes), dtype=np.intp) * len(nodes), counts)
+    ids = np.fromiter(map(index.__getitem__, found), dtype=np.intp, count=len(found))
+    return indptr, np.sort(ids + offset) - offset
 
 
 def _gather(table: tuple[np.ndarray, np.ndarray], ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

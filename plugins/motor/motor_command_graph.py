@@ -465,26 +465,108 @@ class MotorCommandGraph(MotorSystem):
             }
         return state
 
-    def set_state(self, state: dict[str, Any]) -> None:
+    def set_state(self, state: dict[str, Any], *, check: bool = False) -> None:
+        """Add the saved nodes, edges, sequences, labels and movements performed together, per subsystem.
+
+        Everything is checked first (types, shapes, finite values, edges between known nodes, sequences of known
+        edges); a saved edge replaces one of the same name built already (from clips, say).
+        """
+        if not isinstance(state, dict):
+            raise ConfigError("invalid motor command graph state", expected="a table of subsystems")
+        keys = ("nodes", "edges", "sequences", "labels", "together")
+
+        def bad(problem: str, key: tuple, expected: str) -> ConfigError:
+            return ConfigError(problem, key=key, expected=expected)
+
+        def names(value: Any, key: tuple, known: set) -> list[str]:
+            if not (isinstance(value, list) and value and all(isinstance(v, str) and v in known for v in value)):
+                raise bad(f"invalid list {value!r}"[:200], key, "a non-empty list of known edge or movement names")
+            return list(value)
+
+        nodes, edges = {}, {}
         for name, entry in state.items():
             if name not in self.graphs:
                 raise ConfigError(f"unknown subsystem {name!r}", key=(name,), expected="a subsystem", available=list(self.graphs))
-            g = self.graphs[name]
-            for node, value in entry.get("nodes", {}).items():
-                g.add_node(node, state=np.asarray(value, dtype=float), hub=False)
-            for i, e in enumerate(entry.get("edges", [])):
+            if not isinstance(entry, dict):
+                raise bad("invalid subsystem state", (name,), "a table of " + ", ".join(keys))
+            for k in entry:
+                if k not in keys:
+                    raise ConfigError(f"unknown key {k!r}", key=(name, k), expected="a subsystem state key",
+                                      available=keys)
+            table = entry.get("nodes", {})
+            if not isinstance(table, dict):
+                raise bad("invalid nodes", (name, "nodes"), "a table of node = state")
+            k = len(self.subsystems[name])
+            for node, value in table.items():
                 try:
-                    commands = [command_from_dict(c) for c in e["commands" if "commands" in e else "strokes"]]
-                except (TypeError, ValueError, KeyError) as exc:
-                    raise ConfigError(f"invalid edge ({exc})", key=(name, "edges", i), expected="an edge written by get_state") from None
-                if e["name"] in self._edges:  # the same command built already (from clips, say): the saved one replaces it
-                    known = self._edges[e["name"]]
-                    self.graphs[known.subsystem].remove_edge(known.source, known.target, known.name)
-                self._add(Edge(e["name"], name, e["from"], e["to"], tuple(commands), "loaded"))
-                self._counter = max(self._counter, int(e["name"].rsplit(":e", 1)[-1]))
-            self.sequences.update(entry.get("sequences", {}))
-            self.labels.update(entry.get("labels", {}))
-            self.together.update(entry.get("together", {}))
+                    array = np.asarray(value, dtype=float)
+                except (TypeError, ValueError, OverflowError):
+                    array = np.zeros(0)
+                if node == "hub" or array.shape != (k, 3) or not np.isfinite(array).all() or np.abs(array).max() >= 1e6:
+                    raise bad(f"invalid node {node!r}", (name, "nodes", node),
+                              f"a node other than the hub with a state of shape ({k}, 3) of finite numbers")
+                nodes[(name, node)] = array
+            known_nodes = set(self.graphs[name].nodes) | {n for (s, n) in nodes if s == name}
+            items = entry.get("edges", [])
+            if not isinstance(items, list):
+                raise bad("invalid edges", (name, "edges"), "a list of edges")
+            for i, e in enumerate(items):
+                key = (name, "edges", i)
+                what = "an edge written by get_state: {from, to, name, commands}"
+                if not isinstance(e, dict) or not all(isinstance(e.get(x), str) for x in ("from", "to", "name")):
+                    raise bad("invalid edge", key, what)
+                number = e["name"].removeprefix(f"{name}:e")
+                if number == e["name"] or not number.isascii() or not number.isdigit() or len(number) > 9:
+                    raise bad(f"invalid edge name {e['name']!r}", (*key, "name"), f"{name}:e<number>")
+                if e["name"] in edges:
+                    raise bad(f"edge {e['name']!r} twice", (*key, "name"), "each edge once")
+                for end in ("from", "to"):
+                    if e[end] not in known_nodes:
+                        raise ConfigError(f"unknown node {e[end]!r}", key=(*key, end),
+                                          expected="a node of the subsystem", available=sorted(known_nodes))
+                commands = e.get("commands", e.get("strokes"))
+                if not isinstance(commands, list) or not commands or not all(isinstance(c, dict) for c in commands):
+                    raise bad("invalid commands", key, "a non-empty list of commands written by get_state")
+                try:
+                    built = tuple(command_from_dict(c) for c in commands)
+                except (TypeError, ValueError, KeyError, OverflowError) as exc:
+                    raise bad(f"invalid edge ({exc})"[:300], key, "an edge written by get_state") from None
+                values = [v for c in built for k, v in c.to_dict(arrays=True).items() if k != "shape"]
+                if not all(np.isfinite(np.asarray(v, dtype=float)).all() and np.abs(v).max() < 1e6 for v in values):
+                    raise bad("invalid edge (a number that is not finite, or beyond 1e6)", key,
+                              "an edge written by get_state")
+                if not all(0 < c.duration <= 3600 for c in built):
+                    raise bad("invalid edge (a command longer than an hour)", key, "an edge written by get_state")
+                edges[e["name"]] = (Edge(e["name"], name, e["from"], e["to"], built, "loaded"), int(number))
+        known_edges = set(self._edges) | set(edges)
+        sequences, labels, together = {}, {}, {}
+        for name, entry in state.items():
+            for k, out in (("sequences", sequences), ("labels", labels), ("together", together)):
+                if not isinstance(entry.get(k, {}), dict):
+                    raise bad(f"invalid {k}", (name, k), "a table of movement = ...")
+            for movement, value in entry.get("sequences", {}).items():
+                sequences[movement] = names(value, (name, "sequences", movement), known_edges)
+        known_sequences = set(self.sequences) | set(sequences)
+        for name, entry in state.items():
+            for movement, label in entry.get("labels", {}).items():
+                if movement not in known_sequences or not isinstance(label, str) or not label:
+                    raise bad(f"invalid label of {movement!r}", (name, "labels", movement), "sequence = movement name")
+                labels[movement] = label
+            for movement, value in entry.get("together", {}).items():
+                together[movement] = names(value, (name, "together", movement), known_edges | known_sequences)
+        if check:
+            return
+        for (name, node), array in nodes.items():
+            self.graphs[name].add_node(node, state=array, hub=False)
+        for edge, number in edges.values():
+            if edge.name in self._edges:  # the same command built already (from clips, say): the saved one replaces it
+                known = self._edges[edge.name]
+                self.graphs[known.subsystem].remove_edge(known.source, known.target, known.name)
+            self._add(edge)
+            self._counter = max(self._counter, number)
+        self.sequences.update(sequences)
+        self.labels.update(labels)
+        self.together.update(together)
 
 
 @hookimpl

@@ -264,19 +264,47 @@ class Posegraph(MotorSystem):
             }
         }
 
-    def set_state(self, state: dict[str, Any]) -> None:
+    def set_state(self, state: dict[str, Any], *, check: bool = False) -> None:
+        """Learn the saved movements (new names only); every entry is checked before the first is learned."""
+        if not isinstance(state, dict):
+            raise ConfigError("invalid posegraph state", expected="a table {learned = ...}")
         for key in state:
             if key != "learned":
                 raise ConfigError(f"unknown key {key!r}", key=(key,), expected="a posegraph state key", available=["learned"])
+        learned = state.get("learned", {})
+        if not isinstance(learned, dict):
+            raise ConfigError("invalid learned movements", key=("learned",),
+                              expected="a table of learned movements by name")
         root = self.body.root_index
-        for name, entry in state.get("learned", {}).items():
-            poses = np.asarray(entry.get("poses"), dtype=float)
-            if poses.ndim != 3 or poses.shape[1:] != (self.body.n_parts, 3) or not np.isfinite(poses).all():
-                raise ConfigError(f"invalid poses of learned movement {name!r}", key=("learned", name, "poses"),
-                                  expected=f"an array of shape (nodes, {self.body.n_parts}, 3) of finite numbers")
-            hub = self.rest_pose() - self.rest_pose()[root]
+        shape = f"an array of shape (nodes >= 1, {self.body.n_parts}, 3) of finite numbers (metres, below 1e6)"
+        known = set(self.paths) | set(self.movements())
+        plans = []
+        for name, entry in learned.items():
+            key = ("learned", name)
+            if not name or name in known:
+                raise ConfigError(f"movement {name!r} already exists" if name else "empty movement name", key=key,
+                                  expected="a movement the character does not know yet", available=sorted(known))
+            if not isinstance(entry, dict) or not isinstance(entry.get("source", ""), str):
+                raise ConfigError(f"invalid learned movement {name!r}", key=key,
+                                  expected="{source = text, poses = ...}")
+            for k in entry:
+                if k not in ("source", "poses"):
+                    raise ConfigError(f"unknown key {k!r}", key=(*key, k), expected="a learned movement's key",
+                                      available=["source", "poses"])
+            try:
+                poses = np.asarray(entry.get("poses"), dtype=float)
+            except (TypeError, ValueError, OverflowError):
+                poses = np.zeros(0)
+            if (poses.ndim != 3 or poses.shape[1:] != (self.body.n_parts, 3) or not len(poses)
+                    or not np.isfinite(poses).all() or np.abs(poses).max() >= 1e6):
+                raise ConfigError(f"invalid poses of learned movement {name!r}", key=(*key, "poses"), expected=shape)
+            plans.append((name, poses, entry.get("source", "")))
+        if check:
+            return
+        hub = self.rest_pose() - self.rest_pose()[root]
+        for name, poses, source in plans:
             interior = poses - self.rest_pose()[root]  # learn() stores root-relative poses lifted to the rest root
-            self.learn(name, np.concatenate([[hub], interior, [hub]]), source=str(entry.get("source", "")), announce=False)
+            self.learn(name, np.concatenate([[hub], interior, [hub]]), source=source, announce=False)
 
     def describe(self) -> dict[str, Any]:
         return {

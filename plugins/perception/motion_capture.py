@@ -23,7 +23,7 @@ class MotionCapture(Perception):
     parameters = (
         Parameter("facing_window", float, 3.0, "Seconds over which the target's facing is a running median "
                   "(steady through kicks and head turns; a real turn is followed after half of it; 0: every "
-                  "frame on its own).", minimum=0.0),
+                  "frame on its own).", minimum=0.0, maximum=60.0),
     )
 
     def reset(self, fps: float) -> None:

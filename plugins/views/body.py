@@ -18,7 +18,7 @@ import numpy as np
 from plugins.lib.rendering import poses_png
 from toolkit import ConfigError, Parameter, View, hookimpl
 
-__all__ = ["BodyView", "key_pose_strip"]
+__all__ = ["BodyView", "body_frame", "key_pose_strip"]
 
 
 def key_pose_strip(motion_positions: np.ndarray, keys: int, root: int) -> np.ndarray:
@@ -27,6 +27,18 @@ def key_pose_strip(motion_positions: np.ndarray, keys: int, root: int) -> np.nda
     poses = motion_positions[frames].copy()
     poses[..., [0, 2]] -= poses[:, root : root + 1, [0, 2]]
     return poses
+
+
+def body_frame(motion: Any, body: Any) -> np.ndarray:
+    """A recording's world positions (F, P, 3) turned, frame by frame, to face +z about its root (the facing found
+    from the body's facing parts, smoothed over the recording, as perceptions find it), heights kept; hidden parts
+    NaN."""
+    from plugins.lib.root_frame import root_relative, smooth_heading
+
+    window = max(1, int(round(motion.fps)))  # one second
+    poses, visible, root, _ = root_relative(motion.positions, motion.visible, body, lambda h: smooth_heading(h, window))
+    poses = poses + np.array([0.0, 1.0, 0.0]) * root[:, None, 1:2]  # back to the root's height above the ground
+    return np.where(visible[..., None], poses, np.nan)
 
 
 class BodyView(View):
@@ -42,22 +54,34 @@ class BodyView(View):
         Parameter("fps", float, 30.0, "Frame rate the movements are performed at before sampling.", minimum=1.0),
     )
 
-    def draw(self, subject: Any, out: Path) -> list[Path]:
+    recordings = "all"
+    """``likeme show --body PROFILE FILE ...`` draws the recordings' key poses in one picture, a row each."""
+
+    def draw(self, subject: Any, out: Path, recordings: Any = None) -> list[Path]:
+        """Draw ``subject``'s hub pose and a strip of key poses per movement of its repertoire, or per recording of
+        ``recordings`` (:func:`~plugins.views.demonstration.recording` each) when given, to the PNG file ``out``."""
         character = subject
         body, motor = character.body, character.motor
-        movements = list(self.params["movements"]) or sorted(motor.movements())
-        unknown = [m for m in movements if m not in motor.movements()]
-        if unknown:
-            raise ConfigError(f"unknown movement {unknown[0]!r}", key=("movements",), expected="a movement of "
-                              f"{character.name}", available=sorted(motor.movements()))
+        if recordings:
+            rows = [(f"{demo.who}  {demo.motion.duration:.2f} s", body_frame(demo.motion, body)) for demo in recordings]
+        else:
+            movements = list(self.params["movements"]) or sorted(motor.movements())
+            unknown = [m for m in movements if m not in motor.movements()]
+            if unknown:
+                raise ConfigError(f"unknown movement {unknown[0]!r}", key=("movements",), expected="a movement of "
+                                  f"{character.name}", available=sorted(motor.movements()))
+            rows = []
+            for movement in movements:
+                motion = motor.perform(movement, fps=self.params["fps"])
+                rows.append((f"{motor.label(movement)}  {motion.duration:.2f} s", motion.positions))
         rest = np.asarray(motor.rest_pose(), dtype=float)
         extent = np.ptp(rest[np.isfinite(rest).all(axis=1)], axis=0)
         height = max(float(extent[1]), 0.2)
         cell = max(float(extent[0]), float(extent[2]), height * 0.5) * 1.5  # one pose's width in the strip
         row = height * 1.6
         keys = self.params["keys"]
-        columns = self.params["columns"] or max(1, int(np.ceil(len(movements) / 12)))
-        rows = int(np.ceil(len(movements) / columns))
+        columns = self.params["columns"] or max(1, int(np.ceil(len(rows) / 12)))
+        n_rows = int(np.ceil(len(rows) / columns))
         label_width = cell * 3.2
         strip = label_width + keys * cell + cell * 0.5
         root = body.root_index
@@ -68,21 +92,20 @@ class BodyView(View):
         poses.append(hub * 1.4 + np.array([top, row * 0.1, 0.0]))
         labels.append(f"{character.name}: hub pose")
         points.append([top, row * 0.1 + height * 1.55, 0.0])
-        for i, movement in enumerate(movements):
-            c, r = divmod(i, rows)
-            motion = motor.perform(movement, fps=self.params["fps"])
+        for i, (label, positions) in enumerate(rows):
+            c, r = divmod(i, n_rows)
             y = -(r + 1) * row - height * 0.3
             x = c * strip + label_width
-            for k, pose in enumerate(key_pose_strip(motion.positions, keys, root)):
+            for k, pose in enumerate(key_pose_strip(positions, keys, root)):
                 poses.append(pose + np.array([x + (k + 0.5) * cell, y, 0.0]))
-            labels.append(f"{motor.label(movement)}  {motion.duration:.2f} s")
+            labels.append(label)
             points.append([x - cell * 0.1, y + height * 0.5, 0.0])
         width = self.params["width"]
-        lower = (0.0, -(rows + 1) * row)
+        lower = (0.0, -n_rows * row - height * 0.5)  # the feet of the last row, and a margin
         upper = (columns * strip, row * 0.1 + height * 1.8)
         size = (width, self.params["height"] or int(width * (upper[1] - lower[1]) / (upper[0] - lower[0])))
         return [poses_png(out, body, np.stack(poses), np.array(points), labels, lower=lower, upper=upper, size=size,
-                          radius=max(height / 28.0, 0.006), font_size=max(10, min(20, int(size[1] / (rows + 2) / 5))),
+                          radius=max(height / 28.0, 0.006), font_size=max(10, min(20, int(size[1] / (n_rows + 2) / 5))),
                           align="right")]
 
 

@@ -19,7 +19,7 @@ import numpy as np
 from toolkit import ConfigError, Motion, load_character
 from toolkit.motion import concatenate
 
-__all__ = ["Demonstration", "demonstration", "perform_sequence", "require", "watch"]
+__all__ = ["Demonstration", "demonstration", "perform_sequence", "recording", "require", "watch"]
 
 
 @dataclass(frozen=True)
@@ -99,6 +99,22 @@ def perform_sequence(character: Any, demonstrator: str, movements: Sequence[str]
     return Demonstration(who.name, motion, tuple(truth), who.body)
 
 
+def recording(profile: Any, path: Any) -> Demonstration:
+    """A recording read through a body profile (:class:`~toolkit.profile.BodyProfile`) as a demonstration to watch:
+    its world positions, and its true segments from ``NAME.segments.csv`` beside it when there is one (the format
+    of the benchmarks' streams, :func:`plugins.bench.data.read_segments`), else none."""
+    from pathlib import Path
+
+    from plugins.bench.data import read_segments
+
+    path = Path(path)
+    motion = profile.read(path)
+    truth = path.with_suffix(".segments.csv")
+    segments = tuple((s, min(e, motion.n_frames), m) for s, e, m in read_segments(truth)
+                     if s < motion.n_frames) if truth.is_file() else ()
+    return Demonstration(path.name, motion, segments, profile.body)
+
+
 def watch(character: Any, demo: Demonstration, each: Callable[[Any], None] | None = None) -> tuple[Any, list[Any]]:
     """``character`` watches ``demo`` through ``motion-capture`` with its own segmenter and matcher, frame by frame.
 
@@ -111,7 +127,8 @@ def watch(character: Any, demo: Demonstration, each: Callable[[Any], None] | Non
     from toolkit.observe import Observer
 
     perception = character.pm.registry.get("perception", "motion-capture")()
-    observer = Observer(character, demo.body or character.body, demo.motion.fps, perception=perception)
+    observer = Observer(character, demo.body or character.body, demo.motion.fps, perception=perception,
+                        keep=None)  # every row: the views plot the whole demonstration
     motion = demo.motion
     found: list[Any] = []
     for f in range(motion.n_frames + 1):

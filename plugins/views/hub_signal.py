@@ -33,11 +33,17 @@ class HubSignalView(View):
 
     name = "hub-signal"
     parameters = DEMONSTRATION
+    needs = {"segmenter": "hub-threshold"}
+    """What the character must have; ``likeme show --body PROFILE FILE`` composes an observer with it."""
+    recordings = "each"
+    """``likeme show --body PROFILE FILE ...`` draws one picture per recording (``draw(..., recording=...)``)."""
 
-    def draw(self, subject: Any, out: Path) -> list[Path]:
+    def draw(self, subject: Any, out: Path, recording: Any = None) -> list[Path]:
+        """Draw ``subject`` watching a demonstration (the parameters') or ``recording`` (a
+        :func:`~plugins.views.demonstration.recording`) to the PNG file ``out``."""
         character = subject
         segmenter = require(character, "segmenter", "hub-threshold")
-        demo = demonstrate(self, character)
+        demo = demonstrate(self, character, recording)
         observer, found = watch(character, demo)
         fps = observer.fps
         seen = Motion(np.array(observer.poses), fps, character.body.parts, np.array(observer.visible))
@@ -45,7 +51,7 @@ class HubSignalView(View):
         start, end = segmenter.thresholds
         t = seen.times
         fig, (top, ax) = figure(self.params["width"], self.params["height"], (1, 4))
-        timeline(top, demo, found, fps)
+        timeline(top, demo, found, fps, recognised=character.matcher is not None)
         for o in found:
             ax.axvspan(o.segment.start_time, o.segment.end_time, color="#d8d8d8", lw=0)
         ax.plot(t, raw, color="#9a9a9a", lw=0.8, label="distance to the nearest hub (eq. 1)")

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from plugins.views.demonstration import require, watch
-from plugins.views.plotting import DEMONSTRATION, PALETTE, demonstrate, figure, save_figure, timeline
+from plugins.views.plotting import DEMONSTRATION, FREE_LABEL, PALETTE, demonstrate, figure, save_figure, timeline
 from toolkit import View, hookimpl
 
 __all__ = ["PredictionErrorView"]
@@ -38,18 +38,24 @@ class PredictionErrorView(View):
 
     name = "prediction-error"
     parameters = DEMONSTRATION
+    needs = {"matcher": "forward-model"}
+    """What the character must have; ``likeme show --body PROFILE FILE`` composes an observer with it."""
+    recordings = "each"
+    """``likeme show --body PROFILE FILE ...`` draws one picture per recording (``draw(..., recording=...)``)."""
 
-    def draw(self, subject: Any, out: Path) -> list[Path]:
+    def draw(self, subject: Any, out: Path, recording: Any = None) -> list[Path]:
+        """Draw ``subject`` watching a demonstration (the parameters') or ``recording`` (a
+        :func:`~plugins.views.demonstration.recording`) to the PNG file ``out``."""
         character = subject
         matcher = require(character, "matcher", "forward-model")
-        demo = demonstrate(self, character)
+        demo = demonstrate(self, character, recording)
         segments: list[dict[str, Any]] = []
         observer, found = watch(character, demo, each=lambda o: segments.append({"observation": o,
                                                                                **matcher.inspect()}))
         fps = observer.fps
         threshold, deviation = matcher.params["threshold"], matcher.params["deviation"]
         fig, (top, ax) = figure(self.params["width"], self.params["height"], (1, 4))
-        timeline(top, demo, found, fps)
+        timeline(top, demo, found, fps, recognised=character.matcher is not None)
         colour: dict[str, str] = {}
         highest = 2.0 * max(threshold, deviation)
         for seg in segments:
@@ -78,12 +84,14 @@ class PredictionErrorView(View):
                     ax.scatter([t[-1]], [e[-1]], marker="x", s=45, color=c, zorder=4)
                 else:
                     ax.text(t[-1], e[-1], " " + ">".join(_short(p) for p in path), fontsize=7, color=c,
+                            gid=FREE_LABEL,  # hidden where it would overlap another
                             va="center", clip_on=True)
                 highest = max(highest, min(float(e.max()), 6.0 * threshold))
             if committed is not None:
                 ax.axvline(committed, color="black", lw=1.5)
                 share = seg["committed_at"] / s.n_frames
-                ax.text(committed, 0.98, f" commits to {_short(seg['committed'])}\n at {share:.0%}",
+                ax.text(committed, 0.98, f" commits to {_short(seg['committed'])}\n at {share:.0%}", gid=FREE_LABEL,
+                        zorder=4,
                         transform=ax.get_xaxis_transform(), fontsize=8, va="top")
             if seg["deviated_at"] is not None:
                 ax.axvline((s.start + seg["deviated_at"] - 1) / fps, color="black", lw=1.5, ls=":")
@@ -91,11 +99,12 @@ class PredictionErrorView(View):
             if learned:
                 why = "deviated: learns" if o.match.details.get("deviated") else "learns"
                 ax.text((s.start_time + s.end_time) / 2, 0.8, f"{why}\n{', '.join(_short(n) for n in learned)}",
+                        gid=FREE_LABEL, zorder=4,
                         transform=ax.get_xaxis_transform(), fontsize=8, ha="center", va="top", color="#404040")
         for name, c in colour.items():
             ax.plot([], [], color=c, label=f"candidate {_short(name)}")
-        ax.plot([], [], color="#e6194b", label=f"threshold {threshold:g} m")
-        ax.plot([], [], color="#e6194b", ls="--", label=f"deviation limit {deviation:g} m (while imitating, thick)")
+        ax.plot([], [], color="#e6194b", label=f"threshold {threshold:.3g} m")
+        ax.plot([], [], color="#e6194b", ls="--", label=f"deviation limit {deviation:.3g} m (while imitating, thick)")
         ax.plot([], [], color="black", label="commits (response facilitation)")
         ax.plot([], [], color="black", ls=":", label="deviates: stops imitating")
         ax.scatter([], [], marker="x", color="black", label="drops out / deviates")
@@ -103,7 +112,8 @@ class PredictionErrorView(View):
         ax.set_xlim(0, demo.motion.duration)
         ax.set_xlabel("time (s)")
         ax.set_ylabel("prediction error (m)")
-        ax.legend(loc="upper left", fontsize=8, ncols=2)
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, ncols=1 + len(colour) // 16)  # outside:
+        # the commitments and drop-outs stay in view
         ax.set_title(f"{character.name} predicting with the edges of the active node: {len(found)} segment(s)",
                      fontsize=10, loc="left")
         return [save_figure(fig, out)]

@@ -33,16 +33,28 @@ from toolkit import View, hookimpl
 __all__ = ["SpeedProfileView"]
 
 
+TRAJECTORIES = 3
+"""At most this many parts get a trajectory panel: those that travel most."""
+
+
 class SpeedProfileView(View):
     """Speed of the chosen parts, break points and direction clusters over a demonstration (K&G 2006, §4.3)."""
 
     name = "speed-profile"
     parameters = DEMONSTRATION
+    needs = {"segmenter": "velocity-direction"}
+    """What the character must have; ``likeme show --body PROFILE FILE`` composes an observer with it."""
+    recordings = "each"
+    """``likeme show --body PROFILE FILE ...`` draws one picture per recording (``draw(..., recording=...)``)."""
 
-    def draw(self, subject: Any, out: Path) -> list[Path]:
+    def draw(self, subject: Any, out: Path, recording: Any = None) -> list[Path]:
+        """Draw ``subject`` watching a demonstration (the parameters') or ``recording`` (a
+        :func:`~plugins.views.demonstration.recording`) to the PNG file ``out``."""
+        from matplotlib.ticker import MaxNLocator
+
         character = subject
         segmenter = require(character, "segmenter", "velocity-direction")
-        demo = demonstrate(self, character)
+        demo = demonstrate(self, character, recording)
         analysed: dict[tuple[int, int], object] = {}  # each movement the working memory closed, once
 
         def keep(_observation: object) -> None:
@@ -60,15 +72,17 @@ class SpeedProfileView(View):
         poses = poses * scale[:, None]
         speed = np.nanmax(np.linalg.norm(np.diff(poses, axis=0), axis=2), axis=1) * fps if len(poses) > 1 else np.zeros(0)
         placed = [j for j, i in enumerate(idx) if not character.body.angle_mask[i]]  # parts with a trajectory in space
+        if len(placed) > TRAJECTORIES:  # the parts that travel most (all of a recording's joints would not fit)
+            travel = np.nansum(np.linalg.norm(np.diff(poses[:, placed], axis=0), axis=2), axis=0)
+            placed = sorted(placed[j] for j in np.argsort(-travel, kind="stable")[:TRAJECTORIES])
 
         fig = blank(self.params["width"], self.params["height"])
         k = len(placed)  # the left three quarters: the timeline and the speed; the right quarter: one trajectory per part
-        rows = [["top", "."]] * k + [["speed", f"part{j}"] for j in range(k) for _ in range(4)]
-        axes = fig.subplot_mosaic(rows, width_ratios=[3, 1])
-        top, ax = axes["top"], axes["speed"]
-        ax.sharex(top)
-        trajectory_axes = [axes[f"part{j}"] for j in range(k)]
-        timeline(top, demo, found, fps)
+        left, right = fig.subfigures(1, 2, width_ratios=[3, 1]) if k else (fig, None)
+        top, ax = left.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [1, 4]})
+        trajectory_axes = list(np.atleast_1d(right.subplots(k, 1))) if k else []
+        timeline(top, demo, found, fps, recognised=character.matcher is not None)
+        top.tick_params(axis="x", labelbottom=False)
         t = (np.arange(len(speed)) + 0.5) / fps
         ax.plot(t, speed, color="#b0b0b0", lw=0.8, label="speed of the fastest part (frame to frame)")
         ax.axhline(segmenter.params["rest_speed"], color="#909090", ls=":", lw=1.2,
@@ -105,17 +119,20 @@ class SpeedProfileView(View):
                 tax.set_xlim((x0 + x1) / 2 - 0.05, (x0 + x1) / 2 + 0.05)
                 tax.set_ylim((y0 + y1) / 2 - 0.05, (y0 + y1) / 2 + 0.05)
             tax.set_aspect("equal", adjustable="box")
-            tax.set_title(f"{chosen[j]} (x, y, m): clusters and breaks", fontsize=8)
+            tax.set_title(f"{chosen[j]}: x, y (m)", fontsize=8)
             tax.tick_params(labelsize=7)
+            tax.xaxis.set_major_locator(MaxNLocator(nbins=2))  # a narrow panel: few ticks, none overlapping
         ax.plot([], [], color="#e6194b", label=f"speed break points ({n_speed})")
         ax.plot([], [], color="#4363d8", ls="--", label=f"direction break points ({n_direction})")
         ax.scatter([], [], marker="v", color="black", label=f"breaks kept ({n_kept})")
         ax.set_xlabel("time (s)")
-        ax.set_ylabel("speed (m/s; fingers: rad/s x angle_scale)" if len(placed) < len(idx) else "speed (m/s)")
+        fingers = int(character.body.angle_mask[idx].sum())
+        ax.set_ylabel("speed (m/s; fingers: rad/s x angle_scale)" if fingers else "speed (m/s)")
         ax.set_xlim(0, demo.motion.duration)
         ax.set_ylim(bottom=0)
         ax.legend(loc="upper right", fontsize=8)
-        watched = ", ".join(chosen[j] for j in placed) + (f" and {len(idx) - len(placed)} fingers" if len(placed) < len(idx) else "")
+        watched = (", ".join(chosen[j] for j in placed) if len(chosen) - fingers <= TRAJECTORIES else
+                   f"{len(chosen) - fingers} parts") + (f" and {fingers} fingers" if fingers else "")
         ax.set_title(f"{character.name} watching {watched}: {len(movements)} movement(s) in working memory, "
                      f"points coloured by direction cluster", fontsize=10, loc="left")
         return [save_figure(fig, out)]

@@ -1,0 +1,695 @@
+"""``likeme bench fuzz``: hostile inputs, made by mutating real-looking files, through the commands a user runs.
+
+The seeds are files the project makes itself (:func:`make_seeds`): BVH files with rotation channels and End Sites
+(a small hand-written hierarchy, a skeleton with the Bandai-Namco joint names, and a stream written by the
+``make-data`` machinery with a tiny repertoire and its profile), the built-in character and observer TOML files,
+the body profiles, the built-in scenarios, a state file written by ``likeme run learn_windmill --save`` and CSV
+joint-position files. Case ``i`` of seed ``s`` mutates one seed with :func:`plugins.bench.fuzz_mutate.mutate`
+(generator ``numpy.random.default_rng([s, i])``, so any case can be made again alone) and runs it through a command:
+
+- ``bvh``: ``likeme validate F.bvh``, ``likeme validate --body PROFILE F.bvh``, ``likeme observe --body PROFILE
+  --repertoire DIR F.bvh``;
+- ``toml`` (characters, observer template), ``profile``: ``likeme validate F`` (a profile also ``--body F`` with a
+  BVH file it maps, or ``observe --body F``);
+- ``scenario``: ``likeme run F --duration 1`` or ``likeme validate F``;
+- ``state``: ``likeme run learn_windmill --load F --duration 1``;
+- ``csv``: ``toolkit.positions.read_positions(F, fps=30.0)`` (skipped with a note while that module is absent).
+
+Cases run one after another in one long-lived worker process that calls ``toolkit.cli.main`` in-process, under
+``RLIMIT_AS`` of ``--memory`` MB; the parent kills and restarts it on a timeout or a crash. Outcomes:
+
+- ``ok``: exit status 0;
+- ``documented``: exit status 1 and exactly one ``likeme: error: ...`` line on stderr, no traceback;
+- ``traceback``: any other exception or exit status (a crash of the worker included);
+- ``hang``: no answer within ``--timeout`` seconds;
+- ``memory``: ``MemoryError``, or the worker killed by a signal (the kernel's OOM killer).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import os
+import re
+import select
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import traceback
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["TARGETS", "OUTCOMES", "Case", "Result", "make_seeds", "make_case", "Worker", "classify", "run_fuzz",
+           "cmd_fuzz"]
+
+ROOT = Path(__file__).resolve().parents[2]
+CHARACTERS = ROOT / "characters"
+
+TARGETS = ("bvh", "toml", "profile", "scenario", "state", "csv")
+"""What can be fuzzed, in the order cases are dealt out."""
+OUTCOMES = ("ok", "documented", "traceback", "hang", "memory")
+"""How a case can end (see the module docstring)."""
+BAD = ("traceback", "hang", "memory")
+"""The outcomes that make ``likeme bench fuzz`` fail."""
+
+FORMAT = {"bvh": "bvh", "toml": "toml", "profile": "toml", "scenario": "toml", "state": "json", "csv": "csv"}
+SUFFIX = {"bvh": ".bvh", "toml": ".toml", "json": ".json", "csv": ".csv"}
+
+
+# -- seeds -----------------------------------------------------------------------------------------------------------
+
+
+def _hand_bvh() -> str:
+    """A small hand-written hierarchy: root with six channels, rotation-only children, End Sites; 12 frames."""
+    from toolkit.bvh import BVH, Joint, format_bvh
+
+    joints = [Joint("hips", -1, (0.0, 0.0, 0.0), ("Xposition", "Yposition", "Zposition", "Zrotation", "Xrotation",
+                                                  "Yrotation")),
+              Joint("spine", 0, (0.0, 10.0, 0.0), ("Zrotation", "Xrotation", "Yrotation")),
+              Joint("head", 1, (0.0, 10.0, 0.0), ("Zrotation", "Yrotation", "Xrotation")),
+              Joint("head_end", 2, (0.0, 5.0, 0.0), (), True),
+              Joint("arm", 1, (5.0, 8.0, 0.0), ("Xrotation", "Yrotation", "Zrotation")),
+              Joint("arm_end", 4, (10.0, 0.0, 0.0), (), True)]
+    t = np.linspace(0.0, 1.0, 12)[:, None]
+    values = np.hstack([t * [1.0, 0.0, 2.0] + [0.0, 90.0, 0.0], np.sin(t * [3.0, 2.0, 1.0]) * 20.0,
+                        np.cos(t * [1.0, 2.0, 3.0]) * 10.0, t * [5.0, -5.0, 0.0], t * [0.0, 30.0, 60.0]])
+    return format_bvh(BVH(joints, 1.0 / 30.0, values, "hand"))
+
+
+BANDAI_TREE = (("Hips", None), ("Chest", "Hips"), ("Neck", "Chest"), ("Head", "Neck"), ("UpperArm_L", "Chest"),
+               ("LowerArm_L", "UpperArm_L"), ("Hand_L", "LowerArm_L"), ("UpperArm_R", "Chest"),
+               ("LowerArm_R", "UpperArm_R"), ("Hand_R", "LowerArm_R"), ("UpperLeg_L", "Hips"),
+               ("LowerLeg_L", "UpperLeg_L"), ("Foot_L", "LowerLeg_L"), ("Toes_L", "Foot_L"), ("UpperLeg_R", "Hips"),
+               ("LowerLeg_R", "UpperLeg_R"), ("Foot_R", "LowerLeg_R"), ("Toes_R", "Foot_R"))
+"""The joints of the Bandai-Namco skeleton that ``characters/profiles/bandai-namco.toml`` maps (End Sites added)."""
+
+
+def _bandai_bvh(rng: np.random.Generator) -> str:
+    """A skeleton with the Bandai-Namco joint names, six channels on every joint, End Sites; 20 frames at 30 fps."""
+    from toolkit.bvh import BVH, Joint, format_bvh
+
+    offsets = {"Chest": (0, 20, 0), "Neck": (0, 25, 0), "Head": (0, 10, 0), "UpperArm_L": (15, 20, 0),
+               "UpperArm_R": (-15, 20, 0), "UpperLeg_L": (10, -5, 0), "UpperLeg_R": (-10, -5, 0),
+               "Toes_L": (0, -5, 12), "Toes_R": (0, -5, 12)}
+    down = {"LowerLeg": (0, -40, 0), "Foot": (0, -40, 0), "LowerArm": (25, 0, 0), "Hand": (22, 0, 0)}
+    six = ("Xposition", "Yposition", "Zposition", "Zrotation", "Yrotation", "Xrotation")
+    joints, index = [], {}
+    ends = {"Head", "Hand_L", "Hand_R", "Toes_L", "Toes_R"}
+    for name, parent in BANDAI_TREE:
+        off = offsets.get(name) or next((v for k, v in down.items() if name.startswith(k)), (0, 90, 0))
+        if name.endswith("_R") and name.startswith(("LowerArm", "Hand")):
+            off = (-off[0], off[1], off[2])
+        index[name] = len(joints)
+        joints.append(Joint(name, index[parent] if parent else -1, tuple(map(float, off)), six))
+        if name in ends:
+            joints.append(Joint(f"{name}_end", index[name], (0.0, 8.0, 3.0), (), True))
+    n = sum(1 for j in joints if not j.end_site)
+    base = np.array([j.offset for j in joints if not j.end_site]).reshape(1, n, 3)
+    rot = rng.normal(0.0, 10.0, (20, n, 3))
+    values = np.concatenate([np.repeat(base, 20, axis=0), rot], axis=2).reshape(20, n * 6)
+    return format_bvh(BVH(joints, 1.0 / 30.0, values, "bandai"))
+
+
+def _absolute_refs(text: str, folder: Path) -> str:
+    """A built-in TOML file's relative references (``"../max.toml"``) made absolute, so a copy elsewhere loads."""
+    return re.sub(r'"(\.\./[^"]+\.toml)"', lambda m: json.dumps((folder / m.group(1)).resolve().as_posix()), text)
+
+
+def _positions_csv(names: list[str], positions: np.ndarray, fps: float, with_time: bool) -> str:
+    header = [f"{n}_{a}" for n in names for a in "xyz"]
+    rows = positions.reshape(len(positions), -1)
+    if with_time:
+        header = ["time"] + header
+        rows = np.hstack([np.arange(len(rows))[:, None] / fps, rows])
+    return ",".join(header) + "\n" + "\n".join(",".join(f"{v:.6g}" for v in row) for row in rows) + "\n"
+
+
+def make_seeds(dest: Path, pm: Any, *, seed: int = 0) -> dict[str, list[dict[str, Any]]]:
+    """Write the seed files into ``dest``; return, by target, the seeds (``path`` and what a command needs beside).
+
+    Each seed is a dict with ``path`` (the file to mutate) and, where a command needs them, ``profile`` (a profile
+    that maps the BVH file), ``bvh`` (a BVH file a profile maps), ``repertoire`` (a folder of labelled clips).
+    """
+    from toolkit.bvh import read_bvh
+    from toolkit.cli import main
+
+    from plugins.bench.data import make_data
+
+    dest = Path(dest)
+    rng = np.random.default_rng(seed)
+    seeds: dict[str, list[dict[str, Any]]] = {t: [] for t in TARGETS}
+    (dest / "bvh").mkdir(parents=True, exist_ok=True)
+
+    # BVH: a hand-written hierarchy, a Bandai-Namco-like skeleton, a generated stream with its repertoire and profile
+    hand = dest / "bvh" / "hand.bvh"
+    hand.write_text(_hand_bvh(), encoding="utf-8")
+    bandai = dest / "bvh" / "bandai.bvh"
+    bandai.write_text(_bandai_bvh(rng), encoding="utf-8")
+    bandai_profile = CHARACTERS / "profiles" / "bandai-namco.toml"
+    data = make_data(pm, dest / "data", seed=seed, streams=1, per_stream=3)
+    repertoire = dest / "repertoire"
+    for name in ("bow", "clap", "jump"):
+        shutil.copytree(data / "repertoire" / name, repertoire / name, dirs_exist_ok=True)
+    stream = dest / "bvh" / "stream.bvh"
+    shutil.copyfile(data / "streams" / "stream_1.bvh", stream)
+    max_profile = dest / "max-profile.toml"
+    shutil.copyfile(data / "profile.toml", max_profile)
+    seeds["bvh"] = [{"path": hand},
+                    {"path": bandai, "profile": bandai_profile},
+                    {"path": stream, "profile": max_profile, "repertoire": repertoire}]
+    seeds["bvh"].append(seeds["bvh"][-1])  # the stream twice: the only seed that is also observed
+    seeds["profile"] = [{"path": bandai_profile, "bvh": bandai},
+                        {"path": max_profile, "bvh": stream, "repertoire": repertoire}]
+
+    # TOML: the built-in characters and observer template; the built-in scenarios
+    (dest / "toml").mkdir(exist_ok=True)
+    (dest / "scenario").mkdir(exist_ok=True)
+    for f in sorted(CHARACTERS.glob("*.toml")) + sorted((CHARACTERS / "observers").glob("*.toml")):
+        copy = dest / "toml" / f.name
+        copy.write_text(_absolute_refs(f.read_text(encoding="utf-8"), f.parent), encoding="utf-8")
+        seeds["toml"].append({"path": copy})
+    for f in sorted((CHARACTERS / "scenarios").glob("*.toml")):
+        copy = dest / "scenario" / f.name
+        copy.write_text(_absolute_refs(f.read_text(encoding="utf-8"), f.parent), encoding="utf-8")
+        seeds["scenario"].append({"path": copy})
+
+    # a state file, as a user makes one
+    state = dest / "state" / "windmill.json"
+    state.parent.mkdir(exist_ok=True)
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()) as err:
+        status = main(["run", "learn_windmill", "--save", str(state)])
+    if status != 0:
+        raise RuntimeError(f"could not write the state seed: {err.getvalue()}")
+    seeds["state"] = [{"path": state}]
+
+    # CSV joint positions of the generated stream: with and without a time column
+    motion = read_bvh(stream)
+    positions, _ = motion.forward_kinematics()
+    (dest / "csv").mkdir(exist_ok=True)
+    for with_time in (False, True):
+        f = dest / "csv" / f"stream{'_time' if with_time else ''}.csv"
+        f.write_text(_positions_csv(motion.names, positions, motion.fps, with_time), encoding="utf-8")
+        seeds["csv"].append({"path": f})
+    return seeds
+
+
+# -- cases -----------------------------------------------------------------------------------------------------------
+
+
+@dataclass
+class Case:
+    """One mutated input and how it is run."""
+
+    index: int
+    target: str
+    seed_file: str
+    mutations: list[str]
+    data: bytes
+    name: str
+    """The input's file name (in the case folder)."""
+    argv: list[str] | None = None
+    """The ``likeme`` arguments (``{input}`` stands for the input file), or None for a direct call."""
+    call: str | None = None
+    """``module:function`` called as ``function(input, fps=30.0)`` instead of a command (the csv target)."""
+
+    def command(self) -> str:
+        """The command that replays the case from the folder its input was written to."""
+        if self.argv is not None:
+            return "likeme " + " ".join(_quote(a.replace("{input}", self.name)) for a in self.argv)
+        module, function = self.call.split(":")
+        return f"python -c 'from {module} import {function}; {function}(\"{self.name}\", fps=30.0)'"
+
+
+def _quote(arg: str) -> str:
+    import shlex
+
+    return shlex.quote(arg)
+
+
+def _command(target: str, seed: dict[str, Any], rng: np.random.Generator) -> list[str]:
+    """The ``likeme`` arguments a user would give with this kind of file."""
+    f = "{input}"
+    if target == "bvh":
+        if "repertoire" in seed:  # observing sizes filters from the frame rate: two in three cases of the stream
+            return (["observe", "--body", str(seed["profile"]), "--repertoire", str(seed["repertoire"]), f]
+                    if rng.random() < 2 / 3 else ["validate", "--body", str(seed["profile"]), f])
+        options = [["validate", f]]
+        if "profile" in seed:
+            options.append(["validate", "--body", str(seed["profile"]), f])
+        return options[int(rng.integers(len(options)))]
+    if target == "profile":
+        options = [["validate", f], ["validate", "--body", f, str(seed["bvh"])]]
+        if "repertoire" in seed:
+            options.append(["observe", "--body", f, "--repertoire", str(seed["repertoire"]), str(seed["bvh"])])
+        return options[int(rng.integers(len(options)))]
+    if target == "scenario":
+        return ["run", f, "--duration", _duration(rng)] if rng.random() < 0.75 else ["validate", f]
+    if target == "state":
+        return ["run", "learn_windmill", "--load", f, "--duration", _duration(rng)]
+    return ["validate", f]
+
+
+HOSTILE_DURATIONS = ("nan", "inf", "-1", "0", "1e300", "1e-9")
+"""What ``--duration`` is, in one case in ten of the scenario and state targets (else 1 second)."""
+
+
+def _duration(rng: np.random.Generator) -> str:
+    return HOSTILE_DURATIONS[int(rng.integers(len(HOSTILE_DURATIONS)))] if rng.random() < 0.1 else "1"
+
+
+def make_case(index: int, target: str, seeds: dict[str, list[dict[str, Any]]], seed: int) -> Case:
+    """Case ``index`` of run ``seed`` for ``target``: the same numbers always give the same input and command."""
+    from plugins.bench.fuzz_mutate import mutate
+
+    rng = np.random.default_rng([seed, index, TARGETS.index(target)])
+    pool = seeds[target]
+    chosen = pool[int(rng.integers(len(pool)))]
+    fmt = FORMAT[target]
+    data, applied = mutate(Path(chosen["path"]).read_bytes(), fmt, rng)
+    name = f"case{index:05d}{SUFFIX[fmt]}"
+    if target == "csv":
+        return Case(index, target, Path(chosen["path"]).name, applied, data, name, call="toolkit.positions:read_positions")
+    return Case(index, target, Path(chosen["path"]).name, applied, data, name, argv=_command(target, chosen, rng))
+
+
+# -- the worker ------------------------------------------------------------------------------------------------------
+
+
+OWN_CODE = ("toolkit", "plugins", "tests")
+"""The folders of the project's own code: where a failure is located (not the libraries, not this harness)."""
+
+
+def _own(filename: str) -> str:
+    """``filename`` relative to the project if it is the project's own code (not this harness), else ''."""
+    path = Path(filename).resolve()
+    if path == Path(__file__).resolve() or ROOT not in path.parents:
+        return ""
+    rel = path.relative_to(ROOT)
+    return rel.as_posix() if rel.parts[0] in OWN_CODE else ""
+
+
+def _where(tb: Any) -> str:
+    """The innermost frame of the traceback in the project's own code (``toolkit/x.py:12 in f``)."""
+    found = ""
+    for frame in traceback.extract_tb(tb):
+        if own := _own(frame.filename):
+            found = f"{own}:{frame.lineno} in {frame.name}"
+    return found
+
+
+def run_one(request: dict[str, Any]) -> dict[str, Any]:
+    """Run one case in this process (the worker's side): exit status, stderr, and any exception not handled."""
+    from toolkit.cli import main
+    from toolkit.errors import LikemeError
+
+    out, err = io.StringIO(), io.StringIO()
+    result: dict[str, Any] = {"rc": None, "exception": None, "message": "", "where": ""}
+    cwd = os.getcwd()
+    try:
+        os.chdir(request["cwd"])
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            if request.get("argv") is not None:
+                result["rc"] = main(request["argv"])
+            else:
+                from importlib import import_module
+
+                module, function = request["call"].split(":")
+                try:
+                    getattr(import_module(module), function)(request["input"], fps=30.0)
+                    result["rc"] = 0
+                except LikemeError as exc:
+                    print(f"likeme: error: {exc}", file=sys.stderr)
+                    result["rc"] = 1
+    except SystemExit as exc:  # argparse's exit: a status, a message already on stderr
+        result["rc"] = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+        if exc.code is not None and not isinstance(exc.code, int):
+            err.write(f"{exc.code}\n")
+    except BaseException as exc:  # noqa: BLE001 - the point: anything that escapes is a finding
+        result["exception"] = "MemoryError" if isinstance(exc, MemoryError) else type(exc).__name__  # numpy's too
+        result["message"] = str(exc)[:300]
+        result["where"] = _where(exc.__traceback__)
+        err.write("".join(traceback.format_exception(exc))[-6000:])
+        del exc
+    finally:
+        os.chdir(cwd)
+    text = err.getvalue()
+    result["stderr"] = text if len(text) <= 20000 else text[:10000] + "\n[...]\n" + text[-10000:]
+    return result
+
+
+def _worker_main(memory_mb: int, warm: list[list[str]], stacks: str = "") -> None:
+    """The worker process: read one JSON request a line, answer one JSON line on the protocol descriptor.
+
+    With ``stacks``, ``SIGUSR1`` writes the worker's Python stack to that file (how a hang is located).
+    """
+    import faulthandler
+    import resource
+
+    if stacks:
+        faulthandler.register(signal.SIGUSR1, file=open(stacks, "a", encoding="utf-8"), all_threads=False)  # noqa: SIM115
+    proto = os.fdopen(os.dup(1), "w", buffering=1, encoding="utf-8")
+    requests = os.fdopen(os.dup(0), "r", encoding="utf-8")
+    devnull = os.open(os.devnull, os.O_RDWR)
+    for fd in (0, 1, 2):  # the code under test reads nothing of the protocol and writes nowhere
+        os.dup2(devnull, fd)
+    with tempfile.TemporaryDirectory() as tmp:
+        for argv in warm:  # import what the commands import before the memory limit and the first timeout
+            run_one({"argv": argv, "cwd": tmp})
+    if memory_mb > 0:
+        limit = memory_mb * 1024 * 1024
+        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+    proto.write(json.dumps({"ready": True}) + "\n")
+    for line in requests:
+        request = json.loads(line)
+        result = run_one(request)
+        try:
+            proto.write(json.dumps(result) + "\n")
+        except MemoryError:
+            proto.write(json.dumps({"rc": None, "exception": "MemoryError", "message": "", "where": "",
+                                    "stderr": "MemoryError"}) + "\n")
+        if result["exception"] == "MemoryError":
+            return  # a fresh worker for the next case
+
+
+class Worker:
+    """A long-lived ``python -m plugins.bench.fuzz --worker`` process, restarted after a timeout or a crash."""
+
+    def __init__(self, memory_mb: int, warm: list[list[str]] | None = None, *, start_timeout: float = 120.0) -> None:
+        self._stacks = tempfile.NamedTemporaryFile(prefix="likeme-fuzz-stacks-", suffix=".txt", delete=False)  # noqa: SIM115
+        self._stacks.close()
+        self.memory_mb = memory_mb
+        self.warm = warm or []
+        self.start_timeout = start_timeout
+        self.proc: subprocess.Popen | None = None
+        self.restarts = 0
+
+    def start(self) -> None:
+        env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
+                   MALLOC_ARENA_MAX="2", PYTHONHASHSEED="0", MPLBACKEND="Agg")
+        env["PYTHONPATH"] = os.pathsep.join([str(ROOT), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+        self.proc = subprocess.Popen([sys.executable, "-m", "plugins.bench.fuzz", "--worker", str(self.memory_mb),
+                                      json.dumps(self.warm), self._stacks.name], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                     stderr=subprocess.DEVNULL, env=env, cwd=str(ROOT), start_new_session=True)
+        answer = self._read(self.start_timeout)
+        if not isinstance(answer, dict) or not answer.get("ready"):
+            self.stop()
+            raise RuntimeError(f"the fuzz worker did not start ({answer!r})")
+
+    def _read(self, timeout: float) -> dict[str, Any] | str:
+        """One answer line, or 'timeout', or 'died'."""
+        assert self.proc is not None and self.proc.stdout is not None
+        deadline = time.monotonic() + timeout
+        buf = b""
+        fd = self.proc.stdout.fileno()
+        while True:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                return "timeout"
+            ready, _, _ = select.select([fd], [], [], left)
+            if not ready:
+                continue
+            chunk = os.read(fd, 1 << 20)
+            if not chunk:
+                return "died"
+            buf += chunk
+            if buf.endswith(b"\n"):
+                return json.loads(buf)
+
+    def close(self) -> None:
+        """Stop the worker for good."""
+        self.stop()
+        Path(self._stacks.name).unlink(missing_ok=True)
+
+    def _stack(self) -> str:
+        """The innermost frame of the project's code where the (hung) worker is now, from its stack dump."""
+        assert self.proc is not None
+        path = Path(self._stacks.name)
+        before = path.stat().st_size
+        try:
+            os.kill(self.proc.pid, signal.SIGUSR1)
+        except ProcessLookupError:
+            return ""
+        deadline = time.monotonic() + 2.0
+        while path.stat().st_size == before and time.monotonic() < deadline:
+            time.sleep(0.05)
+        time.sleep(0.1)
+        with path.open(encoding="utf-8", errors="replace") as handle:
+            handle.seek(before)
+            dump = handle.read()
+        for file, line, function in re.findall(r'File "([^"]+)", line (\d+) in (\S+)', dump):  # innermost first
+            if own := _own(file):
+                return f"{own}:{line} in {function}"
+        return ""
+
+    def stop(self) -> None:
+        if self.proc is None:
+            return
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(self.proc.pid, signal.SIGKILL)  # the worker's own session: it and any child it started
+        self.proc.wait()
+        for stream in (self.proc.stdin, self.proc.stdout):
+            with contextlib.suppress(OSError):
+                stream.close()
+        self.proc = None
+
+    def run(self, request: dict[str, Any], timeout: float) -> dict[str, Any]:
+        """Run one request; a timeout or a death of the worker is reported as such, and the worker restarted."""
+        if self.proc is None:
+            self.start()
+        assert self.proc is not None and self.proc.stdin is not None
+        try:
+            self.proc.stdin.write((json.dumps(request) + "\n").encode())
+            self.proc.stdin.flush()
+            answer = self._read(timeout)
+        except BrokenPipeError:
+            answer = "died"
+        if isinstance(answer, dict):
+            if answer.get("exception") == "MemoryError":
+                self.stop()  # the worker exits after a MemoryError; the next case starts a fresh one
+                self.restarts += 1
+            return answer
+        if answer == "died":
+            self.proc.wait()
+            code = self.proc.returncode
+            self.stop()
+            self.restarts += 1
+            name = signal.Signals(-code).name if code is not None and code < 0 else f"exit status {code}"
+            return {"rc": None, "died": name, "exception": None, "message": "", "where": "",
+                    "stderr": f"the worker died ({name})"}
+        where = self._stack()
+        self.stop()
+        self.restarts += 1
+        return {"rc": None, "timeout": True, "exception": None, "message": "", "where": where,
+                "stderr": f"no answer within {timeout:g} s (killed); it was at {where or 'an unknown place'}"}
+
+
+def classify(result: dict[str, Any]) -> str:
+    """The outcome of a case from what the worker answered (one of :data:`OUTCOMES`)."""
+    if result.get("timeout"):
+        return "hang"
+    if result.get("died"):
+        return "memory" if result["died"] == "SIGKILL" else "traceback"  # the parent kills only on a timeout
+    if result.get("exception") == "MemoryError":
+        return "memory"
+    if result.get("exception"):
+        return "traceback"
+    lines = result.get("stderr", "").splitlines()
+    if result.get("rc") == 0:
+        return "ok"
+    errors = [line for line in lines if line.startswith("likeme: error: ")]
+    if result.get("rc") == 1 and len(errors) == 1 and not any(line.startswith("Traceback") for line in lines):
+        return "documented"
+    return "traceback"
+
+
+@dataclass
+class Result:
+    """What happened to one case."""
+
+    case: Case
+    outcome: str
+    answer: dict[str, Any] = field(default_factory=dict)
+    seconds: float = 0.0
+
+    def key(self) -> str:
+        """What groups equal failures: the exception and where it was raised, or the kind of failure."""
+        a = self.answer
+        if self.outcome == "hang":
+            return f"hang at {a.get('where') or '?'}"
+        if a.get("died"):
+            return f"worker died ({a['died']})"
+        if a.get("exception"):
+            return f"{a['exception']} at {a.get('where') or '?'}"
+        if self.outcome == "traceback":
+            return f"exit status {a.get('rc')!r}, {sum(1 for x in a.get('stderr', '').splitlines() if x.startswith('likeme: error: '))} error lines"
+        return self.outcome
+
+
+# -- the run ---------------------------------------------------------------------------------------------------------
+
+
+def _positions_available() -> bool:
+    from importlib.util import find_spec
+
+    return find_spec("toolkit.positions") is not None
+
+
+def run_fuzz(pm: Any, *, n: int = 2000, seed: int = 0, targets: tuple[str, ...] = TARGETS, timeout: float = 10.0,
+             memory_mb: int = 1024, out: Path | None = None, progress: Any = None,
+             notes: list[str] | None = None) -> list[Result]:
+    """Make and run ``n`` cases dealt round-robin over ``targets``; return their results.
+
+    ``out``: every case that is not ok or documented is written there (``NAME`` input, ``NAME.stderr`` with the
+    command that replays it and what it printed). ``notes`` collects what was skipped and why.
+    """
+    notes = notes if notes is not None else []
+    targets = tuple(targets)
+    if "csv" in targets and not _positions_available():
+        notes.append("csv skipped: toolkit.positions is absent (no read_positions to fuzz)")
+        targets = tuple(t for t in targets if t != "csv")
+    if not targets:
+        return []
+    results: list[Result] = []
+    with tempfile.TemporaryDirectory(prefix="likeme-fuzz-") as tmp:
+        tmp = Path(tmp)
+        if out is not None:  # the seeds beside the failing cases, so that their commands replay them
+            Path(out).mkdir(parents=True, exist_ok=True)
+            shutil.rmtree(Path(out) / "seeds", ignore_errors=True)
+        seeds = make_seeds((Path(out).resolve() if out is not None else tmp) / "seeds", pm, seed=seed)
+        stream = seeds["bvh"][-1]
+        warm = [["validate", str(CHARACTERS / "max.toml")],
+                ["observe", "--body", str(stream["profile"]), "--repertoire", str(stream["repertoire"]),
+                 str(stream["path"])],
+                ["run", "learn_windmill", "--load", str(seeds["state"][0]["path"]), "--duration", "0.2"]]
+        worker = Worker(memory_mb, warm)
+        case_dir = tmp / "case"
+        try:
+            for i in range(n):
+                case = make_case(i, targets[i % len(targets)], seeds, seed)
+                shutil.rmtree(case_dir, ignore_errors=True)
+                case_dir.mkdir()
+                (case_dir / case.name).write_bytes(case.data)
+                request = {"cwd": str(case_dir), "input": case.name, "call": case.call,
+                           "argv": None if case.argv is None else [a.replace("{input}", case.name) for a in case.argv]}
+                started = time.monotonic()
+                answer = worker.run(request, timeout)
+                result = Result(case, classify(answer), answer, time.monotonic() - started)
+                results.append(result)
+                if out is not None and result.outcome in BAD:
+                    _keep(result, Path(out))
+                if progress is not None:
+                    progress(result)
+        finally:
+            worker.close()
+    return results
+
+
+def _keep(result: Result, out: Path) -> None:
+    """Write a failing case's input and its stderr (with the command that replays it) into ``out``."""
+    case = result.case
+    (out / case.name).write_bytes(case.data)
+    a = result.answer
+    head = [f"# target: {case.target}; seed file: {case.seed_file}; mutations: {', '.join(case.mutations)}",
+            f"# outcome: {result.outcome}: {result.key()}", f"# replay (in this folder): {case.command()}"]
+    if a.get("message"):
+        head.append(f"# message: {a['message']}")
+    (out / f"{case.name}.stderr").write_text("\n".join(head) + "\n" + a.get("stderr", ""), encoding="utf-8")
+
+
+def summary_line(results: list[Result]) -> str:
+    """``fuzz: N inputs, T tracebacks, H hangs, M over memory``."""
+    count = {o: sum(1 for r in results if r.outcome == o) for o in OUTCOMES}
+    return (f"fuzz: {len(results)} inputs, {count['traceback']} tracebacks, {count['hang']} hangs, "
+            f"{count['memory']} over memory")
+
+
+def failures(results: list[Result]) -> list[tuple[str, str, list[Result]]]:
+    """The failing cases grouped by target and :meth:`Result.key`, most frequent first."""
+    groups: dict[tuple[str, str], list[Result]] = {}
+    for r in results:
+        if r.outcome in BAD:
+            groups.setdefault((r.case.target, r.key()), []).append(r)
+    return sorted(((t, k, rs) for (t, k), rs in groups.items()), key=lambda g: (g[0], -len(g[2]), g[1]))
+
+
+def _out_dir(value: str | None) -> Path | None:
+    """``--out DIR``: a folder to write into, created if missing, checked before the run."""
+    from toolkit.errors import ConfigError
+
+    if not value:
+        return None
+    path = Path(value)
+    expected = "a folder to write the failing cases into (created if missing)"
+    if path.exists() and not path.is_dir():
+        raise ConfigError("not a folder", file=path, key=("--out",), expected=expected)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=path, prefix=".likeme-probe-"):
+            pass
+    except OSError as exc:
+        raise ConfigError(f"cannot write there ({exc.strerror or exc})", file=path, key=("--out",),
+                          expected=expected) from None
+    return path
+
+
+def cmd_fuzz(args: Any, pm: Any) -> int:
+    """``likeme bench fuzz``: print a table of outcomes per target, the failures by place, and the closing line."""
+    from rich.console import Console
+    from rich.progress import Progress
+    from rich.table import Table
+
+    from toolkit.errors import ConfigError
+
+    targets = tuple(t.strip() for t in args.targets.split(",") if t.strip())
+    unknown = [t for t in targets if t not in TARGETS]
+    if unknown or not targets:
+        raise ConfigError(f"unknown fuzz target(s) {unknown}" if unknown else "no fuzz target", key=("--targets",),
+                          expected="a comma-separated list of targets", available=list(TARGETS))
+    if args.n < 1 or not (args.timeout > 0) or args.timeout == float("inf") or args.memory < 0:
+        raise ConfigError(f"--n {args.n}, --timeout {args.timeout}, --memory {args.memory}",
+                          key=("--n" if args.n < 1 else "--timeout" if not 0 < args.timeout < float("inf") else "--memory",),
+                          expected="--n >= 1, a finite --timeout > 0 (seconds), --memory >= 0 (MB, 0: no limit)")
+    out_dir = _out_dir(getattr(args, "out_dir", None))
+    console = Console(stderr=True)
+    notes: list[str] = []
+    with Progress(console=console, transient=True, disable=args.quiet) as bar:
+        task = bar.add_task("fuzz", total=args.n)
+        results = run_fuzz(pm, n=args.n, seed=args.seed, targets=targets, timeout=args.timeout,
+                           memory_mb=args.memory, out=out_dir, notes=notes,
+                           progress=lambda r: bar.advance(task))
+    out = Console()
+    table = Table(title=f"likeme bench fuzz --n {args.n} --seed {args.seed}")
+    table.add_column("target")
+    for o in OUTCOMES:
+        table.add_column(o, justify="right")
+    for t in TARGETS:
+        rows = [r for r in results if r.case.target == t]
+        if rows:
+            table.add_row(t, *(str(sum(1 for r in rows if r.outcome == o)) for o in OUTCOMES))
+    table.add_row("all", *(str(sum(1 for r in results if r.outcome == o)) for o in OUTCOMES), style="bold")
+    out.print(table)
+    groups = failures(results)
+    if groups:
+        print("failures by target and place (count; first case: mutations; command):")
+        for target, key, rs in groups:
+            first = rs[0]
+            print(f"  {target:<8} {len(rs):4d}  {key}\n      {first.case.name}: {', '.join(first.case.mutations)}; "
+                  f"{first.case.command()}")
+    for note in notes:
+        print(f"note: {note}")
+    if out_dir is not None:
+        print(f"failing inputs, their stderr and the seeds they came from: {out_dir}")
+    print(summary_line(results))
+    return 1 if any(r.outcome in BAD for r in results) else 0
+
+
+if __name__ == "__main__" and len(sys.argv) >= 3 and sys.argv[1] == "--worker":
+    _worker_main(int(sys.argv[2]), json.loads(sys.argv[3]) if len(sys.argv) > 3 else [],
+                 sys.argv[4] if len(sys.argv) > 4 else "")

@@ -1,0 +1,314 @@
+"""The scikit-learn style estimators (toolkit.estimators) and repertoires built in memory, on generated data.
+
+The same pipeline as ``likeme bench recognition|segmentation`` on the same clips must give the same answers; the
+estimators must behave as scikit-learn estimators (clone, cross_val_score, GridSearchCV, get/set_params).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from sklearn.base import clone
+from sklearn.model_selection import GridSearchCV, LeaveOneGroupOut, cross_val_score
+
+from plugins.bench.data import make_data
+from plugins.bench.mocap import recognition, segmentation
+from plugins.lib.clip_repertoire import clip_repertoire, load_clip_repertoire
+from toolkit import ConfigError, create_plugin_manager
+from toolkit.estimators import (UNKNOWN, EstimatorInputError, MovementClassifier, MovementSegmenter, load_recordings,
+                                load_streams, to_breakpoints)
+from toolkit.observe import Observer, compose_observer
+from toolkit.profile import load_profile
+
+KEEP = ("bow", "clap", "kick", "nod", "point", "salute", "wave", "jump")
+"""The movements the cross-validation tests use (a few, to stay quick)."""
+
+
+@pytest.fixture(scope="module")
+def data(tmp_path_factory):
+    dest = make_data(create_plugin_manager(), tmp_path_factory.mktemp("estimators"), streams=2, per_stream=3)
+    return dest, load_profile(dest / "profile.toml")
+
+
+@pytest.fixture(scope="module")
+def performers(data):
+    """Max's clips and Morris's demos of the KEEP movements, grouped by performer."""
+    dest, profile = data
+    motions, labels, groups = [], [], []
+    for folder in ("repertoire", "demos"):
+        m, y, g = load_recordings(dest / folder, profile, group=r"^([a-z]+)_?")
+        keep = [i for i, label in enumerate(y) if label in KEEP]
+        motions += [m[i] for i in keep]
+        labels += [y[i] for i in keep]
+        groups += [g[i] for i in keep]
+    return motions, labels, groups
+
+
+def test_memory_repertoire_is_the_folder_repertoire(data):
+    dest, profile = data
+    folder = load_clip_repertoire(dest / "repertoire", profile)
+    motions, labels, _ = load_recordings(dest / "repertoire", profile)
+    memory = clip_repertoire(motions, labels, profile)
+    assert memory.folder is None and folder.folder == dest / "repertoire"
+    np.testing.assert_array_equal(memory.hubs, folder.hubs)
+    assert [c.movement for c in memory.clips] == [c.movement for c in folder.clips]
+    for a, b in zip(memory.clips, folder.clips):
+        np.testing.assert_array_equal(a.motion.positions, b.motion.positions)
+    pm = create_plugin_manager()
+    by_folder = compose_observer(pm, profile, dest / "repertoire")
+    by_memory = compose_observer(pm, profile, memory)
+    assert list(by_memory.motor.graph.nodes(data=True)) == list(by_folder.motor.graph.nodes(data=True))
+    assert list(by_memory.motor.graph.edges) == list(by_folder.motor.graph.edges)
+    np.testing.assert_array_equal(by_memory.motor.node_poses, by_folder.motor.node_poses)
+    demos, _, _ = load_recordings(dest / "demos", profile)
+    for motion in demos[::9]:
+        a = Observer(by_folder, profile.body, motion.fps).classify(motion)
+        b = Observer(by_memory, profile.body, motion.fps).classify(motion)
+        assert (a.movement, a.match.confidence, a.decided_at) == (b.movement, b.match.confidence, b.decided_at)
+
+
+def test_memory_repertoire_follows_the_motor_hub_settings(data):
+    """A repertoire built with other hub settings than the motor system's is rebuilt with the motor's, as the
+    folder would be read with them."""
+    dest, profile = data
+    motions, labels, _ = load_recordings(dest / "repertoire", profile)
+    pm = create_plugin_manager()
+    settings = {"motor": {"hub_radius": 0.2, "hub_share": 0.5}}
+    by_folder = compose_observer(pm, profile, dest / "repertoire", settings=settings)
+    by_memory = compose_observer(pm, profile, clip_repertoire(motions, labels, profile), settings=settings)
+    np.testing.assert_array_equal(by_memory.motor.clips.hubs, by_folder.motor.clips.hubs)
+    assert by_memory.motor.clips.hub_radius == 0.2
+
+
+def test_memory_repertoire_and_clips_folder_together_is_an_error(data):
+    dest, profile = data
+    motions, labels, _ = load_recordings(dest / "repertoire", profile)
+    with pytest.raises(ConfigError, match="clips given twice"):
+        compose_observer(create_plugin_manager(), profile, clip_repertoire(motions, labels, profile),
+                         settings={"motor": {"clips": str(dest / "repertoire")}})
+
+
+@pytest.mark.parametrize("matcher", ["path-search", "dtw", "forward-model"])
+def test_classifier_answers_as_bench_recognition(data, matcher):
+    """fit on the repertoire folder's clips, predict the demos: the answers and the accuracy of
+    ``likeme bench recognition`` on the same folders, item by item."""
+    dest, profile = data
+    bench = recognition(create_plugin_manager(), profile, dest / "repertoire", dest / "demos", [matcher])
+    X, y, _ = load_recordings(dest / "repertoire", profile)
+    Xd, yd, _ = load_recordings(dest / "demos", profile)
+    clf = MovementClassifier(profile, matcher=matcher).fit(X, y)
+    predicted = clf.predict(Xd)
+    assert list(predicted) == [row["recognised"] for row in bench["items"]]
+    assert clf.score(Xd, yd) == pytest.approx(bench["plugins"][0]["accuracy"])
+    assert clf.score(Xd, yd) > 0.8
+    assert list(clf.classes_) == sorted(set(y))
+    scores = clf.decision_function(Xd)
+    assert scores.shape == (len(Xd), len(clf.classes_))
+    confidence = [row["confidence"] for row in bench["items"]]
+    np.testing.assert_allclose(scores.max(axis=1), confidence, atol=1e-4)
+    answered = predicted != UNKNOWN
+    assert (clf.classes_[scores[answered].argmax(axis=1)] == predicted[answered]).all()
+
+
+def test_arrays_are_motions_at_fps(data):
+    dest, profile = data
+    X, y, _ = load_recordings(dest / "repertoire", profile)
+    arrays = [m.positions for m in X]
+    a = MovementClassifier(profile).fit(X, y).predict(X[:6])
+    b = MovementClassifier(profile, fps=30.0).fit(arrays, y).predict(arrays[:6])
+    assert list(a) == list(b)
+    assert (a == np.array(y[:6], dtype=object)).all()
+
+
+def test_labels_that_are_numbers_come_back_as_numbers(data):
+    dest, profile = data
+    X, y, _ = load_recordings(dest / "repertoire", profile)
+    names = sorted(set(y))
+    numbers = np.array([names.index(label) for label in y])
+    clf = MovementClassifier(profile, unknown=-1).fit(X, numbers)
+    assert clf.classes_.tolist() == list(range(len(names)))
+    predicted = clf.predict(X[:5])
+    assert predicted.tolist() == numbers[:5].tolist() and predicted.dtype.kind == "i"
+    assert clf.score(X[:5], numbers[:5]) == 1.0
+    rejecting = clone(clf).set_params(matcher__max_distance=0.0, matcher__spread=0.0).fit(X, numbers)
+    assert rejecting.predict(X[:3]).tolist() == [-1, -1, -1]
+    with pytest.raises(EstimatorInputError, match="the label -1"):
+        clf.fit(X[:2], [0, -1])
+
+
+def test_segmenter_scores_as_bench_segmentation(data):
+    dest, profile = data
+    bench = segmentation(create_plugin_manager(), profile, dest / "streams", ["hub-threshold"])
+    streams, truth = load_streams(dest / "streams", profile)
+    seg = MovementSegmenter(profile).fit(streams)
+    found = seg.predict(streams)
+    assert [len(f) for f in found] == [row["found"] for row in bench["items"]]
+    assert seg.score(streams, truth) == pytest.approx(bench["plugins"][0]["f1"])
+    for spans, motion in zip(found, streams):
+        assert all(0 <= a < b <= motion.n_frames for a, b in spans)
+        assert all(spans[i][1] <= spans[i + 1][0] for i in range(len(spans) - 1))
+    breakpoints = seg.predict_breakpoints(streams)
+    assert [b[-1] for b in breakpoints] == [m.n_frames for m in streams]
+    assert breakpoints[0] == to_breakpoints(found[0], streams[0].n_frames)
+
+
+def test_segmenter_with_a_repertoire_given(data):
+    """Hubs from a repertoire given as (motions, labels) or built: the same segments either way."""
+    dest, profile = data
+    streams, truth = load_streams(dest / "streams", profile)
+    X, y, _ = load_recordings(dest / "repertoire", profile)
+    a = MovementSegmenter(profile, repertoire=(X, y)).fit(streams).predict(streams)
+    b = MovementSegmenter(profile, repertoire=clip_repertoire(X, y, profile)).fit(streams).predict(streams)
+    assert a == b and all(a)
+
+
+def test_grid_search_over_a_segmenter_parameter(data):
+    """A threshold above every movement's distance from the hub finds nothing (F1 0); the search keeps the other.
+    (The template's hub-threshold measures in body sizes: its ``size_threshold``.)"""
+    dest, profile = data
+    streams, truth = load_streams(dest / "streams", profile)
+    search = GridSearchCV(MovementSegmenter(profile), {"segmenter__size_threshold": [0.1, 50.0]}, cv=2)
+    search.fit(streams, truth)
+    assert search.best_params_ == {"segmenter__size_threshold": 0.1}
+    assert list(search.cv_results_["mean_test_score"]) == [1.0, 0.0]
+    assert search.best_estimator_.predict(streams[:1])[0]
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.integers(0, 1000), max_size=12), st.integers(1, 2000))
+def test_to_breakpoints_is_ruptures_form(cuts, n):
+    cuts = sorted(set(c for c in cuts if c < n))
+    segments = list(zip(cuts[::2], cuts[1::2]))
+    b = to_breakpoints(segments, n)
+    assert b[-1] == n and b == sorted(set(b))
+    assert {e for s in segments for e in s if 0 < e < n} == set(b[:-1])
+
+
+def test_cross_val_score_across_performers(performers, data):
+    """Leave one performer out: the scores are those of fitting on one performer and scoring on the other."""
+    _, profile = data
+    X, y, groups = performers
+    assert sorted(set(groups)) == ["max", "morris"]
+    scores = cross_val_score(MovementClassifier(profile), X, y, groups=groups, cv=LeaveOneGroupOut())
+    expected = []
+    for held in ("max", "morris"):
+        train = [i for i, g in enumerate(groups) if g != held]
+        test = [i for i, g in enumerate(groups) if g == held]
+        clf = MovementClassifier(profile).fit([X[i] for i in train], [y[i] for i in train])
+        expected.append(clf.score([X[i] for i in test], [y[i] for i in test]))
+    np.testing.assert_allclose(scores, expected)
+    assert min(scores) > 0.7
+
+
+def test_grid_search_over_a_plugin_parameter(performers, data):
+    """A max_distance far below the noise rejects every demo of a movement known from one take ("unknown"); the
+    search finds the working one. (A movement of several takes is accepted within twice its takes' spread: the
+    template's ``spread``.)"""
+    _, profile = data
+    X, y, groups = performers
+    search = GridSearchCV(MovementClassifier(profile), {"matcher__max_distance": [0.0005, 0.05]},
+                          cv=LeaveOneGroupOut())
+    search.fit(X, y, groups=groups)
+    assert search.best_params_ == {"matcher__max_distance": 0.05}
+    results = search.cv_results_  # split 1 holds Morris out: the observer knows Max's one take of each
+    assert results["split1_test_score"][0] == 0.0 < results["split1_test_score"][1]
+    assert results["mean_test_score"][0] < results["mean_test_score"][1]
+    assert search.best_estimator_.get_params()["matcher__max_distance"] == 0.05
+    assert search.best_estimator_.settings == {"matcher": {"max_distance": 0.05}}
+
+
+def test_clone_keeps_plugin_parameters(data):
+    _, profile = data
+    clf = MovementClassifier(profile, matcher="dtw").set_params(matcher__window=0.3)
+    copy = clone(clf)
+    assert copy is not clf and copy.get_params() == clf.get_params()
+    assert copy.get_params()["matcher__window"] == 0.3
+    assert not hasattr(copy, "character_")
+
+
+PARAMS = {"matcher__k": st.integers(1, 20), "matcher__max_skip": st.integers(1, 5),
+          "matcher__max_distance": st.floats(0.0, 1.0), "matcher__per_movement": st.booleans(),
+          "segmenter__threshold": st.floats(0.001, 0.5), "motor__hub_radius": st.floats(0.0, 0.5),
+          "matcher": st.just("path-search"), "fps": st.floats(1.0, 240.0)}
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(st.dictionaries(st.sampled_from(sorted(PARAMS)), st.none()).flatmap(
+    lambda keys: st.fixed_dictionaries({k: PARAMS[k] for k in keys})))
+def test_get_set_params_round_trip(data, params):
+    _, profile = data
+    clf = MovementClassifier(profile).set_params(**params)
+    got = clf.get_params()
+    for key, value in params.items():
+        assert got[key] == value
+    again = MovementClassifier(profile).set_params(**got)  # every plugin parameter now written in settings
+    plugin = {k: v for k, v in got.items() if k != "settings"}
+    assert {k: v for k, v in again.get_params().items() if k != "settings"} == plugin
+    assert clone(clf).get_params() == got
+
+
+SEGMENTER_PARAMS = {"segmenter__threshold": st.floats(0.0, 1.0), "segmenter__min_duration": st.floats(0.0, 2.0),
+                    "segmenter__release": st.floats(0.0, 1.0), "segmenter": st.just("hub-threshold")}
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(st.dictionaries(st.sampled_from(sorted(SEGMENTER_PARAMS)), st.none()).flatmap(
+    lambda keys: st.fixed_dictionaries({k: SEGMENTER_PARAMS[k] for k in keys})))
+def test_segmenter_get_set_params_round_trip(data, params):
+    _, profile = data
+    seg = MovementSegmenter(profile).set_params(**params)
+    got = seg.get_params()
+    assert {k: got[k] for k in params} == params
+    assert clone(seg).get_params() == got
+
+
+def test_plugin_parameters_follow_the_plugin(data):
+    _, profile = data
+    clf = MovementClassifier(profile)
+    assert "matcher__k" in clf.get_params()
+    clf.set_params(matcher="dtw")
+    params = clf.get_params()
+    assert "matcher__k" not in params and "matcher__window" in params
+    assert "motor__clips" not in params and "motor__profile" not in params
+    seg = MovementSegmenter(profile, segmenter="velocity-direction")
+    assert not any(k.startswith("matcher__") for k in seg.get_params())
+    assert any(k.startswith("segmenter__") for k in seg.get_params())
+
+
+def test_errors(data):
+    dest, profile = data
+    X, y, _ = load_recordings(dest / "repertoire", profile)
+    clf = MovementClassifier(profile)
+    with pytest.raises(EstimatorInputError, match="31 motions and 30 labels"):
+        clf.fit(X, y[:-1])
+    with pytest.raises(ValueError, match=r"X\[1\] has shape \(10, 3\)"):
+        clf.fit([X[0], np.zeros((10, 3))], y[:2])
+    with pytest.raises(EstimatorInputError, match="X is one motion"):
+        clf.fit(X[0], y[:1])
+    with pytest.raises(EstimatorInputError, match="the label 'unknown'"):
+        clf.fit(X[:2], ["bow", UNKNOWN])
+    with pytest.raises(EstimatorInputError, match="without '#'"):
+        clf.fit(X[:2], ["bow", "bow#2"])
+    with pytest.raises(EstimatorInputError) as err:
+        clf.set_params(matcher__kk=3)
+    assert "unknown parameter 'matcher__kk' of matcher plugin 'path-search'" in str(err.value)
+    assert "matcher__k" in err.value.available and "segmenter__threshold" in err.value.available
+    with pytest.raises(EstimatorInputError, match="unknown parameter 'nosuch__k'"):
+        clf.set_params(nosuch__k=3)
+    with pytest.raises(EstimatorInputError, match="unknown parameter 'matchr'"):
+        clf.set_params(matchr="dtw")
+    with pytest.raises(EstimatorInputError, match="out of range"):
+        clf.set_params(matcher__k=0)
+    with pytest.raises(EstimatorInputError, match="has no capture group"):
+        load_recordings(dest / "repertoire", profile, group="max")
+    streams, truth = load_streams(dest / "streams", profile)
+    with pytest.raises(EstimatorInputError, match="2 streams and 1 segment lists"):
+        MovementSegmenter(profile).fit(streams).score(streams, truth[:1])
+    from sklearn.exceptions import NotFittedError
+
+    with pytest.raises(NotFittedError):
+        MovementClassifier(profile).predict(X)
