@@ -238,6 +238,15 @@ CASES = [
     ("show-recording-view", "recordings shown by a view that draws none", {"p.toml": PROFILE, "m.bvh": BVH}, ["show", "--body", "p.toml", "m.bvh", "--view", "posegraph"], ["key --view", "view 'posegraph' does not draw recordings", "available:", "speed-profile"]),
     ("show-recording-no-body", "a recording shown without its body profile", {"m.bvh": BVH}, ["show", "m.bvh", "--view", "body"], ["key character", "cannot show m.bvh", "with --body PROFILE recordings"]),
     ("show-recordings-one-png", "two recordings' pictures to one file", {"p.toml": PROFILE, "m.bvh": BVH}, ["show", "--body", "p.toml", "m.bvh", "m.bvh", "--view", "hub-signal", "--out", "x.png"], ["x.png: key --out", "one file for several pictures", "expected a folder"]),
+    # -- wiring: joint-position recordings through profiles, --fps, live input (issue 20)
+    ("observe-unknown-format", "a recording of an unknown format", {"p.toml": PROFILE, "m.txt": "x"}, ["observe", "--body", "p.toml", "--repertoire", ".", "m.txt"], ["m.txt: unknown recording format '.txt'", "available: .bvh, .csv, .npy"]),
+    ("observe-stdin-and-files", "standard input mixed with files", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "-", "m.bvh"], ["key files: '-' (standard input) with 1 other file(s)", "expected either '-' alone"]),
+    ("csv-no-frame-rate", "a CSV without a time column, no --fps, no fps in the profile", {"p.toml": PROFILE, "m.csv": "hips_x,hips_y,hips_z\n0,1,2\n"}, ["validate", "--body", "p.toml", "m.csv"], ["m.csv: no frame rate: the file has no 'time' column", "--fps"]),
+    ("csv-missing-joint", "a CSV without a joint the profile maps", {"p.toml": PROFILE, "m.csv": "hips_x,hips_y,hips_z,head_x,head_y,head_z\n0,1,2,0,2,0\n"}, ["validate", "--fps", "30", "--body", "p.toml", "m.csv"], ["p.toml:7: key parts.nose", "joint 'head_end' of part 'nose' is not in m.csv", "available: hips, head"]),
+    ("npy-not-an-array", "a .npy file that is text", {"m.npy": "x"}, ["validate", "--fps", "30", "m.npy"], ["m.npy: not a readable .npy array", "expected a NumPy array (frames, joints, 3) of numbers"]),
+    ("fps-option", "--fps of 0", {"m.bvh": BVH}, ["validate", "--fps", "0", "m.bvh"], ["argument --fps: invalid frame rate '0'", "expected frames per second in (0, 10000]"]),
+    ("profile-fps", "a profile's fps is not a frame rate", {"p.toml": PROFILE.replace('units = "cm"', 'units = "cm"\nfps = -30')}, ["validate", "p.toml"], ["p.toml:4: key profile.fps: invalid fps -30", "expected frames per second"]),
+    ("profile-joints", "a profile's joints list lacks a mapped joint", {"p.toml": PROFILE.replace('units = "cm"', 'units = "cm"\njoints = ["hips", "head"]')}, ["validate", "p.toml"], ["p.toml:4: key profile.joints: joint 'head_end' of part 'nose' is not in the joints list", "available: hips, head"]),
 ]
 
 

@@ -147,7 +147,9 @@ def test_a_bounded_working_memory_gives_the_observations_an_unbounded_one_gives(
         got = fed(bounded, positions, cuts)
     assert key(got) == key(whole)
     held = bounded.memory.n - bounded.memory.offset
-    assert bounded.memory.offset > 0 and held < len(positions)
+    needed = bounded.memory.n - bounded.loop.needed_from  # the rows from the oldest one still needed
+    assert 1 <= needed <= len(positions)
+    assert held <= max(2 * needed, 1)  # never more than twice what it needs (ObservationLog.forget)
 
 
 def test_a_segment_that_never_closes_is_cut_every_max_segment_seconds(data, profile, pm, scripted):

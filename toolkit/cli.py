@@ -89,6 +89,20 @@ def count_type(low: int, high: int) -> Any:
     return parse
 
 
+def fps_type(text: str) -> float:
+    """``--fps``: a frame rate in (0, :data:`toolkit.positions.MAX_FPS`] Hz, the range every reader accepts."""
+    from toolkit.positions import MAX_FPS
+
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid number: {text!r}") from None
+    if not (math.isfinite(value) and 0.0 < value <= MAX_FPS):
+        raise argparse.ArgumentTypeError(f"invalid frame rate {text!r}: expected frames per second in "
+                                         f"(0, {MAX_FPS:g}]")
+    return value
+
+
 OUTPUT_FILES = {"json": "--json", "csv": "--csv", "plot": "--plot", "out": "--out"}
 """Arguments naming a file a command writes, and how they are named in messages (a string value only: ``likeme run
 --json`` is a flag and is left alone)."""
@@ -217,10 +231,16 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
                    "the template's)")
     p.set_defaults(handler=cmd_show)
 
-    p = sub.add_parser("observe", help="watch motion-capture files: segments, recognised movements, decisions")
-    p.add_argument("files", nargs="+", metavar="FILE.bvh")
+    p = sub.add_parser("observe", help="watch recordings (BVH, CSV joint positions, .npy arrays, or '-': frames "
+                       "piped in): segments, recognised movements, decisions")
+    p.add_argument("files", nargs="+", metavar="FILE", help="recordings (.bvh, .csv, .npy; see docs/formats.md), or "
+                   "'-' alone: CSV or JSON lines on standard input, each observation printed as its segment closes")
     p.add_argument("--body", required=True, metavar="PROFILE", help="body profile TOML of the files")
     p.add_argument("--repertoire", required=True, metavar="DIR", help="labelled clips: one folder per movement")
+    p.add_argument("--fps", type=fps_type, default=None, metavar="HZ",
+                   help="frame rate of recordings without one of their own (a CSV without a time column, a .npy "
+                   "array, standard input); wins over the profile's fps; a BVH's Frame Time and a CSV's time column "
+                   "win over it")
     p.add_argument("--segmenter", metavar="NAME", help="segmenter (default: the observer template's, "
                    "characters/observers/recordings.toml)")
     p.add_argument("--matcher", metavar="NAME", help="matcher (default: the observer template's)")
@@ -235,11 +255,15 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print JSON instead of text")
     p.set_defaults(handler=cmd_observe)
 
-    p = sub.add_parser("validate", help="check character, scenario and body-profile files and BVH motion files")
-    p.add_argument("files", nargs="+", metavar="FILE", help="character, scenario or profile TOML files, or BVH files")
-    p.add_argument("--body", metavar="PROFILE", help="also check that each BVH file has the joints this profile maps, "
-                   "and warn where the profile is probably wrong for it (units, up axis, facing)")
+    p = sub.add_parser("validate", help="check character, scenario and body-profile files and recordings")
+    p.add_argument("files", nargs="+", metavar="FILE", help="character, scenario or profile TOML files, or "
+                   "recordings (.bvh, .csv, .npy)")
+    p.add_argument("--body", metavar="PROFILE", help="also check that each recording has the joints this profile "
+                   "maps (and read a .npy array with its joint names), and warn where the profile is probably wrong "
+                   "for it (units, up axis, facing)")
     p.add_argument("--strict", action="store_true", help="exit with status 1 on a warning too")
+    p.add_argument("--fps", type=fps_type, default=None, metavar="HZ",
+                   help="frame rate of recordings without one of their own (as for observe)")
     p.set_defaults(handler=cmd_validate)
 
     p = sub.add_parser("profile", help="propose a body profile for a recording (BVH, or CSV joint positions)")
@@ -597,17 +621,55 @@ def _recording_views(pm: PluginManager) -> list[str]:
     return [n for n in pm.registry.names("view") if getattr(pm.registry.get("view", n), "recordings", None)]
 
 
-def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
-    import json
+def _segment_row(o: Any) -> dict[str, Any]:
+    """One observation as ``likeme observe`` reports it."""
+    return {"start_frame": o.segment.start, "end_frame": o.segment.end, "start_s": round(o.segment.start_time, 3),
+            "end_s": round(o.segment.end_time, 3), "movement": o.movement or "unknown",
+            "confidence": round(o.match.confidence, 3) if o.match else 0.0,
+            "decided_at_frame": o.segment.start + (o.decided_at if o.decided_at is not None else o.segment.n_frames),
+            "decision_fraction": round(o.decision_fraction, 3), **_why_unknown(o)}
 
-    from toolkit.files import check_regular_file
+
+def _segment_text(seg: dict[str, Any]) -> str:
+    """One segment as ``likeme observe`` prints it (two lines for an unknown one with its reason)."""
+    line = (f"  frames {seg['start_frame']:5d}-{seg['end_frame']:<5d} ({seg['start_s']:6.2f}-{seg['end_s']:6.2f} s)  "
+            f"{seg['movement']:<16} confidence {seg['confidence']:.2f}  decided at frame {seg['decided_at_frame']} "
+            f"({seg['decision_fraction']:.0%} of the segment)")
+    if "nearest" in seg or "reason" in seg:
+        line += f"\n    {_why_text(seg)}"
+    return line
+
+
+def _file_error(err: LikemeError, path: str) -> str:
+    """An error while reading or watching ``path``, as one line naming the file (a plugin's failure: at the end)."""
+    text = str(err)
+    return text if path in text else f"{text} (watching {path})"
+
+
+def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
+    """Watch recordings (``.bvh``, ``.csv``, ``.npy``, or ``-``: frames on standard input) with an observer.
+
+    Each file is reported when it has been watched; a file that fails is reported as one ``likeme: error:`` line
+    on standard error naming it, the others are still watched, and the command exits with status 1 at the end.
+    """
     from toolkit.observe import NO_CORRESPONDENCE, Observer, compose_observer, observer_plugins
     from toolkit.params import check_settings, parse_settings
     from toolkit.profile import load_profile
 
     profile = load_profile(args.body)
-    for path in args.files:  # a FIFO, a device, a directory or a missing file fails before any work
-        check_regular_file(path, "BVH file", "motion")
+    if "-" in args.files and len(args.files) > 1:
+        raise ConfigError(f"'-' (standard input) with {len(args.files) - 1} other file(s)", key=("files",),
+                          expected="either '-' alone (frames piped in) or recording files")
+    files, failed = [], 0
+    for path in args.files if args.files != ["-"] else ():
+        try:  # a FIFO, a device, a directory, a missing file or an unknown format is reported before any work
+            _check_recording_path(path)
+            files.append(path)
+        except LikemeError as err:
+            failed += 1
+            print(f"likeme: error: {_file_error(err, str(path))}", file=sys.stderr)
+    if failed and not files:
+        return 1
     for name, kind in ((args.segmenter, "segmenter"), (args.matcher, "matcher"), (args.correspondence, "correspondence")):
         if name is not None and name != NO_CORRESPONDENCE:
             pm.registry.get(kind, name)  # an unknown name fails here, listing the registered ones
@@ -619,34 +681,80 @@ def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
                                  correspondence=args.correspondence or "",
                                  lengths_for_height="" if args.lengths_for_height is None else args.lengths_for_height,
                                  settings=settings)
+    if args.files == ["-"]:
+        return _observe_live(args, character, profile, Observer)
     report = []
-    for path in args.files:
-        # the file streamed a block of frames at a time (header first), so reading memory does not grow with it
-        with profile.stream(path) as motion:
-            observer = Observer(character, profile.body, motion.fps)
-            observer.reset()
-            found = []
-            for positions, visible in motion:
-                found.extend(observer.push_block(positions, visible))
-            found.extend(observer.flush())
-        report.append({"file": str(path), "frames": motion.n_frames, "fps": round(motion.fps, 3), "segments": [
-            {"start_frame": o.segment.start, "end_frame": o.segment.end, "start_s": round(o.segment.start_time, 3),
-             "end_s": round(o.segment.end_time, 3), "movement": o.movement or "unknown",
-             "confidence": round(o.match.confidence, 3) if o.match else 0.0,
-             "decided_at_frame": o.segment.start + (o.decided_at if o.decided_at is not None else o.segment.n_frames),
-             "decision_fraction": round(o.decision_fraction, 3), **_why_unknown(o)} for o in found]})
-    if args.json:
-        print(json.dumps(report, indent=1))
-        return 0
-    for entry in report:
+    for path in files:
+        try:
+            entry = _observe_file(path, args, character, profile, Observer)
+        except LikemeError as err:
+            failed += 1
+            sys.stdout.flush()  # the files before it first, then its error
+            print(f"likeme: error: {_file_error(err, str(path))}", file=sys.stderr)
+            continue
+        if args.json:
+            report.append(entry)
+            continue
         n = len(entry["segments"])
         print(f"{entry['file']}: {entry['frames']} frames at {entry['fps']:g} fps, {n} segment{'' if n == 1 else 's'}")
         for seg in entry["segments"]:
-            print(f"  frames {seg['start_frame']:5d}-{seg['end_frame']:<5d} ({seg['start_s']:6.2f}-{seg['end_s']:6.2f} s)  "
-                  f"{seg['movement']:<16} confidence {seg['confidence']:.2f}  decided at frame {seg['decided_at_frame']} "
-                  f"({seg['decision_fraction']:.0%} of the segment)")
-            if "nearest" in seg or "reason" in seg:
-                print(f"    {_why_text(seg)}")
+            print(_segment_text(seg))
+    if args.json:
+        print(json.dumps(report, indent=1))
+    return 1 if failed else 0
+
+
+def _check_recording_path(path: str) -> None:
+    """A recording named on the command line: a regular file (not a FIFO, a device or a folder) of a known format."""
+    from toolkit.files import check_regular_file
+    from toolkit.profile import recording_format
+
+    check_regular_file(path, "BVH file" if Path(path).suffix.lower() not in (".csv", ".npy") else
+                       "recording of joint positions", "motion")
+    recording_format(path)
+
+
+def _observe_file(path: str, args: argparse.Namespace, character: Any, profile: Any, observer_class: Any) -> dict:
+    """Watch one recording file; its report entry."""
+    # the file streamed a block of frames at a time (header first), so reading memory does not grow with it
+    with profile.stream(path, fps=args.fps) as motion:
+        observer = observer_class(character, profile.body, motion.fps)
+        observer.reset()
+        found = []
+        for positions, visible in motion:
+            found.extend(observer.push_block(positions, visible))
+        found.extend(observer.flush())
+    return {"file": str(path), "frames": motion.n_frames, "fps": round(motion.fps, 3),
+            "segments": [_segment_row(o) for o in found]}
+
+
+def _observe_live(args: argparse.Namespace, character: Any, profile: Any, observer_class: Any) -> int:
+    """``likeme observe -``: frames on standard input, each observation printed (and flushed) as its segment closes."""
+    import numpy as np
+
+    from toolkit.live import SOURCE, LiveInput
+
+    live = LiveInput(sys.stdin.buffer, profile, args.fps if args.fps is not None else profile.fps)
+    observer = observer_class(character, profile.body, live.fps)
+    observer.reset()
+    count = frames = 0
+
+    def emit(observations: list) -> None:
+        nonlocal count
+        for o in observations:
+            seg = _segment_row(o)
+            count += 1
+            print(json.dumps({"file": SOURCE, **seg}) if args.json else _segment_text(seg), flush=True)
+
+    if not args.json:
+        print(f"{SOURCE}: standard input at {live.fps:g} fps", flush=True)
+    for positions in live:
+        frames += 1
+        emit(observer.push(positions, np.isfinite(positions).all(axis=-1)))
+    emit(observer.flush())
+    if not args.json:
+        print(f"{SOURCE}: {frames} frames at {round(live.fps, 3):g} fps, {count} segment{'' if count == 1 else 's'}",
+              flush=True)
     return 0
 
 
@@ -696,7 +804,8 @@ def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
         warned += _warn(args.body, _profile_warnings(profile))
     for path in args.files:
         try:
-            if str(path).lower().endswith(".bvh"):
+            suffix = Path(path).suffix.lower()
+            if suffix == ".bvh":
                 with open_bvh(path) as bvh:  # every frame read and checked, a block at a time
                     for _ in bvh.blocks():
                         pass
@@ -707,6 +816,9 @@ def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
                 print(line)
                 if profile is not None:  # where the profile is probably wrong for this file (plugins/lib/profile_check)
                     warned += _warn(path, _recording_warnings(profile, path, flips))
+                continue
+            if suffix in (".csv", ".npy"):
+                print(_validate_positions(path, profile, args.fps))
                 continue
             table = read_toml(check_regular_file(path, "TOML file", "config"))
             if is_scenario(table):
@@ -844,6 +956,49 @@ def cmd_profile(args: argparse.Namespace, pm: PluginManager) -> int:
         print(f"likeme: note: {args.file}: TODO: {text}", file=sys.stderr)
     _warn(args.file, warnings)
     return 0
+
+
+def _validate_positions(path: str, profile: Any, fps: float | None) -> str:
+    """``likeme validate`` of a CSV or ``.npy`` recording: every frame read and checked, a block at a time; with a
+    profile, its joints checked against the profile's and read as it reads them."""
+    import numpy as np
+
+    from toolkit.positions import iter_position_blocks
+
+    kind = "CSV" if Path(path).suffix.lower() == ".csv" else "NumPy array"
+    rate = fps if fps is not None or profile is None else profile.fps
+    if profile is not None:
+        names = profile.npy_joints if kind != "CSV" else None
+    elif kind != "CSV":
+        names = _npy_joint_names(path)
+    else:
+        names = None
+    header, blocks = iter_position_blocks(path, names=names, fps=rate)
+    unmapped = profile.check(header) if profile is not None else []
+    frames = hidden = 0
+    for block in blocks:
+        frames += len(block)
+        hidden += int((~np.isfinite(block).all(axis=-1)).sum())
+    line = (f"ok    {path}: {kind}: {len(header.names)} joints, {frames} frames at {header.fps:g} fps, "
+            f"{hidden} missing joint positions")
+    if profile is not None:
+        line += f"; profile {profile.name!r} maps {len(profile.joints)}, leaves {len(unmapped)} unmapped"
+    return line
+
+
+def _npy_joint_names(path: str) -> list[str] | None:
+    """Placeholder joint names (``joint_0``...) for a ``.npy`` array validated without a profile, or None when its
+    header is not that of an array of joints (the reader then names what is wrong)."""
+    import numpy as np
+
+    from toolkit.files import check_regular_file
+
+    check_regular_file(path, "recording of joint positions", "motion")
+    try:
+        shape = np.load(path, mmap_mode="r", allow_pickle=False).shape
+    except (ValueError, OSError, EOFError):
+        return None
+    return [f"joint_{k}" for k in range(shape[1])] if len(shape) == 3 and 0 < shape[1] <= 10_000 else None
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -306,6 +306,11 @@ def _field_starts(line: str, delimiter: str) -> list[int]:
 def _layout(path: Path, names: tuple[str, ...] | None) -> _Layout:
     with _open(path) as f:
         line = _read_line(f, 1, path)
+    return _parse_header(line, path, names)
+
+
+def _parse_header(line: str, path: Path, names: tuple[str, ...] | None) -> _Layout:
+    """A header line's layout (also the header of CSV lines on standard input, :mod:`toolkit.live`)."""
     if not line.strip():
         raise ConfigError("no header line" if not line else "the header line is empty", file=path, line=1,
                           expected="a header naming the columns JOINT_x, JOINT_y, JOINT_z of each joint")

@@ -3,10 +3,13 @@
 A profile is a TOML file (``docs/conventions.md`` has the format) saying which
 source joints are the tracked body parts, which part is the root, which parts
 give the facing (a left/right pair and an optional forward marker, like the
-paper's knees and nose), the source's up axis and its units. Reading a BVH file
+paper's knees and nose), the source's up axis and its units. Reading a recording
 through a profile gives a :class:`~toolkit.motion.Motion` of world positions in
 metres with ``+y`` up, one column per tracked part, and the :class:`Body` to
-perceive it with.
+perceive it with. Recordings are read by their suffix (:data:`RECORDING_SUFFIXES`,
+``docs/formats.md``): BVH files, CSV joint positions and ``.npy`` arrays
+(:mod:`toolkit.positions`); the optional ``fps`` key gives the frame rate of
+files without one of their own, ``joints`` the joint names of a ``.npy`` array.
 
 Example (the Bandai-Namco skeleton, ``characters/profiles/bandai-namco.toml``)::
 
@@ -28,7 +31,7 @@ Example (the Bandai-Namco skeleton, ``characters/profiles/bandai-namco.toml``)::
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -37,13 +40,14 @@ import numpy as np
 
 from toolkit.body import Body
 import toolkit.bvh as bvh_module
-from toolkit.bvh import BVH, BVHStream, open_bvh, read_bvh
+from toolkit.bvh import BVH, open_bvh, read_bvh
 from toolkit.errors import ConfigError
 from toolkit.files import check_regular_file
 from toolkit.motion import Motion
 from toolkit.params import finite_number
 
-__all__ = ["BodyProfile", "MotionStream", "is_profile", "load_profile", "UNITS", "UP_AXES"]
+__all__ = ["BodyProfile", "MotionStream", "is_profile", "load_profile", "recording_format", "RECORDING_SUFFIXES",
+           "UNITS", "UP_AXES"]
 
 UNITS: dict[str, float] = {"metre": 1.0, "meter": 1.0, "m": 1.0, "centimetre": 0.01, "centimeter": 0.01, "cm": 0.01,
                            "millimetre": 0.001, "millimeter": 0.001, "mm": 0.001, "inch": 0.0254, "in": 0.0254,
@@ -60,8 +64,24 @@ UP_AXES: dict[str, np.ndarray] = {
 }
 """Rotations taking a source whose up axis is the key to likeme's ``+y`` up (right-handed, proper rotations)."""
 
-_PROFILE_KEYS = ("name", "description", "units", "up")
+_PROFILE_KEYS = ("name", "description", "units", "up", "fps", "joints")
 _TABLES = ("profile", "parts", "facing", "bones", "colours")
+
+
+RECORDING_SUFFIXES = (".bvh", ".csv", ".npy")
+"""The recording formats a profile reads, by file name suffix (any case): BVH, CSV joint positions, NumPy arrays
+(``docs/formats.md``)."""
+
+
+def recording_format(path: str | Path) -> str:
+    """A recording's format, its suffix in lower case (one of :data:`RECORDING_SUFFIXES`); a :class:`ConfigError`
+    listing the accepted suffixes for any other."""
+    suffix = Path(path).suffix.lower()
+    if suffix not in RECORDING_SUFFIXES:
+        raise ConfigError(f"unknown recording format {Path(path).suffix or '(no suffix)'!r}", file=path,
+                          expected="a recording named by its format: .bvh (BVH), .csv (joint positions) or .npy "
+                                   "(NumPy array of joint positions)", available=RECORDING_SUFFIXES)
+    return suffix
 
 
 @dataclass(frozen=True)
@@ -80,6 +100,13 @@ class BodyProfile:
     up : str
         The source's up axis (``"+y"``, ``"+z"``...).
     file : Path or None
+    fps : float or None
+        The frame rate of recordings without one of their own (a CSV without a ``time`` column, a ``.npy`` array):
+        the ``[profile]`` table's ``fps`` key. A ``fps`` argument of :meth:`read` and :meth:`stream` wins over it;
+        a BVH's ``Frame Time`` and a CSV's ``time`` column win over both.
+    array_joints : tuple of str or None
+        The joints of a ``.npy`` array, in the array's order (the ``[profile]`` table's ``joints`` key); without
+        it, an array's joints are the mapped joints, in the order of ``[parts]`` (each once).
     """
 
     name: str
@@ -89,6 +116,8 @@ class BodyProfile:
     up: str = "+y"
     file: Path | None = None
     description: str = ""
+    fps: float | None = None
+    array_joints: tuple[str, ...] | None = None
 
     def _where(self, part: str) -> dict[str, Any]:
         from toolkit.character import find_key_line
@@ -96,78 +125,116 @@ class BodyProfile:
         key = ("parts", part)
         return {"file": self.file, "key": key, "line": find_key_line(self.file, key) if self.file else None}
 
-    def check(self, bvh: BVH) -> list[str]:
-        """Raise a :class:`ConfigError` naming any mapped joint the file lacks; return the joints left unmapped."""
-        names = bvh.names
+    @property
+    def npy_joints(self) -> tuple[str, ...]:
+        """The joint names of a ``.npy`` array read through this profile: :attr:`array_joints`, else the mapped
+        joints in the order of ``[parts]``, each once."""
+        return self.array_joints if self.array_joints is not None else tuple(dict.fromkeys(self.joints))
+
+    def check(self, recording: Any) -> list[str]:
+        """Raise a :class:`ConfigError` naming any mapped joint the recording lacks (with the joints it has); return
+        the joints left unmapped.
+
+        ``recording`` has ``names`` (its joints) and ``source`` (its file name): a :class:`~toolkit.bvh.BVH` or a
+        :class:`~toolkit.positions.JointPositions` (a header is enough).
+        """
+        names = list(recording.names)
         for part, joint in zip(self.body.parts, self.joints):
             if joint not in names:
-                raise ConfigError(f"joint {joint!r} of part {part!r} is not in {bvh.source}", **self._where(part),
-                                  expected="a joint of the file", available=names)
+                raise ConfigError(f"joint {joint!r} of part {part!r} is not in {recording.source}",
+                                  **self._where(part), expected="a joint of the file", available=names)
         used = set(self.joints)
         return [n for n in names if n not in used]
 
-    def convert(self, joint_positions: np.ndarray, names: list[str]) -> np.ndarray:
+    def convert(self, joint_positions: np.ndarray, names: list[str] | tuple[str, ...]) -> np.ndarray:
         """Source joint positions (F, J, 3) to part positions (F, P, 3) in metres, +y up."""
-        index = [names.index(j) for j in self.joints]
+        index = [list(names).index(j) for j in self.joints]
         return (joint_positions[:, index] * self.scale) @ UP_AXES[self.up].T
 
     def motion(self, bvh: BVH) -> Motion:
-        """The world positions of the tracked parts over the file's frames."""
+        """The world positions of the tracked parts over a BVH file's frames."""
         self.check(bvh)
         return Motion(self.convert(bvh.positions(), bvh.names), bvh.fps, self.body.parts)
 
-    def read(self, path: str | Path) -> Motion:
-        """Read a BVH file and return its motion through this profile."""
-        return self.motion(read_bvh(path))
+    def read(self, path: str | Path, fps: float | None = None) -> Motion:
+        """Read a recording (``.bvh``, ``.csv`` or ``.npy``, by its suffix) and return its motion through this profile.
 
-    def stream(self, path: str | Path, block: int | None = None) -> MotionStream:
-        """A BVH file's motion through this profile, ``block`` frames at a time (:class:`MotionStream`).
-
-        ``block`` defaults to :data:`toolkit.bvh.BLOCK`. The header is read and checked against the profile at
-        once; the frames follow as they are iterated, with forward kinematics run per block, so the memory does not
-        grow with the file. The blocks are ``profile.read(path)`` sliced, bit for bit, and a bad value raises the
-        error ``read`` raises.
+        ``fps``: the frame rate of a recording without one of its own (a CSV without a ``time`` column, a ``.npy``
+        array); it wins over the profile's ``fps`` and is ignored for a BVH file and a CSV with a time column.
         """
-        bvh = open_bvh(path)
-        try:
-            self.check(bvh.header)
-        except BaseException:
-            bvh.close()
-            raise
-        return MotionStream(self, bvh, bvh_module.BLOCK if block is None else block)
+        if recording_format(path) == ".bvh":
+            return self.motion(read_bvh(path))
+        with self.stream(path, fps=fps) as motion:
+            blocks = [positions for positions, _ in motion]
+        positions = np.concatenate(blocks) if blocks else np.empty((0, len(self.body.parts), 3))
+        return Motion(positions, motion.fps, self.body.parts)
+
+    def stream(self, path: str | Path, block: int | None = None, fps: float | None = None) -> MotionStream:
+        """A recording's motion through this profile, ``block`` frames at a time (:class:`MotionStream`).
+
+        ``block`` defaults to :data:`toolkit.bvh.BLOCK`; ``fps`` as for :meth:`read`. The header is read and checked
+        against the profile at once (the joint names, the frame rate); the frames follow as they are iterated, a
+        block at a time (for a BVH file with forward kinematics run per block), so the memory does not grow with
+        the file. The blocks are ``profile.read(path)`` sliced, bit for bit, and a bad value raises the error
+        ``read`` raises.
+        """
+        block = bvh_module.BLOCK if block is None else max(1, int(block))
+        if recording_format(path) == ".bvh":
+            bvh = open_bvh(path)
+            try:
+                self.check(bvh.header)
+            except BaseException:
+                bvh.close()
+                raise
+            header = bvh.header
+            return MotionStream(self, bvh.names, bvh.fps, (header._kinematics(v)[0] for v in bvh.blocks(block)),
+                                bvh.close, n_frames=bvh.n_frames)
+        from toolkit.positions import iter_position_blocks
+
+        rate = fps if fps is not None else self.fps
+        if recording_format(path) == ".npy":
+            header, blocks = iter_position_blocks(path, names=self.npy_joints, fps=rate, frames=block)
+        else:
+            header, blocks = iter_position_blocks(path, fps=rate, frames=block)
+        self.check(header)
+        return MotionStream(self, header.names, header.fps, blocks, getattr(blocks, "close", None))
 
 
 class MotionStream:
-    """The blocks of a motion file read through a profile (made by :meth:`BodyProfile.stream`).
+    """The blocks of a recording read through a profile (made by :meth:`BodyProfile.stream`).
 
-    ``fps``, ``n_frames`` and ``parts`` are known before the first block; iterating yields ``(positions, visible)``
-    blocks, positions (k, P, 3) in metres with +y up and visibility (k, P), as :meth:`BodyProfile.read` would give
-    them. A context manager: leaving it closes the file.
+    ``fps`` and ``parts`` are known before the first block; iterating yields ``(positions, visible)`` blocks,
+    positions (k, P, 3) in metres with +y up and visibility (k, P), as :meth:`BodyProfile.read` would give them.
+    ``n_frames`` is the file's frame count for a BVH file (from its header), for the other formats the number of
+    frames read so far (all of them once iterated). A context manager: leaving it closes the file.
     """
 
-    def __init__(self, profile: BodyProfile, bvh: BVHStream, block: int) -> None:
-        self.profile, self.bvh, self.block = profile, bvh, max(1, int(block))
+    def __init__(self, profile: BodyProfile, names: Sequence[str], fps: float, blocks: Iterator[np.ndarray],
+                 close: Callable[[], Any] | None = None, *, n_frames: int | None = None) -> None:
+        self.profile, self.names, self._fps = profile, list(names), float(fps)
+        self._blocks, self._close, self._n_frames, self._read = blocks, close, n_frames, 0
 
     @property
     def fps(self) -> float:
-        return self.bvh.fps
+        return self._fps
 
     @property
     def n_frames(self) -> int:
-        return self.bvh.n_frames
+        return self._n_frames if self._n_frames is not None else self._read
 
     @property
     def parts(self) -> list[str]:
         return list(self.profile.body.parts)
 
     def __iter__(self) -> Iterator[tuple[np.ndarray, np.ndarray]]:
-        header, names = self.bvh.header, self.bvh.names
-        for values in self.bvh.blocks(self.block):
-            positions = self.profile.convert(header._kinematics(values)[0], names)
+        for values in self._blocks:
+            positions = self.profile.convert(values, self.names)
+            self._read += len(positions)
             yield positions, np.isfinite(positions).all(axis=-1)
 
     def close(self) -> None:
-        self.bvh.close()
+        if self._close is not None:
+            self._close()
 
     def __enter__(self) -> MotionStream:
         return self
@@ -239,5 +306,28 @@ def load_profile(path: str | Path) -> BodyProfile:
         key = exc.key if exc.key and exc.key[0] in ("bones", "colours") else ("facing", *exc.key[1:]) if exc.key and \
             exc.key[0] in ("facing", "root") else exc.key
         raise fail(exc.problem, key, expected=exc.expected, available=exc.available) from None
+    fps = head.get("fps")
+    if fps is not None:
+        from toolkit.positions import MAX_FPS
+
+        if isinstance(fps, bool) or not isinstance(fps, int | float) or not 0 < fps <= MAX_FPS:  # NaN fails too
+            raise fail(f"invalid fps {fps!r}", ("profile", "fps"),
+                       expected=f"frames per second of recordings without a time of their own, a number in "
+                                f"(0, {MAX_FPS:g}]")
+        fps = float(fps)
+    array_joints = head.get("joints")
+    if array_joints is not None:
+        if not isinstance(array_joints, list) or not array_joints or \
+                not all(isinstance(j, str) and j for j in array_joints):
+            raise fail(f"invalid joints {array_joints!r}", ("profile", "joints"),
+                       expected="a list naming the joints of a .npy array in order, like joints = [\"Hips\", ...]")
+        twice = sorted({j for j in array_joints if array_joints.count(j) > 1})
+        if twice:
+            raise fail(f"joints named twice: {twice}", ("profile", "joints"), expected="each joint once")
+        for part, joint in parts.items():
+            if joint not in array_joints:
+                raise fail(f"joint {joint!r} of part {part!r} is not in the joints list", ("profile", "joints"),
+                           expected="a list holding every joint [parts] maps", available=array_joints)
+        array_joints = tuple(array_joints)
     return BodyProfile(str(head.get("name", path.stem)), body, tuple(parts.values()), scale, up, path,
-                       str(head.get("description", "")))
+                       str(head.get("description", "")), fps, array_joints)

@@ -391,6 +391,8 @@ class WatchingLoop:
         self._known: set[str] = set()  # movements found in the motor system's repertoire
         self._keep_frames: int | None = None
         self._max_frames: int | None = None
+        self.needed_from = 0  # with ``keep``: the oldest row still needed, as of the last packet (memory holds at
+        # most twice the rows from there on: ObservationLog.forget)
 
     # -- the stream ----------------------------------------------------------------------------------------
 
@@ -407,6 +409,7 @@ class WatchingLoop:
         self.perceived = ObservationLog(own, fps, capacity=capacity) if self.character.correspondence else None
         self._open, self._view, self._early = None, None, None
         self._since, self._floor, self._last_end, self._known = -1, 0, 0, set()
+        self.needed_from = 0
         bounded = self.keep is not None
         self._keep_frames = int(round(self.keep * float(fps))) if bounded else None
         self._max_frames = max(1, int(round(self.max_segment * float(fps)))) if bounded and self.max_segment else None
@@ -524,6 +527,7 @@ class WatchingLoop:
         holds = getattr(self.character.segmenter, "holds_since", None)
         if isinstance(holds, (int, np.integer)) and holds >= 0:
             need = min(need, max(int(holds), self._floor, n - self._max_frames if self._max_frames else 0))
+        self.needed_from = need
         self.memory.forget(need)
         if self.perceived is not None:
             self.perceived.forget(need)

@@ -14,10 +14,21 @@ terminal).
 from __future__ import annotations
 
 import io
-from collections.abc import Sequence
-from typing import Any
+from collections.abc import Iterable, Sequence
+from typing import Any, TypeVar
 
-__all__ = ["text_table"]
+T = TypeVar("T")
+
+__all__ = ["text_table", "progress"]
+
+
+def progress(items: Iterable[T], label: str) -> Iterable[T]:
+    """``items`` with a progress bar on standard error (never standard output: a piped table starts with the table),
+    cleared when done; the bar is drawn only where standard error is a terminal."""
+    from rich.console import Console
+    from rich.progress import track
+
+    return track(items, description=label, transient=True, console=Console(stderr=True))
 
 
 def text_table(rows: Sequence[Sequence[Any]], columns: Sequence[tuple[str, str]], *, header: bool = True,

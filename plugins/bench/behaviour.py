@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from plugins.bench import progress as progress_bar
 from toolkit import World, load_character
 from toolkit.state import write_atomic
 
@@ -83,9 +84,7 @@ def behaviour_benchmark(pm: Any, *, episodes: int = 100, seed: int = 0, progress
     jobs = [c for c in BEHAVIOUR_CONDITIONS for _ in range(episodes)]
     started = time.perf_counter()
     if progress:
-        from rich.progress import track
-
-        jobs = track(jobs, description="behaviour episodes", transient=True)
+        jobs = progress_bar(jobs, "behaviour episodes")
     rows = [_episode(pm, rng, c) for c in jobs]
     elapsed = time.perf_counter() - started
     table = {}

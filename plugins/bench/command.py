@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from toolkit import hookimpl
-from toolkit.cli import count_type, number_type, seed_type
+from toolkit.cli import count_type, fps_type, number_type, seed_type
 
 MATCHERS = ("path-search", "forward-model", "dtw")
 """The matchers ``likeme bench recognition`` and ``stream`` compare when none is named."""
@@ -77,6 +77,10 @@ def _common(p: argparse.ArgumentParser) -> None:
                    "(default: the observer template's; 0: metres as written, the papers)")
     p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
                    help="override a parameter of the observer, e.g. --set matcher.k=4 (repeatable)")
+    p.add_argument("--fps", type=fps_type, default=None, metavar="HZ",
+                   help="frame rate of the demos and streams without one of their own (CSV without a time column, "
+                   ".npy); wins over the profile's fps (which repertoire clips use); a BVH's Frame Time and a CSV's "
+                   "time column win over it")
     p.add_argument("--json", metavar="FILE", help="also write the results as JSON")
     p.add_argument("--csv", metavar="FILE", help="also write the results as CSV (one row per plugin and per item)")
     p.add_argument("--plot", metavar="PNG", help="draw the results (confusion matrices, scores per plugin)")
@@ -102,7 +106,7 @@ def _motion_capture_commands(sub: Any) -> None:
 
     p = sub.add_parser("segmentation", help="segment streams with known segments with every segmenter named")
     _common(p)
-    p.add_argument("--streams", required=True, metavar="DIR", help="NAME.bvh files with NAME.segments.csv")
+    p.add_argument("--streams", required=True, metavar="DIR", help="NAME.bvh (or .csv, .npy) files with NAME.segments.csv")
     p.add_argument("--repertoire", metavar="DIR", help="clips the hubs are found from (default: the streams' ends)")
     p.add_argument("--segmenter", action="append", metavar="NAME", help=f"segmenter (repeatable; default: {', '.join(SEGMENTERS)})")
     p.set_defaults(handler=_handler("mocap", "run", "segmentation"))
@@ -110,7 +114,7 @@ def _motion_capture_commands(sub: Any) -> None:
     p = sub.add_parser("stream", help="segment and recognise streams end to end with every pairing")
     _common(p)
     p.add_argument("--repertoire", required=True, metavar="DIR", help="labelled clips: one folder per movement")
-    p.add_argument("--streams", required=True, metavar="DIR", help="NAME.bvh files with NAME.segments.csv")
+    p.add_argument("--streams", required=True, metavar="DIR", help="NAME.bvh (or .csv, .npy) files with NAME.segments.csv")
     p.add_argument("--segmenter", action="append", metavar="NAME", help="segmenter (repeatable)")
     p.add_argument("--matcher", action="append", metavar="NAME", help="matcher (repeatable)")
     p.set_defaults(handler=_handler("mocap", "run", "stream"))
@@ -118,6 +122,8 @@ def _motion_capture_commands(sub: Any) -> None:
     p = sub.add_parser("make-data", help="write repertoire, demos, streams and a profile from the built-in characters")
     p.add_argument("dest", metavar="DIR")
     p.add_argument("--seed", type=seed_type, default=0)
+    p.add_argument("--format", choices=("bvh", "csv", "npy"), default="bvh",
+                   help="the recordings' format: BVH, CSV joint positions or .npy arrays (default: bvh)")
     p.set_defaults(handler=_handler("data", "cmd_make_data"))
 
     p = sub.add_parser("bandai", help="build benchmark folders from the Bandai-Namco clips (links; nothing copied)")

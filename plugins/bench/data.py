@@ -9,13 +9,14 @@
 from __future__ import annotations
 
 import csv
+import json
 from pathlib import Path
 
 import numpy as np
 
 from toolkit import ConfigError
 
-__all__ = ["read_segments", "make_data", "bandai"]
+__all__ = ["read_segments", "make_data", "bandai", "write_positions", "convert_recordings", "FORMATS"]
 
 
 def read_segments(path: Path) -> list[tuple[int, int, str]]:
@@ -42,13 +43,18 @@ def read_segments(path: Path) -> list[tuple[int, int, str]]:
     return out
 
 
-def make_data(pm, dest: Path, *, seed: int = 0, streams: int = 6, per_stream: int = 6, noise: float = 0.003) -> Path:
+def make_data(pm, dest: Path, *, seed: int = 0, streams: int = 6, per_stream: int = 6, noise: float = 0.003,
+              fmt: str = "bvh") -> Path:
     """Write a benchmark folder from the project's own characters.
 
     ``repertoire/NAME/max.bvh``: Max's own movements; ``demos/NAME/morris_S.bvh``: Morris's versions of them at
     speeds 0.8, 1.0 and 1.25 with observation noise; ``streams/stream_K.bvh`` with ``.segments.csv``: Morris's
-    movements one after another from his rest pose; ``profile.toml``: the body profile (metres, +y up).
+    movements one after another from his rest pose; ``profile.toml``: the body profile (metres, +y up). ``fmt``
+    ``"csv"`` or ``"npy"``: the same recordings as joint positions (:func:`convert_recordings`).
     """
+    if fmt not in FORMATS:
+        raise ConfigError(f"unknown format {fmt!r}", key=("--format",), expected="a recording format",
+                          available=FORMATS)
     from toolkit import load_character
     from toolkit.bvh import from_joint_positions, write_bvh
     from toolkit.character import resolve_file
@@ -93,7 +99,62 @@ def make_data(pm, dest: Path, *, seed: int = 0, streams: int = 6, per_stream: in
     facing = f'left = "{f.left}"\nright = "{f.right}"' + (f'\nforward = "{f.forward}"' if f.forward else "")
     (dest / "profile.toml").write_text(f'[profile]\nname = "max"\nunits = "metre"\nup = "+y"\n\n[parts]\n{parts}\n\n'
                                        f"[facing]\n{facing}\n", encoding="utf-8")
-    return dest
+    return convert_recordings(dest, fmt)
+
+
+FORMATS = ("bvh", "csv", "npy")
+"""The recording formats ``likeme bench make-data --format`` writes."""
+
+
+def write_positions(path: Path, names: list[str], positions: np.ndarray, fps: float | None = None) -> Path:
+    """Joint positions (F, J, 3) as a recording :mod:`toolkit.positions` reads, by the suffix of ``path``.
+
+    ``.csv``: a header ``JOINT_x,JOINT_y,JOINT_z...`` (and ``time`` first when ``fps`` is given: frame k at k / fps
+    seconds), numbers written exactly (shortest round-trip form), NaN as an empty cell; ``.npy``: the array.
+    """
+    path = Path(path)
+    positions = np.asarray(positions, dtype=float)
+    if path.suffix.lower() == ".npy":
+        np.save(path, positions)
+        return path
+    rows = positions.reshape(len(positions), -1)
+    header = [f"{n}_{a}" for n in names for a in "xyz"]
+    if fps is not None:
+        header.insert(0, "time")
+        rows = np.column_stack([np.arange(len(rows)) / fps, rows])
+    lines = [",".join(header)]
+    lines += [",".join("" if not np.isfinite(v) else repr(float(v)) for v in row) for row in rows]
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path
+
+
+def convert_recordings(folder: Path, fmt: str, *, time: bool = False) -> Path:
+    """Every ``.bvh`` file under ``folder`` replaced by the same joint positions as ``.csv`` or ``.npy``.
+
+    The positions are the BVH file's (forward kinematics of what the file holds), so a body profile reads the same
+    motion from either. ``time``: a CSV gets a time column (else the frame rate goes in ``profile.toml``). The
+    ``profile.toml`` beside them gets ``fps`` (and ``joints``, the arrays' joint order, for ``.npy``).
+    """
+    from toolkit.bvh import read_bvh
+
+    folder = Path(folder)
+    if fmt not in FORMATS:
+        raise ConfigError(f"unknown format {fmt!r}", key=("--format",), expected="a recording format",
+                          available=FORMATS)
+    if fmt == "bvh":
+        return folder
+    fps = names = None
+    for path in sorted(folder.rglob("*.bvh")):
+        bvh = read_bvh(path)
+        fps, names = bvh.fps, bvh.names
+        write_positions(path.with_suffix("." + fmt), names, bvh.positions(), fps if time and fmt == "csv" else None)
+        path.unlink()
+    profile = folder / "profile.toml"
+    if profile.is_file() and fps is not None:
+        extra = f"fps = {fps!r}\n" + (f"joints = {json.dumps(names)}\n" if fmt == "npy" else "")
+        text = profile.read_text(encoding="utf-8").replace("[profile]\n", "[profile]\n" + extra, 1)
+        profile.write_text(text, encoding="utf-8")
+    return folder
 
 
 def _write_segments(path: Path, rows: list[tuple[int, int, str]]) -> None:
@@ -157,7 +218,7 @@ STYLE_PATTERN = r"^dataset-1_[^_]+_([^_]+)_"
 
 def cmd_make_data(args, pm) -> int:
     """``likeme bench make-data DIR``."""
-    print(make_data(pm, Path(args.dest), seed=args.seed))
+    print(make_data(pm, Path(args.dest), seed=args.seed, fmt=getattr(args, "format", "bvh")))
     return 0
 
 

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from plugins.bench import progress as progress_bar
 from plugins.bench import text_table
 from toolkit import World, load_character
 from toolkit.state import write_atomic
@@ -177,9 +178,7 @@ def facilitation_benchmark(pm: Any, *, demonstrations: int = 200, repertoire: in
     rows = []
     jobs = range(demonstrations)
     if progress:
-        from rich.progress import track
-
-        jobs = track(jobs, description="demonstrations", transient=True)
+        jobs = progress_bar(jobs, "demonstrations")
     started = time.perf_counter()
     frames_before = world.frame
     for i in jobs:

@@ -1,6 +1,7 @@
 """Benchmarks on motion-capture files: ``likeme bench recognition|segmentation|stream``.
 
-Every sub-command reads BVH files through a body profile (:mod:`toolkit.profile`) and watches them with
+Every sub-command reads recordings (BVH, CSV joint positions or ``.npy`` arrays, by suffix; a folder may mix them)
+through a body profile (:mod:`toolkit.profile`) and watches them with
 :class:`toolkit.observe.Observer`, so the toolkit's segmenters and matchers and the baselines (``dtw``,
 ``ruptures``) are measured on the same clips in the same loop:
 
@@ -10,7 +11,8 @@ Every sub-command reads BVH files through a body profile (:mod:`toolkit.profile`
   against the whole repertoire), ``open`` (leave one movement out: only "unknown" is right) and ``groups`` (leave
   one group out: the repertoire folder's clips whose file names share a group, a style or a performer, are the
   demos of a repertoire made of all the other clips).
-- ``segmentation``: each stream ``NAME.bvh`` has ``NAME.segments.csv`` (:func:`plugins.bench.data.read_segments`).
+- ``segmentation``: each stream ``NAME.bvh`` (or ``.csv``, ``.npy``) has ``NAME.segments.csv``
+  (:func:`plugins.bench.data.read_segments`).
   Precision, recall, F1 and boundary error (:mod:`plugins.bench.metrics`) per segmenter.
 - ``stream``: segment and recognise end to end for every pairing; the movement error rate (edit distance over the
   true count).
@@ -34,6 +36,7 @@ from typing import Any
 
 import numpy as np
 
+from plugins.bench import progress as progress_bar
 from plugins.bench import text_table
 from plugins.bench.command import MATCHERS, SEGMENTERS
 from plugins.bench.data import read_segments
@@ -41,7 +44,7 @@ from plugins.bench.metrics import confusion_matrix, macro_f1, movement_error_rat
 from plugins.lib.clip_repertoire import clip_files
 from toolkit import ConfigError
 from toolkit.observe import Observer, compose_observer
-from toolkit.profile import load_profile
+from toolkit.profile import RECORDING_SUFFIXES, load_profile
 
 __all__ = ["MATCHERS", "SEGMENTERS", "recognition", "segmentation", "stream", "table", "write_outputs", "plot", "run"]
 
@@ -55,9 +58,12 @@ def _labelled(folder: Path) -> list[tuple[str, Path]]:
 
 
 def _streams(folder: Path) -> list[tuple[Path, list[tuple[int, int, str]]]]:
-    files = sorted(Path(folder).glob("*.bvh"))
+    """The recordings of a streams folder (``NAME.bvh``, ``.csv`` or ``.npy``, any mix) with their true segments."""
+    files = sorted(p for p in Path(folder).iterdir() if p.suffix.lower() in RECORDING_SUFFIXES and
+                   not p.name.lower().endswith(".segments.csv")) if Path(folder).is_dir() else []
     if not files:
-        raise ConfigError("no streams found", file=folder, expected="NAME.bvh files with NAME.segments.csv beside them")
+        raise ConfigError("no streams found", file=folder,
+                          expected="NAME.bvh (or NAME.csv, NAME.npy) files with NAME.segments.csv beside them")
     out = []
     for path in files:
         csv_path = path.with_suffix(".segments.csv")
@@ -108,9 +114,7 @@ class _Clock:
 def _progress(items: list, label: str, quiet: bool):
     if quiet:
         return items
-    from rich.progress import track
-
-    return track(items, description=label, transient=True)
+    return progress_bar(items, label)
 
 
 PROTOCOLS = ("closed", "open", "groups")
@@ -118,7 +122,7 @@ PROTOCOLS = ("closed", "open", "groups")
 
 def recognition(pm, profile, repertoire: Path, demos: Path | None, matchers: Sequence[str], *, settings=None,
                 quiet: bool = True, observer: dict[str, Any] | None = None, protocol: str = "closed",
-                group: str | None = None) -> dict[str, Any]:
+                group: str | None = None, fps: float | None = None) -> dict[str, Any]:
     """Classify every demo clip with every matcher; per-plugin scores and per-item rows.
 
     A demo whose movement (its folder's name) is not in the repertoire is right when it is answered "unknown".
@@ -131,7 +135,7 @@ def recognition(pm, profile, repertoire: Path, demos: Path | None, matchers: Seq
     :func:`toolkit.observe.compose_observer` (``correspondence``, ``lengths_for_height``).
     """
     observer = dict(observer or {})
-    runs = _runs(profile, Path(repertoire), demos, protocol, group)
+    runs = _runs(profile, Path(repertoire), demos, protocol, group, fps)
     plugins, rows = [], []
     for name in matchers:
         truth, predicted, fractions, frames, seconds = [], [], [], 0, 0.0
@@ -173,17 +177,17 @@ UNKNOWN = "unknown"
 """What a demo of a movement the observer does not know should be answered."""
 
 
-def _runs(profile, repertoire: Path, demos: Path | None, protocol: str, group: str | None):
+def _runs(profile, repertoire: Path, demos: Path | None, protocol: str, group: str | None, fps: float | None = None):
     """The protocol's runs: ((movement left out, files left out, group), [(label, path, motion)...]) each."""
     if protocol not in PROTOCOLS:
         raise ConfigError(f"unknown protocol {protocol!r}", key=("protocol",), expected="a protocol",
                           available=list(PROTOCOLS))
     if protocol == "groups":
-        return _group_runs(profile, repertoire, group)
+        return _group_runs(profile, repertoire, group, fps)
     if demos is None:
         raise ConfigError(f"protocol {protocol!r} needs demo clips", key=("demos",),
                           expected="--demos DIR: one folder of clips per true movement")
-    motions = [(label, path, profile.read(path)) for label, path in _labelled(demos)]
+    motions = [(label, path, profile.read(path, fps)) for label, path in _labelled(demos)]
     if protocol == "closed":
         return [((None, frozenset(), None), motions)]
     known = set(clip_files(repertoire))
@@ -195,7 +199,7 @@ def _runs(profile, repertoire: Path, demos: Path | None, protocol: str, group: s
     return runs
 
 
-def _group_runs(profile, repertoire: Path, group: str | None):
+def _group_runs(profile, repertoire: Path, group: str | None, fps: float | None = None):
     """Leave one group out: the clips of each group as demos of a repertoire of every other group's clips."""
     if not group:
         raise ConfigError("protocol 'groups' needs a pattern", key=("group",),
@@ -223,7 +227,7 @@ def _group_runs(profile, repertoire: Path, group: str | None):
     if len(by_group) < 2:
         raise ConfigError(f"{len(by_group)} group found", file=repertoire, key=("group",),
                           expected="at least two groups to leave one out", available=sorted(by_group))
-    return [((None, frozenset(p for _, p in items), name), [(label, p, profile.read(p)) for label, p in items])
+    return [((None, frozenset(p for _, p in items), name), [(label, p, profile.read(p, fps)) for label, p in items])
             for name, items in sorted(by_group.items())]
 
 
@@ -245,9 +249,10 @@ def _repertoire_without(folder: Path, movement: str | None, files: frozenset[Pat
 
 
 def segmentation(pm, profile, streams: Path, segmenters: Sequence[str], *, repertoire: Path | None = None,
-                 settings=None, quiet: bool = True, observer: dict[str, Any] | None = None) -> dict[str, Any]:
+                 settings=None, quiet: bool = True, observer: dict[str, Any] | None = None,
+                 fps: float | None = None) -> dict[str, Any]:
     """Segment every stream with every segmenter; precision, recall, F1, boundary error and speed."""
-    data = [(path, truth, profile.read(path)) for path, truth in _streams(streams)]
+    data = [(path, truth, profile.read(path, fps)) for path, truth in _streams(streams)]
     plugins, rows, timelines = [], [], _timelines(data)
     for name in segmenters:
         clock = _Clock(compose_observer(pm, profile, repertoire or streams, segmenter=name, matcher=None,
@@ -280,9 +285,10 @@ def _timelines(data) -> dict[str, dict[str, Any]]:
 
 
 def stream(pm, profile, repertoire: Path, streams: Path, segmenters: Sequence[str], matchers: Sequence[str], *,
-           settings=None, quiet: bool = True, observer: dict[str, Any] | None = None) -> dict[str, Any]:
+           settings=None, quiet: bool = True, observer: dict[str, Any] | None = None,
+           fps: float | None = None) -> dict[str, Any]:
     """Segment and recognise every stream with every pairing; the movement error rate."""
-    data = [(path, truth, profile.read(path)) for path, truth in _streams(streams)]
+    data = [(path, truth, profile.read(path, fps)) for path, truth in _streams(streams)]
     plugins, rows, timelines = [], [], _timelines(data)
     for seg in segmenters:
         for mat in matchers:
@@ -370,14 +376,15 @@ def run(kind: str, args: Any, pm: Any) -> int:
     if kind == "recognition":
         result = recognition(pm, profile, Path(args.repertoire), Path(args.demos) if args.demos else None,
                              args.matcher or MATCHERS, settings=settings, quiet=args.quiet, observer=observer,
-                             protocol=args.protocol, group=args.group)
+                             protocol=args.protocol, group=args.group, fps=args.fps)
     elif kind == "segmentation":
         result = segmentation(pm, profile, Path(args.streams), args.segmenter or SEGMENTERS,
                               repertoire=Path(args.repertoire) if args.repertoire else None, settings=settings,
-                              quiet=args.quiet, observer=observer)
+                              quiet=args.quiet, observer=observer, fps=args.fps)
     else:
         result = stream(pm, profile, Path(args.repertoire), Path(args.streams), args.segmenter or SEGMENTERS[:2],
-                        args.matcher or MATCHERS, settings=settings, quiet=args.quiet, observer=observer)
+                        args.matcher or MATCHERS, settings=settings, quiet=args.quiet, observer=observer,
+                        fps=args.fps)
     print(table(result))
     if kind == "recognition":
         for row in result["plugins"]:

@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from plugins.bench import progress as progress_bar
 from plugins.bench import text_table
 from plugins.bench.metrics import match_segments, movement_error_rate, segmentation_scores
 from toolkit import World, load_character
@@ -70,9 +71,7 @@ def watch_benchmark(
     started = time.perf_counter()
     steps = range(limit)
     if progress:
-        from rich.progress import track
-
-        steps = track(steps, description=f"{observer} watches {demonstrator}", transient=True)
+        steps = progress_bar(steps, f"{observer} watches {demonstrator}")
     quiet = 0
     for _ in steps:
         world.step()

@@ -35,12 +35,13 @@ import numpy as np
 from plugins.lib.pose_distance import pose_distance
 from plugins.lib.root_frame import root_relative, smooth_heading
 from toolkit import ConfigError, Motion, Parameter
-from toolkit.profile import BodyProfile, load_profile
+from toolkit.profile import RECORDING_SUFFIXES, BodyProfile, load_profile
 
 __all__ = ["Clip", "ClipRepertoire", "load_clip_repertoire", "clip_repertoire", "find_hubs", "root_relative_motion",
            "clip_files", "example_name", "CLIP_PARAMETERS", "repertoire_for"]
 
-CLIP_SUFFIXES = (".bvh",)
+CLIP_SUFFIXES = RECORDING_SUFFIXES
+"""Clip files a repertoire folder holds (any mix): BVH, CSV joint positions, NumPy arrays (``docs/formats.md``)."""
 
 
 @dataclass(frozen=True)
@@ -101,6 +102,12 @@ def example_name(movement: str, earlier: int) -> str:
     return movement if earlier == 0 else f"{movement}{EXAMPLE_MARK}{earlier + 1}"
 
 
+def _is_clip(path: Path) -> bool:
+    """A clip by its suffix (:data:`CLIP_SUFFIXES`); a stream's true segments (``NAME.segments.csv``, beside it in a
+    benchmark's streams folder) is not one."""
+    return path.suffix.lower() in CLIP_SUFFIXES and not path.name.lower().endswith(".segments.csv")
+
+
 def clip_files(folder: Path) -> dict[str, list[Path]]:
     """Clip files by movement name (sub-folder name), sorted; a :class:`ConfigError` if there are none."""
     folder = Path(folder)
@@ -108,11 +115,11 @@ def clip_files(folder: Path) -> dict[str, list[Path]]:
         raise ConfigError("not a folder", file=folder, expected="a folder with one sub-folder of BVH clips per movement")
     out: dict[str, list[Path]] = {}
     for sub in sorted(p for p in folder.iterdir() if p.is_dir()):
-        files = sorted(p for p in sub.iterdir() if p.suffix.lower() in CLIP_SUFFIXES)
+        files = sorted(p for p in sub.iterdir() if _is_clip(p))
         if files:
             out[sub.name] = files
     if not out:  # a flat folder of recordings: each file on its own (its ends still give hubs)
-        for path in sorted(p for p in folder.iterdir() if p.suffix.lower() in CLIP_SUFFIXES):
+        for path in sorted(p for p in folder.iterdir() if _is_clip(p)):
             out[path.stem] = [path]
     for movement, files in out.items():
         if EXAMPLE_MARK in movement:  # bow#2 is the name of bow's second example: it would replace that one
@@ -122,7 +129,8 @@ def clip_files(folder: Path) -> dict[str, list[Path]]:
                               f"examples: {example_name('bow', 1)}, {example_name('bow', 2)}...); rename the folder")
     if not out:
         raise ConfigError("no clips found", file=folder,
-                          expected="sub-folders named after movements holding .bvh clips (walk/take1.bvh ...)",
+                          expected="sub-folders named after movements holding .bvh, .csv or .npy clips "
+                                   "(walk/take1.bvh ...)",
                           available=[p.name for p in folder.iterdir()])
     return out
 
