@@ -432,3 +432,52 @@ def test_the_documented_bounds_are_the_module_constants():
     assert f"`MAX_FPS` = {MAX_FPS:,.0f}" in doc
     assert f"`MAX_COLUMNS` ({pos.MAX_COLUMNS:,})" in doc and f"`MAX_JOINTS` ({pos.MAX_JOINTS:,})" in doc
     assert f"`TIME_TOLERANCE` ({pos.TIME_TOLERANCE:.0%})" in doc and pos.MAX_LINE_CHARS == 1 << 20
+
+
+# -- C3D marker files ---------------------------------------------------------------------------------
+
+
+def _write_c3d(path, labels, positions, fps=120.0):
+    from plugins.bench.data import write_positions
+
+    return write_positions(path, list(labels), positions, fps=fps)
+
+
+@settings(max_examples=25, deadline=None)
+@given(frames=st.integers(1, 40), joints=st.integers(1, 6), seed=st.integers(0, 2**16),
+       fps=st.sampled_from([30.0, 60.0, 100.0, 120.0, 240.0]), block=st.integers(1, 50))
+def test_a_c3d_file_round_trips_as_32_bit_floats_with_missing_points(tmp_path_factory, frames, joints, seed, fps, block):
+    rng = np.random.default_rng(seed)
+    positions = rng.normal(scale=2.0, size=(frames, joints, 3))
+    positions[rng.random((frames, joints)) < 0.1] = np.nan  # not reconstructed in that frame
+    labels = [f"M{j}" for j in range(joints)]
+    path = _write_c3d(tmp_path_factory.mktemp("c3d") / "t.c3d", labels, positions, fps)
+    got = read_positions(path)
+    assert got.names == tuple(labels) and got.fps == pytest.approx(fps)
+    np.testing.assert_allclose(got.positions, positions.astype(np.float32), equal_nan=True)
+    header, blocks = iter_position_blocks(path, frames=block)
+    parts = list(blocks)
+    assert all(len(b) <= block for b in parts) and header.names == got.names
+    np.testing.assert_array_equal(np.concatenate(parts), got.positions)
+
+
+def test_c3d_names_select_and_order_points_and_repeated_labels_are_numbered(tmp_path):
+    positions = np.arange(2 * 3 * 3, dtype=float).reshape(2, 3, 3)
+    path = _write_c3d(tmp_path / "m.c3d", ["Head", "Head", ""], positions)
+    assert read_positions(path).names == ("Head", "Head#2", "point#3")
+    got = read_positions(path, names=["point#3", "Head"])
+    np.testing.assert_array_equal(got.positions, positions[:, [2, 0]])
+    with pytest.raises(ConfigError, match=r"m.c3d: no point labelled 'Nose'; expected a point of this file; "
+                                          r"available: Head, Head#2, point#3"):
+        read_positions(path, names=["Nose"])
+
+
+def test_a_broken_c3d_file_is_one_error_naming_it(tmp_path):
+    good = _write_c3d(tmp_path / "good.c3d", ["A", "B"], np.zeros((30, 2, 3))).read_bytes()
+    for name, data in (("zeros.c3d", b"\0" * 100), ("cut.c3d", good[:700]), ("empty.c3d", b"")):
+        (tmp_path / name).write_bytes(data)
+        with pytest.raises(ConfigError, match=rf"{name}: not a readable C3D file \(.*\); expected a C3D"):
+            read_positions(tmp_path / name)
+    fast = _write_c3d(tmp_path / "fast.c3d", ["A"], np.zeros((3, 1, 3)), fps=50_000.0)
+    with pytest.raises(ConfigError, match=r"fast.c3d: POINT:RATE is 50000 frames per second; expected a frame rate"):
+        read_positions(fast)

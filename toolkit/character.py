@@ -205,6 +205,17 @@ def _raise(err: Exception) -> Any:
     raise err
 
 
+def builtin_characters() -> Path:
+    """The folder of the built-in characters (with ``scenarios/``, ``observers/`` and ``profiles/``): the project's
+    ``characters/`` in a source tree or an editable install, else the copy a regular install puts under
+    ``<prefix>/share/likeme/characters``."""
+    import sys
+
+    project = Path(__file__).resolve().parent.parent / "characters"
+    installed = Path(sys.prefix) / "share" / "likeme" / "characters"
+    return project if project.is_dir() or not installed.is_dir() else installed
+
+
 def character_paths(pm: PluginManager | None = None) -> list[Path]:
     """Folders searched for character and scenario files named without a path.
 
@@ -220,8 +231,7 @@ def character_paths(pm: PluginManager | None = None) -> list[Path]:
     env = os.environ.get("LIKEME_CHARACTERS")
     if env:
         paths.extend(Path(p) for p in env.split(os.pathsep) if p)
-    project = Path(__file__).resolve().parent.parent / "characters"
-    paths.append(project)
+    paths.append(Path(__file__).resolve().parent.parent / "characters")
     paths.append(Path(sys.prefix) / "share" / "likeme" / "characters")
     if pm is not None:
         for result in pm.hook.likeme_character_paths():

@@ -896,7 +896,7 @@ def _read_recording(path: str) -> tuple[list[str], Any, list[int] | None, float 
                     break
             positions = np.concatenate(kept) if kept else np.zeros((0, len(bvh.names), 3))
             return list(bvh.names), positions, [j.parent for j in bvh.joints], bvh.fps, bvh.n_frames
-    if suffix == ".csv":
+    if suffix in (".csv", ".c3d"):  # joint positions with their names (a C3D file: its labelled points)
         from toolkit.positions import iter_position_blocks
 
         fps: float | None = None
@@ -916,8 +916,8 @@ def _read_recording(path: str) -> tuple[list[str], Any, list[int] | None, float 
         positions = np.concatenate(kept) if kept else header.positions
         return list(header.names), positions, None, fps, len(positions)
     raise ConfigError(f"cannot propose a profile for a {suffix or 'suffix-less'} file", file=path, key=("FILE",),
-                      expected="a BVH file or a CSV of joint positions (a .npy array has no joint names)",
-                      available=(".bvh", ".csv"))
+                      expected="a BVH file, a CSV of joint positions or a C3D file (a .npy array has no joint "
+                               "names)", available=(".bvh", ".csv", ".c3d"))
 
 
 def cmd_profile(args: argparse.Namespace, pm: PluginManager) -> int:

@@ -1,4 +1,4 @@
-"""Joint-position recordings: CSV tables and NumPy ``.npy`` arrays of world positions per frame.
+"""Joint-position recordings: CSV tables, NumPy ``.npy`` arrays and C3D marker files of world positions per frame.
 
 Many recordings have joint positions without rotations or a hierarchy (a Kinect, a pose estimator, a marker
 export). This module reads them as :class:`JointPositions`: joint names, positions ``(F, J, 3)`` in the file's own
@@ -8,6 +8,9 @@ units and axes (a body profile converts them, as for BVH), NaN where a value is 
 - **CSV**: one row per frame; a header naming ``JOINT_x``, ``JOINT_y``, ``JOINT_z`` for each joint (any order, other
   columns ignored); the frame rate from a ``time`` column in seconds, else from the ``fps`` argument.
 - **.npy**: an array ``(frames, joints, 3)`` of numbers; the joint names and the frame rate come from the caller.
+- **.c3d**: a C3D motion-capture file (read with the maintained ``c3d`` package): its 3D points are the joints, named
+  by ``POINT:LABELS``, at the file's ``POINT:RATE``; a point with a negative residual (not reconstructed in that
+  frame) is missing.
 
 Reading is bounded and streaming (issue 21): only regular files are opened; lines, columns, joints and the frame
 rate are bounded (:data:`MAX_LINE_CHARS`, :data:`MAX_COLUMNS`, :data:`MAX_JOINTS`, :data:`MAX_FPS`); numbers are
@@ -22,10 +25,12 @@ from __future__ import annotations
 import csv
 import io
 import re
+import warnings
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, replace
 from numbers import Real
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 
@@ -35,7 +40,7 @@ from toolkit.files import check_regular_file, open_regular
 __all__ = ["JointPositions", "read_positions", "iter_position_blocks", "SUFFIXES", "MAX_FPS", "MAX_JOINTS",
            "MAX_COLUMNS", "MAX_LINE_CHARS", "TIME_TOLERANCE"]
 
-SUFFIXES = (".csv", ".npy")
+SUFFIXES = (".csv", ".npy", ".c3d")
 """File name suffixes this module reads (compared case-insensitively)."""
 
 MAX_FPS = 10_000.0
@@ -56,6 +61,7 @@ TIME_TOLERANCE = 0.25
 _BLOCK_CHARS = 1 << 20  # a CSV block ends after about this many characters even if it has fewer than ``frames`` rows
 _FPS_HINT = "a frame rate: give `fps` in the profile's [profile] table or --fps"
 _AXES = "xyz"
+T = TypeVar("T")
 _COORDINATE = re.compile(r"^(?P<joint>.+)[_.](?P<axis>[xyzXYZ])$")
 
 
@@ -152,6 +158,8 @@ def iter_position_blocks(path: str | Path, *, names: Sequence[str] | None = None
     names = _check_names(names, path)
     if suffix == ".npy":
         return _npy(path, names, fps, frames)
+    if suffix == ".c3d":
+        return _c3d(path, names, frames)
     return _csv(path, names, fps, frames)
 
 
@@ -227,6 +235,93 @@ def _npy(path: Path, names: tuple[str, ...] | None, fps: float | None,
             yield block
 
     return header, blocks()
+
+
+# -- C3D --------------------------------------------------------------------------------------------
+
+
+def _c3d(path: Path, names: tuple[str, ...] | None, frames: int) -> tuple[JointPositions, Iterator[np.ndarray]]:
+    """A C3D file's 3D points as joints: names from ``POINT:LABELS`` (stripped; an empty or repeated label becomes
+    ``LABEL#k``, k its point's number from 1), the rate from ``POINT:RATE`` (the file's own rate: ``fps`` given by the
+    caller does not apply, as for BVH), a negative residual (``c3d``'s fourth column) missing. ``names`` selects and
+    orders the points, as for a CSV."""
+    import struct
+
+    import c3d  # the maintained pure-Python reader (C3D.org format): imported where C3D is read
+
+    expected = "a C3D motion-capture file with 3D points"
+    broken = (ValueError, KeyError, IndexError, AssertionError, TypeError, EOFError, struct.error, OverflowError,
+              MemoryError, UnicodeDecodeError)
+    handle = open_regular(path, "C3D file", "motion")
+    try:
+        with warnings.catch_warnings():  # the library warns of what a marker file need not have (analog data)
+            warnings.simplefilter("ignore")
+            reader = c3d.Reader(handle)
+            labels = [str(label).strip() for label in reader.point_labels]
+            n_points, rate = int(reader.point_used), float(reader.point_rate)
+    except broken as exc:
+        handle.close()
+        raise ConfigError(f"not a readable C3D file ({type(exc).__name__}: {exc})", file=path,
+                          expected=expected) from None
+    except BaseException:
+        handle.close()
+        raise
+    try:
+        if not 0 < n_points <= MAX_JOINTS:
+            raise ConfigError(f"{n_points} 3D points", file=path, expected=f"between 1 and {MAX_JOINTS} points")
+        fps = _check_fps(rate, path, "POINT:RATE")
+        labels = (labels + [""] * n_points)[:n_points]
+        seen: set[str] = set()
+        for k, label in enumerate(labels):
+            if not label or label in seen:
+                label = f"{label or 'point'}#{k + 1}"
+            labels[k] = label
+            seen.add(label)
+        if names is None:
+            columns = list(range(n_points))
+        else:
+            missing = [n for n in names if n not in seen]
+            if missing:
+                raise ConfigError(f"no point labelled {missing[0]!r}", file=path, expected="a point of this file",
+                                  available=labels)
+            columns = [labels.index(n) for n in names]
+    except BaseException:
+        handle.close()
+        raise
+    header = JointPositions(tuple(labels[c] for c in columns), np.empty((0, len(columns), 3)), fps, str(path))
+
+    def blocks() -> Iterator[np.ndarray]:
+        rows: list[np.ndarray] = []
+        try:
+            for _, points, _ in _quiet(reader.read_frames(copy=True, check_nan=False)):
+                points = np.asarray(points, dtype=float)
+                xyz = points[columns, :3].copy()
+                xyz[(points[columns, 3] < 0) | ~np.isfinite(xyz).all(axis=1)] = np.nan
+                rows.append(xyz)
+                if len(rows) == frames:
+                    yield np.stack(rows)
+                    rows = []
+        except broken as exc:
+            raise ConfigError(f"not a readable C3D file ({type(exc).__name__}: {exc})", file=path,
+                              expected=expected) from None
+        finally:
+            handle.close()
+        if rows:
+            yield np.stack(rows)
+
+    return header, blocks()
+
+
+def _quiet(items: Iterator[T]) -> Iterator[T]:
+    """``items`` advanced with warnings ignored (the C3D library warns of what a marker file need not have)."""
+    while True:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            try:
+                item = next(items)
+            except StopIteration:
+                return
+        yield item
 
 
 # -- CSV --------------------------------------------------------------------------------------------

@@ -68,9 +68,9 @@ _PROFILE_KEYS = ("name", "description", "units", "up", "fps", "joints")
 _TABLES = ("profile", "parts", "facing", "bones", "colours")
 
 
-RECORDING_SUFFIXES = (".bvh", ".csv", ".npy")
-"""The recording formats a profile reads, by file name suffix (any case): BVH, CSV joint positions, NumPy arrays
-(``docs/formats.md``)."""
+RECORDING_SUFFIXES = (".bvh", ".csv", ".npy", ".c3d")
+"""The recording formats a profile reads, by file name suffix (any case): BVH, CSV joint positions, NumPy arrays,
+C3D markers (``docs/formats.md``)."""
 
 
 def recording_format(path: str | Path) -> str:
@@ -79,8 +79,9 @@ def recording_format(path: str | Path) -> str:
     suffix = Path(path).suffix.lower()
     if suffix not in RECORDING_SUFFIXES:
         raise ConfigError(f"unknown recording format {Path(path).suffix or '(no suffix)'!r}", file=path,
-                          expected="a recording named by its format: .bvh (BVH), .csv (joint positions) or .npy "
-                                   "(NumPy array of joint positions)", available=RECORDING_SUFFIXES)
+                          expected="a recording named by its format: .bvh (BVH), .csv (joint positions), .npy "
+                                   "(NumPy array of joint positions) or .c3d (C3D markers)",
+                          available=RECORDING_SUFFIXES)
     return suffix
 
 

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import argparse
 from importlib import import_module
-from pathlib import Path
 from typing import Any
 
 from toolkit import hookimpl
@@ -122,16 +121,16 @@ def _motion_capture_commands(sub: Any) -> None:
     p = sub.add_parser("make-data", help="write repertoire, demos, streams and a profile from the built-in characters")
     p.add_argument("dest", metavar="DIR")
     p.add_argument("--seed", type=seed_type, default=0)
-    p.add_argument("--format", choices=("bvh", "csv", "npy"), default="bvh",
-                   help="the recordings' format: BVH, CSV joint positions or .npy arrays (default: bvh)")
+    p.add_argument("--format", choices=("bvh", "csv", "npy", "c3d"), default="bvh",  # plugins.bench.data.FORMATS
+                   help="the recordings' format: BVH, CSV joint positions, .npy arrays or C3D markers (default: bvh)")
     p.set_defaults(handler=_handler("data", "cmd_make_data"))
 
     p = sub.add_parser("bandai", help="build benchmark folders from the Bandai-Namco clips (links; nothing copied)")
     p.add_argument("src", metavar="BANDAI_DIR")
     p.add_argument("dest", metavar="DIR")
     p.add_argument("--seed", type=seed_type, default=0)
-    p.add_argument("--profile", default=str(Path(__file__).resolve().parents[2] / "characters" / "profiles"
-                                            / "bandai-namco.toml"), help="the body profile to put beside the data")
+    p.add_argument("--profile", default=None, help="the body profile to put beside the data (default: the built-in "
+                   "profiles/bandai-namco.toml, from the source tree or the installed copy)")
     p.set_defaults(handler=_handler("data", "cmd_bandai"))
 
 

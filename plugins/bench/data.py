@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import csv
 import json
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -102,7 +103,7 @@ def make_data(pm, dest: Path, *, seed: int = 0, streams: int = 6, per_stream: in
     return convert_recordings(dest, fmt)
 
 
-FORMATS = ("bvh", "csv", "npy")
+FORMATS = ("bvh", "csv", "npy", "c3d")
 """The recording formats ``likeme bench make-data --format`` writes."""
 
 
@@ -110,12 +111,30 @@ def write_positions(path: Path, names: list[str], positions: np.ndarray, fps: fl
     """Joint positions (F, J, 3) as a recording :mod:`toolkit.positions` reads, by the suffix of ``path``.
 
     ``.csv``: a header ``JOINT_x,JOINT_y,JOINT_z...`` (and ``time`` first when ``fps`` is given: frame k at k / fps
-    seconds), numbers written exactly (shortest round-trip form), NaN as an empty cell; ``.npy``: the array.
+    seconds), numbers written exactly (shortest round-trip form), NaN as an empty cell; ``.npy``: the array;
+    ``.c3d``: 3D points labelled with the joint names at ``fps`` (required), as C3D stores them (32-bit floats), NaN
+    as a point not reconstructed (residual -1).
     """
     path = Path(path)
     positions = np.asarray(positions, dtype=float)
     if path.suffix.lower() == ".npy":
         np.save(path, positions)
+        return path
+    if path.suffix.lower() == ".c3d":
+        import c3d
+
+        if fps is None:
+            raise ValueError("a C3D file needs a frame rate")
+        writer = c3d.Writer(point_rate=float(fps), point_units="m   ")
+        writer.set_point_labels(list(names))
+        missing = ~np.isfinite(positions).all(axis=-1)
+        points = np.zeros((*positions.shape[:2], 5), dtype=np.float32)
+        points[..., :3] = np.where(missing[..., None], 0.0, positions)
+        points[..., 3] = np.where(missing, -1.0, 0.0)
+        writer.add_frames([(frame, np.zeros((0, 0), dtype=np.float32)) for frame in points])
+        with open(path, "wb") as handle, warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # "no analog data": a marker file has none
+            writer.write(handle)
         return path
     rows = positions.reshape(len(positions), -1)
     header = [f"{n}_{a}" for n in names for a in "xyz"]
@@ -129,7 +148,7 @@ def write_positions(path: Path, names: list[str], positions: np.ndarray, fps: fl
 
 
 def convert_recordings(folder: Path, fmt: str, *, time: bool = False) -> Path:
-    """Every ``.bvh`` file under ``folder`` replaced by the same joint positions as ``.csv`` or ``.npy``.
+    """Every ``.bvh`` file under ``folder`` replaced by the same joint positions as ``.csv``, ``.npy`` or ``.c3d``.
 
     The positions are the BVH file's (forward kinematics of what the file holds), so a body profile reads the same
     motion from either. ``time``: a CSV gets a time column (else the frame rate goes in ``profile.toml``). The
@@ -147,7 +166,8 @@ def convert_recordings(folder: Path, fmt: str, *, time: bool = False) -> Path:
     for path in sorted(folder.rglob("*.bvh")):
         bvh = read_bvh(path)
         fps, names = bvh.fps, bvh.names
-        write_positions(path.with_suffix("." + fmt), names, bvh.positions(), fps if time and fmt == "csv" else None)
+        write_positions(path.with_suffix("." + fmt), names, bvh.positions(),
+                        fps if (time and fmt == "csv") or fmt == "c3d" else None)
         path.unlink()
     profile = folder / "profile.toml"
     if profile.is_file() and fps is not None:
@@ -224,5 +244,9 @@ def cmd_make_data(args, pm) -> int:
 
 def cmd_bandai(args, pm) -> int:
     """``likeme bench bandai SRC DIR``."""
-    print(bandai(Path(args.src), Path(args.dest), Path(args.profile), seed=args.seed))
+    from toolkit.character import resolve_file
+
+    profile = Path(args.profile) if args.profile else resolve_file("profiles/bandai-namco.toml", None, pm,
+                                                                   key=("--profile",))
+    print(bandai(Path(args.src), Path(args.dest), profile, seed=args.seed))
     return 0

@@ -46,11 +46,13 @@ from typing import Any
 
 import numpy as np
 
+from toolkit.character import builtin_characters
+
 __all__ = ["TARGETS", "OUTCOMES", "Case", "Result", "make_seeds", "make_case", "Worker", "classify", "run_fuzz",
            "cmd_fuzz"]
 
-ROOT = Path(__file__).resolve().parents[2]
-CHARACTERS = ROOT / "characters"
+ROOT = Path(__file__).resolve().parents[2]  # where the toolkit and plugins packages are (the source tree or site-packages)
+CHARACTERS = builtin_characters()
 
 TARGETS = ("bvh", "toml", "profile", "scenario", "state", "csv")
 """What can be fuzzed, in the order cases are dealt out."""
