@@ -36,13 +36,65 @@ def _record_hook_calls():
     PluginManager.__init__ = original
 
 
+HOOK_CHECK = "test_every_hook_is_called_by_a_test"
+"""tests/test_docs.py's check that every hook was called by some test: it needs every other test to have run."""
+
+
 def pytest_collection_modifyitems(session, config, items):
     """The check that every hook was called runs last, when every other test has run; ``config.whole_suite`` says
-    whether every test module was collected (run alone, that check cannot know)."""
-    last = [i for i in items if i.name.startswith("test_every_hook_is_called_by_a_test")]
+    whether every test module was collected (run alone, that check cannot know).
+
+    Under pytest-xdist (``pytest -n auto``) no worker sees every test run: the workers leave that check out and
+    send the hooks they saw called to the controller, which makes the check when every worker is done
+    (:func:`pytest_sessionfinish`)."""
+    last = [i for i in items if i.name.startswith(HOOK_CHECK)]
     items[:] = [i for i in items if i not in last] + last
     collected = {Path(str(i.fspath)).name for i in items}
     config.whole_suite = {p.name for p in (ROOT / "tests").glob("test_*.py")} <= collected
+    if hasattr(config, "workerinput") and last:  # an xdist worker
+        items[:] = [i for i in items if i not in last]
+        config.hook.pytest_deselected(items=last)
+
+
+_WORKERS: list[tuple[bool, set[str]]] = []
+"""(whole suite collected, hooks called) of every xdist worker that finished (on the controller)."""
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_testnodedown(node, error):
+    """The controller: note what a worker that finished saw."""
+    out = getattr(node, "workeroutput", None) or {}
+    if "called_hooks" in out:
+        _WORKERS.append((out["whole_suite"], set(out["called_hooks"])))
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_sessionfinish(session, exitstatus):
+    """A worker sends the hooks it saw called; the controller checks that every hook was called by some test (on
+    any worker), reported as the same tests ``tests/test_docs.py`` defines, when every worker collected every test
+    module."""
+    config = session.config
+    if hasattr(config, "workeroutput"):  # an xdist worker
+        config.workeroutput["called_hooks"] = sorted(CALLED_HOOKS)
+        config.workeroutput["whole_suite"] = bool(getattr(config, "whole_suite", False))
+        return
+    if not _WORKERS or not all(whole for whole, _ in _WORKERS):
+        return
+    from tests.test_docs import HOOKS
+
+    called = set().union(*(hooks for _, hooks in _WORKERS))
+    failed = 0
+    for name in sorted(HOOKS):
+        test = f"{HOOK_CHECK}[{name}]"
+        ok = name in called
+        failed += not ok
+        report = pytest.TestReport(f"tests/test_docs.py::{test}", ("tests/test_docs.py", 0, test), {},
+                            "passed" if ok else "failed",
+                            None if ok else f"no test made the toolkit call {name} with an implementation registered "
+                                            "(on any xdist worker)", "call")
+        config.hook.pytest_runtest_logreport(report=report)
+    if failed:
+        session.exitstatus = pytest.ExitCode.TESTS_FAILED
 
 
 def play_recording_postures(path: Path | str, actor: str = "max", **matcher_params):

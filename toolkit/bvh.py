@@ -32,7 +32,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from toolkit.errors import ConfigError
 from toolkit.files import check_regular_file, open_regular
@@ -131,6 +130,8 @@ class BVH:
 
     def _kinematics(self, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`forward_kinematics` of channel values (n, C); each frame on its own (the same bits in any block)."""
+        from scipy.spatial.transform import Rotation
+
         n = len(values)
         positions = np.empty((n, len(self.joints), 3))
         rotations = np.empty((n, len(self.joints), 3, 3))

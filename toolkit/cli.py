@@ -17,12 +17,13 @@ import re
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from toolkit import __version__
-from toolkit.components import KINDS
 from toolkit.errors import ConfigError, LikemeError
-from toolkit.manager import PluginManager, create_plugin_manager
+
+if TYPE_CHECKING:  # pragma: no cover
+    from toolkit.manager import PluginManager
 
 __all__ = ["main", "build_parser"]
 
@@ -270,12 +271,28 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p.add_argument("--out", metavar="PROFILE.toml", help="write the profile there (default: print it)")
     p.set_defaults(handler=cmd_profile)
 
+    pm.load_command_plugins()  # a lazy manager's plugins that add commands (none to do for a loaded one)
     pm.hook.likeme_register_commands(subparsers=sub)
     return parser
 
 
+def create_plugin_manager() -> PluginManager:
+    """The command's plugin manager: lazy (:func:`toolkit.manager.create_plugin_manager`), so that the parser is
+    built with only the plugins that add commands; :func:`main` loads the others when a command runs."""
+    from toolkit.manager import create_plugin_manager as create
+
+    return create(lazy=True)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``likeme`` command; returns the exit status."""
+    """Entry point of the ``likeme`` command; returns the exit status.
+
+    ``likeme --version`` is answered before anything is loaded; the parser (``--help``) needs only the plugins that
+    add commands; every other plugin, and the libraries it imports, is loaded when a command runs.
+    """
+    if list(sys.argv[1:] if argv is None else argv) == ["--version"]:
+        print(f"likeme {__version__}")
+        return 0
     try:
         pm = create_plugin_manager()
         parser = build_parser(pm)
@@ -284,6 +301,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             parser.print_help()
             return 1
         check_outputs(args)
+        pm.load_all()
         return int(args.handler(args, pm) or 0)
     except LikemeError as err:
         print(f"likeme: error: {err}", file=sys.stderr)
@@ -386,6 +404,8 @@ def cmd_run(args: argparse.Namespace, pm: PluginManager) -> int:
 
 def plugins_table(pm: PluginManager, *, params: bool = False) -> dict[str, Any]:
     """Every registered component by kind, and every loaded plugin with its hooks."""
+    from toolkit.components import KINDS
+
     registry = pm.registry
     components: dict[str, list[dict[str, Any]]] = {}
     for kind in KINDS:
@@ -423,6 +443,8 @@ def plugins_table(pm: PluginManager, *, params: bool = False) -> dict[str, Any]:
 
 def components_markdown(pm: PluginManager) -> str:
     """Every registered component with its summary and parameter table, as Markdown (``docs/components.md``)."""
+    from toolkit.components import KINDS
+
     lines = [
         "# Component reference",
         "",
@@ -444,6 +466,8 @@ def components_markdown(pm: PluginManager) -> str:
 
 
 def cmd_plugins(args: argparse.Namespace, pm: PluginManager) -> int:
+    from toolkit.components import KINDS
+
     if args.markdown:
         print(components_markdown(pm), end="")
         return 0

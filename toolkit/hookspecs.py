@@ -167,6 +167,12 @@ def likeme_register_commands(subparsers: argparse._SubParsersAction) -> None:
     Call ``subparsers.add_parser(NAME, help=...)`` and ``set_defaults(handler=FUNC)``
     on it; ``FUNC(args, pm)`` is called with the parsed arguments and the plugin
     manager and returns the exit status.
+
+    To build its parser ``likeme`` imports only the plugins that may add commands: those a distribution names in
+    the ``likeme.commands`` entry-point group (``NAME = "module"``, NAME as in ``likeme``), or every ``likeme``
+    entry of a distribution that names none there. Name yours there, and keep its module light (import what a
+    command needs in its handler), so that ``likeme --help`` stays fast; the other plugins are imported when a
+    command runs.
     """
 
 

@@ -24,7 +24,13 @@ by default it becomes a :class:`~toolkit.errors.PluginError` naming the plugin a
 policy a world runs with (``likeme run --keep-going``) the plugin is unregistered, the failure reported, and the
 implementations not yet called are called.
 
-Nothing is loaded at import time: call :func:`create_plugin_manager`.
+Nothing is loaded at import time: call :func:`create_plugin_manager`. The ``likeme`` command makes a *lazy* one
+(``create_plugin_manager(lazy=True)``): it reads the entry points (metadata only) and imports only the plugins that
+add commands, builds its parser, and imports the others when a command runs (:meth:`PluginManager.load_all`), so
+that ``likeme --help`` imports no plugin that only registers components. Which plugins add commands: a distribution
+names them in a second group, ``likeme.commands`` (``NAME = "module"``, the same NAME as in ``likeme``); a
+distribution that declares no ``likeme.commands`` entry has every ``likeme`` entry imported for the command line,
+as before. The order plugins are registered in (and so the order of hook calls) does not depend on this.
 """
 
 from __future__ import annotations
@@ -36,16 +42,19 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from importlib import metadata
 from types import ModuleType, TracebackType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import pluggy
 
 from toolkit import hookspecs
-from toolkit.components import KINDS, Component, Matcher, Perception
 from toolkit.errors import ConfigError, LikemeError, PluginError
+
+if TYPE_CHECKING:  # pragma: no cover
+    from toolkit.components import Component
 
 __all__ = [
     "ENTRY_POINT_GROUP",
+    "COMMANDS_GROUP",
     "DISTRIBUTION",
     "PluginManager",
     "PluginInfo",
@@ -55,6 +64,7 @@ __all__ = [
 ]
 
 ENTRY_POINT_GROUP = "likeme"
+COMMANDS_GROUP = "likeme.commands"
 DISTRIBUTION = "likeme"
 ENV_DISABLE_AUTOLOAD = "LIKEME_DISABLE_PLUGIN_AUTOLOAD"
 ENV_TRACE = "LIKEME_TRACE_HOOKS"
@@ -101,6 +111,8 @@ class Registry:
     """
 
     def __init__(self, components: Iterable[ComponentInfo], failed: Sequence[PluginInfo] = ()) -> None:
+        from toolkit.components import KINDS
+
         self.failed = tuple(failed)
         self._by_kind: dict[str, dict[str, ComponentInfo]] = {kind: {} for kind in KINDS}
         for info in components:
@@ -118,6 +130,8 @@ class Registry:
         try:
             return self._by_kind[kind][name].cls
         except KeyError:
+            from toolkit.components import KINDS
+
             label = KINDS[kind].kind
             expected = f"the name of a registered {label}"
             if self.failed:
@@ -148,6 +162,12 @@ class PluginManager(pluggy.PluginManager):
         self.failed: list[tuple[PluginInfo, PluginError]] = []
         self._registry: Registry | None = None
         self._policies: list[tuple[str, Failed | None]] = []
+        self._entries: list[tuple[PluginInfo, metadata.EntryPoint]] | None = None  # found, in loading order
+        self._third_party = True
+        self._imported: dict[str, object | None] = {}  # entry name -> module (None: a third-party one that failed)
+        self._early: list[str] = []  # registered before the others, for the command line
+        self._loaded = False
+        self._extra: list[tuple[str, object]] = []  # create_plugin_manager(plugins=...), registered after the entries
         self.tracing = False
         self.add_hookcall_monitoring(lambda *_: None, self._after_hookcall)
 
@@ -198,12 +218,21 @@ class PluginManager(pluggy.PluginManager):
 
     # -- loading -------------------------------------------------------------------
 
-    def load_entry_points(self, *, third_party: bool = True) -> None:
-        """Register every entry of the ``likeme`` group (only the built-ins if ``third_party`` is false)."""
+    def find_entry_points(self, *, third_party: bool = True) -> None:
+        """Read the ``likeme`` group, built-ins first (metadata only: no plugin is imported); once per manager.
+
+        Third-party entries are left out (in :attr:`skipped`) if ``third_party`` is false. Two distributions
+        registering one name is an error.
+        """
+        if self._entries is not None:
+            return
+        self._third_party = third_party
         seen: dict[str, PluginInfo] = {}
-        for ep in sorted(metadata.entry_points(group=ENTRY_POINT_GROUP), key=_builtin_first):
-            dist = ep.dist.metadata["Name"] if ep.dist is not None else "(unknown)"
-            version = ep.dist.version if ep.dist is not None else "?"
+        entries = []
+        found = metadata.entry_points(group=ENTRY_POINT_GROUP)
+        known: dict[int, tuple[str, str]] = {}  # the distributions of ``found``, alive while it is
+        for ep in sorted(found, key=lambda ep: _builtin_first(ep, known)):
+            dist, version = _distribution(ep, known)
             info = PluginInfo(ep.name, ep.value, dist, version)
             if info.name in seen:
                 if seen[info.name].module == info.module:  # the same distribution found twice on sys.path
@@ -218,21 +247,77 @@ class PluginManager(pluggy.PluginManager):
             if not third_party and _normalise(dist) != DISTRIBUTION:
                 self.skipped.append(info)
                 continue
-            builtin = _normalise(dist) == DISTRIBUTION
+            entries.append((info, ep))
+        self._entries = entries
+
+    def load_entry_points(self, *, third_party: bool = True) -> None:
+        """Import and register every entry of the ``likeme`` group (only the built-ins if ``third_party`` is false),
+        in the order :meth:`find_entry_points` gives (built-ins first); those registered early for the command line
+        (:meth:`load_command_plugins`) are registered again in that order."""
+        self.find_entry_points(third_party=third_party)
+        for name in self._early:  # hook calls go by registration order: the same as if all were loaded at once
+            if self.get_plugin(name) is not None:
+                self.unregister(name=name)
+        self._early = []
+        for info, ep in self._entries or []:
+            self._load(info, ep)
+        self._loaded = True
+        for name, plugin in self._extra:  # create_plugin_manager(plugins=...): after the entry points
+            self.register_plugin(plugin, PluginInfo(name, getattr(plugin, "__name__", repr(plugin)),
+                                                    "(registered in Python)", ""))
+        self._extra = []
+
+    def load_command_plugins(self) -> None:
+        """Import and register only the entries that may add commands (``likeme_register_commands``): those a
+        distribution names in the ``likeme.commands`` group, and every entry of a distribution that names none
+        there. Nothing for a manager that has loaded every entry or never looked for them."""
+        if self._entries is None or self._loaded:
+            return
+        declared: dict[str, set[str]] = {}
+        found = metadata.entry_points(group=COMMANDS_GROUP)
+        known: dict[int, tuple[str, str]] = {}
+        for ep in found:
+            dist = _normalise(_distribution(ep, known)[0])
+            declared.setdefault(dist, set()).add(ep.name)
+        for info, ep in self._entries:
+            names = declared.get(_normalise(info.distribution))
+            if (names is None or info.name in names) and self._load(info, ep):
+                self._early.append(info.name)
+
+    def load_all(self) -> None:
+        """Load the entries a lazy manager (``create_plugin_manager(lazy=True)``) left for later; nothing for a
+        manager that loaded them, or was made without entry points."""
+        if self._entries is not None and not self._loaded:
+            self.load_entry_points(third_party=self._third_party)
+
+    def _load(self, info: PluginInfo, ep: metadata.EntryPoint) -> bool:
+        """Import one entry point's module (once) and register it; whether it is registered. A built-in that fails
+        is an error; a third-party one is left out, recorded and announced once (:meth:`_fail`)."""
+        if self.get_plugin(info.name) is not None:
+            return False
+        builtin = _normalise(info.distribution) == DISTRIBUTION
+        if info.name not in self._imported:
             try:
-                module = ep.load()
+                self._imported[info.name] = ep.load()
             except Exception as exc:  # a broken import must name itself
-                error = PluginError(ep.name, f"import of {ep.value} ({dist})", f"{type(exc).__name__}: {exc}")
+                error = PluginError(info.name, f"import of {info.module} ({info.distribution})",
+                                    f"{type(exc).__name__}: {exc}")
                 if builtin:
                     raise error from exc
+                self._imported[info.name] = None
                 self._fail(info, error)
-                continue
-            try:
-                self.register_plugin(module, info)
-            except PluginError as error:
-                if builtin:
-                    raise
-                self._fail(info, error)
+        module = self._imported[info.name]
+        if module is None:
+            return False
+        try:
+            self.register_plugin(module, info)
+        except PluginError as error:
+            if builtin:
+                raise
+            self._imported[info.name] = None
+            self._fail(info, error)
+            return False
+        return True
 
     def _fail(self, info: PluginInfo, error: PluginError) -> None:
         """A third-party entry point that failed: left out, recorded and announced on one warning line."""
@@ -268,6 +353,7 @@ class PluginManager(pluggy.PluginManager):
     @property
     def registry(self) -> Registry:
         """Every component registered by the loaded plugins (collected once, then cached)."""
+        self.load_all()  # a lazy manager's components are those of every plugin, as an eager one's
         if self._registry is None:
             self._registry = Registry(self._collect(), [info for info, _ in self.failed])
         return self._registry
@@ -275,6 +361,8 @@ class PluginManager(pluggy.PluginManager):
     def _collect(self) -> list[ComponentInfo]:
         """Each plugin's registration hooks called through pluggy (one plugin at a time, so that every class is
         credited to the plugin that returned it)."""
+        from toolkit.components import KINDS
+
         found: dict[tuple[str, str], ComponentInfo] = {}
         for kind, hook_name in REGISTER_HOOKS.items():
             impls = getattr(self.hook, hook_name).get_hookimpls()  # registration order
@@ -330,6 +418,8 @@ def _culprit(tb: TracebackType | None, impls: Sequence[pluggy.HookImpl]) -> plug
 
 
 def _check_registered(classes: Any, kind: str, info: PluginInfo, hook_name: str) -> list[type[Component]]:
+    from toolkit.components import KINDS
+
     base = KINDS[kind]
     if classes is None:
         return []
@@ -354,6 +444,8 @@ def _check_registered(classes: Any, kind: str, info: PluginInfo, hook_name: str)
 def _check_declared(cls: type, info: PluginInfo, hook_name: str) -> None:
     """A declared capability must be implemented, and an implemented one declared (the runtime goes by the
     declaration)."""
+    from toolkit.components import Matcher, Perception
+
     pairs = []
     if issubclass(cls, Matcher):
         pairs.append(("streaming", cls.streaming, "observe", cls.observe is not Matcher.observe))
@@ -373,8 +465,24 @@ def _normalise(name: str) -> str:
     return re.sub(r"[-_.]+", "-", name).lower()
 
 
-def _builtin_first(ep: metadata.EntryPoint) -> tuple[int, str]:
-    dist = ep.dist.metadata["Name"] if ep.dist is not None else ""
+def _distribution(ep: metadata.EntryPoint, known: dict[int, tuple[str, str]] | None = None) -> tuple[str, str]:
+    """The name and version of an entry point's distribution. ``known`` (distribution id -> name and version, kept
+    by the caller while the entry points live) parses each distribution's metadata once, not once per entry point:
+    every entry point of one distribution shares its ``dist``."""
+    dist = ep.dist
+    if dist is None:
+        return "(unknown)", "?"
+    if known is not None and id(dist) in known:
+        return known[id(dist)]
+    meta = dist.metadata
+    found = (meta["Name"], meta["Version"])
+    if known is not None:
+        known[id(dist)] = found
+    return found
+
+
+def _builtin_first(ep: metadata.EntryPoint, known: dict[int, tuple[str, str]] | None = None) -> tuple[int, str]:
+    dist = _distribution(ep, known)[0] if ep.dist is not None else ""
     return (0 if _normalise(dist) == DISTRIBUTION else 1, ep.name)
 
 
@@ -383,6 +491,7 @@ def create_plugin_manager(
     autoload: bool | None = None,
     plugins: Iterable[tuple[str, object]] = (),
     trace: bool | None = None,
+    lazy: bool = False,
 ) -> PluginManager:
     """A fresh plugin manager with the built-ins, the third-party entry points and ``plugins``.
 
@@ -394,6 +503,10 @@ def create_plugin_manager(
         Further plugin objects to register after the entry points (tests use this).
     trace : bool, optional
         Trace hook calls to standard error. Default: whether ``LIKEME_TRACE_HOOKS`` is set.
+    lazy : bool
+        Find the entry points but import none: :meth:`PluginManager.load_command_plugins` imports those that add
+        commands, :meth:`PluginManager.load_all` (or the first use of :attr:`PluginManager.registry`) the others
+        (the ``likeme`` command's start-up). ``plugins`` are then registered by ``load_all``, after the entry points.
     """
     if autoload is None:
         autoload = os.environ.get(ENV_DISABLE_AUTOLOAD, "") in ("", "0")
@@ -403,13 +516,14 @@ def create_plugin_manager(
     if trace:
         pm.trace.root.setwriter(lambda text: sys.stderr.write(text))
         pm.enable_tracing()
-    pm.load_entry_points(third_party=autoload)
-    if not any(_normalise(i.distribution) == DISTRIBUTION for i in pm.plugin_infos.values()):
+    pm.find_entry_points(third_party=autoload)
+    if not any(_normalise(info.distribution) == DISTRIBUTION for info, _ in pm._entries or []):
         raise PluginError(
             DISTRIBUTION,
             "entry points",
             "no built-in plugins found: install the project (pip install -e .) so that its entry points exist",
         )
-    for name, plugin in plugins:
-        pm.register_plugin(plugin, PluginInfo(name, getattr(plugin, "__name__", repr(plugin)), "(registered in Python)", ""))
+    pm._extra = [(name, plugin) for name, plugin in plugins]
+    if not lazy:
+        pm.load_all()
     return pm

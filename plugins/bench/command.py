@@ -10,7 +10,6 @@ import argparse
 from importlib import import_module
 from typing import Any
 
-from plugins.action.script import MAX_RANDOM
 from toolkit import hookimpl
 from toolkit.cli import count_type, fps_type, number_type, seed_type
 
@@ -18,6 +17,18 @@ MATCHERS = ("path-search", "forward-model", "dtw")
 """The matchers ``likeme bench recognition`` and ``stream`` compare when none is named."""
 SEGMENTERS = ("hub-threshold", "velocity-direction", "ruptures")
 """The segmenters ``likeme bench segmentation`` compares when none is named (``stream``: the first two)."""
+
+
+SCRIPT_MAX_RANDOM = 100_000
+"""``plugins.action.script.MAX_RANDOM`` written out for ``--help`` (which imports no component module; a test keeps
+the two equal)."""
+
+
+def _movements(text: str) -> int:
+    """``bench watch --movements``: an integer in [1, the most a script draws]."""
+    from plugins.action.script import MAX_RANDOM
+
+    return count_type(1, MAX_RANDOM)(text)
 
 
 def _handler(module: str, function: str, *extra: Any):
@@ -132,8 +143,8 @@ def likeme_register_commands(subparsers):
     p = sub.add_parser("watch", help="an observer watches a demonstrator's random movements (B&B §5)")
     p.add_argument("--observer", default="max", help="observer character (default: max)")
     p.add_argument("--demonstrator", default="morris", help="demonstrator character (default: morris)")
-    p.add_argument("--movements", type=count_type(1, MAX_RANDOM), default=200,
-                   help=f"number of random movements, at most {MAX_RANDOM} (default: 200)")
+    p.add_argument("--movements", type=_movements, default=200,
+                   help=f"number of random movements, at most {SCRIPT_MAX_RANDOM} (default: 200)")
     p.add_argument("--seed", type=seed_type, default=0)
     p.add_argument("--noise", type=number_type(0.0, 1.0, "metres"), default=0.005,
                    help="vision noise, metres (default: 0.005)")
@@ -188,6 +199,12 @@ def likeme_register_commands(subparsers):
     p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
                    help="override an observer parameter (repeatable)")
     p.set_defaults(handler=_handler("memory", "cmd_memory"))
+
+    p = sub.add_parser("startup", help="how long likeme takes to start: the medians of likeme --version, --help "
+                       "and plugins, each run in a fresh process")
+    p.add_argument("--runs", type=count_type(1, 1000), default=20, help="runs of each command (default: 20)")
+    p.add_argument("--json", metavar="FILE", help="also write the times as JSON")
+    p.set_defaults(handler=_handler("startup", "cmd_startup"))
 
     p = sub.add_parser("vision", help="rendered-vision against synthetic-vision on the same frames: agreement, "
                        "position difference, milliseconds per frame")

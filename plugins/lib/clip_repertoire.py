@@ -31,8 +31,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.cluster.hierarchy import fcluster, linkage
-from scipy.spatial.distance import squareform
 
 from plugins.lib.pose_distance import pose_distance
 from plugins.lib.root_frame import root_relative, smooth_heading
@@ -143,6 +141,9 @@ def find_hubs(ends: np.ndarray, radius: float, share: float) -> np.ndarray:
     Average-linkage clusters of eq. 1 distance cut at ``radius`` metres; a cluster
     with at least ``share`` of the ends is a hub, its medoid the hub pose.
     """
+    from scipy.cluster.hierarchy import fcluster, linkage
+    from scipy.spatial.distance import squareform
+
     n = len(ends)
     if n == 1:
         return ends.copy()

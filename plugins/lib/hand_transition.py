@@ -35,7 +35,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.interpolate import PchipInterpolator
 
 from plugins.lib.guiding_stroke import progress
 
@@ -66,6 +65,8 @@ class HandTransition:
     __hash__ = None  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
+        from scipy.interpolate import PchipInterpolator
+
         keys = np.asarray(self.keys, dtype=float)
         times = np.asarray(self.times, dtype=float)
         if keys.ndim != 2 or keys.shape[1] != 3 or len(keys) < 2 or not np.isfinite(keys).all():

@@ -21,8 +21,6 @@ same setting holds for a mouse and a giant.
 from __future__ import annotations
 
 import numpy as np
-from scipy.ndimage import minimum_filter1d
-from scipy.signal import lfilter
 
 __all__ = ["RestPosture", "DwellingRest", "dwell_weights"]
 
@@ -67,6 +65,8 @@ class RestPosture:
     def update(self, poses: np.ndarray, visible: np.ndarray, size: float) -> np.ndarray:
         """The rest posture after each frame of a block (n, P, 3): poses (n, P, 3) hidden parts held, masks (n, P),
         ``size`` the body's size (m) that speeds are measured in."""
+        from scipy.signal import lfilter
+
         poses = np.asarray(poses, dtype=float)
         n, p = poses.shape[:2]
         if n == 0:
@@ -185,6 +185,8 @@ class DwellingRest:
     def noise_floor(self, spreads: np.ndarray, floor: float) -> np.ndarray:
         """The smallest of the spreads (n,) over the last ``floor`` seconds up to each frame (this block's and the
         ones before: causal, whatever the blocks)."""
+        from scipy.ndimage import minimum_filter1d
+
         window = max(1, int(round(floor * self.fps)))
         x = np.concatenate([self._spreads, np.asarray(spreads, dtype=float)])
         x = np.where(np.isfinite(x), x, np.inf)

@@ -24,7 +24,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import argrelextrema, savgol_filter
 
 __all__ = ["StrokeCriteria", "StrokeAnalysis", "analyse", "breaks", "speed_breaks", "direction_clusters",
            "direction_breaks"]
@@ -60,6 +59,8 @@ def speed_breaks(speed: np.ndarray, drop: float, moving: float = 0.0) -> list[in
     # Written out, not scipy.signal.find_peaks: K&G §4.3's criterion is a share of the neighbouring maxima (a ratio,
     # where find_peaks's prominence is a difference to the lower base of higher peaks) and a hold joins minima with
     # nothing faster than the rest speed between them, which no find_peaks option (plateau, distance, wlen) expresses.
+    from scipy.signal import argrelextrema
+
     speed = np.asarray(speed, dtype=float)
     n = len(speed)
     if n < 3:
@@ -149,6 +150,8 @@ def analyse(window: np.ndarray, fps: float, criteria: StrokeCriteria = StrokeCri
     Speed minima below ``drop`` of their neighbouring maxima cut; direction-cluster changes cut where the
     direction turns sharply at a dip of the speed (see the module). Pieces shorter than ``min_stroke`` merge.
     """
+    from scipy.signal import savgol_filter
+
     c = criteria
     n = len(window)
     empty = np.zeros(max(0, n - 1))

@@ -22,7 +22,6 @@ the body's frame (hidden parts held, ``docs/conventions.md``); ``visible`` (F, P
 from __future__ import annotations
 
 import numpy as np
-from scipy.ndimage import uniform_filter1d
 
 __all__ = ["frame_rotation", "body_velocity", "travel_part"]
 
@@ -58,6 +57,8 @@ def body_velocity(world: np.ndarray, local: np.ndarray, visible: np.ndarray, roo
     (a step's sway left and right cancels; a change of pace within a second is kept), then turned by each frame's
     :func:`frame_rotation`. A motion of one frame has no velocity (NaN).
     """
+    from scipy.ndimage import uniform_filter1d
+
     world = np.asarray(world, dtype=float)
     n = len(world)
     out = np.full((n, 3), np.nan)

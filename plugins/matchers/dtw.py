@@ -23,7 +23,6 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from dtaidistance import dtw_ndim
 
 from toolkit import Match, Matcher, Motion, Parameter, hookimpl
 
@@ -36,6 +35,8 @@ def frame_distance(series: np.ndarray, template: np.ndarray, window: float = 0.0
     ``window``: Sakoe-Chiba band as a share of the longer series (0: none). The same series at any length
     (every frame repeated k times) is at the same distance from the same template.
     """
+    from dtaidistance import dtw_ndim
+
     band = int(window * max(len(series), len(template))) or None
     if band is not None:
         band = max(band, abs(len(series) - len(template)) + 1)

@@ -102,7 +102,6 @@ from types import MappingProxyType
 from typing import Any, Protocol
 
 import numpy as np
-from scipy.ndimage import uniform_filter1d
 
 from plugins.lib.strokes import StrokeCriteria
 from toolkit import Match, Matcher, Motion, Parameter, hookimpl
@@ -238,6 +237,8 @@ def _lengths(observed: np.ndarray) -> np.ndarray:
 
     Noise adds length at every frame; the positions are averaged over three frames first.
     """
+    from scipy.ndimage import uniform_filter1d
+
     if len(observed) >= 3:
         observed = uniform_filter1d(observed, size=3, axis=0, mode="nearest")
     return np.linalg.norm(np.diff(observed, axis=0), axis=-1).sum(axis=0) if len(observed) > 1 else \
@@ -600,6 +601,8 @@ class ForwardModel(Matcher):
         ``observed`` (n, k, 3) followed from its first frame: the forward model's own prediction (:meth:`_error`,
         anchors and ``relative`` included) with the observed path lengths up to each frame (the positions
         averaged over three frames, as :func:`_lengths` does, over the whole take at once)."""
+        from scipy.ndimage import uniform_filter1d
+
         track = Track(subsystem, self._scale_of(subsystem), self.motor.is_hand(subsystem), "hub", 0, {}, [],
                       first=observed[0])
         smooth = uniform_filter1d(observed, size=3, axis=0, mode="nearest") if len(observed) >= 3 else observed
@@ -625,6 +628,8 @@ class ForwardModel(Matcher):
 
         The edges before it were followed correctly; learning starts from the frame the demonstration passed it.
         """
+        from scipy.ndimage import uniform_filter1d
+
         lead = self._lead(track.committed_path[0])
         arcs = np.cumsum([self._edge(e).arcs[lead, -1] for e in track.committed_path])
         joined = self._anchor(track, track.committed_path[0])[lead]

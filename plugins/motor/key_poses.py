@@ -31,7 +31,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.interpolate import PchipInterpolator
 
 from toolkit.body import Body
 from toolkit.errors import ConfigError
@@ -213,6 +212,8 @@ def interpolate(
     velocity where the motion turns. ``speed`` > 1 plays faster. The first and
     last frames are exactly the first and last keys.
     """
+    from scipy.interpolate import PchipInterpolator
+
     if speed <= 0:
         raise ValueError("speed must be positive")
     duration = float(times[-1]) / speed

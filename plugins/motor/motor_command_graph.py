@@ -38,7 +38,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-import networkx as nx
 import numpy as np
 
 from plugins.lib.clip_repertoire import CLIP_PARAMETERS, example_name, repertoire_for
@@ -120,6 +119,8 @@ class MotorCommandGraph(MotorSystem):
     )
 
     def attach(self, owner: Any) -> None:
+        import networkx as nx
+
         super().attach(owner)
         body = owner.body
         self.body = body

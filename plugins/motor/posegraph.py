@@ -27,7 +27,6 @@ from __future__ import annotations
 
 from typing import Any
 
-import networkx as nx
 import numpy as np
 
 from plugins.lib.clip_repertoire import CLIP_PARAMETERS, example_name, repertoire_for
@@ -72,6 +71,8 @@ class Posegraph(MotorSystem):
     # -- the graph -------------------------------------------------------------------------
 
     def _build(self) -> None:
+        import networkx as nx
+
         rate = self.params["node_rate"]
         poses: list[np.ndarray] = [self.key_poses[h] for h in self.hubs]
         travel: list[np.ndarray] = [np.zeros(3) for _ in self.hubs]  # at rest in the hubs
@@ -131,6 +132,8 @@ class Posegraph(MotorSystem):
 
     def _add_path(self, name: str, start: str, interior: np.ndarray, end: str, poses: list[np.ndarray],
                   travel: list[np.ndarray], velocity: np.ndarray, *, label: str | None = None) -> None:
+        import networkx as nx
+
         label = label or name
         path = [start]
         for j, (pose, v) in enumerate(zip(interior, velocity), 1):

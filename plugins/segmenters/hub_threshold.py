@@ -64,8 +64,6 @@ from collections.abc import Sequence
 from typing import Any, Protocol
 
 import numpy as np
-from scipy.ndimage import minimum_filter1d
-from scipy.signal import butter, lfilter, lfilter_zi
 
 from plugins.lib.body_size import body_scale
 from plugins.lib.pose_distance import pose_distance
@@ -146,6 +144,8 @@ class HubThreshold(Segmenter):
     # -- streaming ---------------------------------------------------------------------
 
     def reset(self, parts: Sequence[str], fps: float) -> None:
+        from scipy.signal import butter
+
         if tuple(parts) != tuple(self.template_parts):
             raise ConfigError("hub-threshold compares poses in the observer's own parts", expected=f"the parts "
                               f"{list(self.template_parts)} (the watching loop maps the observed body's parts onto "
@@ -221,6 +221,8 @@ class HubThreshold(Segmenter):
         and where the rest changed at each frame (n, 3) (:meth:`DwellingRest.update`; -1: it did not). With
         reference = rest the filter restarts at the distance from the new rest where it changes (the old rest no
         longer counts)."""
+        from scipy.signal import lfilter, lfilter_zi
+
         poses = np.asarray(poses, dtype=float)
         visible = np.asarray(visible, dtype=bool)
         n = len(poses)
@@ -299,6 +301,8 @@ class HubThreshold(Segmenter):
         thresholds apply to (the filtered distance minus its running minimum over ``floor`` seconds; the filtered
         distance itself without a floor). Frames with nothing visible hold the last value.
         """
+        from scipy.ndimage import minimum_filter1d
+
         self.reset(motion.parts, motion.fps)
         raw, filtered, _ = self._evidence(motion.positions, motion.visible)
         self.reset(motion.parts, motion.fps)

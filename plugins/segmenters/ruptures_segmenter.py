@@ -32,8 +32,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-import ruptures as rpt
-from scipy.spatial.distance import pdist
 
 from toolkit import Motion, Parameter, Segment, Segmenter, hookimpl
 from toolkit.motion import fill_hidden
@@ -49,6 +47,8 @@ def rbf_gamma(x: np.ndarray, sample: int = BANDWIDTH_SAMPLE) -> float:
     The same value as :class:`ruptures.costs.CostRbf` computes from all pairs when ``len(x) <= sample``;
     memory is O(sample^2) whatever the length of the stream.
     """
+    from scipy.spatial.distance import pdist
+
     x = np.asarray(x, dtype=np.double)
     if x.ndim == 1:
         x = x.reshape(-1, 1)
@@ -125,6 +125,8 @@ class RupturesSegmenter(Segmenter):
     def _bounds(self, poses: np.ndarray, visible: np.ndarray) -> list[int]:
         """0, the change points of ``poses`` (frames, not strided), ``len(poses)``; just the ends when fewer than
         two frames are seen or the stretch is too short to be cut."""
+        import ruptures as rpt
+
         n, stride = len(poses), self.params["stride"]
         seen = visible.any(axis=1)
         if seen.sum() < 2:

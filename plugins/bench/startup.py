@@ -1,0 +1,64 @@
+"""``likeme bench startup``: how long the ``likeme`` command takes to start.
+
+Each command (``likeme --version``, ``likeme --help``, ``likeme plugins``) is run ``--runs`` times in a fresh
+process, the commands taking turns so that a change in the machine's load falls on all of them alike; the wall time
+of each run is measured from here (process start to exit) and the median printed with the fastest and slowest. The
+machine's load average is printed too: on a shared machine it is the first thing the figures depend on.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from toolkit.errors import LikemeError
+
+COMMANDS: tuple[tuple[str, ...], ...] = (("--version",), ("--help",), ("plugins",))
+"""What is timed: the version, the help (the parser), and a command that loads every plugin."""
+
+
+def likeme_command() -> list[str]:
+    """How to start likeme: the ``likeme`` script installed beside this Python, else ``python -m toolkit.cli``."""
+    script = Path(sys.executable).with_name("likeme")
+    return [str(script)] if script.is_file() else [sys.executable, "-m", "toolkit.cli"]
+
+
+def time_commands(runs: int, command: list[str] | None = None) -> list[dict[str, Any]]:
+    """Wall times (s) of every command of :data:`COMMANDS`, ``runs`` each, in turns after one untimed warm-up round
+    (which fills the file cache and Python's bytecode cache)."""
+    command = command or likeme_command()
+    times: dict[tuple[str, ...], list[float]] = {argv: [] for argv in COMMANDS}
+    for round_ in range(runs + 1):
+        for argv in COMMANDS:
+            start = time.perf_counter()
+            result = subprocess.run([*command, *argv], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+            elapsed = time.perf_counter() - start
+            if result.returncode != 0:
+                raise LikemeError(f"'likeme {' '.join(argv)}' exited with status {result.returncode}: "
+                                  f"{result.stderr.strip()[-300:]}")
+            if round_:
+                times[argv].append(elapsed)
+    return [{"command": "likeme " + " ".join(argv), "runs": runs, "median_s": statistics.median(t),
+             "min_s": min(t), "max_s": max(t)} for argv, t in times.items()]
+
+
+def cmd_startup(args: argparse.Namespace, pm: Any) -> int:
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    command = likeme_command()
+    rows = time_commands(args.runs, command)
+    load_after = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    print(f"{' '.join(command)}: {args.runs} runs each; {os.cpu_count()} cores, load average {load:.2f} before, "
+          f"{load_after:.2f} after")
+    print(f"{'command':<18} {'median ms':>10} {'min ms':>8} {'max ms':>8}")
+    for r in rows:
+        print(f"{r['command']:<18} {r['median_s'] * 1000:10.0f} {r['min_s'] * 1000:8.0f} {r['max_s'] * 1000:8.0f}")
+    if args.json:
+        Path(args.json).write_text(json.dumps({"load_average": [load, load_after], "rows": rows}, indent=1) + "\n")
+    return 0
