@@ -153,6 +153,7 @@ CASES = [
     ("cli-bad-int", "not a number", {}, ["demo", "--seed", "x"], ["argument --seed: invalid int value: 'x'"]),
     ("cli-bench-set", "bad --set", {}, ["bench", "watch", "--movements", "1", "--set", "floor=0"], ["key --set", "invalid setting 'floor=0'", "expected TABLE.KEY=VALUE"]),
     # -- views
+    ("view-width-huge", "a picture 100,000 pixels wide", {}, ["show", "max", "--view", "body", "--set", "width=100000"], ["key width", "value 100000 out of range", "expected an integer in [64, 8192]"]),
     ("view-unknown", "unknown view", {}, ["show", "max", "--view", "graph"], ["unknown view 'graph'", "available:", "hub-signal"]),
     ("view-segmenter", "a signal view of a segmenter the character does not have", {}, ["show", "max", "--view", "speed-profile"], ["key --view", "Max has no velocity-direction segmenter (its segmenter is 'hub-threshold')", "expected a character whose [segmenter] plugin is velocity-direction"]),
     ("view-movement", "a view asked to perform an unknown movement", {}, ["show", "max", "--view", "hub-signal", "--set", 'movements=["fly"]'], ["key movements", "unknown movement 'fly'", "available:", "wave"]),

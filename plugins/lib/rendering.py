@@ -21,9 +21,11 @@ import numpy as np
 
 from toolkit.body import Body
 
-__all__ = ["plotter", "BodyFigure", "Movie", "part_colours", "hex_to_rgb", "GREY", "save_png", "draw_bodies", "frame_2d", "add_labels", "poses_png"]
+__all__ = ["MAX_PIXELS", "plotter", "BodyFigure", "Movie", "part_colours", "hex_to_rgb", "GREY", "save_png", "draw_bodies", "frame_2d", "add_labels", "poses_png"]
 
 GREY = "#b0b0b0"
+MAX_PIXELS = 8192
+"""The largest width or height of a picture a view draws, in pixels (a bound on the memory a setting can ask for)."""
 """The colour of a part the observer does not see."""
 
 _PALETTE = ("#e6194b", "#3cb44b", "#4363d8", "#f58231", "#911eb4", "#42d4f4", "#f032e6", "#bfef45", "#fabed4",

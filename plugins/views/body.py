@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from plugins.lib.rendering import poses_png
+from plugins.lib.rendering import MAX_PIXELS, poses_png
 from toolkit import ConfigError, Parameter, View, hookimpl
 
 __all__ = ["BodyView", "body_frame", "key_pose_strip"]
@@ -49,8 +49,9 @@ class BodyView(View):
         Parameter("keys", int, 6, "Key poses shown per movement.", minimum=1, maximum=30),
         Parameter("movements", list, [], "Movements to show (default: all of the repertoire)."),
         Parameter("columns", int, 0, "Columns of movement strips (0: one per 12 movements).", minimum=0),
-        Parameter("width", int, 1600, "Image width in pixels.", minimum=64),
-        Parameter("height", int, 0, "Image height in pixels (0: from the number of rows).", minimum=0),
+        Parameter("width", int, 1600, "Image width in pixels.", minimum=64, maximum=MAX_PIXELS),
+        Parameter("height", int, 0, "Image height in pixels (0: from the number of rows).", minimum=0,
+                  maximum=MAX_PIXELS),
         Parameter("fps", float, 30.0, "Frame rate the movements are performed at before sampling.", minimum=1.0),
     )
 

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from plugins.lib.rendering import poses_png
+from plugins.lib.rendering import MAX_PIXELS, poses_png
 from toolkit import ConfigError, Parameter, View, hookimpl
 
 __all__ = ["CorrespondenceView"]
@@ -33,7 +33,7 @@ class CorrespondenceView(View):
         Parameter("poses", int, 6, "Frames shown, evenly over the recording.", minimum=1, maximum=30),
         Parameter("seen_from", str, "side", "Where the bodies are seen from: the side (a bow, a lean show) or the "
                   "front (a stance, the arms' spread show).", choices=("side", "front")),
-        Parameter("width", int, 1600, "Image width in pixels.", minimum=64),
+        Parameter("width", int, 1600, "Image width in pixels.", minimum=64, maximum=MAX_PIXELS),
     )
 
     def draw(self, subject: Any, out: Path) -> list[Path]:

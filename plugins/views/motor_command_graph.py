@@ -25,7 +25,7 @@ import numpy as np
 
 from plugins.views.demonstration import demonstration, require
 from toolkit.watching import ObservationLog
-from plugins.lib.rendering import add_labels, draw_bodies, part_colours, plotter, save_png
+from plugins.lib.rendering import MAX_PIXELS, add_labels, draw_bodies, part_colours, plotter, save_png
 from toolkit import Parameter, View, hookimpl
 
 __all__ = ["MotorCommandGraphView", "edge_trajectories"]
@@ -46,8 +46,8 @@ class MotorCommandGraphView(View):
         Parameter("demonstrator", str, "", "Character (file or name) who performs it (empty: the character itself)."),
         Parameter("at", float, 0.3, "Share of the demonstration watched before the picture is taken.",
                   minimum=0.0, maximum=1.0),
-        Parameter("width", int, 1000, "Image width in pixels.", minimum=64),
-        Parameter("height", int, 900, "Image height in pixels.", minimum=64),
+        Parameter("width", int, 1000, "Image width in pixels.", minimum=64, maximum=MAX_PIXELS),
+        Parameter("height", int, 900, "Image height in pixels.", minimum=64, maximum=MAX_PIXELS),
     )
 
     def draw(self, subject: Any, out: Path) -> list[Path]:

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from toolkit import Parameter
+from plugins.lib.rendering import MAX_PIXELS
 
 __all__ = ["DEMONSTRATION", "FREE_LABEL", "PALETTE", "blank", "colours", "figure", "fit_labels", "save_figure",
            "span_label", "timeline", "demonstrate"]
@@ -32,8 +33,8 @@ DEMONSTRATION = (
     Parameter("rest", float, 0.6, "Seconds of stillness before, between and after the movements.", minimum=0.0),
     Parameter("noise", float, 0.0, "Standard deviation (m) of Gaussian observation noise.", minimum=0.0),
     Parameter("seed", int, 0, "Seed of the noise."),
-    Parameter("width", int, 1400, "Image width in pixels.", minimum=200),
-    Parameter("height", int, 800, "Image height in pixels.", minimum=200),
+    Parameter("width", int, 1400, "Image width in pixels.", minimum=200, maximum=MAX_PIXELS),
+    Parameter("height", int, 800, "Image height in pixels.", minimum=200, maximum=MAX_PIXELS),
 )
 """The parameters every signal view shares: what is demonstrated, and the picture's size."""
 

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from plugins.views.demonstration import demonstration, require
-from plugins.lib.rendering import _PALETTE, add_labels, hex_to_rgb, plotter, save_png
+from plugins.lib.rendering import MAX_PIXELS, _PALETTE, add_labels, hex_to_rgb, plotter, save_png
 from toolkit import Parameter, View, hookimpl
 
 __all__ = ["PosegraphView", "pose_layout"]
@@ -47,8 +47,8 @@ class PosegraphView(View):
                   "(empty: the character itself)."),
         Parameter("speed", float, 1.0, "Speed of the performed movement.", minimum=0.05),
         Parameter("labels", bool, True, "Name each movement beside its nodes."),
-        Parameter("width", int, 1200, "Image width in pixels.", minimum=64),
-        Parameter("height", int, 900, "Image height in pixels.", minimum=64),
+        Parameter("width", int, 1200, "Image width in pixels.", minimum=64, maximum=MAX_PIXELS),
+        Parameter("height", int, 900, "Image height in pixels.", minimum=64, maximum=MAX_PIXELS),
     )
 
     def draw(self, subject: Any, out: Path) -> list[Path]:

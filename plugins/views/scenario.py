@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from plugins.lib.rendering import BodyFigure, Movie, plotter
+from plugins.lib.rendering import BodyFigure, MAX_PIXELS, Movie, plotter
 from toolkit import Parameter, View, hookimpl
 from toolkit.motion import facing_vector
 
@@ -106,8 +106,8 @@ class ScenarioView(View):
         Parameter("formats", list, ["png", "gif", "mp4"], "What to write: png (numbered frames), gif, mp4."),
         Parameter("every", int, 1, "Keep one frame in this many (the movie plays at the frame rate divided by it).",
                   minimum=1),
-        Parameter("width", int, 800, "Frame width in pixels.", minimum=64),
-        Parameter("height", int, 600, "Frame height in pixels.", minimum=64),
+        Parameter("width", int, 800, "Frame width in pixels.", minimum=64, maximum=MAX_PIXELS),
+        Parameter("height", int, 600, "Frame height in pixels.", minimum=64, maximum=MAX_PIXELS),
         Parameter("reach", float, 2.5, "Length (m) of the field of view drawn on the ground.", minimum=0.1),
         Parameter("notes", float, 3.0, "Seconds a segment or label stays on screen.", minimum=0.0),
     )
