@@ -34,7 +34,7 @@ from scipy.spatial import cKDTree
 
 from plugins.lib.pose_distance import pose_distance
 
-__all__ = ["PoseIndex", "nearest_by_scan", "MAX_TREES"]
+__all__ = ["MAX_TREES", "PoseIndex", "nearest_by_scan"]
 
 MAX_TREES = 4
 """Most visibility patterns whose tree is kept at once (each a copy of the poses' visible coordinates)."""

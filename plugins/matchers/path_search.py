@@ -45,6 +45,13 @@ clips has long varied clips (a dance of a minute) whose many poses fill all k st
 never gets a hypothesis. ``max_stay`` limits how many samples in a row a path may stay on one node, as ``max_skip``
 limits how far it may jump: without it a path may stand on one pose of a long clip that resembles the average of a
 whole demonstration, which explains no movement.
+
+The whole-graph search of step 2 (issue 22): on a posegraph of more than :data:`INDEX_MIN_NODES` nodes the k start
+poses come from a spatial index (:class:`plugins.lib.pose_index.PoseIndex`, built on the first search and again
+after the graph learns), which gives exactly the scan's k nearest in the scan's order. Below that size the scan is
+as fast. The scan is kept, exact by construction, where the index would have to answer another question: with
+attention (weights), with nodes excluded (the spread between takes), and with ``per_movement`` (each movement's
+nearest pose, however far).
 """
 
 from __future__ import annotations
@@ -56,11 +63,17 @@ import numpy as np
 
 from plugins.lib.attention import movement_weights
 from plugins.lib.pose_distance import path_distance, pose_distance
+from plugins.lib.pose_index import PoseIndex
 from plugins.lib.travel import body_velocity, travel_part
 from toolkit import Match, Matcher, Motion, Parameter, hookimpl
 from toolkit.components import provides
 
-__all__ = ["PathSearch", "PoseGraph", "Takes", "Travelling"]
+__all__ = ["INDEX_MIN_NODES", "PathSearch", "PoseGraph", "Takes", "Travelling"]
+
+INDEX_MIN_NODES = 5000
+"""Posegraphs of more nodes than this find the k start poses with :class:`plugins.lib.pose_index.PoseIndex`
+(``likeme bench posegraph``: the scan takes about 1.5 ms at 10,000 nodes of 11 parts; below a few thousand the
+index gains nothing worth its tree)."""
 
 
 class PoseGraph(Protocol):
@@ -110,6 +123,9 @@ class PathSearch(Matcher):
 
     name = "path-search"
     motor_systems = ("posegraph",)
+    index_min_nodes = INDEX_MIN_NODES
+    """Above this many nodes the start poses come from the spatial index (tests set it to force the index on or
+    off)."""
     parameters = (
         Parameter("k", int, 8, "Number of start poses and of paths kept at every step (the beam width). "
                   "Larger is more robust to noise and occlusion, and slower.", minimum=1),
@@ -170,6 +186,7 @@ class PathSearch(Matcher):
         self.succ = _reach(motor.graph, nodes, index, self.params["max_skip"], forward=True)
         self.pred = _reach(motor.graph, nodes, index, self.params["max_skip"], forward=False)
         self._cache_version = n
+        self._index = None  # the spatial index of the nodes, built by the first search that uses it
         self.spreads = self._spreads(index) if self.params["spread"] > 0 else {}
 
     def _spreads(self, index: dict[str, int]) -> dict[str, float]:
@@ -277,13 +294,18 @@ class PathSearch(Matcher):
         mid = int(ev[np.argmin(np.abs(ev - mid))])  # the visible frame nearest the middle
         nodes = self.nodes_compared
         k = self.params["k"]
-        first = pose_distance(nodes, obs[mid], vis[mid], weights)
-        if exclude is not None:
-            first = np.where(exclude, np.inf, first)
-        start = self._best(np.argsort(first, kind="stable"), np.arange(len(nodes)), k)
+        if weights is None and exclude is None and not self.params["per_movement"] and len(nodes) > self.index_min_nodes:
+            if getattr(self, "_index", None) is None or self._index.poses is not nodes:
+                self._index = PoseIndex(nodes)
+            start, costs = self._index.nearest(obs[mid], vis[mid], k)  # the scan's k nearest, in its order
+        else:
+            first = pose_distance(nodes, obs[mid], vis[mid], weights)
+            if exclude is not None:
+                first = np.where(exclude, np.inf, first)
+            start = self._best(np.argsort(first, kind="stable"), np.arange(len(nodes)), k)
+            costs = first[start]
         # beams: array of paths (B, length) and costs (B,)
         paths = start[:, None]
-        costs = first[start]
         paths, costs = self._extend(paths, costs, obs, vis, range(mid + 1, n), self.succ, weights, exclude, append=True)
         # the stays the forward half made on the middle node count toward the backward half's
         repeats = np.cumprod(paths == paths[:, :1], axis=1).sum(axis=1) - 1

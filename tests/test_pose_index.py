@@ -1,0 +1,134 @@
+"""The spatial index of the posegraph's poses (plugins/lib/pose_index.py) gives exactly the exhaustive scan's k
+nearest poses by eq. 1, in the scan's order, and path search answers the same with it on and off."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from plugins.lib import pose_index
+from plugins.lib.pose_distance import pose_distance
+from plugins.lib.pose_index import PoseIndex, nearest_by_scan
+from toolkit import Motion, load_character
+
+
+def scan(poses, query, visible, k):
+    """The scan as path search wrote it: eq. 1 to every pose, a stable argsort, the first k."""
+    d = pose_distance(poses, query, visible)
+    order = np.argsort(d, kind="stable")[:k]
+    return order, d[order]
+
+
+@st.composite
+def cases(draw):
+    n = draw(st.integers(1, 3000))
+    parts = draw(st.integers(1, 8))
+    seed = draw(st.integers(0, 2**32 - 1))
+    rng = np.random.default_rng(seed)
+    if draw(st.booleans()):  # poses on a grid of few values: many exact ties in eq. 1
+        poses = rng.integers(-2, 3, size=(n, parts, 3)).astype(float) * 0.1
+    else:  # poses near a few smooth "movements", as a posegraph's are
+        centres = rng.normal(0, 0.3, size=(draw(st.integers(1, 20)), parts, 3))
+        poses = centres[rng.integers(len(centres), size=n)] + rng.normal(0, 0.01, size=(n, parts, 3))
+    if draw(st.booleans()):  # exact duplicates of some poses
+        poses[rng.integers(n, size=n // 3)] = poses[rng.integers(n, size=n // 3)]
+    visible = rng.random(parts) < draw(st.sampled_from([1.0, 0.7, 0.3]))
+    query = poses[rng.integers(n)] + rng.normal(0, draw(st.sampled_from([0.0, 0.005, 0.1])), size=(parts, 3))
+    k = draw(st.integers(1, 40))
+    return poses, query, visible, k
+
+
+@settings(max_examples=150, deadline=None)
+@given(cases(), st.sampled_from([1, 4, 64]))
+def test_the_index_returns_exactly_the_scans_k_nearest_in_the_scans_order(case, first_batch):
+    poses, query, visible, k = case
+    pose_index.FIRST_BATCH, saved = first_batch, pose_index.FIRST_BATCH
+    try:
+        got = PoseIndex(poses).nearest(query, visible, k)
+    finally:
+        pose_index.FIRST_BATCH = saved
+    want = scan(poses, query, visible, k)
+    np.testing.assert_array_equal(got[0], want[0])
+    np.testing.assert_array_equal(got[1], want[1])
+    np.testing.assert_array_equal(nearest_by_scan(poses, query, visible, k)[0], want[0])
+
+
+def test_ties_come_in_index_order_as_the_stable_argsort_gives_them():
+    rng = np.random.default_rng(1)
+    poses = rng.normal(0, 1, size=(2000, 5, 3))
+    twin = rng.normal(0, 1, size=(5, 3))
+    at = np.array([1999, 7, 1500, 300, 12, 1000])  # the same pose at six places, nearest the query
+    poses[at] = twin
+    index = PoseIndex(poses)
+    pose_index.FIRST_BATCH, saved = 4, pose_index.FIRST_BATCH
+    try:
+        got, dist = index.nearest(twin + 0.001, None, 4)
+    finally:
+        pose_index.FIRST_BATCH = saved
+    np.testing.assert_array_equal(got, [7, 12, 300, 1000])  # the four lowest of the six tied, ascending
+    assert len(set(dist.tolist())) == 1
+
+
+def test_one_tree_per_visibility_pattern_at_most_max_trees_kept():
+    rng = np.random.default_rng(2)
+    poses = rng.normal(0, 1, size=(500, 6, 3))
+    index = PoseIndex(poses)
+    patterns = [np.arange(6) != i for i in range(6)]
+    for visible in patterns:
+        index.nearest(poses[0], visible, 3)
+    assert len(index._trees) == pose_index.MAX_TREES
+    assert index.tree(patterns[-1]).m == 15  # the five visible parts' coordinates
+    assert index.tree(patterns[-1]) is index.tree(patterns[-1])  # cached
+
+
+def test_poses_that_are_not_finite_are_scanned_not_put_in_a_tree():
+    rng = np.random.default_rng(3)
+    poses = rng.normal(0, 1, size=(300, 4, 3))
+    poses[10, 2] = np.nan
+    index = PoseIndex(poses)
+    got = index.nearest(poses[5], np.ones(4, dtype=bool), 5)
+    want = scan(poses, poses[5], np.ones(4, dtype=bool), 5)
+    np.testing.assert_array_equal(got[0], want[0])
+    assert not index._trees
+
+
+@pytest.fixture(scope="module")
+def max_and_morris():
+    from toolkit.manager import create_plugin_manager
+
+    pm = create_plugin_manager()
+    return load_character("max", pm), load_character("morris", pm)
+
+
+def demonstrations(observer, demonstrator, seed):
+    """Morris performing each of Max's movements he knows too, at three speeds, with 3 mm of noise and a part
+    hidden now and then (the demos of ``likeme bench make-data``, plugins/bench/data.py)."""
+    rng = np.random.default_rng(seed)
+    shared = sorted(set(observer.motor.movements()) & set(demonstrator.motor.movements()))
+    for movement in shared:
+        for speed in (0.8, 1.0, 1.25):
+            motion = demonstrator.motor.perform(movement, fps=30.0, speed=speed)
+            motion = motion.onto(observer.body.parts).root_relative(observer.body.root)
+            positions = motion.positions + rng.normal(0, 0.003, motion.positions.shape)
+            visible = motion.visible & (rng.random(motion.visible.shape) > 0.1)
+            yield Motion(positions, motion.fps, motion.parts, visible)
+
+
+def test_path_search_answers_the_same_with_the_index_forced_on_and_off(max_and_morris, monkeypatch):
+    observer, demonstrator = max_and_morris
+    matcher = observer.matcher
+    monkeypatch.setattr(pose_index, "FIRST_BATCH", 8)  # small batches: the tree answers, it does not fall back
+    motions = list(demonstrations(observer, demonstrator, 0))
+    assert len(motions) >= 10
+    answers = {}
+    for forced, threshold in (("on", 0), ("off", 10**9)):
+        monkeypatch.setattr(matcher, "index_min_nodes", threshold)
+        matcher._cache_version = -1
+        answers[forced] = [matcher.match(m) for m in motions]
+        if forced == "on":
+            assert matcher._index is not None and matcher._index._trees  # the trees answered
+    assert matcher._index is None  # off: never built
+    for on, off in zip(answers["on"], answers["off"]):
+        assert (on.movement, on.path, on.confidence) == (off.movement, off.path, off.confidence)
