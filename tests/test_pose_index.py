@@ -132,3 +132,14 @@ def test_path_search_answers_the_same_with_the_index_forced_on_and_off(max_and_m
     assert matcher._index is None  # off: never built
     for on, off in zip(answers["on"], answers["off"]):
         assert (on.movement, on.path, on.confidence) == (off.movement, off.path, off.confidence)
+
+
+def test_the_benchmark_checks_every_answer_of_the_index_against_the_scan():
+    from plugins.bench.posegraph_index import run
+    from toolkit.manager import create_plugin_manager
+
+    row = run(3000, parts=None, k=8, queries=20, noise=0.002, seed=0, pm=create_plugin_manager())
+    assert row["agree"] == "20/20"
+    assert row["nodes"] == 3000 and row["parts"] == 11 and row["index_ms"] > 0 and row["scan_ms"] > 0
+    wide = run(500, parts=14, k=3, queries=5, noise=0.0, seed=1, pm=create_plugin_manager())
+    assert wide["agree"] == "5/5" and wide["parts"] == 14

@@ -200,6 +200,20 @@ def likeme_register_commands(subparsers):
                    help="override an observer parameter (repeatable)")
     p.set_defaults(handler=_handler("memory", "cmd_memory"))
 
+    p = sub.add_parser("posegraph", help="the k nearest poses of a posegraph of --nodes poses: the spatial index "
+                       "(plugins.lib.pose_index) against the exhaustive scan; build time, query time, memory")
+    p.add_argument("--nodes", type=count_type(1, 10_000_000), action="append", metavar="N",
+                   help="poses in the graph (repeatable, one table row each; default: 100000)")
+    p.add_argument("--parts", type=count_type(1, 100), default=None, help="parts per pose (default: the body's, 11)")
+    p.add_argument("--k", type=count_type(1, 1000), default=8, help="poses asked for (default: 8, path search's k)")
+    p.add_argument("--queries", type=count_type(1, 100_000), default=200, help="observed poses asked (default: 200)")
+    p.add_argument("--noise", type=number_type(0.0, 1.0, "metres"), default=0.002,
+                   help="noise of the graph's poses, metres per coordinate (default: 0.002)")
+    p.add_argument("--seed", type=seed_type, default=0)
+    p.add_argument("--no-scan", action="store_true", help="time the index only (no scan, answers not compared)")
+    p.add_argument("--json", metavar="FILE", help="also write the rows as JSON")
+    p.set_defaults(handler=_handler("posegraph_index", "cmd_posegraph"))
+
     p = sub.add_parser("startup", help="how long likeme takes to start: the medians of likeme --version, --help "
                        "and plugins, each run in a fresh process")
     p.add_argument("--runs", type=count_type(1, 1000), default=20, help="runs of each command (default: 20)")

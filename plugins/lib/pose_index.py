@@ -42,6 +42,9 @@ MAX_TREES = 4
 FIRST_BATCH = 64
 """Candidates asked of the tree in the first batch (at least 4 k); each further batch is four times larger."""
 
+LEAF_SIZE = 64
+"""Poses per leaf of a tree (``cKDTree``'s ``leafsize``)."""
+
 _SLACK = 1e-9
 """Relative margin on the lower bound, so floating-point rounding in the tree's L1 sum never stops a search early."""
 
@@ -85,7 +88,7 @@ class PoseIndex:
         tree = self._trees.get(key)
         if tree is None:
             data = np.ascontiguousarray(self.poses[:, visible].reshape(len(self.poses), -1))
-            tree = cKDTree(data, balanced_tree=False, compact_nodes=False)  # the faster build; queries as fast
+            tree = cKDTree(data, leafsize=LEAF_SIZE, balanced_tree=False, compact_nodes=False)  # the faster build; queries as fast
             self._trees[key] = tree
             while len(self._trees) > MAX_TREES:
                 self._trees.popitem(last=False)
