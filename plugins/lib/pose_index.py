@@ -88,7 +88,8 @@ class PoseIndex:
         tree = self._trees.get(key)
         if tree is None:
             data = np.ascontiguousarray(self.poses[:, visible].reshape(len(self.poses), -1))
-            tree = cKDTree(data, leafsize=LEAF_SIZE, balanced_tree=False, compact_nodes=False)  # the faster build; queries as fast
+            # the faster build (no median split, no shrunk boxes): queries measured as fast
+            tree = cKDTree(data, leafsize=LEAF_SIZE, balanced_tree=False, compact_nodes=False)
             self._trees[key] = tree
             while len(self._trees) > MAX_TREES:
                 self._trees.popitem(last=False)

@@ -294,7 +294,8 @@ class PathSearch(Matcher):
         mid = int(ev[np.argmin(np.abs(ev - mid))])  # the visible frame nearest the middle
         nodes = self.nodes_compared
         k = self.params["k"]
-        if weights is None and exclude is None and not self.params["per_movement"] and len(nodes) > self.index_min_nodes:
+        indexed = weights is None and exclude is None and not self.params["per_movement"]
+        if indexed and len(nodes) > self.index_min_nodes:
             if getattr(self, "_index", None) is None or self._index.poses is not nodes:
                 self._index = PoseIndex(nodes)
             start, costs = self._index.nearest(obs[mid], vis[mid], k)  # the scan's k nearest, in its order
