@@ -239,5 +239,8 @@ def likeme_register_commands(subparsers):
     p.add_argument("--seed", type=seed_type, default=0)
     p.add_argument("--segmenter", metavar="NAME", help="the observer's segmenter (default: the observer template's)")
     p.add_argument("--matcher", metavar="NAME", help="the observer's matcher (default: the template's)")
+    p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE", dest="settings",
+                   help="override an observer parameter, e.g. --set matcher.per_movement=false (repeatable; checked "
+                   "when the observer is composed)")
     p.add_argument("--json", metavar="FILE", help="also write the results as JSON")
     p.set_defaults(handler=_handler("scaling", "cmd_scaling"))

@@ -105,14 +105,16 @@ def _names(character: Any) -> str:
 
 
 def stream_axis(pm: Any, data: Path, minutes: Sequence[float], *, fps: float, seed: int = 0,
-                segmenter: str | None = None, matcher: str | None = None, block: int = 120) -> tuple[list[dict], str]:
+                segmenter: str | None = None, matcher: str | None = None, block: int = 120,
+                settings: dict[str, Any] | None = None) -> tuple[list[dict], str]:
     """Seconds of observing per minute of stream for each length in ``minutes`` (a fresh observer each)."""
     from plugins.bench.memory import random_stream
     from toolkit.observe import Observer, compose_observer
     from toolkit.profile import load_profile
 
     profile = load_profile(data / "profile.toml")
-    character = compose_observer(pm, profile, data / "repertoire", segmenter=segmenter, matcher=matcher or "")
+    character = compose_observer(pm, profile, data / "repertoire", segmenter=segmenter, matcher=matcher or "",
+                                 settings=settings)
     rows = []
     for length in minutes:
         observer = Observer(character, profile.body, fps)
@@ -134,9 +136,11 @@ def stream_axis(pm: Any, data: Path, minutes: Sequence[float], *, fps: float, se
 
 
 def repertoire_axis(pm: Any, profile: Any, movements: Sequence[int], *, fps: float, seed: int = 0,
-                    segmenter: str | None = None, matcher: str | None = None) -> tuple[list[dict], str]:
+                    segmenter: str | None = None, matcher: str | None = None,
+                    settings: dict[str, Any] | None = None) -> tuple[list[dict], str]:
     """Build time per clip frame and query time for repertoires of each size in ``movements``; each row also has
-    the posegraph's nodes and a ``path-search`` query time (the graph axis)."""
+    the posegraph's nodes and a ``path-search`` query time (the graph axis: the same observer when its matcher is
+    path search, else the template's path search without ``settings``)."""
     from plugins.lib.clip_repertoire import clip_repertoire
     from toolkit.observe import Observer, compose_observer
 
@@ -147,7 +151,8 @@ def repertoire_axis(pm: Any, profile: Any, movements: Sequence[int], *, fps: flo
         frames = sum(m.n_frames for m in motions)
         began = time.perf_counter()
         repertoire = clip_repertoire(motions, labels, profile)
-        character = compose_observer(pm, profile, repertoire, segmenter=segmenter, matcher=matcher or "")
+        character = compose_observer(pm, profile, repertoire, segmenter=segmenter, matcher=matcher or "",
+                                     settings=settings)
         build = time.perf_counter() - began
         names = _names(character)
         query, right = _queries(Observer(character, profile.body, fps), demos)
@@ -185,6 +190,7 @@ def cmd_scaling(args: Any, pm: Any) -> int:
     """``likeme bench scaling``."""
     from plugins.bench.memory import _data
     from toolkit.errors import ConfigError
+    from toolkit.params import parse_settings
     from toolkit.profile import load_profile
 
     sizes = QUICK if args.quick else SIZES
@@ -198,25 +204,27 @@ def cmd_scaling(args: Any, pm: Any) -> int:
     for value in movements:
         if value < 1:
             raise ConfigError(f"value {value}", key=("--movements",), expected="a whole number >= 1")
-    out: dict[str, Any] = {"fps": args.fps, "quick": bool(args.quick)}
+    settings = parse_settings(list(args.settings))
+    out: dict[str, Any] = {"fps": args.fps, "quick": bool(args.quick), "settings": list(args.settings)}
+    given = "".join(f"; --set {text}" for text in args.settings)
     with tempfile.TemporaryDirectory(prefix="likeme-scaling-") as tmp:
         data = _data(pm, Path(tmp) / "data")
         stream, names = stream_axis(pm, data, minutes, fps=args.fps, seed=args.seed, segmenter=args.segmenter,
-                                    matcher=args.matcher)
+                                    matcher=args.matcher, settings=settings)
         slope = loglog_slope([r["frames"] for r in stream], [r["seconds"] for r in stream])
         out["stream"] = {"observer": names, "rows": stream, "slope": slope}
-        print(_table(f"stream length ({names}; {args.fps:g} fps)",
+        print(_table(f"stream length ({names}{given}; {args.fps:g} fps)",
                      [[f"{r['minutes']:g}", r["frames"], r["segments"], f"{r['seconds']:.2f}",
                        f"{r['s_per_minute']:.3f}", f"{r['frames_per_s']:,.0f}"] for r in stream],
                      ["minutes", "frames", "segments", "observe s", "s per minute", "frames/s"], slope,
                      "observe seconds against frames"), flush=True)
         profile = load_profile(data / "profile.toml")
         rep, names = repertoire_axis(pm, profile, movements, fps=args.fps, seed=args.seed, segmenter=args.segmenter,
-                                     matcher=args.matcher)
+                                     matcher=args.matcher, settings=settings)
     build_slope = loglog_slope([r["clip_frames"] for r in rep], [r["build_s"] for r in rep])
     query_slope = loglog_slope([r["movements"] for r in rep], [r["query_ms"] for r in rep])
     out["repertoire"] = {"observer": names, "rows": rep, "build_slope": build_slope, "query_slope": query_slope}
-    print(_table(f"repertoire size ({names}; {len(rep[0:1]) and rep[0]['queries']} demo queries)",
+    print(_table(f"repertoire size ({names}{given}; {rep[0]['queries']} demo queries)",
                  [[r["movements"], r["clip_frames"], f"{r['build_s']:.2f}", f"{r['build_us_per_frame']:.0f}",
                    f"{r['query_ms']:.2f}", f"{r['right']}/{r['queries']}"] for r in rep],
                  ["movements", "clip frames", "build s", "build us/frame", "query ms", "right"], build_slope,
