@@ -175,7 +175,8 @@ def repertoire_axis(pm: Any, profile: Any, movements: Sequence[int], *, fps: flo
             graph = compose_observer(pm, profile, repertoire, segmenter=segmenter, matcher="path-search")
             search, _ = _queries(Observer(graph, profile.body, fps), demos)
         nodes = len(graph.motor.node_root_relative) if hasattr(graph.motor, "node_root_relative") else 0
-        rows.append({"movements": n, "clip_frames": frames, "build_s": build, "build_us_per_frame": 1e6 * build / frames,
+        rows.append({"movements": n, "clip_frames": frames, "build_s": build,
+                     "build_us_per_frame": 1e6 * build / frames,
                      "query_ms": 1e3 * query, "right": right, "queries": len(demos), "nodes": nodes,
                      "path_search_ms": 1e3 * search})
     return rows, names
