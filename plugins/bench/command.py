@@ -241,3 +241,20 @@ def likeme_register_commands(subparsers):
                    "folder (created if missing), to replay")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(handler=_handler("fuzz", "cmd_fuzz"))
+
+    p = sub.add_parser("scaling", help="cost against stream length, repertoire size and graph size, with the "
+                       "log-log slope of each (1.0 = linear)")
+    p.add_argument("--fps", type=fps_type, default=30.0, help="frame rate of the streams and clips (default: 30)")
+    p.add_argument("--minutes", type=number_type(1e-6, 1e6, "minutes"), action="append", metavar="MIN",
+                   help="stream length (repeatable; default: 1, 10, 60)")
+    p.add_argument("--movements", type=count_type(1, 100_000), action="append", metavar="N",
+                   help="repertoire size (repeatable; default: 5, 50, 500)")
+    p.add_argument("--quick", action="store_true", help="small sizes (a test): 0.05-0.2 minutes, 3-12 movements")
+    p.add_argument("--seed", type=seed_type, default=0)
+    p.add_argument("--segmenter", metavar="NAME", help="the observer's segmenter (default: the observer template's)")
+    p.add_argument("--matcher", metavar="NAME", help="the observer's matcher (default: the template's)")
+    p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE", dest="settings",
+                   help="override an observer parameter, e.g. --set matcher.per_movement=false (repeatable; checked "
+                   "when the observer is composed)")
+    p.add_argument("--json", metavar="FILE", help="also write the results as JSON")
+    p.set_defaults(handler=_handler("scaling", "cmd_scaling"))
