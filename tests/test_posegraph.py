@@ -77,3 +77,20 @@ def test_learned_movement_is_a_new_path_through_new_nodes():
     assert motor.perform("new-wave", fps=30).n_frames > 10
     with pytest.raises(Exception, match="already exists"):
         motor.learn("new-wave", poses)
+
+
+@settings(max_examples=30, deadline=None)
+@given(n=st.integers(2, 60), block=st.integers(1, 2000), seed=st.integers(0, 2**16))
+def test_find_hubs_block_by_block_is_the_all_pairs_answer(n, block, seed):
+    """The clip ends' eq. 1 distances are taken a block of rows at a time (bounded memory for large repertoires):
+    the same hubs, bit for bit, as one call over every pair."""
+    from unittest import mock
+
+    from plugins.lib import clip_repertoire
+
+    rng = np.random.default_rng(seed)
+    ends = rng.normal(scale=0.05, size=(n, 4, 3))
+    ends[rng.random(n) < 0.5] *= 0.1  # a crowd of ends near the rest, as real clips have
+    whole = clip_repertoire.find_hubs(ends, 0.06, 0.2)  # the default block holds every pair of these few ends
+    with mock.patch.object(clip_repertoire, "PAIR_BLOCK", block):
+        np.testing.assert_array_equal(clip_repertoire.find_hubs(ends, 0.06, 0.2), whole)

@@ -135,6 +135,10 @@ def clip_files(folder: Path) -> dict[str, list[Path]]:
     return out
 
 
+PAIR_BLOCK = 2**22
+"""Numbers of pose differences ``find_hubs`` holds at once (rows x n ends x P parts x 3): about 32 MB."""
+
+
 def find_hubs(ends: np.ndarray, radius: float, share: float) -> np.ndarray:
     """Hub poses (H, P, 3) among the clip end poses ``ends`` (N, P, 3), largest cluster first.
 
@@ -147,7 +151,10 @@ def find_hubs(ends: np.ndarray, radius: float, share: float) -> np.ndarray:
     n = len(ends)
     if n == 1:
         return ends.copy()
-    d = pose_distance(ends[:, None], ends[None, :], True)
+    # eq. 1 between every pair of ends, a block of rows at a time: the (rows, n, P, 3) differences stay near 32 MB
+    # whatever the repertoire's size (one call over all pairs needed n^2 P 3 floats: 4 GB at 2,000 movements)
+    rows = max(1, PAIR_BLOCK // max(1, n * ends[0].size))
+    d = np.concatenate([pose_distance(ends[i : i + rows, None], ends[None, :], True) for i in range(0, n, rows)])
     d = 0.5 * (d + d.T)
     np.fill_diagonal(d, 0.0)
     labels = fcluster(linkage(squareform(d, checks=False), "average"), t=radius, criterion="distance")
