@@ -23,6 +23,7 @@ import csv
 import io
 import itertools
 import json
+import time
 import tomllib
 from pathlib import Path
 from typing import Any
@@ -181,9 +182,13 @@ def cmd_sweep(args: Any, pm: Any) -> int:
 
     grid = load_grid(args.grid)
     _check(grid, pm)
+    start = time.perf_counter()
     rows = sweep(grid, jobs=args.jobs, scheduler=args.scheduler)
+    wall = time.perf_counter() - start
     keys = list(dict.fromkeys(k for r in rows for k in r if k != "benchmark"))
     print(text_table([[_text(r.get(k, "")) for k in keys] for r in rows], [(k, "left") for k in keys]))
+    where = f"scheduler {args.scheduler}" if args.scheduler else f"{args.jobs} job{'s' if args.jobs > 1 else ''}"
+    print(f"\n{len(rows)} cells in {wall:.1f} s wall time ({where})")
     if args.json:
         write_atomic(Path(args.json), json.dumps(rows, indent=1, default=float) + "\n")
     if args.csv:
