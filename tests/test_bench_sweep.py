@@ -107,3 +107,17 @@ def test_a_setting_no_plugin_has_fails_before_any_cell(folder, capsys):
     (folder / "unset.toml").write_text(GRID.replace("segmenter.min_duration", "segmenter.nothing"))
     assert main(["bench", "sweep", str(folder / "unset.toml")]) == 1
     assert "nothing" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("where", [{"jobs": 2}, {"scheduler": "local:1"}])
+def test_a_workers_error_is_one_error_line_here(folder, where):
+    """A bad item's error (here a profile that does not exist) comes back from the worker as a LikemeError."""
+    from plugins.bench.mocap import cell
+    from toolkit.errors import LikemeError
+
+    if "scheduler" in where:
+        pytest.importorskip("dask.distributed", reason="dask.distributed not installed: pip install 'likeme[dask]'")
+    spec = {"benchmark": "segmentation", "streams": str(folder / "d" / "streams"), "segmenters": ["hub-threshold"]}
+    specs = [{**spec, "body": str(folder / "d" / "profile.toml")}, {**spec, "body": str(folder / "no-profile.toml")}]
+    with pytest.raises(LikemeError, match="no-profile.toml"):
+        run_items(cell, specs, **where)

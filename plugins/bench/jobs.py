@@ -13,8 +13,9 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from toolkit import ConfigError
+from toolkit.errors import LikemeError
 
-__all__ = ["run_items", "LOCAL_PREFIX"]
+__all__ = ["LOCAL_PREFIX", "run_items"]
 
 LOCAL_PREFIX = "local:"
 """``--scheduler local:N`` starts a Dask ``LocalCluster`` of N worker processes for the run."""
@@ -43,7 +44,7 @@ def run_items(function: Callable[[Any], Any], items: Sequence[Any], jobs: int = 
     """
     items = list(items)
     if scheduler:
-        return _dask(function, items, scheduler)
+        return _raise(_dask(_Call(function), items, scheduler))
     if jobs < 1:
         raise ConfigError(f"--jobs {jobs}", key=("--jobs",), expected="a number of processes, 1 or more")
     if jobs == 1 or len(items) <= 1:
@@ -54,7 +55,35 @@ def run_items(function: Callable[[Any], Any], items: Sequence[Any], jobs: int = 
     # spawn: a fresh interpreter per worker (no forked copy of a threaded parent); the function is found by name
     with ProcessPoolExecutor(max_workers=min(jobs, len(items)),
                              mp_context=multiprocessing.get_context("spawn")) as pool:
-        return list(pool.map(function, items))
+        return _raise(list(pool.map(_Call(function), items)))
+
+
+class _Failed:
+    """A :class:`~toolkit.errors.LikemeError` a worker met, as its message (not every error class pickles)."""
+
+    def __init__(self, message: str) -> None:
+        self.message = message
+
+
+class _Call:
+    """``function(item)`` in a worker, a user's error (bad input, a plugin's failure) returned as :class:`_Failed`."""
+
+    def __init__(self, function: Callable[[Any], Any]) -> None:
+        self.function = function
+
+    def __call__(self, item: Any) -> Any:
+        try:
+            return self.function(item)
+        except LikemeError as err:
+            return _Failed(str(err))
+
+
+def _raise(results: list[Any]) -> list[Any]:
+    """The results, or the first worker's error raised here as one ``likeme: error:`` line."""
+    for result in results:
+        if isinstance(result, _Failed):
+            raise LikemeError(result.message)
+    return results
 
 
 def _dask(function: Callable[[Any], Any], items: list[Any], scheduler: str) -> list[Any]:

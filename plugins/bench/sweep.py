@@ -32,7 +32,7 @@ from plugins.bench import text_table
 from plugins.bench.command import MATCHERS, SEGMENTERS
 from toolkit import ConfigError
 
-__all__ = ["load_grid", "cells", "sweep", "TIMING", "cmd_sweep"]
+__all__ = ["TIMING", "cells", "cmd_sweep", "load_grid", "sweep"]
 
 BENCHMARKS = ("recognition", "segmentation", "stream")
 TOP_KEYS = ("benchmark", "data", "plugins", "set", "protocol", "group", "fps", "correspondence", "lengths_for_height")
