@@ -23,6 +23,7 @@ import csv
 import io
 import itertools
 import json
+import math
 import time
 import tomllib
 from pathlib import Path
@@ -197,4 +198,7 @@ def cmd_sweep(args: Any, pm: Any) -> int:
 
 
 def _text(value: Any) -> str:
-    return f"{value:.4g}" if isinstance(value, float) else str(value)
+    """A cell of the printed table; a score that does not apply (NaN) is '-', as in the benchmarks' tables."""
+    if isinstance(value, float):
+        return "-" if math.isnan(value) else f"{value:.4g}"
+    return str(value)
