@@ -66,7 +66,18 @@ def _check_set(args: argparse.Namespace, pm: Any) -> None:
     check_settings(settings, pm, plugins)
 
 
+def _jobs_options(p: argparse.ArgumentParser) -> None:
+    """``--jobs N`` and ``--scheduler ADDRESS`` (:func:`plugins.bench.jobs.run_items`; ``docs/scaling.md``)."""
+    p.add_argument("--jobs", type=count_type(1, 1024), default=1, metavar="N",
+                   help="run the items in N local processes (default: 1, this process); the figures do not depend "
+                   "on N (frames per second aside)")
+    p.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                   help="run the items on a Dask distributed cluster: a scheduler's address (tcp://HOST:8786) or "
+                   "local:N for a LocalCluster of N workers (needs likeme[dask]; docs/scaling.md)")
+
+
 def _common(p: argparse.ArgumentParser) -> None:
+    _jobs_options(p)
     p.add_argument("--body", required=True, metavar="PROFILE", help="body profile TOML of the files")
     p.add_argument("--correspondence", metavar="NAME", default="", help="correspondence (default: the observer "
                    "template's; none: the papers' plain observer)")
@@ -117,6 +128,14 @@ def _motion_capture_commands(sub: Any) -> None:
     p.add_argument("--segmenter", action="append", metavar="NAME", help="segmenter (repeatable)")
     p.add_argument("--matcher", action="append", metavar="NAME", help="matcher (repeatable)")
     p.set_defaults(handler=_handler("mocap", "run", "stream"))
+
+    p = sub.add_parser("sweep", help="a grid of data folders, plugins and parameters through recognition, "
+                       "segmentation or stream: one tidy table with every figure (docs/scaling.md)")
+    p.add_argument("grid", metavar="GRID.toml", help="the grid: benchmark, data folders, plugins, --set values")
+    _jobs_options(p)
+    p.add_argument("--json", metavar="FILE", help="also write the table as JSON (a list of rows)")
+    p.add_argument("--csv", metavar="FILE", help="also write the table as CSV (one row per cell and plugin)")
+    p.set_defaults(handler=_handler("sweep", "cmd_sweep"))
 
     p = sub.add_parser("make-data", help="write repertoire, demos, streams and a profile from the built-in characters")
     p.add_argument("dest", metavar="DIR")

@@ -46,7 +46,8 @@ from toolkit import ConfigError
 from toolkit.observe import Observer, compose_observer
 from toolkit.profile import RECORDING_SUFFIXES, load_profile
 
-__all__ = ["MATCHERS", "SEGMENTERS", "recognition", "segmentation", "stream", "table", "write_outputs", "plot", "run"]
+__all__ = ["MATCHERS", "SEGMENTERS", "recognition", "segmentation", "stream", "cell", "merge", "table",
+           "write_outputs", "plot", "run"]
 
 
 
@@ -367,13 +368,73 @@ def plot(result: dict[str, Any], path: Path) -> Path:
     return plot_result(result, path)
 
 
+def cell(spec: dict[str, Any]) -> dict[str, Any]:
+    """One benchmark run from plain data, in whichever process runs it (:func:`plugins.bench.jobs.run_items`).
+
+    ``spec``: ``benchmark`` (``recognition``, ``segmentation`` or ``stream``), ``body`` (a profile path),
+    ``repertoire``, ``demos``, ``streams`` (folders or None), ``matchers``, ``segmenters`` (names), ``set``
+    (``TABLE.KEY=VALUE`` strings), ``observer`` (arguments of :func:`toolkit.observe.compose_observer`),
+    ``protocol``, ``group``, ``fps``. The process builds its own plugin manager (the installed plugins), profile and
+    observers; the result is that of :func:`recognition`, :func:`segmentation` or :func:`stream`.
+    """
+    from toolkit.manager import create_plugin_manager
+
+    pm, profile = create_plugin_manager(), load_profile(spec["body"])
+    settings, observer, fps = _settings(spec.get("set", ())), dict(spec.get("observer") or {}), spec.get("fps")
+    folder = {k: Path(spec[k]) if spec.get(k) else None for k in ("repertoire", "demos", "streams")}
+    if spec["benchmark"] == "recognition":
+        return recognition(pm, profile, folder["repertoire"], folder["demos"], spec["matchers"], settings=settings,
+                           observer=observer, protocol=spec.get("protocol", "closed"), group=spec.get("group"),
+                           fps=fps)
+    if spec["benchmark"] == "segmentation":
+        return segmentation(pm, profile, folder["streams"], spec["segmenters"], repertoire=folder["repertoire"],
+                            settings=settings, observer=observer, fps=fps)
+    return stream(pm, profile, folder["repertoire"], folder["streams"], spec["segmenters"], spec["matchers"],
+                  settings=settings, observer=observer, fps=fps)
+
+
+def merge(results: Sequence[dict[str, Any]]) -> dict[str, Any]:
+    """The results of one benchmark run per plugin (:func:`cell`) as one result: plugins and items in order,
+    each stream's timeline with every plugin's segments."""
+    out = {**results[0], "plugins": [p for r in results for p in r["plugins"]],
+           "items": [i for r in results for i in r["items"]]}
+    if "timelines" in out:
+        timelines = {t["item"]: {**t, "found": {}} for t in results[0]["timelines"]}
+        for r in results:
+            for t in r["timelines"]:
+                timelines[t["item"]]["found"].update(t["found"])
+        out["timelines"] = list(timelines.values())
+    return out
+
+
+def _parallel(kind: str, args: Any, observer: dict[str, Any]) -> dict[str, Any]:
+    """``--jobs N`` or ``--scheduler ADDRESS``: one :func:`cell` per plugin (per pairing for ``stream``), merged in
+    the plugins' order, so the table is the one a single process prints (frames per second aside)."""
+    from plugins.bench.jobs import run_items
+
+    spec = {"benchmark": kind, "body": str(args.body), "set": list(args.set), "observer": observer, "fps": args.fps,
+            "repertoire": getattr(args, "repertoire", None), "demos": getattr(args, "demos", None),
+            "streams": getattr(args, "streams", None), "protocol": getattr(args, "protocol", "closed"),
+            "group": getattr(args, "group", None)}
+    if kind == "recognition":
+        specs = [{**spec, "matchers": [m]} for m in args.matcher or MATCHERS]
+    elif kind == "segmentation":
+        specs = [{**spec, "segmenters": [s]} for s in args.segmenter or SEGMENTERS]
+    else:
+        specs = [{**spec, "segmenters": [s], "matchers": [m]} for s in args.segmenter or SEGMENTERS[:2]
+                 for m in args.matcher or MATCHERS]
+    return merge(run_items(cell, specs, jobs=args.jobs, scheduler=args.scheduler))
+
+
 def run(kind: str, args: Any, pm: Any) -> int:
     """``likeme bench recognition|segmentation|stream``: run the benchmark, print its table, write its outputs."""
     profile = load_profile(args.body)
     settings = _settings(args.set)
     observer = {"correspondence": args.correspondence,
                 "lengths_for_height": "" if args.lengths_for_height is None else args.lengths_for_height}
-    if kind == "recognition":
+    if getattr(args, "jobs", 1) > 1 or getattr(args, "scheduler", None):
+        result = _parallel(kind, args, observer)
+    elif kind == "recognition":
         result = recognition(pm, profile, Path(args.repertoire), Path(args.demos) if args.demos else None,
                              args.matcher or MATCHERS, settings=settings, quiet=args.quiet, observer=observer,
                              protocol=args.protocol, group=args.group, fps=args.fps)
