@@ -248,6 +248,10 @@ CASES = [
     ("fps-option", "--fps of 0", {"m.bvh": BVH}, ["validate", "--fps", "0", "m.bvh"], ["argument --fps: invalid frame rate '0'", "expected frames per second in (0, 10000]"]),
     ("profile-fps", "a profile's fps is not a frame rate", {"p.toml": PROFILE.replace('units = "cm"', 'units = "cm"\nfps = -30')}, ["validate", "p.toml"], ["p.toml:4: key profile.fps: invalid fps -30", "expected frames per second"]),
     ("profile-joints", "a profile's joints list lacks a mapped joint", {"p.toml": PROFILE.replace('units = "cm"', 'units = "cm"\njoints = ["hips", "head"]')}, ["validate", "p.toml"], ["p.toml:4: key profile.joints: joint 'head_end' of part 'nose' is not in the joints list", "available: hips, head"]),
+    # -- sweeps: likeme bench sweep, --jobs, --scheduler (issue 22)
+    ("sweep-key", "a sweep grid with an unknown key", {"g.toml": 'benchmark = "stream"\nthreads = 4\n'}, ["bench", "sweep", "g.toml"], ["g.toml", "threads", "available:"]),
+    ("sweep-folder", "a sweep grid naming a missing folder", {"g.toml": 'benchmark = "segmentation"\n[data.d]\nbody = "p.toml"\nstreams = "nowhere"\n', "p.toml": PROFILE}, ["bench", "sweep", "g.toml"], ["nowhere"]),
+    ("sweep-scheduler", "--scheduler local: without a number", {"p.toml": PROFILE}, ["bench", "segmentation", "--body", "p.toml", "--streams", ".", "--scheduler", "local:x"], ["local:x"]),
 ]
 
 
