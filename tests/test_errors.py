@@ -322,6 +322,20 @@ def render() -> str:
     return "\n".join(out) + "\n"
 
 
+def test_errors_pickle_with_every_field():
+    """A worker process (``--jobs``, a Dask cluster) sends its error back whole: class, fields and message."""
+    import pickle
+
+    from toolkit.errors import ConfigError, PluginError
+
+    config = ConfigError("bad", file="a/b.toml", key=("matcher", "k"), line=3, column=7, expected="an integer",
+                         available=["1", "2"])
+    plugin = PluginError("dtw", "Matcher.conclude", "ValueError: x")
+    for error in (config, plugin, ConfigError("plain")):
+        copy = pickle.loads(pickle.dumps(error))
+        assert type(copy) is type(error) and str(copy) == str(error) and vars(copy) == vars(error)
+
+
 def test_docs_errors_table_is_current():
     assert (ROOT / "docs" / "errors.md").read_text() == render(), "regenerate: python -m tests.test_errors > docs/errors.md"
 

@@ -98,6 +98,12 @@ class ConfigError(LikemeError):
             text += f"; available: {listed}"
         return text
 
+    def __reduce__(self) -> tuple:
+        """Pickled with every field (an error raised in a worker process of ``--jobs`` or a Dask cluster)."""
+        return _config_error, (self.problem, {"file": self.file, "key": self.key, "line": self.line,
+                                              "column": self.column, "expected": self.expected,
+                                              "available": self.available})
+
     def within(self, *, file: str | Path | None = None, prefix: Sequence[str | int] = ()) -> ConfigError:
         """The same error placed inside ``file`` under the key path ``prefix``."""
         return ConfigError(
@@ -109,6 +115,11 @@ class ConfigError(LikemeError):
             expected=self.expected,
             available=self.available,
         )
+
+
+def _config_error(problem: str, fields: dict) -> ConfigError:
+    """A :class:`ConfigError` from its pickled fields."""
+    return ConfigError(problem, **fields)
 
 
 class PluginError(LikemeError):
@@ -129,3 +140,7 @@ class PluginError(LikemeError):
         self.where = where
         self.problem = problem
         super().__init__(f"plugin {plugin!r} failed in {where}: {problem}")
+
+    def __reduce__(self) -> tuple:
+        """Pickled with its three fields (an error raised in a worker process)."""
+        return PluginError, (self.plugin, self.where, self.problem)
