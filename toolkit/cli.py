@@ -112,11 +112,10 @@ OUTPUT_DIRS = {"render": "--render", "dest": "DIR"}
 
 def _probe(folder: Path, path: Path, option: str, expected: str) -> None:
     """Create and remove a temporary file in ``folder``: the only sure test that the command can write there."""
-    import tempfile
+    from toolkit.files import probe_writable
 
     try:
-        with tempfile.NamedTemporaryFile(dir=folder, prefix=".likeme-probe-"):
-            pass
+        probe_writable(folder)
     except OSError as exc:
         raise ConfigError(f"cannot write there ({exc.strerror or exc})", file=path, key=(option,),
                           expected=expected) from None

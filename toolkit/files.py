@@ -22,7 +22,7 @@ from typing import BinaryIO
 
 from toolkit.errors import ConfigError
 
-__all__ = ["check_regular_file", "open_regular", "max_bytes", "LIMITS"]
+__all__ = ["check_regular_file", "open_regular", "probe_writable", "max_bytes", "LIMITS"]
 
 LIMITS: dict[str, tuple[str, int]] = {"motion": ("LIKEME_MAX_MOTION_MB", 4096), "config": ("LIKEME_MAX_CONFIG_MB", 16),
                                       "state": ("LIKEME_MAX_STATE_MB", 64)}
@@ -109,3 +109,13 @@ def open_regular(path: str | Path, what: str = "file", kind: str = "config") -> 
         os.close(fd)
         raise
     return os.fdopen(fd, "rb")
+
+
+def probe_writable(folder: str | Path, prefix: str = ".likeme-probe-") -> None:
+    """Create and remove a temporary file named ``PREFIX*.tmp`` in ``folder``: the only sure test that this process
+    can write there (permissions, read-only mounts, quotas). Raises the :class:`OSError` for the caller to word."""
+    import tempfile
+
+    fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=".tmp", dir=folder)
+    os.close(fd)
+    Path(tmp).unlink(missing_ok=True)  # (a saving process may have swept it away already)

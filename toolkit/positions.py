@@ -34,6 +34,7 @@ from typing import TypeVar
 
 import numpy as np
 
+from toolkit.bvh import MAX_FPS
 from toolkit.errors import ConfigError
 from toolkit.files import check_regular_file, open_regular
 
@@ -43,8 +44,8 @@ __all__ = ["JointPositions", "read_positions", "iter_position_blocks", "SUFFIXES
 SUFFIXES = (".csv", ".npy", ".c3d")
 """File name suffixes this module reads (compared case-insensitively)."""
 
-MAX_FPS = 10_000.0
-"""Frame rates are accepted in ``(0, MAX_FPS]`` Hz, from a time column or the ``fps`` argument."""
+# Frame rates are accepted in ``(0, MAX_FPS]`` Hz, from a time column or the ``fps`` argument: the bound every
+# reader of recordings shares (toolkit.bvh.MAX_FPS).
 
 MAX_JOINTS = 10_000
 """The most joints a recording may have."""

@@ -66,7 +66,7 @@ from typing import Any
 
 from toolkit.character import Character
 from toolkit.errors import ConfigError, PluginError
-from toolkit.files import LIMITS, max_bytes, open_regular
+from toolkit.files import LIMITS, max_bytes, open_regular, probe_writable
 from toolkit.hookspecs import hookimpl
 
 __all__ = ["FORMAT", "VERSION", "READS", "MAX_BYTES", "MAX_DEPTH", "MAX_INT", "MAX_STRING", "write_atomic",
@@ -224,9 +224,7 @@ def save_state(target: Any, path: str | Path) -> None:
 
 def _probe_folder(folder: Path, name: str, path: Path) -> None:
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".tmp", dir=folder)
-        os.close(fd)
-        Path(tmp).unlink(missing_ok=True)  # (a saving process may have swept it away already)
+        probe_writable(folder, prefix=f".{name}.")  # named as the saves' own temporary files, which a save sweeps
     except OSError as exc:
         raise ConfigError(f"cannot write in the folder {folder}: {_reason(exc)}", file=path,
                           expected="--save into a folder this user can write") from None
