@@ -112,7 +112,8 @@ class Hierarchical(ActionSystem):
                 if not known or self.hierarchy.tuples[path[-1]].movement != movement:
                     raise ConfigError(f"not a path of the hierarchy: {path_text!r}", key=("experience", movement, path_text),
                                       expected="top > ... > leaf tuple names joined by '>'")
-                self.correspondence.setdefault(movement, Counter())[path] += int(n)
+                if int(n) > 0:  # a count of 0 (an override clearing what a file extended) is no experience
+                    self.correspondence.setdefault(movement, Counter())[path] += int(n)
         self.transitions: Counter[tuple[str, str]] = Counter()
         self.history: list[tuple[int, tuple[str, ...], str | None]] = []  # (frame, path, object) of each behaviour begun
         self._rng = np.random.default_rng(self.params["seed"])
