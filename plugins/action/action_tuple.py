@@ -121,6 +121,8 @@ class ActionHierarchy:
                 parts.append("can-I: " + ", ".join(x.describe() for x in t.can))
             if t.until:
                 parts.append("until: " + ", ".join(x.describe() for x in t.until))
+            if t.children and t.retries != DEFAULT_RETRIES:
+                parts.append(f"retries {t.retries}")
             if t.effect != "none":
                 parts.append(f"effect {t.effect}" + (f" (chance {t.chance:g})" if t.chance < 1 else ""))
             lines.append("  " * depth + label + (f"   [{'; '.join(parts)}]" if parts else ""))
