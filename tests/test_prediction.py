@@ -59,10 +59,12 @@ def test_the_imagined_world_is_the_one_where_the_success_context_holds():
 def test_a_character_with_another_success_context_predicts_otherwise(tmp_path):
     """A character for whom reaching succeeds when the object is *not* held (he reaches to push things about)
     imagines the cheese still free, where he would not eat it but reach for it again."""
-    world, morris, system = setting(tmp_path=tmp_path, extra='[action.tuples.reach]\nuntil = [{ trigger = "not-holding" }]\n')
+    pusher = '[action.tuples.reach]\nuntil = [{ trigger = "not-holding" }]\n'
+    world, morris, system = setting(tmp_path=tmp_path, extra=pusher)
     assert predict(system, morris, REACH_HUNGER, "cheese", then(world)) == ("reach the cheese",)
     # and one whose get and reach have no success context predicts nothing
-    world, morris, system = setting(tmp_path=tmp_path, extra='[action.tuples.reach]\nuntil = []\n[action.tuples.get]\nuntil = []\n')
+    aimless = '[action.tuples.reach]\nuntil = []\n[action.tuples.get]\nuntil = []\n'
+    world, morris, system = setting(tmp_path=tmp_path, extra=aimless)
     assert predict(system, morris, REACH_HUNGER, "cheese", then(world)) == ()
 
 

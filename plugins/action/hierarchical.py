@@ -18,13 +18,14 @@ without any) if its effect took place. Before every decision the active tuples
 are checked from the top: a tuple whose do-until contexts all hold has
 succeeded and ends (with everything below it), and so does one whose should-I
 triggers no longer hold (its drive is satisfied); a tuple whose other triggers
-no longer hold (its object gone, a can-I trigger false) has failed and ends. The lowest tuple still active then decides its child again: ``get``
-(until holding) reaches again, or jumps, until the object is held; once it is,
-``get`` ends and its parent decides again, so ``eat`` follows. A failed child
-counts against its parent: after ``retries`` failures in a row the parent gives
-up on its object (it is not chosen for that object again), so nothing loops
-forever; a tuple none of whose children can run gives up at once. :attr:`log`
-records each tuple's beginning and end.
+no longer hold (its object gone, a can-I trigger false) has failed and ends.
+The lowest tuple still active then decides its child again: ``get`` (until
+holding) reaches again, or jumps, until the object is held; once it is, ``get``
+ends and its parent decides again, so ``eat`` follows. A failed child counts
+against its parent: after ``retries`` failures in a row the parent gives up on
+its object (it is not chosen for that object again), so nothing loops forever;
+a tuple none of whose children can run gives up at once. :attr:`log` records
+each tuple's beginning and end.
 
 While acting the character keeps two maps (§6.1, §7.4):
 
@@ -138,7 +139,7 @@ class Hierarchical(ActionSystem):
         """
         obj = context.object
         if t.select is not None:
-            ignored = {o for n, o in getattr(self, "_given_up", ()) if n == t.name}
+            ignored = {o for n, o in self._given_up if n == t.name}
             if ignored:
                 context = TriggerContext(context.actor, context.world, obj, context.beliefs, context.drives,
                                          {**context.params, "ignored": ignored})
@@ -146,7 +147,7 @@ class Hierarchical(ActionSystem):
             if obj is None:
                 return 0.0, None
             context = TriggerContext(context.actor, context.world, obj, context.beliefs, context.drives, context.params)
-        elif (t.name, obj) in getattr(self, "_given_up", ()):
+        elif (t.name, obj) in self._given_up:
             return 0.0, obj
         v = 1.0
         for trigger in (*t.should, *t.can):
@@ -256,13 +257,13 @@ class Hierarchical(ActionSystem):
             if v <= 0:
                 self._end(i, False)
                 return
-            if obj != entry.object:  # a new object of attention (the last one eaten): what was below was for the old one
+            if obj != entry.object:  # a new object of attention (the last eaten): what was below was for the old one
                 entry.object = obj
                 del self._stack[i + 1:]
                 return
 
     def _descend(self, actor: Any, world: Any) -> tuple[tuple[str, ...], str | None] | None:
-        """From the lowest active tuple down to a leaf: each level's group competes again; ``None`` if nothing can run."""
+        """From the lowest active tuple down to a leaf, each level's group competing; ``None`` if nothing can run."""
         for _ in range(MAX_STEPS):
             if not self._stack:
                 won = self._compete(self.hierarchy.top, self.context(actor, world, None))
@@ -325,7 +326,7 @@ class Hierarchical(ActionSystem):
             target.position = np.array([front[0], target.radius, front[2]]) + 0.35 * heading
             self._satisfy(path, leaf)
             done = True
-        if self._stack and self._stack[-1].name == leaf.name:  # the leaf's outcome: its success context, else its effect
+        if self._stack and self._stack[-1].name == leaf.name:  # its outcome: its success context, else its effect
             if leaf.until:
                 context = self.context(actor, world, obj)
                 done = all(u.evaluate(context) > 0 for u in leaf.until)
