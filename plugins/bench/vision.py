@@ -41,6 +41,10 @@ def _watched(pm: Any, scenario: str, observer: str) -> tuple[Any, Any, Any]:
     from toolkit.scenario import load_scenario
 
     world = load_scenario(scenario, pm).world
+    if observer not in world.actors:
+        raise ConfigError(f"no actor {observer!r} in {scenario!r}", key=("--observer",),
+                          expected="an actor of the scenario that watches another",
+                          available=[a.id for a in world.actors.values() if a.target is not None])
     actor = world.actors[observer]
     if actor.target is None:
         raise ConfigError(f"actor {observer!r} watches nobody in {scenario!r}", key=("--observer",),
