@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import json
 import re
-import tempfile
 import time
 from pathlib import Path
 from typing import Any, Sequence
@@ -200,20 +199,14 @@ def _table(title: str, rows: list[list[Any]], columns: list[str], slope: float, 
             + f"\n  log-log slope of {what}: {slope:.2f} (1.0 = linear)\n")
 
 
-_DATA: dict[str, Any] = {}
-"""The data folder of this process (:func:`_axis_item`), made at its first item and removed when it exits."""
-
-
 def _axis_item(item: dict[str, Any], pm: Any) -> tuple[list[dict], str]:
     """One size of one axis (``item["axis"]``: ``stream`` minutes or ``repertoire`` movements) in whichever process
-    runs it, on the data folder of that process (:func:`plugins.bench.memory._data`, the same files everywhere)."""
-    from plugins.bench.memory import _data
+    runs it, on the data folder of that process (:func:`plugins.bench.memory.process_data`, the same files
+    everywhere)."""
+    from plugins.bench.memory import process_data
     from toolkit.profile import load_profile
 
-    if "data" not in _DATA:
-        _DATA["tmp"] = tempfile.TemporaryDirectory(prefix="likeme-scaling-")
-        _DATA["data"] = _data(pm, Path(_DATA["tmp"].name) / "data")
-    data, options = _DATA["data"], {k: item[k] for k in ("fps", "seed", "segmenter", "matcher", "settings")}
+    data, options = process_data(pm), {k: item[k] for k in ("fps", "seed", "segmenter", "matcher", "settings")}
     if item["axis"] == "stream":
         return stream_axis(pm, data, [item["size"]], **options)
     return repertoire_axis(pm, load_profile(data / "profile.toml"), [item["size"]], **options)
