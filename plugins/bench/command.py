@@ -149,6 +149,7 @@ def _motion_capture_commands(sub: Any) -> None:
 
     p = sub.add_parser("bandai", help="build benchmark folders from the Bandai-Namco clips (links; nothing copied)")
     p.add_argument("src", metavar="BANDAI_DIR")
+    _jobs_options(p, "the streams, each read from its clips and written; the same files whatever N")
     p.add_argument("dest", metavar="DIR")
     p.add_argument("--seed", type=seed_type, default=0)
     p.add_argument("--profile", default=None, help="the body profile to put beside the data (default: the built-in "

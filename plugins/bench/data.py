@@ -12,6 +12,7 @@ import csv
 import json
 import warnings
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -183,7 +184,7 @@ def _write_segments(path: Path, rows: list[tuple[int, int, str]]) -> None:
 
 
 def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams: int = 12, per_stream: int = 5,
-           gestures_only: bool = True) -> Path:
+           gestures_only: bool = True, jobs: int = 1, scheduler: str | None = None) -> Path:
     """Benchmark folders from the Bandai-Namco clips (links and generated streams; nothing is copied).
 
     ``repertoire/``: the normal-style clips; ``demos/``: every other style of the movements the repertoire has;
@@ -191,8 +192,12 @@ def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams:
     DIR/all --protocol groups --group STYLE_PATTERN``, :data:`STYLE_PATTERN`); ``streams/``: ``per_stream`` random
     gesture demos (other styles) one after another, with their segments. Locomotion never returns to a standing
     pose, so streams hold gestures only unless told otherwise.
+
+    Each stream's clips are drawn here, one stream after another; the streams are then read and written as items
+    of :func:`plugins.bench.jobs.run_items` (``jobs`` local processes or the Dask ``scheduler``), the same files
+    whatever wrote them.
     """
-    from toolkit.bvh import BVH, read_bvh, write_bvh
+    from plugins.bench.jobs import run_items
 
     src, dest = Path(src), Path(dest)
     files = sorted(src.glob("dataset-1_*.bvh"))
@@ -217,19 +222,29 @@ def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams:
             (c not in locomotion or not gestures_only) for p in ps]
     rng = np.random.default_rng(seed)
     (dest / "streams").mkdir(parents=True, exist_ok=True)
-    for k in range(streams):
-        chosen = [pool[i] for i in rng.choice(len(pool), per_stream, replace=False)]
-        parts = [read_bvh(p) for p in chosen]
-        rows, at = [], 0
-        for p, b in zip(chosen, parts):
-            rows.append((at, at + b.n_frames, p.stem.split("_")[1]))
-            at += b.n_frames
-        first = parts[0]
-        values = np.concatenate([b.values for b in parts])
-        write_bvh(BVH(first.joints, first.frame_time, values, "stream"), dest / "streams" / f"stream_{k + 1:02d}.bvh")
-        _write_segments(dest / "streams" / f"stream_{k + 1:02d}.segments.csv", rows)
+    items = [{"clips": [str(pool[i]) for i in rng.choice(len(pool), per_stream, replace=False)],
+              "path": str(dest / "streams" / f"stream_{k + 1:02d}.bvh")} for k in range(streams)]
+    run_items(_bandai_stream, items, jobs=jobs, scheduler=scheduler)
     (dest / "profile.toml").write_text(Path(profile_path).read_text(encoding="utf-8"), encoding="utf-8")
     return dest
+
+
+def _bandai_stream(item: dict[str, Any]) -> str:
+    """One stream of :func:`bandai`: the clips ``item["clips"]`` one after another, written to ``item["path"]``
+    with its ``.segments.csv`` beside it."""
+    from toolkit.bvh import BVH, read_bvh, write_bvh
+
+    chosen = [Path(p) for p in item["clips"]]
+    parts = [read_bvh(p) for p in chosen]
+    rows, at = [], 0
+    for p, b in zip(chosen, parts):
+        rows.append((at, at + b.n_frames, p.stem.split("_")[1]))
+        at += b.n_frames
+    first = parts[0]
+    path = Path(item["path"])
+    write_bvh(BVH(first.joints, first.frame_time, np.concatenate([b.values for b in parts]), "stream"), path)
+    _write_segments(path.with_name(path.name[: -len(".bvh")] + ".segments.csv"), rows)
+    return item["path"]
 
 
 STYLE_PATTERN = r"^dataset-1_[^_]+_([^_]+)_"
@@ -248,5 +263,5 @@ def cmd_bandai(args, pm) -> int:
 
     profile = Path(args.profile) if args.profile else resolve_file("profiles/bandai-namco.toml", None, pm,
                                                                    key=("--profile",))
-    print(bandai(Path(args.src), Path(args.dest), profile, seed=args.seed))
+    print(bandai(Path(args.src), Path(args.dest), profile, seed=args.seed, jobs=args.jobs, scheduler=args.scheduler))
     return 0
