@@ -142,6 +142,7 @@ def _motion_capture_commands(sub: Any) -> None:
 
     p = sub.add_parser("make-data", help="write repertoire, demos, streams and a profile from the built-in characters")
     p.add_argument("dest", metavar="DIR")
+    _jobs_options(p, "the BVH files, written from motions performed here; the same files whatever N")
     p.add_argument("--seed", type=seed_type, default=0)
     p.add_argument("--format", choices=("bvh", "csv", "npy", "c3d"), default="bvh",  # plugins.bench.data.FORMATS
                    help="the recordings' format: BVH, CSV joint positions, .npy arrays or C3D markers (default: bvh)")

@@ -46,19 +46,23 @@ def read_segments(path: Path) -> list[tuple[int, int, str]]:
 
 
 def make_data(pm, dest: Path, *, seed: int = 0, streams: int = 6, per_stream: int = 6, noise: float = 0.003,
-              fmt: str = "bvh") -> Path:
+              fmt: str = "bvh", jobs: int = 1, scheduler: str | None = None) -> Path:
     """Write a benchmark folder from the project's own characters.
 
     ``repertoire/NAME/max.bvh``: Max's own movements; ``demos/NAME/morris_S.bvh``: Morris's versions of them at
     speeds 0.8, 1.0 and 1.25 with observation noise; ``streams/stream_K.bvh`` with ``.segments.csv``: Morris's
     movements one after another from his rest pose; ``profile.toml``: the body profile (metres, +y up). ``fmt``
     ``"csv"`` or ``"npy"``: the same recordings as joint positions (:func:`convert_recordings`).
+
+    Every movement is performed and every noise drawn here, in order; the BVH files are then written as items of
+    :func:`plugins.bench.jobs.run_items` (``jobs`` local processes or the Dask ``scheduler``), the same files
+    whatever wrote them.
     """
     if fmt not in FORMATS:
         raise ConfigError(f"unknown format {fmt!r}", key=("--format",), expected="a recording format",
                           available=FORMATS)
+    from plugins.bench.jobs import run_items
     from toolkit import load_character
-    from toolkit.bvh import from_joint_positions, write_bvh
     from toolkit.character import resolve_file
     from toolkit.motion import Motion, concatenate
 
@@ -70,12 +74,13 @@ def make_data(pm, dest: Path, *, seed: int = 0, streams: int = 6, per_stream: in
     order = [root] + [i for i in range(body.n_parts) if i != root]
     names = [body.parts[i] for i in order]
     parents = [-1] + [0] * (len(order) - 1)
+    files: list[dict] = []
 
     def save(motion, path: Path, jitter: float = 0.0) -> None:
         positions = motion.positions[:, order] + rng.normal(0.0, jitter, motion.positions.shape) if jitter else \
             motion.positions[:, order]
-        path.parent.mkdir(parents=True, exist_ok=True)
-        write_bvh(from_joint_positions(names, parents, positions, motion.fps), path)
+        files.append({"path": str(path), "names": names, "parents": parents, "positions": positions,
+                      "fps": motion.fps})
 
     dest = Path(dest)
     movements = [m for m in max_c.motor.movements() if m in morris.motor.movements()]
@@ -95,13 +100,25 @@ def make_data(pm, dest: Path, *, seed: int = 0, streams: int = 6, per_stream: in
             at += still + motion.n_frames
         pieces.append(Motion(np.repeat(rest[None], 15, axis=0), 30.0, body.parts))
         save(concatenate(pieces), dest / "streams" / f"stream_{k + 1}.bvh", noise)
+        (dest / "streams").mkdir(parents=True, exist_ok=True)
         _write_segments(dest / "streams" / f"stream_{k + 1}.segments.csv", rows)
+    run_items(_write_recording, files, jobs=jobs, scheduler=scheduler)
     parts = "\n".join(f'{p} = "{p}"' for p in body.parts)
     f = body.facing
     facing = f'left = "{f.left}"\nright = "{f.right}"' + (f'\nforward = "{f.forward}"' if f.forward else "")
     (dest / "profile.toml").write_text(f'[profile]\nname = "max"\nunits = "metre"\nup = "+y"\n\n[parts]\n{parts}\n\n'
                                        f"[facing]\n{facing}\n", encoding="utf-8")
     return convert_recordings(dest, fmt)
+
+
+def _write_recording(item: dict[str, Any]) -> str:
+    """One BVH file of :func:`make_data`: ``item["positions"]`` of the joints ``item["names"]``."""
+    from toolkit.bvh import from_joint_positions, write_bvh
+
+    path = Path(item["path"])
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_bvh(from_joint_positions(item["names"], item["parents"], item["positions"], item["fps"]), path)
+    return item["path"]
 
 
 FORMATS = ("bvh", "csv", "npy", "c3d")
@@ -253,7 +270,8 @@ STYLE_PATTERN = r"^dataset-1_[^_]+_([^_]+)_"
 
 def cmd_make_data(args, pm) -> int:
     """``likeme bench make-data DIR``."""
-    print(make_data(pm, Path(args.dest), seed=args.seed, fmt=getattr(args, "format", "bvh")))
+    print(make_data(pm, Path(args.dest), seed=args.seed, fmt=getattr(args, "format", "bvh"), jobs=args.jobs,
+                    scheduler=args.scheduler))
     return 0
 
 
