@@ -12,7 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from plugins.bench.jobs import TIMING_NOTE, run_with_pm
+from plugins.bench.command import TIMING_NOTE
+from plugins.bench.jobs import run_with_pm
 from toolkit.cli import main
 from toolkit.manager import create_plugin_manager
 

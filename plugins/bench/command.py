@@ -10,7 +10,6 @@ import argparse
 from importlib import import_module
 from typing import Any
 
-from plugins.bench.jobs import TIMING_NOTE  # a light module (no benchmark's imports)
 from toolkit import hookimpl
 from toolkit.cli import count_type, fps_type, number_type, seed_type
 
@@ -65,6 +64,11 @@ def _check_set(args: argparse.Namespace, pm: Any) -> None:
         plugins = observer_plugins(pm, segmenters=segmenters, matchers=matchers,
                                    correspondence=getattr(args, "correspondence", ""))
     check_settings(settings, pm, plugins)
+
+
+TIMING_NOTE = ("parallel workers share the machine's cores: each item is timed and its memory measured inside the "
+               "worker that runs it, but the other workers perturb its timings, so keep the default 1 for figures")
+"""What ``--jobs`` says in the ``--help`` of a benchmark whose figures are timings or memory."""
 
 
 def _jobs_options(p: argparse.ArgumentParser, items: str = "", timing: bool = False) -> None:

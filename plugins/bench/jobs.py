@@ -15,15 +15,10 @@ from typing import Any
 from toolkit import ConfigError
 from toolkit.errors import LikemeError
 
-__all__ = ["LOCAL_PREFIX", "TIMING_NOTE", "in_process", "run_items", "run_with_pm"]
+__all__ = ["LOCAL_PREFIX", "in_process", "run_items", "run_with_pm"]
 
 LOCAL_PREFIX = "local:"
 """``--scheduler local:N`` starts a Dask ``LocalCluster`` of N worker processes for the run."""
-
-
-TIMING_NOTE = ("parallel workers share the machine's cores: each item is timed and its memory measured inside the "
-               "worker that runs it, but the other workers perturb its timings, so keep the default 1 for figures")
-"""What the ``--help`` of a benchmark whose figures are timings or memory says about ``--jobs``."""
 
 
 def in_process(jobs: int = 1, scheduler: str | None = None) -> bool:
