@@ -252,6 +252,14 @@ CASES = [
     ("sweep-key", "a sweep grid with an unknown key", {"g.toml": 'benchmark = "stream"\nthreads = 4\n'}, ["bench", "sweep", "g.toml"], ["g.toml", "threads", "available:"]),
     ("sweep-folder", "a sweep grid naming a missing folder", {"g.toml": 'benchmark = "segmentation"\n[data.d]\nbody = "p.toml"\nstreams = "nowhere"\n', "p.toml": PROFILE}, ["bench", "sweep", "g.toml"], ["nowhere"]),
     ("sweep-scheduler", "--scheduler local: without a number", {"p.toml": PROFILE}, ["bench", "segmentation", "--body", "p.toml", "--streams", ".", "--scheduler", "local:x"], ["local:x"]),
+    # -- --jobs and --scheduler on every likeme bench sub-command (issue 22)
+    ("bench-jobs-zero", "--jobs 0", {}, ["bench", "watch", "--jobs", "0"], ["argument --jobs: invalid value 0", "expected an integer in [1, 1024]"]),
+    ("bench-scheduler-nonsense", "--scheduler that is no address", {}, ["bench", "posegraph", "--scheduler", "nonsense"], ["argument --scheduler: invalid address 'nonsense'", "tcp://HOST:PORT", "local:N"]),
+    ("bench-scheduler-local-zero", "--scheduler local:0", {}, ["bench", "fuzz", "--scheduler", "local:0"], ["argument --scheduler: invalid value 'local:0'", "local:N with N workers, 1 or more"]),
+    ("bench-runs-zero", "--runs 0", {}, ["bench", "facilitation", "--runs", "0"], ["argument --runs: invalid value 0", "expected an integer in [1, 10000]"]),
+    ("bench-runs-past-seeds", "runs whose seeds pass the largest seed", {}, ["bench", "watch", "--seed", "9223372036854775807", "--runs", "2"], ["key --runs", "--seed + runs - 1 at most 9223372036854775807"]),
+    ("bench-worker-error", "an error in a --jobs worker", {}, ["bench", "watch", "--runs", "2", "--jobs", "2", "--movements", "1", "--demonstrator", "nobody"], ["nobody"]),
+    ("bench-vision-observer", "bench vision with an actor not in the scenario", {}, ["bench", "vision", "--observer", "nobody", "--frames", "1"], ["key --observer: no actor 'nobody' in 'jump_then_cover_face'", "available: max"]),
 ]
 
 

@@ -71,6 +71,18 @@ TIMING_NOTE = ("parallel workers share the machine's cores: each item is timed a
 """What ``--jobs`` says in the ``--help`` of a benchmark whose figures are timings or memory."""
 
 
+def _scheduler(text: str) -> str:
+    """``--scheduler``: ``local:N`` (N >= 1) or an address with a port (``tcp://HOST:PORT``, ``HOST:PORT``); whether
+    a scheduler answers there is found when the benchmark connects (``plugins.bench.jobs``)."""
+    if text.startswith("local:"):
+        if not text[len("local:"):].isdigit() or int(text[len("local:"):]) < 1:
+            raise argparse.ArgumentTypeError(f"invalid value {text!r}: expected local:N with N workers, 1 or more")
+    elif ":" not in text.split("://")[-1] or not text.split("://")[-1].rsplit(":", 1)[-1].isdigit():
+        raise argparse.ArgumentTypeError(f"invalid address {text!r}: expected a Dask scheduler's address with its "
+                                         "port, tcp://HOST:PORT (as `dask scheduler` prints it), or local:N")
+    return text
+
+
 def _jobs_options(p: argparse.ArgumentParser, items: str = "", timing: bool = False) -> None:
     """``--jobs N`` and ``--scheduler ADDRESS`` (:func:`plugins.bench.jobs.run_items`; ``docs/scaling.md``);
     ``items`` says what an item of this benchmark is, ``timing`` that its figures are timings or memory."""
@@ -78,7 +90,7 @@ def _jobs_options(p: argparse.ArgumentParser, items: str = "", timing: bool = Fa
     after = f"; {TIMING_NOTE}" if timing else "; the figures do not depend on N (frames per second aside)"
     p.add_argument("--jobs", type=count_type(1, 1024), default=1, metavar="N",
                    help=f"run the items{items} in N local processes (default: 1, this process){after}")
-    p.add_argument("--scheduler", metavar="ADDRESS", default=None,
+    p.add_argument("--scheduler", metavar="ADDRESS", default=None, type=_scheduler,
                    help="run the items on a Dask distributed cluster: a scheduler's address (tcp://HOST:8786) or "
                    "local:N for a LocalCluster of N workers (needs likeme[dask]; docs/scaling.md)")
 
