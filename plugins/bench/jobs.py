@@ -30,8 +30,8 @@ def run_with_pm(function: Callable[[Any, Any], Any], items: Sequence[Any], pm: A
                 scheduler: str | None = None) -> list[Any]:
     """``[function(item, pm) for item in items]`` through :func:`run_items`.
 
-    In this process (``jobs`` 1, no ``scheduler``) ``function`` gets the caller's plugin manager ``pm`` (plugins
-    registered by hand included); a worker process builds its own, once, from the installed plugins
+    In this process (``jobs`` 1 or a single item, no ``scheduler``) ``function`` gets the caller's plugin manager
+    ``pm`` (plugins registered by hand included); a worker process builds its own, once, from the installed plugins
     (:func:`toolkit.manager.create_plugin_manager`).
 
     Parameters
@@ -53,7 +53,7 @@ def run_with_pm(function: Callable[[Any, Any], Any], items: Sequence[Any], pm: A
     items = list(items)
     if jobs < 1:
         raise ConfigError(f"--jobs {jobs}", key=("--jobs",), expected="a number of processes, 1 or more")
-    if in_process(jobs, scheduler):
+    if in_process(jobs, scheduler) or (not scheduler and len(items) <= 1):  # as run_items: here
         return [function(item, pm) for item in items]
     return run_items(_WithPm(function), items, jobs=jobs, scheduler=scheduler)
 
