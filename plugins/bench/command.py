@@ -181,7 +181,7 @@ def likeme_register_commands(subparsers):
     _motion_capture_commands(sub)
 
     p = sub.add_parser("watch", help="an observer watches a demonstrator's random movements (B&B §5)")
-    _jobs_options(p, "the runs")
+    _jobs_options(p, "the --runs")
     p.add_argument("--runs", type=count_type(1, 10_000), default=1, metavar="R",
                    help="independent runs, each a fresh world with --movements movements, run r with seed --seed + r; "
                    "the figures pool every run (default: 1)")
@@ -202,7 +202,7 @@ def likeme_register_commands(subparsers):
     p.set_defaults(handler=_handler("watch", "cmd_watch"))
 
     p = sub.add_parser("facilitation", help="Max learns Moritz's arm and finger movements and imitates familiar ones early (K&G §4-5)")
-    _jobs_options(p, "the runs")
+    _jobs_options(p, "the --runs")
     p.add_argument("--runs", type=count_type(1, 10_000), default=1, metavar="R",
                    help="independent runs, each a fresh Max who learns his own repertoire, run r with seed --seed + r; "
                    "the figures pool every run's demonstrations (default: 1)")
