@@ -257,6 +257,14 @@ CASES = [
     ("tuple-chance-inner", "a chance on a tuple with children", {"c.toml": CHILD + '[action.tuples.get]\nchance = 0.5\n'}, ["validate", "c.toml"], ["key action.tuples.get.chance", "only a leaf"]),
     ("tuple-retries", "retries that are not a whole number", {"c.toml": CHILD + '[action.tuples.get]\nretries = 1.5\n'}, ["validate", "c.toml"], ["key action.tuples.get.retries", "invalid value 1.5", "whole number in [0, 100]"]),
     ("tuple-retries-leaf", "retries on a leaf", {"c.toml": CHILD + '[action.tuples.reach]\nretries = 2\n'}, ["validate", "c.toml"], ["key action.tuples.reach.retries", "only a tuple with children"]),
+    # -- --jobs and --scheduler on every likeme bench sub-command (issue 22)
+    ("bench-jobs-zero", "--jobs 0", {}, ["bench", "watch", "--jobs", "0"], ["argument --jobs: invalid value 0", "expected an integer in [1, 1024]"]),
+    ("bench-scheduler-nonsense", "--scheduler that is no address", {}, ["bench", "posegraph", "--scheduler", "nonsense"], ["argument --scheduler: invalid address 'nonsense'", "tcp://HOST:PORT", "local:N"]),
+    ("bench-scheduler-local-zero", "--scheduler local:0", {}, ["bench", "fuzz", "--scheduler", "local:0"], ["argument --scheduler: invalid value 'local:0'", "local:N with N workers, 1 or more"]),
+    ("bench-runs-zero", "--runs 0", {}, ["bench", "facilitation", "--runs", "0"], ["argument --runs: invalid value 0", "expected an integer in [1, 10000]"]),
+    ("bench-runs-past-seeds", "runs whose seeds pass the largest seed", {}, ["bench", "watch", "--seed", "9223372036854775807", "--runs", "2"], ["key --runs", "--seed + runs - 1 at most 9223372036854775807"]),
+    ("bench-worker-error", "an error in a --jobs worker", {}, ["bench", "watch", "--runs", "2", "--jobs", "2", "--movements", "1", "--demonstrator", "nobody"], ["nobody"]),
+    ("bench-vision-observer", "bench vision with an actor not in the scenario", {}, ["bench", "vision", "--observer", "nobody", "--frames", "1"], ["key --observer: no actor 'nobody' in 'jump_then_cover_face'", "available: max"]),
 ]
 
 

@@ -66,12 +66,31 @@ def _check_set(args: argparse.Namespace, pm: Any) -> None:
     check_settings(settings, pm, plugins)
 
 
-def _jobs_options(p: argparse.ArgumentParser) -> None:
-    """``--jobs N`` and ``--scheduler ADDRESS`` (:func:`plugins.bench.jobs.run_items`; ``docs/scaling.md``)."""
+TIMING_NOTE = ("parallel workers share the machine's cores: each item is timed and its memory measured inside the "
+               "worker that runs it, but the other workers perturb its timings, so keep the default 1 for figures")
+"""What ``--jobs`` says in the ``--help`` of a benchmark whose figures are timings or memory."""
+
+
+def _scheduler(text: str) -> str:
+    """``--scheduler``: ``local:N`` (N >= 1) or an address with a port (``tcp://HOST:PORT``, ``HOST:PORT``); whether
+    a scheduler answers there is found when the benchmark connects (``plugins.bench.jobs``)."""
+    if text.startswith("local:"):
+        if not text[len("local:"):].isdigit() or int(text[len("local:"):]) < 1:
+            raise argparse.ArgumentTypeError(f"invalid value {text!r}: expected local:N with N workers, 1 or more")
+    elif ":" not in text.split("://")[-1] or not text.split("://")[-1].rsplit(":", 1)[-1].isdigit():
+        raise argparse.ArgumentTypeError(f"invalid address {text!r}: expected a Dask scheduler's address with its "
+                                         "port, tcp://HOST:PORT (as `dask scheduler` prints it), or local:N")
+    return text
+
+
+def _jobs_options(p: argparse.ArgumentParser, items: str = "", timing: bool = False) -> None:
+    """``--jobs N`` and ``--scheduler ADDRESS`` (:func:`plugins.bench.jobs.run_items`; ``docs/scaling.md``);
+    ``items`` says what an item of this benchmark is, ``timing`` that its figures are timings or memory."""
+    items = f" ({items})" if items else ""
+    after = f"; {TIMING_NOTE}" if timing else "; the figures do not depend on N (frames per second aside)"
     p.add_argument("--jobs", type=count_type(1, 1024), default=1, metavar="N",
-                   help="run the items in N local processes (default: 1, this process); the figures do not depend "
-                   "on N (frames per second aside)")
-    p.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                   help=f"run the items{items} in N local processes (default: 1, this process){after}")
+    p.add_argument("--scheduler", metavar="ADDRESS", default=None, type=_scheduler,
                    help="run the items on a Dask distributed cluster: a scheduler's address (tcp://HOST:8786) or "
                    "local:N for a LocalCluster of N workers (needs likeme[dask]; docs/scaling.md)")
 
@@ -139,6 +158,7 @@ def _motion_capture_commands(sub: Any) -> None:
 
     p = sub.add_parser("make-data", help="write repertoire, demos, streams and a profile from the built-in characters")
     p.add_argument("dest", metavar="DIR")
+    _jobs_options(p, "the BVH files, written from motions performed here; the same files whatever N")
     p.add_argument("--seed", type=seed_type, default=0)
     p.add_argument("--format", choices=("bvh", "csv", "npy", "c3d"), default="bvh",  # plugins.bench.data.FORMATS
                    help="the recordings' format: BVH, CSV joint positions, .npy arrays or C3D markers (default: bvh)")
@@ -146,6 +166,7 @@ def _motion_capture_commands(sub: Any) -> None:
 
     p = sub.add_parser("bandai", help="build benchmark folders from the Bandai-Namco clips (links; nothing copied)")
     p.add_argument("src", metavar="BANDAI_DIR")
+    _jobs_options(p, "the streams, each read from its clips and written; the same files whatever N")
     p.add_argument("dest", metavar="DIR")
     p.add_argument("--seed", type=seed_type, default=0)
     p.add_argument("--profile", default=None, help="the body profile to put beside the data (default: the built-in "
@@ -160,6 +181,10 @@ def likeme_register_commands(subparsers):
     _motion_capture_commands(sub)
 
     p = sub.add_parser("watch", help="an observer watches a demonstrator's random movements (B&B §5)")
+    _jobs_options(p, "the --runs")
+    p.add_argument("--runs", type=count_type(1, 10_000), default=1, metavar="R",
+                   help="independent runs, each a fresh world with --movements movements, run r with seed --seed + r; "
+                   "the figures pool every run (default: 1)")
     p.add_argument("--observer", default="max", help="observer character (default: max)")
     p.add_argument("--demonstrator", default="morris", help="demonstrator character (default: morris)")
     p.add_argument("--movements", type=_movements, default=200,
@@ -177,6 +202,10 @@ def likeme_register_commands(subparsers):
     p.set_defaults(handler=_handler("watch", "cmd_watch"))
 
     p = sub.add_parser("facilitation", help="Max learns Moritz's arm and finger movements and imitates familiar ones early (K&G §4-5)")
+    _jobs_options(p, "the --runs")
+    p.add_argument("--runs", type=count_type(1, 10_000), default=1, metavar="R",
+                   help="independent runs, each a fresh Max who learns his own repertoire, run r with seed --seed + r; "
+                   "the figures pool every run's demonstrations (default: 1)")
     p.add_argument("--demonstrations", type=int, default=200, help="demonstrations after the repertoire (default: 200)")
     p.add_argument("--repertoire", type=int, default=6, help="random movements learned first (default: 6)")
     p.add_argument("--noise", type=float, default=0.002, help="observation noise, metres (default: 0.002)")
@@ -198,6 +227,7 @@ def likeme_register_commands(subparsers):
 
     p = sub.add_parser("memory", help="the observer's memory against stream length: a live observer fed for "
                        "--minutes, and likeme observe on generated BVH streams")
+    _jobs_options(p, "the live observer and each --observe-minutes stream", timing=True)
     p.add_argument("--minutes", type=float, default=60.0, help="simulated minutes fed to the live observer "
                    "(default: 60)")
     p.add_argument("--every", type=float, default=10.0, help="print a line every this many minutes (default: 10)")
@@ -221,6 +251,7 @@ def likeme_register_commands(subparsers):
 
     p = sub.add_parser("posegraph", help="the k nearest poses of a posegraph of --nodes poses: the spatial index "
                        "(plugins.lib.pose_index) against the exhaustive scan; build time, query time, memory")
+    _jobs_options(p, "one per --nodes, a table row each", timing=True)
     p.add_argument("--nodes", type=count_type(1, 10_000_000), action="append", metavar="N",
                    help="poses in the graph (repeatable, one table row each; default: 100000)")
     p.add_argument("--parts", type=count_type(1, 100), default=None, help="parts per pose (default: the body's, 11)")
@@ -235,12 +266,14 @@ def likeme_register_commands(subparsers):
 
     p = sub.add_parser("startup", help="how long likeme takes to start: the medians of likeme --version, --help "
                        "and plugins, each run in a fresh process")
+    _jobs_options(p, "the runs: each command once", timing=True)
     p.add_argument("--runs", type=count_type(1, 1000), default=20, help="runs of each command (default: 20)")
     p.add_argument("--json", metavar="FILE", help="also write the times as JSON")
     p.set_defaults(handler=_handler("startup", "cmd_startup"))
 
     p = sub.add_parser("vision", help="rendered-vision against synthetic-vision on the same frames: agreement, "
                        "position difference, milliseconds per frame")
+    _jobs_options(p, "one per --resolution, each stepping the scenario itself", timing=True)
     p.add_argument("--scenario", default="jump_then_cover_face", help="scenario to watch (default: jump_then_cover_face)")
     p.add_argument("--observer", default="max", help="the watching actor (default: max)")
     p.add_argument("--resolution", type=int, action="append", help="rendered-vision resolution, repeatable "
@@ -250,6 +283,8 @@ def likeme_register_commands(subparsers):
 
     p = sub.add_parser("fuzz", help="mutated real-looking inputs through the commands a user runs: only documented "
                        "errors allowed (docs/robustness.md)")
+    _jobs_options(p, "blocks of cases, each through its own worker process; a case is made from its number alone, "
+                  "so its outcome does not depend on N, but loaded cores reach --timeout sooner")
     p.add_argument("--n", type=int, default=2000, help="number of mutated inputs (default: 2000)")
     p.add_argument("--seed", type=int, default=0, help="seed of the mutations (default: 0)")
     p.add_argument("--targets", default="bvh,toml,profile,scenario,state,csv", help="comma-separated: bvh, toml, "
@@ -263,6 +298,7 @@ def likeme_register_commands(subparsers):
 
     p = sub.add_parser("scaling", help="cost against stream length, repertoire size and graph size, with the "
                        "log-log slope of each (1.0 = linear)")
+    _jobs_options(p, "each stream length and each repertoire size", timing=True)
     p.add_argument("--fps", type=fps_type, default=30.0, help="frame rate of the streams and clips (default: 30)")
     p.add_argument("--minutes", type=number_type(1e-6, 1e6, "minutes"), action="append", metavar="MIN",
                    help="stream length (repeatable; default: 1, 10, 60)")

@@ -12,6 +12,7 @@ import csv
 import json
 import warnings
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -45,19 +46,23 @@ def read_segments(path: Path) -> list[tuple[int, int, str]]:
 
 
 def make_data(pm, dest: Path, *, seed: int = 0, streams: int = 6, per_stream: int = 6, noise: float = 0.003,
-              fmt: str = "bvh") -> Path:
+              fmt: str = "bvh", jobs: int = 1, scheduler: str | None = None) -> Path:
     """Write a benchmark folder from the project's own characters.
 
     ``repertoire/NAME/max.bvh``: Max's own movements; ``demos/NAME/morris_S.bvh``: Morris's versions of them at
     speeds 0.8, 1.0 and 1.25 with observation noise; ``streams/stream_K.bvh`` with ``.segments.csv``: Morris's
     movements one after another from his rest pose; ``profile.toml``: the body profile (metres, +y up). ``fmt``
     ``"csv"`` or ``"npy"``: the same recordings as joint positions (:func:`convert_recordings`).
+
+    Every movement is performed and every noise drawn here, in order; the BVH files are then written as items of
+    :func:`plugins.bench.jobs.run_items` (``jobs`` local processes or the Dask ``scheduler``), the same files
+    whatever wrote them.
     """
     if fmt not in FORMATS:
         raise ConfigError(f"unknown format {fmt!r}", key=("--format",), expected="a recording format",
                           available=FORMATS)
+    from plugins.bench.jobs import run_items
     from toolkit import load_character
-    from toolkit.bvh import from_joint_positions, write_bvh
     from toolkit.character import resolve_file
     from toolkit.motion import Motion, concatenate
 
@@ -69,12 +74,13 @@ def make_data(pm, dest: Path, *, seed: int = 0, streams: int = 6, per_stream: in
     order = [root] + [i for i in range(body.n_parts) if i != root]
     names = [body.parts[i] for i in order]
     parents = [-1] + [0] * (len(order) - 1)
+    files: list[dict] = []
 
     def save(motion, path: Path, jitter: float = 0.0) -> None:
         positions = motion.positions[:, order] + rng.normal(0.0, jitter, motion.positions.shape) if jitter else \
             motion.positions[:, order]
-        path.parent.mkdir(parents=True, exist_ok=True)
-        write_bvh(from_joint_positions(names, parents, positions, motion.fps), path)
+        files.append({"path": str(path), "names": names, "parents": parents, "positions": positions,
+                      "fps": motion.fps})
 
     dest = Path(dest)
     movements = [m for m in max_c.motor.movements() if m in morris.motor.movements()]
@@ -94,13 +100,25 @@ def make_data(pm, dest: Path, *, seed: int = 0, streams: int = 6, per_stream: in
             at += still + motion.n_frames
         pieces.append(Motion(np.repeat(rest[None], 15, axis=0), 30.0, body.parts))
         save(concatenate(pieces), dest / "streams" / f"stream_{k + 1}.bvh", noise)
+        (dest / "streams").mkdir(parents=True, exist_ok=True)
         _write_segments(dest / "streams" / f"stream_{k + 1}.segments.csv", rows)
+    run_items(_write_recording, files, jobs=jobs, scheduler=scheduler)
     parts = "\n".join(f'{p} = "{p}"' for p in body.parts)
     f = body.facing
     facing = f'left = "{f.left}"\nright = "{f.right}"' + (f'\nforward = "{f.forward}"' if f.forward else "")
     (dest / "profile.toml").write_text(f'[profile]\nname = "max"\nunits = "metre"\nup = "+y"\n\n[parts]\n{parts}\n\n'
                                        f"[facing]\n{facing}\n", encoding="utf-8")
     return convert_recordings(dest, fmt)
+
+
+def _write_recording(item: dict[str, Any]) -> str:
+    """One BVH file of :func:`make_data`: ``item["positions"]`` of the joints ``item["names"]``."""
+    from toolkit.bvh import from_joint_positions, write_bvh
+
+    path = Path(item["path"])
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_bvh(from_joint_positions(item["names"], item["parents"], item["positions"], item["fps"]), path)
+    return item["path"]
 
 
 FORMATS = ("bvh", "csv", "npy", "c3d")
@@ -183,7 +201,7 @@ def _write_segments(path: Path, rows: list[tuple[int, int, str]]) -> None:
 
 
 def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams: int = 12, per_stream: int = 5,
-           gestures_only: bool = True) -> Path:
+           gestures_only: bool = True, jobs: int = 1, scheduler: str | None = None) -> Path:
     """Benchmark folders from the Bandai-Namco clips (links and generated streams; nothing is copied).
 
     ``repertoire/``: the normal-style clips; ``demos/``: every other style of the movements the repertoire has;
@@ -191,8 +209,12 @@ def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams:
     DIR/all --protocol groups --group STYLE_PATTERN``, :data:`STYLE_PATTERN`); ``streams/``: ``per_stream`` random
     gesture demos (other styles) one after another, with their segments. Locomotion never returns to a standing
     pose, so streams hold gestures only unless told otherwise.
+
+    Each stream's clips are drawn here, one stream after another; the streams are then read and written as items
+    of :func:`plugins.bench.jobs.run_items` (``jobs`` local processes or the Dask ``scheduler``), the same files
+    whatever wrote them.
     """
-    from toolkit.bvh import BVH, read_bvh, write_bvh
+    from plugins.bench.jobs import run_items
 
     src, dest = Path(src), Path(dest)
     files = sorted(src.glob("dataset-1_*.bvh"))
@@ -217,19 +239,29 @@ def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams:
             (c not in locomotion or not gestures_only) for p in ps]
     rng = np.random.default_rng(seed)
     (dest / "streams").mkdir(parents=True, exist_ok=True)
-    for k in range(streams):
-        chosen = [pool[i] for i in rng.choice(len(pool), per_stream, replace=False)]
-        parts = [read_bvh(p) for p in chosen]
-        rows, at = [], 0
-        for p, b in zip(chosen, parts):
-            rows.append((at, at + b.n_frames, p.stem.split("_")[1]))
-            at += b.n_frames
-        first = parts[0]
-        values = np.concatenate([b.values for b in parts])
-        write_bvh(BVH(first.joints, first.frame_time, values, "stream"), dest / "streams" / f"stream_{k + 1:02d}.bvh")
-        _write_segments(dest / "streams" / f"stream_{k + 1:02d}.segments.csv", rows)
+    items = [{"clips": [str(pool[i]) for i in rng.choice(len(pool), per_stream, replace=False)],
+              "path": str(dest / "streams" / f"stream_{k + 1:02d}.bvh")} for k in range(streams)]
+    run_items(_bandai_stream, items, jobs=jobs, scheduler=scheduler)
     (dest / "profile.toml").write_text(Path(profile_path).read_text(encoding="utf-8"), encoding="utf-8")
     return dest
+
+
+def _bandai_stream(item: dict[str, Any]) -> str:
+    """One stream of :func:`bandai`: the clips ``item["clips"]`` one after another, written to ``item["path"]``
+    with its ``.segments.csv`` beside it."""
+    from toolkit.bvh import BVH, read_bvh, write_bvh
+
+    chosen = [Path(p) for p in item["clips"]]
+    parts = [read_bvh(p) for p in chosen]
+    rows, at = [], 0
+    for p, b in zip(chosen, parts):
+        rows.append((at, at + b.n_frames, p.stem.split("_")[1]))
+        at += b.n_frames
+    first = parts[0]
+    path = Path(item["path"])
+    write_bvh(BVH(first.joints, first.frame_time, np.concatenate([b.values for b in parts]), "stream"), path)
+    _write_segments(path.with_name(path.name[: -len(".bvh")] + ".segments.csv"), rows)
+    return item["path"]
 
 
 STYLE_PATTERN = r"^dataset-1_[^_]+_([^_]+)_"
@@ -238,7 +270,8 @@ STYLE_PATTERN = r"^dataset-1_[^_]+_([^_]+)_"
 
 def cmd_make_data(args, pm) -> int:
     """``likeme bench make-data DIR``."""
-    print(make_data(pm, Path(args.dest), seed=args.seed, fmt=getattr(args, "format", "bvh")))
+    print(make_data(pm, Path(args.dest), seed=args.seed, fmt=getattr(args, "format", "bvh"), jobs=args.jobs,
+                    scheduler=args.scheduler))
     return 0
 
 
@@ -248,5 +281,5 @@ def cmd_bandai(args, pm) -> int:
 
     profile = Path(args.profile) if args.profile else resolve_file("profiles/bandai-namco.toml", None, pm,
                                                                    key=("--profile",))
-    print(bandai(Path(args.src), Path(args.dest), profile, seed=args.seed))
+    print(bandai(Path(args.src), Path(args.dest), profile, seed=args.seed, jobs=args.jobs, scheduler=args.scheduler))
     return 0

@@ -3,6 +3,10 @@
 Max starts with hub nodes only, learns random arm and finger movements by watching them once, then watches more
 demonstrations (known ones, some at other speeds, and new ones) with observation noise; the benchmark reports
 recognition, how early he commits (response facilitation), false commits, what he learns and how well he imitates.
+
+``--runs R``: R independent runs (a fresh Max each; run r with seed ``--seed + r``), the items ``--jobs`` and
+``--scheduler`` spread over workers (:func:`plugins.bench.jobs.run_with_pm`); the figures are computed from every
+run's demonstrations together, the same whatever ran them (frames per second aside).
 """
 
 from __future__ import annotations
@@ -21,7 +25,7 @@ from plugins.bench import text_table
 from toolkit import World, load_character
 from toolkit.state import write_atomic
 
-__all__ = ["facilitation_benchmark", "render_facilitation", "cmd_facilitation"]
+__all__ = ["facilitation_benchmark", "facilitation_runs", "render_facilitation", "cmd_facilitation"]
 
 
 class _Replay:
@@ -235,7 +239,48 @@ def facilitation_benchmark(pm: Any, *, demonstrations: int = 200, repertoire: in
         "angle_noise": angle_noise, "hands": hands, **figures,
         "hand": _facilitation_figures([r for r in rows if r["kind"] == "hand"]),
         "frames_per_second": (world.frame - frames_before) / elapsed if elapsed > 0 else float("inf"),
+        "frames": world.frame - frames_before, "seconds": elapsed,
         "rows": rows, "python": platform.python_version(), "numpy": np.__version__,
+    }
+
+
+def _run(item: dict[str, Any], pm: Any) -> dict[str, Any]:
+    """One run of :func:`facilitation_benchmark` from its keyword arguments, in whichever process runs it."""
+    return facilitation_benchmark(pm, **item)
+
+
+def facilitation_runs(pm: Any, *, runs: int = 1, seed: int = 0, jobs: int = 1, scheduler: str | None = None,
+                      progress: bool = False, **options: Any) -> dict[str, Any]:
+    """``runs`` independent runs of :func:`facilitation_benchmark` (run r with seed ``seed + r``; ``options`` its
+    other keyword arguments) in ``jobs`` local processes or on the Dask ``scheduler``; one run: its own result,
+    several: the figures of all their demonstrations together (``rows`` with the run of each)."""
+    from plugins.bench.jobs import in_process, run_with_pm
+    from toolkit.errors import ConfigError
+    from toolkit.scenario import MAX_SEED, check_seed
+
+    check_seed(seed, ("--seed",))
+    if isinstance(runs, bool) or not isinstance(runs, int) or runs < 1 or seed + runs - 1 > MAX_SEED:
+        raise ConfigError(f"invalid value {runs!r}", key=("--runs",),
+                          expected=f"an integer >= 1 with --seed + runs - 1 at most {MAX_SEED}")
+    bar = progress and runs == 1 and in_process(jobs, scheduler)  # a bar over the demonstrations of the one run here
+    began = time.perf_counter()
+    results = run_with_pm(_run, [{**options, "seed": seed + r, "progress": bar} for r in range(runs)], pm,
+                          jobs=jobs, scheduler=scheduler)
+    wall = time.perf_counter() - began
+    if runs == 1:
+        return results[0]
+    rows = [{"run": r, **row} for r, result in enumerate(results) for row in result["rows"]]
+    frames, seconds = sum(r["frames"] for r in results), sum(r["seconds"] for r in results)
+    first = results[0]
+    return {
+        **{k: first[k] for k in ("benchmark", "seed", "repertoire", "noise", "angle_noise", "hands", "python",
+                                 "numpy")},
+        "demonstrations": sum(r["demonstrations"] for r in results), "runs": runs,
+        "seeds": [r["seed"] for r in results],
+        **_facilitation_figures([r for r in rows if r["kind"] == "wrist"]),
+        "hand": _facilitation_figures([r for r in rows if r["kind"] == "hand"]),
+        "frames_per_second": frames / seconds if seconds > 0 else float("inf"), "frames": frames, "seconds": seconds,
+        "wall_s": wall, "jobs": jobs, "scheduler": scheduler, "rows": rows,
     }
 
 
@@ -290,12 +335,18 @@ def render_facilitation(r: dict[str, Any]) -> str:
             f"learned first, noise {r['noise']} m and {r.get('angle_noise', 0.0)} rad)")
     rows = [[label, *(col[i] for col in table)] for i, label in enumerate(labels)]
     rows.append(["frames per second (world)", f"{r['frames_per_second']:.0f}", *([""] * (len(columns) - 1))])
+    if "wall_s" in r:  # several runs: the wall time of them all, on --jobs processes or the --scheduler's workers
+        where = f"--scheduler {r['scheduler']}" if r.get("scheduler") else f"--jobs {r.get('jobs', 1)}"
+        rows.append([f"wall time, {r['runs']} runs (seeds {r['seeds'][0]}-{r['seeds'][-1]})", f"{r['wall_s']:.1f} s",
+                     *([""] * (len(columns) - 1))])
+        rows[-1][0] += f", {where}"
     return "\n".join([head, text_table(rows, [("", "left")] + [(name, "right") for name, _, _ in columns])])
 
 
 def cmd_facilitation(args: argparse.Namespace, pm: Any) -> int:
-    result = facilitation_benchmark(pm, demonstrations=args.demonstrations, repertoire=args.repertoire, seed=args.seed,
-                                    noise=args.noise, hands=args.hands, angle_noise=args.angle_noise, progress=not args.quiet)
+    result = facilitation_runs(pm, demonstrations=args.demonstrations, repertoire=args.repertoire, seed=args.seed,
+                               noise=args.noise, hands=args.hands, angle_noise=args.angle_noise, progress=not args.quiet,
+                               runs=args.runs, jobs=args.jobs, scheduler=args.scheduler)
     print(render_facilitation(result))
     if args.json:
         write_atomic(Path(args.json), json.dumps(result, indent=2, default=float) + "\n")

@@ -16,7 +16,9 @@ joint-position files. Case ``i`` of seed ``s`` mutates one seed with :func:`plug
 - ``csv``: ``toolkit.positions.read_positions(F, fps=30.0)`` (skipped with a note while that module is absent).
 
 Cases run one after another in one long-lived worker process that calls ``toolkit.cli.main`` in-process, under
-``RLIMIT_AS`` of ``--memory`` MB; the parent kills and restarts it on a timeout or a crash. Outcomes:
+``RLIMIT_AS`` of ``--memory`` MB; the parent kills and restarts it on a timeout or a crash. With ``--jobs N`` (or
+``--scheduler``) blocks of cases run in N processes, each with a fuzz worker of its own; the results come back in
+the cases' order. Outcomes:
 
 - ``ok``: exit status 0;
 - ``documented``: exit status 1 and exactly one ``likeme: error: ...`` line on stderr, no traceback;
@@ -543,14 +545,24 @@ def _positions_available() -> bool:
     return find_spec("toolkit.positions") is not None
 
 
+BLOCK = 100
+"""Cases a block on a Dask cluster (``--scheduler``): an item of :func:`plugins.bench.jobs.run_items`."""
+
+
 def run_fuzz(pm: Any, *, n: int = 2000, seed: int = 0, targets: tuple[str, ...] = TARGETS, timeout: float = 10.0,
              memory_mb: int = 1024, out: Path | None = None, progress: Any = None,
-             notes: list[str] | None = None) -> list[Result]:
-    """Make and run ``n`` cases dealt round-robin over ``targets``; return their results.
+             notes: list[str] | None = None, jobs: int = 1, scheduler: str | None = None) -> list[Result]:
+    """Make and run ``n`` cases dealt round-robin over ``targets``; return their results in the cases' order.
 
     ``out``: every case that is not ok or documented is written there (``NAME`` input, ``NAME.stderr`` with the
-    command that replays it and what it printed). ``notes`` collects what was skipped and why.
+    command that replays it and what it printed). ``notes`` collects what was skipped and why. ``jobs`` local
+    processes or the Dask ``scheduler`` each run blocks of cases through a fuzz worker of their own
+    (:func:`_fuzz_block`); a case is made from its number alone, so its outcome does not depend on which ran it
+    (only a case near ``timeout`` can, on loaded cores). ``progress(result)`` is called for each case as it ends
+    here, for each block's cases as the block comes back from a worker.
     """
+    from plugins.bench.jobs import in_process, run_with_pm
+
     notes = notes if notes is not None else []
     targets = tuple(targets)
     if "csv" in targets and not _positions_available():
@@ -558,38 +570,70 @@ def run_fuzz(pm: Any, *, n: int = 2000, seed: int = 0, targets: tuple[str, ...] 
         targets = tuple(t for t in targets if t != "csv")
     if not targets:
         return []
-    results: list[Result] = []
     with tempfile.TemporaryDirectory(prefix="likeme-fuzz-") as tmp:
         tmp = Path(tmp)
         if out is not None:  # the seeds beside the failing cases, so that their commands replay them
             Path(out).mkdir(parents=True, exist_ok=True)
             shutil.rmtree(Path(out) / "seeds", ignore_errors=True)
         seeds = make_seeds((Path(out).resolve() if out is not None else tmp) / "seeds", pm, seed=seed)
-        stream = seeds["bvh"][-1]
-        warm = [["validate", str(CHARACTERS / "max.toml")],
-                ["observe", "--body", str(stream["profile"]), "--repertoire", str(stream["repertoire"]),
-                 str(stream["path"])],
-                ["run", "learn_windmill", "--load", str(seeds["state"][0]["path"]), "--duration", "0.2"]]
-        worker = Worker(memory_mb, warm)
-        case_dir = tmp / "case"
-        try:
-            for i in range(n):
-                case = make_case(i, targets[i % len(targets)], seeds, seed)
-                shutil.rmtree(case_dir, ignore_errors=True)
-                case_dir.mkdir()
-                (case_dir / case.name).write_bytes(case.data)
-                request = {"cwd": str(case_dir), "input": case.name, "call": case.call,
-                           "argv": None if case.argv is None else [a.replace("{input}", case.name) for a in case.argv]}
-                started = time.monotonic()
-                answer = worker.run(request, timeout)
-                result = Result(case, classify(answer), answer, time.monotonic() - started)
+        if in_process(jobs, scheduler):
+            return _run_cases(list(range(n)), targets, seeds, seed, timeout=timeout, memory_mb=memory_mb, tmp=tmp,
+                              out=out, progress=progress)
+        size = BLOCK if scheduler else -(-n // (2 * jobs))  # locally two blocks a process: a slow block is shared
+        items = [{"indices": list(range(i, min(i + size, n))), "targets": targets, "seeds": seeds, "seed": seed,
+                  "timeout": timeout, "memory_mb": memory_mb} for i in range(0, n, size)]
+        results = []
+        for block in run_with_pm(_fuzz_block, items, pm, jobs=jobs, scheduler=scheduler):
+            for result in block:
                 results.append(result)
                 if out is not None and result.outcome in BAD:
                     _keep(result, Path(out))
                 if progress is not None:
                     progress(result)
-        finally:
-            worker.close()
+        return results
+
+
+def _fuzz_block(item: dict[str, Any], pm: Any) -> list[Result]:
+    """The cases ``item["indices"]`` in whichever process runs them, through a fuzz worker of its own; on the
+    caller's seed files where this process sees them, else on its own (:func:`make_seeds`: the same files)."""
+    with tempfile.TemporaryDirectory(prefix="likeme-fuzz-") as tmp:
+        seeds = item["seeds"]
+        if not all(Path(s["path"]).is_file() for pool in seeds.values() for s in pool):  # another machine
+            seeds = make_seeds(Path(tmp) / "seeds", pm, seed=item["seed"])
+        return _run_cases(item["indices"], tuple(item["targets"]), seeds, item["seed"], timeout=item["timeout"],
+                          memory_mb=item["memory_mb"], tmp=Path(tmp))
+
+
+def _run_cases(indices: list[int], targets: tuple[str, ...], seeds: dict[str, list[dict[str, Any]]], seed: int, *,
+               timeout: float, memory_mb: int, tmp: Path, out: Path | None = None,
+               progress: Any = None) -> list[Result]:
+    """Make and run the cases ``indices`` one after another through one :class:`Worker` (case folders in ``tmp``)."""
+    stream = seeds["bvh"][-1]
+    warm = [["validate", str(CHARACTERS / "max.toml")],
+            ["observe", "--body", str(stream["profile"]), "--repertoire", str(stream["repertoire"]),
+             str(stream["path"])],
+            ["run", "learn_windmill", "--load", str(seeds["state"][0]["path"]), "--duration", "0.2"]]
+    worker = Worker(memory_mb, warm)
+    case_dir = tmp / "case"
+    results: list[Result] = []
+    try:
+        for i in indices:
+            case = make_case(i, targets[i % len(targets)], seeds, seed)
+            shutil.rmtree(case_dir, ignore_errors=True)
+            case_dir.mkdir()
+            (case_dir / case.name).write_bytes(case.data)
+            request = {"cwd": str(case_dir), "input": case.name, "call": case.call,
+                       "argv": None if case.argv is None else [a.replace("{input}", case.name) for a in case.argv]}
+            started = time.monotonic()
+            answer = worker.run(request, timeout)
+            result = Result(case, classify(answer), answer, time.monotonic() - started)
+            results.append(result)
+            if out is not None and result.outcome in BAD:
+                _keep(result, Path(out))
+            if progress is not None:
+                progress(result)
+    finally:
+        worker.close()
     return results
 
 
@@ -665,7 +709,7 @@ def cmd_fuzz(args: Any, pm: Any) -> int:
         task = bar.add_task("fuzz", total=args.n)
         results = run_fuzz(pm, n=args.n, seed=args.seed, targets=targets, timeout=args.timeout,
                            memory_mb=args.memory, out=out_dir, notes=notes,
-                           progress=lambda r: bar.advance(task))
+                           progress=lambda r: bar.advance(task), jobs=args.jobs, scheduler=args.scheduler)
     out = Console()
     table = Table(title=f"likeme bench fuzz --n {args.n} --seed {args.seed}")
     table.add_column("target")

@@ -15,10 +15,65 @@ from typing import Any
 from toolkit import ConfigError
 from toolkit.errors import LikemeError
 
-__all__ = ["LOCAL_PREFIX", "run_items"]
+__all__ = ["LOCAL_PREFIX", "in_process", "run_items", "run_with_pm"]
 
 LOCAL_PREFIX = "local:"
 """``--scheduler local:N`` starts a Dask ``LocalCluster`` of N worker processes for the run."""
+
+
+def in_process(jobs: int = 1, scheduler: str | None = None) -> bool:
+    """Whether :func:`run_items` runs the items in this process (``--jobs 1`` and no ``--scheduler``)."""
+    return not scheduler and jobs == 1
+
+
+def run_with_pm(function: Callable[[Any, Any], Any], items: Sequence[Any], pm: Any, jobs: int = 1,
+                scheduler: str | None = None) -> list[Any]:
+    """``[function(item, pm) for item in items]`` through :func:`run_items`.
+
+    In this process (``jobs`` 1 or a single item, no ``scheduler``) ``function`` gets the caller's plugin manager
+    ``pm`` (plugins registered by hand included); a worker process builds its own, once, from the installed plugins
+    (:func:`toolkit.manager.create_plugin_manager`).
+
+    Parameters
+    ----------
+    function
+        A module-level function (picklable) of one item and a plugin manager.
+    items
+        Plain, picklable data; every per-item seed derives from the item.
+    pm
+        The caller's plugin manager.
+    jobs, scheduler
+        As :func:`run_items`.
+
+    Returns
+    -------
+    list
+        The results in the order of ``items``.
+    """
+    items = list(items)
+    if jobs < 1:
+        raise ConfigError(f"--jobs {jobs}", key=("--jobs",), expected="a number of processes, 1 or more")
+    if in_process(jobs, scheduler) or (not scheduler and len(items) <= 1):  # as run_items: here
+        return [function(item, pm) for item in items]
+    return run_items(_WithPm(function), items, jobs=jobs, scheduler=scheduler)
+
+
+_WORKER_PM: list[Any] = []
+"""The plugin manager of a worker process, built at its first item."""
+
+
+class _WithPm:
+    """``function(item, pm)`` in a worker, ``pm`` the worker's own plugin manager."""
+
+    def __init__(self, function: Callable[[Any, Any], Any]) -> None:
+        self.function = function
+
+    def __call__(self, item: Any) -> Any:
+        if not _WORKER_PM:
+            from toolkit.manager import create_plugin_manager
+
+            _WORKER_PM.append(create_plugin_manager())
+        return self.function(item, _WORKER_PM[0])
 
 
 def run_items(function: Callable[[Any], Any], items: Sequence[Any], jobs: int = 1,

@@ -12,6 +12,11 @@ Two measurements, each printed as a table (``docs/benchmarks.md`` keeps the figu
   ``resource.getrusage(RUSAGE_CHILDREN)``) on generated BVH streams of ``--observe-minutes`` minutes each (the same
   movements, written into a temporary folder), capped at ``--limit`` GB of address space so that a reader that
   needs more fails instead of taking the machine.
+
+The live observer and each ``--observe-minutes`` stream are the items of ``--jobs`` / ``--scheduler``
+(:func:`plugins.bench.jobs.run_with_pm`): each is measured inside the process that runs it, on that process's own
+copy of the data (:func:`process_data`). Run in this process (the default), each table row is printed as it is
+measured; from workers, when they are all back.
 """
 
 from __future__ import annotations
@@ -31,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["random_stream", "live_memory", "observe_memory", "write_stream", "cmd_memory"]
+__all__ = ["random_stream", "live_memory", "observe_memory", "write_stream", "process_data", "cmd_memory"]
 
 NOISE = 0.003
 """Observation noise (m) on the generated streams, as ``make-data`` writes its streams."""
@@ -80,6 +85,19 @@ def _data(pm: Any, folder: Path) -> Path:
     from plugins.bench.data import make_data
 
     return make_data(pm, folder, seed=0, streams=0)
+
+
+_DATA: dict[str, Any] = {}
+"""This process's data folder (:func:`process_data`) and the temporary folder holding it."""
+
+
+def process_data(pm: Any) -> Path:
+    """The repertoire and profile of :func:`_data` in a temporary folder of this process, made at the first call
+    (the same files in every process) and removed when the process exits."""
+    if "data" not in _DATA:
+        _DATA["tmp"] = tempfile.TemporaryDirectory(prefix="likeme-memory-")
+        _DATA["data"] = _data(pm, Path(_DATA["tmp"].name) / "data")
+    return _DATA["data"]
 
 
 def live_memory(pm: Any, data: Path, *, minutes: float, fps: float, every: float, block: int, seed: int = 0,
@@ -188,12 +206,42 @@ def observe_memory(data: Path, path: Path, *, limit: float = 4.0, extra: tuple[s
             "wall_s": round(wall, 1), "status": done.returncode, "error": error, "measured_by": how}
 
 
+def _memory_item(item: dict[str, Any], pm: Any) -> dict[str, Any]:
+    """One item of ``likeme bench memory`` in whichever process runs it: the live observer (its table printed here
+    when ``item["print"]``, else returned as text) or ``likeme observe`` on one generated stream (its row)."""
+    import io
+
+    from toolkit.observe import compose_observer
+    from toolkit.profile import load_profile
+
+    data = process_data(pm)
+    if item["what"] == "observe":
+        folder = Path(_DATA["tmp"].name)
+        path = write_stream(pm, folder / f"stream_{item['minutes']:g}min.bvh", minutes=item["minutes"],
+                            fps=item["fps"], seed=item["seed"])
+        try:
+            return observe_memory(data, path, limit=item["limit"])
+        finally:
+            path.unlink()
+    character = compose_observer(pm, load_profile(data / "profile.toml"), data / "repertoire",
+                                 segmenter=item["segmenter"], matcher=item["matcher"] or "",
+                                 correspondence=item["correspondence"], settings=item["settings"])
+    names = {k: c.name for k, c in character.components().items() if k != "action"}
+    head = (f"live observer: {item['minutes']:g} simulated minutes at {item['fps']:g} fps, {item['block']} frames a "
+            f"packet; " + ", ".join(f"{k} {v}" for k, v in names.items()) + "\n")
+    if item["print"]:
+        print(head, end="", flush=True)
+    out = None if item["print"] else io.StringIO()
+    rows = live_memory(pm, data, minutes=item["minutes"], fps=item["fps"], every=item["every"], block=item["block"],
+                       seed=item["seed"], trace=item["trace"], settings=item["settings"], segmenter=item["segmenter"],
+                       matcher=item["matcher"], correspondence=item["correspondence"], out=out)
+    return {"rows": rows, "names": "" if item["print"] else head, "text": "" if out is None else out.getvalue()}
+
+
 def cmd_memory(args: Any, pm: Any) -> int:
     """``likeme bench memory``."""
     from toolkit.errors import ConfigError
-    from toolkit.observe import compose_observer
     from toolkit.params import parse_settings
-    from toolkit.profile import load_profile
 
     for name in ("minutes", "fps", "every", "limit"):
         value = getattr(args, name)
@@ -204,28 +252,31 @@ def cmd_memory(args: Any, pm: Any) -> int:
     for value in args.observe_minutes or ():
         if not np.isfinite(value) or value <= 0:
             raise ConfigError(f"value {value}", key=("--observe-minutes",), expected="a finite number > 0")
-    with tempfile.TemporaryDirectory(prefix="likeme-memory-") as tmp:
-        data = _data(pm, Path(tmp) / "data")
-        if not args.no_live:
-            character = compose_observer(pm, load_profile(data / "profile.toml"), data / "repertoire",
-                                         segmenter=args.segmenter, matcher=args.matcher or "",
-                                         correspondence=args.correspondence, settings=parse_settings(list(args.set)))
-            names = {k: c.name for k, c in character.components().items() if k != "action"}
-            print(f"live observer: {args.minutes:g} simulated minutes at {args.fps:g} fps, {args.block} frames a "
-                  f"packet; " + ", ".join(f"{k} {v}" for k, v in names.items()))
-            live_memory(pm, data, minutes=args.minutes, fps=args.fps, every=args.every, block=args.block,
-                        seed=args.seed, trace=args.tracemalloc, settings=parse_settings(list(args.set)),
-                        segmenter=args.segmenter, matcher=args.matcher, correspondence=args.correspondence)
-        if args.observe_minutes:
-            print(f"\nlikeme observe (a subprocess; address space capped at {args.limit:g} GB)")
-            # hand-padded as the live table above: a row as each subprocess ends
-            print(f"{'minutes':>8} {'file MB':>8} {'peak RSS MB':>11} {'wall s':>7} {'status':>6}  measured by")
-            for minutes in args.observe_minutes:
-                path = write_stream(pm, Path(tmp) / f"stream_{minutes:g}min.bvh", minutes=minutes, fps=args.fps,
-                                    seed=args.seed)
-                row = observe_memory(data, path, limit=args.limit)
-                print(f"{minutes:8g} {row['size_mb']:8.1f} {row['peak_rss_mb']:11.1f} {row['wall_s']:7.1f} "
-                      f"{row['status']:6d}  {row['measured_by']}" + (f"  ({row['error']})" if row["error"] else ""),
-                      flush=True)
-                path.unlink()
+    from plugins.bench.jobs import in_process, run_with_pm
+
+    here = in_process(args.jobs, args.scheduler)
+    settings = parse_settings(list(args.set))
+    live = {"what": "live", "minutes": args.minutes, "fps": args.fps, "every": args.every, "block": args.block,
+            "seed": args.seed, "trace": args.tracemalloc, "settings": settings, "segmenter": args.segmenter,
+            "matcher": args.matcher, "correspondence": args.correspondence, "print": here}
+    streams = [{"what": "observe", "minutes": m, "fps": args.fps, "seed": args.seed, "limit": args.limit}
+               for m in args.observe_minutes or ()]
+    items = ([] if args.no_live else [live]) + streams
+    # here, one item at a time and each row printed as it is measured; from workers, every item at once
+    batches = [[item] for item in items] if here else [items]
+    for batch in batches:
+        for item, result in zip(batch, run_with_pm(_memory_item, batch, pm, jobs=args.jobs,
+                                                   scheduler=args.scheduler)):
+            if item["what"] == "live":
+                if not here:
+                    print(result["names"] + result["text"], end="", flush=True)
+                continue
+            if item is streams[0]:
+                print(f"\nlikeme observe (a subprocess; address space capped at {args.limit:g} GB)")
+                # hand-padded as the live table above: a row as each subprocess ends
+                print(f"{'minutes':>8} {'file MB':>8} {'peak RSS MB':>11} {'wall s':>7} {'status':>6}  measured by")
+            row = result
+            print(f"{item['minutes']:8g} {row['size_mb']:8.1f} {row['peak_rss_mb']:11.1f} {row['wall_s']:7.1f} "
+                  f"{row['status']:6d}  {row['measured_by']}" + (f"  ({row['error']})" if row["error"] else ""),
+                  flush=True)
     return 0

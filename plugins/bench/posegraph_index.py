@@ -127,6 +127,11 @@ def run(n: int, *, parts: int | None, k: int, queries: int, noise: float, seed: 
             "agree": f"{agree}/{queries}" if scan else "not checked"}
 
 
+def _item(item: dict[str, Any], pm: Any) -> dict[str, Any]:
+    """:func:`run` of one ``--nodes`` from its keyword arguments, in whichever process runs it."""
+    return run(pm=pm, **item)
+
+
 HEADER = ("nodes", "parts", "k", "build (s)", "index median (ms)", "index p95 (ms)", "scan median (ms)",
           "scan p95 (ms)", "poses (MB)", "tree (MB)", "same answers")
 
@@ -141,12 +146,17 @@ def cmd_posegraph(args: Any, pm: Any) -> int:
     """``likeme bench posegraph``: print one table row per ``--nodes``."""
     print("| " + " | ".join(HEADER) + " |")
     print("|" + "---|" * len(HEADER))
+    from plugins.bench.jobs import in_process, run_with_pm
+
+    items = [{"n": n, "parts": args.parts, "k": args.k, "queries": args.queries, "noise": args.noise,
+              "seed": args.seed, "scan": not args.no_scan} for n in args.nodes or [100_000]]
+    # one --nodes a row, each measured in the process that runs it (--jobs, --scheduler); here, printed as it ends
+    batches = [[item] for item in items] if in_process(args.jobs, args.scheduler) else [items]
     rows = []
-    for n in args.nodes or [100_000]:
-        r = run(n, parts=args.parts, k=args.k, queries=args.queries, noise=args.noise, seed=args.seed, pm=pm,
-                scan=not args.no_scan)
-        rows.append(r)
-        print("| " + " | ".join(_row(r)) + " |", flush=True)
+    for batch in batches:
+        for r in run_with_pm(_item, batch, pm, jobs=args.jobs, scheduler=args.scheduler):
+            rows.append(r)
+            print("| " + " | ".join(_row(r)) + " |", flush=True)
     if args.json:
         import json
         from pathlib import Path

@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import json
 import re
-import tempfile
 import time
 from pathlib import Path
 from typing import Any, Sequence
@@ -200,12 +199,24 @@ def _table(title: str, rows: list[list[Any]], columns: list[str], slope: float, 
             + f"\n  log-log slope of {what}: {slope:.2f} (1.0 = linear)\n")
 
 
+def _axis_item(item: dict[str, Any], pm: Any) -> tuple[list[dict], str]:
+    """One size of one axis (``item["axis"]``: ``stream`` minutes or ``repertoire`` movements) in whichever process
+    runs it, on the data folder of that process (:func:`plugins.bench.memory.process_data`, the same files
+    everywhere)."""
+    from plugins.bench.memory import process_data
+    from toolkit.profile import load_profile
+
+    data, options = process_data(pm), {k: item[k] for k in ("fps", "seed", "segmenter", "matcher", "settings")}
+    if item["axis"] == "stream":
+        return stream_axis(pm, data, [item["size"]], **options)
+    return repertoire_axis(pm, load_profile(data / "profile.toml"), [item["size"]], **options)
+
+
 def cmd_scaling(args: Any, pm: Any) -> int:
     """``likeme bench scaling``."""
-    from plugins.bench.memory import _data
+    from plugins.bench.jobs import run_with_pm
     from toolkit.errors import ConfigError
     from toolkit.params import parse_settings
-    from toolkit.profile import load_profile
 
     sizes = QUICK if args.quick else SIZES
     minutes = args.minutes or sizes["minutes"]
@@ -221,20 +232,21 @@ def cmd_scaling(args: Any, pm: Any) -> int:
     settings = parse_settings(list(args.settings))
     out: dict[str, Any] = {"fps": args.fps, "quick": bool(args.quick), "settings": list(args.settings)}
     given = "".join(f"; --set {text}" for text in args.settings)
-    with tempfile.TemporaryDirectory(prefix="likeme-scaling-") as tmp:
-        data = _data(pm, Path(tmp) / "data")
-        stream, names = stream_axis(pm, data, minutes, fps=args.fps, seed=args.seed, segmenter=args.segmenter,
-                                    matcher=args.matcher, settings=settings)
-        slope = loglog_slope([r["frames"] for r in stream], [r["seconds"] for r in stream])
-        out["stream"] = {"observer": names, "rows": stream, "slope": slope}
-        print(_table(f"stream length ({names}{given}; {args.fps:g} fps)",
-                     [[f"{r['minutes']:g}", r["frames"], r["segments"], f"{r['seconds']:.2f}",
-                       f"{r['s_per_minute']:.3f}", f"{r['frames_per_s']:,.0f}"] for r in stream],
-                     ["minutes", "frames", "segments", "observe s", "s per minute", "frames/s"], slope,
-                     "observe seconds against frames"), flush=True)
-        profile = load_profile(data / "profile.toml")
-        rep, names = repertoire_axis(pm, profile, movements, fps=args.fps, seed=args.seed, segmenter=args.segmenter,
-                                     matcher=args.matcher, settings=settings)
+    # one item per stream length and per repertoire size, each measured in the process that runs it
+    common = {"fps": args.fps, "seed": args.seed, "segmenter": args.segmenter, "matcher": args.matcher,
+              "settings": settings}
+    items = [{"axis": "stream", "size": m, **common} for m in minutes]
+    items += [{"axis": "repertoire", "size": n, **common} for n in movements]
+    done = run_with_pm(_axis_item, items, pm, jobs=args.jobs, scheduler=args.scheduler)
+    stream, names = [r for d in done[:len(minutes)] for r in d[0]], done[0][1]
+    slope = loglog_slope([r["frames"] for r in stream], [r["seconds"] for r in stream])
+    out["stream"] = {"observer": names, "rows": stream, "slope": slope}
+    print(_table(f"stream length ({names}{given}; {args.fps:g} fps)",
+                 [[f"{r['minutes']:g}", r["frames"], r["segments"], f"{r['seconds']:.2f}",
+                   f"{r['s_per_minute']:.3f}", f"{r['frames_per_s']:,.0f}"] for r in stream],
+                 ["minutes", "frames", "segments", "observe s", "s per minute", "frames/s"], slope,
+                 "observe seconds against frames"), flush=True)
+    rep, names = [r for d in done[len(minutes):] for r in d[0]], done[len(minutes)][1]
     build_slope = loglog_slope([r["clip_frames"] for r in rep], [r["build_s"] for r in rep])
     query_slope = loglog_slope([r["movements"] for r in rep], [r["query_ms"] for r in rep])
     out["repertoire"] = {"observer": names, "rows": rep, "build_slope": build_slope, "query_slope": query_slope}

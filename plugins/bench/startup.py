@@ -4,6 +4,10 @@ Each command (``likeme --version``, ``likeme --help``, ``likeme plugins``) is ru
 process, the commands taking turns so that a change in the machine's load falls on all of them alike; the wall time
 of each run is measured from here (process start to exit) and the median printed with the fastest and slowest. The
 machine's load average is printed too: on a shared machine it is the first thing the figures depend on.
+
+Each timed round (every command once) is an item of ``--jobs`` / ``--scheduler`` (:func:`plugins.bench.jobs.
+run_items`), timed in the worker that runs it; parallel rounds share the machine's cores, so the default is one
+round after another here.
 """
 
 from __future__ import annotations
@@ -30,29 +34,39 @@ def likeme_command() -> list[str]:
     return [str(script)] if script.is_file() else [sys.executable, "-m", "toolkit.cli"]
 
 
-def time_commands(runs: int, command: list[str] | None = None) -> list[dict[str, Any]]:
+def time_commands(runs: int, command: list[str] | None = None, *, jobs: int = 1,
+                  scheduler: str | None = None) -> list[dict[str, Any]]:
     """Wall times (s) of every command of :data:`COMMANDS`, ``runs`` each, in turns after one untimed warm-up round
-    (which fills the file cache and Python's bytecode cache)."""
+    here (which fills the file cache and Python's bytecode cache); each timed round is an item of
+    :func:`plugins.bench.jobs.run_items` (``jobs`` local processes or the Dask ``scheduler``)."""
+    from plugins.bench.jobs import run_items
+
     command = command or likeme_command()
-    times: dict[tuple[str, ...], list[float]] = {argv: [] for argv in COMMANDS}
-    for round_ in range(runs + 1):
-        for argv in COMMANDS:
-            start = time.perf_counter()
-            result = subprocess.run([*command, *argv], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-            elapsed = time.perf_counter() - start
-            if result.returncode != 0:
-                raise LikemeError(f"'likeme {' '.join(argv)}' exited with status {result.returncode}: "
-                                  f"{result.stderr.strip()[-300:]}")
-            if round_:
-                times[argv].append(elapsed)
+    _round(command)
+    rounds = run_items(_round, [command] * runs, jobs=jobs, scheduler=scheduler)
+    times = {argv: [r[i] for r in rounds] for i, argv in enumerate(COMMANDS)}
     return [{"command": "likeme " + " ".join(argv), "runs": runs, "median_s": statistics.median(t),
              "min_s": min(t), "max_s": max(t)} for argv, t in times.items()]
+
+
+def _round(command: list[str]) -> list[float]:
+    """The wall time (s) of each command of :data:`COMMANDS` run once with ``command``, in turn."""
+    times = []
+    for argv in COMMANDS:
+        start = time.perf_counter()
+        result = subprocess.run([*command, *argv], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        elapsed = time.perf_counter() - start
+        if result.returncode != 0:
+            raise LikemeError(f"'likeme {' '.join(argv)}' exited with status {result.returncode}: "
+                              f"{result.stderr.strip()[-300:]}")
+        times.append(elapsed)
+    return times
 
 
 def cmd_startup(args: argparse.Namespace, pm: Any) -> int:
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     command = likeme_command()
-    rows = time_commands(args.runs, command)
+    rows = time_commands(args.runs, command, jobs=args.jobs, scheduler=args.scheduler)
     load_after = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(f"{' '.join(command)}: {args.runs} runs each; {os.cpu_count()} cores, load average {load:.2f} before, "
           f"{load_after:.2f} after")
