@@ -26,7 +26,7 @@ from plugins.perception.sensory_buffer import SensoryBuffer
 from toolkit import ConfigError, Parameter, Percept, Perception, hookimpl
 from toolkit.motion import facing_vector
 
-__all__ = ["SyntheticVision", "line_of_sight_blocked"]
+__all__ = ["SyntheticVision", "appearance", "line_of_sight_blocked"]
 
 
 def line_of_sight_blocked(eye: np.ndarray, targets: np.ndarray, target_radii: np.ndarray,
@@ -170,7 +170,27 @@ class SyntheticVision(Perception):
         positions, seen = self._buffer.update(positions, seen)
         # one frame (P, 3): the facing's running median takes this frame's estimate
         pose, mask, root, heading = root_relative(positions, seen, target.body, lambda h: self._facing.update(float(h)))
-        return Percept(world.time, pose, mask, np.where(seen[:, None], positions, np.nan), root, float(heading), objects)
+        kinds, sizes = appearance(world, objects)
+        return Percept(world.time, pose, mask, np.where(seen[:, None], positions, np.nan), root, float(heading), objects,
+                       kinds, sizes)
+
+    def in_view(self, observer: Any, target: Any, world: Any, points: np.ndarray) -> np.ndarray:
+        """Whether an object at each of ``points`` (n, 3) would be seen now: in the field of view and range, and
+        (with ``occlusion``) not behind the target's body, as :meth:`look` decides for the objects it sees."""
+        points = np.asarray(points, dtype=float).reshape(-1, 3)
+        eye = observer.world_pose()[observer.body.index(self.params["eye"])]
+        seen = self._in_view(eye, observer.heading, points)
+        if self.params["occlusion"] and seen.any():
+            parts = self._places(target.body, target.world_pose())
+            seen &= ~line_of_sight_blocked(eye, points, np.zeros(len(points)), parts, self._radii(target.body))
+        return seen
+
+
+def appearance(world: Any, seen: dict[str, np.ndarray]) -> tuple[dict[str, str], dict[str, float]]:
+    """What each seen object looks like: its kind (colour-coded vision tells a cheese from a ball, B&B §4.2) and
+    its apparent radius."""
+    objects = world.objects
+    return ({n: objects[n].kind for n in seen if n in objects}, {n: float(objects[n].radius) for n in seen if n in objects})
 
 
 @hookimpl

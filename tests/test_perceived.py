@@ -1,0 +1,103 @@
+"""Max concludes from what he perceived, never from the world (issue 19; Buchsbaum & Blumberg 2005, §6.1, §7.3.1).
+
+The lying world: while Max's action system interprets and answers what he saw, the world's object table,
+``objects_at`` and Morris's true pose lie (or raise). His conclusions must be exactly those of an honest run.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from plugins.action.hierarchical import Hierarchical
+from tests.conftest import CHARACTERS
+from toolkit import create_plugin_manager, load_scenario
+from toolkit.sightings import Sightings
+
+SCENARIOS = sorted(p.stem for p in (CHARACTERS / "scenarios").glob("*.toml") if "[[objects]]" in p.read_text())
+
+
+def run(name):
+    pm = create_plugin_manager(autoload=False)
+    world = load_scenario(CHARACTERS / "scenarios" / f"{name}.toml", pm).run()
+    return world, world.behaviours("max")
+
+
+class GroundTruth(AssertionError):
+    """Raised when the action system reads the world's ground truth about another actor."""
+
+
+class LyingObjects(dict):
+    """An object table that refuses to be read."""
+
+    def _refuse(self, *args, **kwargs):
+        raise GroundTruth("read the world's objects")
+
+    __getitem__ = __iter__ = __len__ = __contains__ = get = items = keys = values = _refuse
+
+
+def lying(method):
+    """``method`` of the action system, called while the world lies about its objects and the target's pose."""
+
+    def wrapped(self, actor, target, *args):
+        world = actor.world
+        objects, position, heading = world.objects, target.position.copy(), target.heading
+        world.objects = LyingObjects()
+        world.objects_at = lambda frame: (_ for _ in ()).throw(GroundTruth("read objects_at"))
+        target.world_pose = lambda: (_ for _ in ()).throw(GroundTruth("read the target's true pose"))
+        target.local_pose = lambda: (_ for _ in ()).throw(GroundTruth("read the target's true pose"))
+        target.position, target.heading = position + np.array([5.0, 3.0, -7.0]), heading + 2.0  # a lie, if read
+        try:
+            wrapped.calls += 1
+            return method(self, actor, target, *args)
+        finally:
+            world.objects, target.position, target.heading = objects, position, heading
+            del world.objects_at, target.world_pose, target.local_pose
+
+    wrapped.calls = 0
+    return wrapped
+
+
+@pytest.mark.parametrize("name", SCENARIOS)
+def test_max_concludes_the_same_when_the_world_lies(monkeypatch, name):
+    _, honest = run(name)
+    interpret, respond = lying(Hierarchical.interpret), lying(Hierarchical.respond)
+    monkeypatch.setattr(Hierarchical, "interpret", interpret)
+    monkeypatch.setattr(Hierarchical, "respond", respond)
+    _, lied_to = run(name)
+    assert interpret.calls > 0 and respond.calls > 0  # the lie was told
+    assert lied_to == honest
+    assert honest  # there was something to conclude
+
+
+def test_the_lying_world_would_catch_a_reader(monkeypatch):
+    """The check itself: an interpret that reads the world's objects fails under the lie."""
+
+    def peeking(self, actor, target, segment, match, world):
+        return None if "cheese" in world.objects else None
+
+    monkeypatch.setattr(Hierarchical, "interpret", lying(peeking))
+    with pytest.raises(Exception, match="read the world's objects"):
+        run("hungry_morris")
+
+
+def test_sightings_remember_last_seen_positions_and_forget_gone_objects():
+    s = Sightings(fps=10.0, keep=1.0)
+    s.record(0, 0.0, {"cheese": [0, 0.4, 1]}, {"cheese": "cheese"}, {"cheese": 0.04})
+    s.record(1, 0.0, {})  # hidden: still where it was last seen
+    assert set(s.at(1)) == {"cheese"} and s.at(1)["cheese"].row == 0 and s.at(1)["cheese"].kind == "cheese"
+    assert s.at(-1) == {}  # never seen before row 0: it does not exist
+    s.record(2, 0.0, {}, missed=["cheese"])  # not there where it should have been seen: gone
+    assert s.at(2) == {} and set(s.at(1)) == {"cheese"}
+    s.record(3, 0.0, {"cheese": [0, 0.3, 1]})  # seen again
+    assert np.allclose(s.at(3)["cheese"].position, [0, 0.3, 1])
+
+
+def test_sightings_are_bounded_and_keep_each_objects_last_sighting():
+    s = Sightings(fps=10.0, keep=1.0)
+    s.record(0, 0.0, {"ball": [1, 0, 1]})
+    for row in range(1, 500):
+        s.record(row, 0.1, {"cheese": [0, 0.4, 1]})
+    assert s.size <= 2 * 10 + 2  # about keep seconds of rows, not 500
+    assert np.allclose(s.at(499)["ball"].position, [1, 0, 1])  # seen long ago: still where it was last seen
+    assert s.heading(499) == pytest.approx(0.1)
