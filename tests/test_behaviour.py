@@ -105,10 +105,28 @@ def test_failure_different_preferences_give_the_wrong_object():
     assert reach.known and reach.object == "small_cheese"
 
 
-def test_failure_unknown_object_and_perceptual_failure_shrug():
-    """§7.3.1: none of the behaviours Max uses reach for is possible: he cannot identify it."""
+def test_failure_unknown_object_shrug():
+    """§7.3.1 (and §6.3): Max knows nothing of ice cream, so none of the behaviours he reaches for is possible."""
     _, behaviours = run("ice_cream")
     assert not behaviours[0].known and behaviours[0].details["tried"] == ["play > get > reach", "satisfy_hunger > get > reach"]
+
+
+def test_failure_perceptual_failure_shrug(write):
+    """§7.3.1: "through perceptual failure": a box hides the cheese from Max, so for him no food was there when
+    Morris reached: he shrugs. When the cheese is in Morris's hand Max sees it and identifies the eating."""
+    world, (reach, eat) = run("perceptual_failure")
+    assert [(r.movement, r.object) for _, r in world.actors["morris"].performed] == [("reach", "cheese"), ("eat", "cheese")]
+    assert not reach.known and reach.movement == "reach"
+    assert reach.details["tried"] == ["play > get > reach", "satisfy_hunger > get > reach"]
+    assert reach.details["objects_seen"] == ["box"]  # the cheese was never seen
+    assert world.actors["max"].performed[0][1].movement == "shrug"
+    assert eat.known and eat.path == ("satisfy_hunger", "eat") and eat.object == "cheese"
+    # without the box the same reach is understood: the failure is Max's perception, nothing else
+    text = (CHARACTERS / "scenarios" / "perceptual_failure.toml").read_text()
+    scene = write("no_box.toml", text[: text.index('[[objects]]\nname = "box"')].replace('"../', f'"{CHARACTERS}/'))
+    world = load_scenario(scene, create_plugin_manager(autoload=False)).run()
+    reach = world.behaviours("max")[0]
+    assert reach.known and reach.path == ("satisfy_hunger", "get", "reach") and reach.object == "cheese"
 
 
 def test_action_hierarchy_renders_as_a_tree(pm):
