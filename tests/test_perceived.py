@@ -12,6 +12,7 @@ import pytest
 from plugins.action.hierarchical import Hierarchical
 from tests.conftest import CHARACTERS
 from toolkit import create_plugin_manager, load_scenario
+from toolkit import Motion
 from toolkit.sightings import Sightings
 
 SCENARIOS = sorted(p.stem for p in (CHARACTERS / "scenarios").glob("*.toml") if "[[objects]]" in p.read_text())
@@ -101,3 +102,49 @@ def test_sightings_are_bounded_and_keep_each_objects_last_sighting():
     assert s.size <= 2 * 10 + 2  # about keep seconds of rows, not 500
     assert np.allclose(s.at(499)["ball"].position, [1, 0, 1])  # seen long ago: still where it was last seen
     assert s.heading(499) == pytest.approx(0.1)
+
+
+# -- Fig. 13: ranked candidates -------------------------------------------------------------------------------------
+
+
+def test_path_search_ranks_the_runner_up_as_the_best_path_without_the_winner(write, pm):
+    """The second candidate is what path search answers when the first movement is not in the graph at all."""
+    from tests.test_path_search import STICK, observed
+    from toolkit import load_character
+
+    stick = load_character(write("stick.toml", STICK + "candidates = 1\nmax_distance = 0.2\n"), pm)
+    up, front = observed(stick, "raise"), observed(stick, "reach")  # the hand goes up and forward, more up
+    seen = Motion(0.55 * up.positions + 0.45 * front.positions, up.fps, up.parts, up.visible)
+    match = stick.matcher.match(seen)
+    (first, d1), (second, d2) = match.candidates
+    assert first == match.movement == "raise" and d1 == pytest.approx(match.details["mean_distance"])
+    assert second == "reach" and d2 > d1
+    without = STICK.replace('[motor.movements.raise]\nkeys = [{ pose = "stand", at = 0.0 }, { pose = "up", at = 0.5 }, '
+                            '{ pose = "stand", at = 1.0 }]\n', "")
+    assert without != STICK
+    alone = load_character(write("reach_only.toml", without + "max_distance = 0.2\n"), pm).matcher.match(seen.onto(stick.body.parts))
+    assert alone.movement == "reach" and d2 == pytest.approx(alone.details["mean_distance"])
+    plain = load_character(write("plain.toml", STICK + "max_distance = 0.2\n"), pm).matcher.match(seen)
+    assert plain.movement == "raise" and plain.candidates == ()  # by default the best only
+
+
+def test_dtw_ranks_every_movement_by_its_nearest_example(write, pm):
+    from tests.test_path_search import STICK, observed
+    from toolkit import load_character
+
+    stick = load_character(write("stick.toml", STICK.replace('plugin = "path-search"', 'plugin = "dtw"')), pm)
+    match = stick.matcher.match(observed(stick, "reach", offset=(0.0, 0.02, 0.0)))
+    names = [m for m, _ in match.candidates]
+    distances = [d for _, d in match.candidates]
+    assert names[0] == match.movement == "reach" and sorted(names) == ["raise", "reach"]
+    assert distances == sorted(distances) and distances[0] == pytest.approx(match.details["distance"])
+
+
+def test_close_candidates_are_those_within_the_margin_of_the_best():
+    from plugins.action.behaviour_identification import MARGIN, close_candidates
+    from toolkit import Match
+
+    match = Match("reach", 0.5, candidates=(("reach", 0.010), ("jump", 0.010 * (1 + MARGIN) - 1e-6), ("point", 0.02)))
+    assert close_candidates(match) == ["reach", "jump"]
+    assert close_candidates(Match("reach", 0.5)) == ["reach"]  # no ranking: the movement alone
+    assert close_candidates(match, margin=0.0) == ["reach"]
