@@ -148,3 +148,26 @@ def test_close_candidates_are_those_within_the_margin_of_the_best():
     assert close_candidates(match) == ["reach", "jump"]
     assert close_candidates(Match("reach", 0.5)) == ["reach"]  # no ranking: the movement alone
     assert close_candidates(match, margin=0.0) == ["reach"]
+
+
+# -- what Max perceived ---------------------------------------------------------------------------------------------
+
+
+def test_max_perceives_morris_the_cheese_where_it_lay_and_then_in_his_hand():
+    """§6.1.1 from perception: at the reach's start the cheese lies where Max saw it and nobody holds it; at the
+    eat's start Max saw it in Morris's hand (it came there and moves with the hand); once eaten it is gone."""
+    from plugins.action.behaviour_identification import perceived_objects, perceived_target
+
+    world, _ = run("hungry_morris")
+    max_, morris = world.actors["max"], world.actors["morris"]
+    reach, eat = (e.data["segment"] for e in world.events_of("segment_found", "max"))
+    before = perceived_objects(max_, morris, reach.start, reach.end - 1)
+    assert set(before) == {"cheese"} and before["cheese"].held_by is None and before["cheese"].kind == "cheese"
+    assert np.allclose(before["cheese"].position, [0.08, 0.40, 1.26])  # where it lay (no noise in Max's vision)
+    during = perceived_objects(max_, morris, eat.start, eat.end - 1)
+    assert during["cheese"].held_by == "morris"
+    assert "cheese" not in max_.sightings.at(max_.memory.n - 1)  # eaten: not where Max should see it
+    him = perceived_target(max_, morris, reach.start)
+    root = him.world_pose()[him.body.root_index]
+    assert np.allclose(root, [0.0, 0.30, 1.6], atol=0.02) and him.id == "morris"
+    assert abs(np.cos(him.heading - np.pi)) > 0.99  # he faces Max (180 degrees)
