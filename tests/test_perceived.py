@@ -37,8 +37,25 @@ class LyingObjects(dict):
     __getitem__ = __iter__ = __len__ = __contains__ = get = items = keys = values = _refuse
 
 
+class Refusing:
+    """Anything read of it is a :class:`GroundTruth` error."""
+
+    def __init__(self, what):
+        object.__setattr__(self, "_what", what)
+
+    def __getattr__(self, name):
+        raise GroundTruth(f"read {self._what}: .{name}")
+
+    def __iter__(self):
+        raise GroundTruth(f"read {self._what}")
+
+    def __bool__(self):
+        raise GroundTruth(f"read {self._what}")
+
+
 def lying(method):
-    """``method`` of the action system, called while the world lies about its objects and the target's pose."""
+    """``method`` of the action system, called while the world lies about its objects and the target's pose, and
+    refuses to say what the target is, does or did."""
 
     def wrapped(self, actor, target, *args):
         world = actor.world
@@ -48,11 +65,15 @@ def lying(method):
         target.world_pose = lambda: (_ for _ in ()).throw(GroundTruth("read the target's true pose"))
         target.local_pose = lambda: (_ for _ in ()).throw(GroundTruth("read the target's true pose"))
         target.position, target.heading = position + np.array([5.0, 3.0, -7.0]), heading + 2.0  # a lie, if read
+        character, performing, performed = target.character, target.performing, target.performed
+        target.character = Refusing("the target's own character (his drives, his choices, his body)")
+        target.performing, target.performed = Refusing("what the target is doing"), Refusing("what the target did")
         try:
             wrapped.calls += 1
             return method(self, actor, target, *args)
         finally:
             world.objects, target.position, target.heading = objects, position, heading
+            target.character, target.performing, target.performed = character, performing, performed
             del world.objects_at, target.world_pose, target.local_pose
 
     wrapped.calls = 0
