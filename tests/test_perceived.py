@@ -192,3 +192,11 @@ def test_max_perceives_morris_the_cheese_where_it_lay_and_then_in_his_hand():
     root = him.world_pose()[him.body.root_index]
     assert np.allclose(root, [0.0, 0.30, 1.6], atol=0.02) and him.id == "morris"
     assert abs(np.cos(him.heading - np.pi)) > 0.99  # he faces Max (180 degrees)
+
+
+def test_sightings_may_begin_at_a_later_row():
+    s = Sightings(fps=10.0, start=50)
+    s.record(50, 1.0, {"ball": [1, 0, 1]})
+    assert set(s.at(50)) == {"ball"} and s.at(49) == {} and s.heading(50) == 1.0
+    with pytest.raises(ValueError, match="in order"):
+        s.record(52, 1.0, {})

@@ -298,10 +298,8 @@ class Actor:
         """Record the objects of ``percept`` on the row working memory is about to get; a remembered object not seen
         where the eye should have seen it is gone (:meth:`Perception.in_view`)."""
         sightings, row = self._sightings, self.loop.memory.n
-        if sightings is None or row != sightings.n:  # a new stream (watch) or rows pushed by someone else
-            sightings = self._sightings = Sightings(self.world.fps, keep=self.world.history_seconds)
-            for _ in range(row):  # rows before: nothing recorded of them
-                sightings.record(sightings.n, float("nan"), {})
+        if sightings is None or row != sightings.n:  # rows pushed by someone else: nothing is known of them
+            sightings = self._sightings = Sightings(self.world.fps, keep=self.world.history_seconds, start=row)
         seen = percept.objects if isinstance(percept.objects, Mapping) else {}
         believed = sightings.remembered() if row else {}
         unseen = [name for name in believed if name not in seen]
@@ -311,7 +309,9 @@ class Actor:
                                np.array([believed[name] for name in unseen]))
             if where is not None:
                 missed = [name for name, gone in zip(unseen, np.asarray(where, dtype=bool).reshape(-1)) if gone]
-        sightings.record(row, float(percept.heading), seen, percept.kinds if isinstance(percept.kinds, Mapping) else {},
+        heading = percept.heading
+        heading = float(heading) if isinstance(heading, (int, float, np.number)) else float("nan")
+        sightings.record(row, heading, seen, percept.kinds if isinstance(percept.kinds, Mapping) else {},
                          percept.sizes if isinstance(percept.sizes, Mapping) else {}, missed)
         sightings.forget(self.loop.memory.offset)
 

@@ -85,13 +85,16 @@ class Sightings:
         Frame rate of the rows.
     keep : float
         Seconds of rows kept (older sightings are dropped, except each object's last).
+    start : int
+        The row of the first record (rows before it were perceived before this record began: nothing is known of
+        them).
     """
 
-    def __init__(self, fps: float, keep: float = 120.0) -> None:
+    def __init__(self, fps: float, keep: float = 120.0, start: int = 0) -> None:
         self.fps = float(fps)
         self.keep = max(1, int(round(keep * fps)))
-        self.n = 0
-        self.offset = 0  # the first row whose headings are held
+        self.n = int(start)
+        self.offset = int(start)  # the first row whose headings are held
         self._heading = np.full(1024, np.nan)
         self._objects: dict[str, _Track] = {}
 
