@@ -121,8 +121,7 @@ def close_candidates(match: Any, margin: float = MARGIN) -> list[str]:
         return [match.movement]
     best = ranked[0][1]
     close = [m for m, d in ranked if np.isfinite(d) and d <= best * (1.0 + margin) + 1e-12]
-    out = list(dict.fromkeys([match.movement, *close]))
-    return out
+    return list(dict.fromkeys([match.movement, *close]))
 
 
 def _row(memory: Any, row: int) -> int:
