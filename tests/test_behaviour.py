@@ -72,6 +72,38 @@ def test_reach_or_jump_is_decided_by_where_the_food_is():
     assert jump.goal == ("holding the cheese",)
 
 
+def _variant(write, name, *replacements):
+    """Scenario ``name`` with text replaced, written beside the test (character paths made absolute)."""
+    text = (CHARACTERS / "scenarios" / f"{name}.toml").read_text().replace('"../', f'"{CHARACTERS}/')
+    for old, new in replacements:
+        assert old in text
+        text = text.replace(old, new)
+    world = load_scenario(write(f"{name}_variant.toml", text), create_plugin_manager(autoload=False)).run()
+    return world, world.behaviours("max")
+
+
+def test_fig13_ambiguous_motion_the_height_of_the_food_decides(write):
+    """Fig. 13: Morris leaps with his arm out, which looks like a reach (root-relative, §5.1): the matcher ranks
+    reach first and jump within the margin, and the can-I triggers choose: the cheese is high, so it is a jump."""
+    from plugins.action.behaviour_identification import MARGIN
+
+    world, (jump, _) = run("reach_or_jump")
+    assert [r.movement for _, r in world.actors["morris"].performed] == ["jump", "eat"]
+    match = world.events_of("movement_recognised", "max")[0].data["match"]
+    (first, d1), (second, d2) = match.candidates[:2]
+    assert match.movement == first == "reach" and second == "jump" and d2 <= (1 + MARGIN) * d1  # the motion: a reach
+    assert jump.known and jump.movement == "jump" and jump.path == ("satisfy_hunger", "get", "jump")
+    assert jump.object == "cheese" and jump.details["candidates"] == ["reach", "jump"]
+    assert "satisfy_hunger > get > reach" in jump.details["tried"]  # tried first, impossible: the cheese is high
+    # the same leap for cheese within reach: a reach
+    world, (reach, _) = _variant(write, "reach_or_jump", ("position = [0.05, 0.88, 1.3]", "position = [0.05, 0.40, 1.3]"))
+    assert [r.movement for _, r in world.actors["morris"].performed][0] == "reach"
+    assert reach.known and reach.path == ("satisfy_hunger", "get", "reach")
+    # the paper's single answer (no candidates): reach, which the high cheese makes impossible: Max cannot tell
+    _, (single, _) = _variant(write, "reach_or_jump", ("candidates = 2", "candidates = 0"))
+    assert not single.known and single.movement == "reach"
+
+
 def test_several_pieces_of_cheese_the_closest():
     """§6.1.2: without line of sight Max picks the one he would attend to: the closest."""
     _, (reach, _) = run("several_cheeses")
@@ -105,10 +137,28 @@ def test_failure_different_preferences_give_the_wrong_object():
     assert reach.known and reach.object == "small_cheese"
 
 
-def test_failure_unknown_object_and_perceptual_failure_shrug():
-    """§7.3.1: none of the behaviours Max uses reach for is possible: he cannot identify it."""
+def test_failure_unknown_object_shrug():
+    """§7.3.1 (and §6.3): Max knows nothing of ice cream, so none of the behaviours he reaches for is possible."""
     _, behaviours = run("ice_cream")
     assert not behaviours[0].known and behaviours[0].details["tried"] == ["play > get > reach", "satisfy_hunger > get > reach"]
+
+
+def test_failure_perceptual_failure_shrug(write):
+    """§7.3.1: "through perceptual failure": a box hides the cheese from Max, so for him no food was there when
+    Morris reached: he shrugs. When the cheese is in Morris's hand Max sees it and identifies the eating."""
+    world, (reach, eat) = run("perceptual_failure")
+    assert [(r.movement, r.object) for _, r in world.actors["morris"].performed] == [("reach", "cheese"), ("eat", "cheese")]
+    assert not reach.known and reach.movement == "reach"
+    assert reach.details["tried"] == ["play > get > reach", "satisfy_hunger > get > reach"]
+    assert reach.details["objects_seen"] == ["box"]  # the cheese was never seen
+    assert world.actors["max"].performed[0][1].movement == "shrug"
+    assert eat.known and eat.path == ("satisfy_hunger", "eat") and eat.object == "cheese"
+    # without the box the same reach is understood: the failure is Max's perception, nothing else
+    text = (CHARACTERS / "scenarios" / "perceptual_failure.toml").read_text()
+    scene = write("no_box.toml", text[: text.index('[[objects]]\nname = "box"')].replace('"../', f'"{CHARACTERS}/'))
+    world = load_scenario(scene, create_plugin_manager(autoload=False)).run()
+    reach = world.behaviours("max")[0]
+    assert reach.known and reach.path == ("satisfy_hunger", "get", "reach") and reach.object == "cheese"
 
 
 def test_action_hierarchy_renders_as_a_tree(pm):

@@ -98,6 +98,11 @@ class Percept:
         The target's perceived heading in radians (NaN if it could not be found).
     objects : mapping of str to array (3,)
         World positions of the objects the observer can see.
+    kinds : mapping of str to str
+        What each seen object looks like: its kind, as colour-coded vision tells it (B&B §4.2); an object
+        seen without one is of an unknown kind.
+    sizes : mapping of str to float
+        The apparent radius (m) of each seen object.
     """
 
     time: float
@@ -107,6 +112,8 @@ class Percept:
     root: np.ndarray
     heading: float
     objects: Mapping[str, np.ndarray] = field(default_factory=dict)
+    kinds: Mapping[str, str] = field(default_factory=dict)
+    sizes: Mapping[str, float] = field(default_factory=dict)
 
     def __repr__(self) -> str:
         seen = int(np.count_nonzero(self.visible))
@@ -163,7 +170,11 @@ class Match:
     path : tuple
         The matched path through the observer's motor graph, if the matcher has one.
     details : mapping
-        Anything else the matcher wants to report (distances, candidates).
+        Anything else the matcher wants to report (distances).
+    candidates : tuple of (str, float)
+        Ranked candidates, best first (B&B Fig. 13): each movement the matcher found near the segment with its
+        distance (lower is closer; the matcher's own measure, so only ratios between candidates of one match mean
+        anything). Empty when the matcher ranks nothing; when given, the first is ``movement``.
     """
 
     movement: str | None
@@ -171,6 +182,7 @@ class Match:
     decided_at: int | None = None
     path: tuple = ()
     details: Mapping[str, Any] = field(default_factory=dict)
+    candidates: tuple[tuple[str, float], ...] = ()
 
     @property
     def known(self) -> bool:
@@ -348,6 +360,12 @@ class Perception(Component):
         occluders) do not implement it.
         """
         raise NotImplementedError(f"perception {self.name!r} needs a world; it cannot watch recorded poses")
+
+    def in_view(self, observer: Actor, target: Actor, world: World, points: np.ndarray) -> np.ndarray | None:
+        """Whether an object at each of ``points`` (n, 3) would be seen now (in view, not hidden): where an object
+        remembered but not seen any more should have been seen, it is gone. ``None``: this perception cannot tell
+        (remembered objects are then kept where they were last seen)."""
+        return None
 
     def perceive_poses(self, positions: np.ndarray, visible: np.ndarray | None, body: Any,
                        times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

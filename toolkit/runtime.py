@@ -32,6 +32,7 @@ from toolkit.character import Character
 from toolkit.components import Behaviour, Match, MovementRequest, Percept, Segment
 from toolkit.errors import ConfigError, LikemeError, PluginError
 from toolkit.motion import Motion, local_to_world
+from toolkit.sightings import Sightings
 from toolkit.watching import Listener, ObservationLog, WatchingLoop
 
 __all__ = ["World", "Actor", "WorldObject", "Event"]
@@ -105,6 +106,8 @@ class Actor:
         The movement under way.
     memory : ObservationLog or None
         Working memory of what it perceived of ``target``, in its own parts (its watching loop's).
+    sightings : Sightings or None
+        The rest of what it perceived, on the same rows: the objects it saw and the target's perceived heading.
     performed : list of (frame, MovementRequest)
         Everything it started performing.
     """
@@ -124,6 +127,7 @@ class Actor:
         self._posture = np.asarray(character.motor.rest_pose(), dtype=float)  # held while no motion plays
         self.percepts = 0
         self.loop = WatchingLoop(character, call=self._call, listener=_Reports(self))
+        self._sightings: Sightings | None = None
         self.performed: list[tuple[int, MovementRequest]] = []
 
     def __repr__(self) -> str:
@@ -137,6 +141,12 @@ class Actor:
     def memory(self) -> ObservationLog | None:
         """Working memory of what it perceived of its target since it began watching (``None`` when not watching)."""
         return self.loop.memory if self.target is not None else None
+
+    @property
+    def sightings(self) -> Sightings | None:
+        """The objects it saw and the target's heading as perceived, on working memory's rows (``None`` when not
+        watching)."""
+        return self._sightings if self.target is not None else None
 
     # -- acting ----------------------------------------------------------------------
 
@@ -256,6 +266,7 @@ class Actor:
         self.watch_start = self.world.frame + 1  # the world frame of the first percept (memory row 0)
         self._call("perception", "reset", self.world.fps)
         self.loop.reset(target.body.parts, self.world.fps)
+        self._sightings = Sightings(self.world.fps, keep=self.world.history_seconds)
 
     def _observe(self) -> None:
         """Perceive the target and hand the percept to the watching loop."""
@@ -279,8 +290,30 @@ class Actor:
         self.percepts += 1
         world.announce("likeme_target_perceived", world=world, observer=self, target=target, percept=percept)
         world_positions = percept.world if np.shape(percept.world) == (n, 3) else None
+        self._see_objects(percept)
         self.loop.push(np.asarray(percept.pose, dtype=float)[None], np.asarray(percept.visible, dtype=bool)[None],
                        None if world_positions is None else np.asarray(world_positions, dtype=float)[None])
+
+    def _see_objects(self, percept: Percept) -> None:
+        """Record the objects of ``percept`` on the row working memory is about to get; a remembered object not seen
+        where the eye should have seen it is gone (:meth:`Perception.in_view`)."""
+        sightings, row = self._sightings, self.loop.memory.n
+        if sightings is None or row != sightings.n:  # rows pushed by someone else: nothing is known of them
+            sightings = self._sightings = Sightings(self.world.fps, keep=self.world.history_seconds, start=row)
+        seen = percept.objects if isinstance(percept.objects, Mapping) else {}
+        believed = sightings.remembered() if row else {}
+        unseen = [name for name in believed if name not in seen]
+        missed: list[str] = []
+        if unseen:
+            where = self._call("perception", "in_view", self, self.target, self.world,
+                               np.array([believed[name] for name in unseen]))
+            if where is not None:
+                missed = [name for name, gone in zip(unseen, np.asarray(where, dtype=bool).reshape(-1)) if gone]
+        heading = percept.heading
+        heading = float(heading) if isinstance(heading, (int, float, np.number)) else float("nan")
+        sightings.record(row, heading, seen, percept.kinds if isinstance(percept.kinds, Mapping) else {},
+                         percept.sizes if isinstance(percept.sizes, Mapping) else {}, missed)
+        sightings.forget(self.loop.memory.offset)
 
     def stop_imitation(self, target: Actor | None, reason: str) -> None:
         """Stop imitating ``target`` now (and drop queued imitations of it); announces ``imitation_stopped``."""

@@ -340,17 +340,22 @@ class Hierarchical(ActionSystem):
     # -- watching ------------------------------------------------------------------------
 
     def interpret(self, actor: Any, target: Any, segment: Any, match: Any, world: Any) -> Behaviour | None:
+        """Identify the behaviour behind ``match`` from what ``actor`` perceived (its working memory and sightings,
+        :mod:`plugins.action.behaviour_identification`); ``world`` is not read. The matcher's close candidates
+        (Fig. 13) are told apart by the can-I triggers."""
         if not self.params["identify"] or not match.known:
             return None
-        from plugins.action.behaviour_identification import identify
+        from plugins.action.behaviour_identification import close_candidates, identify
 
+        memory = actor.memory
+        if memory is None or memory.n == 0:
+            return None
         if segment is not None:
-            start = actor.watch_start + segment.start
-            middle = (segment.start + segment.end) // 2
-        else:  # committed early: the segment began decided_at frames ago
-            start = world.frame - (match.decided_at or 0)
-            middle = actor.memory.n - 1 - (match.decided_at or 0) // 2
-        return identify(self, actor, target, match.movement, start, middle, world)
+            start, middle, end = segment.start, (segment.start + segment.end) // 2, segment.end - 1
+        else:  # committed early: the segment began decided_at rows ago
+            start = memory.n - 1 - (match.decided_at or 0)
+            middle, end = memory.n - 1 - (match.decided_at or 0) // 2, memory.n - 1
+        return identify(self, actor, target, close_candidates(match), start, middle, end)
 
     def respond(self, actor: Any, target: Any, match: Any, behaviour: Behaviour | None, world: Any) -> MovementRequest | None:
         """Imitate the movement (if ``imitate``); otherwise shrug at a behaviour it cannot identify (if ``shrug``).

@@ -15,7 +15,8 @@ the root taken again (a root-mean-square distance per frame, in metres), so that
 long and short templates compete fairly. (Dividing the root itself by the
 length, as earlier versions did, shrinks with the template's length and made the
 longest template nearest to everything.) A segment farther than
-``max_distance`` from every template is "unknown".
+``max_distance`` from every template is "unknown". Every movement is a ranked
+candidate (``Match.candidates``), by the distance of its nearest example.
 """
 
 from __future__ import annotations
@@ -84,8 +85,12 @@ class DTW(Matcher):
         others = [d for d, lab in zip(distances, self.labels) if lab != label]
         runner_up = min(others) if others else np.inf
         confidence = float(1.0 - per_frame / runner_up) if np.isfinite(runner_up) and runner_up > 0 else 1.0
+        nearest: dict[str, float] = {}  # each movement's nearest example (Fig. 13's ranked candidates)
+        for d, lab in sorted(zip(distances.tolist(), self.labels)):
+            nearest.setdefault(lab, float(d))
         return Match(label, max(0.0, confidence), None, details={"distance": per_frame,
-                                                                  "runner_up": float(runner_up)})
+                                                                  "runner_up": float(runner_up)},
+                     candidates=tuple(nearest.items()))
 
 
 @hookimpl

@@ -46,6 +46,13 @@ never gets a hypothesis. ``max_stay`` limits how many samples in a row a path ma
 limits how far it may jump: without it a path may stand on one pose of a long clip that resembles the average of a
 whole demonstration, which explains no movement.
 
+Ranked candidates (Buchsbaum & Blumberg Fig. 13): with ``candidates`` = n > 0 the answer also ranks up to n runners-up
+(``Match.candidates``): the best path through the graph that leaves out the recognised movement's nodes is the second
+explanation, its majority movement the second candidate, and so on, each with its mean eq. 3 distance. When two are
+about as close (a reach and a jump that look alike), the observer's can-I triggers choose between them
+(:mod:`plugins.action.behaviour_identification`). Each candidate is one more search: 0, the paper's single answer, is
+the default.
+
 The whole-graph search of step 2 (issue 22): on a posegraph of more than :data:`INDEX_MIN_NODES` nodes the k start
 poses come from a spatial index (:class:`plugins.lib.pose_index.PoseIndex`, built on the first search and again
 after the graph learns), which gives exactly the scan's k nearest in the scan's order. Below that size the scan is
@@ -150,6 +157,9 @@ class PathSearch(Matcher):
         Parameter("travel", float, 0.0, "Seconds over which where the body goes counts as one more part: the root's "
                   "displacement over this time, in the body's frame (plugins.lib.travel); 0: root-relative poses "
                   "only (the paper).", minimum=0.0, maximum=10.0),
+        Parameter("candidates", int, 0, "Ranked candidates to report besides the best (B&B Fig. 13): each is the "
+                  "best path through the other movements' nodes (a search with the movements found so far left "
+                  "out), with its mean eq. 3 distance; 0: the best only (one search).", minimum=0, maximum=10),
         Parameter("learn", bool, False, "Add an unknown movement's path to the posegraph as a new movement."),
         Parameter("learn_prefix", str, "learned", "Name prefix of learned movements (learned-1, learned-2...)."),
     )
@@ -276,7 +286,30 @@ class PathSearch(Matcher):
             return Match(None, 0.0, None, node_path, {"reason": "too far from every path", "nearest": movement,
                                                       "max_distance": limit, **details})
         confidence = float(np.exp(-mean / self.params["scale"]) * share)
-        return Match(movement, confidence, None, node_path, details)
+        return Match(movement, confidence, None, node_path, details,
+                     candidates=self._candidates(obs, vis, weights, movement, mean))
+
+    def _candidates(self, obs: np.ndarray, vis: np.ndarray, weights: np.ndarray | None, movement: str,
+                    mean: float) -> tuple[tuple[str, float], ...]:
+        """The recognised movement and up to ``candidates`` runners-up (Fig. 13), by mean eq. 3 distance, best
+        first: each the majority movement of the best path that leaves out the nodes of the movements found before
+        it. Empty when ``candidates`` is 0."""
+        if self.params["candidates"] <= 0:
+            return ()
+        found = [(movement, float(mean))]
+        exclude = self.labels == movement
+        for _ in range(self.params["candidates"]):
+            path, cost, evidence = self.search(obs, vis, weights, exclude)
+            if path is None or not np.isfinite(cost):  # no path through the movements left
+                break
+            voting = self.labels[path][self.labels[path] != ""]
+            if voting.size == 0:
+                break
+            names, counts = np.unique(voting, return_counts=True)
+            other = str(names[int(np.argmax(counts))])
+            found.append((other, float(path_distance(obs, self.nodes_compared[path], vis, weights) / max(evidence, 1))))
+            exclude = exclude | (self.labels == other)
+        return (found[0], *sorted(found[1:], key=lambda c: c[1]))
 
     def search(self, obs: np.ndarray, vis: np.ndarray, weights: np.ndarray | None = None,
                exclude: np.ndarray | None = None) -> tuple[np.ndarray | None, float, int]:

@@ -41,7 +41,14 @@ class MotionCapture(Perception):
     def perceive(self, observer, target, world) -> Percept:
         percept = self.perceive_pose(target.world_pose(), None, target.body, world.time)
         objects = {name: obj.position.copy() for name, obj in world.objects.items()}
-        return Percept(percept.time, percept.pose, percept.visible, percept.world, percept.root, percept.heading, objects)
+        kinds = {name: obj.kind for name, obj in world.objects.items()}
+        sizes = {name: float(obj.radius) for name, obj in world.objects.items()}
+        return Percept(percept.time, percept.pose, percept.visible, percept.world, percept.root, percept.heading, objects,
+                       kinds, sizes)
+
+    def in_view(self, observer, target, world, points) -> np.ndarray:
+        """Every object is tracked: one not reported where it was is gone."""
+        return np.ones(len(np.asarray(points).reshape(-1, 3)), dtype=bool)
 
     def perceive_pose(self, positions, visible, body, time) -> Percept:
         """Root-relative percept of recorded world positions (P, 3); non-finite or masked parts are not seen."""

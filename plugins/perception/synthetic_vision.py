@@ -3,7 +3,8 @@
 Buchsbaum & Blumberg 2005, §4.2 and §5.1. The observer sees the target's
 colour-coded body parts from its own eye: only parts inside its field of view
 and range, and not hidden behind another part or an object (when Morris covers
-his face, his hands hide his nose, §5.2.3). From the visible parts it finds the
+his face, his hands hide his nose, §5.2.3); objects it sees likewise, unless hidden
+behind the target's body or another object (a box in front of the cheese). From the visible parts it finds the
 target's root and facing (the nose against the knees, :mod:`plugins.lib.root_frame`)
 and converts what it sees to root-relative coordinates.
 
@@ -26,7 +27,7 @@ from plugins.perception.sensory_buffer import SensoryBuffer
 from toolkit import ConfigError, Parameter, Percept, Perception, hookimpl
 from toolkit.motion import facing_vector
 
-__all__ = ["SyntheticVision", "line_of_sight_blocked"]
+__all__ = ["SyntheticVision", "appearance", "line_of_sight_blocked"]
 
 
 def line_of_sight_blocked(eye: np.ndarray, targets: np.ndarray, target_radii: np.ndarray,
@@ -144,6 +145,10 @@ class SyntheticVision(Perception):
                 seen &= ~line_of_sight_blocked(eye, positions, radii, all_centres, all_radii, same=same)
             if objects_seen.any():  # objects hidden behind the target's body
                 objects_seen &= ~line_of_sight_blocked(eye, centres, sizes, positions, radii)
+            if objects_seen.any() and len(names) > 1:  # and behind other objects (a screen, a box)
+                others = np.array([world.objects[n].held_by != observer.id for n in names], dtype=bool)
+                same = np.eye(len(names), dtype=bool)[:, others]
+                objects_seen &= ~line_of_sight_blocked(eye, centres, sizes, centres[others], sizes[others], same=same)
         positions, seen = self._hand_percepts(target.body, truth, positions, seen)
         return positions, seen, {n: centres[i].copy() for i, n in enumerate(names) if objects_seen[i]}
 
@@ -170,7 +175,31 @@ class SyntheticVision(Perception):
         positions, seen = self._buffer.update(positions, seen)
         # one frame (P, 3): the facing's running median takes this frame's estimate
         pose, mask, root, heading = root_relative(positions, seen, target.body, lambda h: self._facing.update(float(h)))
-        return Percept(world.time, pose, mask, np.where(seen[:, None], positions, np.nan), root, float(heading), objects)
+        kinds, sizes = appearance(world, objects)
+        return Percept(world.time, pose, mask, np.where(seen[:, None], positions, np.nan), root, float(heading), objects,
+                       kinds, sizes)
+
+    def in_view(self, observer: Any, target: Any, world: Any, points: np.ndarray) -> np.ndarray:
+        """Whether an object at each of ``points`` (n, 3) would be seen now: in the field of view and range, and
+        (with ``occlusion``) not behind the target's body or an object, as :meth:`look` decides for the objects it
+        sees."""
+        points = np.asarray(points, dtype=float).reshape(-1, 3)
+        eye = observer.world_pose()[observer.body.index(self.params["eye"])]
+        seen = self._in_view(eye, observer.heading, points)
+        if self.params["occlusion"] and seen.any():
+            parts = self._places(target.body, target.world_pose())
+            shown = [o for o in world.objects.values() if o.held_by != observer.id]
+            centres = np.concatenate([parts, np.array([o.position for o in shown]).reshape(-1, 3)])
+            radii = np.concatenate([self._radii(target.body), [o.radius for o in shown]])
+            seen &= ~line_of_sight_blocked(eye, points, np.zeros(len(points)), centres, radii)
+        return seen
+
+
+def appearance(world: Any, seen: dict[str, np.ndarray]) -> tuple[dict[str, str], dict[str, float]]:
+    """What each seen object looks like: its kind (colour-coded vision tells a cheese from a ball, B&B §4.2) and
+    its apparent radius."""
+    objects = world.objects
+    return ({n: objects[n].kind for n in seen if n in objects}, {n: float(objects[n].radius) for n in seen if n in objects})
 
 
 @hookimpl
