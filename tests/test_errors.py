@@ -252,6 +252,10 @@ CASES = [
     ("sweep-key", "a sweep grid with an unknown key", {"g.toml": 'benchmark = "stream"\nthreads = 4\n'}, ["bench", "sweep", "g.toml"], ["g.toml", "threads", "available:"]),
     ("sweep-folder", "a sweep grid naming a missing folder", {"g.toml": 'benchmark = "segmentation"\n[data.d]\nbody = "p.toml"\nstreams = "nowhere"\n', "p.toml": PROFILE}, ["bench", "sweep", "g.toml"], ["nowhere"]),
     ("sweep-scheduler", "--scheduler local: without a number", {"p.toml": PROFILE}, ["bench", "segmentation", "--body", "p.toml", "--streams", ".", "--scheduler", "local:x"], ["local:x"]),
+    # -- the look-at layer: [layer] (issue 19)
+    ("layer-part", "a look-at turning a part the body lacks", {"c.toml": CHILD + '[layer]\nparts = ["tail"]\n'}, ["validate", "c.toml"], ["c.toml:5: key layer.parts[0]", "unknown part 'tail'", "available: root, head, nose"]),
+    ("layer-yaw", "a look-at turning the head round to the back", {"c.toml": CHILD + '[layer]\nyaw = 95.0\n'}, ["validate", "c.toml"], ["c.toml:5: key layer.yaw", "value 95.0 out of range", "expected a number in [0, 89]"]),
+    ("layer-plugin", "an unknown layer", {"c.toml": CHILD + '[layer]\nplugin = "look-around"\n'}, ["validate", "c.toml"], ["c.toml:5: key layer.plugin", "unknown layer 'look-around'", "available: look-at"]),
 ]
 
 
