@@ -1,4 +1,4 @@
-"""The look-at layer (plugins/motor/look_at.py): the head turns toward the object of attention over every movement,
+"""The look-at layer (plugins/layers/look_at.py): the head turns toward the object of attention over every movement,
 clamped to its limits and blended in and out; nothing changes without an object (Buchsbaum & Blumberg 2005, §6.1.2).
 """
 
@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from plugins.motor.look_at import blend_weight, gaze_angles, look_at, turn
+from plugins.layers.look_at import blend_weight, gaze_angles, look_at, turn
 from tests.conftest import CHARACTERS
 from toolkit import ConfigError, MovementRequest, World, WorldObject, create_plugin_manager, load_character
 from toolkit.motion import world_to_local
