@@ -32,13 +32,19 @@ def _gaze(pose):
 
 
 @settings(max_examples=200, deadline=None)
-@given(yaw=st.floats(-69.0, 69.0), pitch=st.floats(-44.0, 34.0), distance=st.floats(0.1, 3.0))
-def test_the_gaze_reaches_a_target_within_the_limits(yaw, pitch, distance):
+@given(yaw=st.floats(-69.0, 69.0), pitch=st.floats(-44.0, 34.0), distance=st.floats(0.1, 3.0),
+       yaw0=st.floats(-80.0, 80.0), pitch0=st.floats(-60.0, 60.0))
+def test_the_gaze_reaches_a_target_within_the_limits(yaw, pitch, distance, yaw0, pitch0):
     a, p = np.radians(yaw), np.radians(pitch)
     target = POSE[HEAD] + distance * np.array([np.sin(a) * np.cos(p), np.sin(p), np.cos(a) * np.cos(p)])
-    pose, d_yaw, d_pitch = _look(target)
+    straight, _, _ = _look(target)
+    assert _gaze(straight) == pytest.approx((a, p), abs=1e-9)
+    # from a head the motion already turned (yaw0, pitch0): the same gaze, turned by the difference
+    start = turn(POSE, HEAD, np.array([NOSE]), POSE[NOSE] - POSE[HEAD], np.radians(yaw0), np.radians(pitch0))
+    assert np.degrees(_gaze(start)) == pytest.approx((yaw0, pitch0), abs=1e-9)
+    pose, d_yaw, d_pitch = _look(target, pose=start)
     assert _gaze(pose) == pytest.approx((a, p), abs=1e-9)
-    assert (d_yaw, d_pitch) == pytest.approx((a, p), abs=1e-9)  # from a gaze straight ahead
+    assert np.degrees((d_yaw, d_pitch)) == pytest.approx((yaw - yaw0, pitch - pitch0), abs=1e-7)
     # a rigid turn about the head: the nose keeps its distance, the head and the hand do not move
     assert np.linalg.norm(pose[NOSE] - pose[HEAD]) == pytest.approx(0.12)
     np.testing.assert_array_equal(pose[[HEAD, HAND]], POSE[[HEAD, HAND]])

@@ -18,6 +18,7 @@ imitation or the way back from a stopped one, nothing changes.
 
 from __future__ import annotations
 
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -81,7 +82,7 @@ def turn(pose: np.ndarray, pivot: int, parts: np.ndarray, heading: np.ndarray, y
 def look_at(pose: np.ndarray, target: np.ndarray, *, pivot: int, parts: np.ndarray, gaze: tuple[int, int],
             yaw_limit: float, pitch_up: float, pitch_down: float, weight: float = 1.0
             ) -> tuple[np.ndarray, float, float]:
-    """Turn the head of ``pose`` (P, 3, local frame) toward ``target`` (3,, local frame).
+    """Turn the head of ``pose`` (P, 3) toward ``target`` (3,), both in the local frame.
 
     The gaze (from part ``gaze[0]`` to ``gaze[1]``) is aimed at ``target`` as seen from ``gaze[0]``, clamped to
     ``|yaw| <= yaw_limit`` and ``-pitch_down <= pitch <= pitch_up`` (radians, relative to the local frame), and
@@ -174,8 +175,6 @@ class LookAt(Layer):
 
     def inspect(self) -> Any:
         """The last frame's turn: the object looked at, the blend weight, the yaw and pitch turned (degrees)."""
-        from types import MappingProxyType
-
         return MappingProxyType(dict(self._last))
 
     def describe(self) -> dict[str, Any]:
