@@ -175,3 +175,33 @@ def test_bad_look_at_tables_are_named(pm, table, key):
     with pytest.raises(ConfigError) as err:
         load_character(CHARACTERS / "morris.toml", pm, override={"layer": table})
     assert err.value.key == key
+
+
+def test_a_layer_that_returns_a_wrong_pose_is_named_or_dropped():
+    """A third-party layer's bad answer stops the run with its name, or (skip) the run goes on without it."""
+    from tests.conftest import make_plugin
+    from toolkit import Layer, PluginError
+    from toolkit.manager import PluginInfo
+
+    class Flat(Layer):
+        """Returns one point instead of a pose."""
+
+        name = "flat"
+
+        def apply(self, actor, request, motion, frame, world):
+            return np.zeros(3)
+
+    pm = create_plugin_manager(autoload=False)
+    pm.register_plugin(make_plugin(likeme_register_layers=lambda: [Flat]), PluginInfo("flat", "m", "(tests)", ""))
+    for policy in ("stop", "skip"):
+        morris = load_character(CHARACTERS / "morris.toml", pm, override={"layer": {"plugin": "flat"}})
+        world = World(fps=30.0, pm=pm, on_plugin_error=policy)
+        actor = world.add_actor(morris, "morris", (0.0, 0.0, 1.6), np.pi)
+        actor.request(MovementRequest("reach"))
+        if policy == "stop":
+            with pytest.raises(PluginError, match="flat.*Flat.apply.*shape"):
+                actor.world_pose()
+        else:
+            motion = actor._motion
+            np.testing.assert_array_equal(actor.local_pose(), motion.positions[0])
+            assert morris.layer is None and [e.data["plugin"] for e in world.events_of("plugin_failed")] == ["flat"]

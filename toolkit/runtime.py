@@ -170,9 +170,13 @@ class Actor:
             if pose is None:
                 pose = motion.positions[frame]
             elif np.shape(pose) != (len(self.body.parts), 3):
-                raise PluginError(layer.name, f"{type(layer).__name__}.apply",
-                                  f"returned an array of shape {np.shape(pose)}, expected None or a pose "
-                                  f"({len(self.body.parts)}, 3)")
+                error = PluginError(layer.name, f"{type(layer).__name__}.apply",
+                                    f"returned an array of shape {np.shape(pose)}, expected None or a pose "
+                                    f"({len(self.body.parts)}, 3)")
+                if self.world.on_plugin_error != "skip":
+                    raise error
+                self._drop("layer", layer, error)  # the run goes on with the motions as they are
+                pose = motion.positions[frame]
             self._shown = (key, np.asarray(pose, dtype=float))
         return self._shown[1]
 
