@@ -252,6 +252,11 @@ CASES = [
     ("sweep-key", "a sweep grid with an unknown key", {"g.toml": 'benchmark = "stream"\nthreads = 4\n'}, ["bench", "sweep", "g.toml"], ["g.toml", "threads", "available:"]),
     ("sweep-folder", "a sweep grid naming a missing folder", {"g.toml": 'benchmark = "segmentation"\n[data.d]\nbody = "p.toml"\nstreams = "nowhere"\n', "p.toml": PROFILE}, ["bench", "sweep", "g.toml"], ["nowhere"]),
     ("sweep-scheduler", "--scheduler local: without a number", {"p.toml": PROFILE}, ["bench", "segmentation", "--body", "p.toml", "--streams", ".", "--scheduler", "local:x"], ["local:x"]),
+    # -- acting: do-until persistence and retries, chance of a leaf's effect (issue 19)
+    ("tuple-chance", "a leaf's chance outside [0, 1]", {"c.toml": CHILD + '[action.tuples.reach]\nchance = 1.5\n'}, ["validate", "c.toml"], ["key action.tuples.reach.chance", "invalid value 1.5", "probability in [0, 1]"]),
+    ("tuple-chance-inner", "a chance on a tuple with children", {"c.toml": CHILD + '[action.tuples.get]\nchance = 0.5\n'}, ["validate", "c.toml"], ["key action.tuples.get.chance", "only a leaf"]),
+    ("tuple-retries", "retries that are not a whole number", {"c.toml": CHILD + '[action.tuples.get]\nretries = 1.5\n'}, ["validate", "c.toml"], ["key action.tuples.get.retries", "invalid value 1.5", "whole number in [0, 100]"]),
+    ("tuple-retries-leaf", "retries on a leaf", {"c.toml": CHILD + '[action.tuples.reach]\nretries = 2\n'}, ["validate", "c.toml"], ["key action.tuples.reach.retries", "only a tuple with children"]),
     # -- the look-at layer: [layer] (issue 19)
     ("layer-part", "a look-at turning a part the body lacks", {"c.toml": CHILD + '[layer]\nparts = ["tail"]\n'}, ["validate", "c.toml"], ["c.toml:5: key layer.parts[0]", "unknown part 'tail'", "available: root, head, nose"]),
     ("layer-yaw", "a look-at turning the head round to the back", {"c.toml": CHILD + '[layer]\nyaw = 95.0\n'}, ["validate", "c.toml"], ["c.toml:5: key layer.yaw", "value 95.0 out of range", "expected a number in [0, 89]"]),

@@ -83,8 +83,22 @@ def _watching(actor: Actor, world: World) -> dict[str, Any]:
     return out
 
 
-def _edges(names: list[str]) -> str:
+def _names(value: Any, fallback: str | None = None) -> list[str]:
+    """A matcher's detail as a list of names, whatever its shape.
+
+    A motor command graph reports the edges it learned as a list; a posegraph only says that it learned
+    (``True``), and the name is then the recognised movement ``fallback``; a single name is a one-item list.
+    """
+    if isinstance(value, str):
+        return [value]
+    if isinstance(value, (list, tuple, set, frozenset)):
+        return [str(v) for v in value]
+    return [fallback] if value and fallback else []
+
+
+def _edges(names: Any) -> str:
     """Edge names without their subsystem when they share one (``e1, e2``), else in full."""
+    names = _names(names)
     if len({n.rsplit(":", 1)[0] for n in names}) > 1:
         return ", ".join(names)
     return ", ".join(n.split(":")[-1] for n in names)
@@ -93,7 +107,13 @@ def _edges(names: list[str]) -> str:
 def behaviour_sentence(observer: str, target: str, b: dict[str, Any]) -> str:
     """One identified (or not identified) behaviour as a sentence."""
     if not b["known"]:
-        return f"{observer} does not know why {target} did {b['movement']} and shrugs"
+        text = f"{observer} does not know why {target} did {b['movement']}"
+        response = b.get("response")
+        if response == "shrug":
+            return text + " and shrugs"
+        if response == "imitate":
+            return text + f"; {observer} imitates it"
+        return text
     path = " > ".join(reversed(b["path"]))
     text = f"{observer} believes {target} did {b['movement']}"
     if b["object"]:
@@ -121,6 +141,7 @@ def _behaviour(b: Any, time: float) -> dict[str, Any]:
         "object": b.object,
         "prediction": list(b.prediction),
         "learned": dict(b.details.get("learned", {})) if b.details else {},
+        "response": b.details.get("response") if b.details else None,
     }
 
 
@@ -201,7 +222,7 @@ def render_text(summary: dict[str, Any]) -> str:
                 if r["early"] and r["fraction"] is not None:
                     text += f"; committed after {100 * r['fraction']:.0f}% of the demonstration"
                 if r.get("learned"):  # the edges a motor command graph learned, or (a posegraph) the new movement
-                    text += f"; learned {_edges(r['learned'] if isinstance(r['learned'], list) else [r['movement']])}"
+                    text += f"; learned {_edges(_names(r['learned'], r['movement']))}"
                     text += " (after a deviation)" if r.get("deviated") else ""
                 if r.get("speed") and abs(r["speed"] - 1) > 0.3:
                     text += f"; {r['speed']:.1f}x his own speed"

@@ -22,6 +22,15 @@ Declaration, inside the ``[action]`` table of the ``hierarchical`` action system
     can = [{ trigger = "reachable", distance = 0.5 }]          # can-I triggers
     until = [{ trigger = "holding" }]                          # do-until (success) contexts
     effect = "grasp"                                           # what performing it does to the object
+    chance = 1.0                                               # how often the effect takes place (a grasp can miss)
+
+    [action.tuples.get]
+    until = [{ trigger = "holding" }]                          # stays active until holding (§6.2)
+    retries = 2                                                # children that may fail in a row before it gives up
+    children = ["reach", "jump"]
+
+A tuple stays active until its do-until contexts hold (it succeeded) or its
+triggers no longer hold (it failed); see :mod:`plugins.action.hierarchical`.
 
 Triggers are components registered through ``likeme_register_triggers``; a
 trigger table names one with ``trigger = NAME`` and gives its parameters.
@@ -40,7 +49,11 @@ __all__ = ["ActionTuple", "ActionHierarchy", "EFFECTS", "parse_hierarchy"]
 EFFECTS = ("none", "grasp", "consume", "toss")
 """What completing a leaf tuple's movement does to its object of attention."""
 
-TUPLE_KEYS = ("drive", "select", "should", "can", "until", "children", "movement", "effect", "satisfies", "description")
+TUPLE_KEYS = ("drive", "select", "should", "can", "until", "children", "movement", "effect", "satisfies", "chance",
+              "retries", "description")
+
+DEFAULT_RETRIES = 2
+"""How many of its children may fail in a row before a tuple gives up on its object, unless it says otherwise."""
 
 
 @dataclass
@@ -57,6 +70,8 @@ class ActionTuple:
     movement: str | None = None
     effect: str = "none"
     satisfies: float = 0.0
+    chance: float = 1.0
+    retries: int = DEFAULT_RETRIES
     description: str = ""
     parents: list[str] = field(default_factory=list)
 
@@ -106,8 +121,10 @@ class ActionHierarchy:
                 parts.append("can-I: " + ", ".join(x.describe() for x in t.can))
             if t.until:
                 parts.append("until: " + ", ".join(x.describe() for x in t.until))
+            if t.children and t.retries != DEFAULT_RETRIES:
+                parts.append(f"retries {t.retries}")
             if t.effect != "none":
-                parts.append(f"effect {t.effect}")
+                parts.append(f"effect {t.effect}" + (f" (chance {t.chance:g})" if t.chance < 1 else ""))
             lines.append("  " * depth + label + (f"   [{'; '.join(parts)}]" if parts else ""))
             for child in t.children:
                 walk(child, depth + 1)
@@ -169,6 +186,20 @@ def parse_hierarchy(table: Mapping[str, Any], registry: Any, movements: list[str
         satisfies = spec.get("satisfies", 0.0)
         if isinstance(satisfies, bool) or not isinstance(satisfies, (int, float)) or not 0 <= satisfies <= 1:
             raise ConfigError(f"invalid value {satisfies!r}", key=(*key, "satisfies"), expected="the drive decrease in [0, 1]")
+        chance = spec.get("chance", 1.0)
+        if isinstance(chance, bool) or not isinstance(chance, (int, float)) or not 0 <= chance <= 1:
+            raise ConfigError(f"invalid value {chance!r}", key=(*key, "chance"),
+                              expected="the probability in [0, 1] that the leaf's effect takes place")
+        if "chance" in spec and movement is None:
+            raise ConfigError("only a leaf (a tuple with a movement) has a chance", key=(*key, "chance"),
+                              expected="chance on a tuple with movement = NAME")
+        retries = spec.get("retries", DEFAULT_RETRIES)
+        if isinstance(retries, bool) or not isinstance(retries, int) or not 0 <= retries <= 100:
+            raise ConfigError(f"invalid value {retries!r}", key=(*key, "retries"),
+                              expected="a whole number in [0, 100] of failed children before giving up")
+        if "retries" in spec and not children:
+            raise ConfigError("only a tuple with children retries them", key=(*key, "retries"),
+                              expected="retries on a tuple with children = [...]")
         tuples[name] = ActionTuple(
             name=name,
             drive=drive,
@@ -180,6 +211,8 @@ def parse_hierarchy(table: Mapping[str, Any], registry: Any, movements: list[str
             movement=movement,
             effect=effect,
             satisfies=float(satisfies),
+            chance=float(chance),
+            retries=int(retries),
             description=str(spec.get("description", "")),
         )
     for name, t in tuples.items():

@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from plugins.action.action_tuple import ActionTuple
+from plugins.action.prediction import predict
 from toolkit import Behaviour, TriggerContext
 
 __all__ = ["identify", "line_of_sight", "evaluate_path", "predict"]
@@ -185,33 +186,3 @@ def _learn_affordance(system: Any, target: Any, movement: str, paths: list[tuple
                                   learned={unknown[name].kind: category})
     return None
 
-
-def predict(system: Any, target: Any, path: tuple[str, ...], obj: str | None, then: Any) -> tuple[str, ...]:
-    """What the target will do next once the identified behaviour succeeds (§7.4), best first.
-
-    The success of the identified leaf is its effect on the object (a grasp: the
-    target holds it); every other leaf tuple whose whole path's can-I triggers
-    hold in that imagined world, for the same object, is a candidate. Candidates
-    are ranked by how often the observer itself went from the identified leaf to
-    them (its transition map), then those of the same motivation first.
-    """
-    h = system.hierarchy
-    leaf = h.tuples[path[-1]]
-    if obj is None or obj not in then.objects or leaf.effect != "grasp":
-        return ()
-    imagined = {n: o for n, o in then.objects.items()}
-    held = SimpleNamespace(**vars(then.objects[obj]))
-    held.held_by = target.id
-    imagined[obj] = held
-    world = SimpleNamespace(objects=imagined)
-    candidates = []
-    for name, t in h.tuples.items():
-        if not t.leaf or name == leaf.name:
-            continue
-        for p in h.paths_to(name):
-            ok, selected = evaluate_path(system, target, world, p, obj, system.beliefs)
-            if ok and selected == obj:
-                rank = (-system.transitions.get((leaf.name, name), 0), h.drive_of(p) != h.drive_of(path), name)
-                candidates.append((rank, f"{t.movement} the {obj}"))
-                break
-    return tuple(dict.fromkeys(text for _, text in sorted(candidates)))

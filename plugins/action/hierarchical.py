@@ -9,7 +9,23 @@ dither). The object selection trigger of the winner picks the object of
 attention for everything below it. The same competition repeats in each level's
 action group down to a leaf, whose movement is requested from the motor system.
 When the movement ends its effect is applied (grasp the object, consume it and
-satisfy the drive, toss it) and the do-until contexts are checked.
+satisfy the drive, toss it).
+
+Do-until contexts control the tuples (§6, §6.2): the active tuples (one per
+level, top to leaf) stay active across movements. A leaf is done when its
+movement ends: it succeeded if its do-until (success) contexts hold, or (a leaf
+without any) if its effect took place. Before every decision the active tuples
+are checked from the top: a tuple whose do-until contexts all hold has
+succeeded and ends (with everything below it), and so does one whose should-I
+triggers no longer hold (its drive is satisfied); a tuple whose other triggers
+no longer hold (its object gone, a can-I trigger false) has failed and ends.
+The lowest tuple still active then decides its child again: ``get`` (until
+holding) reaches again, or jumps, until the object is held; once it is, ``get``
+ends and its parent decides again, so ``eat`` follows. A failed child counts
+against its parent: after ``retries`` failures in a row the parent gives up on
+its object (it is not chosen for that object again), so nothing loops forever;
+a tuple none of whose children can run gives up at once. :attr:`log` records
+each tuple's beginning and end.
 
 While acting the character keeps two maps (§6.1, §7.4):
 
@@ -26,6 +42,7 @@ not be identified, shrugs.
 from __future__ import annotations
 
 from collections import Counter
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -34,7 +51,20 @@ from plugins.action.action_tuple import ActionHierarchy, ActionTuple, parse_hier
 from plugins.triggers.drives import Drive, parse_drives
 from toolkit import ActionSystem, Behaviour, ConfigError, MovementRequest, Parameter, TriggerContext, hookimpl
 
-__all__ = ["Hierarchical"]
+__all__ = ["Hierarchical", "Active"]
+
+MAX_STEPS = 1000
+"""Most tuples one decision may begin or end (a guard: each step ends a tuple or gives one up, so it never binds)."""
+
+
+@dataclass
+class Active:
+    """An active action tuple: its name, object of attention, failed children in a row, and (a leaf) its outcome."""
+
+    name: str
+    object: str | None
+    failures: int = 0
+    outcome: bool | None = None
 
 
 class Hierarchical(ActionSystem):
@@ -83,10 +113,15 @@ class Hierarchical(ActionSystem):
                 if not known or self.hierarchy.tuples[path[-1]].movement != movement:
                     raise ConfigError(f"not a path of the hierarchy: {path_text!r}", key=("experience", movement, path_text),
                                       expected="top > ... > leaf tuple names joined by '>'")
-                self.correspondence.setdefault(movement, Counter())[path] += int(n)
+                if int(n) > 0:  # a count of 0 (an override clearing what a file extended) is no experience
+                    self.correspondence.setdefault(movement, Counter())[path] += int(n)
         self.transitions: Counter[tuple[str, str]] = Counter()
         self.history: list[tuple[int, tuple[str, ...], str | None]] = []  # (frame, path, object) of each behaviour begun
         self._rng = np.random.default_rng(self.params["seed"])
+        self._stack: list[Active] = []  # the active tuples, top to leaf
+        self._given_up: set[tuple[str, str | None]] = set()  # (tuple, object) pairs given up on
+        self.log: list[tuple[int, str, str, str | None]] = []  # (frame, began/succeeded/failed/gave up, tuple, object)
+        self._frame = 0
         self._current: tuple[tuple[str, ...], str | None] | None = None
         self._last_leaf: str | None = None
         self._last_time: float | None = None
@@ -98,13 +133,22 @@ class Hierarchical(ActionSystem):
         return TriggerContext(actor, world, obj, self.beliefs, {n: d.level for n, d in self.drives.items()})
 
     def value(self, t: ActionTuple, context: TriggerContext) -> tuple[float, str | None]:
-        """A tuple's value (product of its trigger values) and the object of attention it selects."""
+        """A tuple's value (product of its trigger values) and the object of attention it selects.
+
+        An object this tuple has given up on is not selected (its value for that object is 0).
+        """
         obj = context.object
         if t.select is not None:
+            ignored = {o for n, o in self._given_up if n == t.name}
+            if ignored:
+                context = TriggerContext(context.actor, context.world, obj, context.beliefs, context.drives,
+                                         {**context.params, "ignored": ignored})
             obj = t.select.select(context)
             if obj is None:
                 return 0.0, None
             context = TriggerContext(context.actor, context.world, obj, context.beliefs, context.drives, context.params)
+        elif (t.name, obj) in self._given_up:
+            return 0.0, obj
         v = 1.0
         for trigger in (*t.should, *t.can):
             v *= trigger.evaluate(context)
@@ -153,7 +197,9 @@ class Hierarchical(ActionSystem):
             self._idle_since = now
         if now - self._idle_since < self.params["pause"]:
             return None
-        decision = self.decide(actor, world)
+        self._frame = world.frame
+        self._unwind(actor, world)
+        decision = self._descend(actor, world)
         if decision is None:
             return None
         path, obj = decision
@@ -162,6 +208,81 @@ class Hierarchical(ActionSystem):
         leaf = self.hierarchy.tuples[path[-1]]
         reason = " > ".join(path) + (f" ({obj})" if obj else "")
         return MovementRequest(leaf.movement, reason=reason, object=obj)
+
+    @property
+    def active(self) -> tuple[Active, ...]:
+        """The active tuples, top to leaf (empty when no behaviour is under way)."""
+        return tuple(self._stack)
+
+    def _note_log(self, event: str, entry: Active) -> None:
+        self.log.append((self._frame, event, entry.name, entry.object))
+
+    def _end(self, i: int, success: bool) -> None:
+        """End the active tuple at level ``i`` (and everything below it); a failure counts against its parent."""
+        entry = self._stack[i]
+        del self._stack[i:]
+        self._note_log("succeeded" if success else "failed", entry)
+        if i == 0:
+            return
+        parent = self._stack[i - 1]
+        if success:
+            parent.failures = 0
+            return
+        parent.failures += 1
+        if parent.failures > self.hierarchy.tuples[parent.name].retries:
+            self._give_up(i - 1)
+
+    def _give_up(self, i: int) -> None:
+        """The tuple at level ``i`` gives up on its object: it is not chosen for it again; it ends as a failure."""
+        entry = self._stack[i]
+        self._given_up.add((entry.name, entry.object))
+        self._note_log("gave up", entry)
+        self._end(i, False)
+
+    def _unwind(self, actor: Any, world: Any) -> None:
+        """End the active tuples whose do-until contexts hold (success) or whose triggers no longer hold (failure)."""
+        if self._stack and self.hierarchy.tuples[self._stack[-1].name].leaf:
+            leaf = self._stack[-1]
+            self._end(len(self._stack) - 1, bool(leaf.outcome))  # a leaf performs once per activation
+        for i, entry in enumerate(self._stack):
+            t = self.hierarchy.tuples[entry.name]
+            context = self.context(actor, world, entry.object)
+            if t.until and all(u.evaluate(context) > 0 for u in t.until):
+                self._end(i, True)
+                return
+            if t.should and not all(x.evaluate(context) > 0 for x in t.should):  # motivation satisfied: it is done
+                self._end(i, True)
+                return
+            v, obj = self.value(t, context)
+            if v <= 0:
+                self._end(i, False)
+                return
+            if obj != entry.object:  # a new object of attention (the last eaten): what was below was for the old one
+                entry.object = obj
+                del self._stack[i + 1:]
+                return
+
+    def _descend(self, actor: Any, world: Any) -> tuple[tuple[str, ...], str | None] | None:
+        """From the lowest active tuple down to a leaf, each level's group competing; ``None`` if nothing can run."""
+        for _ in range(MAX_STEPS):
+            if not self._stack:
+                won = self._compete(self.hierarchy.top, self.context(actor, world, None))
+                if won is None:
+                    return None
+                self._stack.append(Active(*won))
+                self._note_log("began", self._stack[-1])
+                continue
+            entry = self._stack[-1]
+            t = self.hierarchy.tuples[entry.name]
+            if t.leaf:
+                return tuple(e.name for e in self._stack), entry.object
+            won = self._compete(t.children, self.context(actor, world, entry.object))
+            if won is None:  # none of its children can run for this object
+                self._give_up(len(self._stack) - 1)
+                continue
+            self._stack.append(Active(*won))
+            self._note_log("began", self._stack[-1])
+        return None
 
     def performed(self, actor: Any, request: MovementRequest, world: Any) -> None:
         if self._current is None or request.imitating is not None:
@@ -185,20 +306,31 @@ class Hierarchical(ActionSystem):
         if leaf.movement != request.movement:
             return
         target = world.objects.get(obj) if obj else None
+        done = leaf.effect == "none"
+        if leaf.chance < 1.0 and leaf.effect != "none" and self._rng.random() >= leaf.chance:
+            target = None  # the movement missed: no effect this time
         if leaf.effect == "grasp" and target is not None:
             context = self.context(actor, world, obj)
             if all(t.evaluate(context) > 0 for t in leaf.can):  # still within reach when the movement ends
                 target.held_by = actor.id
                 target.properties["held_in"] = target.properties.get("held_in", "right_hand")
+                done = True
         elif leaf.effect == "consume" and target is not None and target.held_by == actor.id:
             world.remove_object(obj)
             self._satisfy(path, leaf)
+            done = True
         elif leaf.effect == "toss" and target is not None and target.held_by == actor.id:
             target.held_by = None
             front = actor.world_pose()[actor.body.root_index]
             heading = np.array([np.sin(actor.heading), 0.0, np.cos(actor.heading)])
             target.position = np.array([front[0], target.radius, front[2]]) + 0.35 * heading
             self._satisfy(path, leaf)
+            done = True
+        if self._stack and self._stack[-1].name == leaf.name:  # its outcome: its success context, else its effect
+            if leaf.until:
+                context = self.context(actor, world, obj)
+                done = all(u.evaluate(context) > 0 for u in leaf.until)
+            self._stack[-1].outcome = done
 
     def _satisfy(self, path: tuple[str, ...], leaf: ActionTuple) -> None:
         drive = self.hierarchy.drive_of(path)
@@ -221,10 +353,16 @@ class Hierarchical(ActionSystem):
         return identify(self, actor, target, match.movement, start, middle, world)
 
     def respond(self, actor: Any, target: Any, match: Any, behaviour: Behaviour | None, world: Any) -> MovementRequest | None:
-        """Imitate the movement (if ``imitate``); otherwise shrug at a behaviour it cannot identify (if ``shrug``)."""
+        """Imitate the movement (if ``imitate``); otherwise shrug at a behaviour it cannot identify (if ``shrug``).
+
+        The response is noted in the behaviour's details as ``response`` (``"imitate"``, ``"shrug"`` or absent), so
+        that a report says what the observer did, not what it would have done.
+        """
         if self.params["imitate"] and match.known and match.movement in actor.character.motor.movements():
+            _note(behaviour, "imitate")
             return MovementRequest(match.movement, reason=f"imitating {target.id}'s {match.movement}", imitating=target.id)
         if behaviour is not None and not behaviour.known and self.params["shrug"]:
+            _note(behaviour, "shrug")
             return MovementRequest(self.params["shrug"], reason=f"does not know why {target.id} did {match.movement}")
         return None
 
@@ -317,6 +455,12 @@ class Hierarchical(ActionSystem):
             "drives": {n: round(d.level, 3) for n, d in self.drives.items()},
             "beliefs": dict(self.beliefs),
         }
+
+
+def _note(behaviour: Behaviour | None, response: str) -> None:
+    """Write the observer's response into ``behaviour.details`` (a plain dict; other mappings are left alone)."""
+    if behaviour is not None and isinstance(behaviour.details, dict):
+        behaviour.details["response"] = response
 
 
 @hookimpl

@@ -22,12 +22,14 @@ __all__ = ["ObjectPresent", "closest_object"]
 def closest_object(context: TriggerContext, category: str, prefer: str = "closest") -> str | None:
     """The object believed to afford ``category``, not held by someone else, that the actor prefers.
 
-    ``prefer`` is ``"closest"`` (to the actor's root), ``"farthest"`` or ``"largest"`` (by radius).
+    ``prefer`` is ``"closest"`` (to the actor's root), ``"farthest"`` or ``"largest"`` (by radius). Objects named in
+    ``context.params["ignored"]`` (those the action system has given up on) are left out.
     """
     root = context.actor.world_pose()[context.actor.body.root_index]
+    ignored = context.params.get("ignored", ())
     candidates = [
         (name, obj) for name, obj in context.world.objects.items()
-        if context.category(obj) == category and obj.held_by in (None, context.actor.id)
+        if context.category(obj) == category and obj.held_by in (None, context.actor.id) and name not in ignored
     ]
     if not candidates:
         return None
@@ -50,7 +52,8 @@ class ObjectPresent(Trigger):
     def select(self, context: TriggerContext) -> str | None:
         """The object of attention: the one already attended if it qualifies, else the closest that does."""
         obj = context.attended()
-        if obj is not None and context.category(obj) == self.params["kind"] and obj.held_by in (None, context.actor.id):
+        if (obj is not None and context.category(obj) == self.params["kind"] and obj.held_by in (None, context.actor.id)
+                and context.object not in context.params.get("ignored", ())):
             return context.object
         return closest_object(context, self.params["kind"], self.params["prefer"])
 

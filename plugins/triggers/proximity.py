@@ -7,15 +7,38 @@
   context of get, §6.2, and the can-I trigger of eat).
 
 Distances are horizontal from the character's root; heights are above the ground.
+
+Each of these triggers can also *imagine* the world in which it holds
+(:meth:`Holding.imagine`: the character holds the object), which is how an
+observer imagines the success of a behaviour it identified (§7.4, see
+:mod:`plugins.action.prediction`).
 """
 
 from __future__ import annotations
+
+import copy
+from typing import Any
 
 import numpy as np
 
 from toolkit import Parameter, Trigger, TriggerContext, hookimpl
 
-__all__ = ["Proximity", "Reachable", "ObjectHigh", "Holding", "NotHolding", "horizontal_distance"]
+__all__ = ["Proximity", "Reachable", "ObjectHigh", "Holding", "NotHolding", "horizontal_distance", "imagined_objects"]
+
+
+def imagined_objects(context: TriggerContext, **changes: Any) -> dict[str, Any] | None:
+    """The objects of ``context.world`` with the object of attention changed (``held_by=...``), as copies.
+
+    The real objects are never changed. ``None`` without an object of attention.
+    """
+    if context.object is None or context.object not in context.world.objects:
+        return None
+    objects = {n: copy.copy(o) for n, o in context.world.objects.items()}
+    obj = objects[context.object]
+    obj.properties = dict(obj.properties)
+    for key, value in changes.items():
+        setattr(obj, key, value)
+    return objects
 
 
 def horizontal_distance(context: TriggerContext) -> float:
@@ -94,6 +117,11 @@ class Holding(Trigger):
         obj = context.attended()
         return 1.0 if obj is not None and obj.held_by == context.actor.id else 0.0
 
+    def imagine(self, context: TriggerContext) -> dict[str, Any] | None:
+        """The world in which this trigger holds: ``context.world``'s objects (copies) with the object of attention
+        held by ``context.actor``; ``None`` without an object of attention (§7.4: Morris will hold the cheese)."""
+        return imagined_objects(context, held_by=context.actor.id)
+
     def describe(self) -> str:
         return "holding the object"
 
@@ -106,6 +134,15 @@ class NotHolding(Trigger):
     def evaluate(self, context: TriggerContext) -> float:
         obj = context.attended()
         return 1.0 if obj is None or obj.held_by != context.actor.id else 0.0
+
+    def imagine(self, context: TriggerContext) -> dict[str, Any] | None:
+        """The world in which this trigger holds: the object of attention (copied) held by nobody (put down)."""
+        if context.object is None:
+            return dict(context.world.objects)
+        obj = context.attended()
+        if obj is not None and obj.held_by != context.actor.id:
+            return dict(context.world.objects)  # it already holds
+        return imagined_objects(context, held_by=None)
 
     def describe(self) -> str:
         return "not holding the object"
