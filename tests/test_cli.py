@@ -135,7 +135,7 @@ def test_bench_behaviour_runs(tmp_path):
     result = likeme("bench", "behaviour", "--episodes", "3", "--quiet", "--json", out)
     assert result.returncode == 0, result.stderr
     data = json.loads(out.read_text())
-    assert set(data["conditions"]) == {"line-of-sight", "no-line-of-sight", "close-together"}
+    assert set(data["conditions"]) == {"line-of-sight", "no-line-of-sight", "close-together", "random-placement"}
     assert data["conditions"]["line-of-sight"]["path"] >= 2 / 3
 
 

@@ -64,8 +64,8 @@ def test_the_layout_tables_match_the_rooms_of_plugins():
     readme = (ROOT / "README.md").read_text()
     architecture = (ROOT / "docs" / "architecture.md").read_text()
     rooms = sorted(p.parent.name for p in (ROOT / "plugins").glob("*/__init__.py"))
-    assert rooms == ["action", "bench", "correspondence", "lib", "matchers", "motor", "perception", "segmenters",
-                     "triggers", "views"]
+    assert rooms == ["action", "bench", "correspondence", "layers", "lib", "matchers", "motor", "perception",
+                     "segmenters", "triggers", "views"]
     picture = architecture[architecture.index("## The rooms"):architecture.index("## From files")]
     for room in rooms:
         assert f"`plugins/{room}/`" in readme, room

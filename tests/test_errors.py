@@ -265,6 +265,10 @@ CASES = [
     ("bench-runs-past-seeds", "runs whose seeds pass the largest seed", {}, ["bench", "watch", "--seed", "9223372036854775807", "--runs", "2"], ["key --runs", "--seed + runs - 1 at most 9223372036854775807"]),
     ("bench-worker-error", "an error in a --jobs worker", {}, ["bench", "watch", "--runs", "2", "--jobs", "2", "--movements", "1", "--demonstrator", "nobody"], ["nobody"]),
     ("bench-vision-observer", "bench vision with an actor not in the scenario", {}, ["bench", "vision", "--observer", "nobody", "--frames", "1"], ["key --observer: no actor 'nobody' in 'jump_then_cover_face'", "available: max"]),
+    # -- the look-at layer: [layer] (issue 19)
+    ("layer-part", "a look-at turning a part the body lacks", {"c.toml": CHILD + '[layer]\nparts = ["tail"]\n'}, ["validate", "c.toml"], ["c.toml:5: key layer.parts[0]", "unknown part 'tail'", "available: root, head, nose"]),
+    ("layer-yaw", "a look-at turning the head round to the back", {"c.toml": CHILD + '[layer]\nyaw = 95.0\n'}, ["validate", "c.toml"], ["c.toml:5: key layer.yaw", "value 95.0 out of range", "expected a number in [0, 89]"]),
+    ("layer-plugin", "an unknown layer", {"c.toml": CHILD + '[layer]\nplugin = "look-around"\n'}, ["validate", "c.toml"], ["c.toml:5: key layer.plugin", "unknown layer 'look-around'", "available: look-at"]),
 ]
 
 

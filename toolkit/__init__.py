@@ -26,8 +26,8 @@ __version__ = "0.1.0"
 _EXPORTS: dict[str, str] = {
     "toolkit.body": "Body Facing Hand",
     "toolkit.character": "Character load_character",
-    "toolkit.components": "ActionSystem Behaviour Component Correspondence Match Matcher MotorSystem MovementRequest "
-                          "Percept Perception Segment Segmenter Trigger TriggerContext View",
+    "toolkit.components": "ActionSystem Behaviour Component Correspondence Layer Match Matcher MotorSystem "
+                          "MovementRequest Percept Perception Segment Segmenter Trigger TriggerContext View",
     "toolkit.errors": "ConfigError LikemeError PluginError",
     "toolkit.hookspecs": "hookimpl",
     "toolkit.manager": "PluginManager create_plugin_manager",
@@ -59,8 +59,8 @@ def __dir__() -> list[str]:
 if TYPE_CHECKING:  # pragma: no cover - for type checkers and editors: the same names, imported eagerly
     from toolkit.body import Body, Facing, Hand
     from toolkit.character import Character, load_character
-    from toolkit.components import (ActionSystem, Behaviour, Component, Correspondence, Match, Matcher, MotorSystem,
-                                    MovementRequest, Percept, Perception, Segment, Segmenter, Trigger,
+    from toolkit.components import (ActionSystem, Behaviour, Component, Correspondence, Layer, Match, Matcher,
+                                    MotorSystem, MovementRequest, Percept, Perception, Segment, Segmenter, Trigger,
                                     TriggerContext, View)
     from toolkit.errors import ConfigError, LikemeError, PluginError
     from toolkit.hookspecs import hookimpl
@@ -83,6 +83,7 @@ __all__ = [
     "Event",
     "Facing",
     "Hand",
+    "Layer",
     "LikemeError",
     "Match",
     "Matcher",

@@ -10,6 +10,7 @@ A character file has these tables (``docs/character-format.md`` is the full refe
     [segmenter]   plugin = NAME and its parameters      (optional)
     [matcher]     plugin = NAME and its parameters      (optional)
     [action]      plugin = NAME and its parameters      (optional)
+    [layer]       plugin = NAME and its parameters      (optional; a look-at over every movement)
 
 ``extends`` names another character file; its tables are the defaults, the
 file's own tables are merged over them key by key (a component table whose
@@ -32,7 +33,8 @@ from typing import Any
 import numpy as np
 
 from toolkit.body import Body
-from toolkit.components import ActionSystem, Component, Correspondence, Matcher, MotorSystem, Perception, Segmenter
+from toolkit.components import (ActionSystem, Component, Correspondence, Layer, Matcher, MotorSystem, Perception,
+                                 Segmenter)
 from toolkit.errors import ConfigError, LikemeError, PluginError
 from toolkit.manager import PluginManager
 from toolkit.params import finite_number
@@ -56,6 +58,7 @@ COMPONENT_TABLES: dict[str, bool] = {
     "segmenter": False,
     "matcher": False,
     "action": False,
+    "layer": False,
 }
 """Component tables of a character file and whether each is required."""
 
@@ -72,7 +75,7 @@ class Character:
     name : str
     body : Body
     motor : MotorSystem
-    perception, correspondence, segmenter, matcher, action : component or None
+    perception, correspondence, segmenter, matcher, action, layer : component or None
     files : tuple of Path
         The file it was loaded from first, then the files it extends.
     description : str
@@ -97,6 +100,7 @@ class Character:
     segmenter: Segmenter | None = None
     matcher: Matcher | None = None
     action: ActionSystem | None = None
+    layer: Layer | None = None
     files: tuple[Path, ...] = ()
     description: str = ""
     lengths_for_height: float | None = None
@@ -415,6 +419,7 @@ def compose_character(table: Mapping[str, Any], pm: PluginManager, *, files: tup
         segmenter=built["segmenter"],  # type: ignore[arg-type]
         matcher=built["matcher"],  # type: ignore[arg-type]
         action=built["action"],  # type: ignore[arg-type]
+        layer=built["layer"],  # type: ignore[arg-type]
         files=files,
         description=description,
         lengths_for_height=None if lengths_for is None else float(lengths_for),

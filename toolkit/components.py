@@ -15,7 +15,8 @@ respond       :class:`ActionSystem`     all of it into a :class:`MovementRequest
 ============  ======================  ===============================================
 
 and the :class:`MotorSystem` turns a request into a :class:`~toolkit.motion.Motion`
-the character performs. :class:`Trigger` components are the conditions an action
+the character performs, over which a :class:`Layer` (a look-at) may change the pose
+it shows frame by frame. :class:`Trigger` components are the conditions an action
 system evaluates (can-I, should-I, do-until).
 
 Every component is built from validated parameters (its ``parameters`` tuple)
@@ -61,6 +62,7 @@ __all__ = [
     "Matcher",
     "MotorSystem",
     "ActionSystem",
+    "Layer",
     "Trigger",
     "View",
     "KINDS",
@@ -604,6 +606,25 @@ class ActionSystem(Component):
         return "\n".join(f"{k}: {v}" for k, v in self.describe().items()) or f"{self.name} (no state to show)"
 
 
+class Layer(Component):
+    """Changes the pose a character shows on top of every movement it performs (a look-at turning the head).
+
+    The runtime's acting step asks it for each frame of a movement the character performs (not for the way back
+    from a stopped imitation, nor for the posture held between movements): :meth:`apply` returns the pose to show
+    instead of the motion's, or ``None`` for the motion's own. The motion itself, what the motor system made, is
+    never changed, so a layer cannot break a posegraph or a motor command graph; a layer that changes nothing at a
+    movement's first and last frames keeps the movement's hub-to-hub continuity.
+    """
+
+    kind = "layer"
+
+    @abstractmethod
+    def apply(self, actor: Actor, request: MovementRequest, motion: Motion, frame: int,
+              world: World) -> np.ndarray | None:
+        """The pose (P, 3), in the actor's local frame, it shows at ``frame`` of ``motion``, which performs
+        ``request``; ``None``: ``motion.positions[frame]`` as it is."""
+
+
 class Trigger(Component):
     """A condition an action system evaluates: can-I, should-I, do-until, object selection.
 
@@ -671,6 +692,7 @@ KINDS: dict[str, type[Component]] = {
     "matcher": Matcher,
     "motor": MotorSystem,
     "action": ActionSystem,
+    "layer": Layer,
     "trigger": Trigger,
     "view": View,
 }

@@ -35,6 +35,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from toolkit.components import (
         ActionSystem,
         Behaviour,
+        Layer,
         Match,
         Matcher,
         MotorSystem,
@@ -111,6 +112,15 @@ def likeme_register_action_systems() -> list[type[ActionSystem]]:
 
     An action system chooses what its character does, interprets recognised
     movements as behaviour and responds (imitates, predicts, helps).
+    """
+
+
+@hookspec
+def likeme_register_layers() -> list[type[Layer]]:
+    """Return layer component classes (``[layer] plugin = NAME``).
+
+    A layer changes the pose a character shows on top of every movement it performs, frame by frame (a look-at
+    turning the head toward the object of attention), without changing the motion its motor system made.
     """
 
 

@@ -76,6 +76,7 @@ REGISTER_HOOKS: dict[str, str] = {
     "matcher": "likeme_register_matchers",
     "motor": "likeme_register_motor_systems",
     "action": "likeme_register_action_systems",
+    "layer": "likeme_register_layers",
     "trigger": "likeme_register_triggers",
     "view": "likeme_register_views",
 }

@@ -5,6 +5,8 @@ One :meth:`World.step` advances every actor by one frame:
 1. *act*: an actor that is performing moves one frame along its motion; an idle
    actor asks its action system what to do (:meth:`ActionSystem.choose`) and, if
    answered, asks its motor system for the motion (:meth:`MotorSystem.perform`).
+   The pose it shows is the motion's, changed by its layer if it has one
+   (:meth:`Layer.apply`: a look-at turning the head toward the object of attention).
 2. *observe*: an actor that watches a target perceives it and hands the percept
    to its :class:`~toolkit.watching.WatchingLoop` (the same loop an
    :class:`~toolkit.observe.Observer` runs): working memory, segment, match.
@@ -125,6 +127,8 @@ class Actor:
         self._frame = 0
         self._queue: list[MovementRequest] = []
         self._posture = np.asarray(character.motor.rest_pose(), dtype=float)  # held while no motion plays
+        self._started = 0  # movements started: with the frame, the key of the layered pose kept in _shown
+        self._shown: tuple[tuple[int, int], np.ndarray] | None = None
         self.percepts = 0
         self.loop = WatchingLoop(character, call=self._call, listener=_Reports(self))
         self._sightings: Sightings | None = None
@@ -156,10 +160,35 @@ class Actor:
         return self._motion is None
 
     def local_pose(self) -> np.ndarray:
-        """Current positions in the actor's local frame, shape (P, 3): the motion playing, else the posture held."""
+        """Current positions in the actor's local frame, shape (P, 3): the motion playing (changed by the
+        character's layer, if any), else the posture held."""
         if self._motion is None:
             return self._posture
-        return self._motion.positions[min(self._frame, self._motion.n_frames - 1)]
+        return self._layered(min(self._frame, self._motion.n_frames - 1))
+
+    def _layered(self, frame: int) -> np.ndarray:
+        """The pose shown at ``frame`` of the motion playing: the motion's, or what the layer makes of it (once
+        per frame of a movement; not for the way back from a stopped imitation, which performs no request)."""
+        motion = self._motion
+        assert motion is not None
+        layer = self.character.layer
+        if layer is None or self.performing is None:
+            return motion.positions[frame]
+        key = (self._started, frame)
+        if self._shown is None or self._shown[0] != key:
+            pose = self._call("layer", "apply", self, self.performing, motion, frame, self.world)
+            if pose is None:
+                pose = motion.positions[frame]
+            elif np.shape(pose) != (len(self.body.parts), 3):
+                error = PluginError(layer.name, f"{type(layer).__name__}.apply",
+                                    f"returned an array of shape {np.shape(pose)}, expected None or a pose "
+                                    f"({len(self.body.parts)}, 3)")
+                if self.world.on_plugin_error != "skip":
+                    raise error
+                self._drop("layer", layer, error)  # the run goes on with the motions as they are
+                pose = motion.positions[frame]
+            self._shown = (key, np.asarray(pose, dtype=float))
+        return self._shown[1]
 
     def world_pose(self) -> np.ndarray:
         """Current positions in world coordinates, shape (P, 3); finger joint angles (angle parts) as they are."""
@@ -192,6 +221,7 @@ class Actor:
             raise PluginError(motor.name, f"{type(motor).__name__}.perform",
                               f"returned {motion!r}, expected a Motion of at least one frame of the parts {list(self.body.parts)}")
         self._motion, self._frame, self.performing = motion, 0, request
+        self._started += 1
         self.performed.append((self.world.frame, request))
         self.world.emit("movement_started", self, request=request)
         if self.character.action is not None:
@@ -205,7 +235,7 @@ class Actor:
             self._frame += 1
             if self._frame >= self._motion.n_frames:
                 done = self.performing  # None after the way back from a stopped movement
-                self._posture = self._motion.positions[-1]
+                self._posture = self._layered(self._motion.n_frames - 1)
                 self._motion, self.performing = None, None
                 if done is not None and self.character.action is not None:
                     self._call("action", "completed", self, done, self.world)

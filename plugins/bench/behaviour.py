@@ -2,8 +2,12 @@
 
 Random episodes in which Morris is hungry or playful and food and a toy lie around him (the one he wants in front
 of him, the other to his side, or both close together; with or without a screen that hides his head and nose from
-Max). Max watches and identifies the first behaviour; the accuracy of the identified tuple path, motivation (the
+Max; or both anywhere within his reach, ``random-placement``, where only his turning head shows which one he
+wants). Max watches and identifies the first behaviour; the accuracy of the identified tuple path, motivation (the
 top-level tuple) and object is reported per condition against what Morris really did.
+
+The episodes are drawn first, as plain data, and then run in this process or, with ``--jobs N`` or ``--scheduler
+ADDRESS``, in other processes (:func:`plugins.bench.jobs.run_items`); the figures are the same wherever they ran.
 """
 
 from __future__ import annotations
@@ -24,39 +28,79 @@ from toolkit.state import write_atomic
 __all__ = ["BEHAVIOUR_CONDITIONS", "behaviour_benchmark", "render_behaviour", "cmd_behaviour"]
 
 
-BEHAVIOUR_CONDITIONS = ("line-of-sight", "no-line-of-sight", "close-together")
+BEHAVIOUR_CONDITIONS = ("line-of-sight", "no-line-of-sight", "close-together", "random-placement")
+"""The conditions, in the order their episodes are drawn (a condition added at the end leaves the others' episodes
+as they were)."""
+
+MORRIS_AT = (0.0, 0.0, 1.6)
+"""Where Morris stands (facing Max, who stands at the origin facing +z)."""
+REACH = (0.25, 0.42)
+"""Horizontal distances (m) from Morris's root at which objects are placed: within his reach (0.5 m)."""
+SIDE = 90.0
+"""``random-placement``: objects lie anywhere within reach on the side of Morris where his hands go, at azimuths
+(degrees from straight ahead) drawn uniformly in [-SIDE, SIDE]."""
 
 
-def _episode(pm: Any, rng: np.random.Generator, condition: str) -> dict[str, Any]:
-    """One random episode: Morris is hungry or playful, food and a toy lie around him; Max watches and identifies."""
-    from toolkit import WorldObject
+def _draw(rng: np.random.Generator, condition: str) -> dict[str, Any]:
+    """One random episode as plain data (drive, Morris's seed, where the objects lie), drawn from ``rng``.
 
+    Every random draw of an episode happens here, in the parent process and in the episodes' order, so an episode
+    does not depend on which process runs it (:func:`plugins.bench.jobs.run_items`).
+    """
     drive = str(rng.choice(["hunger", "play"]))
-    morris = load_character("morris", pm, override={"action": {"drives": {
-        "hunger": {"level": 0.8 if drive == "hunger" else 0.0, "rate": 0.0},
-        "play": {"level": 0.8 if drive == "play" else 0.0, "rate": 0.0}}, "seed": int(rng.integers(1 << 30))}})
-    max_ = load_character("max", pm, override={"action": {"imitate": False}})
-    world = World(fps=30.0, pm=pm)
-    target = world.add_actor(morris, "morris", (0.0, 0.0, 1.6), np.pi)
-    watcher = world.add_actor(max_, "max", (0.0, 0.0, 0.0), 0.0)
-    watcher.watch(target)
+    seed = int(rng.integers(1 << 30))
     wanted = "cheese" if drive == "hunger" else str(rng.choice(["ball", "baton"]))
     other = str(rng.choice(["ball", "baton"])) if drive == "hunger" else "cheese"
 
-    def place(azimuth_deg: float, distance: float, high: bool) -> np.ndarray:
+    def place(azimuth_deg: float, distance: float, high: bool) -> list[float]:
         a = np.radians(azimuth_deg)  # 0: straight ahead of Morris (towards -z)
         height = rng.uniform(0.75, 1.0) if high else rng.uniform(0.3, 0.5)
-        return np.array([distance * np.sin(a), height, 1.6 - distance * np.cos(a)])
+        return [float(distance * np.sin(a)), float(height), float(MORRIS_AT[2] - distance * np.cos(a))]
 
-    high = bool(rng.random() < 0.3)
-    pos_wanted = place(rng.uniform(-12, 12), rng.uniform(0.25, 0.42), high)
-    if condition == "close-together":
-        pos_other = pos_wanted + np.array([rng.normal(0, 0.02), rng.uniform(-0.02, 0.02), rng.normal(0, 0.02)])
+    if condition == "random-placement":  # both anywhere within reach: nothing puts the wanted one in front
+        pos_wanted = place(rng.uniform(-SIDE, SIDE), rng.uniform(*REACH), bool(rng.random() < 0.3))
+        pos_other = place(rng.uniform(-SIDE, SIDE), rng.uniform(*REACH), bool(rng.random() < 0.3))
     else:
-        side = rng.choice([-1.0, 1.0])
-        pos_other = place(side * rng.uniform(45, 80), rng.uniform(0.25, 0.42), bool(rng.random() < 0.3))
-    world.add_object(WorldObject(wanted, wanted, pos_wanted, radius=0.035))
-    world.add_object(WorldObject(other, other, pos_other, radius=0.035))
+        high = bool(rng.random() < 0.3)
+        pos_wanted = place(rng.uniform(-12, 12), rng.uniform(*REACH), high)
+        if condition == "close-together":
+            pos_other = [float(x) for x in np.asarray(pos_wanted) + np.array(
+                [rng.normal(0, 0.02), rng.uniform(-0.02, 0.02), rng.normal(0, 0.02)])]
+        else:
+            side = rng.choice([-1.0, 1.0])
+            pos_other = place(side * rng.uniform(45, 80), rng.uniform(*REACH), bool(rng.random() < 0.3))
+    return {"condition": condition, "drive": drive, "seed": seed, "wanted": wanted, "other": other,
+            "positions": {wanted: pos_wanted, other: pos_other}}
+
+
+_WORKER_PM: Any = None
+
+
+def _run_episode(item: dict[str, Any], pm: Any = None) -> dict[str, Any]:
+    """Run one drawn episode (:func:`_draw`): Morris acts, Max watches and identifies; in any process.
+
+    Without ``pm`` (a worker of ``--jobs`` or ``--scheduler``) the process's own plugin manager is made once.
+    """
+    from toolkit import WorldObject
+
+    global _WORKER_PM
+    if pm is None:
+        if _WORKER_PM is None:
+            from toolkit.manager import create_plugin_manager
+
+            _WORKER_PM = create_plugin_manager()
+        pm = _WORKER_PM
+    drive, condition, wanted = item["drive"], item["condition"], item["wanted"]
+    morris = load_character("morris", pm, override={"action": {"drives": {
+        "hunger": {"level": 0.8 if drive == "hunger" else 0.0, "rate": 0.0},
+        "play": {"level": 0.8 if drive == "play" else 0.0, "rate": 0.0}}, "seed": item["seed"]}})
+    max_ = load_character("max", pm, override={"action": {"imitate": False}})
+    world = World(fps=30.0, pm=pm)
+    target = world.add_actor(morris, "morris", MORRIS_AT, np.pi)
+    watcher = world.add_actor(max_, "max", (0.0, 0.0, 0.0), 0.0)
+    watcher.watch(target)
+    for name, position in item["positions"].items():
+        world.add_object(WorldObject(name, name, position, radius=0.035))
     if condition == "no-line-of-sight":
         world.add_object(WorldObject("screen", "screen", (0.0, 0.62, 1.0), radius=0.12))
     world.run(until_idle=True, tail=1.0, max_duration=12.0)
@@ -70,25 +114,38 @@ def _episode(pm: Any, rng: np.random.Generator, condition: str) -> dict[str, Any
         "condition": condition,
         "drive": drive,
         "object": wanted,
+        "positions": item["positions"],
         "true_path": list(first[1]) if first else None,
         "true_object": first[2] if first else None,
         "identified": bool(got is not None and got.known),
         "path": list(got.path) if got is not None and got.known else None,
         "identified_object": got.object if got is not None and got.known else None,
+        "line_of_sight": got.details.get("line_of_sight") if got is not None else None,
     }
 
 
-def behaviour_benchmark(pm: Any, *, episodes: int = 100, seed: int = 0, progress: bool = False) -> dict[str, Any]:
-    """Identification accuracy (tuple path, motivation, object) per condition over random episodes (B&B §6)."""
+def behaviour_benchmark(pm: Any, *, episodes: int = 100, seed: int = 0, progress: bool = False, jobs: int = 1,
+                        scheduler: str | None = None,
+                        conditions: tuple[str, ...] = BEHAVIOUR_CONDITIONS) -> dict[str, Any]:
+    """Identification accuracy (tuple path, motivation, object) per condition over random episodes (B&B §6).
+
+    The episodes are drawn here from ``seed`` (every condition's in :data:`BEHAVIOUR_CONDITIONS` order, whichever
+    are run), then run in this process (``jobs`` 1, with ``pm``), in ``jobs`` local processes or on a Dask cluster
+    (``scheduler``): the figures do not depend on where they ran.
+    """
+    from plugins.bench.jobs import run_items
+
     rng = np.random.default_rng(seed)
-    jobs = [c for c in BEHAVIOUR_CONDITIONS for _ in range(episodes)]
+    drawn = [_draw(rng, c) for c in BEHAVIOUR_CONDITIONS for _ in range(episodes)]
+    items = [d for d in drawn if d["condition"] in conditions]
     started = time.perf_counter()
-    if progress:
-        jobs = progress_bar(jobs, "behaviour episodes")
-    rows = [_episode(pm, rng, c) for c in jobs]
+    if jobs == 1 and not scheduler:
+        rows = [_run_episode(item, pm) for item in (progress_bar(items, "behaviour episodes") if progress else items)]
+    else:
+        rows = run_items(_run_episode, items, jobs=jobs, scheduler=scheduler)
     elapsed = time.perf_counter() - started
     table = {}
-    for c in BEHAVIOUR_CONDITIONS:
+    for c in conditions:
         sub = [r for r in rows if r["condition"] == c and r["true_path"]]
         n = max(len(sub), 1)
         table[c] = {
@@ -99,7 +156,8 @@ def behaviour_benchmark(pm: Any, *, episodes: int = 100, seed: int = 0, progress
             "object": sum(r["identified_object"] == r["true_object"] for r in sub) / n,
         }
     return {"benchmark": "behaviour", "seed": seed, "episodes_per_condition": episodes, "conditions": table,
-            "episodes": rows, "seconds": elapsed, "python": platform.python_version(), "numpy": np.__version__}
+            "episodes": rows, "seconds": elapsed, "jobs": jobs, "python": platform.python_version(),
+            "numpy": np.__version__}
 
 
 def render_behaviour(r: dict[str, Any]) -> str:
@@ -115,7 +173,8 @@ def render_behaviour(r: dict[str, Any]) -> str:
 
 
 def cmd_behaviour(args: argparse.Namespace, pm: Any) -> int:
-    result = behaviour_benchmark(pm, episodes=args.episodes, seed=args.seed, progress=not args.quiet)
+    result = behaviour_benchmark(pm, episodes=args.episodes, seed=args.seed, progress=not args.quiet,
+                                 jobs=args.jobs, scheduler=args.scheduler)
     print(render_behaviour(result))
     if args.json:
         write_atomic(Path(args.json), json.dumps(result, indent=2, default=float) + "\n")

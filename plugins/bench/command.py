@@ -219,6 +219,7 @@ def likeme_register_commands(subparsers):
     p.set_defaults(handler=_handler("facilitation", "cmd_facilitation"))
 
     p = sub.add_parser("behaviour", help="an observer identifies the behaviour, motivation and object of a demonstrator (B&B §6)")
+    _jobs_options(p)
     p.add_argument("--episodes", type=int, default=100, help="random episodes per condition (default: 100)")
     p.add_argument("--seed", type=seed_type, default=0)
     p.add_argument("--json", metavar="FILE", help="also write the results (every episode) as JSON")
