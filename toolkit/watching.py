@@ -233,6 +233,13 @@ class WorkingMemory:
         return self._stop - self.start
 
     @property
+    def settled(self) -> bool:
+        """Whether the rows given so far keep their values from now on: every part has been seen, so no first
+        sighting rewrites earlier rows (:class:`ObservationLog`). A matcher may then keep what it computed from
+        them and only add the new rows' share (incremental per-frame work)."""
+        return self._log._all_seen
+
+    @property
     def fps(self) -> float:
         return self._log.fps
 

@@ -245,6 +245,96 @@ def _lengths(observed: np.ndarray) -> np.ndarray:
         np.zeros(observed.shape[1])
 
 
+class _Grown:
+    """Rows computed once each and kept in a buffer that grows by doubling: :meth:`view` is the first ``n`` (a view).
+
+    The forward model's per-frame work is incremental with it: a row of the working memory, once given and settled
+    (:attr:`WorkingMemory.settled <toolkit.watching.WorkingMemory.settled>`), never changes, so what is computed
+    from it is computed once.
+    """
+
+    __slots__ = ("buffer", "n")
+
+    def __init__(self, shape: tuple[int, ...], capacity: int = 64) -> None:
+        self.buffer = np.empty((max(1, capacity), *shape))
+        self.n = 0
+
+    def extend(self, rows: np.ndarray) -> None:
+        """Append ``rows`` (m, *shape)."""
+        end = self.n + len(rows)
+        if end > len(self.buffer):
+            bigger = np.empty((max(end, 2 * len(self.buffer)), *self.buffer.shape[1:]))
+            bigger[: self.n] = self.buffer[: self.n]
+            self.buffer = bigger
+        self.buffer[self.n : end] = rows
+        self.n = end
+
+    def view(self) -> np.ndarray:
+        return self.buffer[: self.n]
+
+
+class _Walk:
+    """:func:`_lengths` of a growing working memory, frame by frame, with exactly the same values.
+
+    The three-frame mean (``uniform_filter1d``, ``mode="nearest"``) is scipy's running sum: ``tmp`` starts at the
+    sum of the first window, then adds each entering row minus the leaving one, and each output is ``tmp / 3``. A
+    new frame changes only the last smoothed row (its right neighbour was the edge's copy) and adds one: the running
+    sum is kept up to the last row whose window lies wholly inside the frames seen, and so are the norms of the
+    steps between the smoothed rows that are final, so a frame costs a few rows whatever the length of the segment.
+    The total is summed by numpy over the kept norms as :func:`_lengths` sums them (same array layout, same order:
+    the same bits). ``tests/test_forward_model_incremental.py`` compares it with :func:`_lengths` on random data.
+    """
+
+    __slots__ = ("tmp", "final", "smooth", "norms", "seen")
+
+    def __init__(self, k: int) -> None:
+        self.tmp: np.ndarray | None = None  # scipy's running window sum at row ``final - 1`` (k, 3)
+        self.final = 0  # smoothed rows [0, final) are final: their windows lie inside the frames seen
+        self.smooth = _Grown((k, 3))  # the final smoothed rows
+        self.norms = _Grown((k,))  # the norms of the steps between final smoothed rows, then one slot more
+        self.seen = 0
+
+    def lengths(self, observed: np.ndarray) -> np.ndarray:
+        """``_lengths(observed)`` for ``observed`` (n, k, 3), whose first rows are the ones given before."""
+        n = len(observed)
+        if n < self.seen:
+            raise ValueError(f"the working memory shrank from {self.seen} to {n} rows")
+        self.seen = n
+        if n < 3:  # no filter below three frames (as _lengths)
+            return _lengths(observed)
+        if self.tmp is None:  # scipy: tmp = 0.0 + x[-1] + x[0] + x[1], the edge repeated
+            self.tmp = (observed[0] + observed[0]) + observed[1]
+            self.smooth.extend((self.tmp / 3)[None])
+            self.final = 1
+        if self.final < n - 1:  # rows final .. n-2: tmp[i] = tmp[i-1] + (x[i+1] - x[i-2])
+            tmp, out = self.tmp, []
+            for i in range(self.final, n - 1):
+                tmp = tmp + (observed[i + 1] - observed[max(i - 2, 0)])
+                out.append(tmp / 3)
+            self.tmp, self.final = tmp, n - 1
+            before = self.smooth.n
+            self.smooth.extend(np.stack(out))
+            rows = self.smooth.buffer[before - 1 : self.smooth.n]
+            self.norms.n = before - 1  # drop the slot of the last edge row
+            self.norms.extend(np.linalg.norm(np.diff(rows, axis=0), axis=-1))
+        # the last row's window repeats its own frame (the edge): tmp[n-1] = tmp[n-2] + (x[n-1] - x[n-3])
+        edge = (self.tmp + (observed[n - 1] - observed[n - 3])) / 3
+        self.norms.n = n - 2
+        self.norms.extend(np.linalg.norm(edge - self.smooth.buffer[n - 2], axis=-1)[None])
+        return self.norms.view().sum(axis=0)
+
+
+@dataclass
+class _Tracked:
+    """What the forward model keeps of one followed subsystem between frames: its rows of the working memory
+    (:meth:`ForwardModel._observed`), their path lengths (:class:`_Walk`) and the rows it gave last."""
+
+    track: Track
+    rows: _Grown
+    walk: _Walk
+    last: np.ndarray | None = None
+
+
 class ForwardModel(Matcher):
     """Edges of the active node predict the demonstration in parallel; the last one left is imitated at once (K&G §4.4)."""
 
@@ -305,6 +395,9 @@ class ForwardModel(Matcher):
         self._tables: dict[int, tuple] = {}
         self._edges: dict[str, _EdgeTable] = {}
         self._memory: WorkingMemory | None = None
+        self._rows: _Grown | None = None  # the working memory in the motor frame, row by row (settled rows)
+        self._last_local: np.ndarray | None = None
+        self._tracked: dict[str, _Tracked] = {}
         self._spreads: dict[str, float] | None = None
         self.tracks: dict[str, Track] = {}
         self.reported = False
@@ -313,6 +406,7 @@ class ForwardModel(Matcher):
 
     def begin(self, memory: WorkingMemory) -> None:
         self._memory = memory
+        self._rows, self._last_local, self._tracked = None, None, {}
         self.fps = memory.fps
         self.tracks = {}  # in the order the subsystems began to move
         self.reported = False  # a commitment to the tracks decided so far has been announced
@@ -355,8 +449,22 @@ class ForwardModel(Matcher):
 
     def _local(self) -> np.ndarray:
         """The working memory in the observer's motor frame (n, P, 3): root-relative positions placed at its own
-        root height (finger angles as seen); hidden parts held, never-seen parts NaN."""
-        return self._memory.positions + self._root_height
+        root height (finger angles as seen); hidden parts held, never-seen parts NaN.
+
+        Settled rows (:attr:`WorkingMemory.settled <toolkit.watching.WorkingMemory.settled>`) are placed once and
+        kept (the same values: each row's own sum); until every part has been seen, all of them every time."""
+        memory = self._memory
+        if not memory.settled:
+            self._rows, self._last_local, self._tracked = None, None, {}
+            return memory.positions + self._root_height
+        rows, n = self._rows, memory.n
+        if rows is None or rows.n > n:
+            rows = self._rows = _Grown(memory.positions.shape[1:], max(64, 2 * n))
+            self._tracked = {}
+        if rows.n < n:
+            rows.extend(memory.positions[rows.n : n] + self._root_height)
+        self._last_local = rows.view()
+        return self._last_local
 
     def _at(self, row: int) -> np.ndarray:
         """One row of the working memory in the motor frame (P, 3)."""
@@ -401,6 +509,8 @@ class ForwardModel(Matcher):
             return
         late = bool(self.tracks)
         waiting = [name for name in self.motor.subsystems if name not in self.tracks]
+        if not waiting:  # every subsystem is followed
+            return
         if late:
             first = memory[:3].mean(axis=0)
             moved = self._moved(waiting, first, memory[-3:].mean(axis=0))
@@ -428,6 +538,8 @@ class ForwardModel(Matcher):
         if not self.params["together"]:
             return False
         waiting = [n for n in self.motor.subsystems if n not in self.tracks]
+        if not waiting:
+            return False
         moved = self._moved(waiting, memory[:3].mean(axis=0), memory[-3:].mean(axis=0))
         return any(d > 0.5 * self.params["min_move"] for d in moved.values())
 
@@ -461,13 +573,35 @@ class ForwardModel(Matcher):
         return float(np.nanmax(d) if self.params["error"] == "max" else np.nanmean(d))
 
     def _observed(self, track: Track, memory: np.ndarray) -> np.ndarray:
-        """The working memory of a subsystem's parts since it is followed, (n, k, 3)."""
-        return memory[track.onset:, self.motor.subsystems[track.subsystem]]
+        """The working memory of a subsystem's parts since it is followed, (n, k, 3).
+
+        Of the working memory :meth:`_local` gave last, the rows are gathered once each and kept (a view)."""
+        idx = self.motor.subsystems[track.subsystem]
+        if memory is not self._last_local or memory is None:
+            return memory[track.onset:, idx]
+        kept = self._tracked.get(track.subsystem)
+        if kept is None or kept.track is not track:
+            kept = self._tracked[track.subsystem] = _Tracked(track, _Grown((len(idx), 3)), _Walk(len(idx)))
+        rows = kept.rows
+        if rows.n < len(memory) - track.onset:
+            rows.extend(memory[track.onset + rows.n :, idx])
+        kept.last = rows.view()
+        return kept.last
+
+    def _walked(self, track: Track, observed: np.ndarray) -> np.ndarray:
+        """``_lengths(observed)`` of the rows :meth:`_observed` gave last for ``track``, frame by frame (:class:`_Walk`:
+        the same values, a few rows' work a frame); of other rows, computed whole."""
+        kept = self._tracked.get(track.subsystem)
+        if kept is None or kept.track is not track or kept.last is not observed:
+            return _lengths(observed)
+        return kept.walk.lengths(observed)
 
     def _follow(self, track: Track, memory: np.ndarray) -> Match | None:
         """One frame of a subsystem's predictions (Fig. 3); a :class:`Match` with ``stop`` when its imitation deviates."""
+        if track.committed is None and not track.candidates:  # nothing left to predict (as below, without the work)
+            return None
         observed = self._observed(track, memory)
-        lengths = _lengths(observed)  # once per frame
+        lengths = self._walked(track, observed)  # once per frame (incremental)
         last = observed[-1]
         frame = self._memory.n - 1
         if track.committed is not None:
