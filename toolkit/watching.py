@@ -102,6 +102,7 @@ class ObservationLog:
         self._all_seen = False
         self.n = 0
         self.offset = 0  # the row number of the first row held (self._pos[0])
+        self.revision = 0  # counts the rewrites of rows already held (WorkingMemory.revision)
 
     def append(self, pose: np.ndarray, visible: np.ndarray, world: np.ndarray | None = None) -> None:
         """One frame: root-relative pose (P, 3), visible (P,), world positions (P, 3) if known."""
@@ -125,6 +126,7 @@ class ObservationLog:
         if not self._all_seen:
             first = ~self._seen & visible.any(axis=0)
             if first.any() and start:  # seen for the first time: the rows before hold that sighting
+                self.revision += 1
                 self._pos[:start, first] = self._pos[start:end][np.argmax(visible[:, first], axis=0), first]
                 self._world[:start, first] = self._world[start:end][np.argmax(visible[:, first], axis=0), first]
             self._seen |= visible.any(axis=0)
@@ -233,11 +235,12 @@ class WorkingMemory:
         return self._stop - self.start
 
     @property
-    def settled(self) -> bool:
-        """Whether the rows given so far keep their values from now on: every part has been seen, so no first
-        sighting rewrites earlier rows (:class:`ObservationLog`). A matcher may then keep what it computed from
-        them and only add the new rows' share (incremental per-frame work)."""
-        return self._log._all_seen
+    def revision(self) -> int:
+        """Counts the times rows already in working memory were rewritten (a part seen for the first time: the
+        rows before hold that sighting, :class:`ObservationLog`). While it stays the same, the rows given keep
+        their values, so a matcher may keep what it computed from them and add only the new rows' share
+        (incremental per-frame work)."""
+        return self._log.revision
 
     @property
     def fps(self) -> float:

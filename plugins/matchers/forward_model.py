@@ -248,9 +248,9 @@ def _lengths(observed: np.ndarray) -> np.ndarray:
 class _Grown:
     """Rows computed once each and kept in a buffer that grows by doubling: :meth:`view` is the first ``n`` (a view).
 
-    The forward model's per-frame work is incremental with it: a row of the working memory, once given and settled
-    (:attr:`WorkingMemory.settled <toolkit.watching.WorkingMemory.settled>`), never changes, so what is computed
-    from it is computed once.
+    The forward model's per-frame work is incremental with it: a row of the working memory, once given, keeps its
+    values while :attr:`WorkingMemory.revision <toolkit.watching.WorkingMemory.revision>` stays the same, so what
+    is computed from it is computed once.
     """
 
     __slots__ = ("buffer", "n")
@@ -333,6 +333,7 @@ class _Tracked:
     rows: _Grown
     walk: _Walk
     last: np.ndarray | None = None
+    stacked: tuple | None = None
 
 
 class ForwardModel(Matcher):
@@ -395,9 +396,10 @@ class ForwardModel(Matcher):
         self._tables: dict[int, tuple] = {}
         self._edges: dict[str, _EdgeTable] = {}
         self._memory: WorkingMemory | None = None
-        self._rows: _Grown | None = None  # the working memory in the motor frame, row by row (settled rows)
+        self._rows: _Grown | None = None  # the working memory in the motor frame, row by row
         self._last_local: np.ndarray | None = None
         self._tracked: dict[str, _Tracked] = {}
+        self._revision = 0
         self._spreads: dict[str, float] | None = None
         self.tracks: dict[str, Track] = {}
         self.reported = False
@@ -406,7 +408,7 @@ class ForwardModel(Matcher):
 
     def begin(self, memory: WorkingMemory) -> None:
         self._memory = memory
-        self._rows, self._last_local, self._tracked = None, None, {}
+        self._rows, self._last_local, self._tracked, self._revision = None, None, {}, memory.revision
         self.fps = memory.fps
         self.tracks = {}  # in the order the subsystems began to move
         self.reported = False  # a commitment to the tracks decided so far has been announced
@@ -451,16 +453,14 @@ class ForwardModel(Matcher):
         """The working memory in the observer's motor frame (n, P, 3): root-relative positions placed at its own
         root height (finger angles as seen); hidden parts held, never-seen parts NaN.
 
-        Settled rows (:attr:`WorkingMemory.settled <toolkit.watching.WorkingMemory.settled>`) are placed once and
-        kept (the same values: each row's own sum); until every part has been seen, all of them every time."""
+        Each row is placed once and kept (the same values: each row's own sum), all of them again when rows
+        already given were rewritten (:attr:`WorkingMemory.revision <toolkit.watching.WorkingMemory.revision>`: a
+        part seen for the first time)."""
         memory = self._memory
-        if not memory.settled:
-            self._rows, self._last_local, self._tracked = None, None, {}
-            return memory.positions + self._root_height
         rows, n = self._rows, memory.n
-        if rows is None or rows.n > n:
+        if rows is None or rows.n > n or self._revision != memory.revision:
             rows = self._rows = _Grown(memory.positions.shape[1:], max(64, 2 * n))
-            self._tracked = {}
+            self._tracked, self._revision = {}, memory.revision
         if rows.n < n:
             rows.extend(memory.positions[rows.n : n] + self._root_height)
         self._last_local = rows.view()
@@ -622,7 +622,7 @@ class ForwardModel(Matcher):
                                                                          "return_to": track.last_correct})
         if not track.candidates:
             return None
-        errors = {path: self._error(track, path, lengths, last) for path in self._extended(track, lengths)}
+        errors = self._errors(track, self._extended(track, lengths), lengths, last)
         track.trace.append((frame, errors))
         still = self._distance(track, observed[0], last) if self.params["stillness"] else None
         alive = self._survivors(errors, self._evidence(track, errors), still)
@@ -890,6 +890,40 @@ class ForwardModel(Matcher):
         """
         predicted = self._predict(track, path, self._along(track, path[0], lengths))
         return self._distance(track, predicted + self._onset_offset(track, path[0]), last)
+
+    def _errors(self, track: Track, paths: list[tuple[str, ...]], lengths: np.ndarray,
+                last: np.ndarray) -> dict[tuple[str, ...], float]:
+        """:meth:`_error` of every candidate path, in their order: the one-command paths of a positional subsystem
+        predicted at once (their strokes stacked part by part, :meth:`_stacked`; the same arithmetic row by row, so
+        the same values), the others one by one."""
+        batch = [] if track.hand else [path for path in paths if len(path) == 1]
+        errors: dict[tuple[str, ...], float] = {}
+        if len(batch) > 1:
+            arcs, positions, totals, anchors, offsets = self._stacked(track, tuple(path[0] for path in batch))
+            k = len(lengths)
+            along = np.minimum(lengths + anchors, totals).reshape(-1)  # (C * k,): _along, then _predict's minimum
+            predicted = _along_rows(arcs, positions, along).reshape(len(batch), k, 3) + offsets
+            d = np.linalg.norm(predicted - last, axis=-1) * track.scale
+            combined = d.max(axis=1) if self.params["error"] == "max" else d.mean(axis=1)
+            errors = dict(zip(batch, combined.tolist()))
+        return {path: errors[path] if path in errors else self._error(track, path, lengths, last) for path in paths}
+
+    def _stacked(self, track: Track, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
+        """For commands ``names`` followed by ``track``: their strokes' cumulative lengths (C * k, G) and positions
+        (C * k, G, 3), stroke lengths (C, k), anchors (C, k) and onset offsets (C, k, 3), stacked once per set of
+        candidates (kept until the set changes)."""
+        kept = self._tracked.get(track.subsystem)
+        cache = getattr(kept, "stacked", None) if kept is not None and kept.track is track else None
+        if cache is not None and cache[0] == names:
+            return cache[1]
+        edges = [self._edge(name) for name in names]
+        stacked = (np.concatenate([e.arcs for e in edges]), np.concatenate([e.positions for e in edges]),
+                   np.stack([e.arcs[:, -1] for e in edges]), np.stack([self._anchor(track, n) for n in names]),
+                   np.stack([np.broadcast_to(self._onset_offset(track, n), e.positions[:, 0].shape)
+                             for n, e in zip(names, edges)]))
+        if kept is not None and kept.track is track:
+            kept.stacked = (names, stacked)
+        return stacked
 
     def _along(self, track: Track, name: str, lengths: np.ndarray) -> np.ndarray:
         """How far along a path beginning with command ``name`` each part is: the observed path length plus
