@@ -530,7 +530,8 @@ class ForwardModel(Matcher):
 
     def _moved(self, names: list[str], first: np.ndarray, last: np.ndarray) -> dict[str, float]:
         """How far (m; a hand's radians scaled) each subsystem's parts have moved at most from ``first`` to ``last``."""
-        return {name: float(np.nanmax(np.linalg.norm(last[idx] - first[idx], axis=-1))) * self._scale_of(name)
+        far = np.linalg.norm(last - first, axis=-1)  # every part at once (the same values as part by part)
+        return {name: float(np.fmax.reduce(far[idx])) * self._scale_of(name)  # np.nanmax without its warning
                 for name, idx in self.motor.subsystems.items() if name in names}
 
     def _joining(self, memory: np.ndarray) -> bool:
@@ -945,8 +946,10 @@ class ForwardModel(Matcher):
             anchor = np.zeros(len(edge.arcs))
             if not (self.params["relative"] or track.hand):
                 first = self._first(track)
-                far = np.linalg.norm(edge.positions - first[:, None], axis=-1)
-                far[edge.arcs > 0.5 * edge.arcs[:, -1:]] = np.inf  # the first half of each stroke
+                later = edge.arcs > 0.5 * edge.arcs[:, -1:]  # past the first half of each stroke (a suffix: arcs grow)
+                h = int(len(later[0]) - later.sum(axis=1).min())  # the points no stroke's first half reaches: not looked at
+                far = np.linalg.norm(edge.positions[:, :h] - first[:, None], axis=-1)
+                far[later[:, :h]] = np.inf
                 anchor = edge.arcs[np.arange(len(far)), np.argmin(far, axis=1)]
             track.anchors[name] = anchor
         return anchor
