@@ -383,6 +383,7 @@ class WatchingLoop:
                  max_segment: float | None = MAX_SEGMENT_SECONDS) -> None:
         self.character = character
         self._call = call or (lambda key, method, *a, **k: call_component(character, key, method, *a, **k))
+        self._direct = call is None  # components are called by call_component (the matcher once a frame: directly)
         self.listener = listener or Listener()
         self.keep = _seconds(keep, "keep")
         self.max_segment = _seconds(max_segment, "max_segment")
@@ -475,16 +476,17 @@ class WatchingLoop:
             return []
         closed, since = self._checked_block(result, n, first)
         out: list[Observation] = []
-        k = 0
+        k, onsets = 0, since.tolist()
         for i in range(n):
-            here = []
-            while k < len(closed) and closed[k][0] == i:
-                here.append(closed[k][1])
-                k += 1
-            here = self._clipped(here)
-            out.extend(self._close(s, split=len(here) > 1) for s in here)
+            if k < len(closed) and closed[k][0] == i:  # segments closed at this frame
+                here = []
+                while k < len(closed) and closed[k][0] == i:
+                    here.append(closed[k][1])
+                    k += 1
+                here = self._clipped(here)
+                out.extend(self._close(s, split=len(here) > 1) for s in here)
             row = first + i
-            onset = int(since[i])
+            onset = onsets[i]
             if onset >= 0:
                 onset = max(onset, self._floor, self.memory.offset)
                 if self._max_frames is not None and row - onset >= self._max_frames:  # never closed: cut it here
@@ -572,7 +574,10 @@ class WatchingLoop:
         if self.character.matcher is None or self._view is None:
             return
         self._view.feed(row + 1)
-        match = self._call("matcher", "observe", self._view)
+        if self._direct:  # call_component, without its indirections (once a frame)
+            match = guarded(self.character.matcher, "observe", self._view)
+        else:
+            match = self._call("matcher", "observe", self._view)
         if match is None or self.character.matcher is None:
             return
         self._check_match(match, "observe")
