@@ -104,7 +104,7 @@ def direction_clusters(vectors: np.ndarray, angle: float, max_clusters: int = 12
         means.append(vectors[worst].copy())  # a new cluster around the most different element
         for _ in range(10):  # redistribute and re-average until stable
             labels = np.argmax(vectors @ np.array(means).T, axis=1)
-            new = [_unit(vectors[labels == k].mean(axis=0)) if np.any(labels == k) else means[k] for k in range(len(means))]
+            new = _cluster_means(vectors, labels, means)
             if _allclose(np.array(new), np.array(means)):
                 break
             means = new
@@ -136,6 +136,26 @@ class StrokeAnalysis:
 def _unit(v: np.ndarray) -> np.ndarray:
     n = np.linalg.norm(v)
     return v / n if n > 1e-12 else v
+
+
+def _cluster_means(vectors: np.ndarray, labels: np.ndarray, means: list[np.ndarray]) -> list[np.ndarray]:
+    """Each cluster's mean direction, ``_unit(vectors[labels == k].mean(axis=0))``, or its old one ``means[k]`` if
+    it has no vector: the same values (each cluster's rows summed in their order, divided by their count, and
+    divided by the square root of the mean's dot product with itself, as ``mean`` and ``np.linalg.norm`` do), from
+    one sort of the labels instead of a mask per cluster."""
+    order = np.argsort(labels, kind="stable")
+    grouped = vectors[order]
+    bounds = np.searchsorted(labels[order], np.arange(len(means) + 1)).tolist()
+    new = []
+    for k, mean in enumerate(means):
+        a, b = bounds[k], bounds[k + 1]
+        if a == b:
+            new.append(mean)
+            continue
+        centre = np.add.reduce(grouped[a:b], axis=0) / (b - a)
+        norm = np.sqrt(centre.dot(centre))
+        new.append(centre / norm if norm > 1e-12 else centre)
+    return new
 
 
 def _units(vectors: np.ndarray) -> np.ndarray:
