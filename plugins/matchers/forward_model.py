@@ -273,6 +273,12 @@ class _Grown:
         return self.buffer[: self.n]
 
 
+def _norms(d: np.ndarray) -> np.ndarray:
+    """``np.linalg.norm(d, axis=-1)`` of real values, as numpy computes it (the square root of the summed squares
+    along the last axis), without its argument handling: the same values."""
+    return np.sqrt(np.add.reduce(d * d, axis=-1))
+
+
 class _Walk:
     """:func:`_lengths` of a growing working memory, frame by frame, with exactly the same values.
 
@@ -306,7 +312,19 @@ class _Walk:
             self.tmp = (observed[0] + observed[0]) + observed[1]
             self.smooth.extend((self.tmp / 3)[None])
             self.final = 1
-        if self.final < n - 1:  # rows final .. n-2: tmp[i] = tmp[i-1] + (x[i+1] - x[i-2])
+        if self.final == n - 2 and n >= 4:  # one more final row (the common case: one frame more)
+            self.tmp = self.tmp + (observed[n - 1] - observed[n - 4])
+            row = self.tmp / 3
+            smooth = self.smooth
+            if smooth.n == len(smooth.buffer):
+                smooth.extend(row[None])
+            else:
+                smooth.buffer[smooth.n] = row
+                smooth.n += 1
+            self.final = n - 1
+            self.norms.n = n - 3
+            self.norms.extend(_norms(row - smooth.buffer[n - 3])[None])
+        elif self.final < n - 1:  # rows final .. n-2: tmp[i] = tmp[i-1] + (x[i+1] - x[i-2])
             tmp, out = self.tmp, []
             for i in range(self.final, n - 1):
                 tmp = tmp + (observed[i + 1] - observed[max(i - 2, 0)])
@@ -319,9 +337,14 @@ class _Walk:
             self.norms.extend(np.linalg.norm(np.diff(rows, axis=0), axis=-1))
         # the last row's window repeats its own frame (the edge): tmp[n-1] = tmp[n-2] + (x[n-1] - x[n-3])
         edge = (self.tmp + (observed[n - 1] - observed[n - 3])) / 3
-        self.norms.n = n - 2
-        self.norms.extend(np.linalg.norm(edge - self.smooth.buffer[n - 2], axis=-1)[None])
-        return self.norms.view().sum(axis=0)
+        norms = self.norms
+        norms.n = n - 2
+        if norms.n == len(norms.buffer):
+            norms.extend(_norms(edge - self.smooth.buffer[n - 2])[None])
+        else:
+            norms.buffer[norms.n] = _norms(edge - self.smooth.buffer[n - 2])
+            norms.n += 1
+        return np.add.reduce(norms.buffer[: norms.n], axis=0)
 
 
 @dataclass
@@ -867,6 +890,9 @@ class ForwardModel(Matcher):
                     t = self._mapped_time(commands[lead], left)
                     return np.array([c.position(t) for c in commands])
                 left -= arc[-1]
+        if len(path) == 1:  # one command: every part along its stroke (what the loop below does for one edge)
+            edge = self._edge(path[0])
+            return _along_rows(edge.arcs, edge.positions, np.minimum(lengths, edge.arcs[:, -1]))
         # each part along its own strokes: on the first edge whose stroke is longer than what is left to place
         out = np.empty((len(lengths), 3))
         left = np.array(lengths, dtype=float)
