@@ -151,3 +151,27 @@ def test_frame_by_frame_errors_are_the_whole_segments(write, pm, hidden):
         checked += 1
     assert checked >= 10  # the candidates were followed for a while, across the head's first sighting
     assert (memory.revision > 0) == hidden
+
+
+def _direct_anchor(matcher, track: Track, name: str) -> np.ndarray:
+    """Where each part joins command ``name``: the nearest point of the first half of its stroke to where it was
+    seen at the onset (the formula, one command at a time, over the whole stroke)."""
+    edge = matcher._edge(name)
+    far = np.linalg.norm(edge.positions - track.first[:, None], axis=-1)
+    far[edge.arcs > 0.5 * edge.arcs[:, -1:]] = np.inf
+    return edge.arcs[np.arange(len(far)), np.argmin(far, axis=1)]
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(first=arrays(np.float64, (2, 3), elements=st.floats(-1.0, 2.0)), seed=st.integers(0, 3))
+def test_anchors_placed_at_once_are_placed_one_by_one(write, pm, first, seed):
+    """The anchors of every candidate of a track, placed at once (:meth:`ForwardModel._anchor`: the strokes' first
+    halves stacked), are each command's own nearest first-half point."""
+    character, names = _arms(write, pm, strokes=6, seed=seed)
+    matcher = character.matcher
+    rest = character.motor.rest
+    track = Track("wrists", 1.0, False, "hub", 0, {(name,): 0.0 for name in names}, sorted(names),
+                  first=rest[2:4] + first * 0.2)
+    for name in reversed(names):  # the first asked places them all
+        np.testing.assert_array_equal(matcher._anchor(track, name), _direct_anchor(matcher, track, name))
+    assert set(track.anchors) == set(names)

@@ -96,6 +96,7 @@ angular-velocity minima and direction changes (§4.3).
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
@@ -418,6 +419,7 @@ class ForwardModel(Matcher):
         self._criteria = StrokeCriteria(drop=self.params["drop"], angle=self.params["angle"])
         self._tables: dict[int, tuple] = {}
         self._edges: dict[str, _EdgeTable] = {}
+        self._half_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
         self._memory: WorkingMemory | None = None
         self._rows: _Grown | None = None  # the working memory in the motor frame, row by row
         self._last_local: np.ndarray | None = None
@@ -968,17 +970,38 @@ class ForwardModel(Matcher):
         """
         anchor = track.anchors.get(name)
         if anchor is None:
-            edge = self._edge(name)
-            anchor = np.zeros(len(edge.arcs))
-            if not (self.params["relative"] or track.hand):
-                first = self._first(track)
-                later = edge.arcs > 0.5 * edge.arcs[:, -1:]  # past the first half of each stroke (a suffix: arcs grow)
-                h = int(len(later[0]) - later.sum(axis=1).min())  # the points no stroke's first half reaches: not looked at
-                far = np.linalg.norm(edge.positions[:, :h] - first[:, None], axis=-1)
-                far[later[:, :h]] = np.inf
-                anchor = edge.arcs[np.arange(len(far)), np.argmin(far, axis=1)]
-            track.anchors[name] = anchor
+            if self.params["relative"] or track.hand:
+                anchor = track.anchors[name] = np.zeros(len(self._edge(name).arcs))
+                return anchor
+            # this command's and those of the track's other candidates still without one, at once (all are placed
+            # in the frame the track begins: the same onset posture)
+            names = [n for n in dict.fromkeys([name, *(path[0] for path in track.candidates)]) if n not in track.anchors]
+            positions, later, arcs = self._halves(tuple(names))
+            far = np.linalg.norm(positions - self._first(track)[:, None], axis=-1)  # (C, k, h)
+            far[later] = np.inf
+            placed = np.take_along_axis(arcs, np.argmin(far, axis=-1)[..., None], axis=-1)[..., 0]
+            track.anchors.update(zip(names, placed))
+            anchor = track.anchors[name]
         return anchor
+
+    def _halves(self, names: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The first halves of commands ``names``' strokes, stacked for :meth:`_anchor`: positions (C, k, h, 3), which
+        points lie past the first half of their stroke (C, k, h) and cumulative lengths (C, k, h), where ``h`` is
+        the last point any of them reaches (arcs grow: a stroke's first half is a prefix). Kept for the last sets
+        of candidates (a node's edges are the candidates of every demonstration that starts there)."""
+        tables = [self._edge(name) for name in names]
+        kept = self._half_tables.get(names)
+        if kept is not None and all(a is b for a, b in zip(kept[0], tables)):
+            self._half_tables.move_to_end(names)
+            return kept[1]
+        arcs = np.stack([t.arcs for t in tables])
+        later = arcs > 0.5 * arcs[..., -1:]
+        h = int(arcs.shape[-1] - later.sum(axis=-1).min())
+        halves = (np.stack([t.positions[:, :h] for t in tables]), later[..., :h], arcs[..., :h])
+        self._half_tables[names] = (tables, halves)
+        if len(self._half_tables) > 32:
+            self._half_tables.popitem(last=False)
+        return halves
 
     def _onset_offset(self, track: Track, name: str) -> np.ndarray | float:
         """With ``relative``: the observed onset posture minus where command ``name`` starts (k, 3); else 0."""
