@@ -903,7 +903,10 @@ class ForwardModel(Matcher):
             edge = self._edge(name)
             total = edge.arcs[:, -1]
             here = open_ & ((left <= total) | (i == len(path) - 1))
-            if here.any():
+            if here.all():  # every part on this edge: its strokes as they are (no copy)
+                out[:] = _along_rows(edge.arcs, edge.positions, np.minimum(left, total))
+                open_[:] = False
+            elif here.any():
                 out[here] = _along_rows(edge.arcs[here], edge.positions[here], np.minimum(left[here], total[here]))
                 open_ &= ~here
             if not open_.any():
