@@ -75,14 +75,16 @@ def test_a_running_path_length_refuses_a_memory_that_shrank():
 
 
 def _arms(write, pm, *, relative: bool = False, error: str = "max", strokes: int = 4, seed: int = 0):
-    """The two-wrist body with ``strokes`` random one-second commands from the hub, and one two-command path."""
+    """The two-wrist body with ``strokes`` random one-second commands from the hub (the right wrist held still in
+    every other one)."""
     character = load_character(write("arms.toml", ARMS.format(relative=str(relative).lower(), error=error)), pm)
     motor, rng = character.motor, np.random.default_rng(seed)
     left, right = motor.rest[2], motor.rest[3]
     names = []
-    for _ in range(strokes):
+    for i in range(strokes):  # the right wrist moves a little, or holds still (a stroke of no length)
+        held = right + (rng.normal(0, 0.05, 3) if i % 2 else 0.0)
         names.append(motor.learn("wrists", "hub", [GuidingStroke(left, left + rng.normal(0, 0.2, 3), 1.0),
-                                                   GuidingStroke(right, right + rng.normal(0, 0.05, 3), 1.0)]))
+                                                   GuidingStroke(right, held, 1.0)]))
     return character, names
 
 

@@ -420,6 +420,7 @@ class ForwardModel(Matcher):
         self._tables: dict[int, tuple] = {}
         self._edges: dict[str, _EdgeTable] = {}
         self._half_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
+        self._stroke_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
         self._memory: WorkingMemory | None = None
         self._rows: _Grown | None = None  # the working memory in the motor frame, row by row
         self._last_local: np.ndarray | None = None
@@ -943,14 +944,22 @@ class ForwardModel(Matcher):
     def _stacked(self, track: Track, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
         """For commands ``names`` followed by ``track``: their strokes' cumulative lengths (C * k, G) and positions
         (C * k, G, 3), stroke lengths (C, k), anchors (C, k) and onset offsets (C, k, 3), stacked once per set of
-        candidates (kept until the set changes)."""
+        candidates (kept until the set changes; the strokes for the last sets of candidates of any track)."""
         kept = self._tracked.get(track.subsystem)
         cache = getattr(kept, "stacked", None) if kept is not None and kept.track is track else None
         if cache is not None and cache[0] == names:
             return cache[1]
         edges = [self._edge(name) for name in names]
-        stacked = (np.concatenate([e.arcs for e in edges]), np.concatenate([e.positions for e in edges]),
-                   np.stack([e.arcs[:, -1] for e in edges]), np.stack([self._anchor(track, n) for n in names]),
+        strokes = self._stroke_tables.get(names)
+        if strokes is None or not all(a is b for a, b in zip(strokes[0], edges)):
+            strokes = (edges, (np.concatenate([e.arcs for e in edges]), np.concatenate([e.positions for e in edges]),
+                               np.stack([e.arcs[:, -1] for e in edges])))
+            self._stroke_tables[names] = strokes
+            if len(self._stroke_tables) > 8:
+                self._stroke_tables.popitem(last=False)
+        else:
+            self._stroke_tables.move_to_end(names)
+        stacked = (*strokes[1], np.stack([self._anchor(track, n) for n in names]),
                    np.stack([np.broadcast_to(self._onset_offset(track, n), e.positions[:, 0].shape)
                              for n, e in zip(names, edges)]))
         if kept is not None and kept.track is track:
@@ -990,8 +999,8 @@ class ForwardModel(Matcher):
     def _halves(self, names: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The first halves of commands ``names``' strokes, stacked for :meth:`_anchor`: positions (C, k, h, 3), which
         points lie past the first half of their stroke (C, k, h) and cumulative lengths (C, k, h), where ``h`` is
-        the last point any of them reaches (arcs grow: a stroke's first half is a prefix). Kept for the last sets
-        of candidates (a node's edges are the candidates of every demonstration that starts there)."""
+        the last point the first half of any stroke that moves reaches (arcs grow: a first half is a prefix). Kept
+        for the last sets of candidates (a node's edges are the candidates of every demonstration that starts there)."""
         tables = [self._edge(name) for name in names]
         kept = self._half_tables.get(names)
         if kept is not None and all(a is b for a, b in zip(kept[0], tables)):
@@ -999,7 +1008,9 @@ class ForwardModel(Matcher):
             return kept[1]
         arcs = np.stack([t.arcs for t in tables])
         later = arcs > 0.5 * arcs[..., -1:]
-        h = int(arcs.shape[-1] - later.sum(axis=-1).min())
+        # a part that stays still (no path at all: every point the same) is joined at its first point whatever h is
+        moving = arcs[..., -1] > 0
+        h = int(arcs.shape[-1] - later[moving].sum(axis=-1).min()) if moving.any() else 1
         halves = (np.stack([t.positions[:, :h] for t in tables]), later[..., :h], arcs[..., :h])
         self._half_tables[names] = (tables, halves)
         if len(self._half_tables) > 32:
