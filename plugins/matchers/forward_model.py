@@ -987,7 +987,8 @@ class ForwardModel(Matcher):
                 return anchor
             # this command's and those of the track's other candidates still without one, at once (all are placed
             # in the frame the track begins: the same onset posture)
-            names = [n for n in dict.fromkeys([name, *(path[0] for path in track.candidates)]) if n not in track.anchors]
+            firsts = dict.fromkeys([name, *(path[0] for path in track.candidates)])
+            names = [n for n in firsts if n not in track.anchors]
             positions, later, arcs = self._halves(tuple(names))
             far = np.linalg.norm(positions - self._first(track)[:, None], axis=-1)  # (C, k, h)
             far[later] = np.inf
