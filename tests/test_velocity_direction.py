@@ -212,3 +212,42 @@ def test_the_papers_rest_is_the_default():
     assert plain.params["units"] == "metres" and plain.params["noise"] == 0 and plain.params["pause"] == 0
     explicit = VelocityDirection(parts=["wrist"], level="movement", units="metres", noise=0.0, pause=0.0)
     assert plain.segment(motion) == explicit.segment(motion)
+
+
+@given(seed=st.integers(0, 10_000), cuts=st.lists(st.integers(1, 40), min_size=1, max_size=12),
+       params=st.sampled_from([{}, {"level": "movement"}, {"units": "body", "noise": 2.0, "pause": 0.3},
+                               {"max_movement": 1.0, "memory": 0.2}, {"parts": ["wrist"], "rest_speed": 0.05}]),
+       hidden=st.booleans())
+@settings(max_examples=40, deadline=None)
+def test_a_block_pushed_at_once_is_its_frames_pushed_one_by_one(seed, cuts, params, hidden):
+    """push_block (the block's speeds computed at once, issue 22) closes the same segments at the same frames and
+    reports the same onsets as push frame by frame, whatever the packet sizes; a part not seen in the first frames
+    (before the first movement) and one hidden for a while (held where last seen) included."""
+    rng = np.random.default_rng(seed)
+    motion, _ = stroke_sequence(rng, int(rng.integers(1, 4)), noise=0.003)
+    poses = motion.positions.copy()
+    visible = np.ones(poses.shape[:2], dtype=bool)
+    if hidden:  # the wrist not seen in the first frames (at rest: NaN), then lost for a while (held where last seen)
+        visible[:3, 1] = False
+        poses[:3, 1] = np.nan
+        visible[30:40, 1] = False
+        poses[30:40, 1] = poses[29, 1]
+    one = VelocityDirection(**params)
+    one.reset(motion.parts, motion.fps)
+    expected, onsets = [], []
+    for f in range(len(poses)):
+        expected.extend((f, s) for s in one.push(poses[f], visible[f]))
+        onsets.append(-1 if one.active_since is None else one.active_since)
+    blocks = VelocityDirection(**params)
+    blocks.reset(motion.parts, motion.fps)
+    got, since, at = [], [], 0
+    for n in [*cuts, len(poses)]:
+        closed, block_since = blocks.push_block(poses[at : at + n], visible[at : at + n])
+        got.extend((at + i, s) for i, s in closed)
+        since.extend(block_since.tolist())
+        at += n
+        if at >= len(poses):
+            break
+    assert got == expected
+    assert since == onsets[: len(since)] and len(since) == len(poses)
+    assert blocks.flush() == one.flush()

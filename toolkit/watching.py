@@ -102,6 +102,7 @@ class ObservationLog:
         self._all_seen = False
         self.n = 0
         self.offset = 0  # the row number of the first row held (self._pos[0])
+        self.revision = 0  # counts the rewrites of rows already held (WorkingMemory.revision)
 
     def append(self, pose: np.ndarray, visible: np.ndarray, world: np.ndarray | None = None) -> None:
         """One frame: root-relative pose (P, 3), visible (P,), world positions (P, 3) if known."""
@@ -125,6 +126,7 @@ class ObservationLog:
         if not self._all_seen:
             first = ~self._seen & visible.any(axis=0)
             if first.any() and start:  # seen for the first time: the rows before hold that sighting
+                self.revision += 1
                 self._pos[:start, first] = self._pos[start:end][np.argmax(visible[:, first], axis=0), first]
                 self._world[:start, first] = self._world[start:end][np.argmax(visible[:, first], axis=0), first]
             self._seen |= visible.any(axis=0)
@@ -231,6 +233,14 @@ class WorkingMemory:
     def n(self) -> int:
         """Frames of the segment given so far."""
         return self._stop - self.start
+
+    @property
+    def revision(self) -> int:
+        """Counts the times rows already in working memory were rewritten (a part seen for the first time: the
+        rows before hold that sighting, :class:`ObservationLog`). While it stays the same, the rows given keep
+        their values, so a matcher may keep what it computed from them and add only the new rows' share
+        (incremental per-frame work)."""
+        return self._log.revision
 
     @property
     def fps(self) -> float:
@@ -373,6 +383,7 @@ class WatchingLoop:
                  max_segment: float | None = MAX_SEGMENT_SECONDS) -> None:
         self.character = character
         self._call = call or (lambda key, method, *a, **k: call_component(character, key, method, *a, **k))
+        self._direct = call is None  # components are called by call_component (the matcher once a frame: directly)
         self.listener = listener or Listener()
         self.keep = _seconds(keep, "keep")
         self.max_segment = _seconds(max_segment, "max_segment")
@@ -465,16 +476,17 @@ class WatchingLoop:
             return []
         closed, since = self._checked_block(result, n, first)
         out: list[Observation] = []
-        k = 0
+        k, onsets = 0, since.tolist()
         for i in range(n):
-            here = []
-            while k < len(closed) and closed[k][0] == i:
-                here.append(closed[k][1])
-                k += 1
-            here = self._clipped(here)
-            out.extend(self._close(s, split=len(here) > 1) for s in here)
+            if k < len(closed) and closed[k][0] == i:  # segments closed at this frame
+                here = []
+                while k < len(closed) and closed[k][0] == i:
+                    here.append(closed[k][1])
+                    k += 1
+                here = self._clipped(here)
+                out.extend(self._close(s, split=len(here) > 1) for s in here)
             row = first + i
-            onset = int(since[i])
+            onset = onsets[i]
             if onset >= 0:
                 onset = max(onset, self._floor, self.memory.offset)
                 if self._max_frames is not None and row - onset >= self._max_frames:  # never closed: cut it here
@@ -562,7 +574,10 @@ class WatchingLoop:
         if self.character.matcher is None or self._view is None:
             return
         self._view.feed(row + 1)
-        match = self._call("matcher", "observe", self._view)
+        if self._direct:  # call_component, without its indirections (once a frame)
+            match = guarded(self.character.matcher, "observe", self._view)
+        else:
+            match = self._call("matcher", "observe", self._view)
         if match is None or self.character.matcher is None:
             return
         self._check_match(match, "observe")

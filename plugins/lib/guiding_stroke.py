@@ -32,6 +32,7 @@ Formulas (``u = t / duration``, ``s`` the progress along the chord ``d = target 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -62,10 +63,20 @@ def velocity_profile(u: np.ndarray, peak: float, end_gain: float) -> np.ndarray:
 
 def progress(u: np.ndarray, peak: float, end_gain: float) -> np.ndarray:
     """Share of the path covered at normalised time ``u``: 0 at 0, 1 at 1, increasing."""
+    grid, covered = _progress_table(float(peak), float(end_gain))
+    return np.interp(np.clip(u, 0.0, 1.0), grid, covered)
+
+
+@lru_cache(maxsize=4096)
+def _progress_table(peak: float, end_gain: float) -> tuple[np.ndarray, np.ndarray]:
+    """The tabulated progress integral of a speed profile (read-only): computed once per ``peak`` and ``end_gain``
+    (a repertoire's strokes share a few), not at every evaluation of the forward model."""
     grid = np.linspace(0.0, 1.0, _GRID)
     v = velocity_profile(grid, peak, end_gain)
     cum = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(grid))])
-    return np.interp(np.clip(u, 0.0, 1.0), grid, cum / cum[-1])
+    covered = cum / cum[-1]
+    grid.flags.writeable = covered.flags.writeable = False
+    return grid, covered
 
 
 def lateral_profile(s: np.ndarray, shape: str, roundness: float, skewness: float) -> np.ndarray:
@@ -86,12 +97,19 @@ def lateral_profile(s: np.ndarray, shape: str, roundness: float, skewness: float
     return -out if shape.startswith("right") else out
 
 
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.cross`` of two 3-vectors, written out (the same products and differences, without its generality)."""
+    a0, a1, a2 = a.tolist()
+    b0, b1, b2 = b.tolist()
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
+
+
 def _in_plane_perpendicular(chord: np.ndarray, normal: np.ndarray) -> np.ndarray:
-    perp = np.cross(normal, chord)
+    perp = _cross(normal, chord)
     n = np.linalg.norm(perp)
     if n < 1e-12:  # normal along the chord: any perpendicular will do
         helper = np.array([0.0, 1.0, 0.0]) if abs(chord[1]) < 0.9 * np.linalg.norm(chord) else np.array([1.0, 0.0, 0.0])
-        perp = np.cross(helper, chord)
+        perp = _cross(helper, chord)
         n = np.linalg.norm(perp)
     return perp / max(n, 1e-12)
 

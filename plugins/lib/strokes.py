@@ -104,8 +104,8 @@ def direction_clusters(vectors: np.ndarray, angle: float, max_clusters: int = 12
         means.append(vectors[worst].copy())  # a new cluster around the most different element
         for _ in range(10):  # redistribute and re-average until stable
             labels = np.argmax(vectors @ np.array(means).T, axis=1)
-            new = [_unit(vectors[labels == k].mean(axis=0)) if np.any(labels == k) else means[k] for k in range(len(means))]
-            if np.allclose(new, means):
+            new = _cluster_means(vectors, labels, means)
+            if _allclose(np.array(new), np.array(means)):
                 break
             means = new
     return np.argmax(vectors @ np.array(means).T, axis=1)
@@ -138,6 +138,41 @@ def _unit(v: np.ndarray) -> np.ndarray:
     return v / n if n > 1e-12 else v
 
 
+def _cluster_means(vectors: np.ndarray, labels: np.ndarray, means: list[np.ndarray]) -> list[np.ndarray]:
+    """Each cluster's mean direction, ``_unit(vectors[labels == k].mean(axis=0))``, or its old one ``means[k]`` if
+    it has no vector: the same values (each cluster's rows summed in their order, divided by their count, and
+    divided by the square root of the mean's dot product with itself, as ``mean`` and ``np.linalg.norm`` do), from
+    one sort of the labels instead of a mask per cluster."""
+    order = np.argsort(labels, kind="stable")
+    grouped = vectors[order]
+    bounds = np.searchsorted(labels[order], np.arange(len(means) + 1)).tolist()
+    new = []
+    for k, mean in enumerate(means):
+        a, b = bounds[k], bounds[k + 1]
+        if a == b:
+            new.append(mean)
+            continue
+        centre = np.add.reduce(grouped[a:b], axis=0) / (b - a)
+        norm = np.sqrt(centre.dot(centre))
+        new.append(centre / norm if norm > 1e-12 else centre)
+    return new
+
+
+def _units(vectors: np.ndarray) -> np.ndarray:
+    """:func:`_unit` of each row of ``vectors`` (N, D), the same values: ``np.linalg.norm`` of a vector is the
+    square root of its dot product with itself, taken here row by row, and the rows divided at once."""
+    if not len(vectors):
+        return np.array([_unit(v) for v in vectors])
+    n = np.sqrt(np.array([v.dot(v) for v in vectors]))
+    long = n > 1e-12
+    return np.where(long[:, None], vectors / np.where(long, n, 1.0)[:, None], vectors)
+
+
+def _allclose(a: np.ndarray, b: np.ndarray) -> bool:
+    """``np.allclose(a, b)`` of finite or NaN values (its default tolerances), without its generality's cost."""
+    return bool(np.all(np.abs(a - b) <= 1e-08 + 1e-05 * np.abs(b)))
+
+
 def breaks(window: np.ndarray, fps: float, criteria: StrokeCriteria = StrokeCriteria()) -> list[int]:
     """Break points (indices into ``window``, positions (N, 3k) of the chosen parts) by speed and direction."""
     return analyse(window, fps, criteria).breaks
@@ -166,7 +201,7 @@ def analyse(window: np.ndarray, fps: float, criteria: StrokeCriteria = StrokeCri
     by_speed = sorted(b + 1 for b in speed_breaks(speed, c.drop, c.rest_speed))
     cuts = set(by_speed)
     by_direction: list[int] = []
-    units = np.array([_unit(v) for v in vectors])
+    units = _units(vectors)
     labels = np.full(len(units), -1)
     if moving.any():
         labels[moving] = direction_clusters(units[moving], c.angle)

@@ -96,6 +96,7 @@ angular-velocity minima and direction changes (§4.3).
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
@@ -245,6 +246,120 @@ def _lengths(observed: np.ndarray) -> np.ndarray:
         np.zeros(observed.shape[1])
 
 
+class _Grown:
+    """Rows computed once each and kept in a buffer that grows by doubling: :meth:`view` is the first ``n`` (a view).
+
+    The forward model's per-frame work is incremental with it: a row of the working memory, once given, keeps its
+    values while :attr:`WorkingMemory.revision <toolkit.watching.WorkingMemory.revision>` stays the same, so what
+    is computed from it is computed once.
+    """
+
+    __slots__ = ("buffer", "n")
+
+    def __init__(self, shape: tuple[int, ...], capacity: int = 64) -> None:
+        self.buffer = np.empty((max(1, capacity), *shape))
+        self.n = 0
+
+    def extend(self, rows: np.ndarray) -> None:
+        """Append ``rows`` (m, *shape)."""
+        end = self.n + len(rows)
+        if end > len(self.buffer):
+            bigger = np.empty((max(end, 2 * len(self.buffer)), *self.buffer.shape[1:]))
+            bigger[: self.n] = self.buffer[: self.n]
+            self.buffer = bigger
+        self.buffer[self.n : end] = rows
+        self.n = end
+
+    def view(self) -> np.ndarray:
+        return self.buffer[: self.n]
+
+
+def _norms(d: np.ndarray) -> np.ndarray:
+    """``np.linalg.norm(d, axis=-1)`` of real values, as numpy computes it (the square root of the summed squares
+    along the last axis), without its argument handling: the same values."""
+    return np.sqrt(np.add.reduce(d * d, axis=-1))
+
+
+class _Walk:
+    """:func:`_lengths` of a growing working memory, frame by frame, with exactly the same values.
+
+    The three-frame mean (``uniform_filter1d``, ``mode="nearest"``) is scipy's running sum: ``tmp`` starts at the
+    sum of the first window, then adds each entering row minus the leaving one, and each output is ``tmp / 3``. A
+    new frame changes only the last smoothed row (its right neighbour was the edge's copy) and adds one: the running
+    sum is kept up to the last row whose window lies wholly inside the frames seen, and so are the norms of the
+    steps between the smoothed rows that are final, so a frame costs a few rows whatever the length of the segment.
+    The total is summed by numpy over the kept norms as :func:`_lengths` sums them (same array layout, same order:
+    the same bits). ``tests/test_forward_model_incremental.py`` compares it with :func:`_lengths` on random data.
+    """
+
+    __slots__ = ("tmp", "final", "smooth", "norms", "seen")
+
+    def __init__(self, k: int) -> None:
+        self.tmp: np.ndarray | None = None  # scipy's running window sum at row ``final - 1`` (k, 3)
+        self.final = 0  # smoothed rows [0, final) are final: their windows lie inside the frames seen
+        self.smooth = _Grown((k, 3))  # the final smoothed rows
+        self.norms = _Grown((k,))  # the norms of the steps between final smoothed rows, then one slot more
+        self.seen = 0
+
+    def lengths(self, observed: np.ndarray) -> np.ndarray:
+        """``_lengths(observed)`` for ``observed`` (n, k, 3), whose first rows are the ones given before."""
+        n = len(observed)
+        if n < self.seen:
+            raise ValueError(f"the working memory shrank from {self.seen} to {n} rows")
+        self.seen = n
+        if n < 3:  # no filter below three frames (as _lengths)
+            return _lengths(observed)
+        if self.tmp is None:  # scipy: tmp = 0.0 + x[-1] + x[0] + x[1], the edge repeated
+            self.tmp = (observed[0] + observed[0]) + observed[1]
+            self.smooth.extend((self.tmp / 3)[None])
+            self.final = 1
+        if self.final == n - 2 and n >= 4:  # one more final row (the common case: one frame more)
+            self.tmp = self.tmp + (observed[n - 1] - observed[n - 4])
+            row = self.tmp / 3
+            smooth = self.smooth
+            if smooth.n == len(smooth.buffer):
+                smooth.extend(row[None])
+            else:
+                smooth.buffer[smooth.n] = row
+                smooth.n += 1
+            self.final = n - 1
+            self.norms.n = n - 3
+            self.norms.extend(_norms(row - smooth.buffer[n - 3])[None])
+        elif self.final < n - 1:  # rows final .. n-2: tmp[i] = tmp[i-1] + (x[i+1] - x[i-2])
+            tmp, out = self.tmp, []
+            for i in range(self.final, n - 1):
+                tmp = tmp + (observed[i + 1] - observed[max(i - 2, 0)])
+                out.append(tmp / 3)
+            self.tmp, self.final = tmp, n - 1
+            before = self.smooth.n
+            self.smooth.extend(np.stack(out))
+            rows = self.smooth.buffer[before - 1 : self.smooth.n]
+            self.norms.n = before - 1  # drop the slot of the last edge row
+            self.norms.extend(np.linalg.norm(np.diff(rows, axis=0), axis=-1))
+        # the last row's window repeats its own frame (the edge): tmp[n-1] = tmp[n-2] + (x[n-1] - x[n-3])
+        edge = (self.tmp + (observed[n - 1] - observed[n - 3])) / 3
+        norms = self.norms
+        norms.n = n - 2
+        if norms.n == len(norms.buffer):
+            norms.extend(_norms(edge - self.smooth.buffer[n - 2])[None])
+        else:
+            norms.buffer[norms.n] = _norms(edge - self.smooth.buffer[n - 2])
+            norms.n += 1
+        return np.add.reduce(norms.buffer[: norms.n], axis=0)
+
+
+@dataclass
+class _Tracked:
+    """What the forward model keeps of one followed subsystem between frames: its rows of the working memory
+    (:meth:`ForwardModel._observed`), their path lengths (:class:`_Walk`) and the rows it gave last."""
+
+    track: Track
+    rows: _Grown
+    walk: _Walk
+    last: np.ndarray | None = None
+    stacked: tuple | None = None
+
+
 class ForwardModel(Matcher):
     """Edges of the active node predict the demonstration in parallel; the last one left is imitated at once (K&G §4.4)."""
 
@@ -304,7 +419,13 @@ class ForwardModel(Matcher):
         self._criteria = StrokeCriteria(drop=self.params["drop"], angle=self.params["angle"])
         self._tables: dict[int, tuple] = {}
         self._edges: dict[str, _EdgeTable] = {}
+        self._half_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
+        self._stroke_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
         self._memory: WorkingMemory | None = None
+        self._rows: _Grown | None = None  # the working memory in the motor frame, row by row
+        self._last_local: np.ndarray | None = None
+        self._tracked: dict[str, _Tracked] = {}
+        self._revision = 0
         self._spreads: dict[str, float] | None = None
         self.tracks: dict[str, Track] = {}
         self.reported = False
@@ -313,6 +434,7 @@ class ForwardModel(Matcher):
 
     def begin(self, memory: WorkingMemory) -> None:
         self._memory = memory
+        self._rows, self._last_local, self._tracked, self._revision = None, None, {}, memory.revision
         self.fps = memory.fps
         self.tracks = {}  # in the order the subsystems began to move
         self.reported = False  # a commitment to the tracks decided so far has been announced
@@ -355,8 +477,20 @@ class ForwardModel(Matcher):
 
     def _local(self) -> np.ndarray:
         """The working memory in the observer's motor frame (n, P, 3): root-relative positions placed at its own
-        root height (finger angles as seen); hidden parts held, never-seen parts NaN."""
-        return self._memory.positions + self._root_height
+        root height (finger angles as seen); hidden parts held, never-seen parts NaN.
+
+        Each row is placed once and kept (the same values: each row's own sum), all of them again when rows
+        already given were rewritten (:attr:`WorkingMemory.revision <toolkit.watching.WorkingMemory.revision>`: a
+        part seen for the first time)."""
+        memory = self._memory
+        rows, n = self._rows, memory.n
+        if rows is None or rows.n > n or self._revision != memory.revision:
+            rows = self._rows = _Grown(memory.positions.shape[1:], max(64, 2 * n))
+            self._tracked, self._revision = {}, memory.revision
+        if rows.n < n:
+            rows.extend(memory.positions[rows.n : n] + self._root_height)
+        self._last_local = rows.view()
+        return self._last_local
 
     def _at(self, row: int) -> np.ndarray:
         """One row of the working memory in the motor frame (P, 3)."""
@@ -401,6 +535,8 @@ class ForwardModel(Matcher):
             return
         late = bool(self.tracks)
         waiting = [name for name in self.motor.subsystems if name not in self.tracks]
+        if not waiting:  # every subsystem is followed
+            return
         if late:
             first = memory[:3].mean(axis=0)
             moved = self._moved(waiting, first, memory[-3:].mean(axis=0))
@@ -420,7 +556,8 @@ class ForwardModel(Matcher):
 
     def _moved(self, names: list[str], first: np.ndarray, last: np.ndarray) -> dict[str, float]:
         """How far (m; a hand's radians scaled) each subsystem's parts have moved at most from ``first`` to ``last``."""
-        return {name: float(np.nanmax(np.linalg.norm(last[idx] - first[idx], axis=-1))) * self._scale_of(name)
+        far = np.linalg.norm(last - first, axis=-1)  # every part at once (the same values as part by part)
+        return {name: float(np.fmax.reduce(far[idx])) * self._scale_of(name)  # np.nanmax without its warning
                 for name, idx in self.motor.subsystems.items() if name in names}
 
     def _joining(self, memory: np.ndarray) -> bool:
@@ -428,6 +565,8 @@ class ForwardModel(Matcher):
         if not self.params["together"]:
             return False
         waiting = [n for n in self.motor.subsystems if n not in self.tracks]
+        if not waiting:
+            return False
         moved = self._moved(waiting, memory[:3].mean(axis=0), memory[-3:].mean(axis=0))
         return any(d > 0.5 * self.params["min_move"] for d in moved.values())
 
@@ -461,13 +600,35 @@ class ForwardModel(Matcher):
         return float(np.nanmax(d) if self.params["error"] == "max" else np.nanmean(d))
 
     def _observed(self, track: Track, memory: np.ndarray) -> np.ndarray:
-        """The working memory of a subsystem's parts since it is followed, (n, k, 3)."""
-        return memory[track.onset:, self.motor.subsystems[track.subsystem]]
+        """The working memory of a subsystem's parts since it is followed, (n, k, 3).
+
+        Of the working memory :meth:`_local` gave last, the rows are gathered once each and kept (a view)."""
+        idx = self.motor.subsystems[track.subsystem]
+        if memory is not self._last_local or memory is None:
+            return memory[track.onset:, idx]
+        kept = self._tracked.get(track.subsystem)
+        if kept is None or kept.track is not track:
+            kept = self._tracked[track.subsystem] = _Tracked(track, _Grown((len(idx), 3)), _Walk(len(idx)))
+        rows = kept.rows
+        if rows.n < len(memory) - track.onset:
+            rows.extend(memory[track.onset + rows.n :, idx])
+        kept.last = rows.view()
+        return kept.last
+
+    def _walked(self, track: Track, observed: np.ndarray) -> np.ndarray:
+        """``_lengths(observed)`` of the rows :meth:`_observed` gave last for ``track``, frame by frame (:class:`_Walk`:
+        the same values, a few rows' work a frame); of other rows, computed whole."""
+        kept = self._tracked.get(track.subsystem)
+        if kept is None or kept.track is not track or kept.last is not observed:
+            return _lengths(observed)
+        return kept.walk.lengths(observed)
 
     def _follow(self, track: Track, memory: np.ndarray) -> Match | None:
         """One frame of a subsystem's predictions (Fig. 3); a :class:`Match` with ``stop`` when its imitation deviates."""
+        if track.committed is None and not track.candidates:  # nothing left to predict (as below, without the work)
+            return None
         observed = self._observed(track, memory)
-        lengths = _lengths(observed)  # once per frame
+        lengths = self._walked(track, observed)  # once per frame (incremental)
         last = observed[-1]
         frame = self._memory.n - 1
         if track.committed is not None:
@@ -488,7 +649,7 @@ class ForwardModel(Matcher):
                                                                          "return_to": track.last_correct})
         if not track.candidates:
             return None
-        errors = {path: self._error(track, path, lengths, last) for path in self._extended(track, lengths)}
+        errors = self._errors(track, self._extended(track, lengths), lengths, last)
         track.trace.append((frame, errors))
         still = self._distance(track, observed[0], last) if self.params["stillness"] else None
         alive = self._survivors(errors, self._evidence(track, errors), still)
@@ -732,6 +893,9 @@ class ForwardModel(Matcher):
                     t = self._mapped_time(commands[lead], left)
                     return np.array([c.position(t) for c in commands])
                 left -= arc[-1]
+        if len(path) == 1:  # one command: every part along its stroke (what the loop below does for one edge)
+            edge = self._edge(path[0])
+            return _along_rows(edge.arcs, edge.positions, np.minimum(lengths, edge.arcs[:, -1]))
         # each part along its own strokes: on the first edge whose stroke is longer than what is left to place
         out = np.empty((len(lengths), 3))
         left = np.array(lengths, dtype=float)
@@ -740,7 +904,10 @@ class ForwardModel(Matcher):
             edge = self._edge(name)
             total = edge.arcs[:, -1]
             here = open_ & ((left <= total) | (i == len(path) - 1))
-            if here.any():
+            if here.all():  # every part on this edge: its strokes as they are (no copy)
+                out[:] = _along_rows(edge.arcs, edge.positions, np.minimum(left, total))
+                open_[:] = False
+            elif here.any():
                 out[here] = _along_rows(edge.arcs[here], edge.positions[here], np.minimum(left[here], total[here]))
                 open_ &= ~here
             if not open_.any():
@@ -756,6 +923,48 @@ class ForwardModel(Matcher):
         """
         predicted = self._predict(track, path, self._along(track, path[0], lengths))
         return self._distance(track, predicted + self._onset_offset(track, path[0]), last)
+
+    def _errors(self, track: Track, paths: list[tuple[str, ...]], lengths: np.ndarray,
+                last: np.ndarray) -> dict[tuple[str, ...], float]:
+        """:meth:`_error` of every candidate path, in their order: the one-command paths of a positional subsystem
+        predicted at once (their strokes stacked part by part, :meth:`_stacked`; the same arithmetic row by row, so
+        the same values), the others one by one."""
+        batch = [] if track.hand else [path for path in paths if len(path) == 1]
+        errors: dict[tuple[str, ...], float] = {}
+        if len(batch) > 1:
+            arcs, positions, totals, anchors, offsets = self._stacked(track, tuple(path[0] for path in batch))
+            k = len(lengths)
+            along = np.minimum(lengths + anchors, totals).reshape(-1)  # (C * k,): _along, then _predict's minimum
+            predicted = _along_rows(arcs, positions, along).reshape(len(batch), k, 3) + offsets
+            d = np.linalg.norm(predicted - last, axis=-1) * track.scale
+            combined = d.max(axis=1) if self.params["error"] == "max" else d.mean(axis=1)
+            errors = dict(zip(batch, combined.tolist()))
+        return {path: errors[path] if path in errors else self._error(track, path, lengths, last) for path in paths}
+
+    def _stacked(self, track: Track, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
+        """For commands ``names`` followed by ``track``: their strokes' cumulative lengths (C * k, G) and positions
+        (C * k, G, 3), stroke lengths (C, k), anchors (C, k) and onset offsets (C, k, 3), stacked once per set of
+        candidates (kept until the set changes; the strokes for the last sets of candidates of any track)."""
+        kept = self._tracked.get(track.subsystem)
+        cache = getattr(kept, "stacked", None) if kept is not None and kept.track is track else None
+        if cache is not None and cache[0] == names:
+            return cache[1]
+        edges = [self._edge(name) for name in names]
+        strokes = self._stroke_tables.get(names)
+        if strokes is None or not all(a is b for a, b in zip(strokes[0], edges)):
+            strokes = (edges, (np.concatenate([e.arcs for e in edges]), np.concatenate([e.positions for e in edges]),
+                               np.stack([e.arcs[:, -1] for e in edges])))
+            self._stroke_tables[names] = strokes
+            if len(self._stroke_tables) > 8:
+                self._stroke_tables.popitem(last=False)
+        else:
+            self._stroke_tables.move_to_end(names)
+        stacked = (*strokes[1], np.stack([self._anchor(track, n) for n in names]),
+                   np.stack([np.broadcast_to(self._onset_offset(track, n), e.positions[:, 0].shape)
+                             for n, e in zip(names, edges)]))
+        if kept is not None and kept.track is track:
+            kept.stacked = (names, stacked)
+        return stacked
 
     def _along(self, track: Track, name: str, lengths: np.ndarray) -> np.ndarray:
         """How far along a path beginning with command ``name`` each part is: the observed path length plus
@@ -773,15 +982,41 @@ class ForwardModel(Matcher):
         """
         anchor = track.anchors.get(name)
         if anchor is None:
-            edge = self._edge(name)
-            anchor = np.zeros(len(edge.arcs))
-            if not (self.params["relative"] or track.hand):
-                first = self._first(track)
-                far = np.linalg.norm(edge.positions - first[:, None], axis=-1)
-                far[edge.arcs > 0.5 * edge.arcs[:, -1:]] = np.inf  # the first half of each stroke
-                anchor = edge.arcs[np.arange(len(far)), np.argmin(far, axis=1)]
-            track.anchors[name] = anchor
+            if self.params["relative"] or track.hand:
+                anchor = track.anchors[name] = np.zeros(len(self._edge(name).arcs))
+                return anchor
+            # this command's and those of the track's other candidates still without one, at once (all are placed
+            # in the frame the track begins: the same onset posture)
+            firsts = dict.fromkeys([name, *(path[0] for path in track.candidates)])
+            names = [n for n in firsts if n not in track.anchors]
+            positions, later, arcs = self._halves(tuple(names))
+            far = np.linalg.norm(positions - self._first(track)[:, None], axis=-1)  # (C, k, h)
+            far[later] = np.inf
+            placed = np.take_along_axis(arcs, np.argmin(far, axis=-1)[..., None], axis=-1)[..., 0]
+            track.anchors.update(zip(names, placed))
+            anchor = track.anchors[name]
         return anchor
+
+    def _halves(self, names: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The first halves of commands ``names``' strokes, stacked for :meth:`_anchor`: positions (C, k, h, 3), which
+        points lie past the first half of their stroke (C, k, h) and cumulative lengths (C, k, h), where ``h`` is
+        the last point the first half of any stroke that moves reaches (arcs grow: a first half is a prefix). Kept
+        for the last sets of candidates (a node's edges are the candidates of every demonstration that starts there)."""
+        tables = [self._edge(name) for name in names]
+        kept = self._half_tables.get(names)
+        if kept is not None and all(a is b for a, b in zip(kept[0], tables)):
+            self._half_tables.move_to_end(names)
+            return kept[1]
+        arcs = np.stack([t.arcs for t in tables])
+        later = arcs > 0.5 * arcs[..., -1:]
+        # a part that stays still (no path at all: every point the same) is joined at its first point whatever h is
+        moving = arcs[..., -1] > 0
+        h = int(arcs.shape[-1] - later[moving].sum(axis=-1).min()) if moving.any() else 1
+        halves = (np.stack([t.positions[:, :h] for t in tables]), later[..., :h], arcs[..., :h])
+        self._half_tables[names] = (tables, halves)
+        if len(self._half_tables) > 32:
+            self._half_tables.popitem(last=False)
+        return halves
 
     def _onset_offset(self, track: Track, name: str) -> np.ndarray | float:
         """With ``relative``: the observed onset posture minus where command ``name`` starts (k, 3); else 0."""

@@ -113,6 +113,7 @@ class VelocityDirection(Segmenter):
 
     def attach(self, owner: Any) -> None:
         super().attach(owner)
+        import scipy.signal  # noqa: F401  the stroke analysis's filters: loaded now, not at the end of the first movement
         for i, part in enumerate(self.params["parts"]):
             owner.body.index(part, key=("parts", i))
 
@@ -158,7 +159,6 @@ class VelocityDirection(Segmenter):
         self._frame += 1
         points = pose[self._idx] * self._scale  # hidden parts are held where last seen; never seen: NaN
         seen = np.isfinite(points).all(axis=1)
-        cut: list[Segment] = []
         self._history.append(points.ravel())
         speed = np.nan
         if len(self._history) > self._memory and seen.any():
@@ -167,12 +167,50 @@ class VelocityDirection(Segmenter):
             step = np.linalg.norm(moved, axis=1)
             step = step[np.isfinite(step)]
             speed = float(step.max()) * self._fps / self._memory if step.size else np.nan
+        return self._step(pose, points.ravel(), speed)
+
+    def push_block(self, poses: np.ndarray, visible: np.ndarray) -> tuple[list[tuple[int, Segment]], np.ndarray]:
+        """What ``n`` calls of :meth:`push` give, with the per-frame evidence (the chosen parts' speeds over the
+        sensory memory) computed for the block at once, the same arithmetic element by element; the onset and end
+        of movements are then followed frame by frame (:meth:`_step`)."""
+        n = len(poses)
+        closed: list[tuple[int, Segment]] = []
+        since = np.full(n, -1, dtype=int)
+        if n == 0:
+            return closed, since
+        points = np.asarray(poses)[:, self._idx] * self._scale  # (n, m, 3)
+        flat = points.reshape(n, -1)
+        seen = np.isfinite(points).all(axis=2).any(axis=1)  # some chosen part seen
+        m, before = self._memory, len(self._history)  # frames of the sensory memory before the block
+        rows = np.concatenate([np.array(self._history).reshape(before, -1), flat]) if before else flat
+        speeds = np.full(n, np.nan)
+        # frame i of the block has i + before + 1 frames of history (at most maxlen: enough for the memory)
+        ok = seen & (np.minimum(np.arange(n) + before + 1, self._history.maxlen) > m)
+        if ok.any():
+            i = np.flatnonzero(ok)
+            moved = (rows[i + before] - rows[i + before - m]).reshape(len(i), -1, 3)
+            step = np.linalg.norm(moved, axis=2)
+            finite = np.isfinite(step)
+            best = np.where(finite, step, -np.inf).max(axis=1)
+            speeds[i] = np.where(finite.any(axis=1), best * self._fps / m, np.nan)
+        for f in range(n):
+            self._frame += 1
+            self._history.append(flat[f])
+            closed.extend((f, s) for s in self._step(poses[f], flat[f], float(speeds[f])))
+            if self._start is not None:
+                since[f] = self._start
+        return closed, since
+
+    def _step(self, pose: np.ndarray, points: np.ndarray, speed: float) -> list[Segment]:
+        """One frame after its sensory memory was updated: ``points`` are the chosen parts (3m,), ``speed`` the
+        fastest one's over the sensory memory (NaN: none seen, or not enough frames yet). Segments it closes."""
+        cut: list[Segment] = []
         if self._start is not None:
             longest = int(round(self.params["max_movement"] * self._fps))
             if longest and self._frame - self._start >= max(longest, 2):  # never ended: closed, the next one begun
                 cut = self._close(self._frame)
                 self._start, self._buffer = self._frame, []
-            self._buffer.append(points.ravel())
+            self._buffer.append(points)
         rest = self._rest_speed(pose, speed)
         if self._pause:
             if np.isnan(speed) or len(self._speeds) < self._pause:
