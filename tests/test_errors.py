@@ -252,6 +252,8 @@ CASES = [
     ("sweep-key", "a sweep grid with an unknown key", {"g.toml": 'benchmark = "stream"\nthreads = 4\n'}, ["bench", "sweep", "g.toml"], ["g.toml", "threads", "available:"]),
     ("sweep-folder", "a sweep grid naming a missing folder", {"g.toml": 'benchmark = "segmentation"\n[data.d]\nbody = "p.toml"\nstreams = "nowhere"\n', "p.toml": PROFILE}, ["bench", "sweep", "g.toml"], ["nowhere"]),
     ("sweep-scheduler", "--scheduler local: without a number", {"p.toml": PROFILE}, ["bench", "segmentation", "--body", "p.toml", "--streams", ".", "--scheduler", "local:x"], ["local:x"]),
+    # -- Fig. 3 and the speed re-parameterisation: an edge's demonstration in a state file (issue 19)
+    ("state-edge-shown", "a learned edge whose demonstration has the wrong shape", {"st.json": state(actors={"max": {"character": "Max", "components": {"motor": {"plugin": "motor-command-graph", "state": {"left_wrist": {"nodes": {"n1": [[0.26, 1.4, 0.4]]}, "edges": [{"from": "hub", "to": "n1", "name": "left_wrist:e1", "commands": [{"start": [0.25, 0.92, 0.06], "target": [0.26, 1.4, 0.4], "duration": 0.9}], "shown": [[0.25, 0.92], [0.26, 1.4]], "shown_fps": 30.0}]}}}}}})}, ["run", "imitation_games", "--duration", "0.1", "--load", "st.json"], ["key actors.max.components.motor.state.left_wrist.edges[0].shown: invalid shown", "expected the demonstration's frames, at least two, each [x, y, z] of its 1 parts, finite"]),
 ]
 
 
