@@ -9,14 +9,24 @@ before the demonstration ends: *response facilitation*. While imitating, the
 observation keeps being compared with the chosen edge; if they part by more
 than ``deviation`` the imitation is stopped, the edge is excluded for this
 segment, the subsystem returns to the last correct node (the start of the edge
-the demonstration was on: the edges before it were right) and the rest is
-learned from there (§4.4: "the imitator returns into the last node at which
-accordance with the demonstrated movement was found").
+the demonstration was on: the edges before it were right; §4.4: "the imitator
+returns into the last node at which accordance with the demonstrated movement
+was found") and Fig. 3's loop goes on from there: the edges leaving that node,
+the excluded ones left out, predict what has been seen since the demonstration
+passed it (:meth:`ForwardModel._repredict`). One that prevails explains the rest
+(it is checked, and may deviate in turn); only what no edge explains is learned,
+from the last correct node.
 
-Speed: the forward model is evaluated not at the elapsed time but at the time at
-which the edge would have covered the same length of path as has been observed,
-so a familiar movement performed faster or slower still fits; the ratio of the
-two times re-parameterises the command's speed for the imitation.
+Speed (§4.4): with ``reparameterise`` (the default) the forward model is evaluated
+not at the elapsed time but at the time at which the edge would have covered the
+same length of path as has been observed, so a familiar movement performed faster
+or slower still fits. How much faster is measured against the demonstration the
+edge was learned from (``Edge.shown``: "the motor command (with the speed
+demonstrated at first)"), played from the best start at the best speed factor
+(:meth:`ForwardModel._speed`); the imitation is performed at that factor. A
+commitment waits until the movement has been seen for three frames, so that its
+speed can be told from when it began. Off, the paper's baseline: edges predict at
+the elapsed time, and a familiar movement at another speed is learned as new.
 
 Joining late: a segment often begins after its movement did (a hub threshold is
 crossed once the body has left the hub; a take is cropped in motion). Each part
@@ -217,6 +227,8 @@ class Track:
     the last correct node it returned to when its imitation was stopped."""
     at: int = 0
     """How many of the edges of ``right`` the body has performed (those up to ``home``)."""
+    failed: list[tuple[str, tuple[str, ...]]] = field(default_factory=list)
+    """The commitments (movement, path) that deviated in this segment, in order."""
     origin: int | None = None
     """After a deviation, predicted again from the last correct node (Fig. 3): the row from which the subsystem was
     followed first (``onset`` is then the row it passed the last correct node)."""
@@ -348,9 +360,12 @@ class ForwardModel(Matcher):
                 return {"subsystem": None, "start_node": None, "candidates": {}, "initial": [], "committed": None,
                         "committed_path": (), "deviated": False, "trace": (), "committed_at": None,
                         "deviated_at": None, "anchors": {}}
+            # after a deviation predicted again without a new commitment: the commitment that deviated
+            committed, path = (track.committed, track.committed_path) if track.committed is not None or \
+                not track.failed else track.failed[-1]
             return {"subsystem": track.subsystem, "start_node": track.start_node,
-                    "candidates": dict(track.candidates), "initial": list(track.initial), "committed": track.committed,
-                    "committed_path": tuple(track.committed_path), "deviated": track.deviated,
+                    "candidates": dict(track.candidates), "initial": list(track.initial), "committed": committed,
+                    "committed_path": tuple(path), "deviated": track.deviated,
                     "trace": tuple(track.trace), "committed_at": track.committed_at, "deviated_at": track.deviated_at,
                     "anchors": {k: v.copy() for k, v in track.anchors.items()}}
         return MappingProxyType({**view(self.main), "frames": 0 if self._memory is None else self._memory.n,
@@ -1019,6 +1034,7 @@ class ForwardModel(Matcher):
         if track.deviated_at is None:
             track.deviated_at = len(memory)
         self._last_correct(track, lengths, memory)
+        track.failed.append((track.committed, track.committed_path))
         stop = None
         if track.reported and not track.stopped:
             # stop the imitation; the others' commands were right and are completed by the motor system
@@ -1046,7 +1062,7 @@ class ForwardModel(Matcher):
                       excluded=track.excluded, reported=track.reported, deviated=True, last_correct=node,
                       right=track.right, learn_from=track.learn_from, trace=track.trace,
                       committed_at=track.committed_at, deviated_at=track.deviated_at, stopped=track.stopped,
-                      home=track.home or track.start_node, at=track.at,
+                      home=track.home or track.start_node, at=track.at, failed=track.failed,
                       origin=track.onset if track.origin is None else track.origin)
         self.tracks[name] = again
         now = self._memory.n
