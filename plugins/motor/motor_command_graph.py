@@ -66,7 +66,8 @@ class Edge:
     parts' positions (a hand: joint angles), (m, k, 3), at ``shown_fps`` frames per second. It keeps the speed the
     command "was demonstrated at first" (K&G §4.4): the forward model measures how much faster or slower a familiar
     movement is performed against it. ``None`` (a command written by hand, or saved without it): the commands'
-    own timing stands for it.
+    own timing stands for it. :meth:`MotorCommandGraph.get_state` saves it for edges learned by watching, not for
+    those learned from clips (rebuilt from the clips; a loaded edge keeps the clip's).
     """
 
     name: str
@@ -475,7 +476,8 @@ class MotorCommandGraph(MotorSystem):
             state[name] = {
                 "nodes": {n: d["state"].round(6).tolist() for n, d in g.nodes(data=True) if n != "hub"},
                 "edges": [{"from": e.source, "to": e.target, "name": e.name, "commands": [c.to_dict() for c in e.commands],
-                           **({} if e.shown is None else {"shown": e.shown.round(6).tolist(), "shown_fps": e.shown_fps})}
+                           **({"shown": e.shown.round(6).tolist(), "shown_fps": e.shown_fps}
+                              if e.shown is not None and e.origin in ("inverse model", "loaded") else {})}
                           for e in self.edges(name)],
                 "sequences": sequences,
                 "labels": {m: label for m, label in self.labels.items() if m in sequences},
@@ -594,6 +596,9 @@ class MotorCommandGraph(MotorSystem):
             if edge.name in self._edges:  # the same command built already (from clips, say): the saved one replaces it
                 known = self._edges[edge.name]
                 self.graphs[known.subsystem].remove_edge(known.source, known.target, known.name)
+                if edge.shown is None and known.shown is not None:  # a clip's demonstration is not saved: kept
+                    edge = Edge(edge.name, edge.subsystem, edge.source, edge.target, edge.commands, edge.origin,
+                                known.shown, known.shown_fps)
             self._add(edge)
             self._counter = max(self._counter, number)
         self.sequences.update(sequences)
