@@ -862,19 +862,23 @@ class ForwardModel(Matcher):
 
         if not self.params["reparameterise"] or n_frames < 3:
             return 1.0
-        lead = self._lead(path[0])
-        seen = self._local()[track.onset: track.onset + n_frames, self.motor.subsystems[track.subsystem][lead]]
+        arcs = self._edge(path[0]).arcs[:, -1]
+        parts = np.argsort(-arcs)[: self.SPEED_PARTS]  # the parts that move farthest (a hand: every finger)
+        seen = self._local()[track.onset: track.onset + n_frames, self.motor.subsystems[track.subsystem][parts]]
         if not np.isfinite(seen).all():
             return 1.0
+        times, points, first = self._shown(path, parts)
         seen = seen - seen.mean(axis=0)
-        times, points, first = self._shown(path, lead)
         t = np.arange(n_frames) / self.fps
+        flat = points.reshape(len(points), -1)
 
-        def played(c: np.ndarray, s: np.ndarray) -> np.ndarray:  # (G,) starts and speeds -> (G, n, 3), centred
+        def played(c: np.ndarray, s: np.ndarray) -> np.ndarray:  # (G,) starts and speeds -> (G, n, 3p), centred
             q = (c[:, None] + s[:, None] * t).ravel()
-            out = np.stack([np.interp(q, times, points[:, d]) for d in range(3)], axis=-1).reshape(len(c), len(t), 3)
+            out = np.stack([np.interp(q, times, flat[:, d]) for d in range(flat.shape[1])], axis=-1)
+            out = out.reshape(len(c), len(t), -1)
             return out - out.mean(axis=1, keepdims=True)
 
+        seen = seen.reshape(n_frames, -1)
         speeds = np.geomspace(0.25, 4.0, 49)
         starts = np.arange(-0.5, first + 0.5 / self.fps, 0.5 / self.fps)
         c, s = (a.ravel() for a in np.meshgrid(starts, speeds))
@@ -882,6 +886,9 @@ class ForwardModel(Matcher):
         fit = least_squares(lambda x: (played(x[:1], x[1:]) - seen).ravel(), [c[best], s[best]],
                             bounds=([-0.5, 0.25], [max(first, 1e-6), 4.0]), x_scale=[0.1, 0.1])
         return float(np.clip(fit.x[1], 0.25, 4.0))
+
+    SPEED_PARTS = 5
+    """The most parts a speed is measured on (those that move farthest)."""
 
     MIN_MOVING_FRAMES = 3
     """Frames of movement a speed is measured from (:meth:`_timed`)."""
@@ -896,22 +903,22 @@ class ForwardModel(Matcher):
         away = np.linalg.norm(observed - observed[0], axis=-1).max(axis=1) * track.scale
         return int((away > 0.25 * self.params["min_move"]).sum()) >= self.MIN_MOVING_FRAMES
 
-    def _shown(self, path: tuple[str, ...], part: int) -> tuple[np.ndarray, np.ndarray, float]:
-        """The trajectory of ``part`` along ``path`` as it was first demonstrated: times (M,) and positions (M, 3),
-        the edges laid end to end, and the time the first edge ends. An edge learned by watching keeps the piece of
-        the demonstration it was learned from (``Edge.shown``); one without it (written by hand, or saved without)
-        stands for its commands played at their own speed."""
+    def _shown(self, path: tuple[str, ...], parts: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+        """The trajectories of ``parts`` (indices into the subsystem's parts) along ``path`` as it was first
+        demonstrated: times (M,) and positions (M, p, 3), the edges laid end to end, and the time the first edge
+        ends. An edge learned by watching keeps the piece of the demonstration it was learned from
+        (``Edge.shown``); one without it (written by hand, or saved without) stands for its commands played at
+        their own speed, each part holding its target once its command has ended."""
         times, points, t0, first = [], [], 0.0, 0.0
         for i, name in enumerate(path):
             edge = self.motor.edge(name)
             shown = getattr(edge, "shown", None)
             if shown is not None and getattr(edge, "shown_fps", 0.0) > 0:
-                p, t = shown[:, part], np.arange(len(shown)) / edge.shown_fps
+                p, t = shown[:, parts], np.arange(len(shown)) / edge.shown_fps
             else:
-                grid, p, _ = self._table(edge.commands[part])
-                t = grid
-                if edge.duration > grid[-1]:  # a part whose command ends first holds its target
-                    p, t = np.concatenate([p, p[-1:]]), np.append(grid, edge.duration)
+                t = np.linspace(0.0, edge.duration, max(2, int(np.ceil(edge.duration * 120.0)) + 1))
+                p = np.stack([edge.commands[j].position(np.minimum(t, edge.commands[j].duration)) for j in parts],
+                             axis=1)
             times.append(t + t0)
             points.append(p)
             t0 += float(t[-1])
