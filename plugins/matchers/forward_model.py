@@ -850,9 +850,10 @@ class ForwardModel(Matcher):
         produced a movement of the same length".
 
         The ``n_frames`` rows observed since the track's onset are matched with the path as it was first
-        demonstrated (:meth:`_shown`) played from time ``c`` at ``s`` times its speed: the lead part's positions,
-        each taken relative to its mean over the frames (so a stance unlike one's own does not count), in the least
-        squares sense. ``s`` is the speed factor: first the best of a grid (``s`` from 0.25 to 4, ``c`` from half a
+        demonstrated (:meth:`_shown`) played from time ``c`` at ``s`` times its speed: the positions of the
+        :attr:`SPEED_PARTS` parts that move farthest along its first command (a hand: its fingers, which share one
+        clock), each taken relative to its mean over the frames (so a stance unlike one's own does not count), in
+        the least squares sense. ``s`` is the speed factor: first the best of a grid (``s`` from 0.25 to 4, ``c`` from half a
         second before the path's start to the end of its first edge), then refined. Positions, not path lengths
         walked, are compared: observation noise adds length at every frame, and smoothing it away would stretch
         the movement's onset by the same frames whatever its speed. 1 with ``reparameterise`` off (the paper's
