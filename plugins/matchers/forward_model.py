@@ -884,8 +884,9 @@ class ForwardModel(Matcher):
         starts = np.arange(-0.5, first + 0.5 / self.fps, 0.5 / self.fps)
         c, s = (a.ravel() for a in np.meshgrid(starts, speeds))
         best = int(np.argmin(((played(c, s) - seen) ** 2).sum(axis=(1, 2))))
-        fit = least_squares(lambda x: (played(x[:1], x[1:]) - seen).ravel(), [c[best], s[best]],
-                            bounds=([-0.5, 0.25], [max(first, 1e-6), 4.0]), x_scale=[0.1, 0.1])
+        low, high = np.array([-0.5, 0.25]), np.array([max(first, 1e-6), 4.0])
+        fit = least_squares(lambda x: (played(x[:1], x[1:]) - seen).ravel(),
+                            np.clip([c[best], s[best]], low, high), bounds=(low, high), x_scale=[0.1, 0.1])
         return float(np.clip(fit.x[1], 0.25, 4.0))
 
     SPEED_PARTS = 5
@@ -950,7 +951,7 @@ class ForwardModel(Matcher):
         if not self.tracks:
             return Match.unknown(reason="nothing moved")
         memory = self._local()
-        perform, learned, paths = [], [], []
+        perform, learned, paths, route = [], [], [], []  # route: every edge from the start node (the label's)
         first_from, first_to = None, None
         for name in list(self.tracks):
             track = self._settle(self.tracks[name], memory)
@@ -961,6 +962,7 @@ class ForwardModel(Matcher):
                     track.speed = self._speed(track, track.committed_path, len(self._observed(track, memory)))
                     perform.append(track.committed)
                     paths.extend(track.committed_path)
+                    route.extend(track.committed_path)
                 continue
             # it deviated (now, or while followed) or was never committed: from where the body is, the start node or
             # the last correct node it went back to, it performs what was right and not performed yet, then the
@@ -983,6 +985,7 @@ class ForwardModel(Matcher):
             self.motor.move_to(track.subsystem, end, posture=False)
             perform.append(self.motor.add_sequence(edges))
             paths.extend(edges)
+            route.extend([*track.right, *rest])
             learned.extend(names)
             if first_from is None:
                 first_from, first_to = track.last_correct, end
@@ -1005,7 +1008,7 @@ class ForwardModel(Matcher):
                 details.update({"from": first_from, "to": first_to})
         if len(perform) > 1:
             details["subsystems"] = {self.motor.subsystem_of(m): m for m in perform}
-        label = movement if len(perform) > 1 else (self._path_label(tuple(paths)) or self.motor.label(movement))
+        label = movement if len(perform) > 1 else (self._path_label(tuple(route)) or self.motor.label(movement))
         return Match(label, 1.0 if learned else min(t.confidence for t in tracks if t.committed),
                      None, tuple(paths), details=details)
 
