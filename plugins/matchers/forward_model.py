@@ -232,6 +232,9 @@ class Track:
     origin: int | None = None
     """After a deviation, predicted again from the last correct node (Fig. 3): the row from which the subsystem was
     followed first (``onset`` is then the row it passed the last correct node)."""
+    begun: Track | None = None
+    """After a deviation, predicted again: the segment's first track of the subsystem (what :meth:`ForwardModel.inspect`
+    shows of the segment's start)."""
 
 
 @dataclass(frozen=True)
@@ -363,11 +366,12 @@ class ForwardModel(Matcher):
             # after a deviation predicted again without a new commitment: the commitment that deviated
             committed, path = (track.committed, track.committed_path) if track.committed is not None or \
                 not track.failed else track.failed[-1]
-            return {"subsystem": track.subsystem, "start_node": track.start_node,
+            begun = track.begun or track
+            return {"subsystem": track.subsystem, "start_node": begun.start_node,
                     "candidates": dict(track.candidates), "initial": list(track.initial), "committed": committed,
                     "committed_path": tuple(path), "deviated": track.deviated,
                     "trace": tuple(track.trace), "committed_at": track.committed_at, "deviated_at": track.deviated_at,
-                    "anchors": {k: v.copy() for k, v in track.anchors.items()}}
+                    "anchors": {k: v.copy() for k, v in {**begun.anchors, **track.anchors}.items()}}
         return MappingProxyType({**view(self.main), "frames": 0 if self._memory is None else self._memory.n,
                                  "tracks": {name: view(track) for name, track in self.tracks.items()}})
 
@@ -1074,6 +1078,7 @@ class ForwardModel(Matcher):
                       right=track.right, learn_from=track.learn_from, trace=track.trace,
                       committed_at=track.committed_at, deviated_at=track.deviated_at, stopped=track.stopped,
                       home=track.home or track.start_node, at=track.at, failed=track.failed,
+                      begun=track.begun or track,
                       origin=track.onset if track.origin is None else track.origin)
         self.tracks[name] = again
         now = self._memory.n

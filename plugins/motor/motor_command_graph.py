@@ -596,8 +596,9 @@ class MotorCommandGraph(MotorSystem):
             if edge.name in self._edges:  # the same command built already (from clips, say): the saved one replaces it
                 known = self._edges[edge.name]
                 self.graphs[known.subsystem].remove_edge(known.source, known.target, known.name)
-                if edge.shown is None and known.shown is not None:  # a clip's demonstration is not saved: kept
-                    edge = Edge(edge.name, edge.subsystem, edge.source, edge.target, edge.commands, edge.origin,
+                if edge.shown is None and known.shown is not None:  # a clip's demonstration is not saved: kept,
+                    # and the edge is still the clip's
+                    edge = Edge(edge.name, edge.subsystem, edge.source, edge.target, edge.commands, known.origin,
                                 known.shown, known.shown_fps)
             self._add(edge)
             self._counter = max(self._counter, number)
