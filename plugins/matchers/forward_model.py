@@ -869,7 +869,8 @@ class ForwardModel(Matcher):
             return 1.0
         arcs = self._edge(path[0]).arcs[:, -1]
         parts = np.argsort(-arcs)[: self.SPEED_PARTS]  # the parts that move farthest (a hand: every finger)
-        seen = self._local()[track.onset: track.onset + n_frames, self.motor.subsystems[track.subsystem][parts]]
+        idx = self.motor.subsystems[track.subsystem][parts]  # the rows in the motor frame, as _local places them
+        seen = self._memory.positions[track.onset: track.onset + n_frames, idx] + self._root_height[idx]
         if not np.isfinite(seen).all():
             return 1.0
         times, points, first = self._shown(path, parts)
