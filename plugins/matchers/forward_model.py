@@ -857,14 +857,14 @@ class ForwardModel(Matcher):
         demonstrated (:meth:`_shown`) played from time ``c`` at ``s`` times its speed: the positions of the
         :attr:`SPEED_PARTS` parts that move farthest along its first command (a hand: its fingers, which share one
         clock), each taken relative to its mean over the frames (so a stance unlike one's own does not count), in
-        the least squares sense. ``s`` is the speed factor: first the best of a grid (``s`` from 0.25 to 4, ``c`` from half a
-        second before the path's start to the end of its first edge), then refined. Positions, not path lengths
+        the least squares sense. ``s`` is the speed factor: first the best of a grid on the part that moves farthest
+        (``s`` from 0.25 to 4 in steps of 12%, ``c`` from half a second before the path's start to the end of its
+        first edge, a frame apart), then refined on every part by three grids about the best, each five times
+        finer (to 0.1% of speed). Positions, not path lengths
         walked, are compared: observation noise adds length at every frame, and smoothing it away would stretch
         the movement's onset by the same frames whatever its speed. 1 with ``reparameterise`` off (the paper's
         baseline: a command is predicted at the speed it was learned), or with fewer than three frames.
         """
-        from scipy.optimize import least_squares
-
         if not self.params["reparameterise"] or n_frames < 3:
             return 1.0
         arcs = self._edge(path[0]).arcs[:, -1]
@@ -878,21 +878,25 @@ class ForwardModel(Matcher):
         t = np.arange(n_frames) / self.fps
         flat = points.reshape(len(points), -1)
 
-        def played(c: np.ndarray, s: np.ndarray) -> np.ndarray:  # (G,) starts and speeds -> (G, n, 3p), centred
+        def played(c: np.ndarray, s: np.ndarray, columns: int) -> np.ndarray:  # (G,) starts, speeds -> (G, n, m)
             q = (c[:, None] + s[:, None] * t).ravel()
-            out = np.stack([np.interp(q, times, flat[:, d]) for d in range(flat.shape[1])], axis=-1)
-            out = out.reshape(len(c), len(t), -1)
-            return out - out.mean(axis=1, keepdims=True)
+            out = np.stack([np.interp(q, times, flat[:, d]) for d in range(columns)], axis=-1)
+            out = out.reshape(len(c), len(t), columns)
+            return out - out.mean(axis=1, keepdims=True)  # centred
 
         seen = seen.reshape(n_frames, -1)
-        speeds = np.geomspace(0.25, 4.0, 49)
-        starts = np.arange(-0.5, first + 0.5 / self.fps, 0.5 / self.fps)
+        # the grid on the part that moves farthest, every 1/fps of start and 12% of speed; refined on every part
+        speeds = np.geomspace(0.25, 4.0, 25)
+        starts = np.arange(-0.5, first + 1.0 / self.fps, 1.0 / self.fps)
         c, s = (a.ravel() for a in np.meshgrid(starts, speeds))
-        best = int(np.argmin(((played(c, s) - seen) ** 2).sum(axis=(1, 2))))
-        low, high = np.array([-0.5, 0.25]), np.array([max(first, 1e-6), 4.0])
-        fit = least_squares(lambda x: (played(x[:1], x[1:]) - seen).ravel(),
-                            np.clip([c[best], s[best]], low, high), bounds=(low, high), x_scale=[0.1, 0.1])
-        return float(np.clip(fit.x[1], 0.25, 4.0))
+        best = int(np.argmin(((played(c, s, 3) - seen[:, :3]) ** 2).sum(axis=(1, 2))))
+        c0, s0, dc, ds = c[best], s[best], 1.0 / self.fps, np.log(speeds[1] / speeds[0])
+        for _ in range(3):  # finer grids about the best, on every part: each a fifth of the step before
+            cs, ls = np.meshgrid(c0 + dc * np.linspace(-1, 1, 11), np.log(s0) + ds * np.linspace(-1, 1, 11))
+            cs, ss = cs.ravel(), np.clip(np.exp(ls.ravel()), 0.25, 4.0)
+            best = int(np.argmin(((played(cs, ss, seen.shape[1]) - seen) ** 2).sum(axis=(1, 2))))
+            c0, s0, dc, ds = cs[best], ss[best], dc / 5, ds / 5
+        return float(s0)
 
     SPEED_PARTS = 5
     """The most parts a speed is measured on (those that move farthest)."""
