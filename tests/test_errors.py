@@ -269,6 +269,8 @@ CASES = [
     ("layer-part", "a look-at turning a part the body lacks", {"c.toml": CHILD + '[layer]\nparts = ["tail"]\n'}, ["validate", "c.toml"], ["c.toml:5: key layer.parts[0]", "unknown part 'tail'", "available: root, head, nose"]),
     ("layer-yaw", "a look-at turning the head round to the back", {"c.toml": CHILD + '[layer]\nyaw = 95.0\n'}, ["validate", "c.toml"], ["c.toml:5: key layer.yaw", "value 95.0 out of range", "expected a number in [0, 89]"]),
     ("layer-plugin", "an unknown layer", {"c.toml": CHILD + '[layer]\nplugin = "look-around"\n'}, ["validate", "c.toml"], ["c.toml:5: key layer.plugin", "unknown layer 'look-around'", "available: look-at"]),
+    # -- Fig. 3 and the speed re-parameterisation: an edge's demonstration in a state file (issue 19)
+    ("state-edge-shown", "a learned edge whose demonstration has the wrong shape", {"st.json": state(actors={"max": {"character": "Max", "components": {"motor": {"plugin": "motor-command-graph", "state": {"left_wrist": {"nodes": {"n1": [[0.26, 1.4, 0.4]]}, "edges": [{"from": "hub", "to": "n1", "name": "left_wrist:e1", "commands": [{"start": [0.25, 0.92, 0.06], "target": [0.26, 1.4, 0.4], "duration": 0.9}], "shown": [[0.25, 0.92], [0.26, 1.4]], "shown_fps": 30.0}]}}}}}})}, ["run", "imitation_games", "--duration", "0.1", "--load", "st.json"], ["key actors.max.components.motor.state.left_wrist.edges[0].shown: invalid shown", "expected the demonstration's frames, at least two, each [x, y, z] of its 1 parts, finite"]),
 ]
 
 

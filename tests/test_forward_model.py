@@ -106,7 +106,7 @@ def test_mean_error_halves_it_when_one_of_two_parts_is_off(arms):
 def test_a_faster_demonstration_is_recognised_at_its_speed(arms):
     demo = demonstration(arms, stroke_path(arms.motor.rest[2], [0.3, 0.0, 0.0], duration=0.5))
     commit = next(a for a in feed(arms.matcher, demo) if a is not None)
-    assert commit.path == (arms.out,) and commit.details["speed"] == pytest.approx(2.0, rel=0.15)
+    assert commit.path == (arms.out,) and commit.details["speed"] == pytest.approx(2.0, rel=0.10)
 
 
 def test_a_deviation_after_committing_stops_it_and_returns_to_the_last_correct_node(arms):

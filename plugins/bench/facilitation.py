@@ -218,10 +218,13 @@ def facilitation_benchmark(pm: Any, *, demonstrations: int = 200, repertoire: in
                         for j in range(len(strokes))]
             grid = np.linspace(0.0, strokes[0].duration, 100)
             imitation_error = float(np.mean([_shape_error(x, t.curve(grid)) for x, t in zip(executed, strokes)]))
+        recognised = early if early is not None else final
+        measured = recognised.details.get("speed") if recognised is not None else None
         rows.append({
             "kind": kind,
             "novel": is_novel,
             "speed": speed,
+            "measured_speed": None if measured is None else float(measured),
             "truth": truth,
             "answer": answer,
             "imitation_error": imitation_error,
@@ -294,6 +297,9 @@ def _facilitation_figures(rows: list[dict[str, Any]]) -> dict[str, Any]:
     fractions = [r["fraction"] for r in known_rows if r["committed"] and r["correct"] and r["fraction"] is not None]
     other_speed = [r for r in known_rows if abs(r["speed"] - 1.0) > 0.15]
     errors = [r["imitation_error"] for r in rows if r["imitation_error"] is not None]
+    # the speed factor measured on known movements recognised correctly, against the one they were shown at
+    speed_errors = [abs(r["measured_speed"] / r["speed"] - 1.0) for r in known_rows
+                    if r["correct"] and r.get("measured_speed") is not None]
     return {
         "known": len(known_rows), "novel": len(novel_rows),
         "recognition_accuracy": sum(r["correct"] for r in known_rows) / max(len(known_rows), 1),
@@ -307,6 +313,10 @@ def _facilitation_figures(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "strokes_per_novel_movement": float(np.mean([r["strokes"] for r in novel_rows])) if novel_rows else float("nan"),
         "imitation_error_mean": stat(errors, np.mean),
         "imitation_error_p90": stat(errors, lambda v: np.percentile(v, 90)),
+        "speed_error_median": stat(speed_errors, np.median),
+        "speed_error_p90": stat(speed_errors, lambda v: np.percentile(v, 90)),
+        "speed_within_10": stat(speed_errors, lambda v: np.mean(np.asarray(v) <= 0.10)),
+        "speed_measured": len(speed_errors),
     }
 
 
@@ -324,12 +334,16 @@ def render_facilitation(r: dict[str, Any]) -> str:
             f"{f['false_commits']}",
             f"{f['edges_per_novel_movement']:.2f} ({f['strokes_per_novel_movement'] + 1:.2f})",
             f"{f['imitation_error_mean']:.3f} / {f['imitation_error_p90']:.3f} {unit}",
+            f"{f['speed_error_median']:.3f} / {f['speed_error_p90']:.3f}",
+            f"{f['speed_within_10']:.3f} ({f['speed_measured']})",
         ]
 
     labels = ["demonstrations (known / novel)", "recognition accuracy, known movements", "  at another speed (how many)",
               "committed before the end (known)", "decision fraction, median / 90th percentile", "false commits",
               "edges learned per novel movement (expected: strokes or 1 hand edge, + the return)",
-              "imitation path error, mean / 90th percentile"]
+              "imitation path error, mean / 90th percentile",
+              "speed factor error |measured / shown - 1|, median / 90th percentile",
+              "speed factor within 10% of the shown (how many measured)"]
     table = [cells(f, unit) for _, f, unit in columns]
     head = (f"likeme bench facilitation: Max watches Moritz (seed {r['seed']}, {r['repertoire']} movements of each kind "
             f"learned first, noise {r['noise']} m and {r.get('angle_noise', 0.0)} rad)")

@@ -9,14 +9,24 @@ before the demonstration ends: *response facilitation*. While imitating, the
 observation keeps being compared with the chosen edge; if they part by more
 than ``deviation`` the imitation is stopped, the edge is excluded for this
 segment, the subsystem returns to the last correct node (the start of the edge
-the demonstration was on: the edges before it were right) and the rest is
-learned from there (§4.4: "the imitator returns into the last node at which
-accordance with the demonstrated movement was found").
+the demonstration was on: the edges before it were right; §4.4: "the imitator
+returns into the last node at which accordance with the demonstrated movement
+was found") and Fig. 3's loop goes on from there: the edges leaving that node,
+the excluded ones left out, predict what has been seen since the demonstration
+passed it (:meth:`ForwardModel._repredict`). One that prevails explains the rest
+(it is checked, and may deviate in turn); only what no edge explains is learned,
+from the last correct node.
 
-Speed: the forward model is evaluated not at the elapsed time but at the time at
-which the edge would have covered the same length of path as has been observed,
-so a familiar movement performed faster or slower still fits; the ratio of the
-two times re-parameterises the command's speed for the imitation.
+Speed (§4.4): with ``reparameterise`` (the default) the forward model is evaluated
+not at the elapsed time but at the time at which the edge would have covered the
+same length of path as has been observed, so a familiar movement performed faster
+or slower still fits. How much faster is measured against the demonstration the
+edge was learned from (``Edge.shown``: "the motor command (with the speed
+demonstrated at first)"), played from the best start at the best speed factor
+(:meth:`ForwardModel._speed`); the imitation is performed at that factor. A
+commitment waits until the movement has been seen for three frames, so that its
+speed can be told from when it began. Off, the paper's baseline: edges predict at
+the elapsed time, and a familiar movement at another speed is learned as new.
 
 Joining late: a segment often begins after its movement did (a hub threshold is
 crossed once the body has left the hub; a take is cropped in motion). Each part
@@ -177,7 +187,9 @@ class Track:
     ``onset`` is the row of the segment's working memory from which the subsystem is followed (0 for the first
     subsystem to move; a subsystem that starts later is followed from when it started). After a deviation,
     ``last_correct`` is the node where the demonstration last agreed with the committed path, ``right`` the
-    edges of that path before it, and ``learn_from`` the row from which the rest is learned. ``trace`` holds, per
+    edges before it that were followed correctly, ``excluded`` the edges that failed, and ``learn_from`` the row
+    from which the rest is predicted again (Fig. 3's loop: the subsystem is then followed by a new track from
+    ``last_correct``, ``onset`` = ``learn_from``) and, if no edge explains it, learned. ``trace`` holds, per
     frame, the prediction error of every candidate path evaluated (dropped ones at the frame they drop); while
     imitating, the committed path's error. ``committed_at`` and ``deviated_at`` count the segment's frames seen.
     """
@@ -209,6 +221,21 @@ class Track:
     sums: dict[tuple[str, ...], tuple[float, int]] = field(default_factory=dict)
     """Per candidate path, its summed prediction errors and the frames summed (a path extended from another
     inherits its sums): the race of ``race``."""
+    stopped: bool = False
+    """The imitation of a commitment was stopped at a deviation (once a segment; the body went back to ``home``)."""
+    home: str | None = None
+    """The node the subsystem's body is in, or goes back to, while it is followed: the start node (``None``), or
+    the last correct node it returned to when its imitation was stopped."""
+    at: int = 0
+    """How many of the edges of ``right`` the body has performed (those up to ``home``)."""
+    failed: list[tuple[str, tuple[str, ...]]] = field(default_factory=list)
+    """The commitments (movement, path) that deviated in this segment, in order."""
+    origin: int | None = None
+    """After a deviation, predicted again from the last correct node (Fig. 3): the row from which the subsystem was
+    followed first (``onset`` is then the row it passed the last correct node)."""
+    begun: Track | None = None
+    """After a deviation, predicted again: the segment's first track of the subsystem (what :meth:`ForwardModel.inspect`
+    shows of the segment's start)."""
 
 
 @dataclass(frozen=True)
@@ -402,6 +429,11 @@ class ForwardModel(Matcher):
         Parameter("together", bool, True, "Follow every subsystem that moves during a demonstration, each with its "
                   "own candidates, and imitate them at once (a hand-arm movement, §4.2); off: only the first to move."),
         Parameter("learn", bool, True, "Learn new edges by the inverse model when no edge predicts the demonstration."),
+        Parameter("reparameterise", bool, True, "Speed re-parameterisation (K&G §4.4): an edge predicts the "
+                  "demonstration at the time its command covers the path length seen, so a familiar movement "
+                  "performed faster or slower still fits, and is imitated at the speed measured. Off (the paper's "
+                  "baseline): an edge predicts at the time elapsed, at the speed it was learned, so a familiar "
+                  "movement at another speed is learned as new."),
         Parameter("drop", float, 0.5, "Speed-minimum criterion of the stroke segmentation used for learning.", minimum=0.0, maximum=1.0),
         Parameter("angle", float, 50.0, "Direction criterion (degrees) of the stroke segmentation used for learning.", minimum=1.0, maximum=180.0),
     )
@@ -453,11 +485,15 @@ class ForwardModel(Matcher):
                 return {"subsystem": None, "start_node": None, "candidates": {}, "initial": [], "committed": None,
                         "committed_path": (), "deviated": False, "trace": (), "committed_at": None,
                         "deviated_at": None, "anchors": {}}
-            return {"subsystem": track.subsystem, "start_node": track.start_node,
-                    "candidates": dict(track.candidates), "initial": list(track.initial), "committed": track.committed,
-                    "committed_path": tuple(track.committed_path), "deviated": track.deviated,
+            # after a deviation predicted again without a new commitment: the commitment that deviated
+            committed, path = (track.committed, track.committed_path) if track.committed is not None or \
+                not track.failed else track.failed[-1]
+            begun = track.begun or track
+            return {"subsystem": track.subsystem, "start_node": begun.start_node,
+                    "candidates": dict(track.candidates), "initial": list(track.initial), "committed": committed,
+                    "committed_path": tuple(path), "deviated": track.deviated,
                     "trace": tuple(track.trace), "committed_at": track.committed_at, "deviated_at": track.deviated_at,
-                    "anchors": {k: v.copy() for k, v in track.anchors.items()}}
+                    "anchors": {k: v.copy() for k, v in {**begun.anchors, **track.anchors}.items()}}
         return MappingProxyType({**view(self.main), "frames": 0 if self._memory is None else self._memory.n,
                                  "tracks": {name: view(track) for name, track in self.tracks.items()}})
 
@@ -632,24 +668,20 @@ class ForwardModel(Matcher):
         last = observed[-1]
         frame = self._memory.n - 1
         if track.committed is not None:
-            if track.deviated:
-                return None
-            error = self._error(track, track.committed_path, lengths, last)
+            error = self._error(track, track.committed_path,
+                                self._clock(track, track.committed_path, lengths, len(observed)), last)
             track.trace.append((frame, {track.committed_path: error}))
             if error <= self.params["deviation"]:
                 return None
-            track.deviated, track.deviated_at = True, self._memory.n
-            self._last_correct(track, lengths, memory)
-            if not track.reported:
-                return None
-            # stop the imitation; the others' commands were right and are completed by the motor system
-            self.motor.move_to(track.subsystem, track.last_correct)
-            return Match(track.committed, 0.0, self._memory.n, details={"stop": True, "reason": "deviation",
-                                                                         "subsystem": track.subsystem,
-                                                                         "return_to": track.last_correct})
+            return self._deviate(track, lengths, memory)  # Fig. 3: stop, exclude the edge, predict again
         if not track.candidates:
             return None
-        errors = self._errors(track, self._extended(track, lengths), lengths, last)
+        n = len(observed)
+        paths = self._extended(track, lengths, n)
+        if self.params["reparameterise"]:  # the clock is the path length observed: every candidate at once
+            errors = self._errors(track, paths, lengths, last)
+        else:
+            errors = {path: self._error(track, path, self._clock(track, path, lengths, n), last) for path in paths}
         track.trace.append((frame, errors))
         still = self._distance(track, observed[0], last) if self.params["stillness"] else None
         alive = self._survivors(errors, self._evidence(track, errors), still)
@@ -658,9 +690,9 @@ class ForwardModel(Matcher):
         track.candidates = alive
         if alive and len({self._movement_key(p) for p in alive}) == 1:  # one first command (or movement) prevails
             path = min(alive, key=alive.get)
-            along = self._along(track, path[0], lengths)
+            along = self._along(track, path[0], self._clock(track, path, lengths, n))
             progress = self._progress(path[0], along)
-            if progress >= self.params["min_progress"] or len(path) > 1:
+            if (progress >= self.params["min_progress"] or len(path) > 1) and self._timed(track, observed):
                 self._commit(track, path, along, progress, len(observed), alive[path])
         return None
 
@@ -670,7 +702,7 @@ class ForwardModel(Matcher):
         track.committed_path = self._known_continuation(path)
         track.committed = self.motor.add_sequence(list(track.committed_path))
         track.committed_at = self._memory.n
-        track.speed = self._speed(path[0], along, self._anchor(track, path[0]), n_observed)
+        track.speed = self._speed(track, path, n_observed)
         track.progress = progress
         track.confidence = float(np.exp(-error / self._limit(path)))
 
@@ -787,22 +819,32 @@ class ForwardModel(Matcher):
     def _last_correct(self, track: Track, lengths: np.ndarray, memory: np.ndarray) -> None:
         """The node at which the demonstration last agreed with the committed path: the start of the edge it was on.
 
-        The edges before it were followed correctly; learning starts from the frame the demonstration passed it.
+        That edge is excluded from the segment's predictions (Fig. 3); the edges before it were followed correctly
+        and join ``right``. Predicting again, and learning, start from the frame the demonstration passed the node
+        (with ``reparameterise`` off, the frame the path reached it at its own speed).
         """
         from scipy.ndimage import uniform_filter1d
 
-        lead = self._lead(track.committed_path[0])
-        arcs = np.cumsum([self._edge(e).arcs[lead, -1] for e in track.committed_path])
-        joined = self._anchor(track, track.committed_path[0])[lead]
-        on = int(np.searchsorted(arcs, lengths[lead] + joined - 0.01 / track.scale))
-        on = min(on, len(track.committed_path) - 1)
-        track.last_correct = self.motor.edge(track.committed_path[on]).source
-        track.excluded.add(track.committed_path[on])
-        track.right = track.committed_path[:on]  # the part that was right
-        if track.right:
-            observed = self._observed(track, memory)[:, lead]
-            walked = _arc(uniform_filter1d(observed, size=3, axis=0, mode="nearest"))
-            track.learn_from = track.onset + int(np.searchsorted(walked, arcs[on - 1] - joined))
+        path = track.committed_path
+        lead = self._lead(path[0])
+        observed = self._observed(track, memory)
+        clock = self._clock(track, path, lengths, len(observed))
+        arcs = np.cumsum([self._edge(e).arcs[lead, -1] for e in path])
+        joined = self._anchor(track, path[0])[lead]
+        on = int(np.searchsorted(arcs, clock[lead] + joined - 0.01 / track.scale))
+        on = min(on, len(path) - 1)
+        track.last_correct = self.motor.edge(path[on]).source
+        track.excluded.add(path[on])
+        if not on:
+            return
+        track.right = (*track.right, *path[:on])  # the part that was right
+        if self.params["reparameterise"]:
+            walked = _arc(uniform_filter1d(observed[:, lead], size=3, axis=0, mode="nearest"))
+            row = int(np.searchsorted(walked, arcs[on - 1] - joined))
+        else:  # when the commands, at their own speed, reached the node
+            reached = sum(self.motor.edge(e).duration for e in path[:on])
+            row = int(round((reached - self._mapped_time(self._strokes_of(path[0])[lead], joined)) * self.fps))
+        track.learn_from = track.onset + min(max(row, 0), len(observed) - 1)
 
     def _scale_of(self, subsystem: str) -> float:
         """Metres one unit of the subsystem's values counts as: ``angle_scale`` for a hand's radians, else 1."""
@@ -842,20 +884,21 @@ class ForwardModel(Matcher):
             self._tables[id(stroke)] = table
         return table[1], table[2], table[3]
 
-    def _extended(self, track: Track, lengths: np.ndarray) -> list[tuple[str, ...]]:
+    def _extended(self, track: Track, lengths: np.ndarray, n: int | None = None) -> list[tuple[str, ...]]:
         """Candidate paths whose commands have all been covered by the observation continue along every edge of
-        their end node.
+        their end node but those excluded for this segment (Fig. 3: an edge that failed predicts no more).
 
-        ``lengths`` holds the observed path length of each part of the subsystem.
+        ``lengths`` holds the observed path length of each part of the subsystem, ``n`` the frames observed
+        (:meth:`_clock`; ``None``: as many as the path lengths say).
         """
         out = []
         for path in track.candidates:
             lead = self._lead(path[0])
-            seen = self._along(track, path[0], lengths)[lead]
+            seen = self._along(track, path[0], lengths if n is None else self._clock(track, path, lengths, n))[lead]
             total = sum(self._edge(e).arcs[lead, -1] for e in path)
             end = self.motor.edge(path[-1]).target
             nxt = [edge.name for edge in self.motor.edges_from(track.subsystem, end)] if seen > total + 0.01 / track.scale else []
-            out.extend([(*path, n) for n in nxt if n not in path] or [path])
+            out.extend([(*path, e) for e in nxt if e not in path and e not in track.excluded] or [path])
         return out
 
     def _path_label(self, path: tuple[str, ...]) -> str | None:
@@ -1042,13 +1085,97 @@ class ForwardModel(Matcher):
         stroke = self._strokes_of(name)[lead]
         return self._mapped_time(stroke, along[lead]) / stroke.duration
 
-    def _speed(self, name: str, along: np.ndarray, joined: np.ndarray, n_frames: int) -> float:
-        """How much faster than the command the demonstration goes (1: same speed), from where it was joined."""
-        lead = self._lead(name)
-        stroke = self._strokes_of(name)[lead]
-        elapsed = (n_frames - 1) / self.fps
-        covered = self._mapped_time(stroke, along[lead]) - self._mapped_time(stroke, joined[lead])
-        return float(np.clip(covered / max(elapsed, 1e-6), 0.25, 4.0))
+    def _speed(self, track: Track, path: tuple[str, ...], n_frames: int) -> float:
+        """How much faster than the commands of ``path`` the demonstration goes (1: same speed), K&G §4.4: "map the
+        length of the movement seen so far onto the trajectory predicted by a forward model, yielding the time
+        parameter at which the corresponding motor command (with the speed demonstrated at first) would have
+        produced a movement of the same length".
+
+        The ``n_frames`` rows observed since the track's onset are matched with the path as it was first
+        demonstrated (:meth:`_shown`) played from time ``c`` at ``s`` times its speed: the positions of the
+        :attr:`SPEED_PARTS` parts that move farthest along its first command (a hand: its fingers, which share one
+        clock), each taken relative to its mean over the frames (so a stance unlike one's own does not count), in
+        the least squares sense. ``s`` is the speed factor: first the best of a grid on the part that moves farthest
+        (``s`` from 0.25 to 4 in steps of 12%, ``c`` from half a second before the path's start to the end of its
+        first edge, a frame apart), then refined on every part by three grids about the best, each five times
+        finer (to 0.1% of speed). Positions, not path lengths
+        walked, are compared: observation noise adds length at every frame, and smoothing it away would stretch
+        the movement's onset by the same frames whatever its speed. 1 with ``reparameterise`` off (the paper's
+        baseline: a command is predicted at the speed it was learned), or with fewer than three frames.
+        """
+        if not self.params["reparameterise"] or n_frames < 3:
+            return 1.0
+        arcs = self._edge(path[0]).arcs[:, -1]
+        parts = np.argsort(-arcs)[: self.SPEED_PARTS]  # the parts that move farthest (a hand: every finger)
+        idx = self.motor.subsystems[track.subsystem][parts]  # the rows in the motor frame, as _local places them
+        seen = self._memory.positions[track.onset: track.onset + n_frames, idx] + self._root_height[idx]
+        if not np.isfinite(seen).all():
+            return 1.0
+        times, points, first = self._shown(path, parts)
+        seen = seen - seen.mean(axis=0)
+        t = np.arange(n_frames) / self.fps
+        flat = points.reshape(len(points), -1)
+
+        def played(c: np.ndarray, s: np.ndarray, columns: int) -> np.ndarray:  # (G,) starts, speeds -> (G, n, m)
+            q = (c[:, None] + s[:, None] * t).ravel()
+            out = np.stack([np.interp(q, times, flat[:, d]) for d in range(columns)], axis=-1)
+            out = out.reshape(len(c), len(t), columns)
+            return out - out.mean(axis=1, keepdims=True)  # centred
+
+        seen = seen.reshape(n_frames, -1)
+        # the grid on the part that moves farthest, every 1/fps of start and 12% of speed; refined on every part
+        speeds = np.geomspace(0.25, 4.0, 25)
+        starts = np.arange(-0.5, first + 1.0 / self.fps, 1.0 / self.fps)
+        c, s = (a.ravel() for a in np.meshgrid(starts, speeds))
+        best = int(np.argmin(((played(c, s, 3) - seen[:, :3]) ** 2).sum(axis=(1, 2))))
+        c0, s0, dc, ds = c[best], s[best], 1.0 / self.fps, np.log(speeds[1] / speeds[0])
+        for _ in range(3):  # finer grids about the best, on every part: each a fifth of the step before
+            cs, ls = np.meshgrid(c0 + dc * np.linspace(-1, 1, 11), np.log(s0) + ds * np.linspace(-1, 1, 11))
+            cs, ss = cs.ravel(), np.clip(np.exp(ls.ravel()), 0.25, 4.0)
+            best = int(np.argmin(((played(cs, ss, seen.shape[1]) - seen) ** 2).sum(axis=(1, 2))))
+            c0, s0, dc, ds = cs[best], ss[best], dc / 5, ds / 5
+        return float(s0)
+
+    SPEED_PARTS = 5
+    """The most parts a speed is measured on (those that move farthest)."""
+
+    MIN_MOVING_FRAMES = 3
+    """Frames of movement a speed is measured from (:meth:`_timed`)."""
+
+    def _timed(self, track: Track, observed: np.ndarray) -> bool:
+        """Whether enough of the movement has been seen to measure its speed (:meth:`_speed`): with
+        ``reparameterise``, :attr:`MIN_MOVING_FRAMES` frames on which the subsystem's parts are away from where they
+        were at the onset by more than a quarter of ``min_move`` (with one or two, how fast it goes and when it
+        began cannot be told apart). A commitment waits for them: a frame or two, for a fast movement."""
+        if not self.params["reparameterise"]:
+            return True
+        away = np.linalg.norm(observed - observed[0], axis=-1).max(axis=1) * track.scale
+        return int((away > 0.25 * self.params["min_move"]).sum()) >= self.MIN_MOVING_FRAMES
+
+    def _shown(self, path: tuple[str, ...], parts: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+        """The trajectories of ``parts`` (indices into the subsystem's parts) along ``path`` as it was first
+        demonstrated: times (M,) and positions (M, p, 3), the edges laid end to end, and the time the first edge
+        ends. An edge learned by watching keeps the piece of the demonstration it was learned from
+        (``Edge.shown``); one without it (written by hand, or saved without) stands for its commands played at
+        their own speed, each part holding its target once its command has ended."""
+        times, points, t0, first = [], [], 0.0, 0.0
+        for i, name in enumerate(path):
+            edge = self.motor.edge(name)
+            shown = getattr(edge, "shown", None)
+            if shown is not None and getattr(edge, "shown_fps", 0.0) > 0:
+                p, t = shown[:, parts], np.arange(len(shown)) / edge.shown_fps
+            else:
+                t = np.linspace(0.0, edge.duration, max(2, int(np.ceil(edge.duration * 120.0)) + 1))
+                p = np.stack([edge.commands[j].position(np.minimum(t, edge.commands[j].duration)) for j in parts],
+                             axis=1)
+            times.append(t + t0)
+            points.append(p)
+            t0 += float(t[-1])
+            if i == 0:
+                first = t0
+        times_all, points_all = np.concatenate(times), np.concatenate(points)
+        keep = np.append(np.diff(times_all) > 1e-9, True)  # where two edges meet, the later's first frame
+        return times_all[keep], points_all[keep], first
 
     # -- the end of the demonstration ------------------------------------------------------------
 
@@ -1071,61 +1198,65 @@ class ForwardModel(Matcher):
         if not self.tracks:
             return Match.unknown(reason="nothing moved")
         memory = self._local()
-        perform, learned, paths = [], [], []
+        perform, learned, paths, route = [], [], [], []  # route: every edge from the start node (the label's)
         first_from, first_to = None, None
-        for track in self.tracks.values():
-            idx = self.motor.subsystems[track.subsystem]
-            if self._leader(track, memory):  # the race's finish (relative drop-out)
+        for name in list(self.tracks):
+            track = self._settle(self.tracks[name], memory)
+            if track.committed is not None and not track.deviated:  # its commitment held (or won the race)
                 self.motor.move_to(track.subsystem, self.motor.edge(track.committed_path[-1]).target, posture=False)
-                perform.append(track.committed)
-                paths.extend(track.committed_path)
+                if not track.reported:  # recognised, but not imitated yet (recognised at the end, or another
+                    # subsystem had to be learned): at the speed measured over the whole demonstration
+                    track.speed = self._speed(track, track.committed_path, len(self._observed(track, memory)))
+                    perform.append(track.committed)
+                    paths.extend(track.committed_path)
+                    route.extend(track.committed_path)
                 continue
-            if track.committed is not None and not track.deviated:
-                end = self.motor.edge(track.committed_path[-1]).target
-                expected = self.motor.state(track.subsystem, end) + self._onset_offset(track, track.committed_path[0])
-                if self._distance(track, expected, memory[-1, idx]) <= self.params["deviation"]:
-                    self.motor.move_to(track.subsystem, end, posture=False)  # the body is where imitating left it
-                    if not track.reported:  # recognised, but not imitated yet (another subsystem had to be learned)
-                        perform.append(track.committed)
-                        paths.extend(track.committed_path)
+            # it deviated (now, or while followed) or was never committed: from where the body is, the start node or
+            # the last correct node it went back to, it performs what was right and not performed yet, then the
+            # rest: along the edge that explains it when one does (Fig. 3's loop), else what is learned
+            self.motor.move_to(track.subsystem, track.home or track.start_node)
+            before = list(track.right[track.at:])
+            names: list[str] = []
+            if track.committed is not None:  # another known edge explains the rest: nothing is learned
+                track.speed = self._speed(track, track.committed_path, len(self._observed(track, memory)))
+                rest = list(track.committed_path)
+            else:
+                names = self._learn(track, memory) if self.params["learn"] else []
+                if not names:
                     continue
-                # it ended somewhere else: the committed command was not the right one
-                track.deviated = True
-                self._last_correct(track, _lengths(self._observed(track, memory)), memory)
-            if track.committed is not None and track.reported and not track.deviated:
-                continue
-            if track.deviated or track.committed is None:
-                self.motor.move_to(track.subsystem, track.last_correct)  # back to the last correct node
-            if not self.params["learn"]:
-                continue
-            names = self._learn(track, memory)
-            if not names:
-                continue
-            new = self.motor.add_sequence(names)
-            if track.right:  # the part that was right, then the new one
-                self.motor.add_sequence([*track.right, *names])
-            self.motor.move_to(track.subsystem, self.motor.edge(names[-1]).target, posture=False)
-            perform.append(new)
-            paths.extend(names)
+                rest = names
+                if track.right:  # the part that was right, then the new one
+                    self.motor.add_sequence([*track.right, *names])
+            edges = [*before, *rest]
+            end = self.motor.edge(edges[-1]).target
+            self.motor.move_to(track.subsystem, end, posture=False)
+            perform.append(self.motor.add_sequence(edges))
+            paths.extend(edges)
+            route.extend([*track.right, *rest])
             learned.extend(names)
             if first_from is None:
-                first_from, first_to = track.last_correct, self.motor.edge(names[-1]).target
+                first_from, first_to = track.last_correct, end
         if not perform:
             if self.reported:
                 return None  # already reported when it committed
             return Match.unknown(reason="no edge predicts the demonstration", **self._nearest())
         movement = self.motor.add_together(perform)
         main = self.main
-        details: dict[str, Any] = {"candidates": [c for t in self.tracks.values() for c in t.initial],
-                                   "deviated": any(t.deviated for t in self.tracks.values())}
+        tracks = list(self.tracks.values())
+        details: dict[str, Any] = {"candidates": [c for t in tracks for c in t.initial],
+                                   "deviated": any(t.deviated for t in tracks)}
+        if details["deviated"]:  # the edges that failed, excluded from the segment's predictions (Fig. 3)
+            details["excluded"] = sorted(e for t in tracks for e in t.excluded)
         if learned:
             details.update({"learned": learned, "from": first_from, "to": first_to})
-        else:  # recognised only at the end
+        else:  # recognised only at the end, or again from the last correct node after a deviation
             details.update({"speed": main.speed, "progress": main.progress})
+            if first_from is not None:
+                details.update({"from": first_from, "to": first_to})
         if len(perform) > 1:
             details["subsystems"] = {self.motor.subsystem_of(m): m for m in perform}
-        label = movement if len(perform) > 1 else (self._path_label(tuple(paths)) or self.motor.label(movement))
-        return Match(label, 1.0 if learned else min(t.confidence for t in self.tracks.values() if t.committed),
+        label = movement if len(perform) > 1 else (self._path_label(tuple(route)) or self.motor.label(movement))
+        return Match(label, 1.0 if learned else min(t.confidence for t in tracks if t.committed),
                      None, tuple(paths), details=details)
 
     def _learn(self, track: Track, memory: np.ndarray) -> list[str]:
@@ -1134,7 +1265,8 @@ class ForwardModel(Matcher):
         A subsystem followed from a later onset than the first is learned up to where it came to rest.
         """
         observed = memory[track.learn_from:, self.motor.subsystems[track.subsystem]]
-        if track.onset > 0 and len(observed) > 3:  # it may have stopped before the others did
+        if (track.onset if track.origin is None else track.origin) > 0 and len(observed) > 3:
+            # it may have stopped before the others did
             away = np.linalg.norm(observed - observed[-1], axis=-1).max(axis=1) * track.scale
             moving = np.flatnonzero(away > 0.25 * self.params["min_move"])
             observed = observed[: (int(moving[-1]) + 2 if len(moving) else len(observed))]
@@ -1146,6 +1278,109 @@ class ForwardModel(Matcher):
         """Batch use: the whole segment at once (no facilitation): followed frame by frame, then concluded."""
         early, late = follow(self, motion)
         return late or early or Match.unknown()
+
+    # -- Fig. 3's loop after a deviation, and the speed (K&G §4.4) -------------------------------------
+
+    def _deviate(self, track: Track, lengths: np.ndarray, memory: np.ndarray) -> Match | None:
+        """The demonstration deviates from the committed path (Fig. 3): the edge it was on is excluded from this
+        segment's predictions, the imitation is stopped (the first time; the subsystem returns to the last correct
+        node), and the rest is predicted again from the last correct node (:meth:`_repredict`).
+
+        Returns a :class:`Match` with ``stop`` when an imitation under way was stopped.
+        """
+        track.deviated = True
+        if track.deviated_at is None:
+            track.deviated_at = len(memory)
+        self._last_correct(track, lengths, memory)
+        track.failed.append((track.committed, track.committed_path))
+        stop = None
+        if track.reported and not track.stopped:
+            # stop the imitation; the others' commands were right and are completed by the motor system
+            track.stopped, track.home, track.at = True, track.last_correct, len(track.right)
+            self.motor.move_to(track.subsystem, track.last_correct)
+            stop = Match(track.committed, 0.0, len(memory), details={"stop": True, "reason": "deviation",
+                                                                      "subsystem": track.subsystem,
+                                                                      "return_to": track.last_correct})
+        self._repredict(track, memory)
+        return stop
+
+    def _repredict(self, track: Track, memory: np.ndarray) -> None:
+        """Fig. 3's loop: "edges <- motor commands that can predict the observed movement", again, from the last
+        correct node. A new :class:`Track` follows the subsystem from the row at which the demonstration passed
+        that node, with the edges leaving it as candidates but those excluded; it keeps what the segment has
+        established (the edges that were right, the excluded ones, whether the imitation was stopped, the trace).
+        The rows seen since are followed again one by one, so a candidate drops out, or prevails and is committed
+        to (and checked, and may deviate in turn), as if it had been followed from there. What no edge explains
+        is learned at the end (:meth:`_conclude`), and only that.
+        """
+        node, name = track.last_correct, track.subsystem
+        candidates = {(edge.name,): 0.0 for edge in self.motor.edges_from(name, node)
+                      if edge.name not in track.excluded and self._length(edge.name) * track.scale > self.params["min_move"]}
+        again = Track(name, track.scale, track.hand, node, track.learn_from, candidates, track.initial,
+                      excluded=track.excluded, reported=track.reported, deviated=True, last_correct=node,
+                      right=track.right, learn_from=track.learn_from, trace=track.trace,
+                      committed_at=track.committed_at, deviated_at=track.deviated_at, stopped=track.stopped,
+                      home=track.home or track.start_node, at=track.at, failed=track.failed,
+                      begun=track.begun or track,
+                      origin=track.onset if track.origin is None else track.origin)
+        self.tracks[name] = again
+        now = self._memory.n
+        for row in range(again.onset + 1, len(memory)):  # what has been seen since the node, frame by frame
+            current, seen = self.tracks[name], len(track.trace)
+            self._follow(current, memory[: row + 1])
+            for k in range(seen, len(track.trace)):  # the frame each replayed prediction belongs to
+                frame, errors = track.trace[k]
+                if frame == now - 1:
+                    track.trace[k] = (row, errors)
+            current = self.tracks[name]
+            if current.committed is not None and current.committed_at == now:
+                current.committed_at = row + 1
+
+    def _settle(self, track: Track, memory: np.ndarray) -> Track:
+        """At the end of the demonstration: a subsystem's commitment must end where the demonstration did; while
+        it does not, it deviated (:meth:`_deviate`: the last correct node, the edge excluded, the rest predicted
+        again). With ``dropout = relative`` a subsystem without a commitment is first committed to the race's
+        leader (not checked against the end: the race's finish). Returns the subsystem's track as it is then."""
+        if self._leader(track, memory):
+            return track
+        while track.committed is not None and not self._ended(track, memory):
+            self._deviate(track, _lengths(self._observed(track, memory)), memory)
+            track = self.tracks[track.subsystem]
+            if self._leader(track, memory):
+                break
+        return track
+
+    def _ended(self, track: Track, memory: np.ndarray) -> bool:
+        """Whether the demonstration ended (the last row of ``memory``) where the committed path does."""
+        end = self.motor.edge(track.committed_path[-1]).target
+        expected = self.motor.state(track.subsystem, end) + self._onset_offset(track, track.committed_path[0])
+        seen = memory[-1, self.motor.subsystems[track.subsystem]]
+        return self._distance(track, expected, seen) <= self.params["deviation"]
+
+    def _clock(self, track: Track, path: tuple[str, ...], lengths: np.ndarray, n: int) -> np.ndarray:
+        """How far along ``path`` each part of the subsystem is predicted: with ``reparameterise`` (K&G §4.4) the
+        path length observed (``lengths``, so the prediction does not depend on the speed); off, the path length
+        the part's commands cover, at their own speed, in the time the ``n`` frames observed took (from where the
+        demonstration joined the path, :meth:`_anchor`): the forward model of Fig. 3 without re-parameterisation,
+        which a familiar movement at another speed does not fit."""
+        if self.params["reparameterise"]:
+            return lengths
+        elapsed = (n - 1) / self.fps
+        anchor = self._anchor(track, path[0])
+        out = np.empty(len(lengths))
+        for p in range(len(lengths)):
+            t = self._mapped_time(self._strokes_of(path[0])[p], anchor[p]) + elapsed
+            covered = 0.0
+            for i, name in enumerate(path):
+                edge = self.motor.edge(name)
+                grid, _, arc = self._table(edge.commands[p])
+                if t <= edge.duration or i == len(path) - 1:
+                    covered += float(np.interp(t, grid, arc))
+                    break
+                t -= edge.duration
+                covered += float(arc[-1])
+            out[p] = covered - anchor[p]
+        return out
 
 
 @hookimpl

@@ -61,6 +61,13 @@ class Edge:
     ``commands`` holds one guiding stroke per part of a wrist subsystem, or one hand transition per finger of a
     hand (they share their timing); ``name`` is the movement it is performed and recognised as
     (``left_wrist:e3``); ``origin`` says where it was learned (a clip file, ``"inverse model"``, ``"loaded"``).
+
+    ``shown`` is the piece of the demonstration the command was learned from, when it was learned by watching: the
+    parts' positions (a hand: joint angles), (m, k, 3), at ``shown_fps`` frames per second. It keeps the speed the
+    command "was demonstrated at first" (K&G §4.4): the forward model measures how much faster or slower a familiar
+    movement is performed against it. ``None`` (a command written by hand, or saved without it): the commands'
+    own timing stands for it. :meth:`MotorCommandGraph.get_state` saves it for edges learned by watching, not for
+    those learned from clips (rebuilt from the clips; a loaded edge keeps the clip's).
     """
 
     name: str
@@ -69,6 +76,8 @@ class Edge:
     target: str
     commands: tuple[Command, ...]
     origin: str = ""
+    shown: np.ndarray | None = None
+    shown_fps: float = 0.0
 
     @property
     def duration(self) -> float:
@@ -234,17 +243,19 @@ class MotorCommandGraph(MotorSystem):
         return self.params["hand_tolerance"] if self.is_hand(subsystem) else self.params["tolerance"]
 
     def learn(self, subsystem: str, start: str, commands: list[Command], *, end: str | None = None,
-              origin: str = "") -> str:
+              origin: str = "", shown: np.ndarray | None = None, shown_fps: float = 0.0) -> str:
         """Add an edge of ``commands`` (one per part of the subsystem) from node ``start``; returns its movement name.
 
         Guiding strokes for a wrist subsystem, hand transitions for a hand. The edge ends in ``end`` if given
         (a hub, say), else in the node at the commands' targets (an existing one within :meth:`tolerance`, or a new one).
+        ``shown`` and ``shown_fps``: the piece of the demonstration it was learned from (:attr:`Edge.shown`).
         """
         if end is None:
             target = np.stack([c.target for c in commands])
             end = self._near_node(subsystem, target) or self._new_node(subsystem, target)
         self._counter += 1
-        edge = Edge(f"{subsystem}:e{self._counter}", subsystem, start, end, tuple(commands), origin)
+        edge = Edge(f"{subsystem}:e{self._counter}", subsystem, start, end, tuple(commands), origin,
+                    None if shown is None else np.array(shown, dtype=float), float(shown_fps) if shown is not None else 0.0)
         self._add(edge)
         if self.owner is not None:
             self.owner.announce("likeme_movement_learned", character=self.owner, movement=edge.name,
@@ -264,16 +275,23 @@ class MotorCommandGraph(MotorSystem):
         It is cut into strokes at the break points of :func:`plugins.lib.strokes.breaks` (``criteria``), the
         inverse model turns each into a command (:func:`plugins.lib.inverse_model.commands_from_segment`), and
         the commands become a chain of edges from ``start``; the last ends in the hub when the movement came back
-        within ``hub_tolerance`` metres of it (a hand: within :meth:`tolerance`). Returns the new edges' names.
+        within ``hub_tolerance`` metres of it (a hand: within :meth:`tolerance`). Each edge keeps its piece of the
+        demonstration (:attr:`Edge.shown`). Returns the new edges' names.
         """
         n, k, _ = observed.shape
         hand = self.is_hand(subsystem)
         cuts = breaks(observed.reshape(n, k * 3), fps, criteria)
         home = np.linalg.norm(observed[-1] - self.state(subsystem, "hub"), axis=-1).max() <= (
             self.tolerance(subsystem) if hand else hub_tolerance)
+        pieces = commands_from_segment(observed, fps, cuts, hand=hand, refine=refine)
+        # the frames of each piece, as commands_from_segment cuts them: one piece for a hand, else one per stroke
+        # between break points, pieces shorter than two frames left out
+        ends = [0, *cuts, n - 1]
+        spans = [(0, n - 1)] if hand else [(a, b) for a, b in zip(ends, ends[1:]) if b - a >= 2]
         names, node = [], start
-        for commands, last in commands_from_segment(observed, fps, cuts, hand=hand, refine=refine):
-            name = self.learn(subsystem, node, commands, end="hub" if last and home else None, origin=origin)
+        for (commands, last), (a, b) in zip(pieces, spans):
+            name = self.learn(subsystem, node, commands, end="hub" if last and home else None, origin=origin,
+                              shown=observed[a: b + 1], shown_fps=fps)
             names.append(name)
             node = self.edge(name).target
         return names
@@ -457,7 +475,9 @@ class MotorCommandGraph(MotorSystem):
             sequences = {m: e for m, e in self.sequences.items() if self.subsystem_of(m) == name}
             state[name] = {
                 "nodes": {n: d["state"].round(6).tolist() for n, d in g.nodes(data=True) if n != "hub"},
-                "edges": [{"from": e.source, "to": e.target, "name": e.name, "commands": [c.to_dict() for c in e.commands]}
+                "edges": [{"from": e.source, "to": e.target, "name": e.name, "commands": [c.to_dict() for c in e.commands],
+                           **({"shown": e.shown.round(6).tolist(), "shown_fps": e.shown_fps}
+                              if e.shown is not None and e.origin in ("inverse model", "loaded") else {})}
                           for e in self.edges(name)],
                 "sequences": sequences,
                 "labels": {m: label for m, label in self.labels.items() if m in sequences},
@@ -537,7 +557,21 @@ class MotorCommandGraph(MotorSystem):
                               "an edge written by get_state")
                 if not all(0 < c.duration <= 3600 for c in built):
                     raise bad("invalid edge (a command longer than an hour)", key, "an edge written by get_state")
-                edges[e["name"]] = (Edge(e["name"], name, e["from"], e["to"], built, "loaded"), int(number))
+                shown, shown_fps = e.get("shown"), e.get("shown_fps", 0.0)
+                if shown is not None:
+                    try:
+                        shown = np.asarray(shown, dtype=float)
+                    except (TypeError, ValueError, OverflowError):
+                        shown = np.zeros(0)
+                    if (shown.shape[1:] != (len(built), 3) or len(shown) < 2 or not np.isfinite(shown).all()
+                            or np.abs(shown).max() >= 1e6):
+                        raise bad("invalid shown", (*key, "shown"), f"the demonstration's frames, at least two, "
+                                  f"each [x, y, z] of its {len(built)} parts, finite")
+                    if not (isinstance(shown_fps, (int, float)) and 0 < shown_fps <= 1000):
+                        raise bad(f"invalid shown_fps {shown_fps!r}"[:200], (*key, "shown_fps"),
+                                  "frames per second of shown, above 0 and at most 1000")
+                edges[e["name"]] = (Edge(e["name"], name, e["from"], e["to"], built, "loaded", shown,
+                                           float(shown_fps) if shown is not None else 0.0), int(number))
         known_edges = set(self._edges) | set(edges)
         sequences, labels, together = {}, {}, {}
         for name, entry in state.items():
@@ -562,6 +596,10 @@ class MotorCommandGraph(MotorSystem):
             if edge.name in self._edges:  # the same command built already (from clips, say): the saved one replaces it
                 known = self._edges[edge.name]
                 self.graphs[known.subsystem].remove_edge(known.source, known.target, known.name)
+                if edge.shown is None and known.shown is not None:  # a clip's demonstration is not saved: kept,
+                    # and the edge is still the clip's
+                    edge = Edge(edge.name, edge.subsystem, edge.source, edge.target, edge.commands, known.origin,
+                                known.shown, known.shown_fps)
             self._add(edge)
             self._counter = max(self._counter, number)
         self.sequences.update(sequences)
