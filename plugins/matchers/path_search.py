@@ -52,6 +52,13 @@ after the graph learns), which gives exactly the scan's k nearest in the scan's 
 as fast. The scan is kept, exact by construction, where the index would have to answer another question: with
 attention (weights), with nodes excluded (the spread between takes), and with ``per_movement`` (each movement's
 nearest pose, however far).
+
+Hubs (issue 22): a path that ends near a hub reaches, through it, the first nodes of every movement, and with
+``per_movement`` (one path per movement in the beam) a beam step would list those nodes once per path near the hub:
+candidates growing as the square of the movements. The reach tables are factored through the wide nodes
+(:class:`Fan`): a step lists each node's local reach, and a hub's onward nodes only for the paths that can be the
+best way to them (the least cost up to rounding; :func:`_candidates`), which keeps exactly the paths the full
+listing keeps.
 """
 
 from __future__ import annotations
