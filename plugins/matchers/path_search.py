@@ -416,10 +416,14 @@ class Fan(NamedTuple):
     either meets no wide node, or meets a first one at the distance found without passing through another; so the
     union is exactly :func:`_reach`'s row.)"""
 
+    full: tuple[np.ndarray, np.ndarray]
+    """:func:`_reach`'s table: each node's whole reach, used for the nodes whose row is short."""
+    long: np.ndarray
+    """(N,) bool: the nodes whose reach is longer than :data:`LONG_ROW` and passes a wide node: listed factored."""
     local: tuple[np.ndarray, np.ndarray]
-    """Compressed rows (indptr, sorted node indices): each node's local nodes (itself included)."""
+    """Compressed rows (indptr, sorted node indices): each long node's local nodes (itself included)."""
     wide: tuple[np.ndarray, np.ndarray, np.ndarray]
-    """Compressed rows (indptr, wide node number, distance): the wide nodes each node reaches first."""
+    """Compressed rows (indptr, wide node number, distance): the wide nodes each long node reaches first."""
     rings: tuple[np.ndarray, np.ndarray]
     """Compressed rows (indptr, sorted node indices), row ``w * (max_skip + 1) + d``: the nodes at exactly ``d``
     steps from wide node number ``w``."""
@@ -429,6 +433,10 @@ class Fan(NamedTuple):
 WIDE = 8
 """Nodes with more successors (or predecessors, backward) than this are wide: :class:`Fan` factors the reach
 through them (a posegraph's hubs, each shared by many movements)."""
+
+LONG_ROW = 64
+"""Nodes that reach more nodes than this (through a wide node) have their reach listed factored; shorter rows are
+listed whole, as fast as ever on small graphs."""
 
 
 def _rows(rows: list[list[int]]) -> tuple[np.ndarray, np.ndarray]:
@@ -441,12 +449,21 @@ def _rows(rows: list[list[int]]) -> tuple[np.ndarray, np.ndarray]:
 
 def _fan(graph, nodes, index, max_skip: int, *, forward: bool) -> Fan:
     """:func:`_reach`'s table factored through the wide nodes (:class:`Fan`)."""
+    full = _reach(graph, nodes, index, max_skip, forward=forward)
     g = graph if forward else graph.reverse(copy=False)
     succ = [[index[m] for m in g.successors(node)] for node in nodes]
     wide_nodes = [i for i, s in enumerate(succ) if len(s) > WIDE]
     number = {h: w for w, h in enumerate(wide_nodes)}
+    long = np.zeros(len(nodes), dtype=bool)
+    if wide_nodes:
+        long = np.diff(full[0]) > LONG_ROW
     local, first, dist = [], [], []
     for i in range(len(nodes)):
+        if not long[i]:
+            local.append([])
+            first.append([])
+            dist.append([])
+            continue
         if i in number:  # a wide node reaches everything through itself
             local.append([i])
             first.append([number[i]])
@@ -478,7 +495,7 @@ def _fan(graph, nodes, index, max_skip: int, *, forward: bool) -> Fan:
     np.cumsum([len(r) for r in first], out=indptr[1:])
     wide = (indptr, np.array([w for r in first for w in r], dtype=np.intp),
             np.array([d for r in dist for d in r], dtype=np.intp))
-    return Fan(_rows(local), wide, _rows(rings), max_skip)
+    return Fan(full, long, _rows(local), wide, _rows(rings), max_skip)
 
 
 def _candidates(fan: Fan, ends: np.ndarray, costs: np.ndarray, score) -> tuple[np.ndarray, np.ndarray]:
@@ -492,15 +509,21 @@ def _candidates(fan: Fan, ends: np.ndarray, costs: np.ndarray, score) -> tuple[n
     of ``h``'s ring), the lowest beam index (every total infinite), and as many more as there are paths that end in
     the ring (the one pair whose stay may be barred). Near a hub every movement's first nodes are then listed once
     or twice instead of once per path that reaches the hub."""
-    beam, cand = _gather(fan.local, ends)
+    long = fan.long[ends]
+    if not long.any():  # every row short: listed whole
+        return _gather(fan.full, ends)
+    short = np.flatnonzero(~long)
+    beam, cand = _gather(fan.full, ends[short])
+    beams, nodes = [short[beam]], [cand]
+    factored = np.flatnonzero(long)
+    beam, cand = _gather(fan.local, ends[factored])
+    beams.append(factored[beam])
+    nodes.append(cand)
     indptr, wide, dist = fan.wide
-    counts = indptr[ends + 1] - indptr[ends]
-    if not counts.any():
-        return beam, cand
-    via = np.repeat(np.arange(len(ends)), counts)
-    at = _gather((indptr, np.arange(len(wide), dtype=np.intp)), ends)[1]
+    counts = indptr[ends[factored] + 1] - indptr[ends[factored]]
+    via = np.repeat(factored, counts)
+    at = _gather((indptr, np.arange(len(wide), dtype=np.intp)), ends[factored])[1]
     wide, dist = wide[at], dist[at]
-    beams, nodes = [beam], [cand]
     ring_ptr, ring_nodes = fan.rings
     span = fan.max_skip + 1
     for w in np.unique(wide):
