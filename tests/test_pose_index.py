@@ -188,5 +188,6 @@ def test_the_benchmark_checks_every_answer_of_the_index_against_the_scan():
     row = run(3000, parts=None, k=8, queries=20, noise=0.002, seed=0, pm=create_plugin_manager())
     assert row["agree"] == "20/20"
     assert row["nodes"] == 3000 and row["parts"] == 11 and row["index_ms"] > 0 and row["scan_ms"] > 0
+    assert 0 < row["index_cpu_ms"] < 1e3
     wide = run(500, parts=14, k=3, queries=5, noise=0.0, seed=1, pm=create_plugin_manager())
     assert wide["agree"] == "5/5" and wide["parts"] == 14
