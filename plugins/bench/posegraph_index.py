@@ -138,8 +138,8 @@ HEADER = ("nodes", "parts", "k", "build (s)", "index median (ms)", "index p95 (m
 
 def _row(r: dict[str, Any]) -> list[str]:
     return [f"{r['nodes']:,}", str(r["parts"]), str(r["k"]), f"{r['build_s']:.2f}", f"{r['index_ms']:.3f}",
-            f"{r['index_p95_ms']:.3f}", f"{r['index_cpu_ms']:.3f}", f"{r['scan_ms']:.1f}", f"{r['scan_p95_ms']:.1f}", f"{r['poses_mb']:.0f}",
-            f"{r['tree_mb']:.0f}", r["agree"]]
+            f"{r['index_p95_ms']:.3f}", f"{r['index_cpu_ms']:.3f}", f"{r['scan_ms']:.1f}", f"{r['scan_p95_ms']:.1f}",
+            f"{r['poses_mb']:.0f}", f"{r['tree_mb']:.0f}", r["agree"]]
 
 
 def cmd_posegraph(args: Any, pm: Any) -> int:
