@@ -95,9 +95,12 @@ class FeatureTree:
     order: np.ndarray
     """(N,) the node index of each position."""
     coordinates: np.ndarray
-    """(N, 3S) the poses' visible coordinates, in the order of :attr:`order`."""
+    """(N, 3S) the poses' visible coordinates in single precision (half the memory read per query), in the order of
+    :attr:`order`."""
     margin: float
     """Absolute margin on a feature distance (rounding in the features' sums)."""
+    scale: float
+    """The largest magnitude of a coordinate (the rounding of :meth:`sums` is bounded by it)."""
 
     @classmethod
     def build(cls, coordinates: np.ndarray, parts: int) -> "FeatureTree":
@@ -110,18 +113,25 @@ class FeatureTree:
         order = cKDTree(features, **options).indices  # the tree's order of the poses, then the tree in that order
         tree = cKDTree(features[order], **options)
         scale = float(np.abs(coordinates).max(initial=0.0))
-        return cls(weights, tree, order, np.ascontiguousarray(coordinates[order]), _SLACK * (1.0 + scale))
+        return cls(weights, tree, order, coordinates[order].astype(np.float32), _SLACK * (1.0 + scale), scale)
 
-    def sums(self, positions: np.ndarray, point: np.ndarray) -> np.ndarray:
+    def sums(self, positions: np.ndarray, point: np.ndarray) -> tuple[np.ndarray, float]:
         """The sum over the visible parts of each part's distance from the poses at ``positions`` to ``point``
-        (3S,): eq. 1 times S, computed quickly (within rounding of :func:`pose_distance`)."""
+        (3S,), eq. 1 times S, computed in single precision; and a bound of its error.
+
+        The error: each coordinate and the point rounded to single precision (relative 2**-24 = u), their difference
+        rounded, each part's norm (squares, two sums, a square root) and the sum of the S norms each within a few u,
+        so with R the largest magnitude of a coordinate of the poses or the point the error is at most
+        ``u (R + |point|) (16 S + 4 S**2)``; twice that is returned."""
         d = self.coordinates.take(positions, axis=0)
-        d -= point
+        d -= point.astype(np.float32)
         d *= d
         d = d.reshape(len(positions), -1, 3)
         squares = d[:, :, 0] + d[:, :, 1]
         squares += d[:, :, 2]
-        return np.sqrt(squares, out=squares).sum(axis=1)
+        parts = squares.shape[1]
+        error = 2.0 * 2.0**-24 * (self.scale + float(np.abs(point).max(initial=0.0))) * (16 * parts + 4 * parts**2)
+        return np.sqrt(squares, out=squares).sum(axis=1, dtype=np.float64), error
 
 
 def directions(coordinates: np.ndarray, parts: int, m: int) -> np.ndarray:
@@ -193,7 +203,8 @@ class PoseIndex:
         at = point @ index.weights.T
         # (1) an upper bound of the k-th distance: the k-th nearest of the first poses by features
         at_first = np.atleast_1d(index.tree.query(at, k=first, p=np.inf)[1])
-        bound = np.partition(index.sums(at_first, point), k - 1)[k - 1] * (1.0 + _SLACK) / seen
+        sums, error = index.sums(at_first, point)
+        bound = (np.partition(sums, k - 1)[k - 1] + error) * (1.0 + _SLACK) / seen
         # (2) every pose whose features are within the bound: the rest are farther than the k-th
         found = np.asarray(index.tree.query_ball_point(at, bound * (1.0 + _SLACK) + index.margin, p=np.inf),
                            dtype=np.intp)
@@ -202,8 +213,8 @@ class PoseIndex:
             return nearest_by_scan(self.poses, query, visible, k)
         found.sort()  # in memory order
         # (3) measure the candidates; those within a hair of the k-th again, with the scan's arithmetic
-        sums = index.sums(found, point)
-        ids = index.order[found[sums <= np.partition(sums, k - 1)[k - 1] * (1.0 + 4 * _SLACK)]]
+        sums, error = index.sums(found, point)
+        ids = index.order[found[sums <= (np.partition(sums, k - 1)[k - 1] + 2 * error) * (1.0 + 4 * _SLACK)]]
         d = pose_distance(self.poses[ids], query, visible)
         order = np.lexsort((ids, d))[:k]
         return ids[order], d[order]
