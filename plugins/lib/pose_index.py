@@ -22,8 +22,9 @@ Search: (1) the :data:`FIRST_BATCH` poses nearest by features are measured by eq
 upper bound of the k-th nearest pose's distance (k real poses are that near); (2) every pose whose features lie
 within ``U`` of the query's (the tree's ``query_ball_point``, Chebyshev) is a candidate, and every pose outside is
 farther than ``U`` by the bound, so the k best and every pose tied with the k-th are among the candidates; (3) the
-candidates are measured (a quick eq. 1 over the tree's copy of the coordinates, kept in the tree's order so that
-one query's candidates lie in few stretches of memory), and the few within a hair of the k-th are measured again
+candidates are measured (a quick eq. 1 in single precision over the tree's copy of the coordinates, kept in the
+tree's order so that one query's candidates lie in few stretches of memory, with a bound of its rounding: see
+:meth:`FeatureTree.sums`), and the few within that bound of the k-th are measured again
 with :func:`plugins.lib.pose_distance.pose_distance` on the rows of the poses, the scan's arithmetic: the same
 numbers. The answer is ordered by (eq. 1 distance, node index), the order of the scan's stable ``argsort``. Every
 bound has a relative margin of :data:`_SLACK`, so rounding never drops a pose.
