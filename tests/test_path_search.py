@@ -183,3 +183,75 @@ def test_reach_tables_equal_the_hand_written_ones(case):
     want = reference_reach(graph, nodes, index, max_skip, forward=forward)
     for g, w in zip(got, want):
         assert g.dtype == w.dtype and g.tolist() == w.tolist()
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 30).flatmap(lambda n: st.tuples(
+    st.just(n), st.lists(st.tuples(st.integers(0, max(n - 1, 0)), st.integers(0, max(n - 1, 0))), max_size=3 * n),
+    st.permutations(range(n)), st.integers(1, 5), st.booleans(), st.integers(0, 3), st.integers(0, 6))))
+def test_the_reach_factored_through_wide_nodes_is_the_same_reach(case):
+    """Every long node's local nodes and the rings of the wide nodes it reaches first make up exactly its reach;
+    the other nodes keep their whole reach."""
+    import plugins.matchers.path_search as ps
+
+    n, edges, order, max_skip, forward, wide, long_row = case
+    graph = nx.DiGraph()
+    graph.add_nodes_from(f"n{i}" for i in range(n))
+    graph.add_edges_from((f"n{a}", f"n{b}") for a, b in edges)
+    nodes = [f"n{i}" for i in order]
+    index = {node: i for i, node in enumerate(nodes)}
+    saved = ps.WIDE, ps.LONG_ROW
+    ps.WIDE, ps.LONG_ROW = wide, long_row  # few successors make a node wide: many wide nodes, chains of them
+    try:
+        fan = ps._fan(graph, nodes, index, max_skip, forward=forward)
+    finally:
+        ps.WIDE, ps.LONG_ROW = saved
+    indptr, want = reference_reach(graph, nodes, index, max_skip, forward=forward)
+    assert fan.full[1].tolist() == want.tolist() and fan.full[0].tolist() == indptr.tolist()
+    ring_ptr, ring_nodes = fan.rings
+    for i in range(n):
+        if not fan.long[i]:
+            assert fan.local[0][i] == fan.local[0][i + 1] and fan.wide[0][i] == fan.wide[0][i + 1]
+            continue
+        got = set(fan.local[1][fan.local[0][i]:fan.local[0][i + 1]].tolist())
+        for at in range(fan.wide[0][i], fan.wide[0][i + 1]):
+            w, d = fan.wide[1][at], fan.wide[2][at]
+            for r in range(max_skip - d + 1):
+                row = w * (max_skip + 1) + r
+                got |= set(ring_nodes[ring_ptr[row]:ring_ptr[row + 1]].tolist())
+        assert got == set(want[indptr[i]:indptr[i + 1]].tolist())
+
+
+@pytest.mark.parametrize("settings", [["matcher.per_movement=true"],
+                                      ["matcher.per_movement=true", "matcher.max_stay=1", "matcher.k=3"],
+                                      ["matcher.per_movement=false", "matcher.max_skip=3"]])
+def test_a_beam_step_through_hubs_keeps_the_same_paths_as_listing_every_pair(tmp_path, settings):
+    """Generated repertoires of many movements sharing a hub (likeme bench scaling's): every demo gets the same path,
+    movement and confidence whether the reach is factored through the hub or listed pair by pair."""
+    import plugins.matchers.path_search as ps
+    from plugins.bench.memory import _data
+    from plugins.bench.scaling import _demos, generated_clips
+    from plugins.lib.clip_repertoire import clip_repertoire
+    from toolkit.manager import create_plugin_manager
+    from toolkit.observe import Observer, compose_observer
+    from toolkit.params import parse_settings
+    from toolkit.profile import load_profile
+
+    pm = create_plugin_manager()
+    profile = load_profile(_data(pm, tmp_path / "data") / "profile.toml")
+    motions, labels = generated_clips(pm, 40, seed=3)
+    repertoire = clip_repertoire(motions, labels, profile)
+    answers = {}
+    for long_row in (0, 10**9):  # 0: every row through the hub factored; 10**9: every pair listed, as before
+        saved, ps.LONG_ROW = ps.LONG_ROW, long_row
+        try:
+            character = compose_observer(pm, profile, repertoire, matcher="", settings=parse_settings(settings))
+            observer = Observer(character, profile.body, 30.0)
+            answers[long_row] = [observer.classify(motion).match for _, motion in _demos(pm, 30.0)]
+            table = character.matcher.succ
+        finally:
+            ps.LONG_ROW = saved
+        assert (len(table.wide[1]) > 0) == (long_row == 0)  # the hub (40 movements) is wide
+    assert len(answers[0]) >= 5
+    for a, b in zip(answers[0], answers[10**9]):
+        assert (a.movement, a.path, a.confidence) == (b.movement, b.path, b.confidence)

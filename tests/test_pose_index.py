@@ -41,18 +41,65 @@ def cases(draw):
 
 
 @settings(max_examples=150, deadline=None)
-@given(cases(), st.sampled_from([1, 4, 64]))
-def test_the_index_returns_exactly_the_scans_k_nearest_in_the_scans_order(case, first_batch):
+@given(cases(), st.sampled_from([1, 4, 64]), st.sampled_from([0.25, 1.0]))
+def test_the_index_returns_exactly_the_scans_k_nearest_in_the_scans_order(case, first_batch, max_share):
     poses, query, visible, k = case
-    pose_index.FIRST_BATCH, saved = first_batch, pose_index.FIRST_BATCH
-    try:
+    saved = pose_index.FIRST_BATCH, pose_index.MAX_SHARE
+    pose_index.FIRST_BATCH, pose_index.MAX_SHARE = first_batch, max_share  # 1.0: the tree answers however many
+    try:  # candidates (poses on a grid, far queries)
         got = PoseIndex(poses).nearest(query, visible, k)
     finally:
-        pose_index.FIRST_BATCH = saved
+        pose_index.FIRST_BATCH, pose_index.MAX_SHARE = saved
     want = scan(poses, query, visible, k)
     np.testing.assert_array_equal(got[0], want[0])
     np.testing.assert_array_equal(got[1], want[1])
     np.testing.assert_array_equal(nearest_by_scan(poses, query, visible, k)[0], want[0])
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 12), st.sampled_from([1.0, 0.6, 0.2]))
+def test_the_features_distance_is_a_lower_bound_of_eq_1(seed, parts, share):
+    """|f(a) - f(b)| <= eq. 1(a, b) for every feature, between any two poses, not only the indexed ones."""
+    rng = np.random.default_rng(seed)
+    visible = rng.random(parts) < share
+    visible[rng.integers(parts)] = True
+    scale = rng.uniform(0.01, 1.0, size=(1, parts, 3))  # parts that move much and parts that barely move
+    poses = rng.normal(0, 1, size=(300, parts, 3)) * scale
+    if parts > 1:
+        poses[:, 0] = 0.0  # a root that never moves: its share of every direction is zero
+    index = PoseIndex(poses).tree(visible)
+    blocks = np.linalg.norm(index.weights.reshape(len(index.weights), -1, 3), axis=2)
+    assert np.all(blocks <= (1 + 1e-12) / visible.sum())  # each part's direction has at most unit length / S
+    a, b = rng.normal(0, 1, size=(2, 200, parts, 3)) * scale
+    fa = a[:, visible].reshape(200, -1) @ index.weights.T
+    fb = b[:, visible].reshape(200, -1) @ index.weights.T
+    assert np.all(np.abs(fa - fb).max(axis=1) <= pose_distance(a, b, visible) * (1 + 1e-12))
+
+
+def test_poses_of_movements_are_answered_by_the_tree_and_a_far_query_by_the_scan():
+    rng = np.random.default_rng(4)
+    phase = np.linspace(0, 2 * np.pi, 60)
+    base = rng.normal(0, 0.3, size=(6, 1, 11, 3))  # six movements of 11 parts, 60 poses each
+    swing = rng.normal(0, 0.2, size=(6, 1, 11, 3))
+    clips = base + swing * np.sin(phase)[None, :, None, None]
+    takes = [clips[rng.integers(6)] * rng.uniform(0.9, 1.1) + rng.normal(0, 0.002, size=(60, 11, 3))
+             for _ in range(150)]
+    poses = np.concatenate(takes)  # 9,000 poses
+    poses[:, 0] = 0.0  # root-relative
+    index = PoseIndex(poses)
+    for q in range(40):
+        query = poses[rng.integers(len(poses))] + rng.normal(0, 0.003, size=(11, 3))
+        visible = rng.random(11) > (0.0 if q < 30 else 0.2)
+        for k in (1, 8, 40):
+            got = index.nearest(query, visible, k)
+            want = scan(poses, query, visible, k)
+            np.testing.assert_array_equal(got[0], want[0])
+            np.testing.assert_array_equal(got[1], want[1])
+    assert index.scanned == 0  # every answer came from a tree
+    far = np.full((11, 3), 5.0)  # as far from every pose as from each other: most poses are candidates
+    got = index.nearest(far, None, 8)
+    assert index.scanned == 1
+    np.testing.assert_array_equal(got[0], scan(poses, far, np.ones(11, dtype=bool), 8)[0])
 
 
 def test_ties_come_in_index_order_as_the_stable_argsort_gives_them():
@@ -79,7 +126,7 @@ def test_one_tree_per_visibility_pattern_at_most_max_trees_kept():
     for visible in patterns:
         index.nearest(poses[0], visible, 3)
     assert len(index._trees) == pose_index.MAX_TREES
-    assert index.tree(patterns[-1]).m == 15  # the five visible parts' coordinates
+    assert index.tree(patterns[-1]).tree.m == pose_index.FEATURES  # features of the five visible parts
     assert index.tree(patterns[-1]) is index.tree(patterns[-1])  # cached
 
 
@@ -141,5 +188,6 @@ def test_the_benchmark_checks_every_answer_of_the_index_against_the_scan():
     row = run(3000, parts=None, k=8, queries=20, noise=0.002, seed=0, pm=create_plugin_manager())
     assert row["agree"] == "20/20"
     assert row["nodes"] == 3000 and row["parts"] == 11 and row["index_ms"] > 0 and row["scan_ms"] > 0
+    assert 0 < row["index_cpu_ms"] < 1e3
     wide = run(500, parts=14, k=3, queries=5, noise=0.0, seed=1, pm=create_plugin_manager())
     assert wide["agree"] == "5/5" and wide["parts"] == 14

@@ -59,11 +59,18 @@ after the graph learns), which gives exactly the scan's k nearest in the scan's 
 as fast. The scan is kept, exact by construction, where the index would have to answer another question: with
 attention (weights), with nodes excluded (the spread between takes), and with ``per_movement`` (each movement's
 nearest pose, however far).
+
+Hubs (issue 22): a path that ends near a hub reaches, through it, the first nodes of every movement, and with
+``per_movement`` (one path per movement in the beam) a beam step would list those nodes once per path near the hub:
+candidates growing as the square of the movements. The reach tables are factored through the wide nodes
+(:class:`Fan`): a step lists each node's local reach, and a hub's onward nodes only for the paths that can be the
+best way to them (the least cost up to rounding; :func:`_candidates`), which keeps exactly the paths the full
+listing keeps.
 """
 
 from __future__ import annotations
 
-from typing import Any, Protocol
+from typing import Any, NamedTuple, Protocol
 
 import networkx as nx
 import numpy as np
@@ -193,8 +200,8 @@ class PathSearch(Matcher):
         if self.params["travel"] > 0:  # travel: one more part of every node
             self.nodes_compared = np.concatenate(
                 [motor.node_root_relative, travel_part(motor.node_travel, self.params["travel"])[:, None]], axis=1)
-        self.succ = _reach(motor.graph, nodes, index, self.params["max_skip"], forward=True)
-        self.pred = _reach(motor.graph, nodes, index, self.params["max_skip"], forward=False)
+        self.succ = _fan(motor.graph, nodes, index, self.params["max_skip"], forward=True)
+        self.pred = _fan(motor.graph, nodes, index, self.params["max_skip"], forward=False)
         self._cache_version = n
         self._index = None  # the spatial index of the nodes, built by the first search that uses it
         self.spreads = self._spreads(index) if self.params["spread"] > 0 else {}
@@ -356,20 +363,23 @@ class PathSearch(Matcher):
         ends = paths[:, -1] if append else paths[:, 0]
         steps = []  # per sample: each kept path's new node and the path it grew from (back-pointers)
         for t in frames:
-            beam, cand = _gather(table, ends)
-            stay = np.where(cand == ends[beam], stays[beam] + 1, 0)
             seen = vis[t]
-            if seen.all() and weights is None:  # the hot loop of the search: eq. 1 over every part, inline
-                diff = nodes[cand] - obs[t]  # (pose_distance's arithmetic without its checks: the same numbers)
-                step = np.sqrt(np.einsum("cpi,cpi->cp", diff, diff)).mean(axis=1)
-            elif seen.all():
-                step = pose_distance(nodes[cand], obs[t], None, weights)
-            elif seen.any():  # eq. 1 over the parts seen in this sample: the mask is the same for every candidate,
-                # so the seen parts are taken first and pose_distance needs no mask
-                step = pose_distance(nodes[cand][:, seen], obs[t, seen], None,
-                                     None if weights is None else weights[seen])
-            else:
-                step = np.zeros(len(cand))
+
+            def score(cand, t=t, seen=seen):
+                if seen.all() and weights is None:  # the hot loop of the search: eq. 1 over every part, inline
+                    diff = nodes[cand] - obs[t]  # (pose_distance's arithmetic without its checks: the same numbers)
+                    return np.sqrt(np.einsum("cpi,cpi->cp", diff, diff)).mean(axis=1)
+                if seen.all():
+                    return pose_distance(nodes[cand], obs[t], None, weights)
+                if seen.any():  # eq. 1 over the parts seen in this sample: the mask is the same for every candidate,
+                    # so the seen parts are taken first and pose_distance needs no mask
+                    return pose_distance(nodes[cand][:, seen], obs[t, seen], None,
+                                         None if weights is None else weights[seen])
+                return np.zeros(len(cand))
+
+            beam, cand = _candidates(table, ends, costs, score)
+            stay = np.where(cand == ends[beam], stays[beam] + 1, 0)
+            step = score(cand)
             if exclude is not None:
                 step = np.where(exclude[cand], np.inf, step)
             if limit > 0:
@@ -427,6 +437,151 @@ def _reach(graph, nodes, index, max_skip: int, *, forward: bool) -> tuple[np.nda
     offset = np.repeat(np.arange(len(nodes), dtype=np.intp) * len(nodes), counts)
     ids = np.fromiter(map(index.__getitem__, found), dtype=np.intp, count=len(found))
     return indptr, np.sort(ids + offset) - offset
+
+
+class Fan(NamedTuple):
+    """The reach table of :func:`_reach` factored through the wide nodes (hubs), so that a beam step need not list
+    every movement's first nodes once per path that reaches a hub.
+
+    A node reaches (in 0..max_skip steps) its *local* nodes, found without passing through a wide node, and for
+    each wide node ``h`` it reaches at distance ``j`` without passing through another, every node within
+    ``max_skip - j`` steps of ``h``: the *rings* of ``h`` at distances 0..max_skip - j. (A shortest path to a node
+    either meets no wide node, or meets a first one at the distance found without passing through another; so the
+    union is exactly :func:`_reach`'s row.)"""
+
+    full: tuple[np.ndarray, np.ndarray]
+    """:func:`_reach`'s table: each node's whole reach, used for the nodes whose row is short."""
+    long: np.ndarray
+    """(N,) bool: the nodes whose reach is longer than :data:`LONG_ROW` and passes a wide node: listed factored."""
+    local: tuple[np.ndarray, np.ndarray]
+    """Compressed rows (indptr, sorted node indices): each long node's local nodes (itself included)."""
+    wide: tuple[np.ndarray, np.ndarray, np.ndarray]
+    """Compressed rows (indptr, wide node number, distance): the wide nodes each long node reaches first."""
+    rings: tuple[np.ndarray, np.ndarray]
+    """Compressed rows (indptr, sorted node indices), row ``w * (max_skip + 1) + d``: the nodes at exactly ``d``
+    steps from wide node number ``w``."""
+    max_skip: int
+
+
+WIDE = 8
+"""Nodes with more successors (or predecessors, backward) than this are wide: :class:`Fan` factors the reach
+through them (a posegraph's hubs, each shared by many movements)."""
+
+LONG_ROW = 64
+"""Nodes that reach more nodes than this (through a wide node) have their reach listed factored; shorter rows are
+listed whole, as fast as ever on small graphs."""
+
+
+def _rows(rows: list[list[int]]) -> tuple[np.ndarray, np.ndarray]:
+    """Compressed rows (indptr, indices) of lists of node indices, each row sorted."""
+    indptr = np.zeros(len(rows) + 1, dtype=np.intp)
+    np.cumsum([len(r) for r in rows], out=indptr[1:])
+    flat = [i for r in rows for i in sorted(r)]
+    return indptr, np.array(flat, dtype=np.intp)
+
+
+def _fan(graph, nodes, index, max_skip: int, *, forward: bool) -> Fan:
+    """:func:`_reach`'s table factored through the wide nodes (:class:`Fan`)."""
+    full = _reach(graph, nodes, index, max_skip, forward=forward)
+    g = graph if forward else graph.reverse(copy=False)
+    succ = [[index[m] for m in g.successors(node)] for node in nodes]
+    wide_nodes = [i for i, s in enumerate(succ) if len(s) > WIDE]
+    number = {h: w for w, h in enumerate(wide_nodes)}
+    long = np.zeros(len(nodes), dtype=bool)
+    if wide_nodes:
+        long = np.diff(full[0]) > LONG_ROW
+    local, first, dist = [], [], []
+    for i in range(len(nodes)):
+        if not long[i]:
+            local.append([])
+            first.append([])
+            dist.append([])
+            continue
+        if i in number:  # a wide node reaches everything through itself
+            local.append([i])
+            first.append([number[i]])
+            dist.append([0])
+            continue
+        found, frontier, hubs = {i}, [i], {}
+        for depth in range(1, max_skip + 1):
+            nxt = []
+            for f in frontier:
+                for m in succ[f]:
+                    if m in found or m in hubs:
+                        continue
+                    if m in number:
+                        hubs[m] = depth  # not passed through: its rings stand for what lies beyond
+                    else:
+                        found.add(m)
+                        nxt.append(m)
+            frontier = nxt
+        local.append(list(found))
+        first.append([number[h] for h in hubs])
+        dist.append(list(hubs.values()))
+    rings = []
+    for h in wide_nodes:
+        by_distance = [[] for _ in range(max_skip + 1)]
+        for m, d in nx.single_source_shortest_path_length(g, nodes[h], cutoff=max_skip).items():
+            by_distance[d].append(index[m])
+        rings.extend(by_distance)
+    indptr = np.zeros(len(nodes) + 1, dtype=np.intp)
+    np.cumsum([len(r) for r in first], out=indptr[1:])
+    wide = (indptr, np.array([w for r in first for w in r], dtype=np.intp),
+            np.array([d for r in dist for d in r], dtype=np.intp))
+    return Fan(full, long, _rows(local), wide, _rows(rings), max_skip)
+
+
+def _candidates(fan: Fan, ends: np.ndarray, costs: np.ndarray, score) -> tuple[np.ndarray, np.ndarray]:
+    """The (beam index, node) pairs of a beam step, in the order of :func:`_gather` on :func:`_reach`'s table (by
+    beam, then node), keeping of the pairs through a wide node only those that can be the best way to their node.
+
+    A node ``c`` at ``d`` steps from wide node ``h`` is reached through ``h`` by every path whose end reaches ``h``
+    within ``max_skip - d`` steps, all at the same step cost ``score(c)``: the beam step keeps, for each node, the
+    pair of the least total cost (ties: the first pair, the lowest beam index). Only the paths that can give that
+    pair are listed: those of the least cost up to rounding (a cost within 2**-50 of the cost plus the largest step
+    of ``h``'s ring), the lowest beam index (every total infinite), and as many more as there are paths that end in
+    the ring (the one pair whose stay may be barred). Near a hub every movement's first nodes are then listed once
+    or twice instead of once per path that reaches the hub."""
+    long = fan.long[ends]
+    if not long.any():  # every row short: listed whole
+        return _gather(fan.full, ends)
+    short = np.flatnonzero(~long)
+    beam, cand = _gather(fan.full, ends[short])
+    beams, nodes = [short[beam]], [cand]
+    factored = np.flatnonzero(long)
+    beam, cand = _gather(fan.local, ends[factored])
+    beams.append(factored[beam])
+    nodes.append(cand)
+    indptr, wide, dist = fan.wide
+    counts = indptr[ends[factored] + 1] - indptr[ends[factored]]
+    via = np.repeat(factored, counts)
+    at = _gather((indptr, np.arange(len(wide), dtype=np.intp)), ends[factored])[1]
+    wide, dist = wide[at], dist[at]
+    ring_ptr, ring_nodes = fan.rings
+    span = fan.max_skip + 1
+    for w in np.unique(wide):
+        mine = wide == w
+        for d in range(span):
+            row = w * span + d
+            ring = ring_nodes[ring_ptr[row]:ring_ptr[row + 1]]
+            parents = via[mine & (dist <= fan.max_skip - d)]  # distinct: one distance per path and wide node
+            if not len(ring) or not len(parents):
+                continue
+            if len(parents) > 1:
+                c = costs[parents]
+                inside = int(np.isin(ends[parents], ring).sum())  # paths ending in the ring: their stay may be barred
+                ranked = np.lexsort((parents, c))
+                top = c[ranked[min(inside, len(ranked) - 1)]]
+                steps = score(ring)
+                largest = float(steps[np.isfinite(steps)].max(initial=0.0))
+                keep = c <= top + 2.0 ** -50 * (top + largest)
+                keep[np.argsort(parents, kind="stable")[: inside + 1]] = True
+                parents = parents[keep]
+            beams.append(np.repeat(parents, len(ring)))
+            nodes.append(np.tile(ring, len(parents)))
+    beam, cand = np.concatenate(beams), np.concatenate(nodes)
+    order = np.lexsort((cand, beam))
+    return beam[order], cand[order]
 
 
 def _gather(table: tuple[np.ndarray, np.ndarray], ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
