@@ -8,12 +8,16 @@ treats it as not visible.
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from plugins.lib.strokes import StrokeCriteria, analyse, held
 from plugins.segmenters.velocity_direction import VelocityDirection
+from tests.conftest import CHARACTERS
+from tests.test_robustness import stream as morris_stream
 from tests.test_velocity_direction import stroke_sequence
+from toolkit import Motion, Segment, create_plugin_manager, load_character
 from toolkit.motion import fill_hidden
 
 PARTS = ("root", "wrist", "hand")
@@ -139,3 +143,68 @@ def test_random_visibility_is_no_crash_and_gives_valid_segments(stream, cuts, pa
     one = pushed(VelocityDirection(**params), poses, visible, fps)
     assert_valid(one, len(poses))
     assert blocked(VelocityDirection(**params), poses, visible, fps, cuts) == one
+
+
+# -- every segmenter and the dtw matcher: parts not seen when a movement begins
+
+SEGMENTERS = ("hub-threshold", "ruptures", "velocity-direction")
+BEGINNINGS = ("hidden", "nan-marked-visible", "inf-marked-visible", "never-seen", "nothing-seen")
+
+
+@pytest.fixture(scope="module")
+def watchers():
+    pm = create_plugin_manager(autoload=False)
+    morris = load_character(CHARACTERS / "morris.toml", pm)
+    max_ = {s: load_character(CHARACTERS / "max.toml", pm, override={"segmenter": {"plugin": s}, "matcher": {"plugin": "dtw"}})
+            for s in SEGMENTERS}
+    return morris, max_
+
+
+def begun_unseen(positions, case):
+    """Morris's stream with parts not seen as its first movement begins (frame 20; 15 frames): held-NaN hidden
+    hands and feet, NaN or infinite values marked visible (a raw bad frame), parts never seen, or nothing seen."""
+    poses, visible = positions.copy(), np.ones(positions.shape[:2], dtype=bool)
+    hands = slice(5, None)
+    if case == "hidden":
+        poses[:35, hands], visible[:35, hands] = np.nan, False
+    elif case == "nan-marked-visible":
+        poses[:35, hands] = np.nan
+    elif case == "inf-marked-visible":
+        poses[18:25, 3] = np.inf
+    elif case == "never-seen":
+        poses[:, 2:6], visible[:, 2:6] = np.nan, False
+    else:
+        poses[18:30], visible[18:30] = np.nan, False
+    return poses, visible
+
+
+@pytest.mark.parametrize("case", BEGINNINGS)
+@pytest.mark.parametrize("segmenter", SEGMENTERS)
+def test_parts_not_seen_as_a_movement_begins_are_not_visible(watchers, segmenter, case):
+    """No exception; push frame by frame and push_block agree; the segments are valid and the same as with the bad
+    values marked not visible; dtw matches each segment (and a slice that begins with nothing seen) with one of
+    the observer's movements or none."""
+    morris, max_ = watchers
+    character = max_[segmenter]
+    poses, visible = begun_unseen(morris_stream(morris, ["wave", "jump", "sit"], 1), case)
+    parts = morris.body.parts
+
+    def segments(poses, visible):
+        seg = character.segmenter
+        seg.reset(parts, 30.0)
+        one = [s for f in range(len(poses)) for s in seg.push(poses[f], visible[f])] + seg.flush()
+        seg.reset(parts, 30.0)
+        closed, _ = seg.push_block(poses, visible)
+        assert [s for _, s in closed] + seg.flush() == one
+        return one
+
+    found = segments(poses, visible)
+    assert_valid(found, len(poses))
+    bad = ~np.isfinite(poses).all(axis=2)
+    assert segments(np.where(bad[..., None], np.nan, poses), visible & ~bad) == found
+    if segmenter == "hub-threshold" and case != "never-seen":
+        assert len(found) == 3  # the wave, the jump and the sitting down, whatever was missed as the wave began
+    for s in [*found, Segment(0, 40, 30.0)]:
+        match = character.matcher.match(Motion(poses[s.start : s.end], 30.0, parts, visible[s.start : s.end]))
+        assert match.movement is None or match.movement in character.motor.movements()
+        assert 0.0 <= match.confidence <= 1.0
