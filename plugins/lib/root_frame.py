@@ -75,39 +75,103 @@ def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body) -> np.nda
     return heading
 
 
-def _circular_median(windows: np.ndarray) -> np.ndarray:
+def _circular_median(windows: np.ndarray, rotations: np.ndarray | None = None) -> np.ndarray:
     """The median of each row of angles (n, w), NaN ignored, unwrapped around the row's own circular mean.
 
     Unwrapping around one estimate (the newest, say) splits the others at ±π when that estimate is flipped by half
     a turn; around the mean of the row, the majority stays together and outvotes the flipped few. Rows with no
     finite angle give NaN.
+
+    ``rotations``: ``np.exp(1j * windows)`` where finite and 0 elsewhere, when the caller has them (the rows of a
+    sliding window share their estimates: :func:`_windowed_median` computes each estimate's once).
     """
     ok = np.isfinite(windows)
     angles = np.where(ok, windows, 0.0)
-    ref = np.angle(np.where(ok, np.exp(1j * angles), 0.0).sum(axis=1))[:, None]
-    unwrapped = np.where(ok, ref + np.angle(np.exp(1j * (angles - ref))), np.nan)
+    if rotations is None:
+        rotations = np.where(ok, np.exp(1j * angles), 0.0)
+    ref = np.angle(rotations.sum(axis=1))[:, None]
     out = np.full(len(windows), np.nan)
     full, some = ok.all(axis=1), ok.any(axis=1)
-    out[full] = np.median(unwrapped[full], axis=1)  # most rows: without nanmedian's cost
+    if full.any():  # most rows: without nanmedian's cost, and unwrapping only the elements near the middle
+        out[full] = _unwrapped_median(angles[full], ref[full])
     partial = some & ~full  # a stream's first frames, a clip's ends, frames without an estimate
-    out[partial] = np.nanmedian(unwrapped[partial], axis=1)
+    if partial.any():
+        a, r = angles[partial], ref[partial]
+        out[partial] = np.nanmedian(np.where(ok[partial], r + np.angle(np.exp(1j * (a - r))), np.nan), axis=1)
     return np.angle(np.exp(1j * out))
+
+
+_CLOSE = 1e-9
+"""A bound (rad) on how far :func:`_unwrapped_median`'s quick unwrapping lies from the exact one (which differs from
+it by a few units in the last place, about 1e-15) away from the wrap; the wrap itself is within ``_WRAP``."""
+_WRAP = 1e-6
+
+
+def _unwrapped(angles: np.ndarray, ref: np.ndarray) -> np.ndarray:
+    """``angles`` unwrapped around ``ref``: ``ref + np.angle(np.exp(1j * (angles - ref)))`` (element by element)."""
+    return ref + np.angle(np.exp(1j * (angles - ref)))
+
+
+def _unwrapped_median(angles: np.ndarray, ref: np.ndarray) -> np.ndarray:
+    """``np.median(_unwrapped(angles, ref), axis=1)`` of rows of finite angles (n, w) and their refs (n, 1), the same
+    values, with the exact unwrapping (a complex exponential and an angle) computed for a few elements per row only.
+
+    The quick unwrapping ``ref + (d - 2π round(d / 2π))`` (``d = angles - ref``; the angles themselves when no ``d``
+    reaches the wrap) lies within ``_CLOSE`` of the exact one wherever it is not within ``_WRAP`` of the wrap (those
+    elements are unwrapped exactly at once). Order
+    statistics move no more than the values do, so the exact middle values of a row lie within ``_CLOSE`` of the
+    quick ones: every element whose quick value is more than twice that below (above) them is below (above) the
+    middle, and the middle is found among the few left, unwrapped exactly and sorted.
+    """
+    n, w = angles.shape
+    d = angles - ref
+    spread = np.abs(d)
+    if not len(d) or not (spread <= 64.0).all():  # angles of many turns: the quick unwrapping is not close enough
+        return np.median(_unwrapped(angles, ref), axis=1) if len(d) else np.zeros(0)
+    if spread.max() < np.pi - _WRAP:  # no row wraps (most streams): the angles are their own quick unwrapping
+        quick, near = angles, np.zeros(angles.shape, dtype=bool)
+    else:
+        turns = np.round(d / (2 * np.pi))
+        wrapped = d - 2 * np.pi * turns
+        quick = ref + wrapped
+        near = np.abs(np.abs(wrapped) - np.pi) < _WRAP
+        if near.any():
+            quick[near] = _unwrapped(angles[near], np.broadcast_to(ref, angles.shape)[near])
+    ranks = [(w - 1) // 2, w // 2]  # the middle element, or the two middle ones (np.median: their mean)
+    middle = np.partition(quick, ranks, axis=1)[:, ranks]
+    lo, hi = middle[:, :1] - 2 * _CLOSE, middle[:, 1:] + 2 * _CLOSE
+    below = (quick < lo).sum(axis=1)  # certainly below the middle
+    band = (quick >= lo) & (quick <= hi)
+    rows, cols = np.nonzero(band)
+    exact = quick[rows, cols]
+    far = ~near[rows, cols]
+    exact[far] = _unwrapped(angles[rows[far], cols[far]], ref[rows[far], 0])
+    order = np.lexsort((exact, rows))  # by row, then by exact value
+    exact = exact[order]
+    first = np.concatenate([[0], np.cumsum(band.sum(axis=1))[:-1]])  # each row's first element in ``exact``
+    a, b = exact[first + ranks[0] - below], exact[first + ranks[1] - below]
+    return np.where(ranks[0] == ranks[1], a, (a + b) / 2)
 
 
 _WINDOW_BUDGET = 1 << 20
 """Numbers of windows gathered at a time by :func:`_windowed_median` (a window is as long as seconds x fps)."""
 
 
-def _windowed_median(view: np.ndarray, rows: np.ndarray) -> np.ndarray:
-    """:func:`_circular_median` of the rows ``rows`` of a sliding-window view, a bounded number of rows at a time.
+def _windowed_median(padded: np.ndarray, window: int, rows: np.ndarray) -> np.ndarray:
+    """:func:`_circular_median` of the rows ``rows`` of the sliding windows of ``window`` estimates over ``padded``,
+    a bounded number of rows at a time.
 
     Gathering every row at once would copy frames x window numbers (a whole recording times seconds x fps);
-    each row's median depends only on that row, so the result is the same bit for bit.
+    each row's median depends only on that row, so the result is the same bit for bit. Each estimate's complex
+    exponential is computed once, not once per window it falls in.
     """
-    step = max(1, _WINDOW_BUDGET // max(1, view.shape[1]))
-    if len(rows) <= step:
-        return _circular_median(view[rows])
-    return np.concatenate([_circular_median(view[rows[i : i + step]]) for i in range(0, len(rows), step)])
+    finite = np.isfinite(padded)
+    rotations = np.where(finite, np.exp(1j * np.where(finite, padded, 0.0)), 0.0)
+    view = np.lib.stride_tricks.sliding_window_view(padded, window)  # views: nothing copied yet
+    turned = np.lib.stride_tricks.sliding_window_view(rotations, window)
+    step = max(1, _WINDOW_BUDGET // max(1, window))
+    return np.concatenate([_circular_median(view[rows[i : i + step]], turned[rows[i : i + step]])
+                           for i in range(0, len(rows), step)]) if len(rows) else np.zeros(0)
 
 
 class HeadingFilter:
@@ -158,8 +222,7 @@ class HeadingFilter:
         if not have.any():
             return out
         padded = np.concatenate([np.full(self.window - 1, np.nan), estimates])
-        windows = np.lib.stride_tricks.sliding_window_view(padded, self.window)  # a view: nothing copied yet
-        out[have] = _windowed_median(windows, ends[have] - 1)  # the last w estimates to each frame
+        out[have] = _windowed_median(padded, self.window, ends[have] - 1)  # the last w estimates to each frame
         return out
 
 
@@ -179,8 +242,7 @@ def smooth_heading(heading: np.ndarray, window: int) -> np.ndarray:
     if n == 0 or window <= 1 or not np.isfinite(heading).any():
         return heading.copy()
     padded = np.pad(heading, half, constant_values=np.nan)  # near the ends the window shrinks: the facing stays
-    windows = np.lib.stride_tricks.sliding_window_view(padded, 2 * half + 1)  # continuous from frame to frame
-    return _windowed_median(windows, np.arange(n))
+    return _windowed_median(padded, 2 * half + 1, np.arange(n))  # continuous from frame to frame
 
 
 def to_root_relative(

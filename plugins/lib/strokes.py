@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["StrokeCriteria", "StrokeAnalysis", "analyse", "breaks", "speed_breaks", "direction_clusters",
+__all__ = ["StrokeCriteria", "StrokeAnalysis", "analyse", "breaks", "held", "speed_breaks", "direction_clusters",
            "direction_breaks"]
 
 
@@ -173,6 +173,29 @@ def _allclose(a: np.ndarray, b: np.ndarray) -> bool:
     return bool(np.all(np.abs(a - b) <= 1e-08 + 1e-05 * np.abs(b)))
 
 
+def held(window: np.ndarray) -> np.ndarray:
+    """``window`` (N, D) with its non-finite values (a part hidden and not held, or not seen yet) as not visible:
+    each column holds its last finite value, takes its first finite value before that (a part not seen yet does not
+    move) and is 0 where it has none (a part never seen in the movement). The window itself (the same values) when
+    every value is finite.
+
+    Hidden parts do not move (``docs/conventions.md``): filled so, they add no speed and no direction to the
+    analysis, and the smoothing filter (which refuses NaN) sees only numbers.
+    """
+    window = np.asarray(window, dtype=float)
+    finite = np.isfinite(window)
+    if finite.all():
+        return window
+    n = len(window)
+    rows = np.where(finite, np.arange(n)[:, None], -1)
+    last = np.maximum.accumulate(rows, axis=0)  # the last finite row of each column so far (-1: none yet)
+    first = np.where(finite.any(axis=0), np.argmax(finite, axis=0), 0)  # the first finite row of each column
+    source = np.where(last >= 0, last, first[None, :])
+    filled = np.take_along_axis(window, source, axis=0)
+    filled[:, ~finite.any(axis=0)] = 0.0
+    return filled
+
+
 def breaks(window: np.ndarray, fps: float, criteria: StrokeCriteria = StrokeCriteria()) -> list[int]:
     """Break points (indices into ``window``, positions (N, 3k) of the chosen parts) by speed and direction."""
     return analyse(window, fps, criteria).breaks
@@ -188,6 +211,7 @@ def analyse(window: np.ndarray, fps: float, criteria: StrokeCriteria = StrokeCri
     from scipy.signal import savgol_filter
 
     c = criteria
+    window = held(window)
     n = len(window)
     empty = np.zeros(max(0, n - 1))
     if n < 4:

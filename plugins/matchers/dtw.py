@@ -21,6 +21,7 @@ candidate (``Match.candidates``), by the distance of its nearest example.
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import numpy as np
@@ -36,13 +37,42 @@ def frame_distance(series: np.ndarray, template: np.ndarray, window: float = 0.0
     ``window``: Sakoe-Chiba band as a share of the longer series (0: none). The same series at any length
     (every frame repeated k times) is at the same distance from the same template.
     """
-    from dtaidistance import dtw_ndim
-
-    band = int(window * max(len(series), len(template))) or None
-    if band is not None:
-        band = max(band, abs(len(series) - len(template)) + 1)
-    d = dtw_ndim.distance_fast(series, template, window=band)
+    series = np.ascontiguousarray(series, dtype=np.double)
+    template = np.ascontiguousarray(template, dtype=np.double)
+    d = _dtw(series, template, _band(window, len(series), len(template)))
     return float(np.sqrt(d * d / (len(series) + len(template))))
+
+
+def _band(window: float, n: int, m: int) -> int | None:
+    """The Sakoe-Chiba band (frames) of ``window`` for series of ``n`` and ``m`` frames; ``None``: none."""
+    band = int(window * max(n, m)) or None
+    return None if band is None else max(band, abs(n - m) + 1)
+
+
+def _dtw(series: np.ndarray, template: np.ndarray, band: int | None) -> float:
+    """:func:`dtaidistance.dtw_ndim.distance_fast` of two C-contiguous double arrays: the same C function with the
+    same settings (:func:`_c_settings`), without its per-call checks and settings object (most of a short
+    segment's cost). Where that C module or its signature is not there (another dtaidistance release, a build
+    without C), the public :func:`~dtaidistance.dtw_ndim.distance_fast` gives the same number."""
+    try:
+        from dtaidistance import dtw_cc
+
+        return dtw_cc.distance_ndim(series, template, **_c_settings(band))
+    except (ImportError, AttributeError, TypeError):
+        from dtaidistance import dtw_ndim
+
+        return dtw_ndim.distance_fast(series, template, window=band)
+
+
+@functools.lru_cache(maxsize=256)
+def _c_settings(band: int | None) -> dict[str, Any]:
+    """The keyword arguments :func:`dtaidistance.dtw_ndim.distance_fast` (``window=band``, every other argument its
+    default) hands to its C function: :class:`dtaidistance.dtw.DTWSettings` ``.c_kwargs()`` of them."""
+    from dtaidistance import innerdistance
+    from dtaidistance.dtw import DTWSettings
+
+    return DTWSettings(window=band, max_dist=None, max_step=None, max_length_diff=None, penalty=None, psi=None,
+                       use_pruning=False, inner_dist=innerdistance.default, use_ndim=True).c_kwargs()
 
 
 class DTW(Matcher):
@@ -76,7 +106,10 @@ class DTW(Matcher):
         if not motion.visible.any() or not self.templates:
             return Match.unknown(reason="nothing visible")
         series = self._series(motion.filled().positions)
-        distances = np.array([frame_distance(series, template, self.params["window"]) for template in self.templates])
+        window, n = self.params["window"], len(series)
+        summed = np.array([_dtw(series, template, _band(window, n, len(template))) for template in self.templates])
+        lengths = np.array([n + len(template) for template in self.templates], dtype=float)
+        distances = np.sqrt(summed * summed / lengths)  # frame_distance of each template, element by element
         best = int(np.argmin(distances))
         per_frame = float(distances[best])
         if self.params["max_distance"] and per_frame > self.params["max_distance"]:

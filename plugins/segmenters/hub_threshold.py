@@ -225,6 +225,9 @@ class HubThreshold(Segmenter):
 
         poses = np.asarray(poses, dtype=float)
         visible = np.asarray(visible, dtype=bool)
+        finite = np.isfinite(poses).all(axis=-1)
+        if not finite.all():  # a bad value is not seen, whatever the mask said (NaN, as a part not seen yet)
+            visible, poses = visible & finite, np.where(finite[..., None], poses, np.nan)
         n = len(poses)
         events = np.full((n, 3), -1, dtype=np.int64)
         body = self.params["units"] == "body"

@@ -128,6 +128,7 @@ class RupturesSegmenter(Segmenter):
         import ruptures as rpt
 
         n, stride = len(poses), self.params["stride"]
+        visible = visible & np.isfinite(poses).all(axis=2)  # a bad value is not seen, whatever the mask said
         seen = visible.any(axis=1)
         if seen.sum() < 2:
             return [0, n]
