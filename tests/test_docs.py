@@ -79,3 +79,45 @@ def test_every_file_the_docs_name_exists():
     for doc in [ROOT / "README.md", *(ROOT / "docs").glob("*.md")]:
         for path in re.findall(r"`((?:toolkit|plugins|characters|tests)/[\w/.-]+\.(?:py|toml))`", doc.read_text()):
             assert (ROOT / path).is_file(), f"{doc.name} names {path}, which does not exist"
+
+
+def _examples_table():
+    """The rows of docs/examples.md's table of the papers' worked examples, each a list of its cells."""
+    text = (ROOT / "docs" / "examples.md").read_text()
+    lines = [line for line in text.splitlines() if line.startswith("|")]
+    header = [c.strip() for c in lines[0].strip("|").split("|")]
+    assert header[:6] == ["paper", "section / figure", "what happens", "scenario", "command", "tests"], header
+    return [[c.strip() for c in line.strip("|").split("|")] for line in lines[2:]]
+
+
+def test_examples_table_names_real_scenarios_and_tests_and_every_scenario():
+    """docs/examples.md: every scenario and `likeme run` command names a file in characters/scenarios/, every test
+    named exists (the file and a test function of that name, parametrised or not), every row names a test, and every
+    scenario file has a row (a new scenario needs its example row)."""
+    import ast
+
+    scenarios = {p.stem for p in (ROOT / "characters" / "scenarios").glob("*.toml")}
+    named, functions = set(), {}
+    rows = _examples_table()
+    assert len(rows) >= 20
+    for row in rows:
+        where = f"docs/examples.md row {row[1]!r}"
+        found = re.findall(r"characters/scenarios/([\w-]+)\.toml", row[3])
+        for name in found + re.findall(r"likeme run ([\w-]+)", row[4]):
+            assert name in scenarios, f"{where}: no characters/scenarios/{name}.toml"
+            named.add(name)
+        tests = re.findall(r"`tests/(test_\w+\.py)::(\w+)(?:\[[^\]]*\])?`", row[5])
+        assert tests, f"{where}: names no test"
+        for file, name in tests:
+            path = ROOT / "tests" / file
+            assert path.is_file(), f"{where}: no tests/{file}"
+            if file not in functions:
+                functions[file] = {n.name for n in ast.walk(ast.parse(path.read_text()))
+                                   if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef))}
+            assert name.startswith("test_") and name in functions[file], f"{where}: no {name} in tests/{file}"
+    assert not scenarios - named, f"scenarios without a row in docs/examples.md: {sorted(scenarios - named)}"
+
+
+def test_examples_doc_is_linked():
+    assert "docs/examples.md" in (ROOT / "README.md").read_text()
+    assert "examples.md" in (ROOT / "docs" / "architecture.md").read_text()
