@@ -158,6 +158,7 @@ class VelocityDirection(Segmenter):
     def push(self, pose: np.ndarray, visible: np.ndarray) -> list[Segment]:
         self._frame += 1
         points = pose[self._idx] * self._scale  # hidden parts are held where last seen; never seen: NaN
+        points[~np.isfinite(points)] = np.nan  # an infinite value is not seen either (no inf - inf below)
         seen = np.isfinite(points).all(axis=1)
         self._history.append(points.ravel())
         speed = np.nan
@@ -179,6 +180,7 @@ class VelocityDirection(Segmenter):
         if n == 0:
             return closed, since
         points = np.asarray(poses)[:, self._idx] * self._scale  # (n, m, 3)
+        points[~np.isfinite(points)] = np.nan  # an infinite value is not seen either (no inf - inf below)
         flat = points.reshape(n, -1)
         seen = np.isfinite(points).all(axis=2).any(axis=1)  # some chosen part seen
         m, before = self._memory, len(self._history)  # frames of the sensory memory before the block
