@@ -240,3 +240,10 @@ def test_hunger_rises_until_morris_acts_on_it(write):
     first_frame, request = world.actors["morris"].performed[0]
     assert request.movement == "reach"
     assert 2.9 <= first_frame / world.fps <= 3.8  # hunger passes 0.3 after 3 s at 0.1 per second
+
+
+def test_a_candidate_margin_of_zero_leaves_fig13_to_the_motion_alone(write):
+    """With ``candidate_margin = 0`` only the best candidate counts: the ambiguous leap is read as a reach (the
+    motion's first choice), which the high cheese makes impossible, so Max cannot say why Morris did it."""
+    _, (first, _) = _variant(write, "reach_or_jump", ("imitate = false", "imitate = false\ncandidate_margin = 0.0"))
+    assert first.movement == "reach" and not first.known

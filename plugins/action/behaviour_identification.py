@@ -69,8 +69,9 @@ __all__ = ["MARGIN", "GRIP", "PerceivedActor", "PerceivedObject", "close_candida
            "evaluate_path", "perceived_objects", "perceived_target", "predict", "seen_held"]
 
 MARGIN = 0.25
-"""Relative margin of Fig. 13: a matcher's candidate whose distance is within ``(1 + MARGIN)`` times the best's is
-close enough that the motion alone does not tell them apart, and the can-I triggers decide."""
+"""The relative margin of Fig. 13 (the default of the hierarchical action system's ``candidate_margin``): a matcher's
+candidate whose distance is within ``(1 + MARGIN)`` times the best's is close enough that the motion alone does not
+tell them apart, and the can-I triggers decide."""
 
 GRIP = 0.06
 """Metres beyond an object's radius within which it is at the target's hand (seen held, with :func:`seen_held`)."""

@@ -81,6 +81,8 @@ class Hierarchical(ActionSystem):
         Parameter("pause", float, 0.5, "Seconds between the end of one behaviour and the next decision.", minimum=0.0),
         Parameter("identify", bool, True, "Identify the behaviour behind recognised movements of others (§6.1)."),
         Parameter("learn_affordances", bool, True, "Learn what unknown objects afford by watching (§6.3)."),
+        Parameter("candidate_margin", float, 0.25, "Fig. 13: a matcher's ranked candidate within (1 + this) times the "
+                  "best's distance is close enough for the can-I triggers to choose it instead.", minimum=0.0),
         Parameter("sight_angle", float, 20.0, "Degrees (horizontal) around the target's head-to-nose line within which "
                   "an object counts as in its line of sight (§6.1.2).", minimum=0.0, maximum=180.0),
         Parameter("gaze", list, ["head", "nose"], "The target's parts whose line gives its line of sight.", items=str),
@@ -355,7 +357,7 @@ class Hierarchical(ActionSystem):
         else:  # committed early: the segment began decided_at rows ago
             start = memory.n - 1 - (match.decided_at or 0)
             middle, end = memory.n - 1 - (match.decided_at or 0) // 2, memory.n - 1
-        return identify(self, actor, target, close_candidates(match), start, middle, end)
+        return identify(self, actor, target, close_candidates(match, self.params["candidate_margin"]), start, middle, end)
 
     def respond(self, actor: Any, target: Any, match: Any, behaviour: Behaviour | None, world: Any) -> MovementRequest | None:
         """Imitate the movement (if ``imitate``); otherwise shrug at a behaviour it cannot identify (if ``shrug``).
