@@ -18,6 +18,7 @@ import pytest
 
 from plugins.lib.guiding_stroke import GuidingStroke
 from tests.conftest import CHARACTERS
+from tests.test_forward_model import ARMS  # the two-wrist character of the forward model's tests
 from toolkit import create_plugin_manager, load_character, load_scenario
 from toolkit.watching import feed
 
@@ -120,33 +121,6 @@ def test_with_it_on_the_same_is_recognised(write):
     fast, _ = _again(world, "left_front", 2.0)
     assert [m.path for m in fast] == [("left_wrist:e1",), ("left_wrist:e2",)]
     assert graph.number_of_edges() == edges
-
-
-ARMS = """
-[character]
-name = "Arms"
-
-[body]
-parts = ["root", "head", "left_wrist", "right_wrist"]
-root = "root"
-facing = { left = "left_wrist", right = "right_wrist", forward = "head" }
-
-[motor]
-plugin = "motor-command-graph"
-rest = "rest"
-subsystems = { wrists = ["left_wrist", "right_wrist"] }
-hands = false
-arms = []
-
-[motor.poses.rest]
-root = [0.0, 1.0, 0.0]
-head = [0.0, 1.6, 0.1]
-left_wrist = [0.25, 0.9, 0.05]
-right_wrist = [-0.25, 0.9, 0.05]
-
-[matcher]
-plugin = "forward-model"
-"""
 
 
 @pytest.mark.parametrize("speed", SPEEDS)
