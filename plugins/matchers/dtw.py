@@ -97,6 +97,7 @@ class DTW(Matcher):
         for _, motion in examples:
             positions = motion.filled().positions  # hidden parts held (docs/conventions.md); never seen: 0
             self.templates.append(self._series(positions - positions[:, root : root + 1]))
+        import dtaidistance.dtw_ndim  # noqa: F401  loaded when the observer is composed, not at the first match
 
     def _series(self, rel: np.ndarray) -> np.ndarray:
         series = np.nan_to_num(rel[:: self.params["stride"]]).reshape(-1, rel.shape[1] * 3)

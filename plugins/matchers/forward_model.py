@@ -461,6 +461,11 @@ class ForwardModel(Matcher):
         self._spreads: dict[str, float] | None = None
         self.tracks: dict[str, Track] = {}
         self.reported = False
+        every = getattr(motor, "edges", None)  # optional (not in CommandGraphs): every edge of a subsystem
+        if callable(every):  # the repertoire's tables once, at composition; learned edges' when first met
+            for subsystem in motor.subsystems:
+                for edge in every(subsystem):
+                    self._edge(edge.name)
 
     # -- streaming ------------------------------------------------------------------------------
 

@@ -184,6 +184,7 @@ class PathSearch(Matcher):
             provides(owner.motor, Takes, needed_by="path-search's spread", what="a posegraph that knows its takes",
                      key=("spread",), expected="spread = 0, or a motor system with takes() (posegraph)")
         self._cache_version = -1
+        self._refresh()  # the tables of the graph as composed, now rather than at the first match (rebuilt on learning)
 
     def _refresh(self) -> None:
         """(Re)build the successor and predecessor tables after the graph changed (learning)."""

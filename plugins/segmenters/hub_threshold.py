@@ -140,6 +140,7 @@ class HubThreshold(Segmenter):
         self.template_parts = owner.body.parts
         self._positions = ~np.asarray(getattr(owner.body, "angle_mask", np.zeros(len(self.template), bool)), bool)
         self._hub_size = body_scale(self.template, self._positions)
+        import scipy.signal  # noqa: F401  the low-pass filter's: loaded now, not at the first stream's reset
 
     # -- streaming ---------------------------------------------------------------------
 

@@ -30,6 +30,7 @@ values as it goes and is linear in memory.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -70,6 +71,10 @@ class RupturesSegmenter(Segmenter):
         Parameter("window", float, 60.0, "Seconds of stream held and searched at once (memory is bounded by it; "
                   "no segment is longer); 0: the whole stream, held until it ends.", minimum=0.0),
     )
+
+    def attach(self, owner: Any) -> None:
+        super().attach(owner)
+        import ruptures  # noqa: F401  loaded when the observer is composed, not inside the first stream's flush
 
     def reset(self, parts: Sequence[str], fps: float) -> None:
         self._fps = float(fps)
