@@ -177,3 +177,21 @@ def test_anchors_placed_at_once_are_placed_one_by_one(write, pm, first, seed):
     for name in reversed(names):  # the first asked places them all
         np.testing.assert_array_equal(matcher._anchor(track, name), _direct_anchor(matcher, track, name))
     assert set(track.anchors) == set(names)
+
+
+@given(seed=st.integers(0, 10_000), c=st.integers(1, 6), k=st.integers(1, 5), h=st.integers(1, 40),
+       hidden=st.booleans())
+@settings(max_examples=60, deadline=None)
+def test_anchor_distances_from_coordinate_planes_are_the_stacked_norms_bit_for_bit(seed, c, k, h, hidden):
+    """The anchors' distances (:func:`_distances`, coordinate planes) equal ``np.linalg.norm`` of the stacked
+    positions exactly, a part never seen (NaN) included."""
+    from plugins.matchers.forward_model import _distances
+
+    rng = np.random.default_rng(seed)
+    positions = rng.normal(size=(c, k, h, 3)) * rng.uniform(0.01, 3.0)
+    first = rng.normal(size=(k, 3))
+    if hidden:
+        first[rng.integers(k)] = np.nan
+    want = np.linalg.norm(positions - first[:, None], axis=-1)
+    got = _distances(*(np.ascontiguousarray(positions[..., i]) for i in range(3)), first)
+    assert np.array_equal(got, want, equal_nan=True)

@@ -122,6 +122,14 @@ from toolkit.watching import WorkingMemory, follow
 __all__ = ["ForwardModel", "Track", "CommandGraphs"]
 
 
+def _distances(x: np.ndarray, y: np.ndarray, z: np.ndarray, first: np.ndarray) -> np.ndarray:
+    """``np.linalg.norm(positions - first[:, None], axis=-1)`` of points given as coordinate planes x, y, z (C, k, h)
+    and ``first`` (k, 3): the same arithmetic in the same order (the squares summed x, y, z, then the root), so the
+    same bits, without the (C, k, h, 3) temporaries of the stacked form."""
+    dx, dy, dz = x - first[:, 0, None], y - first[:, 1, None], z - first[:, 2, None]
+    return np.sqrt(dx * dx + dy * dy + dz * dz)
+
+
 class CommandGraphs(Protocol):
     """A motor system of motor command graphs, one per subsystem, whose edges are commands (K&G §4.2).
 
@@ -1037,17 +1045,16 @@ class ForwardModel(Matcher):
             # in the frame the track begins: the same onset posture)
             firsts = dict.fromkeys([name, *(path[0] for path in track.candidates)])
             names = [n for n in firsts if n not in track.anchors]
-            positions, later, arcs = self._halves(tuple(names))
-            far = np.linalg.norm(positions - self._first(track)[:, None], axis=-1)  # (C, k, h)
-            far[later] = np.inf
+            (x, y, z), later, arcs = self._halves(tuple(names))
+            far = np.where(later, np.inf, _distances(x, y, z, self._first(track)))  # (C, k, h)
             placed = np.take_along_axis(arcs, np.argmin(far, axis=-1)[..., None], axis=-1)[..., 0]
             track.anchors.update(zip(names, placed))
             anchor = track.anchors[name]
         return anchor
 
-    def _halves(self, names: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The first halves of commands ``names``' strokes, stacked for :meth:`_anchor`: positions (C, k, h, 3), which
-        points lie past the first half of their stroke (C, k, h) and cumulative lengths (C, k, h), where ``h`` is
+    def _halves(self, names: tuple[str, ...]) -> tuple[tuple[np.ndarray, ...], np.ndarray, np.ndarray]:
+        """The first halves of commands ``names``' strokes, stacked for :meth:`_anchor`: positions as three
+        contiguous coordinate planes x, y, z (C, k, h) each (:func:`_distances`), which points lie past the first half of their stroke (C, k, h) and cumulative lengths (C, k, h), where ``h`` is
         the last point the first half of any stroke that moves reaches (arcs grow: a first half is a prefix). Kept
         for the last sets of candidates (a node's edges are the candidates of every demonstration that starts there)."""
         tables = [self._edge(name) for name in names]
@@ -1060,7 +1067,9 @@ class ForwardModel(Matcher):
         # a part that stays still (no path at all: every point the same) is joined at its first point whatever h is
         moving = arcs[..., -1] > 0
         h = int(arcs.shape[-1] - later[moving].sum(axis=-1).min()) if moving.any() else 1
-        halves = (np.stack([t.positions[:, :h] for t in tables]), later[..., :h], arcs[..., :h])
+        positions = np.stack([t.positions[:, :h] for t in tables])  # (C, k, h, 3)
+        planes = tuple(np.ascontiguousarray(positions[..., c]) for c in range(3))
+        halves = (planes, later[..., :h], arcs[..., :h])
         self._half_tables[names] = (tables, halves)
         if len(self._half_tables) > 32:
             self._half_tables.popitem(last=False)
