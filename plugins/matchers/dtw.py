@@ -49,19 +49,26 @@ def _band(window: float, n: int, m: int) -> int | None:
     return None if band is None else max(band, abs(n - m) + 1)
 
 
-def _dtw(series: np.ndarray, template: np.ndarray, band: int | None) -> float:
+def _dtw(series: np.ndarray, template: np.ndarray, band: int | None, max_dist: float | None = None) -> float:
     """:func:`dtaidistance.dtw_ndim.distance_fast` of two C-contiguous double arrays: the same C function with the
     same settings (:func:`_c_settings`), without its per-call checks and settings object (most of a short
     segment's cost). Where that C module or its signature is not there (another dtaidistance release, a build
-    without C), the public :func:`~dtaidistance.dtw_ndim.distance_fast` gives the same number."""
+    without C), the public :func:`~dtaidistance.dtw_ndim.distance_fast` gives the same number.
+
+    ``max_dist`` (dtaidistance's early abandoning): infinity as soon as the distance is sure to exceed it; a distance
+    up to it is the same number as without it (only cells above it, which no path up to it goes through, are
+    skipped). ``None`` or 0: never abandoned."""
     try:
         from dtaidistance import dtw_cc
 
-        return dtw_cc.distance_ndim(series, template, **_c_settings(band))
+        settings = _c_settings(band)
+        if max_dist:
+            settings = {**settings, "max_dist": max_dist}
+        return dtw_cc.distance_ndim(series, template, **settings)
     except (ImportError, AttributeError, TypeError):
         from dtaidistance import dtw_ndim
 
-        return dtw_ndim.distance_fast(series, template, window=band)
+        return dtw_ndim.distance_fast(series, template, window=band, max_dist=max_dist or None)
 
 
 @functools.lru_cache(maxsize=256)
@@ -97,6 +104,11 @@ class DTW(Matcher):
         for _, motion in examples:
             positions = motion.filled().positions  # hidden parts held (docs/conventions.md); never seen: 0
             self.templates.append(self._series(positions - positions[:, root : root + 1]))
+        seen: set[str] = set()  # each movement's first example is warped in full; its further ones (extras) are
+        self._firsts, self._extras = [], []  # abandoned once sure to be farther than the movement's nearest so far
+        for i, label in enumerate(self.labels):
+            (self._extras if label in seen else self._firsts).append(i)
+            seen.add(label)
         import dtaidistance.dtw_ndim  # noqa: F401  loaded when the observer is composed, not at the first match
 
     def _series(self, rel: np.ndarray) -> np.ndarray:
@@ -108,8 +120,24 @@ class DTW(Matcher):
             return Match.unknown(reason="nothing visible")
         series = self._series(motion.filled().positions)
         window, n = self.params["window"], len(series)
-        summed = np.array([_dtw(series, template, _band(window, n, len(template))) for template in self.templates])
-        lengths = np.array([n + len(template) for template in self.templates], dtype=float)
+        templates = self.templates
+        lengths = np.array([n + len(template) for template in templates], dtype=float)
+        summed = np.empty(len(templates))
+        for i in self._firsts:
+            summed[i] = _dtw(series, templates[i], _band(window, n, len(templates[i])))
+        nearest_so_far = {}
+        for i in self._firsts:
+            nearest_so_far[self.labels[i]] = np.sqrt(summed[i] * summed[i] / lengths[i])
+        for i in self._extras:
+            # only each movement's nearest example counts (the best, the runner-up over the other movements and
+            # every candidate are per-movement minima): an example farther than its movement's nearest so far is
+            # abandoned (infinity). The bound is that distance back in dtaidistance's units, a billionth wider, so
+            # an abandoned example is surely farther, and one that is not has its exact distance.
+            label = self.labels[i]
+            bound = nearest_so_far[label] * np.sqrt(lengths[i]) * (1.0 + 1e-9)
+            summed[i] = _dtw(series, templates[i], _band(window, n, len(templates[i])),
+                             bound if np.isfinite(bound) else None)
+            nearest_so_far[label] = min(nearest_so_far[label], np.sqrt(summed[i] * summed[i] / lengths[i]))
         distances = np.sqrt(summed * summed / lengths)  # frame_distance of each template, element by element
         best = int(np.argmin(distances))
         per_frame = float(distances[best])

@@ -197,6 +197,8 @@ class PathSearch(Matcher):
         self.node_names = nodes
         self.labels = np.array([motor.movement_of(nd) or "" for nd in nodes], dtype=object)
         _, self.label_ids = np.unique(self.labels.astype(str), return_inverse=True)  # a number per movement
+        self._by_label = np.argsort(self.label_ids, kind="stable")  # the nodes grouped by movement, in node order
+        self._label_starts = np.flatnonzero(np.diff(self.label_ids[self._by_label], prepend=-1))
         self.nodes_compared = motor.node_root_relative
         if self.params["travel"] > 0:  # travel: one more part of every node
             self.nodes_compared = np.concatenate(
@@ -341,10 +343,14 @@ class PathSearch(Matcher):
                 self._index = PoseIndex(nodes)
             start, costs = self._index.nearest(obs[mid], vis[mid], k)  # the scan's k nearest, in its order
         else:
-            first = pose_distance(nodes, obs[mid], vis[mid], weights)
+            if weights is None and vis[mid].all():  # every part seen: eq. 1 inline, as the beam's score does (the
+                diff = nodes - obs[mid]  # same numbers as pose_distance: its masked sum over n parts is the mean)
+                first = np.sqrt(np.einsum("cpi,cpi->cp", diff, diff)).mean(axis=1)
+            else:
+                first = pose_distance(nodes, obs[mid], vis[mid], weights)
             if exclude is not None:
                 first = np.where(exclude, np.inf, first)
-            start = self._best(np.argsort(first, kind="stable"), np.arange(len(nodes)), k)
+            start = self._starts(first, k)
             costs = first[start]
         # beams: array of paths (B, length) and costs (B,)
         paths = start[:, None]
@@ -400,6 +406,30 @@ class PathSearch(Matcher):
             row = parent[row]
         grown = np.stack(grown[::-1], axis=1)  # (B, samples) in the order the samples were taken
         return (np.hstack([paths[row], grown]) if append else np.hstack([grown[:, ::-1], paths[row]])), costs
+
+    def _starts(self, first: np.ndarray, k: int) -> np.ndarray:
+        """``_best(np.argsort(first, kind="stable"), np.arange(N), k)`` without sorting all N nodes: the start nodes
+        of a search from every node's distance ``first`` (N,), best first (ties: the lower node).
+
+        The k best are the nodes up to the k-th smallest distance (:func:`numpy.partition`), ranked by (distance,
+        node) as the stable sort ranks them; with ``per_movement`` each movement's first node in that order is its
+        nearest node (the lowest of its nearest on ties). With NaN distances (which the sort puts last) the sort
+        itself answers."""
+        n = len(first)
+        if n <= k or np.isnan(first).any():
+            return self._best(np.argsort(first, kind="stable"), np.arange(n), k)
+        kth = np.partition(first, k - 1)[k - 1]
+        chosen = np.flatnonzero(first <= kth)  # the k best and the nodes tied with the k-th: the first k by node
+        if self.params["per_movement"]:
+            grouped = first[self._by_label]
+            least = np.repeat(np.minimum.reduceat(grouped, self._label_starts), np.diff(self._label_starts, append=n))
+            at = np.where(grouped == least, np.arange(n), n)  # each movement's nearest nodes; the first of them:
+            nearest = self._by_label[np.minimum.reduceat(at, self._label_starts)]
+        ranked = chosen[np.lexsort((chosen, first[chosen]))][:k]
+        if not self.params["per_movement"]:
+            return ranked
+        both = np.union1d(ranked, nearest)
+        return both[np.lexsort((both, first[both]))]
 
     def _best(self, ranked: np.ndarray, cand: np.ndarray, k: int) -> np.ndarray:
         """The first ``k`` of ``ranked`` (indices into ``cand``, best first) and, with ``per_movement``, the first of
