@@ -651,18 +651,31 @@ class ForwardModel(Matcher):
     def _observed(self, track: Track, memory: np.ndarray) -> np.ndarray:
         """The working memory of a subsystem's parts since it is followed, (n, k, 3).
 
-        Of the working memory :meth:`_local` gave last, the rows are gathered once each and kept (a view)."""
+        Of the working memory :meth:`_local` gave last, or of its first rows (a replay after a deviation,
+        :meth:`_repredict`, feeds them one more at a time), the rows are gathered once each and kept (a view)."""
         idx = self.motor.subsystems[track.subsystem]
-        if memory is not self._last_local or memory is None:
+        if memory is None or (memory is not self._last_local and not self._leading(memory)):
             return memory[track.onset:, idx]
+        n = len(memory) - track.onset
         kept = self._tracked.get(track.subsystem)
         if kept is None or kept.track is not track:
             kept = self._tracked[track.subsystem] = _Tracked(track, _Grown((len(idx), 3)), _Walk(len(idx)))
         rows = kept.rows
-        if rows.n < len(memory) - track.onset:
+        if rows.n > n:  # fewer rows than kept (not a replay's next row): gathered whole, not kept
+            return memory[track.onset:, idx]
+        if rows.n < n:
             rows.extend(memory[track.onset + rows.n :, idx])
         kept.last = rows.view()
         return kept.last
+
+    def _leading(self, memory: np.ndarray) -> bool:
+        """Whether ``memory`` is the first rows of the working memory :meth:`_local` gave last (a view of them, so
+        the same values)."""
+        local = self._last_local
+        if local is None or memory.base is None or memory.base is not local.base or len(memory) > len(local):
+            return False
+        return memory.strides == local.strides and memory.shape[1:] == local.shape[1:] and \
+            memory.__array_interface__["data"][0] == local.__array_interface__["data"][0]
 
     def _walked(self, track: Track, observed: np.ndarray) -> np.ndarray:
         """``_lengths(observed)`` of the rows :meth:`_observed` gave last for ``track``, frame by frame (:class:`_Walk`:
