@@ -461,6 +461,7 @@ class ForwardModel(Matcher):
         self._edges: dict[str, _EdgeTable] = {}
         self._half_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
         self._stroke_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
+        self._placed: OrderedDict[tuple[tuple[str, ...], bytes], tuple[tuple, np.ndarray]] = OrderedDict()
         self._memory: WorkingMemory | None = None
         self._rows: _Grown | None = None  # the working memory in the motor frame, row by row
         self._last_local: np.ndarray | None = None
@@ -651,18 +652,31 @@ class ForwardModel(Matcher):
     def _observed(self, track: Track, memory: np.ndarray) -> np.ndarray:
         """The working memory of a subsystem's parts since it is followed, (n, k, 3).
 
-        Of the working memory :meth:`_local` gave last, the rows are gathered once each and kept (a view)."""
+        Of the working memory :meth:`_local` gave last, or of its first rows (a replay after a deviation,
+        :meth:`_repredict`, feeds them one more at a time), the rows are gathered once each and kept (a view)."""
         idx = self.motor.subsystems[track.subsystem]
-        if memory is not self._last_local or memory is None:
+        if memory is None or (memory is not self._last_local and not self._leading(memory)):
             return memory[track.onset:, idx]
+        n = len(memory) - track.onset
         kept = self._tracked.get(track.subsystem)
         if kept is None or kept.track is not track:
             kept = self._tracked[track.subsystem] = _Tracked(track, _Grown((len(idx), 3)), _Walk(len(idx)))
         rows = kept.rows
-        if rows.n < len(memory) - track.onset:
+        if rows.n > n:  # fewer rows than kept (not a replay's next row): gathered whole, not kept
+            return memory[track.onset:, idx]
+        if rows.n < n:
             rows.extend(memory[track.onset + rows.n :, idx])
         kept.last = rows.view()
         return kept.last
+
+    def _leading(self, memory: np.ndarray) -> bool:
+        """Whether ``memory`` is the first rows of the working memory :meth:`_local` gave last (a view of them, so
+        the same values)."""
+        local = self._last_local
+        if local is None or memory.base is None or memory.base is not local.base or len(memory) > len(local):
+            return False
+        return memory.strides == local.strides and memory.shape[1:] == local.shape[1:] and \
+            memory.__array_interface__["data"][0] == local.__array_interface__["data"][0]
 
     def _walked(self, track: Track, observed: np.ndarray) -> np.ndarray:
         """``_lengths(observed)`` of the rows :meth:`_observed` gave last for ``track``, frame by frame (:class:`_Walk`:
@@ -999,7 +1013,7 @@ class ForwardModel(Matcher):
 
     def _stacked(self, track: Track, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
         """For commands ``names`` followed by ``track``: their strokes' cumulative lengths (C * k, G) and positions
-        (C * k, G, 3), stroke lengths (C, k), anchors (C, k) and onset offsets (C, k, 3), stacked once per set of
+        (C * k, G, 3), stroke lengths (C, k), anchors (C, k) and onset offsets (C, k, 3; 0.0 without ``relative``), stacked once per set of
         candidates (kept until the set changes; the strokes for the last sets of candidates of any track)."""
         kept = self._tracked.get(track.subsystem)
         cache = getattr(kept, "stacked", None) if kept is not None and kept.track is track else None
@@ -1011,13 +1025,14 @@ class ForwardModel(Matcher):
             strokes = (edges, (np.concatenate([e.arcs for e in edges]), np.concatenate([e.positions for e in edges]),
                                np.stack([e.arcs[:, -1] for e in edges])))
             self._stroke_tables[names] = strokes
-            if len(self._stroke_tables) > 8:
+            if len(self._stroke_tables) > 32:
                 self._stroke_tables.popitem(last=False)
         else:
             self._stroke_tables.move_to_end(names)
-        stacked = (*strokes[1], np.stack([self._anchor(track, n) for n in names]),
-                   np.stack([np.broadcast_to(self._onset_offset(track, n), e.positions[:, 0].shape)
-                             for n, e in zip(names, edges)]))
+        # without ``relative`` every offset is 0.0: added as a scalar (the same additions as of zeros stacked)
+        offsets = np.stack([np.broadcast_to(self._onset_offset(track, n), e.positions[:, 0].shape)
+                            for n, e in zip(names, edges)]) if self.params["relative"] else 0.0
+        stacked = (*strokes[1], np.stack([self._anchor(track, n) for n in names]), offsets)
         if kept is not None and kept.track is track:
             kept.stacked = (names, stacked)
         return stacked
@@ -1045,9 +1060,20 @@ class ForwardModel(Matcher):
             # in the frame the track begins: the same onset posture)
             firsts = dict.fromkeys([name, *(path[0] for path in track.candidates)])
             names = [n for n in firsts if n not in track.anchors]
-            (x, y, z), later, arcs = self._halves(tuple(names))
-            far = np.where(later, np.inf, _distances(x, y, z, self._first(track)))  # (C, k, h)
-            placed = np.take_along_axis(arcs, np.argmin(far, axis=-1)[..., None], axis=-1)[..., 0]
+            halves = self._halves(tuple(names))
+            first = self._first(track)
+            key = (tuple(names), first.tobytes())  # a replay of the same frames places them from the same posture
+            kept = self._placed.get(key)
+            if kept is not None and kept[0] is halves:
+                self._placed.move_to_end(key)
+                placed = kept[1]
+            else:
+                (x, y, z), later, arcs = halves
+                far = np.where(later, np.inf, _distances(x, y, z, first))  # (C, k, h)
+                placed = np.take_along_axis(arcs, np.argmin(far, axis=-1)[..., None], axis=-1)[..., 0]
+                self._placed[key] = (halves, placed)
+                if len(self._placed) > 32:
+                    self._placed.popitem(last=False)
             track.anchors.update(zip(names, placed))
             anchor = track.anchors[name]
         return anchor
