@@ -42,9 +42,9 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from toolkit import ConfigError, Trigger
+from toolkit import ConfigError, Trigger, TriggerContext
 
-__all__ = ["ActionTuple", "ActionHierarchy", "EFFECTS", "parse_hierarchy"]
+__all__ = ["ActionTuple", "ActionHierarchy", "EFFECTS", "evaluate_path", "parse_hierarchy"]
 
 EFFECTS = ("none", "grasp", "consume", "toss")
 """What completing a leaf tuple's movement does to its object of attention."""
@@ -246,3 +246,24 @@ def _check_acyclic(tuples: dict[str, ActionTuple]) -> None:
 
     for name in tuples:
         visit(name, ())
+
+
+def evaluate_path(system: Any, target: Any, world: Any, path: tuple[str, ...], attention: str | None,
+                  beliefs: dict[str, str]) -> tuple[bool, str | None]:
+    """Whether every can-I trigger along ``path`` holds for ``target`` in ``world``; and the object of attention.
+
+    Each object selection trigger on the way picks the object the triggers below it are evaluated for, starting
+    from ``attention``. Used wherever a character asks whether another could do what it would do itself:
+    identification (§6.1.1) and prediction (§7.4)."""
+    context = TriggerContext(target, world, attention, beliefs, {})
+    obj = attention
+    for name in path:
+        t = system.hierarchy.tuples[name]
+        if t.select is not None:
+            obj = t.select.select(context)
+            if obj is None:
+                return False, None
+            context = TriggerContext(target, world, obj, beliefs, {})
+        if any(trigger.evaluate(context) <= 0 for trigger in t.can):
+            return False, obj
+    return True, obj

@@ -61,9 +61,9 @@ from typing import Any
 
 import numpy as np
 
-from plugins.action.action_tuple import ActionTuple
+from plugins.action.action_tuple import evaluate_path
 from plugins.action.prediction import predict
-from toolkit import Behaviour, TriggerContext
+from toolkit import Behaviour
 
 __all__ = ["MARGIN", "GRIP", "PerceivedActor", "PerceivedObject", "close_candidates", "identify", "line_of_sight",
            "evaluate_path", "perceived_objects", "perceived_target", "predict", "seen_held"]
@@ -221,23 +221,6 @@ def line_of_sight(system: Any, observer: Any, target: Any, row: int, objects: di
         if angle <= best_angle:
             best, best_angle = name, angle
     return best
-
-
-def evaluate_path(system: Any, target: Any, world: Any, path: tuple[str, ...], attention: str | None,
-                  beliefs: dict[str, str]) -> tuple[bool, str | None]:
-    """Whether every can-I trigger along ``path`` holds for ``target`` in ``world``; and the object of attention."""
-    context = TriggerContext(target, world, attention, beliefs, {})
-    obj = attention
-    for name in path:
-        t: ActionTuple = system.hierarchy.tuples[name]
-        if t.select is not None:
-            obj = t.select.select(context)
-            if obj is None:
-                return False, None
-            context = TriggerContext(target, world, obj, beliefs, {})
-        if any(trigger.evaluate(context) <= 0 for trigger in t.can):
-            return False, obj
-    return True, obj
 
 
 def _words(text: str, obj: str | None) -> str:

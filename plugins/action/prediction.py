@@ -28,9 +28,10 @@ from __future__ import annotations
 from types import SimpleNamespace
 from typing import Any
 
+from plugins.action.action_tuple import evaluate_path
 from toolkit import TriggerContext
 
-__all__ = ["predict", "success_context", "imagine", "possible"]
+__all__ = ["predict", "success_context", "imagine"]
 
 
 def success_context(system: Any, path: tuple[str, ...]) -> list[Any]:
@@ -57,19 +58,6 @@ def imagine(triggers: list[Any], target: Any, objects: dict[str, Any], obj: str 
     if not all(trigger.evaluate(context) > 0 for trigger in triggers):
         return None
     return world.objects
-
-
-def possible(system: Any, target: Any, world: Any, path: tuple[str, ...], obj: str | None,
-             beliefs: dict[str, str]) -> bool:
-    """Whether every object selection and can-I trigger along ``path`` holds for ``target`` and the object ``obj``."""
-    context = TriggerContext(target, world, obj, beliefs, {})
-    for name in path:
-        t = system.hierarchy.tuples[name]
-        if t.select is not None and t.select.select(context) != obj:
-            return False
-        if any(trigger.evaluate(context) <= 0 for trigger in t.can):
-            return False
-    return True
 
 
 def predict(system: Any, target: Any, path: tuple[str, ...], obj: str | None, then: Any) -> tuple[str, ...]:
@@ -109,7 +97,8 @@ def predict(system: Any, target: Any, path: tuple[str, ...], obj: str | None, th
         if not t.leaf:
             continue
         for p in h.paths_to(name):
-            if possible(system, target, world, p, obj, system.beliefs):
+            ok, selected = evaluate_path(system, target, world, p, obj, system.beliefs)
+            if ok and selected == obj:
                 rank = (-system.transitions.get((leaf, name), 0), h.drive_of(p) != h.drive_of(path), name)
                 candidates.append((rank, f"{t.movement} the {obj}"))
                 break
