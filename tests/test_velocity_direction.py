@@ -251,3 +251,20 @@ def test_a_block_pushed_at_once_is_its_frames_pushed_one_by_one(seed, cuts, para
     assert got == expected
     assert since == onsets[: len(since)] and len(since) == len(poses)
     assert blocks.flush() == one.flush()
+
+
+@pytest.mark.parametrize("level", ["movement", "stroke"])
+@pytest.mark.parametrize("moving", [22, 23, 52])
+def test_a_movement_after_one_closed_at_max_movement_begins_after_it(level, moving):
+    """A movement closed at ``max_movement`` and followed by a rest too short to report: the next movement is
+    back-dated to where its motion began, but never into the movement already reported (segments stay disjoint).
+    Found by hypothesis in CI: (58, 70) then (67, 73)."""
+    speed = np.concatenate([np.zeros(10), np.full(moving, 0.5), np.zeros(5), np.full(30, 0.5), np.zeros(20)])
+    poses = np.zeros((len(speed), 2, 3))
+    poses[:, 1, 0] = np.cumsum(speed) / FPS
+    seg = VelocityDirection(max_movement=1.0, level=level)
+    seg.reset(["root", "wrist"], FPS)
+    got = [s for f in range(len(poses)) for s in seg.push(poses[f], np.ones(2, bool))] + seg.flush()
+    assert len(got) >= 3
+    assert all(a.end <= b.start for a, b in zip(got, got[1:])), [(s.start, s.end) for s in got]
+    assert got[-1].end > len(poses) - 25  # the second motion is still found

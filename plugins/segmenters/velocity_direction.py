@@ -143,6 +143,7 @@ class VelocityDirection(Segmenter):
         self._buffer: list[np.ndarray] = []  # working memory: positions of the chosen parts since onset
         self._history: deque[np.ndarray] = deque(maxlen=2 * self._memory + 2)  # the sensory memory
         self._last: tuple[int, int, np.ndarray] | None = None  # the last movement closed: start, end, working memory
+        self._done = 0  # the end of the last movement reported: a movement begins no earlier
         self._analysis: StrokeAnalysis | None = None
         self._pause = max(self._memory, int(round(self.params["pause"] * self._fps))) if self.params["pause"] > 0 else 0
         self._speeds: deque[float] = deque(maxlen=max(1, self._pause))  # for the mean over `pause`
@@ -224,7 +225,9 @@ class VelocityDirection(Segmenter):
             self._moving += 1
             self._resting = 0
             if self._start is None and self._moving >= self._memory:
-                self._start = max(0, self._frame - 2 * self._memory - self._pause // 2)
+                # back-dated to where the motion began, but not into a movement already reported (one closed by
+                # `max_movement` just before a rest too short to report)
+                self._start = max(self._done, self._frame - 2 * self._memory - self._pause // 2)
                 self._buffer = list(self._history)[-(self._frame - self._start + 1):]
         else:
             self._resting += 1
@@ -271,7 +274,7 @@ class VelocityDirection(Segmenter):
         self._buffer = []
         if end - start < 2:
             return []
-        self._last, self._analysis = (start, end, window), None
+        self._last, self._analysis, self._done = (start, end, window), None, end
         if self.params["level"] == "movement":
             return [Segment(start, end, self._fps)]
         cuts = self.analyse(window).breaks
