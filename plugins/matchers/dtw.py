@@ -115,44 +115,81 @@ class DTW(Matcher):
         series = np.nan_to_num(rel[:: self.params["stride"]]).reshape(-1, rel.shape[1] * 3)
         return np.ascontiguousarray(series, dtype=np.double)
 
+    def _prepared(self) -> _Prepared:
+        """What :meth:`match` needs of the templates, computed once per list of templates (set by :meth:`attach`)."""
+        prepared = getattr(self, "_prep", None)
+        if prepared is None or prepared.templates is not self.templates or prepared.labels is not self.labels:
+            prepared = self._prep = _Prepared(self.templates, self.labels, self._firsts, self._extras)
+        return prepared
+
     def match(self, motion: Motion) -> Match:
         if not motion.visible.any() or not self.templates:
             return Match.unknown(reason="nothing visible")
-        series = self._series(motion.filled().positions)
+        prep = self._prepared()
+        # every part seen in every frame: nothing to fill (fill_hidden would copy the same coordinates)
+        positions = np.asarray(motion.positions, dtype=float) if motion.visible.all() else motion.filled().positions
+        series = self._series(positions)
         window, n = self.params["window"], len(series)
-        templates = self.templates
-        lengths = np.array([n + len(template) for template in templates], dtype=float)
+        templates = prep.templates
+        if prep.dropped is not None and not series[:, prep.dropped].any():
+            # the coordinates that are 0 in every template and in the segment (the root's, root-relative) add an
+            # exact +0.0 to each frame pair's sum of squares, taken in dtaidistance's order: left out, the same bits
+            series, templates = np.ascontiguousarray(series[:, prep.kept]), prep.reduced
+        lengths = n + prep.sizes
         summed = np.empty(len(templates))
-        for i in self._firsts:
-            summed[i] = _dtw(series, templates[i], _band(window, n, len(templates[i])))
+        if window:
+            bands = [_band(window, n, size) for size in prep.sizes.tolist()]
+        else:
+            bands = prep.no_band
+        for i in prep.firsts:
+            summed[i] = _dtw(series, templates[i], bands[i])
         nearest_so_far = {}
-        for i in self._firsts:
-            nearest_so_far[self.labels[i]] = np.sqrt(summed[i] * summed[i] / lengths[i])
-        for i in self._extras:
+        for i in prep.firsts:
+            nearest_so_far[prep.labels[i]] = np.sqrt(summed[i] * summed[i] / lengths[i])
+        for i in prep.extras:
             # only each movement's nearest example counts (the best, the runner-up over the other movements and
             # every candidate are per-movement minima): an example farther than its movement's nearest so far is
             # abandoned (infinity). The bound is that distance back in dtaidistance's units, a billionth wider, so
             # an abandoned example is surely farther, and one that is not has its exact distance.
-            label = self.labels[i]
+            label = prep.labels[i]
             bound = nearest_so_far[label] * np.sqrt(lengths[i]) * (1.0 + 1e-9)
-            summed[i] = _dtw(series, templates[i], _band(window, n, len(templates[i])),
-                             bound if np.isfinite(bound) else None)
+            summed[i] = _dtw(series, templates[i], bands[i], bound if np.isfinite(bound) else None)
             nearest_so_far[label] = min(nearest_so_far[label], np.sqrt(summed[i] * summed[i] / lengths[i]))
         distances = np.sqrt(summed * summed / lengths)  # frame_distance of each template, element by element
         best = int(np.argmin(distances))
         per_frame = float(distances[best])
         if self.params["max_distance"] and per_frame > self.params["max_distance"]:
             return Match.unknown(distance=per_frame)
-        label = self.labels[best]
-        others = [d for d, lab in zip(distances, self.labels) if lab != label]
-        runner_up = min(others) if others else np.inf
+        label = prep.labels[best]
+        # each movement's nearest example (Fig. 13's ranked candidates), ranked by distance, ties by name
+        nearest = np.minimum.reduceat(distances[prep.order], prep.starts)
+        others = nearest[prep.names != label]
+        runner_up = float(others.min()) if len(others) else np.inf
         confidence = float(1.0 - per_frame / runner_up) if np.isfinite(runner_up) and runner_up > 0 else 1.0
-        nearest: dict[str, float] = {}  # each movement's nearest example (Fig. 13's ranked candidates)
-        for d, lab in sorted(zip(distances.tolist(), self.labels)):
-            nearest.setdefault(lab, float(d))
-        return Match(label, max(0.0, confidence), None, details={"distance": per_frame,
-                                                                  "runner_up": float(runner_up)},
-                     candidates=tuple(nearest.items()))
+        ranked = sorted(zip(nearest.tolist(), prep.names.tolist()))
+        return Match(label, max(0.0, confidence), None, details={"distance": per_frame, "runner_up": runner_up},
+                     candidates=tuple((lab, d) for d, lab in ranked))
+
+
+class _Prepared:
+    """The templates as :meth:`DTW.match` uses them, computed once: their sizes, the coordinates that are 0 in all
+    of them (``dropped``; ``None`` if none) with the templates without them (``reduced``), and the examples
+    grouped by movement (``order``, ``starts``, ``names``: the movements sorted by name, for
+    :func:`numpy.minimum.reduceat`)."""
+
+    def __init__(self, templates: list[np.ndarray], labels: list[str], firsts: list[int], extras: list[int]):
+        self.templates, self.labels, self.firsts, self.extras = templates, labels, list(firsts), list(extras)
+        self.sizes = np.array([len(t) for t in templates], dtype=float)
+        self.no_band = [None] * len(templates)
+        zero = np.logical_and.reduce([~t.any(axis=0) for t in templates]) if templates else np.zeros(0, bool)
+        self.dropped = np.flatnonzero(zero) if zero.any() and not zero.all() else None
+        self.kept = np.flatnonzero(~zero)
+        self.reduced = [np.ascontiguousarray(t[:, self.kept]) for t in templates]
+        names = np.array(labels, dtype=object)
+        self.order = np.argsort(names, kind="stable")
+        sorted_names = names[self.order]
+        self.starts = np.flatnonzero(np.r_[True, sorted_names[1:] != sorted_names[:-1]])
+        self.names = sorted_names[self.starts]
 
 
 @hookimpl
