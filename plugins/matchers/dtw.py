@@ -28,7 +28,7 @@ import numpy as np
 
 from toolkit import Match, Matcher, Motion, Parameter, hookimpl
 
-__all__ = ["DTW", "frame_distance"]
+__all__ = ["DTW", "frame_distance", "warp_all"]
 
 
 def frame_distance(series: np.ndarray, template: np.ndarray, window: float = 0.0) -> float:
@@ -82,6 +82,67 @@ def _c_settings(band: int | None) -> dict[str, Any]:
                        use_pruning=False, inner_dist=innerdistance.default, use_ndim=True).c_kwargs()
 
 
+def warp_all(series: np.ndarray, columns: np.ndarray, starts: np.ndarray, out: np.ndarray) -> np.ndarray:
+    """:func:`dtaidistance.dtw_ndim.distance_fast` of ``series`` (n, D) against every template at once (no band, no
+    early abandoning): the same arithmetic in the same order, so the same bits.
+
+    ``columns`` (D, M): the templates' frames side by side, coordinate by coordinate; template ``t`` is columns
+    ``starts[t]:starts[t + 1]``; ``out`` (T,) receives the distances. Each frame pair's squared distance is summed
+    over the coordinates in order from 0.0, as dtaidistance's C loop does; here a whole row of a template is summed
+    at once (independent sums, which the compiler runs side by side without reordering any one of them). Then the
+    same recurrence (the cell's cost plus the least of its three predecessors) and the square root of the last
+    cell. Plain Python as written (the reference); :func:`_kernel` compiles it with numba (no ``fastmath``: no
+    reordered sums, no fused multiply-adds).
+    """
+    n, dims = series.shape
+    width = 0
+    for t in range(len(starts) - 1):
+        width = max(width, starts[t + 1] - starts[t])
+    cost = np.empty(width)
+    before = np.empty(width + 1)
+    now = np.empty(width + 1)
+    for t in range(len(starts) - 1):
+        a = starts[t]
+        m = starts[t + 1] - a
+        before[0] = 0.0
+        for j in range(1, m + 1):
+            before[j] = np.inf
+        for i in range(n):
+            for j in range(m):
+                cost[j] = 0.0
+            for k in range(dims):
+                x = series[i, k]
+                column = columns[k, a : a + m]
+                for j in range(m):
+                    d = x - column[j]
+                    cost[j] += d * d
+            now[0] = np.inf
+            for j in range(m):
+                least = before[j]
+                if before[j + 1] < least:
+                    least = before[j + 1]
+                if now[j] < least:
+                    least = now[j]
+                now[j + 1] = cost[j] + least
+            before, now = now, before
+        out[t] = np.sqrt(before[m])
+    return out
+
+
+@functools.lru_cache(maxsize=1)
+def _kernel():
+    """:func:`warp_all` compiled by numba (cached on disk), or ``None`` without numba (dtaidistance is used then,
+    with the same numbers). Imported and compiled when a dtw observer is composed, never by importing this module."""
+    try:
+        import numba
+    except ImportError:
+        return None
+    kernel = numba.njit(cache=True, nogil=True, boundscheck=False)(warp_all)
+    one = np.zeros((1, 1))
+    kernel(one, one, np.array([0, 1], dtype=np.int64), np.empty(1))  # compiled (or loaded) now, not at a match
+    return kernel
+
+
 class DTW(Matcher):
     """Nearest example by multivariate dynamic time warping (dtaidistance); decides at the segment's end."""
 
@@ -111,6 +172,8 @@ class DTW(Matcher):
             seen.add(label)
         import dtaidistance.dtw_ndim  # noqa: F401  loaded when the observer is composed, not at the first match
 
+        _kernel()
+
     def _series(self, rel: np.ndarray) -> np.ndarray:
         series = np.nan_to_num(rel[:: self.params["stride"]]).reshape(-1, rel.shape[1] * 3)
         return np.ascontiguousarray(series, dtype=np.double)
@@ -121,6 +184,27 @@ class DTW(Matcher):
         if prepared is None or prepared.templates is not self.templates or prepared.labels is not self.labels:
             prepared = self._prep = _Prepared(self.templates, self.labels, self._firsts, self._extras)
         return prepared
+
+    def _warp_one_by_one(self, series: np.ndarray, templates: list[np.ndarray], prep: _Prepared,
+                         lengths: np.ndarray, summed: np.ndarray) -> None:
+        """dtaidistance's distance of ``series`` to each template into ``summed``; a movement's further examples
+        abandoned (infinity) once surely farther than its nearest so far."""
+        window, n = self.params["window"], len(series)
+        bands = [_band(window, n, size) for size in prep.sizes.tolist()] if window else prep.no_band
+        for i in prep.firsts:
+            summed[i] = _dtw(series, templates[i], bands[i])
+        nearest_so_far = {}
+        for i in prep.firsts:
+            nearest_so_far[prep.labels[i]] = np.sqrt(summed[i] * summed[i] / lengths[i])
+        for i in prep.extras:
+            # only each movement's nearest example counts (the best, the runner-up over the other movements and
+            # every candidate are per-movement minima): an example farther than its movement's nearest so far is
+            # abandoned (infinity). The bound is that distance back in dtaidistance's units, a billionth wider, so
+            # an abandoned example is surely farther, and one that is not has its exact distance.
+            label = prep.labels[i]
+            bound = nearest_so_far[label] * np.sqrt(lengths[i]) * (1.0 + 1e-9)
+            summed[i] = _dtw(series, templates[i], bands[i], bound if np.isfinite(bound) else None)
+            nearest_so_far[label] = min(nearest_so_far[label], np.sqrt(summed[i] * summed[i] / lengths[i]))
 
     def match(self, motion: Motion) -> Match:
         if not motion.visible.any() or not self.templates:
@@ -137,24 +221,14 @@ class DTW(Matcher):
             series, templates = np.ascontiguousarray(series[:, prep.kept]), prep.reduced
         lengths = n + prep.sizes
         summed = np.empty(len(templates))
-        if window:
-            bands = [_band(window, n, size) for size in prep.sizes.tolist()]
+        kernel = None if window else _kernel()
+        if kernel is not None:
+            # every example warped in full, in one call: each movement's nearest is the same example at the same
+            # distance as with early abandoning (an abandoned example is surely farther), so the same Match
+            columns, starts = prep.columns(templates is prep.reduced)
+            kernel(series, columns, starts, summed)
         else:
-            bands = prep.no_band
-        for i in prep.firsts:
-            summed[i] = _dtw(series, templates[i], bands[i])
-        nearest_so_far = {}
-        for i in prep.firsts:
-            nearest_so_far[prep.labels[i]] = np.sqrt(summed[i] * summed[i] / lengths[i])
-        for i in prep.extras:
-            # only each movement's nearest example counts (the best, the runner-up over the other movements and
-            # every candidate are per-movement minima): an example farther than its movement's nearest so far is
-            # abandoned (infinity). The bound is that distance back in dtaidistance's units, a billionth wider, so
-            # an abandoned example is surely farther, and one that is not has its exact distance.
-            label = prep.labels[i]
-            bound = nearest_so_far[label] * np.sqrt(lengths[i]) * (1.0 + 1e-9)
-            summed[i] = _dtw(series, templates[i], bands[i], bound if np.isfinite(bound) else None)
-            nearest_so_far[label] = min(nearest_so_far[label], np.sqrt(summed[i] * summed[i] / lengths[i]))
+            self._warp_one_by_one(series, templates, prep, lengths, summed)
         distances = np.sqrt(summed * summed / lengths)  # frame_distance of each template, element by element
         best = int(np.argmin(distances))
         per_frame = float(distances[best])
@@ -190,6 +264,16 @@ class _Prepared:
         sorted_names = names[self.order]
         self.starts = np.flatnonzero(np.r_[True, sorted_names[1:] != sorted_names[:-1]])
         self.names = sorted_names[self.starts]
+        self._columns: dict[bool, tuple[np.ndarray, np.ndarray]] = {}
+
+    def columns(self, reduced: bool) -> tuple[np.ndarray, np.ndarray]:
+        """The templates (``reduced``: without the dropped coordinates) side by side for :func:`warp_all`: the (D, M)
+        coordinates and the (T + 1,) starts."""
+        if reduced not in self._columns:
+            templates = self.reduced if reduced else self.templates
+            starts = np.cumsum([0] + [len(t) for t in templates]).astype(np.int64)
+            self._columns[reduced] = (np.ascontiguousarray(np.concatenate(templates).T), starts)
+        return self._columns[reduced]
 
 
 @hookimpl
