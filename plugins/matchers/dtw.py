@@ -190,7 +190,7 @@ class DTW(Matcher):
         """dtaidistance's distance of ``series`` to each template into ``summed``; a movement's further examples
         abandoned (infinity) once surely farther than its nearest so far."""
         window, n = self.params["window"], len(series)
-        bands = [_band(window, n, size) for size in prep.sizes.tolist()] if window else prep.no_band
+        bands = [_band(window, n, len(t)) for t in templates] if window else prep.no_band
         for i in prep.firsts:
             summed[i] = _dtw(series, templates[i], bands[i])
         nearest_so_far = {}
