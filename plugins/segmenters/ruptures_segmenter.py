@@ -78,9 +78,9 @@ class RupturesSegmenter(Segmenter):
 
     def reset(self, parts: Sequence[str], fps: float) -> None:
         self._fps = float(fps)
-        self._frames: list[np.ndarray] = []
-        self._visible: list[np.ndarray] = []
-        self._offset = 0  # the frame number of self._frames[0]
+        self._blocks: list[tuple[np.ndarray, np.ndarray]] = []  # copies of the poses and masks held, block by block
+        self._held = 0  # frames held
+        self._offset = 0  # the frame number of the first frame held
         self._window = int(round(self.params["window"] * self._fps)) if self.params["window"] > 0 else 0
 
     @property
@@ -90,33 +90,58 @@ class RupturesSegmenter(Segmenter):
     @property
     def holds_since(self) -> int | None:
         """The first frame a segment still to be reported may begin at (the first frame held), ``None`` if none."""
-        return self._offset if self._frames else None
+        return self._offset if self._held else None
 
     def push(self, pose: np.ndarray, visible: np.ndarray) -> list[Segment]:
-        self._frames.append(np.array(pose, dtype=float))  # copies: the poses given are views of working memory
-        self._visible.append(np.array(visible, dtype=bool))
-        if self._window and len(self._frames) >= max(self._window, 2):
+        # copies: the poses given are views of working memory
+        self._blocks.append((np.array(pose, dtype=float)[None], np.array(visible, dtype=bool)[None]))
+        self._held += 1
+        if self._window and self._held >= max(self._window, 2):
             return self._advance()
         return []
 
+    def push_block(self, poses: np.ndarray, visible: np.ndarray) -> tuple[list[tuple[int, Segment]], np.ndarray]:
+        """What pushing the ``n`` poses one by one gives (segments come out only when a window is full), with one
+        copy of each stretch up to the window's end rather than one per frame."""
+        n = len(poses)
+        closed: list[tuple[int, Segment]] = []
+        full = max(self._window, 2) if self._window else 0
+        i = 0
+        while i < n:
+            take = n - i if not full else min(n - i, full - self._held)
+            self._blocks.append((np.array(poses[i : i + take], dtype=float),
+                                 np.array(visible[i : i + take], dtype=bool)))
+            self._held += take
+            i += take
+            if full and self._held >= full:
+                closed.extend((i - 1, s) for s in self._advance())
+        return closed, np.full(n, -1, dtype=int)
+
+    def _taken(self) -> tuple[np.ndarray, np.ndarray]:
+        """The poses (n, P, 3) and masks (n, P) held, and nothing held any more."""
+        poses = np.concatenate([b for b, _ in self._blocks])
+        visible = np.concatenate([v for _, v in self._blocks])
+        self._blocks, self._held = [], 0
+        return poses, visible
+
     def flush(self) -> list[Segment]:
-        if not self._frames:
+        if not self._held:
             return []
-        poses, visible = np.array(self._frames), np.array(self._visible)
+        poses, visible = self._taken()
         out = self._segments(self._bounds(poses, visible), visible.any(axis=1), self._offset)
-        self._offset += len(self._frames)
-        self._frames, self._visible = [], []
+        self._offset += len(poses)
         return out
 
     def _advance(self) -> list[Segment]:
         """A full window: the stretches before its last change point (all of it when that is in its first half),
         the frames from there kept."""
-        poses, visible = np.array(self._frames), np.array(self._visible)
+        poses, visible = self._taken()
         n = len(poses)
         bounds = self._bounds(poses, visible)
         last = bounds[-2] if len(bounds) > 2 and bounds[-2] >= n // 2 else n
         out = self._segments([b for b in bounds if b <= last], visible.any(axis=1), self._offset)
-        self._frames, self._visible = self._frames[last:], self._visible[last:]
+        if last < n:
+            self._blocks, self._held = [(poses[last:], visible[last:])], n - last
         self._offset += last
         return out
 
