@@ -110,12 +110,22 @@ def warp_all(series: np.ndarray, columns: np.ndarray, starts: np.ndarray, out: n
         for i in range(n):
             for j in range(m):
                 cost[j] = 0.0
-            for k in range(dims):
+            k = 0
+            while k + 4 <= dims:  # four coordinates a pass, added in their order (fewer loads and stores of cost)
+                x0, x1, x2, x3 = series[i, k], series[i, k + 1], series[i, k + 2], series[i, k + 3]
+                c0, c1 = columns[k, a : a + m], columns[k + 1, a : a + m]
+                c2, c3 = columns[k + 2, a : a + m], columns[k + 3, a : a + m]
+                for j in range(m):
+                    d0, d1, d2, d3 = x0 - c0[j], x1 - c1[j], x2 - c2[j], x3 - c3[j]
+                    cost[j] = (((cost[j] + d0 * d0) + d1 * d1) + d2 * d2) + d3 * d3
+                k += 4
+            while k < dims:
                 x = series[i, k]
                 column = columns[k, a : a + m]
                 for j in range(m):
                     d = x - column[j]
                     cost[j] += d * d
+                k += 1
             now[0] = np.inf
             for j in range(m):
                 least = before[j]
