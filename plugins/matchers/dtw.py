@@ -185,7 +185,9 @@ class DTW(Matcher):
         _kernel()
 
     def _series(self, rel: np.ndarray) -> np.ndarray:
-        series = np.nan_to_num(rel[:: self.params["stride"]]).reshape(-1, rel.shape[1] * 3)
+        series = rel[:: self.params["stride"]].reshape(-1, rel.shape[1] * 3)
+        if not np.isfinite(series).all():  # nan_to_num changes nothing in a finite series (and costs more than this)
+            series = np.nan_to_num(series)
         return np.ascontiguousarray(series, dtype=np.double)
 
     def _prepared(self) -> _Prepared:
@@ -247,8 +249,9 @@ class DTW(Matcher):
         label = prep.labels[best]
         # each movement's nearest example (Fig. 13's ranked candidates), ranked by distance, ties by name
         nearest = np.minimum.reduceat(distances[prep.order], prep.starts)
-        others = nearest[prep.names != label]
-        runner_up = float(others.min()) if len(others) else np.inf
+        others = nearest.copy()
+        others[prep.slot[label]] = np.inf  # the nearest of every other movement (none: infinity)
+        runner_up = float(others.min())
         confidence = float(1.0 - per_frame / runner_up) if np.isfinite(runner_up) and runner_up > 0 else 1.0
         ranked = sorted(zip(nearest.tolist(), prep.names.tolist()))
         return Match(label, max(0.0, confidence), None, details={"distance": per_frame, "runner_up": runner_up},
@@ -274,6 +277,7 @@ class _Prepared:
         sorted_names = names[self.order]
         self.starts = np.flatnonzero(np.r_[True, sorted_names[1:] != sorted_names[:-1]])
         self.names = sorted_names[self.starts]
+        self.slot = {name: i for i, name in enumerate(self.names.tolist())}
         self._columns: dict[bool, tuple[np.ndarray, np.ndarray]] = {}
 
     def columns(self, reduced: bool) -> tuple[np.ndarray, np.ndarray]:
