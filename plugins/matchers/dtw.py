@@ -17,6 +17,11 @@ length, as earlier versions did, shrinks with the template's length and made the
 longest template nearest to everything.) A segment farther than
 ``max_distance`` from every template is "unknown". Every movement is a ranked
 candidate (``Match.candidates``), by the distance of its nearest example.
+
+Speed (issue 22): with numba installed and no band, :func:`warp_all` warps the
+segment against every template in one compiled call, with dtaidistance's
+arithmetic in dtaidistance's order (the same bits; ``tests/test_dtw_kernel.py``
+compares them); otherwise dtaidistance is called once per template.
 """
 
 from __future__ import annotations
