@@ -88,27 +88,44 @@ def speed_breaks(speed: np.ndarray, drop: float, moving: float = 0.0) -> list[in
 
 
 def direction_clusters(vectors: np.ndarray, angle: float, max_clusters: int = 12) -> np.ndarray:
-    """Divisive clustering of unit movement vectors (N, D); returns a cluster label per vector."""
+    """Divisive clustering of unit movement vectors (N, D); returns a cluster label per vector.
+
+    One cluster around the mean direction; while the vector least like its nearest mean is more than ``angle``
+    degrees from it (and there are fewer than ``max_clusters``), it founds a new cluster and the vectors are
+    redistributed to the nearest mean and the means re-averaged (:func:`_centres`) until they stay put (at most ten
+    rounds). The means are one array (k, D); each similarity matrix ``vectors @ means.T`` is computed once for the
+    means it belongs to, and a round whose labels are those of the round before ends the re-averaging at once (its
+    means would be the same values, which the formula's test then finds close). The same labels as the formula
+    written out cluster by cluster (``tests/test_strokes_clusters.py`` holds it to that formula).
+    """
     n = len(vectors)
     if n == 0:
         return np.zeros(0, dtype=int)
     cos_limit = np.cos(np.radians(angle))
-    means = [_unit(vectors.mean(axis=0))]
+    means = _unit(vectors.mean(axis=0))[None, :]
+    sims = vectors @ means.T  # always the similarities to the current means
+    rows = np.arange(n)
     for _ in range(4 * max_clusters):
-        sims = vectors @ np.array(means).T
-        labels = np.argmax(sims, axis=1)
-        best = sims[np.arange(n), labels]
-        worst = int(np.argmin(best))
+        labels = sims.argmax(axis=1)
+        best = sims[rows, labels]
+        worst = int(best.argmin())
         if best[worst] >= cos_limit or len(means) >= max_clusters:
             break
-        means.append(vectors[worst].copy())  # a new cluster around the most different element
+        means = np.concatenate([means, vectors[worst][None, :]])  # a new cluster around the most different element
+        labels = None
         for _ in range(10):  # redistribute and re-average until stable
-            labels = np.argmax(vectors @ np.array(means).T, axis=1)
-            new = _cluster_means(vectors, labels, means)
-            if _allclose(np.array(new), np.array(means)):
+            sims = vectors @ means.T
+            again = sims.argmax(axis=1)
+            if labels is not None and (again == labels).all():
+                break  # the same clusters: the same means again
+            labels = again
+            new = _centres(vectors, labels, means)
+            if _allclose(new, means):
                 break
             means = new
-    return np.argmax(vectors @ np.array(means).T, axis=1)
+        else:
+            sims = vectors @ means.T
+    return sims.argmax(axis=1)
 
 
 def direction_breaks(labels: np.ndarray) -> list[int]:
@@ -158,6 +175,31 @@ def _cluster_means(vectors: np.ndarray, labels: np.ndarray, means: list[np.ndarr
     return new
 
 
+def _centres(vectors: np.ndarray, labels: np.ndarray, means: np.ndarray) -> np.ndarray:
+    """Each cluster's mean direction (k, D) as one array: the values of :func:`_cluster_means` (a cluster's rows
+    summed in their order, divided by their count, divided by the square root of the mean's dot product with itself;
+    its old mean ``means[k]`` if it has no vector).
+
+    The rows are laid out per cluster in a (longest, k, D) array padded with -0.0, which leaves any sum as it is
+    (x + -0.0 is x, for x = +0.0 too), and summed along its first axis at once: numpy adds the (k, D) layers one
+    after the other, as it sums one cluster's rows one after the other.
+    """
+    k, d = means.shape
+    run = (labels[:, None] == np.arange(k)).cumsum(axis=0)  # rows of each cluster so far
+    counts = run[-1]
+    padded = np.full((int(counts.max()), k, d), -0.0)
+    padded[run[np.arange(len(labels)), labels] - 1, labels] = vectors
+    centre = padded.sum(axis=0)
+    full = bool(counts.all())
+    centre /= counts[:, None] if full else np.maximum(counts, 1)[:, None]
+    norm = np.sqrt(np.array([c.dot(c) for c in centre]))
+    long = norm > 1e-12
+    if full and long.all():
+        return centre / norm[:, None]
+    centre = np.where(long[:, None], centre / np.where(long, norm, 1.0)[:, None], centre)
+    return centre if full else np.where((counts > 0)[:, None], centre, means)
+
+
 def _units(vectors: np.ndarray) -> np.ndarray:
     """:func:`_unit` of each row of ``vectors`` (N, D), the same values: ``np.linalg.norm`` of a vector is the
     square root of its dot product with itself, taken here row by row, and the rows divided at once."""
@@ -170,7 +212,7 @@ def _units(vectors: np.ndarray) -> np.ndarray:
 
 def _allclose(a: np.ndarray, b: np.ndarray) -> bool:
     """``np.allclose(a, b)`` of finite or NaN values (its default tolerances), without its generality's cost."""
-    return bool(np.all(np.abs(a - b) <= 1e-08 + 1e-05 * np.abs(b)))
+    return bool((abs(a - b) <= 1e-08 + 1e-05 * abs(b)).all())
 
 
 def held(window: np.ndarray) -> np.ndarray:
