@@ -13,7 +13,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from plugins.lib.strokes import _centres, _cluster_means, _unit, direction_clusters
+from plugins.lib.strokes import (StrokeAnalysis, StrokeCriteria, _centres, _cluster_means, _unit, analyse, direction_breaks,
+                                 direction_clusters, held, speed_breaks)
 
 values = st.floats(-10.0, 10.0, allow_nan=False, allow_infinity=False)
 
@@ -93,3 +94,123 @@ def test_a_long_cluster_is_summed_in_order():
     means = np.zeros((4, 69))
     expected = [_unit(vectors[labels == c].mean(axis=0)) for c in range(3)] + [means[3]]
     np.testing.assert_array_equal(_centres(vectors, labels, means), np.array(expected))
+
+
+def reference_speed_breaks(speed: np.ndarray, drop: float, moving: float = 0.0) -> list[int]:
+    """:func:`speed_breaks` as it was written before it was vectorised: a hold at a time."""
+    from scipy.signal import argrelextrema
+
+    speed = np.asarray(speed, dtype=float)
+    n = len(speed)
+    if n < 3:
+        return []
+    low = argrelextrema(speed, np.less_equal, order=2)[0]
+    low = low[(low >= 2) & (low <= n - 3)]
+    if not len(low):
+        return []
+    holds = [[int(low[0])]]
+    for m in low[1:]:
+        previous = holds[-1][-1]
+        if m == previous + 1 or speed[previous : m + 1].max() <= moving:
+            holds[-1].append(int(m))
+        else:
+            holds.append([int(m)])
+    minima = [(h[0] + h[-1]) // 2 for h in holds]
+    bounds = [0, *(h[-1] for h in holds[:-1])], [*(h[0] for h in holds[1:]), n - 1]
+    out = []
+    for i, (m, hold) in enumerate(zip(minima, holds)):
+        left, right = speed[bounds[0][i] : hold[0] + 1].max(), speed[hold[-1] : bounds[1][i] + 1].max()
+        side = min(left, right)
+        if speed[hold].min() < drop * side and side > moving:
+            out.append(m)
+    return out
+
+
+def reference_analyse(window: np.ndarray, fps: float, c: StrokeCriteria) -> StrokeAnalysis:
+    """:func:`analyse` as it was written before it was vectorised: a cluster change, a slow vector at a time."""
+    from scipy.signal import savgol_filter
+
+    window = held(window)
+    n = len(window)
+    empty = np.zeros(max(0, n - 1))
+    if n < 4:
+        return StrokeAnalysis(np.asarray(window, dtype=float), empty, np.full(len(empty), -1), [], [], [])
+    smooth = int(round(c.smooth * fps)) | 1
+    if smooth >= 5 and n > smooth:
+        window = savgol_filter(window, smooth, 2, axis=0, mode="interp")
+    vectors = np.diff(window, axis=0)
+    speed = np.linalg.norm(vectors.reshape(len(vectors), -1, 3), axis=2).max(axis=1) * fps
+    moving = speed > c.rest_speed
+    by_speed = sorted(b + 1 for b in reference_speed_breaks(speed, c.drop, c.rest_speed))
+    cuts = set(by_speed)
+    by_direction: list[int] = []
+    units = np.array([_unit(v) for v in vectors])
+    labels = np.full(len(units), -1)
+    if moving.any():
+        labels[moving] = reference_direction_clusters(units[moving], c.angle)
+        for i in range(1, len(labels)):
+            if labels[i] < 0:
+                labels[i] = labels[i - 1]
+        k = max(2, int(round(0.1 * fps)))
+        dips = np.array(reference_speed_breaks(speed, c.corner, c.rest_speed), dtype=int) + 1
+        for b in direction_breaks(labels):
+            before, after = _unit(vectors[max(0, b - k) : b].sum(axis=0)), _unit(vectors[b : b + k].sum(axis=0))
+            sharp = np.degrees(np.arccos(np.clip(before @ after, -1.0, 1.0))) >= 0.5 * c.angle
+            near = dips[np.abs(dips - b) <= k]
+            if sharp and near.size:
+                by_direction.append(int(near[np.argmin(np.abs(near - b))]))
+    cuts.update(by_direction)
+    shortest = max(1, int(round(c.min_stroke * fps)))
+    kept: list[int] = []
+    for cut in sorted(cuts):
+        if cut - (kept[-1] if kept else 0) >= shortest and n - cut >= shortest:
+            kept.append(cut)
+    return StrokeAnalysis(window, speed, labels, by_speed, sorted(set(by_direction)), kept)
+
+
+@st.composite
+def speeds(draw):
+    """Speed profiles with holds, plateaus, pauses below the rest speed and repeated values."""
+    levels = st.sampled_from([0.0, 0.01, 0.05, 0.08, 0.1, 0.3, 0.5, 1.0, 1.5])
+    return np.array(draw(st.lists(st.one_of(levels, st.floats(0.0, 2.0)), max_size=60)))
+
+
+@given(speeds(), st.floats(0.0, 1.0), st.sampled_from([0.0, 0.05, 0.08, 0.3]))
+@settings(max_examples=400, deadline=None)
+def test_speed_breaks_are_the_reference_minima(speed, drop, moving):
+    assert speed_breaks(speed, drop, moving) == reference_speed_breaks(speed, drop, moving)
+
+
+@st.composite
+def movements(draw):
+    """A movement's working memory (N, 3k): strokes in a few directions at changing speeds, pauses, turns, a part
+    hidden now and then (NaN)."""
+    parts = draw(st.integers(1, 4))
+    n = draw(st.integers(0, 90))
+    turns = draw(st.lists(st.integers(1, max(1, n)), max_size=6))
+    directions = draw(arrays(np.float64, (len(turns) + 1, 3 * parts), elements=st.floats(-1.0, 1.0)))
+    which = np.searchsorted(np.sort(turns), np.arange(n), side="right")
+    pace = draw(arrays(np.float64, n, elements=st.sampled_from([0.0, 0.001, 0.002, 0.01, 0.02, 0.05])))
+    noise = draw(arrays(np.float64, (n, 3 * parts), elements=st.floats(-0.003, 0.003)))
+    steps = directions[which] * pace[:, None] + noise if n else np.zeros((0, 3 * parts))
+    window = np.cumsum(steps, axis=0)
+    hidden = draw(st.lists(st.tuples(st.integers(0, max(0, n - 1)), st.integers(0, parts - 1)), max_size=4))
+    for row, part in hidden:
+        if n:
+            window[row, 3 * part : 3 * part + 3] = np.nan
+    return window
+
+
+@given(movements(), st.sampled_from([30.0, 60.0, 120.0]),
+       st.builds(StrokeCriteria, rest_speed=st.sampled_from([0.05, 0.08, 0.3]), drop=st.floats(0.1, 0.9),
+                 angle=st.floats(10.0, 120.0), corner=st.floats(0.3, 1.0), min_stroke=st.sampled_from([0.0, 0.05, 0.15]),
+                 smooth=st.sampled_from([0.0, 0.1, 0.2])))
+@settings(max_examples=300, deadline=None)
+def test_analysis_is_the_reference_analysis(window, fps, criteria):
+    """The whole stroke analysis, vectorised, gives the same window, speed, clusters and breaks as the reference."""
+    got, expected = analyse(window, fps, criteria), reference_analyse(window, fps, criteria)
+    np.testing.assert_array_equal(got.window, expected.window)
+    np.testing.assert_array_equal(got.speed, expected.speed)
+    np.testing.assert_array_equal(got.clusters, expected.clusters)
+    assert (got.speed_breaks, got.direction_breaks, got.breaks) == (
+        expected.speed_breaks, expected.direction_breaks, expected.breaks)

@@ -56,35 +56,41 @@ def speed_breaks(speed: np.ndarray, drop: float, moving: float = 0.0) -> list[in
     starts or ends at full speed still brackets its minima; both sides must rise above ``moving``, so a dip
     between two flickers of noise at rest separates no strokes.
     """
+    minima, lowest, side = _minima(np.asarray(speed, dtype=float), moving)
+    return minima[(lowest < drop * side) & (side > moving)].tolist()
+
+
+def _minima(speed: np.ndarray, moving: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The holds of :func:`speed_breaks` (whatever the share): each hold's middle, its lowest speed and the smaller
+    of its sides' highest speeds, as arrays (one element a hold). A minimum only compares speeds and takes maxima,
+    so it is computed for every sample at once with the same values as sample by sample."""
     # Written out, not scipy.signal.find_peaks: K&G §4.3's criterion is a share of the neighbouring maxima (a ratio,
     # where find_peaks's prominence is a difference to the lower base of higher peaks) and a hold joins minima with
     # nothing faster than the rest speed between them, which no find_peaks option (plateau, distance, wlen) expresses.
-    from scipy.signal import argrelextrema
-
-    speed = np.asarray(speed, dtype=float)
     n = len(speed)
-    if n < 3:
-        return []
-    low = argrelextrema(speed, np.less_equal, order=2)[0]
-    low = low[(low >= 2) & (low <= n - 3)]  # two samples on each side, inside the movement
+    none = np.zeros(0, dtype=int), np.zeros(0), np.zeros(0)
+    if n < 5:
+        return none
+    # scipy.signal.argrelextrema(speed, np.less_equal, order=2), two samples on each side inside the movement
+    middle = speed[2 : n - 2]
+    low = np.flatnonzero((middle <= speed[1 : n - 3]) & (middle <= speed[: n - 4]) & (middle <= speed[3 : n - 1])
+                         & (middle <= speed[4:])) + 2
     if not len(low):
-        return []
-    holds = [[int(low[0])]]
-    for m in low[1:]:
-        previous = holds[-1][-1]
-        if m == previous + 1 or speed[previous : m + 1].max() <= moving:
-            holds[-1].append(int(m))
-        else:
-            holds.append([int(m)])
-    minima = [(h[0] + h[-1]) // 2 for h in holds]
-    bounds = [0, *(h[-1] for h in holds[:-1])], [*(h[0] for h in holds[1:]), n - 1]  # the neighbouring holds
-    out = []
-    for i, (m, hold) in enumerate(zip(minima, holds)):
-        left, right = speed[bounds[0][i] : hold[0] + 1].max(), speed[hold[-1] : bounds[1][i] + 1].max()
-        side = min(left, right)
-        if speed[hold].min() < drop * side and side > moving:
-            out.append(m)
-    return out
+        return none
+    padded = np.append(speed, -np.inf)  # a range may end at the last sample
+    # a minimum joins the hold before it when next to its last minimum or with nothing faster than `moving` between
+    joined = np.zeros(0, dtype=bool)
+    if len(low) > 1:
+        between = np.maximum.reduceat(padded, np.stack([low[:-1], low[1:] + 1], axis=1).ravel())[::2]
+        joined = (low[1:] == low[:-1] + 1) | (between <= moving)
+    first = np.flatnonzero(np.concatenate([[True], ~joined]))  # the first minimum of each hold (index into low)
+    last = np.append(first[1:] - 1, len(low) - 1)
+    minima = (low[first] + low[last]) // 2
+    left = np.append(0, low[last[:-1]])  # a side reaches to the neighbouring hold or to the end of the movement
+    right = np.append(low[first[1:]], n - 1)
+    highest = np.maximum.reduceat(padded, np.stack([left, low[first] + 1, low[last], right + 1], axis=1).ravel())
+    lowest = np.minimum.reduceat(speed[low], first)
+    return minima, lowest, np.minimum(highest[0::4], highest[2::4])
 
 
 def direction_clusters(vectors: np.ndarray, angle: float, max_clusters: int = 12) -> np.ndarray:
@@ -264,26 +270,30 @@ def analyse(window: np.ndarray, fps: float, criteria: StrokeCriteria = StrokeCri
     vectors = np.diff(window, axis=0)
     speed = np.linalg.norm(vectors.reshape(len(vectors), -1, 3), axis=2).max(axis=1) * fps
     moving = speed > c.rest_speed
-    by_speed = sorted(b + 1 for b in speed_breaks(speed, c.drop, c.rest_speed))
+    minima, lowest, side = _minima(speed, c.rest_speed)
+    by_speed = sorted((minima[(lowest < c.drop * side) & (side > c.rest_speed)] + 1).tolist())
     cuts = set(by_speed)
     by_direction: list[int] = []
     units = _units(vectors)
     labels = np.full(len(units), -1)
     if moving.any():
         labels[moving] = direction_clusters(units[moving], c.angle)
-        for i in range(1, len(labels)):  # slow vectors take the cluster of the one before
-            if labels[i] < 0:
-                labels[i] = labels[i - 1]
+        # slow vectors take the cluster of the one before (none before the first moving one: -1)
+        last = np.maximum.accumulate(np.where(moving, np.arange(len(labels)), -1))
+        labels = np.where(last >= 0, labels[np.maximum(last, 0)], -1)
         k = max(2, int(round(0.1 * fps)))
-        dips = np.array(speed_breaks(speed, c.corner, c.rest_speed), dtype=int) + 1
-        for b in direction_breaks(labels):
+        dips = minima[(lowest < c.corner * side) & (side > c.rest_speed)] + 1
+        changes = np.flatnonzero(labels[1:] != labels[:-1]) + 1  # direction_breaks(labels)
+        if changes.size and dips.size:
             # a cluster change inside one stroke is no break: the direction must turn sharply there, at a dip
             # of the speed (a C stroke turns gradually, an S stroke swings its direction at full speed)
-            before, after = _unit(vectors[max(0, b - k) : b].sum(axis=0)), _unit(vectors[b : b + k].sum(axis=0))
-            sharp = np.degrees(np.arccos(np.clip(before @ after, -1.0, 1.0))) >= 0.5 * c.angle
-            near = dips[np.abs(dips - b) <= k]
-            if sharp and near.size:
-                by_direction.append(int(near[np.argmin(np.abs(near - b))]))
+            distance = np.abs(dips[None, :] - changes[:, None])
+            near = (distance <= k).any(axis=1)
+            changes, distance = changes[near], distance[near]
+            for b, d in zip(changes.tolist(), distance):
+                before, after = _unit(vectors[max(0, b - k) : b].sum(axis=0)), _unit(vectors[b : b + k].sum(axis=0))
+                if np.degrees(np.arccos(min(max(before @ after, -1.0), 1.0))) >= 0.5 * c.angle:  # np.clip's value
+                    by_direction.append(int(dips[np.argmin(np.where(d <= k, d, k + 1))]))
     cuts.update(by_direction)
     shortest = max(1, int(round(c.min_stroke * fps)))
     kept: list[int] = []
