@@ -157,7 +157,7 @@ class StrokeAnalysis:
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
-    n = np.linalg.norm(v)
+    n = np.sqrt(v.dot(v))  # np.linalg.norm(v) of a vector, without its generality's cost
     return v / n if n > 1e-12 else v
 
 
@@ -290,10 +290,17 @@ def analyse(window: np.ndarray, fps: float, criteria: StrokeCriteria = StrokeCri
             distance = np.abs(dips[None, :] - changes[:, None])
             near = (distance <= k).any(axis=1)
             changes, distance = changes[near], distance[near]
-            for b, d in zip(changes.tolist(), distance):
-                before, after = _unit(vectors[max(0, b - k) : b].sum(axis=0)), _unit(vectors[b : b + k].sum(axis=0))
-                if np.degrees(np.arccos(min(max(before @ after, -1.0), 1.0))) >= 0.5 * c.angle:  # np.clip's value
-                    by_direction.append(int(dips[np.argmin(np.where(d <= k, d, k + 1))]))
+            if changes.size:
+                # the k vectors before and after each change (-0.0 beyond the movement: no term), summed one after
+                # the other, made unit and compared as each change's own would be
+                rows = changes[:, None] + np.arange(-k, k)
+                rows = np.where((rows >= 0) & (rows < len(vectors)), rows, len(vectors))
+                sums = np.append(vectors, np.full((1, vectors.shape[1]), -0.0), axis=0)[rows]
+                before, after = _units(sums[:, :k].sum(axis=1)), _units(sums[:, k:].sum(axis=1))
+                cos = np.array([u.dot(v) for u, v in zip(before, after)])
+                sharp = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))) >= 0.5 * c.angle
+                nearest = np.where(distance <= k, distance, k + 1).argmin(axis=1)
+                by_direction.extend(dips[nearest[sharp]].tolist())
     cuts.update(by_direction)
     shortest = max(1, int(round(c.min_stroke * fps)))
     kept: list[int] = []
