@@ -13,8 +13,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from plugins.lib.strokes import (StrokeAnalysis, StrokeCriteria, _centres, _cluster_means, _unit, analyse, direction_breaks,
-                                 direction_clusters, held, speed_breaks)
+from plugins.lib.strokes import (StrokeAnalysis, StrokeCriteria, _centres, _cluster_means, _unit, analyse, breaks,
+                                 direction_breaks, direction_clusters, held, speed_breaks)
 
 values = st.floats(-10.0, 10.0, allow_nan=False, allow_infinity=False)
 
@@ -203,7 +203,8 @@ def movements(draw):
 
 @given(movements(), st.sampled_from([30.0, 60.0, 120.0]),
        st.builds(StrokeCriteria, rest_speed=st.sampled_from([0.05, 0.08, 0.3]), drop=st.floats(0.1, 0.9),
-                 angle=st.floats(10.0, 120.0), corner=st.floats(0.3, 1.0), min_stroke=st.sampled_from([0.0, 0.05, 0.15]),
+                 angle=st.floats(10.0, 120.0), corner=st.floats(0.3, 1.0),
+                 min_stroke=st.sampled_from([0.0, 0.05, 0.15]),
                  smooth=st.sampled_from([0.0, 0.1, 0.2])))
 @settings(max_examples=300, deadline=None)
 def test_analysis_is_the_reference_analysis(window, fps, criteria):
@@ -214,3 +215,15 @@ def test_analysis_is_the_reference_analysis(window, fps, criteria):
     np.testing.assert_array_equal(got.clusters, expected.clusters)
     assert (got.speed_breaks, got.direction_breaks, got.breaks) == (
         expected.speed_breaks, expected.direction_breaks, expected.breaks)
+
+
+@given(movements(), st.sampled_from([30.0, 60.0, 120.0]),
+       st.builds(StrokeCriteria, rest_speed=st.sampled_from([0.05, 0.08, 0.3]), drop=st.floats(0.1, 0.9),
+                 angle=st.floats(10.0, 120.0), corner=st.floats(0.0, 1.0),
+                 min_stroke=st.sampled_from([0.0, 0.05, 0.15, 0.5]),
+                 smooth=st.sampled_from([0.0, 0.1, 0.2])))
+@settings(max_examples=300, deadline=None)
+def test_breaks_alone_are_the_analysis_breaks(window, fps, criteria):
+    """:func:`breaks` leaves out what cannot change them (a movement too short for two strokes, the clustering where
+    no speed dip could accompany a direction break): the same breaks as the whole analysis."""
+    assert breaks(window, fps, criteria) == reference_analyse(window, fps, criteria).breaks

@@ -245,8 +245,12 @@ def held(window: np.ndarray) -> np.ndarray:
 
 
 def breaks(window: np.ndarray, fps: float, criteria: StrokeCriteria = StrokeCriteria()) -> list[int]:
-    """Break points (indices into ``window``, positions (N, 3k) of the chosen parts) by speed and direction."""
-    return analyse(window, fps, criteria).breaks
+    """Break points (indices into ``window``, positions (N, 3k) of the chosen parts) by speed and direction.
+
+    ``analyse(window, fps, criteria).breaks``, without what cannot change them: no analysis of a movement too short
+    for two strokes, and no direction clustering where no speed dip could accompany a direction break.
+    """
+    return _analyse(window, fps, criteria, clusters=False).breaks
 
 
 def analyse(window: np.ndarray, fps: float, criteria: StrokeCriteria = StrokeCriteria()) -> StrokeAnalysis:
@@ -256,13 +260,19 @@ def analyse(window: np.ndarray, fps: float, criteria: StrokeCriteria = StrokeCri
     Speed minima below ``drop`` of their neighbouring maxima cut; direction-cluster changes cut where the
     direction turns sharply at a dip of the speed (see the module). Pieces shorter than ``min_stroke`` merge.
     """
+    return _analyse(window, fps, criteria)
+
+
+def _analyse(window: np.ndarray, fps: float, c: StrokeCriteria, clusters: bool = True) -> StrokeAnalysis:
+    """:func:`analyse`; with ``clusters`` false only its ``breaks`` are meant (:func:`breaks`): a movement too short
+    for two strokes is not analysed, and the direction clusters are left out (-1) where there is no speed dip."""
     from scipy.signal import savgol_filter
 
-    c = criteria
     window = held(window)
     n = len(window)
     empty = np.zeros(max(0, n - 1))
-    if n < 4:
+    shortest = max(1, int(round(c.min_stroke * fps)))
+    if n < 4 or (not clusters and n < 2 * shortest):  # no piece could be kept on both sides of a break
         return StrokeAnalysis(np.asarray(window, dtype=float), empty, np.full(len(empty), -1), [], [], [])
     smooth = int(round(c.smooth * fps)) | 1
     if smooth >= 5 and n > smooth:
@@ -274,15 +284,14 @@ def analyse(window: np.ndarray, fps: float, criteria: StrokeCriteria = StrokeCri
     by_speed = sorted((minima[(lowest < c.drop * side) & (side > c.rest_speed)] + 1).tolist())
     cuts = set(by_speed)
     by_direction: list[int] = []
-    units = _units(vectors)
-    labels = np.full(len(units), -1)
-    if moving.any():
-        labels[moving] = direction_clusters(units[moving], c.angle)
+    labels = np.full(len(vectors), -1)
+    k = max(2, int(round(0.1 * fps)))
+    dips = minima[(lowest < c.corner * side) & (side > c.rest_speed)] + 1
+    if moving.any() and (clusters or dips.size):
+        labels[moving] = direction_clusters(_units(vectors[moving]), c.angle)
         # slow vectors take the cluster of the one before (none before the first moving one: -1)
         last = np.maximum.accumulate(np.where(moving, np.arange(len(labels)), -1))
         labels = np.where(last >= 0, labels[np.maximum(last, 0)], -1)
-        k = max(2, int(round(0.1 * fps)))
-        dips = minima[(lowest < c.corner * side) & (side > c.rest_speed)] + 1
         changes = np.flatnonzero(labels[1:] != labels[:-1]) + 1  # direction_breaks(labels)
         if changes.size and dips.size:
             # a cluster change inside one stroke is no break: the direction must turn sharply there, at a dip
@@ -302,7 +311,6 @@ def analyse(window: np.ndarray, fps: float, criteria: StrokeCriteria = StrokeCri
                 nearest = np.where(distance <= k, distance, k + 1).argmin(axis=1)
                 by_direction.extend(dips[nearest[sharp]].tolist())
     cuts.update(by_direction)
-    shortest = max(1, int(round(c.min_stroke * fps)))
     kept: list[int] = []
     for cut in sorted(cuts):
         if cut - (kept[-1] if kept else 0) >= shortest and n - cut >= shortest:

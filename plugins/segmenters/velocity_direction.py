@@ -68,7 +68,7 @@ from typing import Any
 import numpy as np
 
 from plugins.lib.body_size import body_scale
-from plugins.lib.strokes import StrokeAnalysis, StrokeCriteria, analyse
+from plugins.lib.strokes import StrokeAnalysis, StrokeCriteria, analyse, breaks
 from toolkit import ConfigError, Parameter, Segment, Segmenter, hookimpl
 
 __all__ = ["VelocityDirection"]
@@ -355,7 +355,7 @@ class VelocityDirection(Segmenter):
         self._last, self._analysis, self._done = (start, end, window), None, end
         if self.params["level"] == "movement":
             return [Segment(start, end, self._fps)]
-        cuts = self.analyse(window).breaks
+        cuts = breaks(window, self._fps, self.criteria)  # analyse(window).breaks (inspect() analyses it in full)
         edges = [0, *cuts, end - start]
         return [Segment(start + a, start + b, self._fps) for a, b in zip(edges, edges[1:]) if b > a]
 
