@@ -13,8 +13,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from plugins.lib.strokes import (StrokeAnalysis, StrokeCriteria, _centres, _cluster_means, _unit, analyse, breaks,
-                                 direction_breaks, direction_clusters, held, speed_breaks)
+from plugins.lib.strokes import (StrokeAnalysis, StrokeCriteria, _centres, _cluster_means, _smoothed, _unit, analyse,
+                                 breaks, direction_breaks, direction_clusters, held, speed_breaks)
 
 values = st.floats(-10.0, 10.0, allow_nan=False, allow_infinity=False)
 
@@ -227,3 +227,16 @@ def test_breaks_alone_are_the_analysis_breaks(window, fps, criteria):
     """:func:`breaks` leaves out what cannot change them (a movement too short for two strokes, the clustering where
     no speed dip could accompany a direction break): the same breaks as the whole analysis."""
     assert breaks(window, fps, criteria) == reference_analyse(window, fps, criteria).breaks
+
+
+@given(st.sampled_from([5, 7, 9, 13, 25]), st.integers(1, 60), st.integers(1, 8), st.integers(0, 2**32 - 1),
+       st.sampled_from([1e-3, 1.0, 100.0]))
+@settings(max_examples=200, deadline=None)
+def test_smoothing_is_savgol_filter(length, extra, parts, seed, size):
+    """The working memory's smoothing (the filter's coefficients and the ends' least-squares fits prepared once per
+    window length) is scipy's savgol_filter in interp mode, bit for bit."""
+    from scipy.signal import savgol_filter
+
+    rng = np.random.default_rng(seed)
+    window = np.cumsum(rng.normal(size=(length + extra, 3 * parts)), axis=0) * size
+    np.testing.assert_array_equal(_smoothed(window, length), savgol_filter(window, length, 2, axis=0, mode="interp"))

@@ -21,6 +21,7 @@ joint angles scaled to metres (``angle_scale``), so one rest speed and one direc
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -221,6 +222,54 @@ def _allclose(a: np.ndarray, b: np.ndarray) -> bool:
     return bool((abs(a - b) <= 1e-08 + 1e-05 * abs(b)).all())
 
 
+def _smoothed(window: np.ndarray, length: int) -> np.ndarray:
+    """``scipy.signal.savgol_filter(window, length, 2, axis=0, mode="interp")`` of a finite window (N, D), N > length:
+    the same steps with what depends on ``length`` and D only computed once (:func:`_savgol_plan`): the filter's
+    coefficients convolved over the window, and at each end a quadratic fitted to the ``length`` end rows (the
+    scaled Vandermonde matrix, LAPACK's gelsd with the workspace scipy.linalg.lstsq asks for) and evaluated by
+    Horner's rule. ``tests/test_strokes_clusters.py`` holds it to savgol_filter bit for bit."""
+    from scipy.ndimage import convolve1d
+
+    coeffs, lhs, scale, gelsd, lwork, iwork, rcond, at = _savgol_plan(length, window.shape[1])
+    n, half = len(window), length // 2
+    y = convolve1d(window, coeffs, axis=0, mode="constant")
+    for start, rows in ((0, slice(0, half)), (n - length, slice(n - half, n))):
+        fit, _, _, info = gelsd(lhs, window[start : start + length], lwork, iwork, rcond, False, False)
+        if info != 0:  # as scipy.linalg.lstsq would say
+            from scipy.signal import savgol_filter
+
+            return savgol_filter(window, length, 2, axis=0, mode="interp")
+        p = (fit[:3].T / scale).T
+        values = np.zeros_like(at[start > 0])
+        for j in range(3):
+            values = values * at[start > 0] + p[j, ...]
+        y[rows] = values / 1.0
+    return y
+
+
+@functools.lru_cache(maxsize=16)
+def _savgol_plan(length: int, width: int) -> tuple:
+    """What :func:`_smoothed` needs for windows ``length`` long of ``width`` columns, as savgol_filter computes it."""
+    from scipy.linalg import get_lapack_funcs
+    from scipy.signal import savgol_coeffs
+
+    coeffs = savgol_coeffs(length, 2)
+    x = np.arange(0, length, dtype=np.float64)
+    rcond = length * np.finfo(np.float64).eps
+    powers = np.flip(np.arange(3, dtype=np.float64))
+    lhs = x[:, None] ** powers[None, :]
+    scale = np.sqrt(np.sum(lhs * lhs, axis=0))
+    lhs /= scale
+    gelsd, gelsd_lwork = get_lapack_funcs(("gelsd", "gelsd_lwork"), (lhs, np.zeros((length, width))))
+    work, iwork, info = gelsd_lwork(length, 3, width, rcond)
+    half = length // 2
+    at = (np.arange(0, half, dtype=np.float64).reshape(-1, 1),  # the rows each end's fit gives, from its first
+          np.arange(length - half, length, dtype=np.float64).reshape(-1, 1))
+    for a in (coeffs, lhs, scale, *at):
+        a.flags.writeable = False
+    return coeffs, lhs, scale, gelsd, int(work.real), int(iwork.real), rcond, at
+
+
 def held(window: np.ndarray) -> np.ndarray:
     """``window`` (N, D) with its non-finite values (a part hidden and not held, or not seen yet) as not visible:
     each column holds its last finite value, takes its first finite value before that (a part not seen yet does not
@@ -276,7 +325,7 @@ def _analyse(window: np.ndarray, fps: float, c: StrokeCriteria, clusters: bool =
         return StrokeAnalysis(np.asarray(window, dtype=float), empty, np.full(len(empty), -1), [], [], [])
     smooth = int(round(c.smooth * fps)) | 1
     if smooth >= 5 and n > smooth:
-        window = savgol_filter(window, smooth, 2, axis=0, mode="interp")
+        window = _smoothed(window, smooth)
     vectors = np.diff(window, axis=0)
     speed = np.linalg.norm(vectors.reshape(len(vectors), -1, 3), axis=2).max(axis=1) * fps
     moving = speed > c.rest_speed
