@@ -13,8 +13,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from plugins.lib.strokes import (StrokeAnalysis, StrokeCriteria, _centres, _cluster_means, _smoothed, _unit, analyse,
-                                 breaks, direction_breaks, direction_clusters, held, speed_breaks)
+from plugins.lib.strokes import (StrokeAnalysis, StrokeCriteria, _centres, _cluster_means, _dots, _smoothed, _unit,
+                                 analyse, breaks, direction_breaks, direction_clusters, held, speed_breaks)
 
 values = st.floats(-10.0, 10.0, allow_nan=False, allow_infinity=False)
 
@@ -240,3 +240,14 @@ def test_smoothing_is_savgol_filter(length, extra, parts, seed, size):
     rng = np.random.default_rng(seed)
     window = np.cumsum(rng.normal(size=(length + extra, 3 * parts)), axis=0) * size
     np.testing.assert_array_equal(_smoothed(window, length), savgol_filter(window, length, 2, axis=0, mode="interp"))
+
+
+@given(arrays(np.float64, st.tuples(st.integers(1, 60), st.integers(1, 80)),
+              elements=st.floats(-1e6, 1e6, allow_nan=False, allow_infinity=False)), st.integers(0, 2**32 - 1))
+@settings(max_examples=300, deadline=None)
+def test_row_dot_products_at_once_are_each_rows_dot(a, seed):
+    """:func:`_dots` (one stacked matmul) gives each row's own ``dot``, bit for bit (the norms and turn angles of
+    the analysis rest on it)."""
+    b = np.random.default_rng(seed).normal(size=a.shape) * 10.0 ** np.random.default_rng(seed).uniform(-3, 3)
+    np.testing.assert_array_equal(_dots(a, b), np.array([u.dot(v) for u, v in zip(a, b)]))
+    np.testing.assert_array_equal(_dots(a, a), np.array([u.dot(u) for u in a]))

@@ -199,7 +199,7 @@ def _centres(vectors: np.ndarray, labels: np.ndarray, means: np.ndarray) -> np.n
     centre = padded.sum(axis=0)
     full = bool(counts.all())
     centre /= counts[:, None] if full else np.maximum(counts, 1)[:, None]
-    norm = np.sqrt(np.array([c.dot(c) for c in centre]))
+    norm = np.sqrt(_dots(centre, centre))
     long = norm > 1e-12
     if full and long.all():
         return centre / norm[:, None]
@@ -212,9 +212,16 @@ def _units(vectors: np.ndarray) -> np.ndarray:
     square root of its dot product with itself, taken here row by row, and the rows divided at once."""
     if not len(vectors):
         return np.array([_unit(v) for v in vectors])
-    n = np.sqrt(np.array([v.dot(v) for v in vectors]))
+    n = np.sqrt(_dots(vectors, vectors))
     long = n > 1e-12
     return np.where(long[:, None], vectors / np.where(long, n, 1.0)[:, None], vectors)
+
+
+def _dots(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``[u.dot(v) for u, v in zip(a, b)]`` of two (N, D) arrays as one array: a stack of (1, D) @ (D, 1) products,
+    which numpy's matmul hands to the same BLAS dot product a vector's ``dot`` calls (``np.linalg.norm`` of a vector
+    too), so the same bits (``tests/test_strokes_clusters.py``); not ``einsum``, which sums in another order."""
+    return np.matmul(a[:, None, :], b[:, :, None])[:, 0, 0]
 
 
 def _allclose(a: np.ndarray, b: np.ndarray) -> bool:
@@ -355,7 +362,7 @@ def _analyse(window: np.ndarray, fps: float, c: StrokeCriteria, clusters: bool =
                 rows = np.where((rows >= 0) & (rows < len(vectors)), rows, len(vectors))
                 sums = np.append(vectors, np.full((1, vectors.shape[1]), -0.0), axis=0)[rows]
                 before, after = _units(sums[:, :k].sum(axis=1)), _units(sums[:, k:].sum(axis=1))
-                cos = np.array([u.dot(v) for u, v in zip(before, after)])
+                cos = _dots(before, after)
                 sharp = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))) >= 0.5 * c.angle
                 nearest = np.where(distance <= k, distance, k + 1).argmin(axis=1)
                 by_direction.extend(dips[nearest[sharp]].tolist())
