@@ -123,7 +123,7 @@ def direction_clusters(vectors: np.ndarray, angle: float, max_clusters: int = 12
         for _ in range(10):  # redistribute and re-average until stable
             sims = vectors @ means.T
             again = sims.argmax(axis=1)
-            if labels is not None and (again == labels).all():
+            if labels is not None and _and(again == labels, axis=None):
                 break  # the same clusters: the same means again
             labels = again
             new = _centres(vectors, labels, means)
@@ -194,14 +194,15 @@ def _centres(vectors: np.ndarray, labels: np.ndarray, means: np.ndarray) -> np.n
     k, d = means.shape
     run = (labels[:, None] == np.arange(k)).cumsum(axis=0)  # rows of each cluster so far
     counts = run[-1]
-    padded = np.full((int(counts.max()), k, d), -0.0)
+    padded = np.empty((int(counts.max()), k, d))
+    padded.fill(-0.0)
     padded[run[np.arange(len(labels)), labels] - 1, labels] = vectors
-    centre = padded.sum(axis=0)
-    full = bool(counts.all())
+    centre = np.add.reduce(padded, axis=0)
+    full = bool(_and(counts, axis=None))
     centre /= counts[:, None] if full else np.maximum(counts, 1)[:, None]
     norm = np.sqrt(_dots(centre, centre))
     long = norm > 1e-12
-    if full and long.all():
+    if full and _and(long, axis=None):
         return centre / norm[:, None]
     centre = np.where(long[:, None], centre / np.where(long, norm, 1.0)[:, None], centre)
     return centre if full else np.where((counts > 0)[:, None], centre, means)
@@ -224,9 +225,12 @@ def _dots(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.matmul(a[:, None, :], b[:, :, None])[:, 0, 0]
 
 
+_and = np.logical_and.reduce  # _and(x, axis=None) is x.all(), without ndarray.all's Python wrapper
+
+
 def _allclose(a: np.ndarray, b: np.ndarray) -> bool:
     """``np.allclose(a, b)`` of finite or NaN values (its default tolerances), without its generality's cost."""
-    return bool((abs(a - b) <= 1e-08 + 1e-05 * abs(b)).all())
+    return bool(_and(abs(a - b) <= 1e-08 + 1e-05 * abs(b), axis=None))
 
 
 def _smoothed(window: np.ndarray, length: int) -> np.ndarray:
