@@ -268,3 +268,48 @@ def test_a_movement_after_one_closed_at_max_movement_begins_after_it(level, movi
     assert len(got) >= 3
     assert all(a.end <= b.start for a, b in zip(got, got[1:])), [(s.start, s.end) for s in got]
     assert got[-1].end > len(poses) - 25  # the second motion is still found
+
+
+@given(runs=st.lists(st.tuples(st.sampled_from([0.0, 0.02, 0.07, 0.09, 0.2, 0.6, np.nan]), st.integers(1, 15)),
+                    min_size=1, max_size=30),
+       cuts=st.lists(st.integers(1, 50), max_size=8),
+       params=st.fixed_dictionaries({}, optional={"max_movement": st.sampled_from([0.0, 0.05, 0.1, 0.3, 1.0]),
+                                                  "memory": st.sampled_from([0.0, 0.05, 0.1, 0.2]),
+                                                  "level": st.sampled_from(["stroke", "movement"]),
+                                                  "rest_speed": st.sampled_from([0.05, 0.08, 0.1])}))
+@settings(max_examples=300, deadline=None)
+def test_a_block_followed_at_once_is_its_frames_stepped_one_by_one(runs, cuts, params):
+    """With a fixed rest speed (the default) push_block finds onsets, ends and max_movement cuts from the block's
+    arrays (issue 22): the same segments at the same frames, the same onsets and the same last working memory as
+    push frame by frame, whatever the packet sizes; frames with no speed (the wrist not seen: NaN) included."""
+    speed = np.repeat([v for v, _ in runs], [k for _, k in runs])  # runs of a speed (m/s)
+    poses = np.zeros((len(speed), 2, 3))
+    poses[:, 1, 0] = np.cumsum(np.nan_to_num(speed)) / FPS
+    poses[:, 1, 1] = np.sin(np.arange(len(speed)) / 3.0) * 0.02  # turns: direction breaks in stroke level
+    poses[np.isnan(speed), 1] = np.nan
+    visible = np.isfinite(poses).all(axis=2)
+    one = VelocityDirection(**params)
+    one.reset(["root", "wrist"], FPS)
+    expected, onsets = [], []
+    for f in range(len(poses)):
+        expected.extend((f, s) for s in one.push(poses[f], visible[f]))
+        onsets.append(-1 if one.active_since is None else one.active_since)
+    blocks = VelocityDirection(**params)
+    blocks.reset(["root", "wrist"], FPS)
+    got, since, at = [], [], 0
+    for n in [*cuts, len(poses)]:
+        closed, block_since = blocks.push_block(poses[at : at + n], visible[at : at + n])
+        got.extend((at + i, s) for i, s in closed)
+        since.extend(block_since.tolist())
+        at += n
+        if at >= len(poses):
+            break
+    assert got == expected
+    assert since == onsets
+    assert (blocks._moving, blocks._resting, blocks._frame) == (one._moving, one._resting, one._frame)
+    mine, theirs = blocks.inspect(), one.inspect()
+    assert mine.keys() == theirs.keys()
+    if mine:
+        assert mine["movement"] == theirs["movement"]
+        np.testing.assert_array_equal(mine["analysis"].window, theirs["analysis"].window)
+    assert blocks.flush() == one.flush()

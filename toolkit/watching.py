@@ -477,7 +477,14 @@ class WatchingLoop:
         closed, since = self._checked_block(result, n, first)
         out: list[Observation] = []
         k, onsets = 0, since.tolist()
-        for i in range(n):
+        matcher = self.character.matcher
+        frames: Sequence[int] = range(n)
+        if self._max_frames is None and (matcher is None or not matcher.streaming):
+            # nothing is fed frame by frame and nothing is cut: a frame where no segment closes only sets the onset
+            # of the segment under way, which the next such frame sets again. The frames that close segments and
+            # the last frame leave the same state, the same observations in the same order.
+            frames = sorted({i for i, _ in closed} | {n - 1})
+        for i in frames:
             if k < len(closed) and closed[k][0] == i:  # segments closed at this frame
                 here = []
                 while k < len(closed) and closed[k][0] == i:

@@ -21,6 +21,7 @@ joint angles scaled to metres (``angle_scale``), so one rest speed and one direc
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -56,59 +57,82 @@ def speed_breaks(speed: np.ndarray, drop: float, moving: float = 0.0) -> list[in
     starts or ends at full speed still brackets its minima; both sides must rise above ``moving``, so a dip
     between two flickers of noise at rest separates no strokes.
     """
+    minima, lowest, side = _minima(np.asarray(speed, dtype=float), moving)
+    return minima[(lowest < drop * side) & (side > moving)].tolist()
+
+
+def _minima(speed: np.ndarray, moving: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The holds of :func:`speed_breaks` (whatever the share): each hold's middle, its lowest speed and the smaller
+    of its sides' highest speeds, as arrays (one element a hold). A minimum only compares speeds and takes maxima,
+    so it is computed for every sample at once with the same values as sample by sample."""
     # Written out, not scipy.signal.find_peaks: K&G §4.3's criterion is a share of the neighbouring maxima (a ratio,
     # where find_peaks's prominence is a difference to the lower base of higher peaks) and a hold joins minima with
     # nothing faster than the rest speed between them, which no find_peaks option (plateau, distance, wlen) expresses.
-    from scipy.signal import argrelextrema
-
-    speed = np.asarray(speed, dtype=float)
     n = len(speed)
-    if n < 3:
-        return []
-    low = argrelextrema(speed, np.less_equal, order=2)[0]
-    low = low[(low >= 2) & (low <= n - 3)]  # two samples on each side, inside the movement
+    none = np.zeros(0, dtype=int), np.zeros(0), np.zeros(0)
+    if n < 5:
+        return none
+    # scipy.signal.argrelextrema(speed, np.less_equal, order=2), two samples on each side inside the movement
+    middle = speed[2 : n - 2]
+    low = np.flatnonzero((middle <= speed[1 : n - 3]) & (middle <= speed[: n - 4]) & (middle <= speed[3 : n - 1])
+                         & (middle <= speed[4:])) + 2
     if not len(low):
-        return []
-    holds = [[int(low[0])]]
-    for m in low[1:]:
-        previous = holds[-1][-1]
-        if m == previous + 1 or speed[previous : m + 1].max() <= moving:
-            holds[-1].append(int(m))
-        else:
-            holds.append([int(m)])
-    minima = [(h[0] + h[-1]) // 2 for h in holds]
-    bounds = [0, *(h[-1] for h in holds[:-1])], [*(h[0] for h in holds[1:]), n - 1]  # the neighbouring holds
-    out = []
-    for i, (m, hold) in enumerate(zip(minima, holds)):
-        left, right = speed[bounds[0][i] : hold[0] + 1].max(), speed[hold[-1] : bounds[1][i] + 1].max()
-        side = min(left, right)
-        if speed[hold].min() < drop * side and side > moving:
-            out.append(m)
-    return out
+        return none
+    padded = np.append(speed, -np.inf)  # a range may end at the last sample
+    # a minimum joins the hold before it when next to its last minimum or with nothing faster than `moving` between
+    joined = np.zeros(0, dtype=bool)
+    if len(low) > 1:
+        between = np.maximum.reduceat(padded, np.stack([low[:-1], low[1:] + 1], axis=1).ravel())[::2]
+        joined = (low[1:] == low[:-1] + 1) | (between <= moving)
+    first = np.flatnonzero(np.concatenate([[True], ~joined]))  # the first minimum of each hold (index into low)
+    last = np.append(first[1:] - 1, len(low) - 1)
+    minima = (low[first] + low[last]) // 2
+    left = np.append(0, low[last[:-1]])  # a side reaches to the neighbouring hold or to the end of the movement
+    right = np.append(low[first[1:]], n - 1)
+    highest = np.maximum.reduceat(padded, np.stack([left, low[first] + 1, low[last], right + 1], axis=1).ravel())
+    lowest = np.minimum.reduceat(speed[low], first)
+    return minima, lowest, np.minimum(highest[0::4], highest[2::4])
 
 
 def direction_clusters(vectors: np.ndarray, angle: float, max_clusters: int = 12) -> np.ndarray:
-    """Divisive clustering of unit movement vectors (N, D); returns a cluster label per vector."""
+    """Divisive clustering of unit movement vectors (N, D); returns a cluster label per vector.
+
+    One cluster around the mean direction; while the vector least like its nearest mean is more than ``angle``
+    degrees from it (and there are fewer than ``max_clusters``), it founds a new cluster and the vectors are
+    redistributed to the nearest mean and the means re-averaged (:func:`_centres`) until they stay put (at most ten
+    rounds). The means are one array (k, D); each similarity matrix ``vectors @ means.T`` is computed once for the
+    means it belongs to, and a round whose labels are those of the round before ends the re-averaging at once (its
+    means would be the same values, which the formula's test then finds close). The same labels as the formula
+    written out cluster by cluster (``tests/test_strokes_clusters.py`` holds it to that formula).
+    """
     n = len(vectors)
     if n == 0:
         return np.zeros(0, dtype=int)
     cos_limit = np.cos(np.radians(angle))
-    means = [_unit(vectors.mean(axis=0))]
+    means = _unit(vectors.mean(axis=0))[None, :]
+    sims = vectors @ means.T  # always the similarities to the current means
+    rows = np.arange(n)
     for _ in range(4 * max_clusters):
-        sims = vectors @ np.array(means).T
-        labels = np.argmax(sims, axis=1)
-        best = sims[np.arange(n), labels]
-        worst = int(np.argmin(best))
+        labels = sims.argmax(axis=1)
+        best = sims[rows, labels]
+        worst = int(best.argmin())
         if best[worst] >= cos_limit or len(means) >= max_clusters:
             break
-        means.append(vectors[worst].copy())  # a new cluster around the most different element
+        means = np.concatenate([means, vectors[worst][None, :]])  # a new cluster around the most different element
+        labels = None
         for _ in range(10):  # redistribute and re-average until stable
-            labels = np.argmax(vectors @ np.array(means).T, axis=1)
-            new = _cluster_means(vectors, labels, means)
-            if _allclose(np.array(new), np.array(means)):
+            sims = vectors @ means.T
+            again = sims.argmax(axis=1)
+            if labels is not None and _and(again == labels, axis=None):
+                break  # the same clusters: the same means again
+            labels = again
+            new = _centres(vectors, labels, means)
+            if _allclose(new, means):
                 break
             means = new
-    return np.argmax(vectors @ np.array(means).T, axis=1)
+        else:
+            sims = vectors @ means.T
+    return sims.argmax(axis=1)
 
 
 def direction_breaks(labels: np.ndarray) -> list[int]:
@@ -134,7 +158,7 @@ class StrokeAnalysis:
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
-    n = np.linalg.norm(v)
+    n = np.sqrt(v.dot(v))  # np.linalg.norm(v) of a vector, without its generality's cost
     return v / n if n > 1e-12 else v
 
 
@@ -158,19 +182,103 @@ def _cluster_means(vectors: np.ndarray, labels: np.ndarray, means: list[np.ndarr
     return new
 
 
+def _centres(vectors: np.ndarray, labels: np.ndarray, means: np.ndarray) -> np.ndarray:
+    """Each cluster's mean direction (k, D) as one array: the values of :func:`_cluster_means` (a cluster's rows
+    summed in their order, divided by their count, divided by the square root of the mean's dot product with itself;
+    its old mean ``means[k]`` if it has no vector).
+
+    The rows are laid out per cluster in a (longest, k, D) array padded with -0.0, which leaves any sum as it is
+    (x + -0.0 is x, for x = +0.0 too), and summed along its first axis at once: numpy adds the (k, D) layers one
+    after the other, as it sums one cluster's rows one after the other.
+    """
+    k, d = means.shape
+    run = (labels[:, None] == np.arange(k)).cumsum(axis=0)  # rows of each cluster so far
+    counts = run[-1]
+    padded = np.empty((int(counts.max()), k, d))
+    padded.fill(-0.0)
+    padded[run[np.arange(len(labels)), labels] - 1, labels] = vectors
+    centre = np.add.reduce(padded, axis=0)
+    full = bool(_and(counts, axis=None))
+    centre /= counts[:, None] if full else np.maximum(counts, 1)[:, None]
+    norm = np.sqrt(_dots(centre, centre))
+    long = norm > 1e-12
+    if full and _and(long, axis=None):
+        return centre / norm[:, None]
+    centre = np.where(long[:, None], centre / np.where(long, norm, 1.0)[:, None], centre)
+    return centre if full else np.where((counts > 0)[:, None], centre, means)
+
+
 def _units(vectors: np.ndarray) -> np.ndarray:
     """:func:`_unit` of each row of ``vectors`` (N, D), the same values: ``np.linalg.norm`` of a vector is the
     square root of its dot product with itself, taken here row by row, and the rows divided at once."""
     if not len(vectors):
         return np.array([_unit(v) for v in vectors])
-    n = np.sqrt(np.array([v.dot(v) for v in vectors]))
+    n = np.sqrt(_dots(vectors, vectors))
     long = n > 1e-12
     return np.where(long[:, None], vectors / np.where(long, n, 1.0)[:, None], vectors)
 
 
+def _dots(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``[u.dot(v) for u, v in zip(a, b)]`` of two (N, D) arrays as one array: a stack of (1, D) @ (D, 1) products,
+    which numpy's matmul hands to the same BLAS dot product a vector's ``dot`` calls (``np.linalg.norm`` of a vector
+    too), so the same bits (``tests/test_strokes_clusters.py``); not ``einsum``, which sums in another order."""
+    return np.matmul(a[:, None, :], b[:, :, None])[:, 0, 0]
+
+
+_and = np.logical_and.reduce  # _and(x, axis=None) is x.all(), without ndarray.all's Python wrapper
+
+
 def _allclose(a: np.ndarray, b: np.ndarray) -> bool:
     """``np.allclose(a, b)`` of finite or NaN values (its default tolerances), without its generality's cost."""
-    return bool(np.all(np.abs(a - b) <= 1e-08 + 1e-05 * np.abs(b)))
+    return bool(_and(abs(a - b) <= 1e-08 + 1e-05 * abs(b), axis=None))
+
+
+def _smoothed(window: np.ndarray, length: int) -> np.ndarray:
+    """``scipy.signal.savgol_filter(window, length, 2, axis=0, mode="interp")`` of a finite window (N, D), N > length:
+    the same steps with what depends on ``length`` and D only computed once (:func:`_savgol_plan`): the filter's
+    coefficients convolved over the window, and at each end a quadratic fitted to the ``length`` end rows (the
+    scaled Vandermonde matrix, LAPACK's gelsd with the workspace scipy.linalg.lstsq asks for) and evaluated by
+    Horner's rule. ``tests/test_strokes_clusters.py`` holds it to savgol_filter bit for bit."""
+    from scipy.ndimage import convolve1d
+
+    coeffs, lhs, scale, gelsd, lwork, iwork, rcond, at = _savgol_plan(length, window.shape[1])
+    n, half = len(window), length // 2
+    y = convolve1d(window, coeffs, axis=0, mode="constant")
+    for start, rows in ((0, slice(0, half)), (n - length, slice(n - half, n))):
+        fit, _, _, info = gelsd(lhs, window[start : start + length], lwork, iwork, rcond, False, False)
+        if info != 0:  # as scipy.linalg.lstsq would say
+            from scipy.signal import savgol_filter
+
+            return savgol_filter(window, length, 2, axis=0, mode="interp")
+        p = (fit[:3].T / scale).T
+        values = np.zeros_like(at[start > 0])
+        for j in range(3):
+            values = values * at[start > 0] + p[j, ...]
+        y[rows] = values / 1.0
+    return y
+
+
+@functools.lru_cache(maxsize=16)
+def _savgol_plan(length: int, width: int) -> tuple:
+    """What :func:`_smoothed` needs for windows ``length`` long of ``width`` columns, as savgol_filter computes it."""
+    from scipy.linalg import get_lapack_funcs
+    from scipy.signal import savgol_coeffs
+
+    coeffs = savgol_coeffs(length, 2)
+    x = np.arange(0, length, dtype=np.float64)
+    rcond = length * np.finfo(np.float64).eps
+    powers = np.flip(np.arange(3, dtype=np.float64))
+    lhs = x[:, None] ** powers[None, :]
+    scale = np.sqrt(np.sum(lhs * lhs, axis=0))
+    lhs /= scale
+    gelsd, gelsd_lwork = get_lapack_funcs(("gelsd", "gelsd_lwork"), (lhs, np.zeros((length, width))))
+    work, iwork, info = gelsd_lwork(length, 3, width, rcond)
+    half = length // 2
+    at = (np.arange(0, half, dtype=np.float64).reshape(-1, 1),  # the rows each end's fit gives, from its first
+          np.arange(length - half, length, dtype=np.float64).reshape(-1, 1))
+    for a in (coeffs, lhs, scale, *at):
+        a.flags.writeable = False
+    return coeffs, lhs, scale, gelsd, int(work.real), int(iwork.real), rcond, at
 
 
 def held(window: np.ndarray) -> np.ndarray:
@@ -197,8 +305,12 @@ def held(window: np.ndarray) -> np.ndarray:
 
 
 def breaks(window: np.ndarray, fps: float, criteria: StrokeCriteria = StrokeCriteria()) -> list[int]:
-    """Break points (indices into ``window``, positions (N, 3k) of the chosen parts) by speed and direction."""
-    return analyse(window, fps, criteria).breaks
+    """Break points (indices into ``window``, positions (N, 3k) of the chosen parts) by speed and direction.
+
+    ``analyse(window, fps, criteria).breaks``, without what cannot change them: no analysis of a movement too short
+    for two strokes, and no direction clustering where no speed dip could accompany a direction break.
+    """
+    return _analyse(window, fps, criteria, clusters=False).breaks
 
 
 def analyse(window: np.ndarray, fps: float, criteria: StrokeCriteria = StrokeCriteria()) -> StrokeAnalysis:
@@ -208,42 +320,57 @@ def analyse(window: np.ndarray, fps: float, criteria: StrokeCriteria = StrokeCri
     Speed minima below ``drop`` of their neighbouring maxima cut; direction-cluster changes cut where the
     direction turns sharply at a dip of the speed (see the module). Pieces shorter than ``min_stroke`` merge.
     """
+    return _analyse(window, fps, criteria)
+
+
+def _analyse(window: np.ndarray, fps: float, c: StrokeCriteria, clusters: bool = True) -> StrokeAnalysis:
+    """:func:`analyse`; with ``clusters`` false only its ``breaks`` are meant (:func:`breaks`): a movement too short
+    for two strokes is not analysed, and the direction clusters are left out (-1) where there is no speed dip."""
     from scipy.signal import savgol_filter
 
-    c = criteria
     window = held(window)
     n = len(window)
     empty = np.zeros(max(0, n - 1))
-    if n < 4:
+    shortest = max(1, int(round(c.min_stroke * fps)))
+    if n < 4 or (not clusters and n < 2 * shortest):  # no piece could be kept on both sides of a break
         return StrokeAnalysis(np.asarray(window, dtype=float), empty, np.full(len(empty), -1), [], [], [])
     smooth = int(round(c.smooth * fps)) | 1
     if smooth >= 5 and n > smooth:
-        window = savgol_filter(window, smooth, 2, axis=0, mode="interp")
+        window = _smoothed(window, smooth)
     vectors = np.diff(window, axis=0)
     speed = np.linalg.norm(vectors.reshape(len(vectors), -1, 3), axis=2).max(axis=1) * fps
     moving = speed > c.rest_speed
-    by_speed = sorted(b + 1 for b in speed_breaks(speed, c.drop, c.rest_speed))
+    minima, lowest, side = _minima(speed, c.rest_speed)
+    by_speed = sorted((minima[(lowest < c.drop * side) & (side > c.rest_speed)] + 1).tolist())
     cuts = set(by_speed)
     by_direction: list[int] = []
-    units = _units(vectors)
-    labels = np.full(len(units), -1)
-    if moving.any():
-        labels[moving] = direction_clusters(units[moving], c.angle)
-        for i in range(1, len(labels)):  # slow vectors take the cluster of the one before
-            if labels[i] < 0:
-                labels[i] = labels[i - 1]
-        k = max(2, int(round(0.1 * fps)))
-        dips = np.array(speed_breaks(speed, c.corner, c.rest_speed), dtype=int) + 1
-        for b in direction_breaks(labels):
+    labels = np.full(len(vectors), -1)
+    k = max(2, int(round(0.1 * fps)))
+    dips = minima[(lowest < c.corner * side) & (side > c.rest_speed)] + 1
+    if moving.any() and (clusters or dips.size):
+        labels[moving] = direction_clusters(_units(vectors[moving]), c.angle)
+        # slow vectors take the cluster of the one before (none before the first moving one: -1)
+        last = np.maximum.accumulate(np.where(moving, np.arange(len(labels)), -1))
+        labels = np.where(last >= 0, labels[np.maximum(last, 0)], -1)
+        changes = np.flatnonzero(labels[1:] != labels[:-1]) + 1  # direction_breaks(labels)
+        if changes.size and dips.size:
             # a cluster change inside one stroke is no break: the direction must turn sharply there, at a dip
             # of the speed (a C stroke turns gradually, an S stroke swings its direction at full speed)
-            before, after = _unit(vectors[max(0, b - k) : b].sum(axis=0)), _unit(vectors[b : b + k].sum(axis=0))
-            sharp = np.degrees(np.arccos(np.clip(before @ after, -1.0, 1.0))) >= 0.5 * c.angle
-            near = dips[np.abs(dips - b) <= k]
-            if sharp and near.size:
-                by_direction.append(int(near[np.argmin(np.abs(near - b))]))
+            distance = np.abs(dips[None, :] - changes[:, None])
+            near = (distance <= k).any(axis=1)
+            changes, distance = changes[near], distance[near]
+            if changes.size:
+                # the k vectors before and after each change (-0.0 beyond the movement: no term), summed one after
+                # the other, made unit and compared as each change's own would be
+                rows = changes[:, None] + np.arange(-k, k)
+                rows = np.where((rows >= 0) & (rows < len(vectors)), rows, len(vectors))
+                sums = np.append(vectors, np.full((1, vectors.shape[1]), -0.0), axis=0)[rows]
+                before, after = _units(sums[:, :k].sum(axis=1)), _units(sums[:, k:].sum(axis=1))
+                cos = _dots(before, after)
+                sharp = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))) >= 0.5 * c.angle
+                nearest = np.where(distance <= k, distance, k + 1).argmin(axis=1)
+                by_direction.extend(dips[nearest[sharp]].tolist())
     cuts.update(by_direction)
-    shortest = max(1, int(round(c.min_stroke * fps)))
     kept: list[int] = []
     for cut in sorted(cuts):
         if cut - (kept[-1] if kept else 0) >= shortest and n - cut >= shortest:
