@@ -484,6 +484,7 @@ class ForwardModel(Matcher):
         self.fps = memory.fps
         self.tracks = {}  # in the order the subsystems began to move
         self.reported = False  # a commitment to the tracks decided so far has been announced
+        self._settled = False  # nothing more can happen in this segment (:meth:`_quiet`)
 
     @property
     def main(self) -> Track | None:
@@ -549,6 +550,8 @@ class ForwardModel(Matcher):
     def observe(self, memory: WorkingMemory) -> Match | None:
         if memory is not self._memory:
             self.begin(memory)
+        elif self._settled:  # every subsystem followed, none with a candidate or a commitment: as below, no work
+            return None
         local = self._local()
         self._start_tracks(local)
         if not self.tracks:
@@ -559,6 +562,9 @@ class ForwardModel(Matcher):
         if stop is not None:
             return stop
         tracks = list(self.tracks.values())
+        if self._quiet(tracks):
+            self._settled = True
+            return None
         if self.reported or not all(t.committed is not None and not t.deviated for t in tracks) or self._joining(local):
             return None
         self.reported = True  # every subsystem under consideration has one prevailing command: imitate them at once
@@ -574,6 +580,16 @@ class ForwardModel(Matcher):
                                                     "speed": t.speed, "progress": t.progress} for t in tracks}
         return Match(labels[0] if len(tracks) == 1 else movement, min(t.confidence for t in tracks), memory.n,
                      path=tuple(e for t in tracks for e in t.committed_path), details=details)
+
+    def _quiet(self, tracks: list[Track]) -> bool:
+        """Whether the rest of the segment can change nothing: no subsystem is left to start (:meth:`_start_tracks`
+        starts none: every one is followed, or ``together`` is off) and no track has a candidate or a commitment
+        (:meth:`_follow` returns at once). Every later frame would then return ``None`` without a change but the rows
+        :meth:`_local` places, which it places when next called (each row by the same addition, alone or in a
+        batch: the same values); :meth:`observe` skips them."""
+        if self.params["together"] and len(self.tracks) < len(self.motor.subsystems):
+            return False
+        return all(t.committed is None and not t.candidates for t in tracks)
 
     def _start_tracks(self, memory: np.ndarray) -> None:
         """Follow every subsystem not yet followed that has moved more than ``min_move`` since the onset.
