@@ -461,6 +461,7 @@ class ForwardModel(Matcher):
         self._edges: dict[str, _EdgeTable] = {}
         self._half_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
         self._stroke_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
+        self._lead_sets: dict[tuple[str, ...], tuple[list, np.ndarray]] = {}
         self._placed: OrderedDict[tuple[tuple[str, ...], bytes], tuple[tuple, np.ndarray]] = OrderedDict()
         self._memory: WorkingMemory | None = None
         self._rows: _Grown | None = None  # the working memory in the motor frame, row by row
@@ -934,15 +935,47 @@ class ForwardModel(Matcher):
         ``lengths`` holds the observed path length of each part of the subsystem, ``n`` the frames observed
         (:meth:`_clock`; ``None``: as many as the path lengths say).
         """
+        paths = list(track.candidates)
+        if (n is None or self.params["reparameterise"]) and not track.hand and len(paths) > 1 and \
+                all(len(path) == 1 for path in paths):
+            # one-command paths (the common case) at once, from the strokes stacked for _errors (the same values:
+            # each is the observed length plus the anchor of the lead part, against the lead's stroke length)
+            names = tuple(path[0] for path in paths)
+            _, _, totals, anchors, _ = self._stacked(track, names)
+            leads = self._leads(names)
+            rows = np.arange(len(names))
+            passed = lengths[leads] + anchors[rows, leads] > totals[rows, leads] + 0.01 / track.scale
+            if not passed.any():
+                return paths
+            out = []
+            for path, past in zip(paths, passed.tolist()):
+                out.extend(self._next(track, path) if past else [path])
+            return out
         out = []
-        for path in track.candidates:
+        for path in paths:
             lead = self._lead(path[0])
             seen = self._along(track, path[0], lengths if n is None else self._clock(track, path, lengths, n))[lead]
             total = sum(self._edge(e).arcs[lead, -1] for e in path)
-            end = self.motor.edge(path[-1]).target
-            nxt = [edge.name for edge in self.motor.edges_from(track.subsystem, end)] if seen > total + 0.01 / track.scale else []
-            out.extend([(*path, e) for e in nxt if e not in path and e not in track.excluded] or [path])
+            out.extend(self._next(track, path) if seen > total + 0.01 / track.scale else [path])
         return out
+
+    def _next(self, track: Track, path: tuple[str, ...]) -> list[tuple[str, ...]]:
+        """A path whose commands have all been covered, continued along each edge of its end node that it does not
+        hold and that is not excluded (itself when there is none)."""
+        end = self.motor.edge(path[-1]).target
+        nxt = [edge.name for edge in self.motor.edges_from(track.subsystem, end)]
+        return [(*path, e) for e in nxt if e not in path and e not in track.excluded] or [path]
+
+    def _leads(self, names: tuple[str, ...]) -> np.ndarray:
+        """The lead part (:meth:`_lead`) of each command of ``names``, as an array (kept per set of commands while
+        their tables are the same)."""
+        tables = [self._edge(name) for name in names]
+        kept = self._lead_sets.get(names)
+        if kept is None or not all(a is b for a, b in zip(kept[0], tables)):
+            kept = self._lead_sets[names] = (tables, np.array([t.lead for t in tables]))
+            if len(self._lead_sets) > 64:
+                del self._lead_sets[next(iter(self._lead_sets))]
+        return kept[1]
 
     def _path_label(self, path: tuple[str, ...]) -> str | None:
         """The labelled movement (clip repertoires) every sequence along ``path`` is an example of, else ``None``."""
