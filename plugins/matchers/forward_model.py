@@ -257,10 +257,34 @@ class _EdgeTable:
     lead: int
 
 
-def _along_rows(arcs: np.ndarray, positions: np.ndarray, x: np.ndarray) -> np.ndarray:
+def _row_keys(arcs: np.ndarray) -> np.ndarray | None:
+    """``arcs`` (R, G) as one sorted complex array for :func:`_along_rows`: row r's values are ``r + 1j * arcs[r]``,
+    and numpy orders complex numbers lexicographically (real part, then imaginary), so one ``searchsorted`` counts,
+    for every row at once, the points of its own row at most a given length. ``None`` when a row does not grow
+    (NaN, or a decrease): then the count is taken by comparing every point."""
+    if not arcs.size or not bool((arcs[:, 1:] >= arcs[:, :-1]).all()):
+        return None
+    keys = np.empty(arcs.shape, dtype=complex)
+    keys.real = np.arange(len(arcs))[:, None]
+    keys.imag = arcs
+    return keys.ravel()
+
+
+def _along_rows(arcs: np.ndarray, positions: np.ndarray, x: np.ndarray, keys: np.ndarray | None = None) -> np.ndarray:
     """Per row r, the point of ``positions[r]`` (G, 3) at path length ``x[r]`` along ``arcs[r]`` (G,), linearly
-    interpolated (``np.interp`` row by row); 0 <= x[r] <= arcs[r, -1]."""
-    j = np.clip((arcs <= x[:, None]).sum(axis=1) - 1, 0, arcs.shape[1] - 2)
+    interpolated (``np.interp`` row by row); 0 <= x[r] <= arcs[r, -1].
+
+    ``keys`` (:func:`_row_keys` of ``arcs``): the points at most ``x[r]`` along each row counted by one binary search
+    instead of a comparison of every point (the same count: exact comparisons of the same numbers)."""
+    if keys is None:
+        count = (arcs <= x[:, None]).sum(axis=1)
+    else:
+        rows = np.arange(len(x))
+        query = np.empty(len(x), dtype=complex)
+        query.real, query.imag = rows, x
+        count = np.searchsorted(keys, query, side="right") - rows * arcs.shape[1]
+        count[np.isnan(x)] = 0  # a NaN length is at most no point
+    j = np.clip(count - 1, 0, arcs.shape[1] - 2)
     rows = np.arange(len(x))
     a0, a1 = arcs[rows, j], arcs[rows, j + 1]
     step = a1 - a0
@@ -941,7 +965,7 @@ class ForwardModel(Matcher):
             # one-command paths (the common case) at once, from the strokes stacked for _errors (the same values:
             # each is the observed length plus the anchor of the lead part, against the lead's stroke length)
             names = tuple(path[0] for path in paths)
-            _, _, totals, anchors, _ = self._stacked(track, names)
+            _, _, totals, _, anchors, _ = self._stacked(track, names)
             leads = self._leads(names)
             rows = np.arange(len(names))
             passed = lengths[leads] + anchors[rows, leads] > totals[rows, leads] + 0.01 / track.scale
@@ -1051,10 +1075,10 @@ class ForwardModel(Matcher):
         batch = [] if track.hand else [path for path in paths if len(path) == 1]
         errors: dict[tuple[str, ...], float] = {}
         if len(batch) > 1:
-            arcs, positions, totals, anchors, offsets = self._stacked(track, tuple(path[0] for path in batch))
+            arcs, positions, totals, keys, anchors, offsets = self._stacked(track, tuple(path[0] for path in batch))
             k = len(lengths)
             along = np.minimum(lengths + anchors, totals).reshape(-1)  # (C * k,): _along, then _predict's minimum
-            predicted = _along_rows(arcs, positions, along).reshape(len(batch), k, 3) + offsets
+            predicted = _along_rows(arcs, positions, along, keys).reshape(len(batch), k, 3) + offsets
             d = np.linalg.norm(predicted - last, axis=-1) * track.scale
             combined = d.max(axis=1) if self.params["error"] == "max" else d.mean(axis=1)
             errors = dict(zip(batch, combined.tolist()))
@@ -1062,7 +1086,7 @@ class ForwardModel(Matcher):
 
     def _stacked(self, track: Track, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
         """For commands ``names`` followed by ``track``: their strokes' cumulative lengths (C * k, G) and positions
-        (C * k, G, 3), stroke lengths (C, k), anchors (C, k) and onset offsets (C, k, 3; 0.0 without ``relative``), stacked once per set of
+        (C * k, G, 3), stroke lengths (C, k), the lengths' search keys (:func:`_row_keys`), anchors (C, k) and onset offsets (C, k, 3; 0.0 without ``relative``), stacked once per set of
         candidates (kept until the set changes; the strokes for the last sets of candidates of any track)."""
         kept = self._tracked.get(track.subsystem)
         cache = getattr(kept, "stacked", None) if kept is not None and kept.track is track else None
@@ -1071,8 +1095,9 @@ class ForwardModel(Matcher):
         edges = [self._edge(name) for name in names]
         strokes = self._stroke_tables.get(names)
         if strokes is None or not all(a is b for a, b in zip(strokes[0], edges)):
-            strokes = (edges, (np.concatenate([e.arcs for e in edges]), np.concatenate([e.positions for e in edges]),
-                               np.stack([e.arcs[:, -1] for e in edges])))
+            arcs = np.concatenate([e.arcs for e in edges])
+            strokes = (edges, (arcs, np.concatenate([e.positions for e in edges]),
+                               np.stack([e.arcs[:, -1] for e in edges]), _row_keys(arcs)))
             self._stroke_tables[names] = strokes
             if len(self._stroke_tables) > 32:
                 self._stroke_tables.popitem(last=False)
