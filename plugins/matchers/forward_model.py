@@ -962,25 +962,30 @@ class ForwardModel(Matcher):
         paths = list(track.candidates)
         if (n is None or self.params["reparameterise"]) and not track.hand and len(paths) > 1 and \
                 all(len(path) == 1 for path in paths):
-            # one-command paths (the common case) at once, from the strokes stacked for _errors (the same values:
-            # each is the observed length plus the anchor of the lead part, against the lead's stroke length)
-            names = tuple(path[0] for path in paths)
-            _, _, totals, _, anchors, _ = self._stacked(track, names)
-            leads = self._leads(names)
-            rows = np.arange(len(names))
-            passed = lengths[leads] + anchors[rows, leads] > totals[rows, leads] + 0.01 / track.scale
-            if not passed.any():
-                return paths
-            out = []
-            for path, past in zip(paths, passed.tolist()):
-                out.extend(self._next(track, path) if past else [path])
-            return out
+            return self._extended_at_once(track, paths, lengths)
         out = []
         for path in paths:
             lead = self._lead(path[0])
             seen = self._along(track, path[0], lengths if n is None else self._clock(track, path, lengths, n))[lead]
             total = sum(self._edge(e).arcs[lead, -1] for e in path)
             out.extend(self._next(track, path) if seen > total + 0.01 / track.scale else [path])
+        return out
+
+    def _extended_at_once(self, track: Track, paths: list[tuple[str, ...]],
+                          lengths: np.ndarray) -> list[tuple[str, ...]]:
+        """:meth:`_extended` of one-command paths (the common case) of a positional subsystem, at once, from the
+        strokes stacked for :meth:`_errors`: each path's lead part's observed length plus its anchor, against the lead's
+        stroke length (the same values, element by element, as path by path)."""
+        names = tuple(path[0] for path in paths)
+        _, _, totals, _, anchors, _ = self._stacked(track, names)
+        leads = self._leads(names)
+        rows = np.arange(len(names))
+        passed = lengths[leads] + anchors[rows, leads] > totals[rows, leads] + 0.01 / track.scale
+        if not passed.any():
+            return paths
+        out = []
+        for path, past in zip(paths, passed.tolist()):
+            out.extend(self._next(track, path) if past else [path])
         return out
 
     def _next(self, track: Track, path: tuple[str, ...]) -> list[tuple[str, ...]]:
