@@ -20,7 +20,7 @@ from hypothesis.extra.numpy import arrays
 
 import plugins.matchers.forward_model as fm
 from plugins.lib.guiding_stroke import GuidingStroke
-from plugins.matchers.forward_model import ForwardModel, Track, _along_rows, _row_keys
+from plugins.matchers.forward_model import ForwardModel, Track, _along_rows, _distances, _row_keys
 from tests.conftest import CHARACTERS
 from tests.test_forward_model_incremental import _arms
 from toolkit import Motion, create_plugin_manager, hookimpl, load_scenario
@@ -197,3 +197,34 @@ def test_the_shortcuts_give_the_same_answers_and_traces_to_the_bit(plays):
     (matches, seen, _), (matches_plain, seen_plain, _) = plays
     assert matches and matches == matches_plain
     assert seen == seen_plain
+
+
+@given(seed=st.integers(0, 10_000), c=st.integers(1, 6), k=st.integers(1, 5), g=st.integers(2, 40),
+       still=st.booleans(), hidden=st.booleans(), on_point=st.booleans(), groups=st.integers(1, 4))
+@settings(max_examples=150, deadline=None)
+def test_anchors_by_groups_of_half_strokes_are_the_masked_argmin_bit_for_bit(seed, c, k, g, still, hidden, on_point,
+                                                                             groups):
+    """:class:`_Halves` (the moving strokes' first halves in groups, points past a half at x = +inf) places every
+    part where the plain computation does: the masked argmin of :func:`_distances` over whole strokes. Strokes that
+    do not move, repeated points (ties), a part seen exactly on a point, a part never seen (NaN) included."""
+    rng = np.random.default_rng(seed)
+    positions = np.cumsum(rng.normal(size=(c, k, g, 3)) * (rng.random((c, k, g, 1)) < 0.8), axis=2)
+    if still:
+        positions[rng.integers(c), rng.integers(k)] = rng.normal(size=3)
+    steps = np.linalg.norm(np.diff(positions, axis=2), axis=-1)
+    arcs = np.concatenate([np.zeros((c, k, 1)), np.cumsum(steps, axis=2)], axis=2)
+    first = rng.normal(size=(k, 3)) * 2
+    if on_point:
+        first[0] = positions[0, 0, rng.integers(g)]
+    if hidden:
+        first[rng.integers(k)] = np.nan
+    later = arcs > 0.5 * arcs[..., -1:]
+    far = np.where(later, np.inf, _distances(*(np.ascontiguousarray(positions[..., i]) for i in range(3)), first))
+    want = np.take_along_axis(arcs, np.argmin(far, axis=-1)[..., None], axis=-1)[..., 0]
+    original = fm._Halves.GROUPS
+    try:
+        fm._Halves.GROUPS = groups
+        got = fm._Halves(arcs, positions).place(first)
+    finally:
+        fm._Halves.GROUPS = original
+    assert np.array_equal(got, want)
