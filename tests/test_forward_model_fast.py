@@ -155,7 +155,7 @@ def _shortcuts(monkeypatch, fast: bool) -> dict[str, int]:
     monkeypatch.setattr(ForwardModel, "_quiet", counted_quiet)
     monkeypatch.setattr(ForwardModel, "_extended_at_once", counted_at_once)
     if not fast:
-        monkeypatch.setattr(fm, "_row_keys", lambda arcs: None)
+        monkeypatch.setattr(fm, "_row_keys", lambda arcs, first=0: None)
     return used
 
 
@@ -228,3 +228,39 @@ def test_anchors_by_groups_of_half_strokes_are_the_masked_argmin_bit_for_bit(see
     finally:
         fm._Halves.GROUPS = original
     assert np.array_equal(got, want)
+
+
+@given(seed=st.integers(0, 10_000), commands=st.lists(st.integers(1, 4), min_size=1, max_size=12),
+       changed=st.booleans(), unsorted=st.booleans())
+@settings(max_examples=100, deadline=None)
+def test_the_table_of_every_stroke_predicts_as_the_stacked_strokes(seed, commands, changed, unsorted):
+    """:class:`_StrokeRows` (every command's strokes as rows of one growing table, a set of candidates as row
+    numbers) gives the points :func:`_along_rows` gives of the same strokes stacked: commands added one by one (the
+    table grows past its first size), a command whose table changed (new rows), a stroke whose lengths do not grow
+    (then every point is compared)."""
+    from plugins.matchers.forward_model import _EdgeTable, _StrokeRows
+
+    rng = np.random.default_rng(seed)
+    g = 12
+    table = _StrokeRows(g)
+
+    def edge(k: int) -> _EdgeTable:
+        steps = np.round(rng.random((k, g - 1)), 1) * (rng.random((k, g - 1)) < 0.7)
+        arcs = np.concatenate([np.zeros((k, 1)), np.cumsum(steps, axis=1)], axis=1)
+        return _EdgeTable([], rng.normal(size=(k, g, 3)), arcs, 0)
+
+    edges = {f"e{i}": edge(k) for i, k in enumerate(commands * 8)}
+    if unsorted:
+        edges["e0"].arcs[0, 3] = -1.0
+    for name, e in edges.items():
+        table.rows(name, e)
+    if changed:
+        edges["e0"] = edge(len(edges["e0"].arcs))
+    names = list(rng.permutation(list(edges)))[: rng.integers(1, len(edges) + 1)]
+    rows = np.concatenate([table.rows(n, edges[n]) + np.arange(len(edges[n].arcs)) for n in names])
+    arcs = np.concatenate([edges[n].arcs for n in names])
+    positions = np.concatenate([edges[n].positions for n in names])
+    x = rng.random(len(rows)) * arcs[:, -1]
+    x = np.where(rng.random(len(x)) < 0.2, arcs[:, -1], x)
+    assert table.sorted == (not unsorted)
+    np.testing.assert_array_equal(table.along(rows, x), _along_rows(arcs, positions, x))

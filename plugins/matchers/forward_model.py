@@ -257,17 +257,80 @@ class _EdgeTable:
     lead: int
 
 
-def _row_keys(arcs: np.ndarray) -> np.ndarray | None:
-    """``arcs`` (R, G) as one sorted complex array for :func:`_along_rows`: row r's values are ``r + 1j * arcs[r]``,
-    and numpy orders complex numbers lexicographically (real part, then imaginary), so one ``searchsorted`` counts,
-    for every row at once, the points of its own row at most a given length. ``None`` when a row does not grow
-    (NaN, or a decrease): then the count is taken by comparing every point."""
+def _row_keys(arcs: np.ndarray, first: int = 0) -> np.ndarray | None:
+    """``arcs`` (R, G) as one sorted complex array for :func:`_along_rows`: row r's values are ``first + r + 1j *
+    arcs[r]``, and numpy orders complex numbers lexicographically (real part, then imaginary), so one
+    ``searchsorted`` counts, for every row at once, the points of its own row at most a given length. ``None`` when
+    a row does not grow (NaN, or a decrease): then the count is taken by comparing every point."""
     if not arcs.size or not bool((arcs[:, 1:] >= arcs[:, :-1]).all()):
         return None
     keys = np.empty(arcs.shape, dtype=complex)
-    keys.real = np.arange(len(arcs))[:, None]
+    keys.real = np.arange(first, first + len(arcs))[:, None]
     keys.imag = arcs
     return keys.ravel()
+
+
+class _StrokeRows:
+    """Every command's strokes the forward model has met, one row per part, in one growing table: cumulative path
+    lengths (R, G), positions (R, G, 3) and the lengths' search keys (:func:`_row_keys`, row numbers as real parts,
+    so the table's keys stay sorted as commands are added). A set of candidates is then a list of row numbers, and
+    predicting them all (:meth:`along`) gathers only the two points about each one's path length, without copying
+    their strokes. A command whose table changes gets new rows (:meth:`rows`)."""
+
+    __slots__ = ("arcs", "positions", "keys", "n", "sorted", "of")
+
+    def __init__(self, points: int) -> None:
+        self.arcs = np.empty((64, points))
+        self.positions = np.empty((64, points, 3))
+        self.keys = np.empty(64 * points, dtype=complex)
+        self.n = 0
+        self.sorted = True  # every row's lengths grow: the keys can be searched
+        self.of: dict[str, tuple[Any, int]] = {}  # command -> (its table, its first row)
+
+    def rows(self, name: str, table: _EdgeTable) -> int:
+        """The first row of command ``name``'s strokes (``table``), added when new or changed."""
+        kept = self.of.get(name)
+        if kept is not None and kept[0] is table:
+            return kept[1]
+        k, g = table.arcs.shape
+        first, end = self.n, self.n + k
+        if end > len(self.arcs):
+            size = max(end, 2 * len(self.arcs))
+            for attr in ("arcs", "positions"):
+                old = getattr(self, attr)
+                new = np.empty((size, *old.shape[1:]))
+                new[:first] = old[:first]
+                setattr(self, attr, new)
+            keys = np.empty(size * g, dtype=complex)
+            keys[: first * g] = self.keys[: first * g]
+            self.keys = keys
+        self.arcs[first:end] = table.arcs
+        self.positions[first:end] = table.positions
+        keys = _row_keys(table.arcs, first)
+        if keys is None:
+            self.sorted = False
+        else:
+            self.keys[first * g : end * g] = keys
+        self.n = end
+        self.of[name] = (table, first)
+        return first
+
+    def along(self, rows: np.ndarray, x: np.ndarray) -> np.ndarray:
+        """:func:`_along_rows` of the strokes in ``rows`` at path lengths ``x``: the same points, the same values."""
+        g = self.arcs.shape[1]
+        if self.sorted:
+            query = np.empty(len(x), dtype=complex)
+            query.real, query.imag = rows, x
+            count = np.searchsorted(self.keys[: self.n * g], query, side="right") - rows * g
+            count[np.isnan(x)] = 0  # a NaN length is at most no point
+        else:
+            count = (self.arcs[rows] <= x[:, None]).sum(axis=1)
+        j = np.clip(count - 1, 0, g - 2)
+        a0, a1 = self.arcs[rows, j], self.arcs[rows, j + 1]
+        step = a1 - a0
+        w = np.divide(x - a0, step, out=np.zeros_like(x), where=step > 0)
+        p0 = self.positions[rows, j]
+        return p0 + np.clip(w, 0.0, 1.0)[:, None] * (self.positions[rows, j + 1] - p0)
 
 
 def _along_rows(arcs: np.ndarray, positions: np.ndarray, x: np.ndarray, keys: np.ndarray | None = None) -> np.ndarray:
@@ -525,6 +588,9 @@ class ForwardModel(Matcher):
 
     streaming = True
 
+    GRID = 200
+    """Points of the fine grid each stroke is tabled on (:meth:`_table`)."""
+
     def attach(self, owner: Any) -> None:
         super().attach(owner)
         motor = owner.motor
@@ -538,6 +604,7 @@ class ForwardModel(Matcher):
         self._edges: dict[str, _EdgeTable] = {}
         self._half_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
         self._stroke_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
+        self._stroke_rows = _StrokeRows(self.GRID)
         self._lead_sets: dict[tuple[str, ...], tuple[list, np.ndarray]] = {}
         self._placed: OrderedDict[tuple[tuple[str, ...], bytes], tuple[tuple, np.ndarray]] = OrderedDict()
         self._memory: WorkingMemory | None = None
@@ -999,7 +1066,7 @@ class ForwardModel(Matcher):
         """(times, positions, cumulative path length) of a stroke on a fine grid, computed once per stroke."""
         table = self._tables.get(id(stroke))
         if table is None or table[0] is not stroke:
-            grid = np.linspace(0.0, stroke.duration, 200)
+            grid = np.linspace(0.0, stroke.duration, self.GRID)
             positions = stroke.position(grid)
             table = (stroke, grid, positions, _arc(positions))
             self._tables[id(stroke)] = table
@@ -1030,7 +1097,7 @@ class ForwardModel(Matcher):
         strokes stacked for :meth:`_errors`: each path's lead part's observed length plus its anchor, against the lead's
         stroke length (the same values, element by element, as path by path)."""
         names = tuple(path[0] for path in paths)
-        _, _, totals, _, anchors, _ = self._stacked(track, names)
+        _, totals, anchors, _ = self._stacked(track, names)
         leads = self._leads(names)
         rows = np.arange(len(names))
         passed = lengths[leads] + anchors[rows, leads] > totals[rows, leads] + 0.01 / track.scale
@@ -1133,19 +1200,20 @@ class ForwardModel(Matcher):
         batch = [] if track.hand else [path for path in paths if len(path) == 1]
         errors: dict[tuple[str, ...], float] = {}
         if len(batch) > 1:
-            arcs, positions, totals, keys, anchors, offsets = self._stacked(track, tuple(path[0] for path in batch))
+            rows, totals, anchors, offsets = self._stacked(track, tuple(path[0] for path in batch))
             k = len(lengths)
             along = np.minimum(lengths + anchors, totals).reshape(-1)  # (C * k,): _along, then _predict's minimum
-            predicted = _along_rows(arcs, positions, along, keys).reshape(len(batch), k, 3) + offsets
+            predicted = self._stroke_rows.along(rows, along).reshape(len(batch), k, 3) + offsets
             d = np.linalg.norm(predicted - last, axis=-1) * track.scale
             combined = d.max(axis=1) if self.params["error"] == "max" else d.mean(axis=1)
             errors = dict(zip(batch, combined.tolist()))
         return {path: errors[path] if path in errors else self._error(track, path, lengths, last) for path in paths}
 
     def _stacked(self, track: Track, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
-        """For commands ``names`` followed by ``track``: their strokes' cumulative lengths (C * k, G) and positions
-        (C * k, G, 3), stroke lengths (C, k), the lengths' search keys (:func:`_row_keys`), anchors (C, k) and onset offsets (C, k, 3; 0.0 without ``relative``), stacked once per set of
-        candidates (kept until the set changes; the strokes for the last sets of candidates of any track)."""
+        """For commands ``names`` followed by ``track``: their strokes' rows in the table of every stroke
+        (:class:`_StrokeRows`, C * k), stroke lengths (C, k), anchors (C, k) and onset offsets (C, k, 3; 0.0 without
+        ``relative``), stacked once per set of candidates (kept until the set changes; the rows and lengths for the
+        last sets of candidates of any track)."""
         kept = self._tracked.get(track.subsystem)
         cache = getattr(kept, "stacked", None) if kept is not None and kept.track is track else None
         if cache is not None and cache[0] == names:
@@ -1153,11 +1221,11 @@ class ForwardModel(Matcher):
         edges = [self._edge(name) for name in names]
         strokes = self._stroke_tables.get(names)
         if strokes is None or not all(a is b for a, b in zip(strokes[0], edges)):
-            arcs = np.concatenate([e.arcs for e in edges])
-            strokes = (edges, (arcs, np.concatenate([e.positions for e in edges]),
-                               np.stack([e.arcs[:, -1] for e in edges]), _row_keys(arcs)))
+            table = self._stroke_rows
+            rows = np.concatenate([table.rows(n, e) + np.arange(len(e.arcs)) for n, e in zip(names, edges)])
+            strokes = (edges, (rows, np.stack([e.arcs[:, -1] for e in edges])))
             self._stroke_tables[names] = strokes
-            if len(self._stroke_tables) > 32:
+            if len(self._stroke_tables) > 64:
                 self._stroke_tables.popitem(last=False)
         else:
             self._stroke_tables.move_to_end(names)
