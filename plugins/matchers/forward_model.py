@@ -767,7 +767,7 @@ class ForwardModel(Matcher):
 
     def _moved(self, names: list[str], first: np.ndarray, last: np.ndarray) -> dict[str, float]:
         """How far (m; a hand's radians scaled) each subsystem's parts have moved at most from ``first`` to ``last``."""
-        far = np.linalg.norm(last - first, axis=-1)  # every part at once (the same values as part by part)
+        far = _norms(last - first)  # every part at once (the same values as part by part)
         return {name: float(np.fmax.reduce(far[idx])) * self._scale_of(name)  # np.nanmax without its warning
                 for name, idx in self.motor.subsystems.items() if name in names}
 
@@ -1204,7 +1204,7 @@ class ForwardModel(Matcher):
             k = len(lengths)
             along = np.minimum(lengths + anchors, totals).reshape(-1)  # (C * k,): _along, then _predict's minimum
             predicted = self._stroke_rows.along(rows, along).reshape(len(batch), k, 3) + offsets
-            d = np.linalg.norm(predicted - last, axis=-1) * track.scale
+            d = _norms(predicted - last) * track.scale
             combined = d.max(axis=1) if self.params["error"] == "max" else d.mean(axis=1)
             errors = dict(zip(batch, combined.tolist()))
         return {path: errors[path] if path in errors else self._error(track, path, lengths, last) for path in paths}
@@ -1305,7 +1305,7 @@ class ForwardModel(Matcher):
 
     def _distance(self, track: Track, predicted: np.ndarray, observed: np.ndarray) -> float:
         """Per-part distances (k, 3 each) combined as ``error`` says: the largest or the mean (radians of a hand scaled)."""
-        d = np.linalg.norm(predicted - observed, axis=-1) * track.scale
+        d = _norms(predicted - observed) * track.scale
         return float(d.max() if self.params["error"] == "max" else d.mean())
 
     def _progress(self, name: str, along: np.ndarray) -> float:
@@ -1378,7 +1378,7 @@ class ForwardModel(Matcher):
         began cannot be told apart). A commitment waits for them: a frame or two, for a fast movement."""
         if not self.params["reparameterise"]:
             return True
-        away = np.linalg.norm(observed - observed[0], axis=-1).max(axis=1) * track.scale
+        away = _norms(observed - observed[0]).max(axis=1) * track.scale
         return int((away > 0.25 * self.params["min_move"]).sum()) >= self.MIN_MOVING_FRAMES
 
     def _shown(self, path: tuple[str, ...], parts: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
