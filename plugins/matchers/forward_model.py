@@ -606,6 +606,7 @@ class ForwardModel(Matcher):
         self._stroke_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
         self._stroke_rows = _StrokeRows(self.GRID)
         self._lead_sets: dict[tuple[str, ...], tuple[list, np.ndarray]] = {}
+        self._scales: dict[str, tuple[Any, float]] = {}
         self._placed: OrderedDict[tuple[tuple[str, ...], bytes], tuple[tuple, np.ndarray]] = OrderedDict()
         self._memory: WorkingMemory | None = None
         self._rows: _Grown | None = None  # the working memory in the motor frame, row by row
@@ -1035,8 +1036,14 @@ class ForwardModel(Matcher):
         track.learn_from = track.onset + min(max(row, 0), len(observed) - 1)
 
     def _scale_of(self, subsystem: str) -> float:
-        """Metres one unit of the subsystem's values counts as: ``angle_scale`` for a hand's radians, else 1."""
-        return self.params["angle_scale"] if self.motor.is_hand(subsystem) else 1.0
+        """Metres one unit of the subsystem's values counts as: ``angle_scale`` for a hand's radians, else 1 (kept
+        per subsystem while its parts are the same)."""
+        parts = self.motor.subsystems.get(subsystem)
+        kept = self._scales.get(subsystem)
+        if kept is None or kept[0] is not parts:
+            kept = self._scales[subsystem] = (parts, self.params["angle_scale"] if self.motor.is_hand(subsystem)
+                                              else 1.0)
+        return kept[1]
 
     def _length(self, name: str) -> float:
         """Path length (m, or radians for a hand) of a command's lead part."""
