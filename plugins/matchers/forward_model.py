@@ -605,7 +605,6 @@ class ForwardModel(Matcher):
         self._half_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
         self._stroke_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
         self._stroke_rows = _StrokeRows(self.GRID)
-        self._lead_sets: dict[tuple[str, ...], tuple[list, np.ndarray]] = {}
         self._scales: dict[str, tuple[Any, float]] = {}
         self._placed: OrderedDict[tuple[tuple[str, ...], bytes], tuple[tuple, np.ndarray]] = OrderedDict()
         self._memory: WorkingMemory | None = None
@@ -1104,8 +1103,7 @@ class ForwardModel(Matcher):
         strokes stacked for :meth:`_errors`: each path's lead part's observed length plus its anchor, against the lead's
         stroke length (the same values, element by element, as path by path)."""
         names = tuple(path[0] for path in paths)
-        _, totals, anchors, _ = self._stacked(track, names)
-        leads = self._leads(names)
+        _, totals, leads, anchors, _ = self._stacked(track, names)
         rows = np.arange(len(names))
         passed = lengths[leads] + anchors[rows, leads] > totals[rows, leads] + 0.01 / track.scale
         if not passed.any():
@@ -1121,17 +1119,6 @@ class ForwardModel(Matcher):
         end = self.motor.edge(path[-1]).target
         nxt = [edge.name for edge in self.motor.edges_from(track.subsystem, end)]
         return [(*path, e) for e in nxt if e not in path and e not in track.excluded] or [path]
-
-    def _leads(self, names: tuple[str, ...]) -> np.ndarray:
-        """The lead part (:meth:`_lead`) of each command of ``names``, as an array (kept per set of commands while
-        their tables are the same)."""
-        tables = [self._edge(name) for name in names]
-        kept = self._lead_sets.get(names)
-        if kept is None or not all(a is b for a, b in zip(kept[0], tables)):
-            kept = self._lead_sets[names] = (tables, np.array([t.lead for t in tables]))
-            if len(self._lead_sets) > 64:
-                del self._lead_sets[next(iter(self._lead_sets))]
-        return kept[1]
 
     def _path_label(self, path: tuple[str, ...]) -> str | None:
         """The labelled movement (clip repertoires) every sequence along ``path`` is an example of, else ``None``."""
@@ -1207,7 +1194,7 @@ class ForwardModel(Matcher):
         batch = [] if track.hand else [path for path in paths if len(path) == 1]
         errors: dict[tuple[str, ...], float] = {}
         if len(batch) > 1:
-            rows, totals, anchors, offsets = self._stacked(track, tuple(path[0] for path in batch))
+            rows, totals, _, anchors, offsets = self._stacked(track, tuple(path[0] for path in batch))
             k = len(lengths)
             along = np.minimum(lengths + anchors, totals).reshape(-1)  # (C * k,): _along, then _predict's minimum
             predicted = self._stroke_rows.along(rows, along).reshape(len(batch), k, 3) + offsets
@@ -1218,7 +1205,7 @@ class ForwardModel(Matcher):
 
     def _stacked(self, track: Track, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
         """For commands ``names`` followed by ``track``: their strokes' rows in the table of every stroke
-        (:class:`_StrokeRows`, C * k), stroke lengths (C, k), anchors (C, k) and onset offsets (C, k, 3; 0.0 without
+        (:class:`_StrokeRows`, C * k), stroke lengths (C, k), lead parts (C,), anchors (C, k) and onset offsets (C, k, 3; 0.0 without
         ``relative``), stacked once per set of candidates (kept until the set changes; the rows and lengths for the
         last sets of candidates of any track)."""
         kept = self._tracked.get(track.subsystem)
@@ -1230,7 +1217,7 @@ class ForwardModel(Matcher):
         if strokes is None or not all(a is b for a, b in zip(strokes[0], edges)):
             table = self._stroke_rows
             rows = np.concatenate([table.rows(n, e) + np.arange(len(e.arcs)) for n, e in zip(names, edges)])
-            strokes = (edges, (rows, np.stack([e.arcs[:, -1] for e in edges])))
+            strokes = (edges, (rows, np.stack([e.arcs[:, -1] for e in edges]), np.array([e.lead for e in edges])))
             self._stroke_tables[names] = strokes
             if len(self._stroke_tables) > 64:
                 self._stroke_tables.popitem(last=False)
