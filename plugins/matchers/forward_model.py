@@ -1205,9 +1205,9 @@ class ForwardModel(Matcher):
 
     def _stacked(self, track: Track, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
         """For commands ``names`` followed by ``track``: their strokes' rows in the table of every stroke
-        (:class:`_StrokeRows`, C * k), stroke lengths (C, k), lead parts (C,), anchors (C, k) and onset offsets (C, k, 3; 0.0 without
-        ``relative``), stacked once per set of candidates (kept until the set changes; the rows and lengths for the
-        last sets of candidates of any track)."""
+        (:class:`_StrokeRows`, C * k), stroke lengths (C, k), lead parts (C,), anchors (C, k) and onset offsets
+        (C, k, 3; 0.0 without ``relative``), stacked once per set of candidates (kept until the set changes; the
+        rows, lengths and leads for the last sets of candidates of any track)."""
         kept = self._tracked.get(track.subsystem)
         cache = getattr(kept, "stacked", None) if kept is not None and kept.track is track else None
         if cache is not None and cache[0] == names:
