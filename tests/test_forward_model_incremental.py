@@ -74,10 +74,13 @@ def test_a_running_path_length_refuses_a_memory_that_shrank():
         walk.lengths(np.zeros((4, 1, 3)))
 
 
-def _arms(write, pm, *, relative: bool = False, error: str = "max", strokes: int = 4, seed: int = 0):
+def _arms(write, pm, *, relative: bool = False, error: str = "max", strokes: int = 4, seed: int = 0,
+          threshold: float = 10.0):
     """The two-wrist body with ``strokes`` random one-second commands from the hub (the right wrist held still in
     every other one)."""
-    character = load_character(write("arms.toml", ARMS.format(relative=str(relative).lower(), error=error)), pm)
+    text = ARMS.format(relative=str(relative).lower(), error=error).replace("threshold = 10.0",
+                                                                            f"threshold = {threshold}")
+    character = load_character(write("arms.toml", text), pm)
     motor, rng = character.motor, np.random.default_rng(seed)
     left, right = motor.rest[2], motor.rest[3]
     names = []

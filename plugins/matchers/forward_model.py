@@ -257,10 +257,97 @@ class _EdgeTable:
     lead: int
 
 
-def _along_rows(arcs: np.ndarray, positions: np.ndarray, x: np.ndarray) -> np.ndarray:
+def _row_keys(arcs: np.ndarray, first: int = 0) -> np.ndarray | None:
+    """``arcs`` (R, G) as one sorted complex array for :func:`_along_rows`: row r's values are ``first + r + 1j *
+    arcs[r]``, and numpy orders complex numbers lexicographically (real part, then imaginary), so one
+    ``searchsorted`` counts, for every row at once, the points of its own row at most a given length. ``None`` when
+    a row does not grow (NaN, or a decrease): then the count is taken by comparing every point."""
+    if not arcs.size or not bool((arcs[:, 1:] >= arcs[:, :-1]).all()):
+        return None
+    keys = np.empty(arcs.shape, dtype=complex)
+    keys.real = np.arange(first, first + len(arcs))[:, None]
+    keys.imag = arcs
+    return keys.ravel()
+
+
+class _StrokeRows:
+    """Every command's strokes the forward model has met, one row per part, in one growing table: cumulative path
+    lengths (R, G), positions (R, G, 3) and the lengths' search keys (:func:`_row_keys`, row numbers as real parts,
+    so the table's keys stay sorted as commands are added). A set of candidates is then a list of row numbers, and
+    predicting them all (:meth:`along`) gathers only the two points about each one's path length, without copying
+    their strokes. A command whose table changes gets new rows (:meth:`rows`)."""
+
+    __slots__ = ("arcs", "positions", "keys", "n", "sorted", "of")
+
+    def __init__(self, points: int) -> None:
+        self.arcs = np.empty((64, points))
+        self.positions = np.empty((64, points, 3))
+        self.keys = np.empty(64 * points, dtype=complex)
+        self.n = 0
+        self.sorted = True  # every row's lengths grow: the keys can be searched
+        self.of: dict[str, tuple[Any, int]] = {}  # command -> (its table, its first row)
+
+    def rows(self, name: str, table: _EdgeTable) -> int:
+        """The first row of command ``name``'s strokes (``table``), added when new or changed."""
+        kept = self.of.get(name)
+        if kept is not None and kept[0] is table:
+            return kept[1]
+        k, g = table.arcs.shape
+        first, end = self.n, self.n + k
+        if end > len(self.arcs):
+            size = max(end, 2 * len(self.arcs))
+            for attr in ("arcs", "positions"):
+                old = getattr(self, attr)
+                new = np.empty((size, *old.shape[1:]))
+                new[:first] = old[:first]
+                setattr(self, attr, new)
+            keys = np.empty(size * g, dtype=complex)
+            keys[: first * g] = self.keys[: first * g]
+            self.keys = keys
+        self.arcs[first:end] = table.arcs
+        self.positions[first:end] = table.positions
+        keys = _row_keys(table.arcs, first)
+        if keys is None:
+            self.sorted = False
+        else:
+            self.keys[first * g : end * g] = keys
+        self.n = end
+        self.of[name] = (table, first)
+        return first
+
+    def along(self, rows: np.ndarray, x: np.ndarray) -> np.ndarray:
+        """:func:`_along_rows` of the strokes in ``rows`` at path lengths ``x``: the same points, the same values."""
+        g = self.arcs.shape[1]
+        if self.sorted:
+            query = np.empty(len(x), dtype=complex)
+            query.real, query.imag = rows, x
+            count = np.searchsorted(self.keys[: self.n * g], query, side="right") - rows * g
+            count[np.isnan(x)] = 0  # a NaN length is at most no point
+        else:
+            count = (self.arcs[rows] <= x[:, None]).sum(axis=1)
+        j = np.clip(count - 1, 0, g - 2)
+        a0, a1 = self.arcs[rows, j], self.arcs[rows, j + 1]
+        step = a1 - a0
+        w = np.divide(x - a0, step, out=np.zeros_like(x), where=step > 0)
+        p0 = self.positions[rows, j]
+        return p0 + np.clip(w, 0.0, 1.0)[:, None] * (self.positions[rows, j + 1] - p0)
+
+
+def _along_rows(arcs: np.ndarray, positions: np.ndarray, x: np.ndarray, keys: np.ndarray | None = None) -> np.ndarray:
     """Per row r, the point of ``positions[r]`` (G, 3) at path length ``x[r]`` along ``arcs[r]`` (G,), linearly
-    interpolated (``np.interp`` row by row); 0 <= x[r] <= arcs[r, -1]."""
-    j = np.clip((arcs <= x[:, None]).sum(axis=1) - 1, 0, arcs.shape[1] - 2)
+    interpolated (``np.interp`` row by row); 0 <= x[r] <= arcs[r, -1].
+
+    ``keys`` (:func:`_row_keys` of ``arcs``): the points at most ``x[r]`` along each row counted by one binary search
+    instead of a comparison of every point (the same count: exact comparisons of the same numbers)."""
+    if keys is None:
+        count = (arcs <= x[:, None]).sum(axis=1)
+    else:
+        rows = np.arange(len(x))
+        query = np.empty(len(x), dtype=complex)
+        query.real, query.imag = rows, x
+        count = np.searchsorted(keys, query, side="right") - rows * arcs.shape[1]
+        count[np.isnan(x)] = 0  # a NaN length is at most no point
+    j = np.clip(count - 1, 0, arcs.shape[1] - 2)
     rows = np.arange(len(x))
     a0, a1 = arcs[rows, j], arcs[rows, j + 1]
     step = a1 - a0
@@ -383,6 +470,59 @@ class _Walk:
         return np.add.reduce(norms.buffer[: norms.n], axis=0)
 
 
+class _Halves:
+    """The first halves of a set of commands' strokes, for :meth:`ForwardModel._anchor`: where along each stroke
+    (path length) lies its first-half point nearest to where the part was seen.
+
+    ``arcs`` (C, k, G) and ``positions`` (C, k, G, 3) are the strokes of C commands of k parts. A point lies in its
+    stroke's first half while its path length is at most half the stroke's. A stroke that moves no part (every
+    path length 0) is joined at 0 wherever the part is. The strokes that move are sorted by the length of their
+    first halves and kept in :attr:`GROUPS` groups, each as contiguous coordinate planes x, y, z cut to its longest
+    half, the points past a half given x = +inf (so their distance is +inf, as the plain computation's mask makes
+    it; with a part never seen, NaN, both give the first point). :meth:`place` computes each distance as
+    :func:`_distances` does (the squares summed x, y, z, then the root: the same bits) and takes each stroke's first
+    nearest point (``np.argmin``), so the anchors are those of the masked argmin over whole strokes, with about a
+    third less arithmetic. ``tests/test_forward_model_fast.py`` compares the two."""
+
+    GROUPS = 3
+
+    __slots__ = ("shape", "groups")
+
+    def __init__(self, arcs: np.ndarray, positions: np.ndarray) -> None:
+        c, k, g = arcs.shape
+        self.shape = (c, k)
+        flat_arcs = arcs.reshape(c * k, g)
+        later = flat_arcs > 0.5 * flat_arcs[:, -1:]
+        halves = g - later.sum(axis=1)  # points in each first half (a prefix: the path lengths grow)
+        moving = np.flatnonzero(flat_arcs[:, -1] > 0)
+        order = moving[np.argsort(halves[moving], kind="stable")]
+        flat = positions.reshape(c * k, g, 3)
+        self.groups = []
+        for rows in np.array_split(order, min(self.GROUPS, len(order))) if len(order) else []:
+            h = int(halves[rows].max())
+            x = np.where(later[rows, :h], np.inf, flat[rows, :h, 0])
+            planes = tuple(np.ascontiguousarray(p) for p in (x, flat[rows, :h, 1], flat[rows, :h, 2]))
+            self.groups.append((rows, rows % k, *planes, np.ascontiguousarray(flat_arcs[rows, :h])))
+
+    def place(self, first: np.ndarray) -> np.ndarray:
+        """The anchors (C, k): per command and part, the path length of the first-half point of its stroke nearest
+        to ``first`` (k, 3), where the part was seen."""
+        placed = np.zeros(self.shape[0] * self.shape[1])
+        for rows, parts, x, y, z, arcs in self.groups:
+            f = first[parts]
+            a = x - f[:, 0, None]
+            a *= a
+            b = y - f[:, 1, None]
+            b *= b
+            a += b
+            np.subtract(z, f[:, 2, None], out=b)
+            b *= b
+            a += b
+            np.sqrt(a, out=a)
+            placed[rows] = arcs[np.arange(len(rows)), a.argmin(axis=1)]
+        return placed.reshape(self.shape)
+
+
 @dataclass
 class _Tracked:
     """What the forward model keeps of one followed subsystem between frames: its rows of the working memory
@@ -448,6 +588,9 @@ class ForwardModel(Matcher):
 
     streaming = True
 
+    GRID = 200
+    """Points of the fine grid each stroke is tabled on (:meth:`_table`)."""
+
     def attach(self, owner: Any) -> None:
         super().attach(owner)
         motor = owner.motor
@@ -461,6 +604,8 @@ class ForwardModel(Matcher):
         self._edges: dict[str, _EdgeTable] = {}
         self._half_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
         self._stroke_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
+        self._stroke_rows = _StrokeRows(self.GRID)
+        self._scales: dict[str, tuple[Any, float]] = {}
         self._placed: OrderedDict[tuple[tuple[str, ...], bytes], tuple[tuple, np.ndarray]] = OrderedDict()
         self._memory: WorkingMemory | None = None
         self._rows: _Grown | None = None  # the working memory in the motor frame, row by row
@@ -484,6 +629,7 @@ class ForwardModel(Matcher):
         self.fps = memory.fps
         self.tracks = {}  # in the order the subsystems began to move
         self.reported = False  # a commitment to the tracks decided so far has been announced
+        self._settled = False  # nothing more can happen in this segment (:meth:`_quiet`)
 
     @property
     def main(self) -> Track | None:
@@ -549,6 +695,8 @@ class ForwardModel(Matcher):
     def observe(self, memory: WorkingMemory) -> Match | None:
         if memory is not self._memory:
             self.begin(memory)
+        elif self._settled:  # every subsystem followed, none with a candidate or a commitment: as below, no work
+            return None
         local = self._local()
         self._start_tracks(local)
         if not self.tracks:
@@ -559,6 +707,9 @@ class ForwardModel(Matcher):
         if stop is not None:
             return stop
         tracks = list(self.tracks.values())
+        if self._quiet(tracks):
+            self._settled = True
+            return None
         if self.reported or not all(t.committed is not None and not t.deviated for t in tracks) or self._joining(local):
             return None
         self.reported = True  # every subsystem under consideration has one prevailing command: imitate them at once
@@ -574,6 +725,16 @@ class ForwardModel(Matcher):
                                                     "speed": t.speed, "progress": t.progress} for t in tracks}
         return Match(labels[0] if len(tracks) == 1 else movement, min(t.confidence for t in tracks), memory.n,
                      path=tuple(e for t in tracks for e in t.committed_path), details=details)
+
+    def _quiet(self, tracks: list[Track]) -> bool:
+        """Whether the rest of the segment can change nothing: no subsystem is left to start (:meth:`_start_tracks`
+        starts none: every one is followed, or ``together`` is off) and no track has a candidate or a commitment
+        (:meth:`_follow` returns at once). Every later frame would then return ``None`` without a change but the rows
+        :meth:`_local` places, which it places when next called (each row by the same addition, alone or in a
+        batch: the same values); :meth:`observe` skips them."""
+        if self.params["together"] and len(self.tracks) < len(self.motor.subsystems):
+            return False
+        return all(t.committed is None and not t.candidates for t in tracks)
 
     def _start_tracks(self, memory: np.ndarray) -> None:
         """Follow every subsystem not yet followed that has moved more than ``min_move`` since the onset.
@@ -606,7 +767,7 @@ class ForwardModel(Matcher):
 
     def _moved(self, names: list[str], first: np.ndarray, last: np.ndarray) -> dict[str, float]:
         """How far (m; a hand's radians scaled) each subsystem's parts have moved at most from ``first`` to ``last``."""
-        far = np.linalg.norm(last - first, axis=-1)  # every part at once (the same values as part by part)
+        far = _norms(last - first)  # every part at once (the same values as part by part)
         return {name: float(np.fmax.reduce(far[idx])) * self._scale_of(name)  # np.nanmax without its warning
                 for name, idx in self.motor.subsystems.items() if name in names}
 
@@ -874,8 +1035,14 @@ class ForwardModel(Matcher):
         track.learn_from = track.onset + min(max(row, 0), len(observed) - 1)
 
     def _scale_of(self, subsystem: str) -> float:
-        """Metres one unit of the subsystem's values counts as: ``angle_scale`` for a hand's radians, else 1."""
-        return self.params["angle_scale"] if self.motor.is_hand(subsystem) else 1.0
+        """Metres one unit of the subsystem's values counts as: ``angle_scale`` for a hand's radians, else 1 (kept
+        per subsystem while its parts are the same)."""
+        parts = self.motor.subsystems.get(subsystem)
+        kept = self._scales.get(subsystem)
+        if kept is None or kept[0] is not parts:
+            kept = self._scales[subsystem] = (parts, self.params["angle_scale"] if self.motor.is_hand(subsystem)
+                                              else 1.0)
+        return kept[1]
 
     def _length(self, name: str) -> float:
         """Path length (m, or radians for a hand) of a command's lead part."""
@@ -905,7 +1072,7 @@ class ForwardModel(Matcher):
         """(times, positions, cumulative path length) of a stroke on a fine grid, computed once per stroke."""
         table = self._tables.get(id(stroke))
         if table is None or table[0] is not stroke:
-            grid = np.linspace(0.0, stroke.duration, 200)
+            grid = np.linspace(0.0, stroke.duration, self.GRID)
             positions = stroke.position(grid)
             table = (stroke, grid, positions, _arc(positions))
             self._tables[id(stroke)] = table
@@ -918,15 +1085,40 @@ class ForwardModel(Matcher):
         ``lengths`` holds the observed path length of each part of the subsystem, ``n`` the frames observed
         (:meth:`_clock`; ``None``: as many as the path lengths say).
         """
+        paths = list(track.candidates)
+        if (n is None or self.params["reparameterise"]) and not track.hand and len(paths) > 1 and \
+                all(len(path) == 1 for path in paths):
+            return self._extended_at_once(track, paths, lengths)
         out = []
-        for path in track.candidates:
+        for path in paths:
             lead = self._lead(path[0])
             seen = self._along(track, path[0], lengths if n is None else self._clock(track, path, lengths, n))[lead]
             total = sum(self._edge(e).arcs[lead, -1] for e in path)
-            end = self.motor.edge(path[-1]).target
-            nxt = [edge.name for edge in self.motor.edges_from(track.subsystem, end)] if seen > total + 0.01 / track.scale else []
-            out.extend([(*path, e) for e in nxt if e not in path and e not in track.excluded] or [path])
+            out.extend(self._next(track, path) if seen > total + 0.01 / track.scale else [path])
         return out
+
+    def _extended_at_once(self, track: Track, paths: list[tuple[str, ...]],
+                          lengths: np.ndarray) -> list[tuple[str, ...]]:
+        """:meth:`_extended` of one-command paths (the common case) of a positional subsystem, at once, from the
+        strokes stacked for :meth:`_errors`: each path's lead part's observed length plus its anchor, against the lead's
+        stroke length (the same values, element by element, as path by path)."""
+        names = tuple(path[0] for path in paths)
+        _, totals, leads, anchors, _ = self._stacked(track, names)
+        rows = np.arange(len(names))
+        passed = lengths[leads] + anchors[rows, leads] > totals[rows, leads] + 0.01 / track.scale
+        if not passed.any():
+            return paths
+        out = []
+        for path, past in zip(paths, passed.tolist()):
+            out.extend(self._next(track, path) if past else [path])
+        return out
+
+    def _next(self, track: Track, path: tuple[str, ...]) -> list[tuple[str, ...]]:
+        """A path whose commands have all been covered, continued along each edge of its end node that it does not
+        hold and that is not excluded (itself when there is none)."""
+        end = self.motor.edge(path[-1]).target
+        nxt = [edge.name for edge in self.motor.edges_from(track.subsystem, end)]
+        return [(*path, e) for e in nxt if e not in path and e not in track.excluded] or [path]
 
     def _path_label(self, path: tuple[str, ...]) -> str | None:
         """The labelled movement (clip repertoires) every sequence along ``path`` is an example of, else ``None``."""
@@ -1002,19 +1194,20 @@ class ForwardModel(Matcher):
         batch = [] if track.hand else [path for path in paths if len(path) == 1]
         errors: dict[tuple[str, ...], float] = {}
         if len(batch) > 1:
-            arcs, positions, totals, anchors, offsets = self._stacked(track, tuple(path[0] for path in batch))
+            rows, totals, _, anchors, offsets = self._stacked(track, tuple(path[0] for path in batch))
             k = len(lengths)
             along = np.minimum(lengths + anchors, totals).reshape(-1)  # (C * k,): _along, then _predict's minimum
-            predicted = _along_rows(arcs, positions, along).reshape(len(batch), k, 3) + offsets
-            d = np.linalg.norm(predicted - last, axis=-1) * track.scale
+            predicted = self._stroke_rows.along(rows, along).reshape(len(batch), k, 3) + offsets
+            d = _norms(predicted - last) * track.scale
             combined = d.max(axis=1) if self.params["error"] == "max" else d.mean(axis=1)
             errors = dict(zip(batch, combined.tolist()))
         return {path: errors[path] if path in errors else self._error(track, path, lengths, last) for path in paths}
 
     def _stacked(self, track: Track, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
-        """For commands ``names`` followed by ``track``: their strokes' cumulative lengths (C * k, G) and positions
-        (C * k, G, 3), stroke lengths (C, k), anchors (C, k) and onset offsets (C, k, 3; 0.0 without ``relative``), stacked once per set of
-        candidates (kept until the set changes; the strokes for the last sets of candidates of any track)."""
+        """For commands ``names`` followed by ``track``: their strokes' rows in the table of every stroke
+        (:class:`_StrokeRows`, C * k), stroke lengths (C, k), lead parts (C,), anchors (C, k) and onset offsets
+        (C, k, 3; 0.0 without ``relative``), stacked once per set of candidates (kept until the set changes; the
+        rows, lengths and leads for the last sets of candidates of any track)."""
         kept = self._tracked.get(track.subsystem)
         cache = getattr(kept, "stacked", None) if kept is not None and kept.track is track else None
         if cache is not None and cache[0] == names:
@@ -1022,10 +1215,11 @@ class ForwardModel(Matcher):
         edges = [self._edge(name) for name in names]
         strokes = self._stroke_tables.get(names)
         if strokes is None or not all(a is b for a, b in zip(strokes[0], edges)):
-            strokes = (edges, (np.concatenate([e.arcs for e in edges]), np.concatenate([e.positions for e in edges]),
-                               np.stack([e.arcs[:, -1] for e in edges])))
+            table = self._stroke_rows
+            rows = np.concatenate([table.rows(n, e) + np.arange(len(e.arcs)) for n, e in zip(names, edges)])
+            strokes = (edges, (rows, np.stack([e.arcs[:, -1] for e in edges]), np.array([e.lead for e in edges])))
             self._stroke_tables[names] = strokes
-            if len(self._stroke_tables) > 32:
+            if len(self._stroke_tables) > 64:
                 self._stroke_tables.popitem(last=False)
         else:
             self._stroke_tables.move_to_end(names)
@@ -1068,9 +1262,7 @@ class ForwardModel(Matcher):
                 self._placed.move_to_end(key)
                 placed = kept[1]
             else:
-                (x, y, z), later, arcs = halves
-                far = np.where(later, np.inf, _distances(x, y, z, first))  # (C, k, h)
-                placed = np.take_along_axis(arcs, np.argmin(far, axis=-1)[..., None], axis=-1)[..., 0]
+                placed = halves.place(first)
                 self._placed[key] = (halves, placed)
                 if len(self._placed) > 32:
                     self._placed.popitem(last=False)
@@ -1078,24 +1270,15 @@ class ForwardModel(Matcher):
             anchor = track.anchors[name]
         return anchor
 
-    def _halves(self, names: tuple[str, ...]) -> tuple[tuple[np.ndarray, ...], np.ndarray, np.ndarray]:
-        """The first halves of commands ``names``' strokes, stacked for :meth:`_anchor`: positions as three
-        contiguous coordinate planes x, y, z (C, k, h) each (:func:`_distances`), which points lie past the first half of their stroke (C, k, h) and cumulative lengths (C, k, h), where ``h`` is
-        the last point the first half of any stroke that moves reaches (arcs grow: a first half is a prefix). Kept
-        for the last sets of candidates (a node's edges are the candidates of every demonstration that starts there)."""
+    def _halves(self, names: tuple[str, ...]) -> _Halves:
+        """The first halves of commands ``names``' strokes, stacked for :meth:`_anchor` (:class:`_Halves`). Kept for
+        the last sets of candidates (a node's edges are the candidates of every demonstration that starts there)."""
         tables = [self._edge(name) for name in names]
         kept = self._half_tables.get(names)
         if kept is not None and all(a is b for a, b in zip(kept[0], tables)):
             self._half_tables.move_to_end(names)
             return kept[1]
-        arcs = np.stack([t.arcs for t in tables])
-        later = arcs > 0.5 * arcs[..., -1:]
-        # a part that stays still (no path at all: every point the same) is joined at its first point whatever h is
-        moving = arcs[..., -1] > 0
-        h = int(arcs.shape[-1] - later[moving].sum(axis=-1).min()) if moving.any() else 1
-        positions = np.stack([t.positions[:, :h] for t in tables])  # (C, k, h, 3)
-        planes = tuple(np.ascontiguousarray(positions[..., c]) for c in range(3))
-        halves = (planes, later[..., :h], arcs[..., :h])
+        halves = _Halves(np.stack([t.arcs for t in tables]), np.stack([t.positions for t in tables]))
         self._half_tables[names] = (tables, halves)
         if len(self._half_tables) > 32:
             self._half_tables.popitem(last=False)
@@ -1116,7 +1299,7 @@ class ForwardModel(Matcher):
 
     def _distance(self, track: Track, predicted: np.ndarray, observed: np.ndarray) -> float:
         """Per-part distances (k, 3 each) combined as ``error`` says: the largest or the mean (radians of a hand scaled)."""
-        d = np.linalg.norm(predicted - observed, axis=-1) * track.scale
+        d = _norms(predicted - observed) * track.scale
         return float(d.max() if self.params["error"] == "max" else d.mean())
 
     def _progress(self, name: str, along: np.ndarray) -> float:
@@ -1189,7 +1372,7 @@ class ForwardModel(Matcher):
         began cannot be told apart). A commitment waits for them: a frame or two, for a fast movement."""
         if not self.params["reparameterise"]:
             return True
-        away = np.linalg.norm(observed - observed[0], axis=-1).max(axis=1) * track.scale
+        away = _norms(observed - observed[0]).max(axis=1) * track.scale
         return int((away > 0.25 * self.params["min_move"]).sum()) >= self.MIN_MOVING_FRAMES
 
     def _shown(self, path: tuple[str, ...], parts: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
