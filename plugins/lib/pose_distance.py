@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["pose_distance", "path_distance"]
+__all__ = ["PoseScan", "pose_distance", "path_distance"]
 
 
 def pose_distance(a: np.ndarray, b: np.ndarray, visible: np.ndarray | None = None,
@@ -61,3 +61,62 @@ def path_distance(observed: np.ndarray, path: np.ndarray, visible: np.ndarray,
     visible : array of bool, shape (N, P)
     """
     return float(np.nansum(pose_distance(observed, path, visible, weights)))
+
+
+class PoseScan:
+    """eq. 1 over every part from one query pose to each of many fixed poses: path search's scan of the whole
+    posegraph (§5.2 step 2), the same numbers as ``np.sqrt(np.einsum("cpi,cpi->cp", d, d)).mean(axis=1)`` with
+    ``d = poses - query``, in about half the time.
+
+    The poses are kept as three coordinate planes (N, P), so each step is one pass of a ufunc over contiguous memory
+    into buffers kept between queries. NumPy's einsum sums the three squares of a part as ``(x² + z²) + y²`` (its
+    vector loop puts x, y, z and a zero in lanes and adds the halves); the planes are summed in that order, and the
+    mean over the parts is the same ``mean(axis=1)`` of a C-ordered (N, P) array. Whether einsum sums so is checked
+    when the scan is built, on up to :data:`SCAN_CHECK` of the poses (another NumPy or machine could sum otherwise):
+    if any number differs the scan calls einsum itself (:attr:`planes` is False).
+
+    Parameters
+    ----------
+    poses : array, shape (N, P, 3)
+        The poses (not changed; the planes are a copy).
+    """
+
+    def __init__(self, poses: np.ndarray):
+        poses = np.asarray(poses, dtype=float)
+        self.poses = poses
+        self._x, self._y, self._z = (np.ascontiguousarray(poses[..., i]) for i in range(3))
+        self._buffers = np.empty((2, *poses.shape[:2]))
+        self.planes = True
+        if len(poses):  # the check: a query that is none of the poses (their mean, moved), on the first poses
+            few = poses[:SCAN_CHECK]
+            query = poses.mean(axis=0) + np.linspace(0.01, 0.02, poses.shape[1])[:, None]
+            if not np.isfinite(query).all():
+                query = np.zeros(poses.shape[1:])
+            planes = PoseScan.__new__(PoseScan)
+            planes._x, planes._y, planes._z = self._x[:SCAN_CHECK], self._y[:SCAN_CHECK], self._z[:SCAN_CHECK]
+            planes._buffers, planes.planes = np.empty((2, *few.shape[:2])), True
+            d = few - query
+            self.planes = bool(np.array_equal(planes(query), np.sqrt(np.einsum("cpi,cpi->cp", d, d)).mean(axis=1),
+                                              equal_nan=True))
+
+    def __call__(self, query: np.ndarray) -> np.ndarray:
+        """eq. 1 over every part from ``query`` (P, 3) to each pose, (N,)."""
+        if not self.planes:
+            d = self.poses - query
+            return np.sqrt(np.einsum("cpi,cpi->cp", d, d)).mean(axis=1)
+        query = np.asarray(query, dtype=float)
+        s, b = self._buffers
+        np.subtract(self._x, query[:, 0], out=s)
+        np.multiply(s, s, out=s)
+        np.subtract(self._z, query[:, 2], out=b)
+        np.multiply(b, b, out=b)
+        np.add(s, b, out=s)
+        np.subtract(self._y, query[:, 1], out=b)
+        np.multiply(b, b, out=b)
+        np.add(s, b, out=s)
+        np.sqrt(s, out=s)
+        return s.mean(axis=1)
+
+
+SCAN_CHECK = 256
+"""Poses on which :class:`PoseScan` checks, when built, that its arithmetic gives einsum's numbers."""

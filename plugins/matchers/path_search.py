@@ -76,7 +76,7 @@ import networkx as nx
 import numpy as np
 
 from plugins.lib.attention import movement_weights
-from plugins.lib.pose_distance import path_distance, pose_distance
+from plugins.lib.pose_distance import PoseScan, path_distance, pose_distance
 from plugins.lib.pose_index import PoseIndex
 from plugins.lib.travel import body_velocity, travel_part
 from toolkit import Match, Matcher, Motion, Parameter, hookimpl
@@ -207,6 +207,7 @@ class PathSearch(Matcher):
         self.pred = _fan(motor.graph, nodes, index, self.params["max_skip"], forward=False)
         self._cache_version = n
         self._index = None  # the spatial index of the nodes, built by the first search that uses it
+        self._scan = PoseScan(self.nodes_compared)  # the scan of every node (the planes, built once per graph)
         self.spreads = self._spreads(index) if self.params["spread"] > 0 else {}
 
     def _spreads(self, index: dict[str, int]) -> dict[str, float]:
@@ -343,9 +344,11 @@ class PathSearch(Matcher):
                 self._index = PoseIndex(nodes)
             start, costs = self._index.nearest(obs[mid], vis[mid], k)  # the scan's k nearest, in its order
         else:
-            if weights is None and vis[mid].all():  # every part seen: eq. 1 inline, as the beam's score does (the
-                diff = nodes - obs[mid]  # same numbers as pose_distance: its masked sum over n parts is the mean)
-                first = np.sqrt(np.einsum("cpi,cpi->cp", diff, diff)).mean(axis=1)
+            if weights is None and vis[mid].all():  # every part seen: eq. 1 over every part, as the beam's score
+                # computes it (the same numbers as pose_distance: its masked sum over n parts is the mean)
+                if getattr(self, "_scan", None) is None or self._scan.poses is not nodes:
+                    self._scan = PoseScan(nodes)
+                first = self._scan(obs[mid])
             else:
                 first = pose_distance(nodes, obs[mid], vis[mid], weights)
             if exclude is not None:
