@@ -258,7 +258,7 @@ class PathSearch(Matcher):
             velocity = np.full((n, 3), np.nan)
         else:
             velocity = body_velocity(motion.world, motion.positions, motion.visible, self.owner.body.root_index,
-                                     motion.fps)[idx]
+                                     motion.fps, frames=idx)
         known = np.isfinite(velocity).all(axis=1)
         part = np.where(known[:, None], travel_part(velocity, self.params["travel"]), 0.0)
         return np.concatenate([poses, part[:, None]], axis=1), np.concatenate([visible, known[:, None]], axis=1)
