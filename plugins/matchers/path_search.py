@@ -367,6 +367,9 @@ class PathSearch(Matcher):
 
     def _extend(self, paths, costs, obs, vis, frames, table, weights, exclude, *, append: bool, stays=None):
         nodes = self.nodes_compared
+        if getattr(self, "_scan", None) is None or self._scan.poses is not nodes:
+            self._scan = PoseScan(nodes)
+        scan = self._scan
         k, limit = self.params["k"], self.params["max_stay"]
         # samples in a row each path has stayed on the end node it grows from
         stays = np.zeros(len(paths), dtype=int) if stays is None else stays
@@ -377,8 +380,7 @@ class PathSearch(Matcher):
 
             def score(cand, t=t, seen=seen):
                 if seen.all() and weights is None:  # the hot loop of the search: eq. 1 over every part, inline
-                    diff = nodes[cand] - obs[t]  # (pose_distance's arithmetic without its checks: the same numbers)
-                    return np.sqrt(np.einsum("cpi,cpi->cp", diff, diff)).mean(axis=1)
+                    return scan(obs[t], cand)  # (pose_distance's arithmetic without its checks: the same numbers)
                 if seen.all():
                     return pose_distance(nodes[cand], obs[t], None, weights)
                 if seen.any():  # eq. 1 over the parts seen in this sample: the mask is the same for every candidate,
