@@ -88,6 +88,9 @@ class PoseScan:
         self.poses = poses
         self._x, self._y, self._z = (np.ascontiguousarray(poses[..., i]) for i in range(3))
         self._buffers = np.empty((2, *poses.shape[:2]))
+        self.finite = bool(np.isfinite(poses).all())
+        self._scale = float(np.abs(poses).max(initial=0.0)) if self.finite else np.inf
+        self._single = None  # the planes in single precision and their buffers, made by the first approximate()
         self.planes = True
         if len(poses):  # the check: a query that is none of the poses (their mean, moved), on the first poses
             few = poses[:SCAN_CHECK]
@@ -132,6 +135,42 @@ class PoseScan:
         np.add(s, b, out=s)
         np.sqrt(s, out=s)
         return s.mean(axis=1)
+
+    def approximate(self, query: np.ndarray) -> tuple[np.ndarray, float] | None:
+        """eq. 1 over every part from ``query`` (P, 3) to each pose computed in single precision, (N,), and a bound
+        of its error: every pose's exact distance (:meth:`__call__`) lies within the bound of its approximation.
+        ``None`` when a pose or the query has a coordinate that is not finite (no bound holds).
+
+        The bound: with u = 2**-24 and M the largest magnitude of a coordinate of the poses plus that of the query,
+        each coordinate rounded to single precision and the difference rounded are within 3uM of the exact
+        difference, each part's norm (a length of at most 2·3**0.5·M: the squares, two sums and a square root)
+        within 15uM of the exact norm, and the sum of the P norms (any order) within (P - 1)u times their total, so
+        the sum is within uM(15P + 3.5P²) of the exact sum; the mean (times 1/P, both rounded) within uM(22 + 3.5P).
+        Twice that (rounded up),
+        plus 1e-9 of the largest distance (the exact distance's own rounding), is returned: the caller compares an
+        approximation against another plus twice the bound."""
+        query = np.asarray(query, dtype=float)
+        if not self.finite or not np.isfinite(query).all() or not self.poses.shape[1]:
+            return None
+        if self._single is None:
+            self._single = (self._x.astype(np.float32), self._y.astype(np.float32), self._z.astype(np.float32),
+                            np.empty((2, *self.poses.shape[:2]), dtype=np.float32),
+                            np.full(self.poses.shape[1], 1.0 / self.poses.shape[1], dtype=np.float32))
+        x, y, z, (s, b), share = self._single
+        q = query.astype(np.float32)
+        np.subtract(x, q[:, 0], out=s)
+        np.multiply(s, s, out=s)
+        np.subtract(z, q[:, 2], out=b)
+        np.multiply(b, b, out=b)
+        np.add(s, b, out=s)
+        np.subtract(y, q[:, 1], out=b)
+        np.multiply(b, b, out=b)
+        np.add(s, b, out=s)
+        np.sqrt(s, out=s)
+        mean = (s @ share).astype(float)  # the sum of the norms over P, any order (the bound allows it)
+        parts = self.poses.shape[1]
+        top = self._scale + float(np.abs(query).max())
+        return mean, 2.0 * 2.0**-24 * top * (22 + 4 * parts) + 1e-9 * float(mean.max(initial=0.0))
 
 
 SCAN_CHECK = 256

@@ -199,6 +199,7 @@ class PathSearch(Matcher):
         _, self.label_ids = np.unique(self.labels.astype(str), return_inverse=True)  # a number per movement
         self._by_label = np.argsort(self.label_ids, kind="stable")  # the nodes grouped by movement, in node order
         self._label_starts = np.flatnonzero(np.diff(self.label_ids[self._by_label], prepend=-1))
+        self._label_sizes = np.diff(self._label_starts, append=len(nodes))
         self.nodes_compared = motor.node_root_relative
         if self.params["travel"] > 0:  # travel: one more part of every node
             self.nodes_compared = np.concatenate(
@@ -348,7 +349,9 @@ class PathSearch(Matcher):
                 # computes it (the same numbers as pose_distance: its masked sum over n parts is the mean)
                 if getattr(self, "_scan", None) is None or self._scan.poses is not nodes:
                     self._scan = PoseScan(nodes)
-                first = self._scan(obs[mid])
+                first = self._screened(obs[mid], k) if exclude is None else None
+                if first is None:
+                    first = self._scan(obs[mid])
             else:
                 first = pose_distance(nodes, obs[mid], vis[mid], weights)
             if exclude is not None:
@@ -411,6 +414,35 @@ class PathSearch(Matcher):
             row = parent[row]
         grown = np.stack(grown[::-1], axis=1)  # (B, samples) in the order the samples were taken
         return (np.hstack([paths[row], grown]) if append else np.hstack([grown[:, ::-1], paths[row]])), costs
+
+    def _screened(self, query: np.ndarray, k: int) -> np.ndarray | None:
+        """Every node's eq. 1 distance to ``query`` (every part seen) as :meth:`_starts` needs it: exact (the
+        scan's numbers) for the nodes that can be start nodes, infinite for the rest; ``None`` where the screen does
+        not apply (a coordinate not finite, or no more nodes than ``k``).
+
+        All nodes are measured in single precision first (:meth:`PoseScan.approximate`, with a bound ``e`` of its
+        error); a node can be among the k nearest (or tied with the k-th) only if its approximation is within
+        ``2e`` of the k-th smallest approximation, and, with ``per_movement``, its movement's nearest only if within
+        ``2e`` of its movement's smallest. Those few are measured again with the scan's arithmetic. :meth:`_starts`
+        then chooses from them exactly as from the full scan: each of its choices (the k best, each movement's
+        nearest, their ties) is a node within those margins, and every other node is farther than it."""
+        n = len(self.nodes_compared)
+        if n <= k:
+            return None
+        screen = self._scan.approximate(query)
+        if screen is None:
+            return None
+        near, error = screen
+        margin = 2.0 * error
+        wanted = near <= np.partition(near, k - 1)[k - 1] + margin
+        if self.params["per_movement"]:
+            grouped = near[self._by_label]
+            least = np.minimum.reduceat(grouped, self._label_starts)
+            wanted[self._by_label[grouped <= np.repeat(least + margin, self._label_sizes)]] = True
+        rows = np.flatnonzero(wanted)
+        first = np.full(n, np.inf)
+        first[rows] = self._scan(query, rows)
+        return first
 
     def _starts(self, first: np.ndarray, k: int) -> np.ndarray:
         """``_best(np.argsort(first, kind="stable"), np.arange(N), k)`` without sorting all N nodes: the start nodes
