@@ -196,7 +196,9 @@ class PathSearch(Matcher):
         index = {node: i for i, node in enumerate(nodes)}
         self.node_names = nodes
         self.labels = np.array([motor.movement_of(nd) or "" for nd in nodes], dtype=object)
-        _, self.label_ids = np.unique(self.labels.astype(str), return_inverse=True)  # a number per movement
+        self._label_names, self.label_ids = np.unique(self.labels.astype(str), return_inverse=True)  # a number per
+        # movement, in the order of the names (so np.unique over numbers ranks as over names); hubs' "" comes first
+        self._hub_id = 0 if len(self._label_names) and self._label_names[0] == "" else -1
         self._by_label = np.argsort(self.label_ids, kind="stable")  # the nodes grouped by movement, in node order
         self._label_starts = np.flatnonzero(np.diff(self.label_ids[self._by_label], prepend=-1))
         self._label_sizes = np.diff(self._label_starts, append=len(nodes))
@@ -278,13 +280,14 @@ class PathSearch(Matcher):
         path, _, evidence = self.search(obs, vis, weights)  # the beam's eq. 3 cost: recomputed below by the one formula
         if path is None:
             return Match.unknown(reason="nothing visible")
-        labels = self.labels[path]
-        voting = labels[labels != ""]
+        ids = self.label_ids[path]
+        voting = ids[ids != self._hub_id]  # the movements' numbers: hubs do not vote
         mean = path_distance(obs, self.nodes_compared[path], vis, weights) / max(evidence, 1)  # eq. 3 per sample
         details: dict[str, Any] = {"mean_distance": mean, "samples": len(path)}
         if voting.size == 0:
             return Match.unknown(reason="only hub poses", path=tuple(self.node_names[i] for i in path), **details)
-        names, counts = np.unique(voting, return_counts=True)
+        numbers, counts = np.unique(voting, return_counts=True)
+        names = self._label_names[numbers]  # the names in their order, as np.unique over the names gives them
         best = int(np.argmax(counts))
         movement, share = str(names[best]), counts[best] / voting.size
         details["votes"] = {str(n): int(c) for n, c in zip(names, counts)}
@@ -529,6 +532,9 @@ class Fan(NamedTuple):
     """Compressed rows (indptr, sorted node indices), row ``w * (max_skip + 1) + d``: the nodes at exactly ``d``
     steps from wide node number ``w``."""
     max_skip: int
+    padded: np.ndarray | None = None
+    """(N, W) each node's whole reach (``full``'s row) padded with -1 to the longest row W, when no node is long and
+    W is at most :data:`LONG_ROW`: a beam step lists its candidates with one indexing."""
 
 
 WIDE = 8
@@ -596,7 +602,13 @@ def _fan(graph, nodes, index, max_skip: int, *, forward: bool) -> Fan:
     np.cumsum([len(r) for r in first], out=indptr[1:])
     wide = (indptr, np.array([w for r in first for w in r], dtype=np.intp),
             np.array([d for r in dist for d in r], dtype=np.intp))
-    return Fan(full, long, _rows(local), wide, _rows(rings), max_skip)
+    padded = None
+    widths = np.diff(full[0])
+    if not long.any() and widths.max(initial=0) <= LONG_ROW:
+        padded = np.full((len(nodes), widths.max(initial=0)), -1, dtype=np.intp)
+        padded[np.repeat(np.arange(len(nodes)), widths), np.arange(len(full[1])) - np.repeat(full[0][:-1], widths)] = \
+            full[1]
+    return Fan(full, long, _rows(local), wide, _rows(rings), max_skip, padded)
 
 
 def _candidates(fan: Fan, ends: np.ndarray, costs: np.ndarray, score) -> tuple[np.ndarray, np.ndarray]:
@@ -610,6 +622,10 @@ def _candidates(fan: Fan, ends: np.ndarray, costs: np.ndarray, score) -> tuple[n
     of ``h``'s ring), the lowest beam index (every total infinite), and as many more as there are paths that end in
     the ring (the one pair whose stay may be barred). Near a hub every movement's first nodes are then listed once
     or twice instead of once per path that reaches the hub."""
+    if fan.padded is not None:  # every row short, at most LONG_ROW: one indexing (the same pairs in the same order)
+        rows = fan.padded[ends]
+        listed = rows >= 0
+        return np.nonzero(listed)[0], rows[listed]
     long = fan.long[ends]
     if not long.any():  # every row short: listed whole
         return _gather(fan.full, ends)
