@@ -152,20 +152,15 @@ class PoseScan:
         query = np.asarray(query, dtype=float)
         if not self.finite or not np.isfinite(query).all() or not self.poses.shape[1]:
             return None
-        if self._single is None:
-            self._single = (self._x.astype(np.float32), self._y.astype(np.float32), self._z.astype(np.float32),
-                            np.empty((2, *self.poses.shape[:2]), dtype=np.float32),
+        if self._single is None:  # the three planes together (3, N, P), a buffer of their shape, 1/P
+            single = np.stack([self._x, self._y, self._z]).astype(np.float32)
+            self._single = (single, np.empty_like(single),
                             np.full(self.poses.shape[1], 1.0 / self.poses.shape[1], dtype=np.float32))
-        x, y, z, (s, b), share = self._single
-        q = query.astype(np.float32)
-        np.subtract(x, q[:, 0], out=s)
-        np.multiply(s, s, out=s)
-        np.subtract(z, q[:, 2], out=b)
-        np.multiply(b, b, out=b)
-        np.add(s, b, out=s)
-        np.subtract(y, q[:, 1], out=b)
-        np.multiply(b, b, out=b)
-        np.add(s, b, out=s)
+        single, d, share = self._single
+        np.subtract(single, query.T.astype(np.float32)[:, None, :], out=d)
+        np.multiply(d, d, out=d)
+        s = np.add(d[0], d[1], out=d[0])
+        np.add(s, d[2], out=s)
         np.sqrt(s, out=s)
         mean = (s @ share).astype(float)  # the sum of the norms over P, any order (the bound allows it)
         parts = self.poses.shape[1]

@@ -348,19 +348,19 @@ class PathSearch(Matcher):
                 self._index = PoseIndex(nodes)
             start, costs = self._index.nearest(obs[mid], vis[mid], k)  # the scan's k nearest, in its order
         else:
-            if weights is None and vis[mid].all():  # every part seen: eq. 1 over every part, as the beam's score
-                # computes it (the same numbers as pose_distance: its masked sum over n parts is the mean)
-                if getattr(self, "_scan", None) is None or self._scan.poses is not nodes:
-                    self._scan = PoseScan(nodes)
-                first = self._screened(obs[mid], k) if exclude is None else None
-                if first is None:
-                    first = self._scan(obs[mid])
+            every = weights is None and vis[mid].all()  # every part seen: eq. 1 over every part, as the beam's
+            # score computes it (the same numbers as pose_distance: its masked sum over n parts is the mean)
+            if every and (getattr(self, "_scan", None) is None or self._scan.poses is not nodes):
+                self._scan = PoseScan(nodes)
+            screened = self._screened(obs[mid], k) if every and exclude is None else None
+            if screened is not None:
+                start, costs = screened
             else:
-                first = pose_distance(nodes, obs[mid], vis[mid], weights)
-            if exclude is not None:
-                first = np.where(exclude, np.inf, first)
-            start = self._starts(first, k)
-            costs = first[start]
+                first = self._scan(obs[mid]) if every else pose_distance(nodes, obs[mid], vis[mid], weights)
+                if exclude is not None:
+                    first = np.where(exclude, np.inf, first)
+                start = self._starts(first, k)
+                costs = first[start]
         # beams: array of paths (B, length) and costs (B,)
         paths = start[:, None]
         paths, costs = self._extend(paths, costs, obs, vis, range(mid + 1, n), self.succ, weights, exclude, append=True)
@@ -383,11 +383,12 @@ class PathSearch(Matcher):
         steps = []  # per sample: each kept path's new node and the path it grew from (back-pointers)
         for t in frames:
             seen = vis[t]
+            every = seen.all()
 
-            def score(cand, t=t, seen=seen):
-                if seen.all() and weights is None:  # the hot loop of the search: eq. 1 over every part, inline
+            def score(cand, t=t, seen=seen, every=every):
+                if every and weights is None:  # the hot loop of the search: eq. 1 over every part, inline
                     return scan(obs[t], cand)  # (pose_distance's arithmetic without its checks: the same numbers)
-                if seen.all():
+                if every:
                     return pose_distance(nodes[cand], obs[t], None, weights)
                 if seen.any():  # eq. 1 over the parts seen in this sample: the mask is the same for every candidate,
                     # so the seen parts are taken first and pose_distance needs no mask
@@ -405,12 +406,15 @@ class PathSearch(Matcher):
             total = costs[beam] + step
             order = np.argsort(total, kind="stable")
             # k best, one path per end node (distinct hypotheses): the first time each end node comes in the order
-            _, first = np.unique(cand[order], return_index=True)
+            first = _firsts(cand[order])
             keep = self._best(order[np.sort(first)], cand, k)
             steps.append((cand[keep], beam[keep]))
             ends, costs, stays = cand[keep], total[keep], stay[keep]
         if not steps:
             return paths, costs
+        if len(steps) == 1:  # one sample: the kept paths' nodes and the paths they grew from, as they are
+            grown, row = steps[0][0][:, None], steps[0][1]
+            return (np.hstack([paths[row], grown]) if append else np.hstack([grown, paths[row]])), costs
         row, grown = np.arange(len(ends)), []
         for node, parent in reversed(steps):  # follow the back-pointers from the last sample to the first
             grown.append(node[row])
@@ -418,17 +422,18 @@ class PathSearch(Matcher):
         grown = np.stack(grown[::-1], axis=1)  # (B, samples) in the order the samples were taken
         return (np.hstack([paths[row], grown]) if append else np.hstack([grown[:, ::-1], paths[row]])), costs
 
-    def _screened(self, query: np.ndarray, k: int) -> np.ndarray | None:
-        """Every node's eq. 1 distance to ``query`` (every part seen) as :meth:`_starts` needs it: exact (the
-        scan's numbers) for the nodes that can be start nodes, infinite for the rest; ``None`` where the screen does
-        not apply (a coordinate not finite, or no more nodes than ``k``).
+    def _screened(self, query: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray] | None:
+        """:meth:`_starts` of every node's eq. 1 distance to ``query`` (every part seen) and the start nodes' distances
+        (the scan's numbers), measuring few nodes with the scan's arithmetic; ``None`` where the screen does not
+        apply (a coordinate not finite, or no more nodes than ``k``).
 
         All nodes are measured in single precision first (:meth:`PoseScan.approximate`, with a bound ``e`` of its
         error); a node can be among the k nearest (or tied with the k-th) only if its approximation is within
-        ``2e`` of the k-th smallest approximation, and, with ``per_movement``, its movement's nearest only if within
-        ``2e`` of its movement's smallest. Those few are measured again with the scan's arithmetic. :meth:`_starts`
-        then chooses from them exactly as from the full scan: each of its choices (the k best, each movement's
-        nearest, their ties) is a node within those margins, and every other node is farther than it."""
+        ``2e`` of the k-th smallest approximation, and, with ``per_movement``, its movement's nearest (or tied with
+        it) only if within ``2e`` of its movement's smallest. Those few (every movement keeps at least its nearest
+        by approximation) are measured again with the scan's arithmetic, and chosen among as :meth:`_starts`
+        chooses among all: the k best by (distance, node), each movement's nearest (the lowest node on ties), the
+        union ranked by (distance, node). Every other node is farther than each of those choices."""
         n = len(self.nodes_compared)
         if n <= k:
             return None
@@ -442,10 +447,19 @@ class PathSearch(Matcher):
             grouped = near[self._by_label]
             least = np.minimum.reduceat(grouped, self._label_starts)
             wanted[self._by_label[grouped <= np.repeat(least + margin, self._label_sizes)]] = True
-        rows = np.flatnonzero(wanted)
-        first = np.full(n, np.inf)
-        first[rows] = self._scan(query, rows)
-        return first
+        rows = np.flatnonzero(wanted)  # ascending: node order
+        first = self._scan(query, rows)
+        kth = np.partition(first, k - 1)[k - 1]
+        chosen = np.flatnonzero(first <= kth)  # positions in rows; the k best and the nodes tied with the k-th
+        chosen = chosen[np.lexsort((chosen, first[chosen]))][:k]  # by (distance, node): rows ascend with positions
+        if self.params["per_movement"]:
+            labels = self.label_ids[rows]
+            by = np.lexsort((rows, first, labels))  # by movement, then (distance, node): each movement's nearest first
+            head = np.ones(len(by), dtype=bool)
+            head[1:] = labels[by[1:]] != labels[by[:-1]]
+            chosen = np.union1d(chosen, by[head])
+            chosen = chosen[np.lexsort((chosen, first[chosen]))]
+        return rows[chosen], first[chosen]
 
     def _starts(self, first: np.ndarray, k: int) -> np.ndarray:
         """``_best(np.argsort(first, kind="stable"), np.arange(N), k)`` without sorting all N nodes: the start nodes
@@ -476,7 +490,7 @@ class PathSearch(Matcher):
         each movement's nodes among them, in rank order."""
         if not self.params["per_movement"]:
             return ranked[:k]
-        _, each = np.unique(self.label_ids[cand[ranked]], return_index=True)
+        each = _firsts(self.label_ids[cand[ranked]])
         chosen = np.zeros(len(ranked), dtype=bool)
         chosen[:k] = True
         chosen[each] = True
@@ -666,6 +680,18 @@ def _candidates(fan: Fan, ends: np.ndarray, costs: np.ndarray, score) -> tuple[n
     beam, cand = np.concatenate(beams), np.concatenate(nodes)
     order = np.lexsort((cand, beam))
     return beam[order], cand[order]
+
+
+def _firsts(values: np.ndarray) -> np.ndarray:
+    """Where each distinct value of ``values`` (1-D) comes first, in the order of the values:
+    ``np.unique(values, return_index=True)[1]`` as NumPy computes it (a stable sort, the head of each run), without
+    its other work."""
+    perm = np.argsort(values, kind="stable")
+    ordered = values[perm]
+    head = np.empty(len(ordered), dtype=bool)
+    head[:1] = True
+    np.not_equal(ordered[1:], ordered[:-1], out=head[1:])
+    return perm[head]
 
 
 def _gather(table: tuple[np.ndarray, np.ndarray], ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
