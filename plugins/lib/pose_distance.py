@@ -120,7 +120,7 @@ class PoseScan:
             s = np.add(d[..., 0], d[..., 2])
             np.add(s, d[..., 1], out=s)
             np.sqrt(s, out=s)
-            return s.mean(axis=1)
+            return _mean(s)
         if not self.planes:
             d = self.poses - query
             return np.sqrt(np.einsum("cpi,cpi->cp", d, d)).mean(axis=1)
@@ -134,7 +134,7 @@ class PoseScan:
         np.multiply(b, b, out=b)
         np.add(s, b, out=s)
         np.sqrt(s, out=s)
-        return s.mean(axis=1)
+        return _mean(s)
 
     def approximate(self, query: np.ndarray) -> tuple[np.ndarray, float] | None:
         """eq. 1 over every part from ``query`` (P, 3) to each pose computed in single precision, (N,), and a bound
@@ -166,6 +166,14 @@ class PoseScan:
         parts = self.poses.shape[1]
         top = self._scale + float(np.abs(query).max())
         return mean, 2.0 * 2.0**-24 * top * (22 + 4 * parts) + 1e-9 * float(mean.max(initial=0.0))
+
+
+def _mean(s: np.ndarray) -> np.ndarray:
+    """``s.mean(axis=1)`` of a 2-D float array as NumPy computes it (``np.add.reduce`` over the axis, then a true
+    division by the count), without its set-up."""
+    out = np.add.reduce(s, axis=1)
+    out /= s.shape[1]
+    return out
 
 
 SCAN_CHECK = 256

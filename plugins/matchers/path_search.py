@@ -404,7 +404,7 @@ class PathSearch(Matcher):
             if limit > 0:
                 step = np.where(stay > limit, np.inf, step)
             total = costs[beam] + step
-            order = np.argsort(total, kind="stable")
+            order = total.argsort(kind="stable")
             # k best, one path per end node (distinct hypotheses): the first time each end node comes in the order
             first = _firsts(cand[order])
             keep = self._best(order[np.sort(first)], cand, k)
@@ -639,7 +639,7 @@ def _candidates(fan: Fan, ends: np.ndarray, costs: np.ndarray, score) -> tuple[n
     if fan.padded is not None:  # every row short, at most LONG_ROW: one indexing (the same pairs in the same order)
         rows = fan.padded[ends]
         listed = rows >= 0
-        return np.nonzero(listed)[0], rows[listed]
+        return listed.nonzero()[0], rows[listed]
     long = fan.long[ends]
     if not long.any():  # every row short: listed whole
         return _gather(fan.full, ends)
@@ -686,7 +686,7 @@ def _firsts(values: np.ndarray) -> np.ndarray:
     """Where each distinct value of ``values`` (1-D) comes first, in the order of the values:
     ``np.unique(values, return_index=True)[1]`` as NumPy computes it (a stable sort, the head of each run), without
     its other work."""
-    perm = np.argsort(values, kind="stable")
+    perm = values.argsort(kind="stable")
     ordered = values[perm]
     head = np.empty(len(ordered), dtype=bool)
     head[:1] = True
