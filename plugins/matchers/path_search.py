@@ -180,6 +180,7 @@ class PathSearch(Matcher):
             provides(owner.motor, Travelling, needed_by="path-search's travel", what="a posegraph that knows where "
                      "its nodes travel", key=("travel",), expected="travel = 0, or a motor system with node_travel "
                      "(posegraph)")
+            import scipy.ndimage  # noqa: F401  (travel's filter: imported at set-up, not in the first match)
         if self.params["spread"] > 0:
             provides(owner.motor, Takes, needed_by="path-search's spread", what="a posegraph that knows its takes",
                      key=("spread",), expected="spread = 0, or a motor system with takes() (posegraph)")
