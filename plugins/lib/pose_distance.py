@@ -146,23 +146,23 @@ class PoseScan:
         difference, each part's norm (a length of at most 2·3**0.5·M: the squares, two sums and a square root)
         within 15uM of the exact norm, and the sum of the P norms (any order) within (P - 1)u times their total, so
         the sum is within uM(15P + 3.5P²) of the exact sum; the mean (times 1/P, both rounded) within uM(22 + 3.5P).
-        Twice that (rounded up),
-        plus 1e-9 of the largest distance (the exact distance's own rounding), is returned: the caller compares an
-        approximation against another plus twice the bound."""
+        Twice uM(22 + 4P), plus 1e-9 of the largest distance (the exact distance's own rounding), is returned: the
+        caller compares an approximation against another plus twice the bound. The single-precision planes are laid
+        out (3, P, N), so each ufunc's inner loop runs over the poses, and are made by the first call."""
         query = np.asarray(query, dtype=float)
         if not self.finite or not np.isfinite(query).all() or not self.poses.shape[1]:
             return None
-        if self._single is None:  # the three planes together (3, N, P), a buffer of their shape, 1/P
-            single = np.stack([self._x, self._y, self._z]).astype(np.float32)
+        if self._single is None:  # the coordinates as (3, P, N) planes: each ufunc's inner loop runs over the N poses
+            single = np.ascontiguousarray(self.poses.transpose(2, 1, 0), dtype=np.float32)
             self._single = (single, np.empty_like(single),
                             np.full(self.poses.shape[1], 1.0 / self.poses.shape[1], dtype=np.float32))
         single, d, share = self._single
-        np.subtract(single, query.T.astype(np.float32)[:, None, :], out=d)
+        np.subtract(single, query.T.astype(np.float32)[:, :, None], out=d)
         np.multiply(d, d, out=d)
         s = np.add(d[0], d[1], out=d[0])
         np.add(s, d[2], out=s)
         np.sqrt(s, out=s)
-        mean = (s @ share).astype(float)  # the sum of the norms over P, any order (the bound allows it)
+        mean = (share @ s).astype(float)  # the sum of the norms over P, any order (the bound allows it)
         parts = self.poses.shape[1]
         top = self._scale + float(np.abs(query).max())
         return mean, 2.0 * 2.0**-24 * top * (22 + 4 * parts) + 1e-9 * float(mean.max(initial=0.0))
