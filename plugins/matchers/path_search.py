@@ -58,7 +58,11 @@ poses come from a spatial index (:class:`plugins.lib.pose_index.PoseIndex`, buil
 after the graph learns), which gives exactly the scan's k nearest in the scan's order. Below that size the scan is
 as fast. The scan is kept, exact by construction, where the index would have to answer another question: with
 attention (weights), with nodes excluded (the spread between takes), and with ``per_movement`` (each movement's
-nearest pose, however far).
+nearest pose, however far). Where every part of the middle sample is seen, that scan is screened
+(:meth:`PathSearch._screened`): every node measured in single precision with a bound of the error
+(:meth:`plugins.lib.pose_distance.PoseScan.approximate`), and only the nodes that can be chosen (within twice the
+bound of the k-th nearest or of their movement's nearest) measured again with the scan's arithmetic, so the start
+nodes and their costs are the scan's to the last bit.
 
 Hubs (issue 22): a path that ends near a hub reaches, through it, the first nodes of every movement, and with
 ``per_movement`` (one path per movement in the beam) a beam step would list those nodes once per path near the hub:
