@@ -291,7 +291,9 @@ class PathSearch(Matcher):
         details: dict[str, Any] = {"mean_distance": mean, "samples": len(path)}
         if voting.size == 0:
             return Match.unknown(reason="only hub poses", path=tuple(self.node_names[i] for i in path), **details)
-        numbers, counts = np.unique(voting, return_counts=True)
+        counts = np.bincount(voting)  # np.unique(voting, return_counts=True): the numbers voted for, ascending
+        numbers = counts.nonzero()[0]
+        counts = counts[numbers]
         names = self._label_names[numbers]  # the names in their order, as np.unique over the names gives them
         best = int(np.argmax(counts))
         movement, share = str(names[best]), counts[best] / voting.size
@@ -462,7 +464,10 @@ class PathSearch(Matcher):
             by = np.lexsort((rows, first, labels))  # by movement, then (distance, node): each movement's nearest first
             head = np.ones(len(by), dtype=bool)
             head[1:] = labels[by[1:]] != labels[by[:-1]]
-            chosen = np.union1d(chosen, by[head])
+            union = np.zeros(len(rows), dtype=bool)  # np.union1d of the two: the positions, ascending
+            union[chosen] = True
+            union[by[head]] = True
+            chosen = union.nonzero()[0]
             chosen = chosen[np.lexsort((chosen, first[chosen]))]
         return rows[chosen], first[chosen]
 
