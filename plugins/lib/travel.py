@@ -50,30 +50,44 @@ def frame_rotation(world: np.ndarray, local: np.ndarray, visible: np.ndarray, ro
 
 
 def body_velocity(world: np.ndarray, local: np.ndarray, visible: np.ndarray, root: int, fps: float,
-                  window: float = 0.25) -> np.ndarray:
+                  window: float = 0.25, frames: np.ndarray | None = None) -> np.ndarray:
     """The root's velocity in the body's own frame (F, 3), m/s; NaN where the root or the facing is not known.
 
     The world velocity is the centred difference of the root's world position, averaged over ``window`` seconds
     (a step's sway left and right cancels; a change of pace within a second is kept), then turned by each frame's
-    :func:`frame_rotation`. A motion of one frame has no velocity (NaN).
+    :func:`frame_rotation`. A motion of one frame has no velocity (NaN). With ``frames`` (indices), only those
+    frames' rows (len(frames), 3): the same numbers as ``body_velocity(...)[frames]``, with the facing found at those
+    frames only (path search samples a segment at its node rate).
     """
     from scipy.ndimage import uniform_filter1d
 
     world = np.asarray(world, dtype=float)
     n = len(world)
-    out = np.full((n, 3), np.nan)
+    out = np.full((n if frames is None else len(frames), 3), np.nan)
     if n < 2:
         return out
     root_seen = np.asarray(visible, dtype=bool)[:, root] & np.isfinite(world[:, root]).all(axis=1)
     if root_seen.sum() < 2:
         return out
-    frames = np.arange(n)
-    track = np.stack([np.interp(frames, frames[root_seen], world[root_seen, root, k]) for k in range(3)], axis=1)
-    velocity = np.gradient(track, axis=0) * fps
+    if root_seen.all():  # np.interp at its own sample points gives those samples back: no call needed
+        track = world[:, root]
+    else:
+        steps = np.arange(n)
+        track = np.stack([np.interp(steps, steps[root_seen], world[root_seen, root, k]) for k in range(3)], axis=1)
+    velocity = np.empty((n, 3))  # np.gradient(track, axis=0) (unit spacing, first-order edges), the same numbers
+    velocity[1:-1] = (track[2:] - track[:-2]) / 2.0
+    velocity[0] = track[1] - track[0]
+    velocity[-1] = track[-1] - track[-2]
+    velocity *= fps
     taps = max(1, int(round(window * fps)))
     if taps > 1:
         velocity = uniform_filter1d(velocity, taps, axis=0, mode="nearest")
-    angle = frame_rotation(world, local, visible, root)
+    if frames is None:
+        angle = frame_rotation(world, local, visible, root)
+    else:  # the facing frame by frame: only where asked
+        frames = np.asarray(frames, dtype=np.intp)
+        velocity, root_seen = velocity[frames], root_seen[frames]
+        angle = frame_rotation(world[frames], np.asarray(local)[frames], np.asarray(visible)[frames], root)
     horizontal = (velocity[:, 0] + 1j * velocity[:, 2]) * np.exp(1j * angle)
     out[:, 0], out[:, 1], out[:, 2] = horizontal.real, velocity[:, 1], horizontal.imag
     out[~root_seen | ~np.isfinite(angle)] = np.nan

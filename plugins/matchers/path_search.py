@@ -58,7 +58,11 @@ poses come from a spatial index (:class:`plugins.lib.pose_index.PoseIndex`, buil
 after the graph learns), which gives exactly the scan's k nearest in the scan's order. Below that size the scan is
 as fast. The scan is kept, exact by construction, where the index would have to answer another question: with
 attention (weights), with nodes excluded (the spread between takes), and with ``per_movement`` (each movement's
-nearest pose, however far).
+nearest pose, however far). Where every part of the middle sample is seen, that scan is screened
+(:meth:`PathSearch._screened`): every node measured in single precision with a bound of the error
+(:meth:`plugins.lib.pose_distance.PoseScan.approximate`), and only the nodes that can be chosen (within twice the
+bound of the k-th nearest or of their movement's nearest) measured again with the scan's arithmetic, so the start
+nodes and their costs are the scan's to the last bit.
 
 Hubs (issue 22): a path that ends near a hub reaches, through it, the first nodes of every movement, and with
 ``per_movement`` (one path per movement in the beam) a beam step would list those nodes once per path near the hub:
@@ -76,7 +80,7 @@ import networkx as nx
 import numpy as np
 
 from plugins.lib.attention import movement_weights
-from plugins.lib.pose_distance import path_distance, pose_distance
+from plugins.lib.pose_distance import PoseScan, path_distance, pose_distance
 from plugins.lib.pose_index import PoseIndex
 from plugins.lib.travel import body_velocity, travel_part
 from toolkit import Match, Matcher, Motion, Parameter, hookimpl
@@ -180,6 +184,7 @@ class PathSearch(Matcher):
             provides(owner.motor, Travelling, needed_by="path-search's travel", what="a posegraph that knows where "
                      "its nodes travel", key=("travel",), expected="travel = 0, or a motor system with node_travel "
                      "(posegraph)")
+            import scipy.ndimage  # noqa: F401  (travel's filter: imported at set-up, not in the first match)
         if self.params["spread"] > 0:
             provides(owner.motor, Takes, needed_by="path-search's spread", what="a posegraph that knows its takes",
                      key=("spread",), expected="spread = 0, or a motor system with takes() (posegraph)")
@@ -196,9 +201,12 @@ class PathSearch(Matcher):
         index = {node: i for i, node in enumerate(nodes)}
         self.node_names = nodes
         self.labels = np.array([motor.movement_of(nd) or "" for nd in nodes], dtype=object)
-        _, self.label_ids = np.unique(self.labels.astype(str), return_inverse=True)  # a number per movement
+        self._label_names, self.label_ids = np.unique(self.labels.astype(str), return_inverse=True)  # a number per
+        # movement, in the order of the names (so np.unique over numbers ranks as over names); hubs' "" comes first
+        self._hub_id = 0 if len(self._label_names) and self._label_names[0] == "" else -1
         self._by_label = np.argsort(self.label_ids, kind="stable")  # the nodes grouped by movement, in node order
         self._label_starts = np.flatnonzero(np.diff(self.label_ids[self._by_label], prepend=-1))
+        self._label_sizes = np.diff(self._label_starts, append=len(nodes))
         self.nodes_compared = motor.node_root_relative
         if self.params["travel"] > 0:  # travel: one more part of every node
             self.nodes_compared = np.concatenate(
@@ -207,6 +215,7 @@ class PathSearch(Matcher):
         self.pred = _fan(motor.graph, nodes, index, self.params["max_skip"], forward=False)
         self._cache_version = n
         self._index = None  # the spatial index of the nodes, built by the first search that uses it
+        self._scan = PoseScan(self.nodes_compared)  # the scan of every node (the planes, built once per graph)
         self.spreads = self._spreads(index) if self.params["spread"] > 0 else {}
 
     def _spreads(self, index: dict[str, int]) -> dict[str, float]:
@@ -257,7 +266,7 @@ class PathSearch(Matcher):
             velocity = np.full((n, 3), np.nan)
         else:
             velocity = body_velocity(motion.world, motion.positions, motion.visible, self.owner.body.root_index,
-                                     motion.fps)[idx]
+                                     motion.fps, frames=idx)
         known = np.isfinite(velocity).all(axis=1)
         part = np.where(known[:, None], travel_part(velocity, self.params["travel"]), 0.0)
         return np.concatenate([poses, part[:, None]], axis=1), np.concatenate([visible, known[:, None]], axis=1)
@@ -276,13 +285,16 @@ class PathSearch(Matcher):
         path, _, evidence = self.search(obs, vis, weights)  # the beam's eq. 3 cost: recomputed below by the one formula
         if path is None:
             return Match.unknown(reason="nothing visible")
-        labels = self.labels[path]
-        voting = labels[labels != ""]
+        ids = self.label_ids[path]
+        voting = ids[ids != self._hub_id]  # the movements' numbers: hubs do not vote
         mean = path_distance(obs, self.nodes_compared[path], vis, weights) / max(evidence, 1)  # eq. 3 per sample
         details: dict[str, Any] = {"mean_distance": mean, "samples": len(path)}
         if voting.size == 0:
             return Match.unknown(reason="only hub poses", path=tuple(self.node_names[i] for i in path), **details)
-        names, counts = np.unique(voting, return_counts=True)
+        counts = np.bincount(voting)  # np.unique(voting, return_counts=True): the numbers voted for, ascending
+        numbers = counts.nonzero()[0]
+        counts = counts[numbers]
+        names = self._label_names[numbers]  # the names in their order, as np.unique over the names gives them
         best = int(np.argmax(counts))
         movement, share = str(names[best]), counts[best] / voting.size
         details["votes"] = {str(n): int(c) for n, c in zip(names, counts)}
@@ -343,15 +355,19 @@ class PathSearch(Matcher):
                 self._index = PoseIndex(nodes)
             start, costs = self._index.nearest(obs[mid], vis[mid], k)  # the scan's k nearest, in its order
         else:
-            if weights is None and vis[mid].all():  # every part seen: eq. 1 inline, as the beam's score does (the
-                diff = nodes - obs[mid]  # same numbers as pose_distance: its masked sum over n parts is the mean)
-                first = np.sqrt(np.einsum("cpi,cpi->cp", diff, diff)).mean(axis=1)
+            every = weights is None and vis[mid].all()  # every part seen: eq. 1 over every part, as the beam's
+            # score computes it (the same numbers as pose_distance: its masked sum over n parts is the mean)
+            if every and (getattr(self, "_scan", None) is None or self._scan.poses is not nodes):
+                self._scan = PoseScan(nodes)
+            screened = self._screened(obs[mid], k) if every and exclude is None else None
+            if screened is not None:
+                start, costs = screened
             else:
-                first = pose_distance(nodes, obs[mid], vis[mid], weights)
-            if exclude is not None:
-                first = np.where(exclude, np.inf, first)
-            start = self._starts(first, k)
-            costs = first[start]
+                first = self._scan(obs[mid]) if every else pose_distance(nodes, obs[mid], vis[mid], weights)
+                if exclude is not None:
+                    first = np.where(exclude, np.inf, first)
+                start = self._starts(first, k)
+                costs = first[start]
         # beams: array of paths (B, length) and costs (B,)
         paths = start[:, None]
         paths, costs = self._extend(paths, costs, obs, vis, range(mid + 1, n), self.succ, weights, exclude, append=True)
@@ -364,6 +380,9 @@ class PathSearch(Matcher):
 
     def _extend(self, paths, costs, obs, vis, frames, table, weights, exclude, *, append: bool, stays=None):
         nodes = self.nodes_compared
+        if getattr(self, "_scan", None) is None or self._scan.poses is not nodes:
+            self._scan = PoseScan(nodes)
+        scan = self._scan
         k, limit = self.params["k"], self.params["max_stay"]
         # samples in a row each path has stayed on the end node it grows from
         stays = np.zeros(len(paths), dtype=int) if stays is None else stays
@@ -371,12 +390,12 @@ class PathSearch(Matcher):
         steps = []  # per sample: each kept path's new node and the path it grew from (back-pointers)
         for t in frames:
             seen = vis[t]
+            every = seen.all()
 
-            def score(cand, t=t, seen=seen):
-                if seen.all() and weights is None:  # the hot loop of the search: eq. 1 over every part, inline
-                    diff = nodes[cand] - obs[t]  # (pose_distance's arithmetic without its checks: the same numbers)
-                    return np.sqrt(np.einsum("cpi,cpi->cp", diff, diff)).mean(axis=1)
-                if seen.all():
+            def score(cand, t=t, seen=seen, every=every):
+                if every and weights is None:  # the hot loop of the search: eq. 1 over every part, inline
+                    return scan(obs[t], cand)  # (pose_distance's arithmetic without its checks: the same numbers)
+                if every:
                     return pose_distance(nodes[cand], obs[t], None, weights)
                 if seen.any():  # eq. 1 over the parts seen in this sample: the mask is the same for every candidate,
                     # so the seen parts are taken first and pose_distance needs no mask
@@ -392,20 +411,65 @@ class PathSearch(Matcher):
             if limit > 0:
                 step = np.where(stay > limit, np.inf, step)
             total = costs[beam] + step
-            order = np.argsort(total, kind="stable")
+            order = total.argsort(kind="stable")
             # k best, one path per end node (distinct hypotheses): the first time each end node comes in the order
-            _, first = np.unique(cand[order], return_index=True)
+            first = _firsts(cand[order])
             keep = self._best(order[np.sort(first)], cand, k)
             steps.append((cand[keep], beam[keep]))
             ends, costs, stays = cand[keep], total[keep], stay[keep]
         if not steps:
             return paths, costs
+        if len(steps) == 1:  # one sample: the kept paths' nodes and the paths they grew from, as they are
+            grown, row = steps[0][0][:, None], steps[0][1]
+            return (np.hstack([paths[row], grown]) if append else np.hstack([grown, paths[row]])), costs
         row, grown = np.arange(len(ends)), []
         for node, parent in reversed(steps):  # follow the back-pointers from the last sample to the first
             grown.append(node[row])
             row = parent[row]
         grown = np.stack(grown[::-1], axis=1)  # (B, samples) in the order the samples were taken
         return (np.hstack([paths[row], grown]) if append else np.hstack([grown[:, ::-1], paths[row]])), costs
+
+    def _screened(self, query: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray] | None:
+        """:meth:`_starts` of every node's eq. 1 distance to ``query`` (every part seen) and the start nodes' distances
+        (the scan's numbers), measuring few nodes with the scan's arithmetic; ``None`` where the screen does not
+        apply (a coordinate not finite, or no more nodes than ``k``).
+
+        All nodes are measured in single precision first (:meth:`PoseScan.approximate`, with a bound ``e`` of its
+        error); a node can be among the k nearest (or tied with the k-th) only if its approximation is within
+        ``2e`` of the k-th smallest approximation, and, with ``per_movement``, its movement's nearest (or tied with
+        it) only if within ``2e`` of its movement's smallest. Those few (every movement keeps at least its nearest
+        by approximation) are measured again with the scan's arithmetic, and chosen among as :meth:`_starts`
+        chooses among all: the k best by (distance, node), each movement's nearest (the lowest node on ties), the
+        union ranked by (distance, node). Every other node is farther than each of those choices."""
+        n = len(self.nodes_compared)
+        if n <= k:
+            return None
+        screen = self._scan.approximate(query)
+        if screen is None:
+            return None
+        near, error = screen
+        margin = 2.0 * error
+        wanted = near <= np.partition(near, k - 1)[k - 1] + margin
+        if self.params["per_movement"]:
+            grouped = near[self._by_label]
+            least = np.minimum.reduceat(grouped, self._label_starts)
+            wanted[self._by_label[grouped <= np.repeat(least + margin, self._label_sizes)]] = True
+        rows = np.flatnonzero(wanted)  # ascending: node order
+        first = self._scan(query, rows)
+        kth = np.partition(first, k - 1)[k - 1]
+        chosen = np.flatnonzero(first <= kth)  # positions in rows; the k best and the nodes tied with the k-th
+        chosen = chosen[np.lexsort((chosen, first[chosen]))][:k]  # by (distance, node): rows ascend with positions
+        if self.params["per_movement"]:
+            labels = self.label_ids[rows]
+            by = np.lexsort((rows, first, labels))  # by movement, then (distance, node): each movement's nearest first
+            head = np.ones(len(by), dtype=bool)
+            head[1:] = labels[by[1:]] != labels[by[:-1]]
+            union = np.zeros(len(rows), dtype=bool)  # np.union1d of the two: the positions, ascending
+            union[chosen] = True
+            union[by[head]] = True
+            chosen = union.nonzero()[0]
+            chosen = chosen[np.lexsort((chosen, first[chosen]))]
+        return rows[chosen], first[chosen]
 
     def _starts(self, first: np.ndarray, k: int) -> np.ndarray:
         """``_best(np.argsort(first, kind="stable"), np.arange(N), k)`` without sorting all N nodes: the start nodes
@@ -436,7 +500,7 @@ class PathSearch(Matcher):
         each movement's nodes among them, in rank order."""
         if not self.params["per_movement"]:
             return ranked[:k]
-        _, each = np.unique(self.label_ids[cand[ranked]], return_index=True)
+        each = _firsts(self.label_ids[cand[ranked]])
         chosen = np.zeros(len(ranked), dtype=bool)
         chosen[:k] = True
         chosen[each] = True
@@ -492,6 +556,9 @@ class Fan(NamedTuple):
     """Compressed rows (indptr, sorted node indices), row ``w * (max_skip + 1) + d``: the nodes at exactly ``d``
     steps from wide node number ``w``."""
     max_skip: int
+    padded: np.ndarray | None = None
+    """(N, W) each node's whole reach (``full``'s row) padded with -1 to the longest row W, when no node is long and
+    W is at most :data:`LONG_ROW`: a beam step lists its candidates with one indexing."""
 
 
 WIDE = 8
@@ -559,7 +626,13 @@ def _fan(graph, nodes, index, max_skip: int, *, forward: bool) -> Fan:
     np.cumsum([len(r) for r in first], out=indptr[1:])
     wide = (indptr, np.array([w for r in first for w in r], dtype=np.intp),
             np.array([d for r in dist for d in r], dtype=np.intp))
-    return Fan(full, long, _rows(local), wide, _rows(rings), max_skip)
+    padded = None
+    widths = np.diff(full[0])
+    if not long.any() and widths.max(initial=0) <= LONG_ROW:
+        padded = np.full((len(nodes), widths.max(initial=0)), -1, dtype=np.intp)
+        padded[np.repeat(np.arange(len(nodes)), widths), np.arange(len(full[1])) - np.repeat(full[0][:-1], widths)] = \
+            full[1]
+    return Fan(full, long, _rows(local), wide, _rows(rings), max_skip, padded)
 
 
 def _candidates(fan: Fan, ends: np.ndarray, costs: np.ndarray, score) -> tuple[np.ndarray, np.ndarray]:
@@ -573,6 +646,10 @@ def _candidates(fan: Fan, ends: np.ndarray, costs: np.ndarray, score) -> tuple[n
     of ``h``'s ring), the lowest beam index (every total infinite), and as many more as there are paths that end in
     the ring (the one pair whose stay may be barred). Near a hub every movement's first nodes are then listed once
     or twice instead of once per path that reaches the hub."""
+    if fan.padded is not None:  # every row short, at most LONG_ROW: one indexing (the same pairs in the same order)
+        rows = fan.padded[ends]
+        listed = rows >= 0
+        return listed.nonzero()[0], rows[listed]
     long = fan.long[ends]
     if not long.any():  # every row short: listed whole
         return _gather(fan.full, ends)
@@ -613,6 +690,18 @@ def _candidates(fan: Fan, ends: np.ndarray, costs: np.ndarray, score) -> tuple[n
     beam, cand = np.concatenate(beams), np.concatenate(nodes)
     order = np.lexsort((cand, beam))
     return beam[order], cand[order]
+
+
+def _firsts(values: np.ndarray) -> np.ndarray:
+    """Where each distinct value of ``values`` (1-D) comes first, in the order of the values:
+    ``np.unique(values, return_index=True)[1]`` as NumPy computes it (a stable sort, the head of each run), without
+    its other work."""
+    perm = values.argsort(kind="stable")
+    ordered = values[perm]
+    head = np.empty(len(ordered), dtype=bool)
+    head[:1] = True
+    np.not_equal(ordered[1:], ordered[:-1], out=head[1:])
+    return perm[head]
 
 
 def _gather(table: tuple[np.ndarray, np.ndarray], ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
