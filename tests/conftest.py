@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import settings
 
 from toolkit import create_plugin_manager, hookimpl, load_scenario
 from toolkit.manager import PluginManager
@@ -15,6 +16,12 @@ ROOT = Path(__file__).resolve().parent.parent
 CHARACTERS = ROOT / "characters"
 BANDAI = ROOT.parent / "shared" / "data" / "bandai-namco-1"
 """Real motion capture (CC BY-NC, never copied into the repository); tests that read it skip where it is absent."""
+
+settings.register_profile("likeme", deadline=None)
+settings.load_profile("likeme")
+"""No test is timed (docs: speed is measured by ``likeme bench``): hypothesis's default deadline (200 ms an example)
+is off for every property test, so a loaded CI machine cannot fail one that only ran slowly once
+(``tests/test_hypothesis_settings.py``). ``--hypothesis-profile`` still chooses another profile."""
 
 CALLED_HOOKS: set[str] = set()
 """Every hook called, with at least one implementation, through any plugin manager made during the test session."""
