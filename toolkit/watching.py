@@ -600,7 +600,9 @@ class WatchingLoop:
         A streaming matcher concludes what it followed. It is fed the segment's own frames first when it did not
         follow it (the segmenter reported it only once it was over), and when it followed it without committing but
         the segmenter closed what was followed as several segments (``split``: strokes of one movement): each of
-        those is matched on its own frames. A commitment made while following stands for the first of them.
+        those is matched on its own frames. A commitment made while following stands for the first of them. The
+        first of them is not fed again when the matcher says it settled within its frames (:meth:`_settled_within`):
+        its state is then the one feeding them again would leave, and its view is cut to the segment.
         """
         if announce:
             self.listener.segment_found(segment)
