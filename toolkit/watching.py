@@ -600,7 +600,9 @@ class WatchingLoop:
         A streaming matcher concludes what it followed. It is fed the segment's own frames first when it did not
         follow it (the segmenter reported it only once it was over), and when it followed it without committing but
         the segmenter closed what was followed as several segments (``split``: strokes of one movement): each of
-        those is matched on its own frames. A commitment made while following stands for the first of them.
+        those is matched on its own frames. A commitment made while following stands for the first of them. The
+        first of them is not fed again when the matcher says it settled within its frames (:meth:`_settled_within`):
+        its state is then the one feeding them again would leave, and its view is cut to the segment.
         """
         if announce:
             self.listener.segment_found(segment)
@@ -610,9 +612,12 @@ class WatchingLoop:
             return Observation(segment, None, None, cut)
         followed = self._open == segment.start and self._view is not None
         if matcher.streaming and (not followed or (split and self._early is None)):
-            self._begin(segment.start)  # matched on its own frames, fed one by one
-            for r in range(segment.start, segment.end):
-                self._feed(r)
+            if followed and self._settled_within(segment):  # its state on these frames is the one it has
+                self._view.feed(segment.end)
+            else:
+                self._begin(segment.start)  # matched on its own frames, fed one by one
+                for r in range(segment.start, segment.end):
+                    self._feed(r)
         early = self._early if self._open == segment.start else None
         late = self._call("matcher", "conclude", self.memory.motion(segment.start, segment.end))
         if late is not None and self.character.matcher is not None:
@@ -621,6 +626,16 @@ class WatchingLoop:
                 self.listener.recognised(segment, late)
         self._open, self._view, self._early = None, None, None
         return _answer(segment, early, late, cut)
+
+    def _settled_within(self, segment: Segment) -> bool:
+        """Whether the matcher that followed from ``segment.start`` says (an optional ``settled()``: after how many
+        frames nothing more changed, or ``None``) that nothing changed after the segment's frames: feeding them
+        again from a new start would leave the state it has (the first stroke of a split movement; nothing was
+        committed, so nothing was reported or learned while following)."""
+        if getattr(self.character.matcher, "settled", None) is None:
+            return False
+        frames = self._call("matcher", "settled")
+        return isinstance(frames, (int, np.integer)) and 0 < frames <= segment.end - segment.start
 
     # -- what plugins return ----------------------------------------------------------------------------------
 

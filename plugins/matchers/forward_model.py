@@ -630,6 +630,7 @@ class ForwardModel(Matcher):
         self.tracks = {}  # in the order the subsystems began to move
         self.reported = False  # a commitment to the tracks decided so far has been announced
         self._settled = False  # nothing more can happen in this segment (:meth:`_quiet`)
+        self._settled_at: tuple[int, int] | None = None  # (frames, revision) when it settled (:meth:`settled`)
 
     @property
     def main(self) -> Track | None:
@@ -709,6 +710,7 @@ class ForwardModel(Matcher):
         tracks = list(self.tracks.values())
         if self._quiet(tracks):
             self._settled = True
+            self._settled_at = (memory.n, memory.revision)
             return None
         if self.reported or not all(t.committed is not None and not t.deviated for t in tracks) or self._joining(local):
             return None
@@ -725,6 +727,21 @@ class ForwardModel(Matcher):
                                                     "speed": t.speed, "progress": t.progress} for t in tracks}
         return Match(labels[0] if len(tracks) == 1 else movement, min(t.confidence for t in tracks), memory.n,
                      path=tuple(e for t in tracks for e in t.committed_path), details=details)
+
+    def settled(self) -> int | None:
+        """After how many frames of the segment followed nothing more changed, if it settled: every subsystem
+        followed, none with a candidate or a commitment (:meth:`_quiet`), and the rows given not rewritten since
+        (:attr:`WorkingMemory.revision <toolkit.watching.WorkingMemory.revision>` the same). Else ``None``.
+
+        Following the same rows from the same start up to any frame from then on leaves the same state as now (every
+        later frame returned at once; the rows not yet placed are placed when next needed, each by the same
+        addition), so a watching loop that must match the first ``m`` rows of what it followed (the first stroke of
+        a movement the segmenter split) may conclude this state for them, its working memory cut to ``m`` rows,
+        when ``m`` is at least this; ``tests/test_watching_settled.py`` compares it with feeding them again."""
+        kept = self._settled_at
+        if not self._settled or kept is None or self._memory is None or kept[1] != self._memory.revision:
+            return None
+        return kept[0]
 
     def _quiet(self, tracks: list[Track]) -> bool:
         """Whether the rest of the segment can change nothing: no subsystem is left to start (:meth:`_start_tracks`
