@@ -97,8 +97,20 @@ def _circular_median(windows: np.ndarray, rotations: np.ndarray | None = None) -
     partial = some & ~full  # a stream's first frames, a clip's ends, frames without an estimate
     if partial.any():
         a, r = angles[partial], ref[partial]
-        out[partial] = np.nanmedian(np.where(ok[partial], r + np.angle(np.exp(1j * (a - r))), np.nan), axis=1)
+        out[partial] = _nanmedian_rows(np.where(ok[partial], r + np.angle(np.exp(1j * (a - r))), np.nan))
     return np.angle(np.exp(1j * out))
+
+
+def _nanmedian_rows(values: np.ndarray) -> np.ndarray:
+    """``np.nanmedian(values, axis=1)`` of rows (n, w) with at least one finite value each, the same numbers
+    without its masked-array machinery: the finite values sorted (NaN sorts last), the middle one, or the mean
+    ``(low + high) / 2`` of the two middle ones, as ``nanmedian`` takes it (an odd count: ``(x + x) / 2``, x)."""
+    ordered = np.sort(values, axis=1)
+    count = np.isfinite(values).sum(axis=1)
+    high = count // 2
+    low = np.where(count % 2 == 1, high, high - 1)
+    rows = np.arange(len(values))
+    return (ordered[rows, low] + ordered[rows, high]) / 2.0
 
 
 _CLOSE = 1e-9
@@ -138,7 +150,7 @@ def _unwrapped_median(angles: np.ndarray, ref: np.ndarray) -> np.ndarray:
         if near.any():
             quick[near] = _unwrapped(angles[near], np.broadcast_to(ref, angles.shape)[near])
     ranks = [(w - 1) // 2, w // 2]  # the middle element, or the two middle ones (np.median: their mean)
-    middle = np.partition(quick, ranks, axis=1)[:, ranks]
+    middle = np.sort(quick, axis=1)[:, ranks]  # the same values as np.partition's at the ranks, sooner (SIMD sort)
     lo, hi = middle[:, :1] - 2 * _CLOSE, middle[:, 1:] + 2 * _CLOSE
     below = (quick < lo).sum(axis=1)  # certainly below the middle
     band = (quick >= lo) & (quick <= hi)
@@ -265,25 +277,55 @@ def to_root_relative(
     """
     world = np.asarray(world, dtype=float)
     visible = np.asarray(visible, dtype=bool) & np.isfinite(world).all(axis=-1)
+    safe_world = np.where(visible[..., None], world, 0.0)
     if heading is None:
-        heading = facing_heading(np.where(visible[..., None], world, 0.0), visible, body)
-    heading = np.asarray(heading, dtype=float)
+        heading = facing_heading(safe_world, visible, body)
+    return _to_root_relative(world, visible, safe_world, body, np.asarray(heading, dtype=float))
+
+
+def _to_local(points: np.ndarray, origin: np.ndarray, heading: np.ndarray) -> np.ndarray:
+    """``toolkit.motion.world_to_local(points, origin, heading)`` of frames (n, P, 3), origins (n, 3) and headings
+    (n,), the same bits, without its einsum (which costs most of the transform).
+
+    The einsum ``"fji,fpj->fpi"`` over the heading matrix ``[[c, 0, s], [0, 1, 0], [-s, 0, c]]`` sums the products
+    from a zero, in the order of ``j``: ``((0 + c x) + 0 y) + (-s) z``, and so on. For finite coordinates and
+    headings that is ``(c x - s z) + 0`` (the zero terms change no sum but a signed zero's sign, which the leading
+    ``0 +``, like the trailing ``+ 0``, makes positive), ``y + 0`` and ``(s x + c z) + 0``; ``c`` and ``s`` are the
+    same ``np.cos``/``np.sin`` of the same array of headings. Non-finite inputs go through ``world_to_local``.
+    """
+    d = points - origin.reshape(-1, 1, 3)
+    if not (np.isfinite(d).all() and np.isfinite(heading).all()):
+        return world_to_local(points, origin, heading)
+    c, s = np.cos(heading)[:, None], np.sin(heading)[:, None]
+    x, y, z = d[..., 0], d[..., 1], d[..., 2]
+    out = np.empty_like(d)
+    np.subtract(c * x, s * z, out=out[..., 0])
+    np.add(y, 0.0, out=out[..., 1])
+    np.add(s * x, c * z, out=out[..., 2])
+    out[..., 0] += 0.0
+    out[..., 2] += 0.0
+    return out
+
+
+def _to_root_relative(world: np.ndarray, visible: np.ndarray, safe_world: np.ndarray, body: Body,
+                      heading: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`to_root_relative` once its inputs are checked: ``visible`` already false where ``world`` is not
+    finite, ``safe_world`` is ``world`` with hidden parts at 0, ``heading`` a float array."""
     root = world[..., body.root_index, :]
     ok = visible[..., body.root_index] & np.isfinite(heading)
-    safe_world = np.where(visible[..., None], world, 0.0)
     safe_root = np.where(ok[..., None], root, 0.0)
     safe_heading = np.where(ok, heading, 0.0)
     if world.ndim == 2:
         pose = world_to_local(safe_world, safe_root, float(safe_heading))
     else:
         flat = safe_world.reshape(-1, *world.shape[-2:])
-        pose = world_to_local(flat, safe_root.reshape(-1, 3), safe_heading.reshape(-1)).reshape(world.shape)
+        pose = _to_local(flat, safe_root.reshape(-1, 3), safe_heading.reshape(-1)).reshape(world.shape)
     mask = visible & ok[..., None]
     angles = body.angle_mask
     if angles.any():  # finger joint angles are not positions: kept as they are, seen when their wrist is seen
         pose[..., angles, :] = world[..., angles, :]
         mask = mask & mask[..., body.carriers]
-    pose = np.where(mask[..., None], pose, np.nan)
+    np.copyto(pose, np.nan, where=~mask[..., None])
     return pose, mask, np.where(ok[..., None], root, np.nan), heading
 
 
@@ -302,5 +344,7 @@ def root_relative(world: np.ndarray, visible: np.ndarray | None, body: Body,
     world = np.asarray(world, dtype=float)
     seen = np.isfinite(world).all(axis=-1)
     visible = seen if visible is None else seen & np.asarray(visible, dtype=bool)
-    found = facing_heading(np.where(visible[..., None], world, 0.0), visible, body)
-    return to_root_relative(world, visible, body, found if smooth is None else smooth(found))
+    safe_world = np.where(visible[..., None], world, 0.0)  # computed once: the facing and the transform share it
+    found = facing_heading(safe_world, visible, body)
+    heading = found if smooth is None else np.asarray(smooth(found), dtype=float)
+    return _to_root_relative(world, visible, safe_world, body, heading)
