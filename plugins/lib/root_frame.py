@@ -86,6 +86,11 @@ def _circular_median(windows: np.ndarray, rotations: np.ndarray | None = None) -
     sliding window share their estimates: :func:`_windowed_median` computes each estimate's once).
     """
     ok = np.isfinite(windows)
+    if ok.all():  # every row full (a stream's rows after its first window): no masking, no row split
+        if rotations is None:
+            rotations = np.exp(1j * windows)
+        ref = np.angle(rotations.sum(axis=1))[:, None]
+        return np.angle(np.exp(1j * _unwrapped_median(windows, ref)))
     angles = np.where(ok, windows, 0.0)
     if rotations is None:
         rotations = np.where(ok, np.exp(1j * angles), 0.0)
@@ -136,21 +141,29 @@ def _unwrapped_median(angles: np.ndarray, ref: np.ndarray) -> np.ndarray:
     middle, and the middle is found among the few left, unwrapped exactly and sorted.
     """
     n, w = angles.shape
-    d = angles - ref
-    spread = np.abs(d)
-    if not len(d) or not (spread <= 64.0).all():  # angles of many turns: the quick unwrapping is not close enough
-        return np.median(_unwrapped(angles, ref), axis=1) if len(d) else np.zeros(0)
-    if spread.max() < np.pi - _WRAP:  # no row wraps (most streams): the angles are their own quick unwrapping
+    if not n:
+        return np.zeros(0)
+    ranks = [(w - 1) // 2, w // 2]  # the middle element, or the two middle ones (np.median: their mean)
+    ordered = np.sort(angles, axis=1)
+    # the largest |angle - ref| of a row is at its smallest or largest angle (rounding keeps the order)
+    spread = np.maximum(np.abs(ordered[:, -1:] - ref), np.abs(ordered[:, :1] - ref)).max()
+    if not spread <= 64.0:  # angles of many turns: the quick unwrapping is not close enough
+        return np.median(_unwrapped(angles, ref), axis=1)
+    if spread < np.pi - _WRAP:  # no row wraps (most streams): the angles are their own quick unwrapping
+        found = _sorted_middle(angles, ordered, ref, ranks)
+        if found is not None:
+            return found
         quick, near = angles, np.zeros(angles.shape, dtype=bool)
+        middle = ordered[:, ranks]
     else:
+        d = angles - ref
         turns = np.round(d / (2 * np.pi))
         wrapped = d - 2 * np.pi * turns
         quick = ref + wrapped
         near = np.abs(np.abs(wrapped) - np.pi) < _WRAP
         if near.any():
             quick[near] = _unwrapped(angles[near], np.broadcast_to(ref, angles.shape)[near])
-    ranks = [(w - 1) // 2, w // 2]  # the middle element, or the two middle ones (np.median: their mean)
-    middle = np.sort(quick, axis=1)[:, ranks]  # the same values as np.partition's at the ranks, sooner (SIMD sort)
+        middle = np.sort(quick, axis=1)[:, ranks]  # the same values as np.partition's at the ranks, sooner
     lo, hi = middle[:, :1] - 2 * _CLOSE, middle[:, 1:] + 2 * _CLOSE
     below = (quick < lo).sum(axis=1)  # certainly below the middle
     band = (quick >= lo) & (quick <= hi)
@@ -165,6 +178,36 @@ def _unwrapped_median(angles: np.ndarray, ref: np.ndarray) -> np.ndarray:
     return np.where(ranks[0] == ranks[1], a, (a + b) / 2)
 
 
+def _sorted_middle(angles: np.ndarray, ordered: np.ndarray, ref: np.ndarray, ranks: list[int]) -> np.ndarray | None:
+    """:func:`_unwrapped_median` of rows that do not wrap (the angles are their own quick unwrapping), read off the
+    rows sorted (``ordered``): the elements below the band about the middle are a prefix of a sorted row and the
+    band a run after it, found from the middle outwards (a whole row only where a neighbour of the middle is in the
+    band: ties). ``None`` where a band holds an exact zero (its sign could depend on the order of the elements, so
+    the caller takes them in the row's own order, as :func:`_unwrapped_median` always did).
+    """
+    n, w = ordered.shape
+    middle = ordered[:, ranks]
+    lo, hi = middle[:, 0] - 2 * _CLOSE, middle[:, 1] + 2 * _CLOSE
+    below = np.full(n, ranks[0])  # elements < lo: the middle element is not, those before it are unless tied
+    if ranks[0] > 0:
+        tied = np.flatnonzero(ordered[:, ranks[0] - 1] >= lo)
+        below[tied] = (ordered[tied] < lo[tied, None]).sum(axis=1)
+    top = np.full(n, ranks[1] + 1)  # elements <= hi
+    if ranks[1] + 1 < w:
+        tied = np.flatnonzero(ordered[:, ranks[1] + 1] <= hi)
+        top[tied] = (ordered[tied] <= hi[tied, None]).sum(axis=1)
+    counts = top - below
+    first = np.concatenate([[0], np.cumsum(counts)[:-1]])  # each row's first element in the band's list
+    rows = np.repeat(np.arange(n), counts)
+    cols = below[rows] + np.arange(len(rows)) - first[rows]
+    exact = _unwrapped(ordered[rows, cols], ref[rows, 0])
+    if not exact.all():
+        return None
+    exact = exact[np.lexsort((exact, rows))]  # by row, then by exact value
+    a, b = exact[first + ranks[0] - below], exact[first + ranks[1] - below]
+    return np.where(ranks[0] == ranks[1], a, (a + b) / 2)
+
+
 _WINDOW_BUDGET = 1 << 20
 """Numbers of windows gathered at a time by :func:`_windowed_median` (a window is as long as seconds x fps)."""
 
@@ -175,15 +218,28 @@ def _windowed_median(padded: np.ndarray, window: int, rows: np.ndarray) -> np.nd
 
     Gathering every row at once would copy frames x window numbers (a whole recording times seconds x fps);
     each row's median depends only on that row, so the result is the same bit for bit. Each estimate's complex
-    exponential is computed once, not once per window it falls in.
+    exponential is computed once, not once per window it falls in. The rows whose windows hold an estimate in every
+    place (all but a stream's first ``window - 1`` frames, say) are taken apart from the others, so that most rows
+    skip the masking that the others need.
     """
     finite = np.isfinite(padded)
     rotations = np.where(finite, np.exp(1j * np.where(finite, padded, 0.0)), 0.0)
     view = np.lib.stride_tricks.sliding_window_view(padded, window)  # views: nothing copied yet
     turned = np.lib.stride_tricks.sliding_window_view(rotations, window)
     step = max(1, _WINDOW_BUDGET // max(1, window))
-    return np.concatenate([_circular_median(view[rows[i : i + step]], turned[rows[i : i + step]])
-                           for i in range(0, len(rows), step)]) if len(rows) else np.zeros(0)
+    rows = np.asarray(rows)
+    out = np.empty(len(rows))
+    if finite.all():
+        groups = [np.arange(len(rows))]
+    else:  # rows with every estimate of their window take the quick path of _circular_median together
+        seen = np.concatenate([[0], np.cumsum(finite)])
+        full = seen[rows + window] - seen[rows] == window
+        groups = [np.flatnonzero(full), np.flatnonzero(~full)]
+    for group in groups:
+        for i in range(0, len(group), step):
+            at = group[i : i + step]
+            out[at] = _circular_median(view[rows[at]], turned[rows[at]])
+    return out
 
 
 class HeadingFilter:
