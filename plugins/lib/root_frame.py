@@ -332,11 +332,28 @@ def to_root_relative(
     heading : array, shape (...)
     """
     world = np.asarray(world, dtype=float)
-    visible = np.asarray(visible, dtype=bool) & np.isfinite(world).all(axis=-1)
-    safe_world = np.where(visible[..., None], world, 0.0)
+    visible = np.asarray(visible, dtype=bool) & _finite_points(world)
+    safe_world = _zero_hidden(world, visible)
     if heading is None:
         heading = facing_heading(safe_world, visible, body)
     return _to_root_relative(world, visible, safe_world, body, np.asarray(heading, dtype=float))
+
+
+def _finite_points(world: np.ndarray) -> np.ndarray:
+    """``np.isfinite(world).all(axis=-1)`` of points (..., 3), sooner: a reduction over an axis of 3 is slow, so
+    the whole array is checked first (most recordings are finite everywhere) and the coordinates are and-ed."""
+    finite = np.isfinite(world)
+    if world.shape[-1] != 3 or not world.size:
+        return finite.all(axis=-1)
+    if finite.all():
+        return np.ones(world.shape[:-1], dtype=bool)
+    return finite[..., 0] & finite[..., 1] & finite[..., 2]
+
+
+def _zero_hidden(world: np.ndarray, visible: np.ndarray) -> np.ndarray:
+    """``np.where(visible[..., None], world, 0.0)``: ``world`` itself (not copied; only read) when every part is
+    seen."""
+    return world if visible.all() else np.where(visible[..., None], world, 0.0)
 
 
 def _to_local(points: np.ndarray, origin: np.ndarray, heading: np.ndarray) -> np.ndarray:
@@ -381,7 +398,8 @@ def _to_root_relative(world: np.ndarray, visible: np.ndarray, safe_world: np.nda
     if angles.any():  # finger joint angles are not positions: kept as they are, seen when their wrist is seen
         pose[..., angles, :] = world[..., angles, :]
         mask = mask & mask[..., body.carriers]
-    np.copyto(pose, np.nan, where=~mask[..., None])
+    if not mask.all():
+        pose[~mask] = np.nan
     return pose, mask, np.where(ok[..., None], root, np.nan), heading
 
 
@@ -398,9 +416,9 @@ def root_relative(world: np.ndarray, visible: np.ndarray | None, body: Body,
     world position (n, 3) and the heading (n,).
     """
     world = np.asarray(world, dtype=float)
-    seen = np.isfinite(world).all(axis=-1)
+    seen = _finite_points(world)
     visible = seen if visible is None else seen & np.asarray(visible, dtype=bool)
-    safe_world = np.where(visible[..., None], world, 0.0)  # computed once: the facing and the transform share it
+    safe_world = _zero_hidden(world, visible)  # computed once: the facing and the transform share it
     found = facing_heading(safe_world, visible, body)
     heading = found if smooth is None else np.asarray(smooth(found), dtype=float)
     return _to_root_relative(world, visible, safe_world, body, heading)
