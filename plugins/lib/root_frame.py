@@ -101,8 +101,9 @@ def _circular_median(windows: np.ndarray, rotations: np.ndarray | None = None) -
         out[full] = _unwrapped_median(angles[full], ref[full])
     partial = some & ~full  # a stream's first frames, a clip's ends, frames without an estimate
     if partial.any():
-        a, r = angles[partial], ref[partial]
-        out[partial] = _nanmedian_rows(np.where(ok[partial], r + np.angle(np.exp(1j * (a - r))), np.nan))
+        a, r, seen = angles[partial], ref[partial], ok[partial]
+        found = _partial_median(np.where(seen, a, np.nan), r)  # the same values, unwrapping only the middle
+        out[partial] = found if found is not None else _nanmedian_rows(np.where(seen, _unwrapped(a, r), np.nan))
     return np.angle(np.exp(1j * out))
 
 
@@ -150,7 +151,7 @@ def _unwrapped_median(angles: np.ndarray, ref: np.ndarray) -> np.ndarray:
     if not spread <= 64.0:  # angles of many turns: the quick unwrapping is not close enough
         return np.median(_unwrapped(angles, ref), axis=1)
     if spread < np.pi - _WRAP:  # no row wraps (most streams): the angles are their own quick unwrapping
-        found = _sorted_middle(angles, ordered, ref, ranks)
+        found = _sorted_middle(ordered, ref, np.full(n, ranks[0]), np.full(n, ranks[1]), np.full(n, w))
         if found is not None:
             return found
         quick, near = angles, np.zeros(angles.shape, dtype=bool)
@@ -178,34 +179,53 @@ def _unwrapped_median(angles: np.ndarray, ref: np.ndarray) -> np.ndarray:
     return np.where(ranks[0] == ranks[1], a, (a + b) / 2)
 
 
-def _sorted_middle(angles: np.ndarray, ordered: np.ndarray, ref: np.ndarray, ranks: list[int]) -> np.ndarray | None:
-    """:func:`_unwrapped_median` of rows that do not wrap (the angles are their own quick unwrapping), read off the
-    rows sorted (``ordered``): the elements below the band about the middle are a prefix of a sorted row and the
-    band a run after it, found from the middle outwards (a whole row only where a neighbour of the middle is in the
-    band: ties). ``None`` where a band holds an exact zero (its sign could depend on the order of the elements, so
-    the caller takes them in the row's own order, as :func:`_unwrapped_median` always did).
+def _sorted_middle(ordered: np.ndarray, ref: np.ndarray, low: np.ndarray, high: np.ndarray,
+                   count: np.ndarray) -> np.ndarray | None:
+    """The median of the exact unwrapping of rows that do not wrap (the angles are their own quick unwrapping, see
+    :func:`_unwrapped_median`), read off the rows sorted: ``ordered`` (n, w), each row's ``count`` finite angles
+    first (NaN sorts last), its middle at ranks ``low`` and ``high`` (equal for an odd count; else the mean of the
+    two, as ``np.median`` and ``np.nanmedian`` take it).
+
+    The elements below the band about the middle are a prefix of a sorted row and the band is the run after it,
+    found from the middle outwards (the whole row is counted only where a neighbour of the middle lies in the band:
+    ties). ``None`` where a band holds an exact zero: its sign could depend on the order of the elements, so the
+    caller takes them in the row's own order, as before.
     """
-    n, w = ordered.shape
-    middle = ordered[:, ranks]
-    lo, hi = middle[:, 0] - 2 * _CLOSE, middle[:, 1] + 2 * _CLOSE
-    below = np.full(n, ranks[0])  # elements < lo: the middle element is not, those before it are unless tied
-    if ranks[0] > 0:
-        tied = np.flatnonzero(ordered[:, ranks[0] - 1] >= lo)
-        below[tied] = (ordered[tied] < lo[tied, None]).sum(axis=1)
-    top = np.full(n, ranks[1] + 1)  # elements <= hi
-    if ranks[1] + 1 < w:
-        tied = np.flatnonzero(ordered[:, ranks[1] + 1] <= hi)
-        top[tied] = (ordered[tied] <= hi[tied, None]).sum(axis=1)
+    n = len(ordered)
+    at = np.arange(n)
+    lo, hi = ordered[at, low] - 2 * _CLOSE, ordered[at, high] + 2 * _CLOSE
+    below = low.copy()  # elements < lo: the middle element is not, those before it are unless tied with it
+    tied = np.flatnonzero(low > 0)
+    tied = tied[ordered[tied, low[tied] - 1] >= lo[tied]]
+    below[tied] = (ordered[tied] < lo[tied, None]).sum(axis=1)
+    top = high + 1  # elements <= hi
+    tied = np.flatnonzero(high + 1 < count)
+    tied = tied[ordered[tied, high[tied] + 1] <= hi[tied]]
+    top[tied] = (ordered[tied] <= hi[tied, None]).sum(axis=1)
     counts = top - below
     first = np.concatenate([[0], np.cumsum(counts)[:-1]])  # each row's first element in the band's list
-    rows = np.repeat(np.arange(n), counts)
+    rows = np.repeat(at, counts)
     cols = below[rows] + np.arange(len(rows)) - first[rows]
     exact = _unwrapped(ordered[rows, cols], ref[rows, 0])
     if not exact.all():
         return None
     exact = exact[np.lexsort((exact, rows))]  # by row, then by exact value
-    a, b = exact[first + ranks[0] - below], exact[first + ranks[1] - below]
-    return np.where(ranks[0] == ranks[1], a, (a + b) / 2)
+    a, b = exact[first + low - below], exact[first + high - below]
+    return np.where(low == high, a, (a + b) / 2)
+
+
+def _partial_median(values: np.ndarray, ref: np.ndarray) -> np.ndarray | None:
+    """``_nanmedian_rows`` of the exact unwrapping of ``values`` (n, w) around ``ref`` (n, 1) (NaN where a row has
+    no angle, at least one finite angle a row), by :func:`_sorted_middle` (the same values) when no row wraps;
+    ``None`` otherwise."""
+    ordered = np.sort(values, axis=1)
+    count = np.isfinite(values).sum(axis=1)
+    last = ordered[np.arange(len(values)), count - 1]
+    spread = np.maximum(np.abs(last - ref[:, 0]), np.abs(ordered[:, 0] - ref[:, 0])).max()
+    if not spread < np.pi - _WRAP:
+        return None
+    high = count // 2
+    return _sorted_middle(ordered, ref, np.where(count % 2 == 1, high, high - 1), high, count)
 
 
 _WINDOW_BUDGET = 1 << 20
