@@ -103,20 +103,8 @@ def _circular_median(windows: np.ndarray, rotations: np.ndarray | None = None) -
     if partial.any():
         a, r, seen = angles[partial], ref[partial], ok[partial]
         found = _partial_median(np.where(seen, a, np.nan), r)  # the same values, unwrapping only the middle
-        out[partial] = found if found is not None else _nanmedian_rows(np.where(seen, _unwrapped(a, r), np.nan))
+        out[partial] = found if found is not None else np.nanmedian(np.where(seen, _unwrapped(a, r), np.nan), axis=1)
     return np.angle(np.exp(1j * out))
-
-
-def _nanmedian_rows(values: np.ndarray) -> np.ndarray:
-    """``np.nanmedian(values, axis=1)`` of rows (n, w) with at least one finite value each, the same numbers
-    without its masked-array machinery: the finite values sorted (NaN sorts last), the middle one, or the mean
-    ``(low + high) / 2`` of the two middle ones, as ``nanmedian`` takes it (an odd count: ``(x + x) / 2``, x)."""
-    ordered = np.sort(values, axis=1)
-    count = np.isfinite(values).sum(axis=1)
-    high = count // 2
-    low = np.where(count % 2 == 1, high, high - 1)
-    rows = np.arange(len(values))
-    return (ordered[rows, low] + ordered[rows, high]) / 2.0
 
 
 _CLOSE = 1e-9
@@ -215,7 +203,7 @@ def _sorted_middle(ordered: np.ndarray, ref: np.ndarray, low: np.ndarray, high: 
 
 
 def _partial_median(values: np.ndarray, ref: np.ndarray) -> np.ndarray | None:
-    """``_nanmedian_rows`` of the exact unwrapping of ``values`` (n, w) around ``ref`` (n, 1) (NaN where a row has
+    """``np.nanmedian`` (by row) of the exact unwrapping of ``values`` (n, w) around ``ref`` (n, 1) (NaN where a row has
     no angle, at least one finite angle a row), by :func:`_sorted_middle` (the same values) when no row wraps;
     ``None`` otherwise."""
     ordered = np.sort(values, axis=1)
