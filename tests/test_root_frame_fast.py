@@ -223,6 +223,14 @@ def test_the_transform_of_non_finite_values_is_world_to_local(seed, n, bad):
     assert same_bits(_to_local(points, origin, heading), world_to_local(points, origin, heading))
 
 
+def test_a_difference_that_overflows_is_transformed_as_world_to_local():
+    points = np.full((2, 3, 3), 1.5e308)
+    origin = np.full((2, 3), -1.5e308)  # finite both, their difference is not
+    heading = np.array([0.3, -2.0])
+    with np.errstate(all="ignore"):
+        assert same_bits(_to_local(points, origin, heading), world_to_local(points, origin, heading))
+
+
 @settings(max_examples=100, deadline=None)
 @given(seed=st.integers(0, 2**31), shape=st.lists(st.integers(0, 6), min_size=0, max_size=3),
        last=st.sampled_from([3, 3, 3, 1, 2]), bad=st.floats(0.0, 0.5))

@@ -181,15 +181,22 @@ def _sorted_middle(ordered: np.ndarray, ref: np.ndarray, low: np.ndarray, high: 
     """
     n = len(ordered)
     at = np.arange(n)
-    lo, hi = ordered[at, low] - 2 * _CLOSE, ordered[at, high] + 2 * _CLOSE
+    first_middle, second_middle = ordered[at, low], ordered[at, high]
+    lo, hi = first_middle - 2 * _CLOSE, second_middle + 2 * _CLOSE
     below = low.copy()  # elements < lo: the middle element is not, those before it are unless tied with it
-    tied = np.flatnonzero(low > 0)
-    tied = tied[ordered[tied, low[tied] - 1] >= lo[tied]]
-    below[tied] = (ordered[tied] < lo[tied, None]).sum(axis=1)
+    tied_below = np.flatnonzero(low > 0)
+    tied_below = tied_below[ordered[tied_below, low[tied_below] - 1] >= lo[tied_below]]
     top = high + 1  # elements <= hi
-    tied = np.flatnonzero(high + 1 < count)
-    tied = tied[ordered[tied, high[tied] + 1] <= hi[tied]]
-    top[tied] = (ordered[tied] <= hi[tied, None]).sum(axis=1)
+    tied_above = np.flatnonzero(high + 1 < count)
+    tied_above = tied_above[ordered[tied_above, high[tied_above] + 1] <= hi[tied_above]]
+    if not (len(tied_below) or len(tied_above)):  # no ties (most rows): each band is the middle element or two
+        a = _unwrapped(first_middle, ref[:, 0])
+        b = _unwrapped(second_middle, ref[:, 0])
+        if not (a.all() and b.all()):
+            return None
+        return np.where(low == high, a, (np.minimum(a, b) + np.maximum(a, b)) / 2)  # the two sorted, as below
+    below[tied_below] = (ordered[tied_below] < lo[tied_below, None]).sum(axis=1)
+    top[tied_above] = (ordered[tied_above] <= hi[tied_above, None]).sum(axis=1)
     counts = top - below
     first = np.concatenate([[0], np.cumsum(counts)[:-1]])  # each row's first element in the band's list
     rows = np.repeat(at, counts)
@@ -372,7 +379,8 @@ def _to_local(points: np.ndarray, origin: np.ndarray, heading: np.ndarray) -> np
     from a zero, in the order of ``j``: ``((0 + c x) + 0 y) + (-s) z``, and so on. For finite coordinates and
     headings that is ``(c x - s z) + 0`` (the zero terms change no sum but a signed zero's sign, which the leading
     ``0 +``, like the trailing ``+ 0``, makes positive), ``y + 0`` and ``(s x + c z) + 0``; ``c`` and ``s`` are the
-    same ``np.cos``/``np.sin`` of the same array of headings. Non-finite inputs go through ``world_to_local``.
+    same ``np.cos``/``np.sin`` of the same array of headings. Non-finite inputs (an overflowing difference too) go
+    through ``world_to_local``.
     """
     d = points - origin.reshape(-1, 1, 3)
     if not (np.isfinite(d).all() and np.isfinite(heading).all()):
