@@ -2,7 +2,8 @@
 
 ``Before`` below is root_frame as it was before this work (the transform through ``toolkit.motion.world_to_local``'s
 einsum, finiteness as an ``all`` over the coordinates, the middle of a row by ``np.partition``, the first rows of a
-stream by ``np.nanmedian``): every quick path is compared with it byte for byte (signed zeros included), over
+stream by ``np.nanmedian``; the facing is shared, its cross product pinned to ``np.cross`` on its own): every quick
+path is compared with it byte for byte (signed zeros included), over
 bodies with and without finger angles and with a forward marker seen from its own behind part, hidden parts,
 non-finite coordinates, headings about ±π and ties.
 """
@@ -15,7 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from plugins.lib import root_frame
-from plugins.lib.root_frame import (HeadingFilter, _circular_median, _finite_points, _to_local,
+from plugins.lib.root_frame import (_UP, HeadingFilter, _circular_median, _cross_up, _finite_points, _to_local,
                                     _zero_hidden, facing_heading, root_relative, smooth_heading, to_root_relative)
 from plugins.perception.motion_capture import MotionCapture
 from tests.conftest import CHARACTERS, ROOT
@@ -221,6 +222,19 @@ def test_the_transform_of_non_finite_values_is_world_to_local(seed, n, bad):
     points, origin, heading = rng.normal(size=(n, 4, 3)), rng.normal(size=(n, 3)), rng.normal(size=n)
     [points, origin, heading][rng.integers(3)].reshape(-1)[rng.integers(n)] = bad
     assert same_bits(_to_local(points, origin, heading), world_to_local(points, origin, heading))
+
+
+@settings(max_examples=150, deadline=None)
+@given(seed=st.integers(0, 2**31), shape=st.lists(st.integers(1, 30), min_size=0, max_size=2),
+       zeros=st.floats(0.0, 0.5), bad=st.floats(0.0, 0.2))
+def test_the_cross_product_with_up_is_np_cross_bit_for_bit(seed, shape, zeros, bad):
+    """facing_heading's only change: its cross product written out (``Before`` shares the rest of it)."""
+    rng = np.random.default_rng(seed)
+    across = rng.normal(size=(*shape, 3)) * rng.choice([1e-300, 1.0, 1e300], (*shape, 3))
+    across[rng.random(across.shape) < zeros] = rng.choice([0.0, -0.0])
+    across[rng.random(across.shape) < bad] = rng.choice([np.nan, np.inf, -np.inf])
+    with np.errstate(all="ignore"):
+        assert same_bits(_cross_up(across), np.cross(across, _UP))
 
 
 def test_a_difference_that_overflows_is_transformed_as_world_to_local():
