@@ -157,7 +157,8 @@ BODIES = {
     "moritz": load_character(CHARACTERS / "moritz.toml", _PM).body,  # finger angles carried by the wrists
     "bandai": load_profile(ROOT / "characters" / "profiles" / "bandai-namco.toml").body,  # toe tip seen from toes
 }
-REST = {name: np.asarray(load_character(CHARACTERS / f"{name}.toml", _PM).motor.rest_pose()) for name in ("max", "moritz")}
+REST = {name: np.asarray(load_character(CHARACTERS / f"{name}.toml", _PM).motor.rest_pose())
+        for name in ("max", "moritz")}
 
 
 def _rest(name, body, rng):
