@@ -150,6 +150,10 @@ def _unwrapped_median(angles: np.ndarray, ref: np.ndarray) -> np.ndarray:
         return np.zeros(0)
     ranks = [(w - 1) // 2, w // 2]  # the middle element, or the two middle ones (np.median: their mean)
     ordered = np.sort(angles, axis=1)
+    if n == 1:  # one row (HeadingFilter.update, a frame at a time): the steps below on floats, without array calls
+        found = _one_row_middle(ordered[0], float(ref[0, 0]), ranks)
+        if found is not None:
+            return found
     # the largest |angle - ref| of a row is at its smallest or largest angle (rounding keeps the order)
     spread = np.maximum(np.abs(ordered[:, -1:] - ref), np.abs(ordered[:, :1] - ref)).max()
     if not spread <= 64.0:  # angles of many turns: the quick unwrapping is not close enough
@@ -223,6 +227,24 @@ def _sorted_middle(ordered: np.ndarray, ref: np.ndarray, low: np.ndarray, high: 
     exact = exact[np.lexsort((exact, rows))]  # by row, then by exact value
     a, b = exact[first + low - below], exact[first + high - below]
     return np.where(low == high, a, (a + b) / 2)
+
+
+def _one_row_middle(row: np.ndarray, ref: float, ranks: list[int]) -> np.ndarray | None:
+    """:func:`_sorted_middle` of one sorted row of finite angles, the same numbers: the spread, the band and the
+    mean of the two middle elements as Python floats (the same double arithmetic), the exact unwrapping by the same
+    numpy functions. ``None`` where the row wraps, a neighbour of the middle is tied with it or a middle element
+    unwraps to an exact zero (the caller's general path)."""
+    low, high = ranks
+    first, second = float(row[low]), float(row[high])
+    if not max(abs(float(row[-1]) - ref), abs(float(row[0]) - ref)) < np.pi - _WRAP:
+        return None
+    lo, hi = first - 2 * _CLOSE, second + 2 * _CLOSE
+    if (low > 0 and row[low - 1] >= lo) or (high + 1 < len(row) and row[high + 1] <= hi):
+        return None
+    a, b = (float(v) for v in _unwrapped(np.array([first, second]), ref))
+    if a == 0.0 or b == 0.0:
+        return None
+    return np.array([a if low == high else (min(a, b) + max(a, b)) / 2])
 
 
 def _partial_median(values: np.ndarray, ref: np.ndarray) -> np.ndarray | None:
