@@ -8,6 +8,10 @@ of the body") against the line through the knees. Only visible parts are used.
 :func:`root_relative` is the transform every perception and the clip repertoire use: the facing found from the
 visible parts, smoothed over time (a running median while frames stream in, a centred one over a whole recording),
 then root-relative coordinates. All functions are vectorised over leading frame axes.
+
+The transform and the running median take quick paths in a watching loop (the rotation written out instead of an
+einsum, the middle of each window read off its sorted estimates, no masking where nothing is hidden); each gives the
+same bits as the formula it replaces (``tests/test_root_frame_fast.py`` compares them byte for byte).
 """
 
 from __future__ import annotations
@@ -47,7 +51,7 @@ def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body) -> np.nda
     visible = np.asarray(visible, dtype=bool)
     li, ri, root = body.index(body.facing.left), body.index(body.facing.right), body.root_index
     across = world[..., li, :] - world[..., ri, :]
-    perp = np.cross(across, _UP)  # +z when left is +x
+    perp = _cross_up(across)  # +z when left is +x
     perp[..., 1] = 0.0
     knees = visible[..., li] & visible[..., ri]
     heading = np.full(world.shape[:-2], np.nan)
@@ -75,6 +79,18 @@ def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body) -> np.nda
     return heading
 
 
+def _cross_up(across: np.ndarray) -> np.ndarray:
+    """``np.cross(across, _UP)`` of float vectors (..., 3), the same bits without its axis handling (most of its cost
+    for a frame or a few): numpy computes each component as the same products and difference,
+    ``a1 * 0 - a2 * 1``, ``a2 * 0 - a0 * 0`` and ``a0 * 1 - a1 * 0``."""
+    a0, a1, a2 = across[..., 0], across[..., 1], across[..., 2]
+    out = np.empty(across.shape)
+    np.subtract(a1 * _UP[2], a2 * _UP[1], out=out[..., 0])
+    np.subtract(a2 * _UP[0], a0 * _UP[2], out=out[..., 1])
+    np.subtract(a0 * _UP[1], a1 * _UP[0], out=out[..., 2])
+    return out
+
+
 def _circular_median(windows: np.ndarray, rotations: np.ndarray | None = None) -> np.ndarray:
     """The median of each row of angles (n, w), NaN ignored, unwrapped around the row's own circular mean.
 
@@ -86,6 +102,11 @@ def _circular_median(windows: np.ndarray, rotations: np.ndarray | None = None) -
     sliding window share their estimates: :func:`_windowed_median` computes each estimate's once).
     """
     ok = np.isfinite(windows)
+    if ok.all():  # every row full (a stream's rows after its first window): no masking, no row split
+        if rotations is None:
+            rotations = np.exp(1j * windows)
+        ref = np.angle(rotations.sum(axis=1))[:, None]
+        return np.angle(np.exp(1j * _unwrapped_median(windows, ref)))
     angles = np.where(ok, windows, 0.0)
     if rotations is None:
         rotations = np.where(ok, np.exp(1j * angles), 0.0)
@@ -96,8 +117,9 @@ def _circular_median(windows: np.ndarray, rotations: np.ndarray | None = None) -
         out[full] = _unwrapped_median(angles[full], ref[full])
     partial = some & ~full  # a stream's first frames, a clip's ends, frames without an estimate
     if partial.any():
-        a, r = angles[partial], ref[partial]
-        out[partial] = np.nanmedian(np.where(ok[partial], r + np.angle(np.exp(1j * (a - r))), np.nan), axis=1)
+        a, r, seen = angles[partial], ref[partial], ok[partial]
+        found = _partial_median(np.where(seen, a, np.nan), r)  # the same values, unwrapping only the middle
+        out[partial] = found if found is not None else np.nanmedian(np.where(seen, _unwrapped(a, r), np.nan), axis=1)
     return np.angle(np.exp(1j * out))
 
 
@@ -124,21 +146,33 @@ def _unwrapped_median(angles: np.ndarray, ref: np.ndarray) -> np.ndarray:
     middle, and the middle is found among the few left, unwrapped exactly and sorted.
     """
     n, w = angles.shape
-    d = angles - ref
-    spread = np.abs(d)
-    if not len(d) or not (spread <= 64.0).all():  # angles of many turns: the quick unwrapping is not close enough
-        return np.median(_unwrapped(angles, ref), axis=1) if len(d) else np.zeros(0)
-    if spread.max() < np.pi - _WRAP:  # no row wraps (most streams): the angles are their own quick unwrapping
+    if not n:
+        return np.zeros(0)
+    ranks = [(w - 1) // 2, w // 2]  # the middle element, or the two middle ones (np.median: their mean)
+    ordered = np.sort(angles, axis=1)
+    if n == 1:  # one row (HeadingFilter.update, a frame at a time): the steps below on floats, without array calls
+        found = _one_row_middle(ordered[0], float(ref[0, 0]), ranks)
+        if found is not None:
+            return found
+    # the largest |angle - ref| of a row is at its smallest or largest angle (rounding keeps the order)
+    spread = np.maximum(np.abs(ordered[:, -1:] - ref), np.abs(ordered[:, :1] - ref)).max()
+    if not spread <= 64.0:  # angles of many turns: the quick unwrapping is not close enough
+        return np.median(_unwrapped(angles, ref), axis=1)
+    if spread < np.pi - _WRAP:  # no row wraps (most streams): the angles are their own quick unwrapping
+        found = _sorted_middle(ordered, ref, np.full(n, ranks[0]), np.full(n, ranks[1]), np.full(n, w))
+        if found is not None:
+            return found
         quick, near = angles, np.zeros(angles.shape, dtype=bool)
+        middle = ordered[:, ranks]
     else:
+        d = angles - ref
         turns = np.round(d / (2 * np.pi))
         wrapped = d - 2 * np.pi * turns
         quick = ref + wrapped
         near = np.abs(np.abs(wrapped) - np.pi) < _WRAP
         if near.any():
             quick[near] = _unwrapped(angles[near], np.broadcast_to(ref, angles.shape)[near])
-    ranks = [(w - 1) // 2, w // 2]  # the middle element, or the two middle ones (np.median: their mean)
-    middle = np.partition(quick, ranks, axis=1)[:, ranks]
+        middle = np.sort(quick, axis=1)[:, ranks]  # the same values as np.partition's at the ranks, sooner
     lo, hi = middle[:, :1] - 2 * _CLOSE, middle[:, 1:] + 2 * _CLOSE
     below = (quick < lo).sum(axis=1)  # certainly below the middle
     band = (quick >= lo) & (quick <= hi)
@@ -153,6 +187,80 @@ def _unwrapped_median(angles: np.ndarray, ref: np.ndarray) -> np.ndarray:
     return np.where(ranks[0] == ranks[1], a, (a + b) / 2)
 
 
+def _sorted_middle(ordered: np.ndarray, ref: np.ndarray, low: np.ndarray, high: np.ndarray,
+                   count: np.ndarray) -> np.ndarray | None:
+    """The median of the exact unwrapping of rows that do not wrap (the angles are their own quick unwrapping, see
+    :func:`_unwrapped_median`), read off the rows sorted: ``ordered`` (n, w), each row's ``count`` finite angles
+    first (NaN sorts last), its middle at ranks ``low`` and ``high`` (equal for an odd count; else the mean of the
+    two, as ``np.median`` and ``np.nanmedian`` take it).
+
+    The elements below the band about the middle are a prefix of a sorted row and the band is the run after it,
+    found from the middle outwards (the whole row is counted only where a neighbour of the middle lies in the band:
+    ties). ``None`` where a band holds an exact zero: its sign could depend on the order of the elements, so the
+    caller takes them in the row's own order, as before.
+    """
+    n = len(ordered)
+    at = np.arange(n)
+    first_middle, second_middle = ordered[at, low], ordered[at, high]
+    lo, hi = first_middle - 2 * _CLOSE, second_middle + 2 * _CLOSE
+    below = low.copy()  # elements < lo: the middle element is not, those before it are unless tied with it
+    tied_below = np.flatnonzero(low > 0)
+    tied_below = tied_below[ordered[tied_below, low[tied_below] - 1] >= lo[tied_below]]
+    top = high + 1  # elements <= hi
+    tied_above = np.flatnonzero(high + 1 < count)
+    tied_above = tied_above[ordered[tied_above, high[tied_above] + 1] <= hi[tied_above]]
+    if not (len(tied_below) or len(tied_above)):  # no ties (most rows): each band is the middle element or two
+        a = _unwrapped(first_middle, ref[:, 0])
+        b = _unwrapped(second_middle, ref[:, 0])
+        if not (a.all() and b.all()):
+            return None
+        return np.where(low == high, a, (np.minimum(a, b) + np.maximum(a, b)) / 2)  # the two sorted, as below
+    below[tied_below] = (ordered[tied_below] < lo[tied_below, None]).sum(axis=1)
+    top[tied_above] = (ordered[tied_above] <= hi[tied_above, None]).sum(axis=1)
+    counts = top - below
+    first = np.concatenate([[0], np.cumsum(counts)[:-1]])  # each row's first element in the band's list
+    rows = np.repeat(at, counts)
+    cols = below[rows] + np.arange(len(rows)) - first[rows]
+    exact = _unwrapped(ordered[rows, cols], ref[rows, 0])
+    if not exact.all():
+        return None
+    exact = exact[np.lexsort((exact, rows))]  # by row, then by exact value
+    a, b = exact[first + low - below], exact[first + high - below]
+    return np.where(low == high, a, (a + b) / 2)
+
+
+def _one_row_middle(row: np.ndarray, ref: float, ranks: list[int]) -> np.ndarray | None:
+    """:func:`_sorted_middle` of one sorted row of finite angles, the same numbers: the spread, the band and the
+    mean of the two middle elements as Python floats (the same double arithmetic), the exact unwrapping by the same
+    numpy functions. ``None`` where the row wraps, a neighbour of the middle is tied with it or a middle element
+    unwraps to an exact zero (the caller's general path)."""
+    low, high = ranks
+    first, second = float(row[low]), float(row[high])
+    if not max(abs(float(row[-1]) - ref), abs(float(row[0]) - ref)) < np.pi - _WRAP:
+        return None
+    lo, hi = first - 2 * _CLOSE, second + 2 * _CLOSE
+    if (low > 0 and row[low - 1] >= lo) or (high + 1 < len(row) and row[high + 1] <= hi):
+        return None
+    a, b = (float(v) for v in _unwrapped(np.array([first, second]), ref))
+    if a == 0.0 or b == 0.0:
+        return None
+    return np.array([a if low == high else (min(a, b) + max(a, b)) / 2])
+
+
+def _partial_median(values: np.ndarray, ref: np.ndarray) -> np.ndarray | None:
+    """``np.nanmedian`` (by row) of the exact unwrapping of ``values`` (n, w) around ``ref`` (n, 1) (NaN where a row has
+    no angle, at least one finite angle a row), by :func:`_sorted_middle` (the same values) when no row wraps;
+    ``None`` otherwise."""
+    ordered = np.sort(values, axis=1)
+    count = np.isfinite(values).sum(axis=1)
+    last = ordered[np.arange(len(values)), count - 1]
+    spread = np.maximum(np.abs(last - ref[:, 0]), np.abs(ordered[:, 0] - ref[:, 0])).max()
+    if not spread < np.pi - _WRAP:
+        return None
+    high = count // 2
+    return _sorted_middle(ordered, ref, np.where(count % 2 == 1, high, high - 1), high, count)
+
+
 _WINDOW_BUDGET = 1 << 20
 """Numbers of windows gathered at a time by :func:`_windowed_median` (a window is as long as seconds x fps)."""
 
@@ -163,15 +271,28 @@ def _windowed_median(padded: np.ndarray, window: int, rows: np.ndarray) -> np.nd
 
     Gathering every row at once would copy frames x window numbers (a whole recording times seconds x fps);
     each row's median depends only on that row, so the result is the same bit for bit. Each estimate's complex
-    exponential is computed once, not once per window it falls in.
+    exponential is computed once, not once per window it falls in. The rows whose windows hold an estimate in every
+    place (all but a stream's first ``window - 1`` frames, say) are taken apart from the others, so that most rows
+    skip the masking that the others need.
     """
     finite = np.isfinite(padded)
     rotations = np.where(finite, np.exp(1j * np.where(finite, padded, 0.0)), 0.0)
     view = np.lib.stride_tricks.sliding_window_view(padded, window)  # views: nothing copied yet
     turned = np.lib.stride_tricks.sliding_window_view(rotations, window)
     step = max(1, _WINDOW_BUDGET // max(1, window))
-    return np.concatenate([_circular_median(view[rows[i : i + step]], turned[rows[i : i + step]])
-                           for i in range(0, len(rows), step)]) if len(rows) else np.zeros(0)
+    rows = np.asarray(rows)
+    out = np.empty(len(rows))
+    if finite.all():
+        groups = [np.arange(len(rows))]
+    else:  # rows with every estimate of their window take the quick path of _circular_median together
+        seen = np.concatenate([[0], np.cumsum(finite)])
+        full = seen[rows + window] - seen[rows] == window
+        groups = [np.flatnonzero(full), np.flatnonzero(~full)]
+    for group in groups:
+        for i in range(0, len(group), step):
+            at = group[i : i + step]
+            out[at] = _circular_median(view[rows[at]], turned[rows[at]])
+    return out
 
 
 class HeadingFilter:
@@ -264,26 +385,75 @@ def to_root_relative(
     heading : array, shape (...)
     """
     world = np.asarray(world, dtype=float)
-    visible = np.asarray(visible, dtype=bool) & np.isfinite(world).all(axis=-1)
+    visible = np.asarray(visible, dtype=bool) & _finite_points(world)
+    safe_world = _zero_hidden(world, visible)
     if heading is None:
-        heading = facing_heading(np.where(visible[..., None], world, 0.0), visible, body)
-    heading = np.asarray(heading, dtype=float)
+        heading = facing_heading(safe_world, visible, body)
+    return _to_root_relative(world, visible, safe_world, body, np.asarray(heading, dtype=float))
+
+
+def _finite_points(world: np.ndarray) -> np.ndarray:
+    """``np.isfinite(world).all(axis=-1)`` of points (..., 3), sooner: a reduction over an axis of 3 is slow, so
+    the whole array is checked first (most recordings are finite everywhere) and the coordinates are and-ed."""
+    finite = np.isfinite(world)
+    if world.shape[-1] != 3 or not world.size:
+        return finite.all(axis=-1)
+    if finite.all():
+        return np.ones(world.shape[:-1], dtype=bool)
+    return finite[..., 0] & finite[..., 1] & finite[..., 2]
+
+
+def _zero_hidden(world: np.ndarray, visible: np.ndarray) -> np.ndarray:
+    """``np.where(visible[..., None], world, 0.0)``: ``world`` itself (not copied; only read) when every part is
+    seen."""
+    return world if visible.all() else np.where(visible[..., None], world, 0.0)
+
+
+def _to_local(points: np.ndarray, origin: np.ndarray, heading: np.ndarray) -> np.ndarray:
+    """``toolkit.motion.world_to_local(points, origin, heading)`` of frames (n, P, 3), origins (n, 3) and headings
+    (n,), the same bits, without its einsum (which costs most of the transform).
+
+    The einsum ``"fji,fpj->fpi"`` over the heading matrix ``[[c, 0, s], [0, 1, 0], [-s, 0, c]]`` sums the products
+    from a zero, in the order of ``j``: ``((0 + c x) + 0 y) + (-s) z``, and so on. For finite coordinates and
+    headings that is ``(c x - s z) + 0`` (the zero terms change no sum but a signed zero's sign, which the leading
+    ``0 +``, like the trailing ``+ 0``, makes positive), ``y + 0`` and ``(s x + c z) + 0``; ``c`` and ``s`` are the
+    same ``np.cos``/``np.sin`` of the same array of headings. Non-finite inputs (an overflowing difference too) go
+    through ``world_to_local``.
+    """
+    d = points - origin.reshape(-1, 1, 3)
+    if not (np.isfinite(d).all() and np.isfinite(heading).all()):
+        return world_to_local(points, origin, heading)
+    c, s = np.cos(heading)[:, None], np.sin(heading)[:, None]
+    x, y, z = d[..., 0], d[..., 1], d[..., 2]
+    out = np.empty_like(d)
+    np.subtract(c * x, s * z, out=out[..., 0])
+    np.add(y, 0.0, out=out[..., 1])
+    np.add(s * x, c * z, out=out[..., 2])
+    out[..., 0] += 0.0
+    out[..., 2] += 0.0
+    return out
+
+
+def _to_root_relative(world: np.ndarray, visible: np.ndarray, safe_world: np.ndarray, body: Body,
+                      heading: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`to_root_relative` once its inputs are checked: ``visible`` already false where ``world`` is not
+    finite, ``safe_world`` is ``world`` with hidden parts at 0, ``heading`` a float array."""
     root = world[..., body.root_index, :]
     ok = visible[..., body.root_index] & np.isfinite(heading)
-    safe_world = np.where(visible[..., None], world, 0.0)
     safe_root = np.where(ok[..., None], root, 0.0)
     safe_heading = np.where(ok, heading, 0.0)
     if world.ndim == 2:
         pose = world_to_local(safe_world, safe_root, float(safe_heading))
     else:
         flat = safe_world.reshape(-1, *world.shape[-2:])
-        pose = world_to_local(flat, safe_root.reshape(-1, 3), safe_heading.reshape(-1)).reshape(world.shape)
+        pose = _to_local(flat, safe_root.reshape(-1, 3), safe_heading.reshape(-1)).reshape(world.shape)
     mask = visible & ok[..., None]
     angles = body.angle_mask
     if angles.any():  # finger joint angles are not positions: kept as they are, seen when their wrist is seen
         pose[..., angles, :] = world[..., angles, :]
         mask = mask & mask[..., body.carriers]
-    pose = np.where(mask[..., None], pose, np.nan)
+    if not mask.all():
+        pose[~mask] = np.nan
     return pose, mask, np.where(ok[..., None], root, np.nan), heading
 
 
@@ -300,7 +470,9 @@ def root_relative(world: np.ndarray, visible: np.ndarray | None, body: Body,
     world position (n, 3) and the heading (n,).
     """
     world = np.asarray(world, dtype=float)
-    seen = np.isfinite(world).all(axis=-1)
+    seen = _finite_points(world)
     visible = seen if visible is None else seen & np.asarray(visible, dtype=bool)
-    found = facing_heading(np.where(visible[..., None], world, 0.0), visible, body)
-    return to_root_relative(world, visible, body, found if smooth is None else smooth(found))
+    safe_world = _zero_hidden(world, visible)  # computed once: the facing and the transform share it
+    found = facing_heading(safe_world, visible, body)
+    heading = found if smooth is None else np.asarray(smooth(found), dtype=float)
+    return _to_root_relative(world, visible, safe_world, body, heading)
