@@ -17,7 +17,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from plugins.matchers import dtw as dtw_module
-from plugins.matchers.dtw import DTW, frame_distance, warp_all
+from plugins.matchers.dtw import frame_distance, warp_all
+from tests.test_matcher_speed import _dtw_matcher as _matcher
 from toolkit import Motion
 
 kernel = dtw_module._kernel()
@@ -59,17 +60,6 @@ def test_the_plain_python_reference_is_dtaidistances_distance_too(seed, count, d
     columns, starts = _side_by_side(templates)
     got = warp_all(series, columns, starts, np.empty(count))
     assert got.tolist() == [dtw_cc.distance_ndim(series, t) for t in templates]
-
-
-def _matcher(labels, templates, **params):
-    matcher = DTW(**params)
-    matcher.labels, matcher.templates = list(labels), [np.ascontiguousarray(t) for t in templates]
-    seen: set[str] = set()
-    matcher._firsts, matcher._extras = [], []
-    for i, label in enumerate(matcher.labels):
-        (matcher._extras if label in seen else matcher._firsts).append(i)
-        seen.add(label)
-    return matcher
 
 
 def _plain(matcher, motion):

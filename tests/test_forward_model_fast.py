@@ -21,9 +21,9 @@ from hypothesis.extra.numpy import arrays
 import plugins.matchers.forward_model as fm
 from plugins.lib.guiding_stroke import GuidingStroke
 from plugins.matchers.forward_model import ForwardModel, Track, _along_rows, _distances, _row_keys
-from tests.conftest import CHARACTERS
 from tests.test_forward_model_incremental import _arms
-from toolkit import Motion, create_plugin_manager, hookimpl, load_scenario
+from tests.test_forward_model_replay import play_fig3_games
+from toolkit import Motion
 from toolkit.watching import follow
 
 
@@ -163,25 +163,10 @@ def _play(monkeypatch, fast: bool):
     """Fig. 3's games: every answer, and each frame's view of the matcher; with the shortcuts, or without."""
     used = _shortcuts(monkeypatch, fast)
 
-    class Traces:
-        def __init__(self) -> None:
-            self.seen: list = []
-
-        @hookimpl
-        def likeme_world_stepped(self, world):
-            matcher = world.actors["max"].character.matcher
-            if matcher._memory is not None:
-                view = matcher.inspect()
-                self.seen.append((view["frames"], repr(view["trace"]), view["committed"], view["committed_path"],
-                                  view["committed_at"], view["deviated_at"], repr(view["anchors"])))
-
-    pm = create_plugin_manager(autoload=False)
-    traces = Traces()
-    pm.register(traces, name="traces")
-    world = load_scenario(CHARACTERS / "scenarios" / "fig3_games.toml", pm).run()
-    matches = [(m.movement, m.confidence, m.decided_at, m.path, repr(m.details))
-               for m in (e.data["match"] for e in world.events_of("movement_recognised", "max"))]
-    return matches, traces.seen, used
+    matches, seen = play_fig3_games(lambda view: (view["frames"], repr(view["trace"]), view["committed"],
+                                                  view["committed_path"], view["committed_at"], view["deviated_at"],
+                                                  repr(view["anchors"])))
+    return matches, seen, used
 
 
 @pytest.fixture(scope="module")

@@ -12,6 +12,29 @@ from tests.conftest import CHARACTERS
 from toolkit import create_plugin_manager, hookimpl, load_scenario
 
 
+def play_fig3_games(snapshot):
+    """Fig. 3's games played once: every answer Max gives, and ``snapshot(view)`` of the forward model's
+    ``inspect()`` after each world step in which it holds a segment."""
+
+    class Traces:
+        def __init__(self) -> None:
+            self.seen: list = []
+
+        @hookimpl
+        def likeme_world_stepped(self, world):
+            matcher = world.actors["max"].character.matcher
+            if matcher._memory is not None:
+                self.seen.append(snapshot(matcher.inspect()))
+
+    pm = create_plugin_manager(autoload=False)
+    traces = Traces()
+    pm.register(traces, name="traces")
+    world = load_scenario(CHARACTERS / "scenarios" / "fig3_games.toml", pm).run()
+    matches = [(m.movement, m.confidence, m.decided_at, m.path, repr(m.details))
+               for m in (e.data["match"] for e in world.events_of("movement_recognised", "max"))]
+    return matches, traces.seen
+
+
 def _play(monkeypatch, incremental: bool):
     used = []
     leading = ForwardModel._leading
@@ -23,25 +46,9 @@ def _play(monkeypatch, incremental: bool):
 
     monkeypatch.setattr(ForwardModel, "_leading", counted)
 
-    class Traces:
-        def __init__(self) -> None:
-            self.seen: list = []
-
-        @hookimpl
-        def likeme_world_stepped(self, world):
-            matcher = world.actors["max"].character.matcher
-            if matcher._memory is not None:
-                view = matcher.inspect()
-                self.seen.append((view["frames"], view["trace"], view["committed"], view["committed_path"],
-                                  view["committed_at"], view["deviated_at"]))
-
-    pm = create_plugin_manager(autoload=False)
-    traces = Traces()
-    pm.register(traces, name="traces")
-    world = load_scenario(CHARACTERS / "scenarios" / "fig3_games.toml", pm).run()
-    matches = [(m.movement, m.confidence, m.decided_at, m.path, repr(m.details))
-               for m in (e.data["match"] for e in world.events_of("movement_recognised", "max"))]
-    return matches, traces.seen, used
+    matches, seen = play_fig3_games(lambda view: (view["frames"], view["trace"], view["committed"],
+                                                  view["committed_path"], view["committed_at"], view["deviated_at"]))
+    return matches, seen, used
 
 
 @pytest.fixture(scope="module")

@@ -214,6 +214,28 @@ def test_the_papers_rest_is_the_default():
     assert plain.segment(motion) == explicit.segment(motion)
 
 
+def _frames_and_blocks(params, parts, poses, visible, cuts):
+    """The same stream pushed frame by frame and in blocks of ``cuts`` frames: each segmenter, the segments each
+    closed (with the frame that closed them) and the onsets it reported at each frame."""
+    one = VelocityDirection(**params)
+    one.reset(parts, FPS)
+    expected, onsets = [], []
+    for f in range(len(poses)):
+        expected.extend((f, s) for s in one.push(poses[f], visible[f]))
+        onsets.append(-1 if one.active_since is None else one.active_since)
+    blocks = VelocityDirection(**params)
+    blocks.reset(parts, FPS)
+    got, since, at = [], [], 0
+    for n in [*cuts, len(poses)]:
+        closed, block_since = blocks.push_block(poses[at : at + n], visible[at : at + n])
+        got.extend((at + i, s) for i, s in closed)
+        since.extend(block_since.tolist())
+        at += n
+        if at >= len(poses):
+            break
+    return one, expected, onsets, blocks, got, since
+
+
 @given(seed=st.integers(0, 10_000), cuts=st.lists(st.integers(1, 40), min_size=1, max_size=12),
        params=st.sampled_from([{}, {"level": "movement"}, {"units": "body", "noise": 2.0, "pause": 0.3},
                                {"max_movement": 1.0, "memory": 0.2}, {"parts": ["wrist"], "rest_speed": 0.05}]),
@@ -232,22 +254,7 @@ def test_a_block_pushed_at_once_is_its_frames_pushed_one_by_one(seed, cuts, para
         poses[:3, 1] = np.nan
         visible[30:40, 1] = False
         poses[30:40, 1] = poses[29, 1]
-    one = VelocityDirection(**params)
-    one.reset(motion.parts, motion.fps)
-    expected, onsets = [], []
-    for f in range(len(poses)):
-        expected.extend((f, s) for s in one.push(poses[f], visible[f]))
-        onsets.append(-1 if one.active_since is None else one.active_since)
-    blocks = VelocityDirection(**params)
-    blocks.reset(motion.parts, motion.fps)
-    got, since, at = [], [], 0
-    for n in [*cuts, len(poses)]:
-        closed, block_since = blocks.push_block(poses[at : at + n], visible[at : at + n])
-        got.extend((at + i, s) for i, s in closed)
-        since.extend(block_since.tolist())
-        at += n
-        if at >= len(poses):
-            break
+    one, expected, onsets, blocks, got, since = _frames_and_blocks(params, motion.parts, poses, visible, cuts)
     assert got == expected
     assert since == onsets[: len(since)] and len(since) == len(poses)
     assert blocks.flush() == one.flush()
@@ -288,22 +295,7 @@ def test_a_block_followed_at_once_is_its_frames_stepped_one_by_one(runs, cuts, p
     poses[:, 1, 1] = np.sin(np.arange(len(speed)) / 3.0) * 0.02  # turns: direction breaks in stroke level
     poses[np.isnan(speed), 1] = np.nan
     visible = np.isfinite(poses).all(axis=2)
-    one = VelocityDirection(**params)
-    one.reset(["root", "wrist"], FPS)
-    expected, onsets = [], []
-    for f in range(len(poses)):
-        expected.extend((f, s) for s in one.push(poses[f], visible[f]))
-        onsets.append(-1 if one.active_since is None else one.active_since)
-    blocks = VelocityDirection(**params)
-    blocks.reset(["root", "wrist"], FPS)
-    got, since, at = [], [], 0
-    for n in [*cuts, len(poses)]:
-        closed, block_since = blocks.push_block(poses[at : at + n], visible[at : at + n])
-        got.extend((at + i, s) for i, s in closed)
-        since.extend(block_since.tolist())
-        at += n
-        if at >= len(poses):
-            break
+    one, expected, onsets, blocks, got, since = _frames_and_blocks(params, ["root", "wrist"], poses, visible, cuts)
     assert got == expected
     assert since == onsets
     assert (blocks._moving, blocks._resting, blocks._frame) == (one._moving, one._resting, one._frame)
