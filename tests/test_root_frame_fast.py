@@ -231,7 +231,8 @@ def test_the_transform_of_non_finite_values_is_world_to_local(seed, n, bad):
     rng = np.random.default_rng(seed)
     points, origin, heading = rng.normal(size=(n, 4, 3)), rng.normal(size=(n, 3)), rng.normal(size=n)
     [points, origin, heading][rng.integers(3)].reshape(-1)[rng.integers(n)] = bad
-    assert same_bits(_to_local(points, origin, heading), world_to_local(points, origin, heading))
+    with np.errstate(invalid="ignore"):  # the cosine of an infinite heading is NaN, as meant here
+        assert same_bits(_to_local(points, origin, heading), world_to_local(points, origin, heading))
 
 
 @settings(max_examples=150, deadline=None)
