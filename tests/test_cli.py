@@ -62,6 +62,17 @@ def test_validate_builtin_characters_and_scenarios():
     assert result.returncode == 0, result.stderr
     assert result.stdout.count("ok ") == len(files)
     assert "character 'Max'" in result.stdout and "scenario 'Max watches Morris'" in result.stdout
+    max_line = next(line for line in result.stdout.splitlines() if "character 'Max'" in line)
+    assert max_line.endswith("action hierarchical, layer look-at")  # every component table, the layer included
+
+
+def test_the_run_report_names_every_component_of_a_character():
+    from toolkit.report import _components_line
+
+    described = {"name": "X", "parts": 3, "motor": {"plugin": "posegraph"}, "layer": {"plugin": "look-at"},
+                 "correspondence": {"plugin": "body-mapping"}}
+    assert _components_line(described) == ("motor posegraph; perception -; correspondence body-mapping; segmenter -; "
+                                            "matcher -; action -; layer look-at")
 
 
 BAD = {

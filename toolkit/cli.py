@@ -785,7 +785,7 @@ def _why_text(seg: dict[str, Any]) -> str:
 
 def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
     from toolkit.bvh import open_bvh
-    from toolkit.character import load_character, read_toml
+    from toolkit.character import COMPONENT_TABLES, load_character, read_toml
     from toolkit.files import check_regular_file
     from toolkit.observe import check_observer_template, is_observer_template
     from toolkit.profile import is_profile, load_profile
@@ -834,7 +834,7 @@ def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
                 warned += _warn(path, _profile_warnings(prof))
             else:
                 c = describe_character(load_character(path, pm))
-                comps = ", ".join(f"{k} {c[k]['plugin']}" for k in ("motor", "perception", "segmenter", "matcher", "action") if k in c)
+                comps = ", ".join(f"{k} {c[k]['plugin']}" for k in COMPONENT_TABLES if k in c)
                 moves = c["motor"].get("movements")
                 print(f"ok    {path}: character {c['name']!r}: {c['parts']} parts, {moves} movements; {comps}")
         except LikemeError as err:

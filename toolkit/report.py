@@ -171,9 +171,16 @@ def summarise(world: World, *, name: str = "") -> dict[str, Any]:
 
 
 def _components_line(c: dict[str, Any]) -> str:
+    """Every component table of the character format in its order: the plugin, or "-" where there is none (an
+    optional table left out: correspondence and layer only when configured, the others always)."""
+    from toolkit.character import COMPONENT_TABLES
+
     parts = []
-    for key in ("motor", "perception", "segmenter", "matcher", "action"):
-        parts.append(f"{key} {c[key]['plugin']}" if key in c else f"{key} -")
+    for key in COMPONENT_TABLES:
+        if key in c:
+            parts.append(f"{key} {c[key]['plugin']}")
+        elif key not in ("correspondence", "layer"):
+            parts.append(f"{key} -")
     return "; ".join(parts)
 
 
