@@ -185,13 +185,15 @@ def test_the_shortcuts_give_the_same_answers_and_traces_to_the_bit(plays):
 
 
 @given(seed=st.integers(0, 10_000), c=st.integers(1, 6), k=st.integers(1, 5), g=st.integers(2, 40),
-       still=st.booleans(), hidden=st.booleans(), on_point=st.booleans(), groups=st.integers(1, 4))
+       still=st.booleans(), hidden=st.booleans(), on_point=st.booleans(), groups=st.integers(1, 4),
+       near=st.booleans(), scale=st.sampled_from([0, -3, -6, 120]))
 @settings(max_examples=150, deadline=None)
 def test_anchors_by_groups_of_half_strokes_are_the_masked_argmin_bit_for_bit(seed, c, k, g, still, hidden, on_point,
-                                                                             groups):
+                                                                             groups, near, scale):
     """:class:`_Halves` (the moving strokes' first halves in groups, points past a half at x = +inf) places every
     part where the plain computation does: the masked argmin of :func:`_distances` over whole strokes. Strokes that
-    do not move, repeated points (ties), a part seen exactly on a point, a part never seen (NaN) included."""
+    do not move, repeated points (ties), a part seen exactly on a point or halfway between two (near ties), a part
+    never seen (NaN), strokes a millimetre or a micrometre long, and coordinates whose squares overflow included."""
     rng = np.random.default_rng(seed)
     positions = np.cumsum(rng.normal(size=(c, k, g, 3)) * (rng.random((c, k, g, 1)) < 0.8), axis=2)
     if still:
@@ -199,8 +201,13 @@ def test_anchors_by_groups_of_half_strokes_are_the_masked_argmin_bit_for_bit(see
     steps = np.linalg.norm(np.diff(positions, axis=2), axis=-1)
     arcs = np.concatenate([np.zeros((c, k, 1)), np.cumsum(steps, axis=2)], axis=2)
     first = rng.normal(size=(k, 3)) * 2
+    positions *= 10.0**scale
+    first *= 10.0**scale
     if on_point:
         first[0] = positions[0, 0, rng.integers(g)]
+    if near:
+        i = rng.integers(g - 1)
+        first[-1] = 0.5 * (positions[-1, -1, i] + positions[-1, -1, i + 1])
     if hidden:
         first[rng.integers(k)] = np.nan
     later = arcs > 0.5 * arcs[..., -1:]
