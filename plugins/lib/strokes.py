@@ -244,8 +244,12 @@ def _round_kernels():
         import numba
     except ImportError:
         return None
-    relabel = numba.njit(cache=True, nogil=True, boundscheck=False)(_relabel)
-    renormed = numba.njit(cache=True, nogil=True, boundscheck=False)(_renormed)
+    try:
+        relabel = numba.njit(cache=True, nogil=True, boundscheck=False)(_relabel)
+        renormed = numba.njit(cache=True, nogil=True, boundscheck=False)(_renormed)
+    except RuntimeError:  # numba finds no writable place for its cache (a read-only installation): compiled each run
+        relabel = numba.njit(nogil=True, boundscheck=False)(_relabel)
+        renormed = numba.njit(nogil=True, boundscheck=False)(_renormed)
     _clusters_compiled(np.eye(2), 10.0, 12, relabel, renormed)  # compiled for the types it is called with
     return relabel, renormed
 
