@@ -174,10 +174,11 @@ def _relabel(sims: np.ndarray, labels: np.ndarray, first: bool, vectors: np.ndar
              counts: np.ndarray) -> bool:
     """One round's redistribution: each row's nearest mean (``sims.argmax(axis=1)``: the first highest, the first
     NaN if any) into ``labels``; true (and nothing else done) when not ``first`` and the labels are those already
-    there. Otherwise each cluster's rows summed in their order from 0.0 (as numpy's ``add.reduce`` starts from its
-    identity: a column of -0.0 sums to 0.0, the sums of :func:`_centres`) into ``centre`` (k, D), their numbers into ``counts``, and each sum divided by its count (an
-    empty cluster's by 1). Plain Python as written (the reference); :func:`_round_kernels` compiles it (no
-    ``fastmath``)."""
+    there. Otherwise each cluster's rows summed in their order from 0.0 into ``centre`` (k, D), as numpy's
+    ``add.reduce`` starts from its identity (a column of -0.0 sums to 0.0: the sums of :func:`_centres`), their
+    numbers into ``counts``, and each sum divided by its count (an empty cluster's by 1). Plain Python as written
+    (the reference); :func:`_round_kernels` compiles it (no ``fastmath``: no reordered sums, no fused multiply-adds).
+    """
     n, k = sims.shape
     same = not first
     for i in range(n):

@@ -115,7 +115,7 @@ class VelocityDirection(Segmenter):
         super().attach(owner)
         import scipy.signal  # noqa: F401  the stroke analysis's filters: loaded now, not at the end of the first movement
 
-        _round_kernels()  # the direction clustering's compiled rounds: compiled (or loaded) now, not at a movement's end
+        _round_kernels()  # the direction clustering's compiled rounds: compiled or loaded now, not at a movement's end
         for i, part in enumerate(self.params["parts"]):
             owner.body.index(part, key=("parts", i))
 
