@@ -111,9 +111,9 @@ def direction_clusters(vectors: np.ndarray, angle: float, max_clusters: int = 12
     n = len(vectors)
     if n == 0:
         return np.zeros(0, dtype=int)
-    kernels = _round_kernels()
-    if kernels is not None:
-        return _clusters_compiled(np.ascontiguousarray(vectors, dtype=float), angle, max_clusters, *kernels)
+    kernels = _round_kernels() if vectors.dtype == np.float64 and vectors.ndim == 2 else None
+    if kernels is not None:  # (what the analysis passes; other types keep numpy's own arithmetic)
+        return _clusters_compiled(np.ascontiguousarray(vectors), angle, max_clusters, *kernels)
     cos_limit = np.cos(np.radians(angle))
     means = _unit(vectors.mean(axis=0))[None, :]
     sims = vectors @ means.T  # always the similarities to the current means
