@@ -13,8 +13,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from plugins.lib.strokes import (StrokeAnalysis, StrokeCriteria, _centres, _cluster_means, _dots, _smoothed, _unit,
-                                 analyse, breaks, direction_breaks, direction_clusters, held, speed_breaks)
+import plugins.lib.strokes as strokes
+from plugins.lib.strokes import (StrokeAnalysis, StrokeCriteria, _centres, _cluster_means, _dots, _relabel, _renormed,
+                                 _round_kernels, _smoothed, _unit, analyse, breaks, direction_breaks,
+                                 direction_clusters, held, speed_breaks)
 
 values = st.floats(-10.0, 10.0, allow_nan=False, allow_infinity=False)
 
@@ -65,8 +67,66 @@ def unit_vectors(draw, most=120):
 @given(unit_vectors(), st.floats(1.0, 180.0), st.integers(1, 12))
 @settings(max_examples=300, deadline=None)
 def test_direction_clusters_are_the_reference_clustering(vectors, angle, max_clusters):
-    np.testing.assert_array_equal(direction_clusters(vectors, angle, max_clusters),
-                                  reference_direction_clusters(vectors, angle, max_clusters))
+    """Compiled rounds (with numba) and numpy's steps (without) both give the reference's labels."""
+    expected = reference_direction_clusters(vectors, angle, max_clusters)
+    np.testing.assert_array_equal(direction_clusters(vectors, angle, max_clusters), expected)
+    np.testing.assert_array_equal(_numpy_direction_clusters(vectors, angle, max_clusters), expected)
+
+
+def _numpy_direction_clusters(vectors, angle, max_clusters=12):
+    """:func:`direction_clusters` as it runs without numba (numpy's steps)."""
+    kernels = strokes._round_kernels
+    strokes._round_kernels = lambda: None
+    try:
+        return direction_clusters(vectors, angle, max_clusters)
+    finally:
+        strokes._round_kernels = kernels
+
+
+def _kernel_pairs():
+    """The round's steps as written (plain Python) and, with numba, compiled."""
+    pairs = [(_relabel, _renormed)]
+    if _round_kernels() is not None:
+        pairs.append(_round_kernels())
+    return pairs
+
+
+@given(arrays(np.float64, st.tuples(st.integers(1, 40), st.integers(1, 24)), elements=values), st.integers(1, 12),
+       st.data())
+@settings(max_examples=300, deadline=None)
+def test_a_compiled_round_is_numpys_round(vectors, k, data):
+    """:func:`_relabel` and :func:`_renormed` (as written and compiled) give the labels of ``argmax`` (ties to the
+    first, NaN first), say when they are unchanged, and give :func:`_centres` and :func:`_allclose` bit for bit,
+    zero signs, empty clusters and unnormalisable means included."""
+    vectors = np.where(np.array(data.draw(arrays(bool, vectors.shape))), -0.0, vectors)
+    if data.draw(st.booleans()):
+        vectors[: data.draw(st.integers(0, len(vectors)))] = 0.0  # means too short to normalise
+    means = data.draw(arrays(np.float64, (k, vectors.shape[1]), elements=values))
+    sims = np.round(vectors @ means.T, data.draw(st.sampled_from([0, 1, 8])))  # ties too
+    if data.draw(st.booleans()):
+        sims[data.draw(st.integers(0, len(sims) - 1)), data.draw(st.integers(0, k - 1))] = np.nan
+    expected_labels = sims.argmax(axis=1)
+    for relabel, renormed in _kernel_pairs():
+        labels, centre, counts = np.zeros(len(vectors), dtype=np.intp), np.empty((k, vectors.shape[1])), np.empty(
+            k, dtype=np.intp)
+        assert not relabel(sims, labels, True, vectors, centre, counts)
+        np.testing.assert_array_equal(labels, expected_labels)
+        np.testing.assert_array_equal(counts, np.bincount(expected_labels, minlength=k))
+        new = np.empty_like(means)
+        close = renormed(centre, np.sqrt(_dots(centre, centre)), counts, means, new)
+        expected = _centres(vectors, expected_labels, means)
+        np.testing.assert_array_equal(new, expected)
+        np.testing.assert_array_equal(np.signbit(new), np.signbit(expected))
+        assert close == strokes._allclose(expected, means)
+        before = centre.copy()
+        assert relabel(sims, labels, False, vectors, centre, counts)  # the same labels again: nothing else done
+        np.testing.assert_array_equal(centre, before)
+        if k > 1 and len(sims) and not np.isnan(sims[0]).any():
+            changed = sims.copy()
+            changed[0] = 0.0
+            changed[0, (expected_labels[0] + 1) % k] = 1.0
+            assert not relabel(changed, labels, False, vectors, centre, counts)
+            assert labels[0] == (expected_labels[0] + 1) % k
 
 
 @given(arrays(np.float64, st.tuples(st.integers(1, 40), st.integers(1, 24)), elements=values), st.integers(1, 12),

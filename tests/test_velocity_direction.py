@@ -305,3 +305,19 @@ def test_a_block_followed_at_once_is_its_frames_stepped_one_by_one(runs, cuts, p
         assert mine["movement"] == theirs["movement"]
         np.testing.assert_array_equal(mine["analysis"].window, theirs["analysis"].window)
     assert blocks.flush() == one.flush()
+
+
+def test_the_compiled_clustering_cuts_where_numpys_steps_cut(monkeypatch):
+    """Random stroke sequences (one part, and the wrist with the root drifting: 6 columns) segment the same with
+    the direction clustering's compiled rounds as with numpy's steps (numba absent), segment for segment."""
+    import plugins.lib.strokes as strokes
+
+    rng = np.random.default_rng(22)
+    motions = [stroke_sequence(rng, int(rng.integers(2, 6)), noise=float(rng.choice([0.001, 0.004])))[0]
+               for _ in range(12)]
+    settings_ = [dict(parts=["wrist"]), dict(parts=["root", "wrist"], angle=20.0, corner=1.0, drop=0.8,
+                                                min_stroke=0.05, smooth=0.0)]
+    compiled = [VelocityDirection(**s).segment(m) for s in settings_ for m in motions]
+    monkeypatch.setattr(strokes, "_round_kernels", lambda: None)
+    assert [VelocityDirection(**s).segment(m) for s in settings_ for m in motions] == compiled
+    assert sum(len(c) for c in compiled) > len(compiled)  # movements were cut into strokes

@@ -104,10 +104,16 @@ def direction_clusters(vectors: np.ndarray, angle: float, max_clusters: int = 12
     means it belongs to, and a round whose labels are those of the round before ends the re-averaging at once (its
     means would be the same values, which the formula's test then finds close). The same labels as the formula
     written out cluster by cluster (``tests/test_strokes_clusters.py`` holds it to that formula).
+
+    With numba, each re-averaging round is two compiled calls (:func:`_relabel`, :func:`_renormed`) around the two
+    products that stay numpy's (the similarity matrix and the means' dot products with themselves, BLAS's bits).
     """
     n = len(vectors)
     if n == 0:
         return np.zeros(0, dtype=int)
+    kernels = _round_kernels() if vectors.dtype == np.float64 and vectors.ndim == 2 else None
+    if kernels is not None:  # (what the analysis passes; other types keep numpy's own arithmetic)
+        return _clusters_compiled(np.ascontiguousarray(vectors), angle, max_clusters, *kernels)
     cos_limit = np.cos(np.radians(angle))
     means = _unit(vectors.mean(axis=0))[None, :]
     sims = vectors @ means.T  # always the similarities to the current means
@@ -133,6 +139,120 @@ def direction_clusters(vectors: np.ndarray, angle: float, max_clusters: int = 12
         else:
             sims = vectors @ means.T
     return sims.argmax(axis=1)
+
+
+def _clusters_compiled(vectors: np.ndarray, angle: float, max_clusters: int, relabel, renormed) -> np.ndarray:
+    """:func:`direction_clusters` with each re-averaging round's small steps compiled: the same steps in the same
+    order (the similarity matrix and the dot products stay numpy's), so the same labels."""
+    n, d = vectors.shape
+    cos_limit = np.cos(np.radians(angle))
+    means = _unit(vectors.mean(axis=0))[None, :]
+    sims = vectors @ means.T
+    rows = np.arange(n)
+    labels = np.empty(n, dtype=np.intp)
+    for _ in range(4 * max_clusters):
+        best = sims[rows, sims.argmax(axis=1)]
+        worst = int(best.argmin())
+        if best[worst] >= cos_limit or len(means) >= max_clusters:
+            break
+        means = np.concatenate([means, vectors[worst][None, :]])
+        k = len(means)
+        centre, counts, new = np.empty((k, d)), np.empty(k, dtype=np.intp), np.empty((k, d))
+        for first in (True, False, False, False, False, False, False, False, False, False):
+            sims = vectors @ means.T
+            if relabel(sims, labels, first, vectors, centre, counts):
+                break  # the same clusters: the same means again
+            if renormed(centre, np.sqrt(_dots(centre, centre)), counts, means, new):
+                break
+            means, new = new, means
+        else:
+            sims = vectors @ means.T
+    return sims.argmax(axis=1)
+
+
+def _relabel(sims: np.ndarray, labels: np.ndarray, first: bool, vectors: np.ndarray, centre: np.ndarray,
+             counts: np.ndarray) -> bool:
+    """One round's redistribution: each row's nearest mean (``sims.argmax(axis=1)``: the first highest, the first
+    NaN if any) into ``labels``; true (and nothing else done) when not ``first`` and the labels are those already
+    there. Otherwise each cluster's rows summed in their order from 0.0 into ``centre`` (k, D), as numpy's
+    ``add.reduce`` starts from its identity (a column of -0.0 sums to 0.0: the sums of :func:`_centres`), their
+    numbers into ``counts``, and each sum divided by its count (an empty cluster's by 1). Plain Python as written
+    (the reference); :func:`_round_kernels` compiles it (no ``fastmath``: no reordered sums, no fused multiply-adds).
+    """
+    n, k = sims.shape
+    same = not first
+    for i in range(n):
+        b = 0
+        top = sims[i, 0]
+        if top == top:
+            for j in range(1, k):
+                x = sims[i, j]
+                if x != x:
+                    b = j
+                    break
+                if x > top:
+                    top = x
+                    b = j
+        if labels[i] != b:
+            same = False
+            labels[i] = b
+    if same:
+        return True
+    d = vectors.shape[1]
+    for c in range(k):
+        counts[c] = 0
+        for j in range(d):
+            centre[c, j] = 0.0
+    for i in range(n):
+        c = labels[i]
+        counts[c] += 1
+        for j in range(d):
+            centre[c, j] += vectors[i, j]
+    for c in range(k):
+        m = float(counts[c]) if counts[c] > 0 else 1.0
+        for j in range(d):
+            centre[c, j] /= m
+    return False
+
+
+def _renormed(centre: np.ndarray, norm: np.ndarray, counts: np.ndarray, means: np.ndarray, new: np.ndarray) -> bool:
+    """The end of a round: ``new`` (k, D) the unit means of :func:`_centres` (``centre`` divided by its ``norm``
+    where that exceeds 1e-12, as it is otherwise, the old mean for an empty cluster) and whether they are
+    :func:`_allclose` to ``means``. Plain Python as written (the reference); compiled by :func:`_round_kernels`."""
+    k, d = centre.shape
+    close = True
+    for c in range(k):
+        for j in range(d):
+            if counts[c] == 0:
+                v = means[c, j]
+            elif norm[c] > 1e-12:
+                v = centre[c, j] / norm[c]
+            else:
+                v = centre[c, j]
+            new[c, j] = v
+            m = means[c, j]
+            if not abs(v - m) <= 1e-08 + 1e-05 * abs(m):
+                close = False
+    return close
+
+
+@functools.lru_cache(maxsize=1)
+def _round_kernels():
+    """:func:`_relabel` and :func:`_renormed` compiled by numba (cached on disk), or ``None`` without numba (the
+    numpy steps of :func:`direction_clusters` run then, with the same labels). Compiled (or loaded) at the first
+    call: the ``velocity-direction`` segmenter calls it when it is attached, not at the end of the first movement."""
+    try:
+        import numba
+    except ImportError:
+        return None
+    try:
+        relabel = numba.njit(cache=True, nogil=True, boundscheck=False)(_relabel)
+        renormed = numba.njit(cache=True, nogil=True, boundscheck=False)(_renormed)
+    except RuntimeError:  # numba finds no writable place for its cache (a read-only installation): compiled each run
+        relabel = numba.njit(nogil=True, boundscheck=False)(_relabel)
+        renormed = numba.njit(nogil=True, boundscheck=False)(_renormed)
+    _clusters_compiled(np.eye(2), 10.0, 12, relabel, renormed)  # compiled for the types it is called with
+    return relabel, renormed
 
 
 def direction_breaks(labels: np.ndarray) -> list[int]:

@@ -68,7 +68,7 @@ from typing import Any
 import numpy as np
 
 from plugins.lib.body_size import body_scale
-from plugins.lib.strokes import StrokeAnalysis, StrokeCriteria, analyse, breaks
+from plugins.lib.strokes import StrokeAnalysis, StrokeCriteria, _round_kernels, analyse, breaks
 from toolkit import ConfigError, Parameter, Segment, Segmenter, hookimpl
 
 __all__ = ["VelocityDirection"]
@@ -114,6 +114,8 @@ class VelocityDirection(Segmenter):
     def attach(self, owner: Any) -> None:
         super().attach(owner)
         import scipy.signal  # noqa: F401  the stroke analysis's filters: loaded now, not at the end of the first movement
+
+        _round_kernels()  # the direction clustering's compiled rounds: compiled or loaded now, not at a movement's end
         for i, part in enumerate(self.params["parts"]):
             owner.body.index(part, key=("parts", i))
 
