@@ -516,6 +516,14 @@ class Matcher(Component):
         """
         return self.match(motion)
 
+    def settled(self) -> int | None:
+        """Optional, for a streaming matcher: after how many frames of the segment it follows nothing more changed
+        in its state (``None``: it cannot say, the default). When the segmenter then closes only the first ``m``
+        frames of what was followed as a segment (a stroke of a longer movement) and ``m`` is at least this, the
+        watching loop concludes the state the matcher has instead of beginning again and feeding it those
+        frames; a matcher that answers must leave the same state either way."""
+        return None
+
 
 class MotorSystem(Component):
     """Produces a character's own movements (and may learn new ones).

@@ -628,12 +628,11 @@ class WatchingLoop:
         return _answer(segment, early, late, cut)
 
     def _settled_within(self, segment: Segment) -> bool:
-        """Whether the matcher that followed from ``segment.start`` says (an optional ``settled()``: after how many
-        frames nothing more changed, or ``None``) that nothing changed after the segment's frames: feeding them
-        again from a new start would leave the state it has (the first stroke of a split movement; nothing was
-        committed, so nothing was reported or learned while following)."""
-        if getattr(self.character.matcher, "settled", None) is None:
-            return False
+        """Whether the matcher that followed from ``segment.start`` says (:meth:`Matcher.settled
+        <toolkit.components.Matcher.settled>`: after how many frames nothing more changed, or ``None``) that nothing
+        changed after the segment's frames: feeding them again from a new start would leave the state it has (the
+        first stroke of a split movement; nothing was committed, so nothing was reported or learned while
+        following)."""
         frames = self._call("matcher", "settled")
         return isinstance(frames, (int, np.integer)) and 0 < frames <= segment.end - segment.start
 
