@@ -18,37 +18,10 @@ from hypothesis.extra.numpy import arrays
 
 from plugins.lib.guiding_stroke import GuidingStroke
 from plugins.matchers.forward_model import Track, _lengths, _Walk
+from tests.test_forward_model import ARMS  # the two-wrist character; its [matcher] table last
 from toolkit import Motion, load_character
 from toolkit.watching import ObservationLog
 
-ARMS = """
-[character]
-name = "Arms"
-
-[body]
-parts = ["root", "head", "left_wrist", "right_wrist"]
-root = "root"
-facing = {{ left = "left_wrist", right = "right_wrist", forward = "head" }}
-
-[motor]
-plugin = "motor-command-graph"
-rest = "rest"
-subsystems = {{ wrists = ["left_wrist", "right_wrist"] }}
-hands = false
-arms = []
-
-[motor.poses.rest]
-root = [0.0, 1.0, 0.0]
-head = [0.0, 1.6, 0.1]
-left_wrist = [0.25, 0.9, 0.05]
-right_wrist = [-0.25, 0.9, 0.05]
-
-[matcher]
-plugin = "forward-model"
-threshold = 10.0
-relative = {relative}
-error = "{error}"
-"""
 
 FPS = 30.0
 coordinates = st.floats(-2.0, 2.0, allow_nan=False, allow_infinity=False)
@@ -78,8 +51,7 @@ def _arms(write, pm, *, relative: bool = False, error: str = "max", strokes: int
           threshold: float = 10.0):
     """The two-wrist body with ``strokes`` random one-second commands from the hub (the right wrist held still in
     every other one)."""
-    text = ARMS.format(relative=str(relative).lower(), error=error).replace("threshold = 10.0",
-                                                                            f"threshold = {threshold}")
+    text = ARMS + f'threshold = {threshold}\nrelative = {str(relative).lower()}\nerror = "{error}"\n'
     character = load_character(write("arms.toml", text), pm)
     motor, rng = character.motor, np.random.default_rng(seed)
     left, right = motor.rest[2], motor.rest[3]

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import CHARACTERS, play_recording_postures
-from toolkit import create_plugin_manager, load_character, load_scenario
+from toolkit import create_plugin_manager, load_character
 
 
 @pytest.fixture(scope="module")
@@ -99,26 +99,9 @@ def test_the_graph_after_the_games_and_where_max_ends_up(games):
 
 
 def test_a_familiar_movement_at_another_speed_is_recognised_not_learned_again(write):
-    pm = create_plugin_manager(autoload=False)
-    scene = write(
-        "speed.toml",
-        f"""
-        [scenario]
-        name = "faster"
-        [[actors]]
-        character = "{CHARACTERS / 'moritz.toml'}"
-        position = [0.0, 0.0, 2.0]
-        heading = 180.0
-        [actors.override.action]
-        plugin = "script"
-        movements = ["left_front"]
-        [[actors]]
-        character = "{CHARACTERS / 'max_learner.toml'}"
-        watch = "moritz"
-        """,
-    )
-    scenario = load_scenario(scene, pm)
-    world = scenario.run()
+    from tests.test_speed_reparameterisation import _world
+
+    world = _world(write, "left_front")
     edges = world.actors["max"].character.motor.graphs["left_wrist"].number_of_edges()
     moritz = world.actors["moritz"]
     moritz.character.action.plan.append("left_front")  # again, twice as fast
