@@ -113,6 +113,18 @@ def test_transition_to_trajectory_to_inverse_model_gives_the_transition_back(cas
     assert command_from_dict(json.loads(json.dumps(back.to_dict()))) == back
 
 
+@pytest.mark.filterwarnings("error")
+def test_a_key_a_subnormal_angle_away_from_the_last_gives_a_finite_curve_without_a_warning():
+    """Hypothesis draws angles such as 5e-324 rad; scipy's PCHIP overflows the reciprocal of that slope (to the right
+    limit, a zero derivative) and warned. The curve is finite, passes through every key and stays monotone."""
+    keys = np.array([[0.0, 0.0, 0.0], [5e-324, 0.0, 0.0], [1.0, 0.5, 0.0]])
+    hand = HandTransition(keys, np.array([0.0, 0.3, 1.0]), 0.5)
+    angles = hand.trajectory(FPS)
+    assert np.isfinite(angles).all()
+    np.testing.assert_array_equal(hand.curve(hand.times), keys)
+    assert (np.diff(angles[:, 0]) >= -1e-12).all()  # monotone between monotone keys (rounding at 1e-324 aside)
+
+
 def test_the_angular_velocity_is_bell_shaped_and_dips_at_a_via_posture_where_the_fingers_turn():
     straight = HandTransition(np.radians([[20, 25, 5], [85, 95, 0]]), np.array([0.0, 1.0]), 0.5)
     t = np.linspace(0.0, 1.0, 201)

@@ -78,7 +78,11 @@ class HandTransition:
         object.__setattr__(self, "keys", keys)
         object.__setattr__(self, "times", times)
         object.__setattr__(self, "peak", float(self.peak))
-        object.__setattr__(self, "_curve", PchipInterpolator(times, keys, axis=0))
+        # scipy takes the harmonic mean of neighbouring slopes; a subnormal slope overflows its reciprocal to inf,
+        # which gives the right limit (a zero derivative at that key) with a RuntimeWarning: not a fault of the keys.
+        with np.errstate(over="ignore", divide="ignore"):
+            curve = PchipInterpolator(times, keys, axis=0)
+        object.__setattr__(self, "_curve", curve)
 
     @property
     def start(self) -> np.ndarray:
