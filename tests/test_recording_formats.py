@@ -141,6 +141,30 @@ def test_fps_option_wins_over_the_profiles_and_a_time_column_wins_over_both(data
     assert report[0]["fps"] == 30.0  # the BVH's Frame Time
 
 
+def test_fps_option_reaches_the_repertoires_clips_too(data, tmp_path, capsys):
+    """A profile without ``fps``: the CSV repertoire's clips have no frame rate of their own either, so ``--fps``
+    reads them as it reads the files watched; the observations are those of a profile that says that rate."""
+    folder = tmp_path / "csv"
+    folder.mkdir()
+    (folder / "repertoire").symlink_to(data / "csv" / "repertoire")
+    (folder / "profile.toml").write_text("\n".join(line for line in (data / "csv" / "profile.toml").read_text()
+                                                   .splitlines() if not line.startswith("fps")))
+    stream, fps = str(data / "csv" / "streams" / "stream_1.csv"), repr(load_profile(data / "csv" / "profile.toml").fps)
+    assert main(["observe", "--body", str(folder / "profile.toml"), "--repertoire", str(folder / "repertoire"),
+                 "--set", "motor.fps=0", "--fps", fps, stream]) == 1  # the clips, when --fps does not reach them
+    assert "repertoire" in (err := capsys.readouterr().err) and "no frame rate" in err
+    status, report, _ = _observe(capsys, folder, [stream], "--fps", fps)
+    _, reference, _ = _observe(capsys, data / "csv", [stream])
+    assert status == 0 and _without_file(report) == _without_file(reference)
+    (folder / "streams").symlink_to(data / "csv" / "streams")
+    tables = []
+    for where, extra in ((folder, ("--fps", fps)), (data / "csv", ())):
+        assert main(["bench", "stream", "--body", str(where / "profile.toml"), "--repertoire",
+                     str(where / "repertoire"), "--streams", str(where / "streams"), *extra]) == 0
+        tables.append(_table(capsys.readouterr().out))
+    assert tables[0] == tables[1]
+
+
 def test_without_a_frame_rate_a_csv_without_time_is_an_error_naming_it(data, tmp_path, capsys):
     profile = tmp_path / "profile.toml"
     profile.write_text((data / "bvh" / "profile.toml").read_text())  # no fps key

@@ -238,8 +238,8 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p.add_argument("--repertoire", required=True, metavar="DIR", help="labelled clips: one folder per movement")
     p.add_argument("--fps", type=fps_type, default=None, metavar="HZ",
                    help="frame rate of recordings without one of their own (a CSV without a time column, a .npy "
-                   "array, standard input); wins over the profile's fps; a BVH's Frame Time and a CSV's time column "
-                   "win over it")
+                   "array, standard input), the files watched and the repertoire's clips alike; wins over the "
+                   "profile's fps; a BVH's Frame Time and a CSV's time column win over it")
     p.add_argument("--segmenter", metavar="NAME", help="segmenter (default: the observer template's, "
                    "characters/observers/recordings.toml)")
     p.add_argument("--matcher", metavar="NAME", help="matcher (default: the observer template's)")
@@ -673,6 +673,8 @@ def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
         if name is not None and name != NO_CORRESPONDENCE:
             pm.registry.get(kind, name)  # an unknown name fails here, listing the registered ones
     settings = parse_settings(list(args.set))
+    if args.fps is not None:  # the repertoire's clips are recordings too: the same rate, unless --set says otherwise
+        settings.setdefault("motor", {}).setdefault("fps", args.fps)
     check_settings(settings, pm, observer_plugins(pm, segmenters=[args.segmenter] if args.segmenter else (),
                                                   matchers=[args.matcher] if args.matcher else (),
                                                   correspondence=args.correspondence or ""))

@@ -107,8 +107,8 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
                    help="override a parameter of the observer, e.g. --set matcher.k=4 (repeatable)")
     p.add_argument("--fps", type=fps_type, default=None, metavar="HZ",
-                   help="frame rate of the demos and streams without one of their own (CSV without a time column, "
-                   ".npy); wins over the profile's fps (which repertoire clips use); a BVH's Frame Time and a CSV's "
+                   help="frame rate of the demos, streams and repertoire clips without one of their own (CSV "
+                   "without a time column, .npy); wins over the profile's fps; a BVH's Frame Time and a CSV's "
                    "time column win over it")
     p.add_argument("--json", metavar="FILE", help="also write the results as JSON")
     p.add_argument("--csv", metavar="FILE", help="also write the results as CSV (one row per plugin and per item)")

@@ -30,7 +30,7 @@ import platform
 import re
 import tempfile
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -79,6 +79,15 @@ def _settings(values: Sequence[str]) -> dict[str, dict[str, Any]]:
     from toolkit.params import parse_settings
 
     return parse_settings(list(values))
+
+
+def _with_clip_rate(settings: Mapping[str, Mapping[str, Any]] | None, fps: float | None) -> dict[str, dict[str, Any]]:
+    """``settings`` with the motor system reading the repertoire's clips at ``fps`` when they have no rate of their
+    own, as the demos and streams are read (a ``motor.fps`` given in ``settings`` wins)."""
+    settings = {table: dict(values) for table, values in (settings or {}).items()}
+    if fps is not None:
+        settings.setdefault("motor", {}).setdefault("fps", fps)
+    return settings
 
 
 def _versions() -> dict[str, str]:
@@ -142,7 +151,7 @@ def recognition(pm, profile, repertoire: Path, demos: Path | None, matchers: Seq
     each group's clips against a repertoire of every other group's clips. ``observer``: further arguments of
     :func:`toolkit.observe.compose_observer` (``correspondence``, ``lengths_for_height``).
     """
-    observer = dict(observer or {})
+    observer, settings = dict(observer or {}), _with_clip_rate(settings, fps)
     runs = _runs(profile, Path(repertoire), demos, protocol, group, fps)
     plugins, rows = [], []
     for name in matchers:
@@ -260,6 +269,7 @@ def segmentation(pm, profile, streams: Path, segmenters: Sequence[str], *, reper
                  settings=None, quiet: bool = True, observer: dict[str, Any] | None = None,
                  fps: float | None = None) -> dict[str, Any]:
     """Segment every stream with every segmenter; precision, recall, F1, boundary error and speed."""
+    settings = _with_clip_rate(settings, fps)
     data = [(path, truth, profile.read(path, fps)) for path, truth in _streams(streams)]
     plugins, rows, timelines = [], [], _timelines(data)
     for name in segmenters:
@@ -296,6 +306,7 @@ def stream(pm, profile, repertoire: Path, streams: Path, segmenters: Sequence[st
            settings=None, quiet: bool = True, observer: dict[str, Any] | None = None,
            fps: float | None = None) -> dict[str, Any]:
     """Segment and recognise every stream with every pairing; the movement error rate."""
+    settings = _with_clip_rate(settings, fps)
     data = [(path, truth, profile.read(path, fps)) for path, truth in _streams(streams)]
     plugins, rows, timelines = [], [], _timelines(data)
     for seg in segmenters:

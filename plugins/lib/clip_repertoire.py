@@ -169,11 +169,15 @@ def find_hubs(ends: np.ndarray, radius: float, share: float) -> np.ndarray:
 
 
 def load_clip_repertoire(folder: str | Path, profile: str | Path | BodyProfile, *, hub_radius: float = 0.06,
-                         hub_share: float = 0.2) -> ClipRepertoire:
-    """Read every clip of ``folder`` through ``profile`` and find the hubs (:func:`clip_repertoire`)."""
+                         hub_share: float = 0.2, fps: float | None = None) -> ClipRepertoire:
+    """Read every clip of ``folder`` through ``profile`` and find the hubs (:func:`clip_repertoire`).
+
+    ``fps``: the frame rate of clips without one of their own (a CSV without a ``time`` column, a ``.npy`` array),
+    as for :meth:`BodyProfile.read <toolkit.profile.BodyProfile.read>`; ``None``: the profile's.
+    """
     profile = profile if isinstance(profile, BodyProfile) else load_profile(profile)
     labelled = [(movement, path) for movement, files in clip_files(Path(folder)).items() for path in files]
-    return clip_repertoire([profile.read(path) for _, path in labelled], [movement for movement, _ in labelled],
+    return clip_repertoire([profile.read(path, fps) for _, path in labelled], [movement for movement, _ in labelled],
                            profile, sources=[path for _, path in labelled], hub_radius=hub_radius,
                            hub_share=hub_share, folder=Path(folder))
 
@@ -252,6 +256,9 @@ CLIP_PARAMETERS = (
               minimum=0.0),
     Parameter("hub_share", float, 0.2, "Share of clip ends a cluster needs to be a hub (the largest always is one).",
               minimum=0.0, maximum=1.0),
+    Parameter("fps", float, 0.0, "Frame rate (Hz) of clips without one of their own (a CSV without a time column, a "
+              ".npy array); 0: the profile's. A BVH's Frame Time and a CSV's time column win over it "
+              "(`likeme observe --fps` sets it).", minimum=0.0),
 )
 """The parameters of a motor system that can build its repertoire from clips."""
 
@@ -281,12 +288,13 @@ def repertoire_for(params: dict, owner: object) -> ClipRepertoire | None:
     file = getattr(owner, "file", None)
     base = file.parent if file is not None else Path.cwd()
     folder, profile_path = (base / params["clips"]).resolve(), (base / params["profile"]).resolve()
-    key = (folder, profile_path, params["hub_radius"], params["hub_share"])
+    fps = params.get("fps") or None
+    key = (folder, profile_path, params["hub_radius"], params["hub_share"], fps)
     if key not in _CACHE:
         if len(_CACHE) > 8:
             _CACHE.clear()
         _CACHE[key] = load_clip_repertoire(folder, profile_path, hub_radius=params["hub_radius"],
-                                           hub_share=params["hub_share"])
+                                           hub_share=params["hub_share"], fps=fps)
     return _same_parts(owner, _CACHE[key])
 
 
