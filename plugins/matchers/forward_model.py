@@ -106,6 +106,7 @@ angular-velocity minima and direction changes (§4.3).
 
 from __future__ import annotations
 
+import functools
 from collections import OrderedDict
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -318,6 +319,11 @@ class _StrokeRows:
     def along(self, rows: np.ndarray, x: np.ndarray) -> np.ndarray:
         """:func:`_along_rows` of the strokes in ``rows`` at path lengths ``x``: the same points, the same values."""
         g = self.arcs.shape[1]
+        kernels = _kernels()
+        if kernels is not None and x.dtype == np.float64 and rows.dtype == np.int64:
+            out = np.empty((len(x), 3))
+            kernels[1](self.arcs, self.positions, rows, x, self.sorted, out)
+            return out
         if self.sorted:
             query = np.empty(len(x), dtype=complex)
             query.real, query.imag = rows, x
@@ -400,6 +406,103 @@ def _norms(d: np.ndarray) -> np.ndarray:
     """``np.linalg.norm(d, axis=-1)`` of real values, as numpy computes it (the square root of the summed squares
     along the last axis), without its argument handling: the same values."""
     return np.sqrt(np.add.reduce(d * d, axis=-1))
+
+
+def _place_rows(x: np.ndarray, y: np.ndarray, z: np.ndarray, arcs: np.ndarray, parts: np.ndarray, first: np.ndarray,
+                rows: np.ndarray, out: np.ndarray) -> None:
+    """One group of :class:`_Halves` placed, stroke by stroke: ``out[rows[r]]`` is ``arcs[r, i]`` at the first ``i``
+    where the distance from ``first[parts[r]]`` to the point (x, y, z)[r, i] is least (``np.argmin``'s rules: the
+    first least, or the first NaN). Each distance is computed as :meth:`_Halves.place` computes it (the squares summed
+    x, y, z, then the root: the same bits). The root is taken only where the summed squares fall below the least so
+    far (the root does not decrease, so nowhere else can it be less): a point whose root equals the least one's keeps
+    the earlier index, as ``argmin`` does. Plain Python as written (the reference); :func:`_kernels` compiles it."""
+    for r in range(x.shape[0]):
+        p = parts[r]
+        fx, fy, fz = first[p, 0], first[p, 1], first[p, 2]
+        a = x[r, 0] - fx
+        a = a * a
+        b = y[r, 0] - fy
+        a = a + b * b
+        b = z[r, 0] - fz
+        least_sum = a + b * b
+        least = np.sqrt(least_sum)
+        at = 0
+        if least == least:  # a NaN first: argmin's answer
+            for i in range(1, x.shape[1]):
+                a = x[r, i] - fx
+                a = a * a
+                b = y[r, i] - fy
+                a = a + b * b
+                b = z[r, i] - fz
+                a = a + b * b
+                if a < least_sum:
+                    d = np.sqrt(a)
+                    if d < least:
+                        least, at = d, i
+                    least_sum = a
+                elif a != a:  # the first NaN
+                    at = i
+                    break
+        out[rows[r]] = arcs[r, at]
+
+
+def _along_table(arcs: np.ndarray, positions: np.ndarray, rows: np.ndarray, x: np.ndarray, ordered: bool,
+                 out: np.ndarray) -> None:
+    """:meth:`_StrokeRows.along` row by row: ``out[i]`` (3,) is the point of stroke ``rows[i]`` (``arcs`` (R, G),
+    ``positions`` (R, G, 3)) at path length ``x[i]``, with numpy's steps and rules: the points at most ``x[i]`` counted
+    (by a binary search when every row's lengths grow, ``ordered``; a NaN length is at most none), the segment
+    before them (clipped to the stroke), the weight ``(x - a0) / step`` (0 where the step is not positive) clipped to
+    [0, 1] as ``np.clip`` clips (NaN and -0 kept), then ``p0 + w * (p1 - p0)``. Plain Python as written (the
+    reference); :func:`_kernels` compiles it."""
+    g = arcs.shape[1]
+    for i in range(rows.shape[0]):
+        r, v = rows[i], x[i]
+        count = 0
+        if ordered:
+            if v == v:
+                lo, hi = 0, g  # the first point longer than v
+                while lo < hi:
+                    mid = (lo + hi) // 2
+                    if arcs[r, mid] > v:
+                        hi = mid
+                    else:
+                        lo = mid + 1
+                count = lo
+        else:
+            for j in range(g):
+                if arcs[r, j] <= v:
+                    count += 1
+        j = min(max(count - 1, 0), g - 2)
+        a0 = arcs[r, j]
+        step = arcs[r, j + 1] - a0
+        w = (v - a0) / step if step > 0 else 0.0
+        if w == w:  # np.clip: max, then min, NaN kept (and -0 too: numpy keeps w where w == 0)
+            w = w if w >= 0.0 else 0.0
+            w = w if w <= 1.0 else 1.0
+        for c in range(3):
+            p0 = positions[r, j, c]
+            out[i, c] = p0 + w * (positions[r, j + 1, c] - p0)
+
+
+@functools.lru_cache(maxsize=1)
+def _kernels() -> tuple[Any, Any] | None:
+    """:func:`_place_rows` and :func:`_along_table` compiled by numba (cached on disk; no ``fastmath``: no reordered
+    sums, no fused multiply-adds), or ``None`` without numba (numpy's steps run then, with the same values).
+    Compiled (or loaded) when a forward model is attached, not in its first demonstration."""
+    try:
+        import numba
+    except ImportError:
+        return None
+    try:
+        place = numba.njit(cache=True, nogil=True, boundscheck=False)(_place_rows)
+        along = numba.njit(cache=True, nogil=True, boundscheck=False)(_along_table)
+    except RuntimeError:  # numba finds no writable place for its cache (a read-only installation): compiled each run
+        place = numba.njit(nogil=True, boundscheck=False)(_place_rows)
+        along = numba.njit(nogil=True, boundscheck=False)(_along_table)
+    one, row = np.zeros((1, 2)), np.zeros(1, dtype=np.int64)
+    place(one, one, one, one, row, np.zeros((1, 3)), row, np.zeros(1))  # compiled for the types they are called with
+    along(one, np.zeros((1, 2, 3)), row, np.zeros(1), True, np.empty((1, 3)))
+    return place, along
 
 
 class _Walk:
@@ -508,6 +611,12 @@ class _Halves:
         """The anchors (C, k): per command and part, the path length of the first-half point of its stroke nearest
         to ``first`` (k, 3), where the part was seen."""
         placed = np.zeros(self.shape[0] * self.shape[1])
+        kernels = _kernels()
+        if kernels is not None and first.dtype == np.float64:  # compiled, stroke by stroke (the same anchors)
+            first = np.ascontiguousarray(first)
+            for rows, parts, x, y, z, arcs in self.groups:
+                kernels[0](x, y, z, arcs, parts, first, rows, placed)
+            return placed.reshape(self.shape)
         for rows, parts, x, y, z, arcs in self.groups:
             f = first[parts]
             a = x - f[:, 0, None]
@@ -600,6 +709,7 @@ class ForwardModel(Matcher):
         # observed root-relative positions are placed at the observer's own root height; finger angles stay as they are
         self._root_height = np.where(owner.body.angle_mask[:, None], 0.0, motor.rest_pose()[owner.body.root_index])
         self._criteria = StrokeCriteria(drop=self.params["drop"], angle=self.params["angle"])
+        _kernels()  # compiled (or loaded from numba's cache) now, not in the first demonstration
         self._tables: dict[int, tuple] = {}
         self._edges: dict[str, _EdgeTable] = {}
         self._half_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
