@@ -838,6 +838,55 @@ class ForwardModel(Matcher):
         return Match(labels[0] if len(tracks) == 1 else movement, min(t.confidence for t in tracks), memory.n,
                      path=tuple(e for t in tracks for e in t.committed_path), details=details)
 
+    def replay(self, memory: WorkingMemory, stop: int) -> list[tuple[int, Match]]:
+        """:meth:`Matcher.replay <toolkit.components.Matcher.replay>`: the rows up to ``stop`` given at once, with the
+        answers and the state of :meth:`observe` after each. Two runs of rows are given without it, because after
+        each of them it would return ``None`` and change nothing but the rows :meth:`_local` places, which it places
+        when next called (each row by the same addition, alone or in a batch):
+
+        - once the segment settled (:meth:`_quiet`), every row to ``stop``;
+        - while no subsystem is followed, the rows before the first at which one has moved more than ``min_move``
+          since the onset (:meth:`_unmoved`: :meth:`_start_tracks`' test for all those rows at once).
+
+        The rows from the first that starts a track until the segment settles are observed one by one.
+        ``tests/test_forward_model_replay_block.py`` compares it with the rows fed one at a time."""
+        events: list[tuple[int, Match]] = []
+        row = memory.start + memory.n
+        if row < stop and memory is not self._memory:  # as observe's first row would
+            self.begin(memory)
+        while row < stop:
+            if self._settled:
+                break
+            if not self.tracks:
+                row = self._unmoved(memory, row, stop)
+                if row >= stop:
+                    break
+            memory.feed(row + 1)
+            match = self.observe(memory)
+            if match is not None:
+                events.append((row, match))
+            row += 1
+        memory.feed(stop)
+        return events
+
+    def _unmoved(self, memory: WorkingMemory, row: int, stop: int) -> int:
+        """The first of rows ``row`` .. ``stop - 1`` after which :meth:`_start_tracks` would start a track while no
+        subsystem is followed (one whose parts are farther than ``min_move`` from where they were at the onset, as
+        :meth:`_moved` measures it, row by row: the same values), else ``stop``. Reads the rows up to ``stop``
+        without giving them: ``memory`` is left as it was."""
+        given = memory.start + memory.n
+        memory.feed(stop)
+        try:
+            local = memory.positions + self._root_height  # what _local places, row by row (the same additions)
+        finally:
+            memory.feed(given)
+        far = _norms(local[row - memory.start :] - local[0])  # (rows, P): _moved's distances for each row
+        moved = np.zeros(len(far), dtype=bool)
+        for name, idx in self.motor.subsystems.items():
+            moved |= np.fmax.reduce(far[:, idx], axis=1) * self._scale_of(name) > self.params["min_move"]
+        hits = np.flatnonzero(moved)
+        return row + int(hits[0]) if len(hits) else stop
+
     def settled(self) -> int | None:
         """After how many frames of the segment followed nothing more changed, if it settled: every subsystem
         followed, none with a candidate or a commitment (:meth:`_quiet`), and the rows given not rewritten since
