@@ -208,7 +208,7 @@ def test_the_shortcuts_give_the_same_answers_and_traces_to_the_bit(plays):
 
 @given(seed=st.integers(0, 10_000), c=st.integers(1, 6), k=st.integers(1, 5), g=st.integers(2, 40),
        still=st.booleans(), hidden=st.booleans(), on_point=st.booleans(), groups=st.integers(1, 4),
-       near=st.booleans(), scale=st.sampled_from([0, -3, -6, 120]))
+       near=st.booleans(), scale=st.sampled_from([0, -3, -6, 120, -160]))
 @settings(max_examples=150, deadline=None)
 @pytest.mark.parametrize("mode", KERNELS)
 def test_anchors_by_groups_of_half_strokes_are_the_masked_argmin_bit_for_bit(mode, seed, c, k, g, still, hidden,
@@ -216,7 +216,8 @@ def test_anchors_by_groups_of_half_strokes_are_the_masked_argmin_bit_for_bit(mod
     """:class:`_Halves` (the moving strokes' first halves in groups, points past a half at x = +inf) places every
     part where the plain computation does: the masked argmin of :func:`_distances` over whole strokes. Strokes that
     do not move, repeated points (ties), a part seen exactly on a point or halfway between two (near ties), a part
-    never seen (NaN), strokes a millimetre or a micrometre long, and coordinates whose squares overflow included;
+    never seen (NaN), strokes a millimetre or a micrometre long, and coordinates whose squares overflow or underflow
+    included;
     compiled, as the compiled loop's plain-Python reference, and by numpy's steps."""
     rng = np.random.default_rng(seed)
     positions = np.cumsum(rng.normal(size=(c, k, g, 3)) * (rng.random((c, k, g, 1)) < 0.8), axis=2)
