@@ -317,7 +317,8 @@ class _StrokeRows:
         return first
 
     def along(self, rows: np.ndarray, x: np.ndarray) -> np.ndarray:
-        """:func:`_along_rows` of the strokes in ``rows`` at path lengths ``x``: the same points, the same values."""
+        """:func:`_along_rows` of the strokes in ``rows`` at path lengths ``x``: the same points, the same values (in a
+        compiled loop, :func:`_along_table`, with numba; else numpy's steps)."""
         g = self.arcs.shape[1]
         kernels = _kernels()
         if kernels is not None and x.dtype == np.float64 and rows.dtype == np.int64:
@@ -585,7 +586,9 @@ class _Halves:
     it; with a part never seen, NaN, both give the first point). :meth:`place` computes each distance as
     :func:`_distances` does (the squares summed x, y, z, then the root: the same bits) and takes each stroke's first
     nearest point (``np.argmin``), so the anchors are those of the masked argmin over whole strokes, with about a
-    third less arithmetic. ``tests/test_forward_model_fast.py`` compares the two."""
+    third less arithmetic. With numba the same arithmetic runs stroke by stroke in a compiled loop
+    (:func:`_place_rows`), the root taken only where a point may be the nearest. ``tests/test_forward_model_fast.py``
+    compares each way with the masked argmin."""
 
     GROUPS = 3
 
