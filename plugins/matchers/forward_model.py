@@ -245,6 +245,9 @@ class Track:
     begun: Track | None = None
     """After a deviation, predicted again: the segment's first track of the subsystem (what :meth:`ForwardModel.inspect`
     shows of the segment's start)."""
+    placed: tuple[dict[str, int], np.ndarray] | None = None
+    """The anchors placed at once when the track began (:meth:`ForwardModel._anchor`): each command's row in them and
+    the array (C, k) whose rows are those of ``anchors``."""
 
 
 @dataclass(frozen=True)
@@ -1405,7 +1408,7 @@ class ForwardModel(Matcher):
         # without ``relative`` every offset is 0.0: added as a scalar (the same additions as of zeros stacked)
         offsets = np.stack([np.broadcast_to(self._onset_offset(track, n), e.positions[:, 0].shape)
                             for n, e in zip(names, edges)]) if self.params["relative"] else 0.0
-        stacked = (*strokes[1], np.stack([self._anchor(track, n) for n in names]), offsets)
+        stacked = (*strokes[1], self._anchors(track, names), offsets)
         if kept is not None and kept.track is track:
             kept.stacked = (names, stacked)
         return stacked
@@ -1414,6 +1417,17 @@ class ForwardModel(Matcher):
         """How far along a path beginning with command ``name`` each part is: the observed path length plus
         where the demonstration joined the command (:meth:`_anchor`)."""
         return lengths + self._anchor(track, name)
+
+    def _anchors(self, track: Track, names: tuple[str, ...]) -> np.ndarray:
+        """:meth:`_anchor` of each of commands ``names``, stacked (C, k): taken from the anchors placed when the track
+        began (their rows, gathered: the same values) when all of them were placed then, else stacked one by one."""
+        self._anchor(track, names[0])  # places the track's candidates, if not yet
+        placed = track.placed
+        if placed is not None:
+            rows = [placed[0].get(name, -1) for name in names]
+            if min(rows) >= 0:
+                return placed[1][rows]
+        return np.stack([self._anchor(track, n) for n in names])
 
     def _anchor(self, track: Track, name: str) -> np.ndarray:
         """Where, along each part's stroke of command ``name`` (path length), the demonstration was first seen.
@@ -1446,6 +1460,8 @@ class ForwardModel(Matcher):
                 if len(self._placed) > 32:
                     self._placed.popitem(last=False)
             track.anchors.update(zip(names, placed))
+            if track.placed is None:
+                track.placed = ({n: i for i, n in enumerate(names)}, placed)
             anchor = track.anchors[name]
         return anchor
 
