@@ -4,13 +4,18 @@
   each frame (:meth:`ForwardModel._quiet`), without placing the rows (placed at the end, the same values);
 - one-command candidates are extended at once from the stacked strokes (:meth:`ForwardModel._extended_at_once`);
 - the stacked strokes' point counts come from one binary search over complex keys (:func:`_row_keys`), not from
-  comparing every point.
+  comparing every point;
+- the anchors and the points along the table of every stroke come from compiled loops (:func:`_kernels`: numba),
+  or from their plain-Python references, or from numpy's steps when numba is absent: each of the three is held to
+  the plain computation (``KERNELS``).
 
 Each is compared with the plain way on random data (hypothesis) and on Fig. 3's games, every answer and every
 frame's trace.
 """
 
 from __future__ import annotations
+
+import contextlib
 
 import numpy as np
 import pytest
@@ -25,6 +30,23 @@ from tests.test_forward_model_incremental import _arms
 from tests.test_forward_model_replay import play_fig3_games
 from toolkit import Motion
 from toolkit.watching import follow
+
+KERNELS = ("compiled", "python", "numpy")
+"""How :class:`_Halves` and :class:`_StrokeRows` compute: numba's compiled loops, the same loops run as plain
+Python (the reference they are compiled from), or numpy's steps (numba absent)."""
+
+
+@contextlib.contextmanager
+def kernels(mode: str):
+    """A context in which the forward model's loops run as ``mode`` says (:data:`KERNELS`)."""
+    with pytest.MonkeyPatch.context() as patch:
+        if mode == "python":
+            patch.setattr(fm, "_kernels", lambda: (fm._place_rows, fm._along_table))
+        elif mode == "numpy":
+            patch.setattr(fm, "_kernels", lambda: None)
+        else:
+            assert fm._kernels() is not None, "numba is a dependency: the compiled loops must be there"
+        yield
 
 
 @given(seed=st.integers(0, 10_000), rows=st.integers(1, 30), points=st.integers(2, 40), ties=st.booleans(),
@@ -186,14 +208,17 @@ def test_the_shortcuts_give_the_same_answers_and_traces_to_the_bit(plays):
 
 @given(seed=st.integers(0, 10_000), c=st.integers(1, 6), k=st.integers(1, 5), g=st.integers(2, 40),
        still=st.booleans(), hidden=st.booleans(), on_point=st.booleans(), groups=st.integers(1, 4),
-       near=st.booleans(), scale=st.sampled_from([0, -3, -6, 120]))
+       near=st.booleans(), scale=st.sampled_from([0, -3, -6, 120, -160]))
 @settings(max_examples=150, deadline=None)
-def test_anchors_by_groups_of_half_strokes_are_the_masked_argmin_bit_for_bit(seed, c, k, g, still, hidden, on_point,
-                                                                             groups, near, scale):
+@pytest.mark.parametrize("mode", KERNELS)
+def test_anchors_by_groups_of_half_strokes_are_the_masked_argmin_bit_for_bit(mode, seed, c, k, g, still, hidden,
+                                                                             on_point, groups, near, scale):
     """:class:`_Halves` (the moving strokes' first halves in groups, points past a half at x = +inf) places every
     part where the plain computation does: the masked argmin of :func:`_distances` over whole strokes. Strokes that
     do not move, repeated points (ties), a part seen exactly on a point or halfway between two (near ties), a part
-    never seen (NaN), strokes a millimetre or a micrometre long, and coordinates whose squares overflow included."""
+    never seen (NaN), strokes a millimetre or a micrometre long, and coordinates whose squares overflow or underflow
+    included;
+    compiled, as the compiled loop's plain-Python reference, and by numpy's steps."""
     rng = np.random.default_rng(seed)
     positions = np.cumsum(rng.normal(size=(c, k, g, 3)) * (rng.random((c, k, g, 1)) < 0.8), axis=2)
     if still:
@@ -216,7 +241,8 @@ def test_anchors_by_groups_of_half_strokes_are_the_masked_argmin_bit_for_bit(see
     original = fm._Halves.GROUPS
     try:
         fm._Halves.GROUPS = groups
-        got = fm._Halves(arcs, positions).place(first)
+        with kernels(mode):
+            got = fm._Halves(arcs, positions).place(first)
     finally:
         fm._Halves.GROUPS = original
     assert np.array_equal(got, want)
@@ -225,11 +251,13 @@ def test_anchors_by_groups_of_half_strokes_are_the_masked_argmin_bit_for_bit(see
 @given(seed=st.integers(0, 10_000), commands=st.lists(st.integers(1, 4), min_size=1, max_size=12),
        changed=st.booleans(), unsorted=st.booleans())
 @settings(max_examples=100, deadline=None)
-def test_the_table_of_every_stroke_predicts_as_the_stacked_strokes(seed, commands, changed, unsorted):
+@pytest.mark.parametrize("mode", KERNELS)
+def test_the_table_of_every_stroke_predicts_as_the_stacked_strokes(mode, seed, commands, changed, unsorted):
     """:class:`_StrokeRows` (every command's strokes as rows of one growing table, a set of candidates as row
     numbers) gives the points :func:`_along_rows` gives of the same strokes stacked: commands added one by one (the
     table grows past its first size), a command whose table changed (new rows), a stroke whose lengths do not grow
-    (then every point is compared)."""
+    (then every point is compared); compiled, as the compiled loop's plain-Python reference, and by numpy's steps.
+    Lengths at a stroke's end, past it, before its start, -0 and NaN included; the values to the bit."""
     from plugins.matchers.forward_model import _EdgeTable, _StrokeRows
 
     rng = np.random.default_rng(seed)
@@ -239,7 +267,9 @@ def test_the_table_of_every_stroke_predicts_as_the_stacked_strokes(seed, command
     def edge(k: int) -> _EdgeTable:
         steps = np.round(rng.random((k, g - 1)), 1) * (rng.random((k, g - 1)) < 0.7)
         arcs = np.concatenate([np.zeros((k, 1)), np.cumsum(steps, axis=1)], axis=1)
-        return _EdgeTable([], rng.normal(size=(k, g, 3)), arcs, 0)
+        positions = rng.normal(size=(k, g, 3))
+        positions[rng.random(k) < 0.3, 0] = -0.0  # strokes from -0: the sign of a zero weight shows
+        return _EdgeTable([], positions, arcs, 0)
 
     edges = {f"e{i}": edge(k) for i, k in enumerate(commands * 8)}
     if unsorted:
@@ -254,5 +284,33 @@ def test_the_table_of_every_stroke_predicts_as_the_stacked_strokes(seed, command
     positions = np.concatenate([edges[n].positions for n in names])
     x = rng.random(len(rows)) * arcs[:, -1]
     x = np.where(rng.random(len(x)) < 0.2, arcs[:, -1], x)
+    pick = rng.random(len(x))
+    x = np.where(pick < 0.05, -0.0, np.where(pick < 0.1, np.nan, np.where(pick < 0.15, arcs[:, -1] + 1.0,
+                                                                         np.where(pick < 0.2, -1.0, x))))
     assert table.sorted == (not unsorted)
-    np.testing.assert_array_equal(table.along(rows, x), _along_rows(arcs, positions, x))
+    with kernels(mode):
+        got = table.along(rows, x)
+    want = _along_rows(arcs, positions, x)
+    assert np.array_equal(np.isnan(got), np.isnan(want))
+    assert np.array_equal(np.where(np.isnan(got), 0.0, got).view(np.uint64),
+                          np.where(np.isnan(want), 0.0, want).view(np.uint64))
+
+
+@pytest.mark.parametrize("mode", KERNELS)
+def test_points_whose_roots_tie_keep_the_earlier_one(mode):
+    """Two points of a stroke whose summed squares differ by a rounding but whose roots are equal (one point's
+    coordinates reversed: the sums round differently) are equally near: the earlier one is the anchor, as numpy's
+    argmin of the roots says, although the later one's summed squares are smaller. Also an exact tie (two points
+    at the same distance) keeps the earlier one."""
+    p = np.array([0.5937480717858228, 0.8911669542823284, 0.3208483045665637])
+    q = p[::-1].copy()
+    squares = [(v[0] * v[0] + v[1] * v[1]) + v[2] * v[2] for v in (p, q)]
+    assert squares[1] < squares[0] and np.sqrt(squares[1]) == np.sqrt(squares[0])
+    exact = np.array([[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    positions = np.stack([np.stack([p, q, p + 10, p + 20, p + 30]),
+                          np.stack([*exact, exact[1] + 2, exact[1] + 4, exact[1] + 6])])[None]  # (1, 2, 5, 3)
+    arcs = np.concatenate([np.zeros((1, 2, 1)), np.cumsum(np.linalg.norm(np.diff(positions, axis=2), axis=-1),
+                                                          axis=2)], axis=2)
+    with kernels(mode):
+        placed = fm._Halves(arcs, positions).place(np.zeros((2, 3)))
+    assert placed.tolist() == [[0.0, 0.0]]

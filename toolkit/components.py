@@ -524,6 +524,24 @@ class Matcher(Component):
         frames; a matcher that answers must leave the same state either way."""
         return None
 
+    def replay(self, memory: WorkingMemory, stop: int) -> list[tuple[int, Match]]:
+        """Optional, for a streaming matcher: the rows of ``memory``'s segment not given yet, up to row ``stop``
+        (exclusive; rows of working memory, as ``memory.start``), given at once (the watching loop calls it when it
+        feeds a segment rows that are all there already: a stroke matched on its own frames, a segment whose onset
+        the segmenter reported late). Returns what :meth:`observe` would have returned after each of those rows,
+        where it was not ``None``, with the row (the commitment, deviations).
+
+        The default gives them one at a time: ``memory.feed(row + 1)``, then :meth:`observe`. A matcher may do less
+        work where it knows nothing can happen; it must return the same answers and leave the same state as the
+        default."""
+        events = []
+        for row in range(memory.start + memory.n, stop):
+            memory.feed(row + 1)
+            match = self.observe(memory)
+            if match is not None:
+                events.append((row, match))
+        return events
+
 
 class MotorSystem(Component):
     """Produces a character's own movements (and may learn new ones).

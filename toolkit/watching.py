@@ -565,11 +565,9 @@ class WatchingLoop:
             return
         if self._open != since:
             self._begin(since)
-            rows = range(since, row + 1)
+            self._replay(row + 1)  # the rows since the onset, all there already
         else:
-            rows = range(row, row + 1)
-        for r in rows:
-            self._feed(r)
+            self._feed(row)
 
     def _begin(self, start: int) -> None:
         self._open, self._early = start, None
@@ -587,12 +585,40 @@ class WatchingLoop:
             match = self._call("matcher", "observe", self._view)
         if match is None or self.character.matcher is None:
             return
-        self._check_match(match, "observe")
+        self._reported(match, "observe")
+
+    def _reported(self, match: Any, method: str) -> None:
+        """What the matcher returned after a row (by ``method``), checked and told: a deviation, or its commitment."""
+        self._check_match(match, method)
         if match.details.get("stop"):
             self.listener.deviated(match)
         elif self._early is None:
             self._early = match
             self.listener.recognised(None, match)
+
+    def _replay(self, stop: int) -> None:
+        """Give the matcher the rows of the segment it follows up to ``stop`` (exclusive), all in working memory
+        already: at once (:meth:`Matcher.replay <toolkit.components.Matcher.replay>`), then what it returned is
+        checked and told in order, as :meth:`_feed` would after each row. Under a caller's failure policy (a world's:
+        a failing matcher may be dropped between two rows) they are fed one at a time."""
+        matcher, view = self.character.matcher, self._view
+        if matcher is None or view is None:
+            return
+        if not self._direct:
+            for r in range(view.start + view.n, stop):
+                self._feed(r)
+            return
+        events = guarded(matcher, "replay", view, stop)
+        try:
+            events = [(int(row), match) for row, match in events]
+        except (TypeError, ValueError):
+            raise PluginError(self._name("matcher"), f"{type(matcher).__name__}.replay", f"returned {_shown(events)}, "
+                              f"expected [(row, Match), ...]") from None
+        if view.n != stop - view.start:
+            raise PluginError(self._name("matcher"), f"{type(matcher).__name__}.replay", f"left {view.n} rows of the segment "
+                              f"from row {view.start} given, expected {stop - view.start} (up to row {stop})")
+        for _, match in events:
+            self._reported(match, "replay")
 
     def _close(self, segment: Segment, *, announce: bool = True, split: bool = False, cut: bool = False) -> Observation:
         """A segment ended: its answer.
@@ -615,9 +641,8 @@ class WatchingLoop:
             if followed and self._settled_within(segment):  # its state on these frames is the one it has
                 self._view.feed(segment.end)
             else:
-                self._begin(segment.start)  # matched on its own frames, fed one by one
-                for r in range(segment.start, segment.end):
-                    self._feed(r)
+                self._begin(segment.start)  # matched on its own frames
+                self._replay(segment.end)
         early = self._early if self._open == segment.start else None
         late = self._call("matcher", "conclude", self.memory.motion(segment.start, segment.end))
         if late is not None and self.character.matcher is not None:

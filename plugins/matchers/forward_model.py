@@ -106,6 +106,7 @@ angular-velocity minima and direction changes (§4.3).
 
 from __future__ import annotations
 
+import functools
 from collections import OrderedDict
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -244,6 +245,9 @@ class Track:
     begun: Track | None = None
     """After a deviation, predicted again: the segment's first track of the subsystem (what :meth:`ForwardModel.inspect`
     shows of the segment's start)."""
+    placed: tuple[dict[str, int], np.ndarray] | None = None
+    """The anchors placed at once when the track began (:meth:`ForwardModel._anchor`): each command's row in them and
+    the array (C, k) whose rows are those of ``anchors``."""
 
 
 @dataclass(frozen=True)
@@ -316,8 +320,14 @@ class _StrokeRows:
         return first
 
     def along(self, rows: np.ndarray, x: np.ndarray) -> np.ndarray:
-        """:func:`_along_rows` of the strokes in ``rows`` at path lengths ``x``: the same points, the same values."""
+        """:func:`_along_rows` of the strokes in ``rows`` at path lengths ``x``: the same points, the same values (in a
+        compiled loop, :func:`_along_table`, with numba; else numpy's steps)."""
         g = self.arcs.shape[1]
+        kernels = _kernels()
+        if kernels is not None and x.dtype == np.float64 and rows.dtype == np.int64:
+            out = np.empty((len(x), 3))
+            kernels[1](self.arcs, self.positions, rows, x, self.sorted, out)
+            return out
         if self.sorted:
             query = np.empty(len(x), dtype=complex)
             query.real, query.imag = rows, x
@@ -402,6 +412,103 @@ def _norms(d: np.ndarray) -> np.ndarray:
     return np.sqrt(np.add.reduce(d * d, axis=-1))
 
 
+def _place_rows(x: np.ndarray, y: np.ndarray, z: np.ndarray, arcs: np.ndarray, parts: np.ndarray, first: np.ndarray,
+                rows: np.ndarray, out: np.ndarray) -> None:
+    """One group of :class:`_Halves` placed, stroke by stroke: ``out[rows[r]]`` is ``arcs[r, i]`` at the first ``i``
+    where the distance from ``first[parts[r]]`` to the point (x, y, z)[r, i] is least (``np.argmin``'s rules: the
+    first least, or the first NaN). Each distance is computed as :meth:`_Halves.place` computes it (the squares summed
+    x, y, z, then the root: the same bits). The root is taken only where the summed squares fall below the least so
+    far (the root does not decrease, so nowhere else can it be less): a point whose root equals the least one's keeps
+    the earlier index, as ``argmin`` does. Plain Python as written (the reference); :func:`_kernels` compiles it."""
+    for r in range(x.shape[0]):
+        p = parts[r]
+        fx, fy, fz = first[p, 0], first[p, 1], first[p, 2]
+        a = x[r, 0] - fx
+        a = a * a
+        b = y[r, 0] - fy
+        a = a + b * b
+        b = z[r, 0] - fz
+        least_sum = a + b * b
+        least = np.sqrt(least_sum)
+        at = 0
+        if least == least:  # a NaN first: argmin's answer
+            for i in range(1, x.shape[1]):
+                a = x[r, i] - fx
+                a = a * a
+                b = y[r, i] - fy
+                a = a + b * b
+                b = z[r, i] - fz
+                a = a + b * b
+                if a < least_sum:
+                    d = np.sqrt(a)
+                    if d < least:
+                        least, at = d, i
+                    least_sum = a
+                elif a != a:  # the first NaN
+                    at = i
+                    break
+        out[rows[r]] = arcs[r, at]
+
+
+def _along_table(arcs: np.ndarray, positions: np.ndarray, rows: np.ndarray, x: np.ndarray, ordered: bool,
+                 out: np.ndarray) -> None:
+    """:meth:`_StrokeRows.along` row by row: ``out[i]`` (3,) is the point of stroke ``rows[i]`` (``arcs`` (R, G),
+    ``positions`` (R, G, 3)) at path length ``x[i]``, with numpy's steps and rules: the points at most ``x[i]`` counted
+    (by a binary search when every row's lengths grow, ``ordered``; a NaN length is at most none), the segment
+    before them (clipped to the stroke), the weight ``(x - a0) / step`` (0 where the step is not positive) clipped to
+    [0, 1] as ``np.clip`` clips (NaN and -0 kept), then ``p0 + w * (p1 - p0)``. Plain Python as written (the
+    reference); :func:`_kernels` compiles it."""
+    g = arcs.shape[1]
+    for i in range(rows.shape[0]):
+        r, v = rows[i], x[i]
+        count = 0
+        if ordered:
+            if v == v:
+                lo, hi = 0, g  # the first point longer than v
+                while lo < hi:
+                    mid = (lo + hi) // 2
+                    if arcs[r, mid] > v:
+                        hi = mid
+                    else:
+                        lo = mid + 1
+                count = lo
+        else:
+            for j in range(g):
+                if arcs[r, j] <= v:
+                    count += 1
+        j = min(max(count - 1, 0), g - 2)
+        a0 = arcs[r, j]
+        step = arcs[r, j + 1] - a0
+        w = (v - a0) / step if step > 0 else 0.0
+        if w == w:  # np.clip: max, then min, NaN kept (and -0 too: numpy keeps w where w == 0)
+            w = w if w >= 0.0 else 0.0
+            w = w if w <= 1.0 else 1.0
+        for c in range(3):
+            p0 = positions[r, j, c]
+            out[i, c] = p0 + w * (positions[r, j + 1, c] - p0)
+
+
+@functools.lru_cache(maxsize=1)
+def _kernels() -> tuple[Any, Any] | None:
+    """:func:`_place_rows` and :func:`_along_table` compiled by numba (cached on disk; no ``fastmath``: no reordered
+    sums, no fused multiply-adds), or ``None`` without numba (numpy's steps run then, with the same values).
+    Compiled (or loaded) when a forward model is attached, not in its first demonstration."""
+    try:
+        import numba
+    except ImportError:
+        return None
+    try:
+        place = numba.njit(cache=True, nogil=True, boundscheck=False)(_place_rows)
+        along = numba.njit(cache=True, nogil=True, boundscheck=False)(_along_table)
+    except RuntimeError:  # numba finds no writable place for its cache (a read-only installation): compiled each run
+        place = numba.njit(nogil=True, boundscheck=False)(_place_rows)
+        along = numba.njit(nogil=True, boundscheck=False)(_along_table)
+    one, row = np.zeros((1, 2)), np.zeros(1, dtype=np.int64)
+    place(one, one, one, one, row, np.zeros((1, 3)), row, np.zeros(1))  # compiled for the types they are called with
+    along(one, np.zeros((1, 2, 3)), row, np.zeros(1), True, np.empty((1, 3)))
+    return place, along
+
+
 class _Walk:
     """:func:`_lengths` of a growing working memory, frame by frame, with exactly the same values.
 
@@ -482,7 +589,9 @@ class _Halves:
     it; with a part never seen, NaN, both give the first point). :meth:`place` computes each distance as
     :func:`_distances` does (the squares summed x, y, z, then the root: the same bits) and takes each stroke's first
     nearest point (``np.argmin``), so the anchors are those of the masked argmin over whole strokes, with about a
-    third less arithmetic. ``tests/test_forward_model_fast.py`` compares the two."""
+    third less arithmetic. With numba the same arithmetic runs stroke by stroke in a compiled loop
+    (:func:`_place_rows`), the root taken only where a point may be the nearest. ``tests/test_forward_model_fast.py``
+    compares each way with the masked argmin."""
 
     GROUPS = 3
 
@@ -508,6 +617,12 @@ class _Halves:
         """The anchors (C, k): per command and part, the path length of the first-half point of its stroke nearest
         to ``first`` (k, 3), where the part was seen."""
         placed = np.zeros(self.shape[0] * self.shape[1])
+        kernels = _kernels()
+        if kernels is not None and first.dtype == np.float64:  # compiled, stroke by stroke (the same anchors)
+            first = np.ascontiguousarray(first)
+            for rows, parts, x, y, z, arcs in self.groups:
+                kernels[0](x, y, z, arcs, parts, first, rows, placed)
+            return placed.reshape(self.shape)
         for rows, parts, x, y, z, arcs in self.groups:
             f = first[parts]
             a = x - f[:, 0, None]
@@ -600,6 +715,7 @@ class ForwardModel(Matcher):
         # observed root-relative positions are placed at the observer's own root height; finger angles stay as they are
         self._root_height = np.where(owner.body.angle_mask[:, None], 0.0, motor.rest_pose()[owner.body.root_index])
         self._criteria = StrokeCriteria(drop=self.params["drop"], angle=self.params["angle"])
+        _kernels()  # compiled (or loaded from numba's cache) now, not in the first demonstration
         self._tables: dict[int, tuple] = {}
         self._edges: dict[str, _EdgeTable] = {}
         self._half_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
@@ -727,6 +843,55 @@ class ForwardModel(Matcher):
                                                     "speed": t.speed, "progress": t.progress} for t in tracks}
         return Match(labels[0] if len(tracks) == 1 else movement, min(t.confidence for t in tracks), memory.n,
                      path=tuple(e for t in tracks for e in t.committed_path), details=details)
+
+    def replay(self, memory: WorkingMemory, stop: int) -> list[tuple[int, Match]]:
+        """:meth:`Matcher.replay <toolkit.components.Matcher.replay>`: the rows up to ``stop`` given at once, with the
+        answers and the state of :meth:`observe` after each. Two runs of rows are given without it, because after
+        each of them it would return ``None`` and change nothing but the rows :meth:`_local` places, which it places
+        when next called (each row by the same addition, alone or in a batch):
+
+        - once the segment settled (:meth:`_quiet`), every row to ``stop``;
+        - while no subsystem is followed, the rows before the first at which one has moved more than ``min_move``
+          since the onset (:meth:`_unmoved`: :meth:`_start_tracks`' test for all those rows at once).
+
+        The rows from the first that starts a track until the segment settles are observed one by one.
+        ``tests/test_forward_model_replay_block.py`` compares it with the rows fed one at a time."""
+        events: list[tuple[int, Match]] = []
+        row = memory.start + memory.n
+        if row < stop and memory is not self._memory:  # as observe's first row would
+            self.begin(memory)
+        while row < stop:
+            if self._settled:
+                break
+            if not self.tracks:
+                row = self._unmoved(memory, row, stop)
+                if row >= stop:
+                    break
+            memory.feed(row + 1)
+            match = self.observe(memory)
+            if match is not None:
+                events.append((row, match))
+            row += 1
+        memory.feed(stop)
+        return events
+
+    def _unmoved(self, memory: WorkingMemory, row: int, stop: int) -> int:
+        """The first of rows ``row`` .. ``stop - 1`` after which :meth:`_start_tracks` would start a track while no
+        subsystem is followed (one whose parts are farther than ``min_move`` from where they were at the onset, as
+        :meth:`_moved` measures it, row by row: the same values), else ``stop``. Reads the rows up to ``stop``
+        without giving them: ``memory`` is left as it was."""
+        given = memory.start + memory.n
+        memory.feed(stop)
+        try:
+            local = memory.positions + self._root_height  # what _local places, row by row (the same additions)
+        finally:
+            memory.feed(given)
+        far = _norms(local[row - memory.start :] - local[0])  # (rows, P): _moved's distances for each row
+        moved = np.zeros(len(far), dtype=bool)
+        for name, idx in self.motor.subsystems.items():
+            moved |= np.fmax.reduce(far[:, idx], axis=1) * self._scale_of(name) > self.params["min_move"]
+        hits = np.flatnonzero(moved)
+        return row + int(hits[0]) if len(hits) else stop
 
     def settled(self) -> int | None:
         """After how many frames of the segment followed nothing more changed, if it settled: every subsystem
@@ -1243,7 +1408,7 @@ class ForwardModel(Matcher):
         # without ``relative`` every offset is 0.0: added as a scalar (the same additions as of zeros stacked)
         offsets = np.stack([np.broadcast_to(self._onset_offset(track, n), e.positions[:, 0].shape)
                             for n, e in zip(names, edges)]) if self.params["relative"] else 0.0
-        stacked = (*strokes[1], np.stack([self._anchor(track, n) for n in names]), offsets)
+        stacked = (*strokes[1], self._anchors(track, names), offsets)
         if kept is not None and kept.track is track:
             kept.stacked = (names, stacked)
         return stacked
@@ -1252,6 +1417,17 @@ class ForwardModel(Matcher):
         """How far along a path beginning with command ``name`` each part is: the observed path length plus
         where the demonstration joined the command (:meth:`_anchor`)."""
         return lengths + self._anchor(track, name)
+
+    def _anchors(self, track: Track, names: tuple[str, ...]) -> np.ndarray:
+        """:meth:`_anchor` of each of commands ``names``, stacked (C, k): taken from the anchors placed when the track
+        began (their rows, gathered: the same values) when all of them were placed then, else stacked one by one."""
+        self._anchor(track, names[0])  # places the track's candidates, if not yet
+        placed = track.placed
+        if placed is not None:
+            rows = [placed[0].get(name, -1) for name in names]
+            if min(rows) >= 0:
+                return placed[1][rows]
+        return np.stack([self._anchor(track, n) for n in names])
 
     def _anchor(self, track: Track, name: str) -> np.ndarray:
         """Where, along each part's stroke of command ``name`` (path length), the demonstration was first seen.
@@ -1284,6 +1460,8 @@ class ForwardModel(Matcher):
                 if len(self._placed) > 32:
                     self._placed.popitem(last=False)
             track.anchors.update(zip(names, placed))
+            if track.placed is None:
+                track.placed = ({n: i for i, n in enumerate(names)}, placed)
             anchor = track.anchors[name]
         return anchor
 
