@@ -26,6 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from plugins.lib.compiled import compiled
+
 __all__ = ["StrokeCriteria", "StrokeAnalysis", "analyse", "breaks", "held", "speed_breaks", "direction_clusters",
            "direction_breaks"]
 
@@ -241,16 +243,10 @@ def _round_kernels():
     """:func:`_relabel` and :func:`_renormed` compiled by numba (cached on disk), or ``None`` without numba (the
     numpy steps of :func:`direction_clusters` run then, with the same labels). Compiled (or loaded) at the first
     call: the ``velocity-direction`` segmenter calls it when it is attached, not at the end of the first movement."""
-    try:
-        import numba
-    except ImportError:
+    kernels = compiled(_relabel, _renormed)
+    if kernels is None:
         return None
-    try:
-        relabel = numba.njit(cache=True, nogil=True, boundscheck=False)(_relabel)
-        renormed = numba.njit(cache=True, nogil=True, boundscheck=False)(_renormed)
-    except RuntimeError:  # numba finds no writable place for its cache (a read-only installation): compiled each run
-        relabel = numba.njit(nogil=True, boundscheck=False)(_relabel)
-        renormed = numba.njit(nogil=True, boundscheck=False)(_renormed)
+    relabel, renormed = kernels
     _clusters_compiled(np.eye(2), 10.0, 12, relabel, renormed)  # compiled for the types it is called with
     return relabel, renormed
 

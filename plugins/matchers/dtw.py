@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from plugins.lib.compiled import compiled
 from toolkit import Match, Matcher, Motion, Parameter, hookimpl
 
 __all__ = ["DTW", "frame_distance", "warp_all"]
@@ -148,11 +149,10 @@ def warp_all(series: np.ndarray, columns: np.ndarray, starts: np.ndarray, out: n
 def _kernel():
     """:func:`warp_all` compiled by numba (cached on disk), or ``None`` without numba (dtaidistance is used then,
     with the same numbers). Imported and compiled when a dtw observer is composed, never by importing this module."""
-    try:
-        import numba
-    except ImportError:
+    kernels = compiled(warp_all)
+    if kernels is None:
         return None
-    kernel = numba.njit(cache=True, nogil=True, boundscheck=False)(warp_all)
+    (kernel,) = kernels
     one = np.zeros((1, 1))
     kernel(one, one, np.array([0, 1], dtype=np.int64), np.empty(1))  # compiled (or loaded) now, not at a match
     return kernel

@@ -115,6 +115,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from plugins.lib.compiled import compiled
 from plugins.lib.strokes import StrokeCriteria
 from toolkit import Match, Matcher, Motion, Parameter, hookimpl
 from toolkit.components import provides
@@ -493,16 +494,10 @@ def _kernels() -> tuple[Any, Any] | None:
     """:func:`_place_rows` and :func:`_along_table` compiled by numba (cached on disk; no ``fastmath``: no reordered
     sums, no fused multiply-adds), or ``None`` without numba (numpy's steps run then, with the same values).
     Compiled (or loaded) when a forward model is attached, not in its first demonstration."""
-    try:
-        import numba
-    except ImportError:
+    kernels = compiled(_place_rows, _along_table)
+    if kernels is None:
         return None
-    try:
-        place = numba.njit(cache=True, nogil=True, boundscheck=False)(_place_rows)
-        along = numba.njit(cache=True, nogil=True, boundscheck=False)(_along_table)
-    except RuntimeError:  # numba finds no writable place for its cache (a read-only installation): compiled each run
-        place = numba.njit(nogil=True, boundscheck=False)(_place_rows)
-        along = numba.njit(nogil=True, boundscheck=False)(_along_table)
+    place, along = kernels
     one, row = np.zeros((1, 2)), np.zeros(1, dtype=np.int64)
     place(one, one, one, one, row, np.zeros((1, 3)), row, np.zeros(1))  # compiled for the types they are called with
     along(one, np.zeros((1, 2, 3)), row, np.zeros(1), True, np.empty((1, 3)))
