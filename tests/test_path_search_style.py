@@ -44,6 +44,21 @@ def test_with_the_posture_removed_a_held_offset_changes_nothing_that_the_paper_r
     assert held.path == plain.path
 
 
+def test_with_still_parts_posture_removed_the_stance_cancels_and_where_the_hand_is_held_counts(write, pm):
+    """``posture = "still"``: the head (still through a raise) held 20 cm forward cancels, as with the whole posture
+    removed; the hand, the part that moves most, keeps its mean, so the hand held 20 cm to the side is as far as in
+    the paper (about 0.04 m per sample) and unknown."""
+    stick = stick_with(write, pm, posture="still")
+    plain = stick.matcher.match(observed(stick, "raise"))
+    head, hand = np.zeros((5, 3)), np.zeros((5, 3))
+    head[1], hand[4] = (0.0, 0.0, 0.2), (0.2, 0.0, 0.0)
+    stooped = stick.matcher.match(styled(observed(stick, "raise"), head))
+    assert stooped.movement == "raise" and stooped.path == plain.path
+    assert stooped.details["mean_distance"] == pytest.approx(plain.details["mean_distance"], abs=1e-12)
+    aside = stick.matcher.match(styled(observed(stick, "raise"), hand))
+    assert aside.movement is None and aside.details["mean_distance"] == pytest.approx(0.04, rel=0.05)
+
+
 def test_the_graphs_nodes_are_compared_about_their_takes_mean_and_hubs_about_themselves(write, pm):
     stick = stick_with(write, pm, posture="removed")
     motor, matcher = stick.motor, stick.matcher

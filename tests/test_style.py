@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from plugins.lib.style import extent, mean_posture, rescale, take_means
+from plugins.lib.style import extent, mean_posture, rescale, stillness, take_means
 
 
 def test_the_mean_posture_is_each_parts_mean_over_the_frames_it_is_seen():
@@ -35,9 +35,10 @@ def test_rescale_is_the_ratio_to_the_reference_within_the_limit():
 
 def test_take_means_gives_each_node_its_takes_posture_and_a_hub_its_own_pose():
     poses = np.array([[[0.0, 0, 0]], [[1.0, 0, 0]], [[3.0, 0, 0]], [[7.0, 0, 0]]])
-    posture, size = take_means(poses, [np.array([1, 2])])
+    posture, size, still = take_means(poses, [np.array([1, 2])])
     assert posture[:, 0, 0] == pytest.approx([0.0, 2.0, 2.0, 7.0])
     assert size == pytest.approx([0.0, 1.0, 1.0, 0.0])
+    assert still[:, 0] == pytest.approx([1.0, 0.0, 0.0, 1.0])  # the take's one part moves; the hubs are still
 
 
 poses = arrays(float, st.tuples(st.integers(2, 12), st.integers(1, 5), st.just(3)),
@@ -66,3 +67,20 @@ def test_the_extent_scales_with_the_movement_about_its_posture_and_rescaling_und
     assert extent(big, visible) == pytest.approx(c * size, abs=1e-9)
     if 1e-2 < c * size < 1e2:  # the rescaled amplitude is the reference, whatever the amplitude, within the limit
         assert extent(big, visible) * rescale(extent(big, visible), 1.0, 100.0) == pytest.approx(1.0)
+
+
+def test_stillness_is_one_minus_each_parts_movement_over_the_most_moving_parts():
+    """Part 0 still, part 1 swinging 1 m either side, part 2 half as far: stillness 1, 0 and 1/2."""
+    poses = np.array([[[0.0, 0, 0], [1.0, 0, 0], [0, 0.5, 0]], [[0.0, 0, 0], [-1.0, 0, 0], [0, -0.5, 0]]])
+    assert stillness(poses, np.ones((2, 3), bool)) == pytest.approx([1.0, 0.0, 0.5])
+    assert stillness(np.zeros((3, 2, 3)), np.ones((3, 2), bool)) == pytest.approx([1.0, 1.0])
+
+
+@settings(max_examples=50, deadline=None)
+@given(poses, st.floats(0.1, 10), st.data())
+def test_stillness_does_not_change_with_a_held_offset_or_the_movements_size(x, c, data):
+    offset = data.draw(arrays(float, (x.shape[1], 3), elements=st.floats(-1, 1, allow_nan=False)))
+    visible = np.ones(x.shape[:2], bool)
+    assume(extent(x, visible) > 1e-3)  # a movement, not rounding
+    mean = mean_posture(x, visible)
+    assert stillness(mean + (x - mean) * c + offset, visible) == pytest.approx(stillness(x, visible), abs=1e-6)

@@ -10,6 +10,10 @@ from), each on its own:
 - **posture**: each part's mean position over the segment (:func:`mean_posture`). Eq. 1 on poses centred on their
   own segment's mean compares the movement about its own held posture: adding a constant offset to a part over the
   whole demonstration changes nothing (a stoop held through a bow, a hand held higher through a wave).
+- **stillness**: how little each part moves in the segment, relative to the part that moves most
+  (:func:`stillness`). The mean posture of the parts that take no part in a movement is the stance; that of the
+  parts that move is also *where* the movement happens (a hand to the mouth, or to the face). Removing each part's
+  mean in proportion to its stillness cancels the stance and keeps where the moving parts go.
 - **amplitude**: the root-mean-square distance of the parts from that mean posture (:func:`extent`), one length for
   the whole segment. Scaling the movement about its posture by ``reference / extent`` (:func:`rescale`) compares
   the movement's shape at a common size: the same gesture made twice as large or half as large compares close.
@@ -22,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["extent", "mean_posture", "rescale", "take_means"]
+__all__ = ["extent", "mean_posture", "rescale", "stillness", "take_means"]
 
 
 def mean_posture(poses: np.ndarray, visible: np.ndarray) -> np.ndarray:
@@ -51,6 +55,22 @@ def extent(poses: np.ndarray, visible: np.ndarray, posture: np.ndarray | None = 
     return float(np.sqrt(np.einsum("ij,ij->i", dev[seen], dev[seen]).mean()))
 
 
+def stillness(poses: np.ndarray, visible: np.ndarray, posture: np.ndarray | None = None) -> np.ndarray:
+    """How still each part is in the segment, (P,) in [0, 1]: 1 minus its root-mean-square distance from its mean
+    posture over that of the segment's most moving part. The part that moves most is 0, a part that does not move
+    is 1; every part 1 when nothing moves (beyond 1e-9 of the largest coordinate: rounding)."""
+    poses = np.asarray(poses, dtype=float)
+    seen = np.asarray(visible, dtype=bool) & np.isfinite(poses).all(axis=-1)
+    mean = mean_posture(poses, seen) if posture is None else np.asarray(posture, dtype=float)
+    dev = np.where(seen[..., None], poses - np.nan_to_num(mean), 0.0)
+    move = np.sqrt((dev ** 2).sum(axis=(0, 2)) / np.maximum(seen.sum(axis=0), 1))
+    top = move.max(initial=0.0)
+    scale = float(np.abs(np.where(seen[..., None], poses, 0.0)).max(initial=0.0))
+    if not top > 1e-9 * max(scale, 1.0):  # nothing moves beyond the rounding of the positions
+        return np.ones(poses.shape[1])
+    return 1.0 - move / top
+
+
 def rescale(size: float, reference: float, limit: float) -> float:
     """The factor that brings a movement of amplitude ``size`` to ``reference``, kept within ``[1/limit, limit]``
     (a movement is taken for a larger or smaller version of another up to ``limit`` times, as path search's
@@ -60,13 +80,14 @@ def rescale(size: float, reference: float, limit: float) -> float:
     return float(np.clip(reference / size, 1.0 / limit, limit))
 
 
-def take_means(poses: np.ndarray, takes: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """Each node's take posture and amplitude: ``(posture (N, P, 3), extent (N,))`` for nodes ``poses`` (N, P, 3)
-    grouped into ``takes`` (arrays of node indices). A node in no take (a hub) is its own posture, of amplitude 0:
-    centred, it is the posture held still."""
+def take_means(poses: np.ndarray, takes: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each node's take posture, amplitude and parts' stillness: ``(posture (N, P, 3), extent (N,), stillness (N,
+    P))`` for nodes ``poses`` (N, P, 3) grouped into ``takes`` (arrays of node indices). A node in no take (a hub) is
+    its own posture, of amplitude 0, every part still: centred, it is the posture held still."""
     poses = np.asarray(poses, dtype=float)
     posture = poses.copy()
     size = np.zeros(len(poses))
+    still = np.ones(poses.shape[:2])
     for take in takes:
         take = np.asarray(take, dtype=np.intp)
         if not len(take):
@@ -75,4 +96,5 @@ def take_means(poses: np.ndarray, takes: list[np.ndarray]) -> tuple[np.ndarray, 
         mean = mean_posture(poses[take], seen)
         posture[take] = np.where(np.isfinite(mean), mean, poses[take])
         size[take] = extent(poses[take], seen, mean)
-    return posture, size
+        still[take] = stillness(poses[take], seen, mean)
+    return posture, size, still

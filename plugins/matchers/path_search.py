@@ -82,7 +82,7 @@ import numpy as np
 from plugins.lib.attention import movement_weights
 from plugins.lib.pose_distance import PoseScan, path_distance, pose_distance
 from plugins.lib.pose_index import PoseIndex
-from plugins.lib.style import extent, mean_posture, rescale, take_means
+from plugins.lib.style import extent, mean_posture, rescale, stillness, take_means
 from plugins.lib.travel import body_velocity, travel_part
 from toolkit import Match, Matcher, Motion, Parameter, hookimpl
 from toolkit.components import provides
@@ -173,8 +173,10 @@ class PathSearch(Matcher):
                   "moves.", minimum=0.0, maximum=1.0),
         Parameter("posture", str, "kept", "'removed': compare each movement about its own held posture, the "
                   "demonstration's poses centred on their mean over the segment and each node's on its take's mean "
-                  "(plugins.lib.style), so a stooped or proud performer's stance cancels; 'kept': eq. 1 on the poses "
-                  "as they are (the paper).", choices=("kept", "removed")),
+                  "(plugins.lib.style), so a stooped or proud performer's stance cancels, and where a hand is held "
+                  "with it; 'still': each part's mean removed as far as the part is still (plugins.lib.style's "
+                  "stillness), so the stance cancels and where the moving parts go still counts; 'kept': eq. 1 on "
+                  "the poses as they are (the paper).", choices=("kept", "removed", "still")),
         Parameter("amplitude", float, 0.0, "Compare movements' shapes at a common size: the demonstration and each "
                   "take are scaled about their mean posture to the repertoire's median take amplitude (RMS distance "
                   "of the parts from the mean posture, plugins.lib.style), by at most this factor either way, so an "
@@ -235,11 +237,11 @@ class PathSearch(Matcher):
         self.separations = self._separations(index) if self.params["separation"] > 0 else {}
 
     def _styled(self) -> bool:
-        return self.params["posture"] == "removed" or self.params["amplitude"] > 0
+        return self.params["posture"] != "kept" or self.params["amplitude"] > 0
 
     def _styled_nodes(self, poses: np.ndarray, index: dict[str, int]) -> np.ndarray:
         """The nodes' poses as compared (:mod:`plugins.lib.style`): each about its take's mean posture, removed with
-        ``posture = "removed"``, scaled by ``amplitude`` to the repertoire's median take amplitude
+        ``posture = "removed"`` (as far as each part is still in the take with ``"still"``), scaled by ``amplitude`` to the repertoire's median take amplitude
         (:attr:`reference_amplitude`). The poses as they are when neither is set (the paper)."""
         self.reference_amplitude = 0.0
         if not self._styled():
@@ -249,13 +251,13 @@ class PathSearch(Matcher):
                      for movement in self.motor.takes().values() for take in movement]
         else:  # no takes known: each movement is one take
             takes = [np.flatnonzero(self.labels == m) for m in np.unique(self.labels[self.labels != ""])]
-        posture, size = take_means(poses, takes)
+        posture, size, still = take_means(poses, takes)
         sizes = [size[t[0]] for t in takes if len(t)]
         self.reference_amplitude = float(np.median(sizes)) if sizes else 0.0
         factor = np.ones(len(poses))
         if self.params["amplitude"] > 0:
             factor = np.array([rescale(z, self.reference_amplitude, self.params["amplitude"]) for z in size])
-        base = 0.0 if self.params["posture"] == "removed" else posture
+        base = {"kept": posture, "removed": 0.0, "still": posture * (1.0 - still)[..., None]}[self.params["posture"]]
         return base + (poses - posture) * factor[:, None, None]
 
     def _styled_samples(self, poses: np.ndarray, visible: np.ndarray) -> np.ndarray:
@@ -268,7 +270,9 @@ class PathSearch(Matcher):
         factor = 1.0
         if self.params["amplitude"] > 0:
             factor = rescale(extent(poses, visible, posture), self.reference_amplitude, self.params["amplitude"])
-        base = 0.0 if self.params["posture"] == "removed" else posture
+        base = {"kept": posture, "removed": 0.0}.get(self.params["posture"])
+        if base is None:  # still: each part's posture removed as far as the part is still in the segment
+            base = posture * (1.0 - stillness(poses, visible, posture))[:, None]
         return base + (poses - posture) * factor
 
     def _spreads(self, index: dict[str, int]) -> dict[str, float]:
