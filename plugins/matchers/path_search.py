@@ -241,16 +241,13 @@ class PathSearch(Matcher):
 
     def _styled_nodes(self, poses: np.ndarray, index: dict[str, int]) -> np.ndarray:
         """The nodes' poses as compared (:mod:`plugins.lib.style`): each about its take's mean posture, removed with
-        ``posture = "removed"`` (as far as each part is still in the take with ``"still"``), scaled by ``amplitude`` to the repertoire's median take amplitude
-        (:attr:`reference_amplitude`). The poses as they are when neither is set (the paper)."""
+        ``posture = "removed"`` (as far as each part is still in the take with ``"still"``), scaled by ``amplitude``
+        to the repertoire's median take amplitude (:attr:`reference_amplitude`). The poses as they are when neither
+        is set (the paper)."""
         self.reference_amplitude = 0.0
         if not self._styled():
             return poses
-        if callable(getattr(self.motor, "takes", None)):
-            takes = [np.array([index[n] for n in take], dtype=np.intp)
-                     for movement in self.motor.takes().values() for take in movement]
-        else:  # no takes known: each movement is one take
-            takes = [np.flatnonzero(self.labels == m) for m in np.unique(self.labels[self.labels != ""])]
+        takes = [take for clips in self._takes(index).values() for take in clips]
         posture, size, still = take_means(poses, takes)
         sizes = [size[t[0]] for t in takes if len(t)]
         self.reference_amplitude = float(np.median(sizes)) if sizes else 0.0
@@ -275,24 +272,36 @@ class PathSearch(Matcher):
             base = posture * (1.0 - stillness(poses, visible, posture))[:, None]
         return base + (poses - posture) * factor
 
+    def _takes(self, index: dict[str, int]) -> dict[str, list[np.ndarray]]:
+        """Movement -> the node indices of each of its takes (``takes()``, the :class:`Takes` protocol; without it
+        each movement is one take)."""
+        if callable(getattr(self.motor, "takes", None)):
+            return {m: [np.array([index[n] for n in take], dtype=np.intp) for take in takes]
+                    for m, takes in self.motor.takes().items()}
+        return {m: [np.flatnonzero(self.labels == m)] for m in self.motor.movements()}
+
+    def _take_distance(self, own: np.ndarray, exclude: np.ndarray) -> float:
+        """The mean eq. 1 distance of the take of nodes ``own`` to the best path through the graph that avoids the
+        nodes ``exclude`` (NaN when there is none)."""
+        nodes = self.nodes_compared
+        obs, vis = nodes[own], np.ones(nodes[own].shape[:2], dtype=bool)
+        path, _, evidence = self.search(obs, vis, None, exclude)
+        return np.nan if path is None else path_distance(obs, nodes[path], vis) / max(evidence, 1)
+
     def _spreads(self, index: dict[str, int]) -> dict[str, float]:
         """Each movement's spread between takes (movements of several takes only): the median over its takes of the
         take's mean eq. 1 distance to the best path through the graph without that take's nodes."""
-        nodes = self.nodes_compared
         out = {}
-        for movement, takes in self.motor.takes().items():
+        for movement, takes in self._takes(index).items():
             if len(takes) < 2:
                 continue
             distances = []
-            for take in takes:
-                own = np.array([index[n] for n in take], dtype=np.intp)
+            for own in takes:
                 if not len(own):
                     continue
-                exclude = np.zeros(len(nodes), dtype=bool)
+                exclude = np.zeros(len(self.nodes_compared), dtype=bool)
                 exclude[own] = True
-                obs, vis = nodes[own], np.ones(nodes[own].shape[:2], dtype=bool)
-                path, _, evidence = self.search(obs, vis, None, exclude)
-                distances.append(path_distance(obs, nodes[path], vis) / max(evidence, 1))
+                distances.append(self._take_distance(own, exclude))
             finite = [d for d in distances if np.isfinite(d)]
             if len(finite) >= 2:
                 out[movement] = float(np.median(finite))
@@ -302,23 +311,12 @@ class PathSearch(Matcher):
         """Each movement's separation from the rest of the repertoire: the median over its takes of the take's mean
         eq. 1 distance to the best path through the graph without any of the movement's nodes (movements with
         another movement beside them only)."""
-        nodes = self.nodes_compared
-        takes = self.motor.takes() if callable(getattr(self.motor, "takes", None)) else {
-            m: [[self.node_names[i] for i in np.flatnonzero(self.labels == m)]] for m in self.motor.movements()}
         out = {}
-        for movement, clips in takes.items():
+        for movement, takes in self._takes(index).items():
             exclude = self.labels == movement
-            if exclude.all() or not (self.labels[~exclude] != "").any():
+            if not (self.labels[~exclude] != "").any():
                 continue
-            distances = []
-            for take in clips:
-                own = np.array([index[n] for n in take], dtype=np.intp)
-                if not len(own):
-                    continue
-                obs, vis = nodes[own], np.ones(nodes[own].shape[:2], dtype=bool)
-                path, _, evidence = self.search(obs, vis, None, exclude)
-                if path is not None:
-                    distances.append(path_distance(obs, nodes[path], vis) / max(evidence, 1))
+            distances = [self._take_distance(own, exclude) for own in takes if len(own)]
             finite = [d for d in distances if np.isfinite(d)]
             if finite:
                 out[movement] = float(np.median(finite))
