@@ -174,3 +174,12 @@ def test_max_recognises_his_own_movements_performed_stooped_larger_and_slower_on
     styled_answers = answers(posture="removed", amplitude=2.0)
     assert {k: m.movement for k, m in styled_answers.items()} == {k: k for k in MAX_MOVEMENTS}
     assert all(m.details["mean_distance"] < 0.01 for m in styled_answers.values())
+
+
+def test_by_default_the_nodes_and_samples_are_compared_as_they_are(write, pm):
+    """The paper: posture kept, amplitude 0, separation 0 compare the graph's own poses and the samples untouched."""
+    stick = stick_with(write, pm)
+    assert stick.matcher.nodes_compared is stick.motor.node_root_relative
+    assert stick.matcher.separations == {} and stick.matcher.reference_amplitude == 0.0
+    motion = styled(observed(stick, "raise"), np.full((5, 3), 0.1), 1.5)
+    assert np.array_equal(stick.matcher.samples(motion)[0], stick.matcher.samples(motion, styled=False)[0])
