@@ -45,18 +45,25 @@ def test_with_the_posture_removed_a_held_offset_changes_nothing_that_the_paper_r
 
 
 def test_with_still_parts_posture_removed_the_stance_cancels_and_where_the_hand_is_held_counts(write, pm):
-    """``posture = "still"``: the head (still through a raise) held 20 cm forward cancels, as with the whole posture
-    removed; the hand, the part that moves most, keeps its mean, so the hand held 20 cm to the side is as far as in
-    the paper (about 0.04 m per sample) and unknown."""
+    """``posture = "still"``: in a raise the hand moves most (stillness 0) and the root, head and knees do not move
+    (stillness 1). Their take posture is removed from the nodes as their own mean is from the demonstration, and the
+    hand is compared as it is on both sides. So the head held 20 cm forward cancels, while the hand held 20 cm to
+    the side is as far as in the paper (0.2 / 5 = 0.04 m per sample) and unknown."""
     stick = stick_with(write, pm, posture="still")
     plain = stick.matcher.match(observed(stick, "raise"))
+    assert stick.matcher._stillness == pytest.approx([1.0, 1.0, 1.0, 1.0, 0.0])
+    motor, nodes = stick.motor, stick.matcher.nodes_compared
+    rows = [motor.nodes.index(n) for n in motor.takes()["raise"][0]]
+    own = motor.node_root_relative[rows]
+    assert nodes[rows, :4] == pytest.approx(own[:, :4] - own[:, :4].mean(axis=0))
+    assert np.array_equal(nodes[:, 4], motor.node_root_relative[:, 4])
     head, hand = np.zeros((5, 3)), np.zeros((5, 3))
     head[1], hand[4] = (0.0, 0.0, 0.2), (0.2, 0.0, 0.0)
     stooped = stick.matcher.match(styled(observed(stick, "raise"), head))
     assert stooped.movement == "raise" and stooped.path == plain.path
     assert stooped.details["mean_distance"] == pytest.approx(plain.details["mean_distance"], abs=1e-12)
     aside = stick.matcher.match(styled(observed(stick, "raise"), hand))
-    assert aside.movement is None and aside.details["mean_distance"] == pytest.approx(0.04, rel=0.05)
+    assert aside.movement is None and aside.details["mean_distance"] == pytest.approx(0.04, abs=1e-9)
 
 
 def test_the_graphs_nodes_are_compared_about_their_takes_mean_and_hubs_about_themselves(write, pm):

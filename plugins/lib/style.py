@@ -13,7 +13,8 @@ from), each on its own:
 - **stillness**: how little each part moves in the segment, relative to the part that moves most
   (:func:`stillness`). The mean posture of the parts that take no part in a movement is the stance; that of the
   parts that move is also *where* the movement happens (a hand to the mouth, or to the face). Removing each part's
-  mean in proportion to its stillness cancels the stance and keeps where the moving parts go.
+  mean in proportion to its stillness in the demonstration, from the demonstration and from every take alike,
+  cancels the stance and keeps where the moving parts go.
 - **amplitude**: the root-mean-square distance of the parts from that mean posture (:func:`extent`), one length for
   the whole segment. Scaling the movement about its posture by ``reference / extent`` (:func:`rescale`) compares
   the movement's shape at a common size: the same gesture made twice as large or half as large compares close.
@@ -80,14 +81,13 @@ def rescale(size: float, reference: float, limit: float) -> float:
     return float(np.clip(reference / size, 1.0 / limit, limit))
 
 
-def take_means(poses: np.ndarray, takes: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Each node's take posture, amplitude and parts' stillness: ``(posture (N, P, 3), extent (N,), stillness (N,
-    P))`` for nodes ``poses`` (N, P, 3) grouped into ``takes`` (arrays of node indices). A node in no take (a hub) is
-    its own posture, of amplitude 0, every part still: centred, it is the posture held still."""
+def take_means(poses: np.ndarray, takes: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Each node's take posture and amplitude: ``(posture (N, P, 3), extent (N,))`` for nodes ``poses`` (N, P, 3)
+    grouped into ``takes`` (arrays of node indices). A node in no take (a hub) is its own posture, of amplitude 0:
+    centred, it is the posture held still."""
     poses = np.asarray(poses, dtype=float)
     posture = poses.copy()
     size = np.zeros(len(poses))
-    still = np.ones(poses.shape[:2])
     for take in takes:
         take = np.asarray(take, dtype=np.intp)
         if not len(take):
@@ -96,5 +96,4 @@ def take_means(poses: np.ndarray, takes: list[np.ndarray]) -> tuple[np.ndarray, 
         mean = mean_posture(poses[take], seen)
         posture[take] = np.where(np.isfinite(mean), mean, poses[take])
         size[take] = extent(poses[take], seen, mean)
-        still[take] = stillness(poses[take], seen, mean)
-    return posture, size, still
+    return posture, size

@@ -174,9 +174,10 @@ class PathSearch(Matcher):
         Parameter("posture", str, "kept", "'removed': compare each movement about its own held posture, the "
                   "demonstration's poses centred on their mean over the segment and each node's on its take's mean "
                   "(plugins.lib.style), so a stooped or proud performer's stance cancels, and where a hand is held "
-                  "with it; 'still': each part's mean removed as far as the part is still (plugins.lib.style's "
-                  "stillness), so the stance cancels and where the moving parts go still counts; 'kept': eq. 1 on "
-                  "the poses as they are (the paper).", choices=("kept", "removed", "still")),
+                  "with it; 'still': each part's mean removed, from the demonstration and from every take alike, as "
+                  "far as the part is still in the demonstration (plugins.lib.style's stillness), so the stance "
+                  "cancels and where the moving parts go still counts; 'kept': eq. 1 on the poses as they are (the "
+                  "paper).", choices=("kept", "removed", "still")),
         Parameter("amplitude", float, 0.0, "Compare movements' shapes at a common size: the demonstration and each "
                   "take are scaled about their mean posture to the repertoire's median take amplitude (RMS distance "
                   "of the parts from the mean posture, plugins.lib.style), by at most this factor either way, so an "
@@ -230,6 +231,7 @@ class PathSearch(Matcher):
                 [self.nodes_compared, travel_part(motor.node_travel, self.params["travel"])[:, None]], axis=1)
         self.succ = _fan(motor.graph, nodes, index, self.params["max_skip"], forward=True)
         self.pred = _fan(motor.graph, nodes, index, self.params["max_skip"], forward=False)
+        self._nodes_kept = self.nodes_compared
         self._cache_version = n
         self._index = None  # the spatial index of the nodes, built by the first search that uses it
         self._scan = PoseScan(self.nodes_compared)  # the scan of every node (the planes, built once per graph)
@@ -241,20 +243,21 @@ class PathSearch(Matcher):
 
     def _styled_nodes(self, poses: np.ndarray, index: dict[str, int]) -> np.ndarray:
         """The nodes' poses as compared (:mod:`plugins.lib.style`): each about its take's mean posture, removed with
-        ``posture = "removed"`` (as far as each part is still in the take with ``"still"``), scaled by ``amplitude``
-        to the repertoire's median take amplitude (:attr:`reference_amplitude`). The poses as they are when neither
-        is set (the paper)."""
+        ``posture = "removed"``, scaled by ``amplitude`` to the repertoire's median take amplitude
+        (:attr:`reference_amplitude`). The poses as they are when neither is set (the paper). With ``"still"`` the
+        posture is kept here and each match removes the share the demonstration asks for (:meth:`_still_nodes`)."""
         self.reference_amplitude = 0.0
         if not self._styled():
             return poses
         takes = [take for clips in self._takes(index).values() for take in clips]
-        posture, size, still = take_means(poses, takes)
+        posture, size = take_means(poses, takes)
+        self._take_posture = posture
         sizes = [size[t[0]] for t in takes if len(t)]
         self.reference_amplitude = float(np.median(sizes)) if sizes else 0.0
         factor = np.ones(len(poses))
         if self.params["amplitude"] > 0:
             factor = np.array([rescale(z, self.reference_amplitude, self.params["amplitude"]) for z in size])
-        base = {"kept": posture, "removed": 0.0, "still": posture * (1.0 - still)[..., None]}[self.params["posture"]]
+        base = 0.0 if self.params["posture"] == "removed" else posture
         return base + (poses - posture) * factor[:, None, None]
 
     def _styled_samples(self, poses: np.ndarray, visible: np.ndarray) -> np.ndarray:
@@ -269,8 +272,19 @@ class PathSearch(Matcher):
             factor = rescale(extent(poses, visible, posture), self.reference_amplitude, self.params["amplitude"])
         base = {"kept": posture, "removed": 0.0}.get(self.params["posture"])
         if base is None:  # still: each part's posture removed as far as the part is still in the segment
-            base = posture * (1.0 - stillness(poses, visible, posture))[:, None]
+            self._stillness = stillness(poses, visible, posture)
+            base = posture * (1.0 - self._stillness)[:, None]
         return base + (poses - posture) * factor
+
+    def _still_nodes(self) -> np.ndarray:
+        """``posture = "still"``: the nodes as compared with the demonstration just sampled, each part's take posture
+        removed as far as the part is still in the demonstration (:attr:`_stillness`), as it is from the
+        demonstration. The nodes as built (:attr:`_nodes_kept`, posture kept) stay for the spreads and
+        separations."""
+        nodes = self._nodes_kept.copy()
+        body = self._take_posture.shape[1]
+        nodes[:, :body] -= self._stillness[None, :, None] * self._take_posture
+        return nodes
 
     def _takes(self, index: dict[str, int]) -> dict[str, list[np.ndarray]]:
         """Movement -> the node indices of each of its takes (``takes()``, the :class:`Takes` protocol; without it
@@ -365,6 +379,8 @@ class PathSearch(Matcher):
             return Match.unknown(reason="nothing visible")
         self._refresh()
         obs, vis = self.samples(motion)
+        if self.params["posture"] == "still":  # the same share of each part's posture removed from the nodes
+            self.nodes_compared = self._still_nodes()
         weights = None
         if self.params["attention"] > 0:
             positions = ~self.owner.body.angle_mask
