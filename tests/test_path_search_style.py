@@ -190,3 +190,34 @@ def test_by_default_the_nodes_and_samples_are_compared_as_they_are(write, pm):
     assert stick.matcher.separations == {} and stick.matcher.reference_amplitude == 0.0
     motion = styled(observed(stick, "raise"), np.full((5, 3), 0.1), 1.5)
     assert np.array_equal(stick.matcher.samples(motion)[0], stick.matcher.samples(motion, styled=False)[0])
+
+
+STANCE = {"left_knee": (0.04, 0.0, 0.0), "right_knee": (-0.04, 0.0, 0.0), "left_foot": (0.06, 0.0, 0.0),
+          "right_foot": (-0.06, 0.0, 0.0), "head": (0.0, -0.04, 0.04), "nose": (0.0, -0.04, 0.04)}
+"""Another performer's stance: wide-legged (knees 4 cm, feet 6 cm further out) with the head stooped forward."""
+
+
+def test_max_recognises_his_arm_movements_from_a_wide_stooped_stance_larger_and_slower_with_still_parts(max_character):
+    """Scenario on generated movements with ``posture = "still"``: Max's arm movements performed from another stance
+    (:data:`STANCE`), 1.3 times as large and at 0.8 times his speed. The paper's eq. 1 puts each just past
+    max_distance; with the still parts' posture removed and the amplitude brought to the repertoire's, each is the
+    movement performed (the hands, which move, are still compared where they are)."""
+    matcher = max_character.matcher
+    parts = max_character.body.parts
+    stance = np.zeros((len(parts), 3))
+    for part, offset in STANCE.items():
+        stance[parts.index(part)] = offset
+    movements = ("wave", "reach", "clap", "knock", "point", "eat", "thumbs_up", "scratch_head")
+
+    def answers(**params):
+        matcher.params = {**matcher.params, **params}
+        matcher._cache_version = -1
+        out = {}
+        for movement in movements:
+            own = max_character.motor.perform(movement, fps=FPS, speed=0.8).root_relative(max_character.body.root)
+            out[movement] = matcher.match(styled(own, stance, 1.3))
+        return out
+
+    assert all(m.movement is None for m in answers().values())
+    still = answers(posture="still", amplitude=2.0)
+    assert {k: m.movement for k, m in still.items()} == {k: k for k in movements}
