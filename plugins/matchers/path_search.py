@@ -38,6 +38,15 @@ graph's nodes, from the clips or key poses they were sampled from (``node_travel
 protocol). A walk forwards, a walk backwards and a run then differ as they do to the eye, not only in the legs.
 Where the motion's world positions are not known the travel part is hidden, and eq. 1 leaves it out.
 
+Style (issue 18; not in the paper, which compares the poses as they are, §5.1 eq. 1): with ``posture = "removed"``
+the demonstration is compared about its own mean posture over the segment and each node about its take's, so a
+posture held through the whole movement (a stoop, a wide stance) cancels; with ``"still"`` each part's posture is
+removed, from the demonstration and from every node alike, as far as the part is still in the demonstration, so the
+stance cancels and where the moving parts go still counts; with ``amplitude`` = a the demonstration and each take are
+scaled about their posture to the repertoire's median take amplitude, at most a times either way
+(:mod:`plugins.lib.style`). With ``separation`` = s a movement is unknown beyond s times its distance to the
+repertoire's other movements.
+
 Two limits on the search itself (issue 18; both off by default, the paper's search). ``per_movement`` keeps, besides
 the k best paths, the best path ending in each movement at every sample (and starts from each movement's nearest
 pose too): §5.2 starts from the k poses nearest the middle frame over the whole graph, and a repertoire of real
