@@ -271,6 +271,9 @@ CASES = [
     ("layer-plugin", "an unknown layer", {"c.toml": CHILD + '[layer]\nplugin = "look-around"\n'}, ["validate", "c.toml"], ["c.toml:5: key layer.plugin", "unknown layer 'look-around'", "available: look-at"]),
     # -- Fig. 3 and the speed re-parameterisation: an edge's demonstration in a state file (issue 19)
     ("state-edge-shown", "a learned edge whose demonstration has the wrong shape", {"st.json": state(actors={"max": {"character": "Max", "components": {"motor": {"plugin": "motor-command-graph", "state": {"left_wrist": {"nodes": {"n1": [[0.26, 1.4, 0.4]]}, "edges": [{"from": "hub", "to": "n1", "name": "left_wrist:e1", "commands": [{"start": [0.25, 0.92, 0.06], "target": [0.26, 1.4, 0.4], "duration": 0.9}], "shown": [[0.25, 0.92], [0.26, 1.4]], "shown_fps": 30.0}]}}}}}})}, ["run", "imitation_games", "--duration", "0.1", "--load", "st.json"], ["key actors.max.components.motor.state.left_wrist.edges[0].shown: invalid shown", "expected the demonstration's frames, at least two, each [x, y, z] of its 1 parts, finite"]),
+    # -- path search across styles: posture, amplitude (issue 18, ps18)
+    ("path-posture", "path search's posture misnamed", {"c.toml": CHILD + '[matcher]\nplugin = "path-search"\nposture = "centred"\n'}, ["validate", "c.toml"], ["c.toml:6: key matcher.posture", "value 'centred' not allowed", "available: kept, removed, still"]),
+    ("path-amplitude", "an amplitude limit below 1", {"c.toml": CHILD + '[matcher]\nplugin = "path-search"\namplitude = 0.5\n'}, ["validate", "c.toml"], ["c.toml:6: key matcher.amplitude", "0 (off) or a factor of at least 1"]),
 ]
 
 

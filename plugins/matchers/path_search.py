@@ -38,6 +38,15 @@ graph's nodes, from the clips or key poses they were sampled from (``node_travel
 protocol). A walk forwards, a walk backwards and a run then differ as they do to the eye, not only in the legs.
 Where the motion's world positions are not known the travel part is hidden, and eq. 1 leaves it out.
 
+Style (issue 18; not in the paper, which compares the poses as they are, §5.1 eq. 1): with ``posture = "removed"``
+the demonstration is compared about its own mean posture over the segment and each node about its take's, so a
+posture held through the whole movement (a stoop, a wide stance) cancels; with ``"still"`` each part's posture is
+removed, from the demonstration and from every node alike, as far as the part is still in the demonstration, so the
+stance cancels and where the moving parts go still counts; with ``amplitude`` = a the demonstration and each take are
+scaled about their posture to the repertoire's median take amplitude, at most a times either way
+(:mod:`plugins.lib.style`). With ``separation`` = s a movement is unknown beyond s times its distance to the
+repertoire's other movements.
+
 Two limits on the search itself (issue 18; both off by default, the paper's search). ``per_movement`` keeps, besides
 the k best paths, the best path ending in each movement at every sample (and starts from each movement's nearest
 pose too): §5.2 starts from the k poses nearest the middle frame over the whole graph, and a repertoire of real
@@ -82,6 +91,7 @@ import numpy as np
 from plugins.lib.attention import movement_weights
 from plugins.lib.pose_distance import PoseScan, path_distance, pose_distance
 from plugins.lib.pose_index import PoseIndex
+from plugins.lib.style import extent, mean_posture, rescale, stillness, take_means
 from plugins.lib.travel import body_velocity, travel_part
 from toolkit import Match, Matcher, Motion, Parameter, hookimpl
 from toolkit.components import provides
@@ -162,9 +172,26 @@ class PathSearch(Matcher):
         Parameter("spread", float, 0.0, "A movement with several takes is unknown beyond this many times its "
                   "spread between takes (each take's mean eq. 1 distance to the rest of the graph); 0: "
                   "max_distance for every movement (the paper).", minimum=0.0),
+        Parameter("separation", float, 0.0, "A movement is unknown beyond this share of its separation from the "
+                  "repertoire's other movements (the median over its takes of the take's mean eq. 1 distance to the "
+                  "best path through the other movements' nodes): 0.5 accepts a demonstration nearer to the movement "
+                  "than halfway to its nearest neighbour; with spread, the smaller limit holds; 0: max_distance (the "
+                  "paper).", minimum=0.0),
         Parameter("attention", float, 0.0, "How much the parts that move in the segment count over the still ones "
                   "(plugins.lib.attention): 0 is eq. 1's plain mean over the visible parts, 1 counts only what "
                   "moves.", minimum=0.0, maximum=1.0),
+        Parameter("posture", str, "kept", "'removed': compare each movement about its own held posture, the "
+                  "demonstration's poses centred on their mean over the segment and each node's on its take's mean "
+                  "(plugins.lib.style), so a stooped or proud performer's stance cancels, and where a hand is held "
+                  "with it; 'still': each part's mean removed, from the demonstration and from every take alike, as "
+                  "far as the part is still in the demonstration (plugins.lib.style's stillness), so the stance "
+                  "cancels and where the moving parts go still counts; 'kept': eq. 1 on the poses as they are (the "
+                  "paper).", choices=("kept", "removed", "still")),
+        Parameter("amplitude", float, 0.0, "Compare movements' shapes at a common size: the demonstration and each "
+                  "take are scaled about their mean posture to the repertoire's median take amplitude (RMS distance "
+                  "of the parts from the mean posture, plugins.lib.style), by at most this factor either way, so an "
+                  "exaggerated or timid style compares close; 0: as performed (the paper).", minimum=0.0,
+                  check=lambda v: None if v == 0 or v >= 1 else "0 (off) or a factor of at least 1"),
         Parameter("travel", float, 0.0, "Seconds over which where the body goes counts as one more part: the root's "
                   "displacement over this time, in the body's frame (plugins.lib.travel); 0: root-relative poses "
                   "only (the paper).", minimum=0.0, maximum=10.0),
@@ -207,52 +234,135 @@ class PathSearch(Matcher):
         self._by_label = np.argsort(self.label_ids, kind="stable")  # the nodes grouped by movement, in node order
         self._label_starts = np.flatnonzero(np.diff(self.label_ids[self._by_label], prepend=-1))
         self._label_sizes = np.diff(self._label_starts, append=len(nodes))
-        self.nodes_compared = motor.node_root_relative
+        self.nodes_compared = self._styled_nodes(motor.node_root_relative, index)
         if self.params["travel"] > 0:  # travel: one more part of every node
             self.nodes_compared = np.concatenate(
-                [motor.node_root_relative, travel_part(motor.node_travel, self.params["travel"])[:, None]], axis=1)
+                [self.nodes_compared, travel_part(motor.node_travel, self.params["travel"])[:, None]], axis=1)
         self.succ = _fan(motor.graph, nodes, index, self.params["max_skip"], forward=True)
         self.pred = _fan(motor.graph, nodes, index, self.params["max_skip"], forward=False)
+        self._nodes_kept = self.nodes_compared
         self._cache_version = n
         self._index = None  # the spatial index of the nodes, built by the first search that uses it
         self._scan = PoseScan(self.nodes_compared)  # the scan of every node (the planes, built once per graph)
         self.spreads = self._spreads(index) if self.params["spread"] > 0 else {}
+        self.separations = self._separations(index) if self.params["separation"] > 0 else {}
+
+    def _styled(self) -> bool:
+        return self.params["posture"] != "kept" or self.params["amplitude"] > 0
+
+    def _styled_nodes(self, poses: np.ndarray, index: dict[str, int]) -> np.ndarray:
+        """The nodes' poses as compared (:mod:`plugins.lib.style`): each about its take's mean posture, removed with
+        ``posture = "removed"``, scaled by ``amplitude`` to the repertoire's median take amplitude
+        (:attr:`reference_amplitude`). The poses as they are when neither is set (the paper). With ``"still"`` the
+        posture is kept here and each match removes the share the demonstration asks for (:meth:`_still_nodes`)."""
+        self.reference_amplitude = 0.0
+        if not self._styled():
+            return poses
+        takes = [take for clips in self._takes(index).values() for take in clips]
+        posture, size = take_means(poses, takes)
+        self._take_posture = posture
+        sizes = [size[t[0]] for t in takes if len(t)]
+        self.reference_amplitude = float(np.median(sizes)) if sizes else 0.0
+        factor = np.ones(len(poses))
+        if self.params["amplitude"] > 0:
+            factor = np.array([rescale(z, self.reference_amplitude, self.params["amplitude"]) for z in size])
+        base = 0.0 if self.params["posture"] == "removed" else posture
+        return base + (poses - posture) * factor[:, None, None]
+
+    def _styled_samples(self, poses: np.ndarray, visible: np.ndarray) -> np.ndarray:
+        """The demonstration's sampled poses as compared: about their own mean posture over the segment, as
+        :meth:`_styled_nodes` treats each take."""
+        if not self._styled():
+            return poses
+        posture = mean_posture(poses, visible)
+        posture = np.where(np.isfinite(posture), posture, 0.0)  # a part never seen is hidden in every sample
+        factor = 1.0
+        if self.params["amplitude"] > 0:
+            factor = rescale(extent(poses, visible, posture), self.reference_amplitude, self.params["amplitude"])
+        base = {"kept": posture, "removed": 0.0}.get(self.params["posture"])
+        if base is None:  # still: each part's posture removed as far as the part is still in the segment
+            self._stillness = stillness(poses, visible, posture)
+            base = posture * (1.0 - self._stillness)[:, None]
+        return base + (poses - posture) * factor
+
+    def _still_nodes(self) -> np.ndarray:
+        """``posture = "still"``: the nodes as compared with the demonstration just sampled, each part's take posture
+        removed as far as the part is still in the demonstration (:attr:`_stillness`), as it is from the
+        demonstration. The nodes as built (:attr:`_nodes_kept`, posture kept) stay for the spreads and
+        separations."""
+        nodes = self._nodes_kept.copy()
+        body = self._take_posture.shape[1]
+        nodes[:, :body] -= self._stillness[None, :, None] * self._take_posture
+        return nodes
+
+    def _takes(self, index: dict[str, int]) -> dict[str, list[np.ndarray]]:
+        """Movement -> the node indices of each of its takes (``takes()``, the :class:`Takes` protocol; without it
+        each movement is one take)."""
+        if callable(getattr(self.motor, "takes", None)):
+            return {m: [np.array([index[n] for n in take], dtype=np.intp) for take in takes]
+                    for m, takes in self.motor.takes().items()}
+        return {m: [np.flatnonzero(self.labels == m)] for m in self.motor.movements()}
+
+    def _take_distance(self, own: np.ndarray, exclude: np.ndarray) -> float:
+        """The mean eq. 1 distance of the take of nodes ``own`` to the best path through the graph that avoids the
+        nodes ``exclude`` (NaN when there is none)."""
+        nodes = self.nodes_compared
+        obs, vis = nodes[own], np.ones(nodes[own].shape[:2], dtype=bool)
+        path, _, evidence = self.search(obs, vis, None, exclude)
+        return np.nan if path is None else path_distance(obs, nodes[path], vis) / max(evidence, 1)
 
     def _spreads(self, index: dict[str, int]) -> dict[str, float]:
         """Each movement's spread between takes (movements of several takes only): the median over its takes of the
         take's mean eq. 1 distance to the best path through the graph without that take's nodes."""
-        nodes = self.nodes_compared
         out = {}
-        for movement, takes in self.motor.takes().items():
+        for movement, takes in self._takes(index).items():
             if len(takes) < 2:
                 continue
             distances = []
-            for take in takes:
-                own = np.array([index[n] for n in take], dtype=np.intp)
+            for own in takes:
                 if not len(own):
                     continue
-                exclude = np.zeros(len(nodes), dtype=bool)
+                exclude = np.zeros(len(self.nodes_compared), dtype=bool)
                 exclude[own] = True
-                obs, vis = nodes[own], np.ones(nodes[own].shape[:2], dtype=bool)
-                path, _, evidence = self.search(obs, vis, None, exclude)
-                distances.append(path_distance(obs, nodes[path], vis) / max(evidence, 1))
+                distances.append(self._take_distance(own, exclude))
             finite = [d for d in distances if np.isfinite(d)]
             if len(finite) >= 2:
                 out[movement] = float(np.median(finite))
         return out
 
+    def _separations(self, index: dict[str, int]) -> dict[str, float]:
+        """Each movement's separation from the rest of the repertoire: the median over its takes of the take's mean
+        eq. 1 distance to the best path through the graph without any of the movement's nodes (movements with
+        another movement beside them only)."""
+        out = {}
+        for movement, takes in self._takes(index).items():
+            exclude = self.labels == movement
+            if not (self.labels[~exclude] != "").any():
+                continue
+            distances = [self._take_distance(own, exclude) for own in takes if len(own)]
+            finite = [d for d in distances if np.isfinite(d)]
+            if finite:
+                out[movement] = float(np.median(finite))
+        return out
+
     def threshold(self, movement: str) -> float:
-        """The mean eq. 3 distance up to which ``movement`` is accepted: ``spread`` times its spread between takes,
-        or ``max_distance`` (one take, or ``spread = 0``)."""
-        spread = self.spreads.get(movement)
-        return self.params["max_distance"] if spread is None else self.params["spread"] * spread
+        """The mean eq. 3 distance up to which ``movement`` is accepted: the smaller of ``spread`` times its spread
+        between takes and ``separation`` times its separation from the other movements, where each is set and
+        known; else ``max_distance`` (one take, or both 0: the paper)."""
+        limits = []
+        if movement in self.spreads:
+            limits.append(self.params["spread"] * self.spreads[movement])
+        if movement in self.separations:
+            limits.append(self.params["separation"] * self.separations[movement])
+        return min(limits) if limits else self.params["max_distance"]
 
     # -- matching ----------------------------------------------------------------------------
 
-    def samples(self, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
+    def samples(self, motion: Motion, styled: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """The observed motion (in the observer's own parts) at the posegraph's node rate: poses (n, P, 3), visible
         (n, P); with ``travel``, the travel as one more part (n, P + 1, 3), hidden where the motion has no world
-        positions."""
+        positions. ``styled``: about the segment's own posture and amplitude as ``posture`` and ``amplitude`` say
+        (False: the poses as performed, which learning keeps)."""
         if motion.parts != self.owner.body.parts:
             raise ValueError(f"path-search matches motions of the observer's own parts {list(self.owner.body.parts)}, "
                              f"not {list(motion.parts)} (Motion.onto maps them by name)")
@@ -260,6 +370,8 @@ class PathSearch(Matcher):
         n = max(1, int(round(motion.duration * rate)))
         idx = np.minimum(np.round(np.arange(n) * motion.fps / rate).astype(int), motion.n_frames - 1)
         poses, visible = motion.positions[idx], motion.visible[idx]
+        if styled:
+            poses = self._styled_samples(poses, visible)
         if self.params["travel"] <= 0:
             return poses, visible
         if motion.world is None:
@@ -276,6 +388,8 @@ class PathSearch(Matcher):
             return Match.unknown(reason="nothing visible")
         self._refresh()
         obs, vis = self.samples(motion)
+        if self.params["posture"] == "still":  # the same share of each part's posture removed from the nodes
+            self.nodes_compared = self._still_nodes()
         weights = None
         if self.params["attention"] > 0:
             positions = ~self.owner.body.angle_mask
@@ -301,10 +415,13 @@ class PathSearch(Matcher):
         node_path = tuple(self.node_names[i] for i in path)
         if movement in self.spreads:
             details["spread"] = self.spreads[movement]
+        if movement in self.separations:
+            details["separation"] = self.separations[movement]
         limit = self.threshold(movement)
         if mean > limit:
             if self.params["learn"]:
-                return self._learn(obs, vis, details)
+                return self._learn(*self.samples(motion, styled=False), details) if self._styled() else \
+                    self._learn(obs, vis, details)
             return Match(None, 0.0, None, node_path, {"reason": "too far from every path", "nearest": movement,
                                                       "max_distance": limit, **details})
         confidence = float(np.exp(-mean / self.params["scale"]) * share)
