@@ -4,6 +4,7 @@ the items (timings aside), bad values refused (see also tests/test_bench_sweep.p
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import io
 import json
@@ -18,8 +19,8 @@ from toolkit.cli import main
 from toolkit.manager import create_plugin_manager
 
 SUB_COMMANDS = ("recognition", "segmentation", "stream", "sweep", "make-data", "bandai", "watch", "facilitation",
-                "memory", "posegraph", "startup", "vision", "fuzz", "scaling")
-"""Every ``likeme bench`` sub-command but ``behaviour`` (whose --jobs is another helper's part)."""
+                "memory", "posegraph", "startup", "vision", "fuzz", "scaling", "behaviour")
+"""Every ``likeme bench`` sub-command (a test checks the list against the command's own)."""
 TIMED = ("memory", "posegraph", "startup", "vision", "scaling")
 """The sub-commands whose figures are timings or memory."""
 
@@ -53,6 +54,18 @@ def test_every_sub_command_takes_jobs_and_scheduler(name):
     text = _help(name)
     assert "--jobs N" in text and "--scheduler ADDRESS" in text and "local:N" in text
     assert (" ".join(TIMING_NOTE.split()) in text) == (name in TIMED)
+
+
+def test_the_list_is_every_sub_command_of_bench():
+    from toolkit.cli import build_parser
+    from toolkit.manager import create_plugin_manager
+
+    def choices(parser):
+        (action,) = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+        return action.choices
+
+    bench = choices(build_parser(create_plugin_manager()))["bench"]
+    assert set(choices(bench)) == set(SUB_COMMANDS)
 
 
 def _square(item, pm):
