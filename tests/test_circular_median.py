@@ -7,7 +7,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from plugins.lib.root_frame import HeadingFilter, _circular_median, _unwrapped, _unwrapped_median, smooth_heading
+from plugins.lib.root_frame import HeadingFilter, _unwrapped, _unwrapped_median, smooth_heading
 
 
 def angles(rng, kind, shape):

@@ -6,7 +6,6 @@ estimators must behave as scikit-learn estimators (clone, cross_val_score, GridS
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 import pytest

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,7 +14,7 @@ from tests.conftest import BANDAI, CHARACTERS
 from tests.skeletons import BANDAI as BANDAI_SKELETON
 from tests.skeletons import KINECT, human, performance, write_skeleton_bvh, write_skeleton_csv
 from toolkit import ConfigError
-from toolkit.bvh import parse_bvh, read_bvh
+from toolkit.bvh import parse_bvh
 from toolkit.cli import main
 from toolkit.positions import read_positions
 from toolkit.profile import load_profile

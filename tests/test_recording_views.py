@@ -9,7 +9,6 @@ project's own, written by ``make_data`` into a temporary folder.
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest

@@ -442,7 +442,6 @@ def analyse(window: np.ndarray, fps: float, criteria: StrokeCriteria = StrokeCri
 def _analyse(window: np.ndarray, fps: float, c: StrokeCriteria, clusters: bool = True) -> StrokeAnalysis:
     """:func:`analyse`; with ``clusters`` false only its ``breaks`` are meant (:func:`breaks`): a movement too short
     for two strokes is not analysed, and the direction clusters are left out (-1) where there is no speed dip."""
-    from scipy.signal import savgol_filter
 
     window = held(window)
     n = len(window)
