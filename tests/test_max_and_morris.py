@@ -207,3 +207,27 @@ def test_a_target_that_is_never_visible_gives_no_segment_and_no_recognition(char
     assert morris.performed  # he did move
     assert not max_.memory.visible.any()
     assert world.events_of("segment_found") == [] and world.events_of("movement_recognised") == []
+
+
+def test_a_world_actors_working_memory_is_bounded_and_its_answers_do_not_depend_on_it(monkeypatch):
+    """A world may run for hours: an actor's working memory keeps the world's ``memory_seconds`` beyond the segment
+    under way (:class:`toolkit.watching.WatchingLoop`'s ``keep``), not every frame since it began watching."""
+    from toolkit.watching import ObservationLog
+
+    monkeypatch.setattr(ObservationLog, "slack", 16)  # let rows go after 16 unused, not 1024: a short scenario
+    pm = create_plugin_manager(autoload=False)
+    runs = []
+    for seconds in (None, 0.5):
+        scenario = load_scenario(CHARACTERS / "scenarios" / "jump_then_cover_face.toml", pm)
+        world = scenario.world
+        world.memory_seconds = seconds
+        world.actors["max"].watch(world.actors["morris"])  # watching begun again, at frame 0, with this history
+        world = scenario.run()
+        max_ = world.actors["max"]
+        runs.append(([(e.data["segment"].start, e.data["segment"].end) for e in world.events_of("segment_found", "max")],
+                     [e.data["match"].movement for e in world.events_of("movement_recognised", "max")],
+                     [(r.movement, r.imitating) for _, r in max_.performed], max_.memory.offset, max_.memory.n))
+    (segments, recognised, performed, offset, n), short = runs
+    assert short[:3] == (segments, recognised, performed) and recognised == ["jump", "cover_face"]
+    assert offset == 0 and short[3] > 0 and short[4] == n  # rows forgotten, every frame still counted
+    assert short[4] - short[3] <= max(2 * (30 // 2 + 1), 16)  # after the last segment: about twice the 0.5 s kept

@@ -143,7 +143,9 @@ class Actor:
 
     @property
     def memory(self) -> ObservationLog | None:
-        """Working memory of what it perceived of its target since it began watching (``None`` when not watching)."""
+        """Working memory of what it perceived of its target since it began watching (``None`` when not watching):
+        the rows of the segment under way and the last :attr:`World.memory_seconds` (its ``offset`` is the first row
+        held; ``n`` counts every frame)."""
         return self.loop.memory if self.target is not None else None
 
     @property
@@ -295,6 +297,7 @@ class Actor:
             )
         self.watch_start = self.world.frame + 1  # the world frame of the first percept (memory row 0)
         self._call("perception", "reset", self.world.fps)
+        self.loop.keep = self.world.memory_seconds  # bounded working memory: a world may run for hours
         self.loop.reset(target.body.parts, self.world.fps)
         self._sightings = Sightings(self.world.fps, keep=self.world.history_seconds)
 
@@ -441,6 +444,10 @@ class World:
         self.events: list[Event] = []
         self.pm = pm
         self.history_seconds = 120.0
+        self.memory_seconds: float | None = 120.0
+        """Seconds of its working memory an actor keeps beyond the segment under way and what its components still
+        need (:class:`toolkit.watching.WatchingLoop`'s ``keep``), read when it begins watching; ``None``: every row
+        since it began (``likeme bench watch`` matches every true segment from memory at the end)."""
         self._removed: dict[str, WorldObject] = {}
         self._policy_key: tuple | None = None
         self._policy_cm: Any = None

@@ -68,6 +68,7 @@ def watch_benchmark(
                          override_at=(None, ("--set",)))  # the arguments are checked above: the rest is --set
     obs.action = None  # watch only: the benchmark measures perception, segmentation and recognition
     world = World(fps=30.0, pm=pm)
+    world.memory_seconds = None  # every row: each true segment is matched from working memory at the end
     target = world.add_actor(demo, "demonstrator", (0.0, 0.0, 1.6), np.pi)
     watcher = world.add_actor(obs, "observer", (0.0, 0.0, 0.0), 0.0)
     watcher.watch(target)
