@@ -121,7 +121,7 @@ from toolkit import Match, Matcher, Motion, Parameter, hookimpl
 from toolkit.components import provides
 from toolkit.watching import WorkingMemory, follow
 
-__all__ = ["ForwardModel", "Track", "CommandGraphs", "moving_weights", "explained"]
+__all__ = ["ForwardModel", "Track", "CommandGraphs", "moving_weights", "explained", "lead_clock"]
 
 
 def _distances(x: np.ndarray, y: np.ndarray, z: np.ndarray, first: np.ndarray) -> np.ndarray:
@@ -204,6 +204,25 @@ def explained(error: float, extent: float, unexplained: float, floor: float = 0.
     together (another body size) or moved together (another place), so the same ``unexplained`` holds for a mouse
     and a person."""
     return bool(error <= unexplained * max(extent, floor))
+
+
+def lead_clock(arcs: np.ndarray, lead: int, length: float) -> np.ndarray:
+    """Every part's path length (k,) at the time at which part ``lead`` has covered ``length`` of its stroke.
+
+    ``arcs`` (k, G) are the cumulative path lengths of one command's strokes on a grid uniform in time (the parts of
+    one command share its duration), so the time is a fractional grid index: where ``arcs[lead]`` reaches
+    ``length`` (its first point there when the lead pauses), clipped to the stroke; each part is read there. A
+    lead that does not move (every length 0) holds every part at its start."""
+    arcs = np.asarray(arcs, dtype=float)
+    g = arcs.shape[1]
+    row = arcs[lead]
+    if not np.isfinite(length) or row[-1] <= 0.0:
+        return arcs[:, 0].copy()
+    length = min(max(length, 0.0), float(row[-1]))
+    j = int(np.clip(np.searchsorted(row, length, side="left") - 1, 0, g - 2))
+    step = row[j + 1] - row[j]
+    w = 0.0 if step <= 0 else min(max((length - row[j]) / step, 0.0), 1.0)
+    return arcs[:, j] + w * (arcs[:, j + 1] - arcs[:, j])
 
 
 def _arc(points: np.ndarray) -> np.ndarray:
@@ -717,6 +736,13 @@ class ForwardModel(Matcher):
                   "subsystems; see the module).", choices=("max", "mean", "moving")),
         Parameter("relative", bool, False, "Compare displacements since the onset instead of positions, so that a "
                   "demonstrator whose posture differs from the observer's own (another style's stance) still fits."),
+        Parameter("clock", str, "parts", "Where along a command each part is predicted: 'parts', each at the path "
+                  "length it has been seen to cover (the default); 'lead', every part at the time at which the "
+                  "command's lead part has covered the lead's observed path (one motor command, one time, as a "
+                  "hand's fingers share one; §4.4's re-parameterisation), so a command that moves parts the "
+                  "demonstrator keeps still, or keeps still parts that move, predicts them where they are not. "
+                  "With relative, displacements are then taken from where the lead joined the command.",
+                  choices=("parts", "lead")),
         Parameter("together", bool, True, "Follow every subsystem that moves during a demonstration, each with its "
                   "own candidates, and imitate them at once (a hand-arm movement, §4.2); off: only the first to move."),
         Parameter("learn", bool, True, "Learn new edges by the inverse model when no edge predicts the demonstration."),
@@ -1222,7 +1248,7 @@ class ForwardModel(Matcher):
         smooth = uniform_filter1d(observed, size=3, axis=0, mode="nearest") if len(observed) >= 3 else observed
         walked = np.concatenate([np.zeros((1, observed.shape[1])),
                                  np.cumsum(np.linalg.norm(np.diff(smooth, axis=0), axis=-1), axis=0)])
-        if track.hand or not len(path):  # a hand's fingers share one clock: frame by frame, as followed
+        if track.hand or not len(path) or self.params["clock"] == "lead":  # one clock: frame by frame, as followed
             return np.array([self._error(track, path, walked[t], observed[t]) for t in range(1, len(observed))])
         # every frame at once: each part along its strokes of the whole path, laid end to end (what _predict does
         # edge by edge: a part past the end of one edge's stroke goes on along the next, and stops at the last end)
@@ -1418,7 +1444,10 @@ class ForwardModel(Matcher):
         The largest over the parts, or their mean (``error``); with ``relative`` the prediction is moved by
         the offset between the observed onset posture and the path's start.
         """
-        predicted = self._predict(track, path, self._along(track, path[0], lengths))
+        along = self._along(track, path[0], lengths)
+        if self.params["clock"] == "lead" and not track.hand:
+            along = self._lead_clock(path, along)
+        predicted = self._predict(track, path, along)
         if self.params["error"] == "moving" and not track.hand:
             self._weights(track, lengths)
         return self._distance(track, predicted + self._onset_offset(track, path[0]), last)
@@ -1433,7 +1462,10 @@ class ForwardModel(Matcher):
         if len(batch) > 1:
             rows, totals, _, anchors, offsets = self._stacked(track, tuple(path[0] for path in batch))
             k = len(lengths)
-            along = np.minimum(lengths + anchors, totals).reshape(-1)  # (C * k,): _along, then _predict's minimum
+            along = np.minimum(lengths + anchors, totals)  # (C, k): _along, then _predict's minimum
+            if self.params["clock"] == "lead":
+                along = np.stack([self._lead_clock((path[0],), a) for path, a in zip(batch, along)])
+            along = along.reshape(-1)
             predicted = self._stroke_rows.along(rows, along).reshape(len(batch), k, 3) + offsets
             d = _norms(predicted - last) * track.scale
             combined = self._combine(track, d, lengths)
@@ -1545,8 +1577,25 @@ class ForwardModel(Matcher):
         """With ``relative``: the observed onset posture minus where command ``name`` starts (k, 3); else 0."""
         if not self.params["relative"]:
             return 0.0
-        start = self._edge(name).positions[:, 0]
-        return self._first(track) - start
+        edge = self._edge(name)
+        if self.params["clock"] == "lead" and not track.hand:  # from where the lead joined the command
+            joined = self._lead_clock((name,), self._anchor(track, name))
+            return self._first(track) - _along_rows(edge.arcs, edge.positions, np.minimum(joined, edge.arcs[:, -1]))
+        return self._first(track) - edge.positions[:, 0]
+
+    def _lead_clock(self, path: tuple[str, ...], along: np.ndarray) -> np.ndarray:
+        """With ``clock = "lead"``: how far along ``path`` each part is (k,) at the time at which the lead part of
+        its first command is ``along[lead]`` along it (:func:`lead_clock`, edge by edge: a lead past the end of one
+        edge goes on along the next, every part with it)."""
+        lead = self._lead(path[0])
+        left, before = float(along[lead]), np.zeros(len(along))
+        for i, name in enumerate(path):
+            edge = self._edge(name)
+            if left <= edge.arcs[lead, -1] or i == len(path) - 1:
+                return before + lead_clock(edge.arcs, lead, left)
+            left -= float(edge.arcs[lead, -1])
+            before = before + edge.arcs[:, -1]
+        return before
 
     def _first(self, track: Track) -> np.ndarray:
         """The subsystem's parts where they were seen at the track's onset (k, 3)."""
