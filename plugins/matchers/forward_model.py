@@ -77,6 +77,25 @@ spread between takes (:meth:`ForwardModel.spreads`: the median over its takes of
 under the nearest other take's commands), in place of ``threshold`` or ``ceiling``, as ``path-search``'s ``spread``
 does for its ``max_distance``. A movement people perform alike is held tight, one they perform in many ways loosely.
 
+Across styles (issue 18; K&G §4.1, §4.4, §6), three more settings, each off by default (the paper):
+
+- ``error = "moving"``: K&G follow the subsystems that move (§4.1). A whole-body subsystem (a repertoire of
+  clips) has many parts that take no part in a movement, and their errors (a head held otherwise, another stance)
+  outweigh those of the few that do. Each part's error is weighted by the path it has been seen to cover since the
+  onset, over the parts' sum (:func:`moving_weights`): the weights have no unit and sum to 1, a still part weighs
+  nothing, and the error stays in metres.
+- ``clock = "lead"``: one motor command has one time (§4.4 re-parameterises it by the path its movement covers,
+  and a hand's fingers share one clock, §4.2). Every part is predicted at the time at which the command's lead part
+  has covered the lead's observed path (:func:`lead_clock`), rather than each part at its own observed path length,
+  so a command that moves parts the demonstrator keeps still (or keeps still parts that move) predicts them where
+  they are not. With ``relative``, displacements are then taken from where the lead joined the command.
+- ``unexplained`` (a share, unit-free; with ``dropout = "relative"``): "unknown" without metres. A candidate is
+  committed to, or wins the race at the end, only while its mean prediction error since the onset is at most
+  ``unexplained`` times the demonstration's own mean extent, the error of predicting that nothing moves
+  (:func:`explained`); the ceiling in metres is then not used. 1 means "predicts better than standing still":
+  the ratio is unchanged when the demonstration and the prediction are scaled or moved together, so it holds for
+  any body and skeleton.
+
 Working memory: the matcher reads the segment from the
 :class:`~toolkit.watching.WorkingMemory` the watching loop gives it (root-relative,
 in the observer's parts, hidden parts held) and keeps no frames of its own; what it
