@@ -291,10 +291,10 @@ class Track:
     """Per candidate path, its summed prediction errors and the frames summed (a path extended from another
     inherits its sums): the race of ``race``."""
     weights: np.ndarray | None = None
+    """With ``error = "moving"``: the parts' weights (k,) at the frame followed last (:func:`moving_weights`)."""
     extent: tuple[float, int] = (0.0, 0)
     """With ``unexplained``: the summed error of predicting no movement (the demonstration's extent) and the frames
     summed."""
-    """With ``error = "moving"``: the parts' weights (k,) at the frame followed last (:func:`moving_weights`)."""
     stopped: bool = False
     """The imitation of a commitment was stopped at a deviation (once a segment; the body went back to ``home``)."""
     home: str | None = None
@@ -1063,7 +1063,8 @@ class ForwardModel(Matcher):
     def _distance_to(self, name: str, state: np.ndarray, seen: np.ndarray) -> float:
         """How far the parts seen (k, 3) are from a state of subsystem ``name``, combined as ``error`` says."""
         d = np.linalg.norm(state - seen, axis=-1) * self._scale_of(name)
-        return float(np.nanmax(d) if self.params["error"] == "max" else np.nanmean(d))  # nothing has moved yet
+        # "moving" is the plain mean here: a state is compared at the onset, before any part has moved
+        return float(np.nanmax(d) if self.params["error"] == "max" else np.nanmean(d))
 
     def _observed(self, track: Track, memory: np.ndarray) -> np.ndarray:
         """The working memory of a subsystem's parts since it is followed, (n, k, 3).
@@ -1467,7 +1468,7 @@ class ForwardModel(Matcher):
         if self.params["clock"] == "lead" and not track.hand:
             along = self._lead_clock(path, along)
         predicted = self._predict(track, path, along)
-        if self.params["error"] == "moving" and not track.hand:
+        if self.params["error"] == "moving":
             self._weights(track, lengths)
         return self._distance(track, predicted + self._onset_offset(track, path[0]), last)
 
