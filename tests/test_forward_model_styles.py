@@ -207,3 +207,18 @@ def test_another_stance_is_recognised_more_often_and_the_plain_demonstrations_no
     offset = (0.0, -0.03, 0.02)  # 3 cm lower and 2 cm forward: another stance
     assert recognised(generated, "new", offset=offset) > recognised(generated, "paper", offset=offset)
     assert recognised(generated, "new") >= recognised(generated, "paper")
+
+
+def test_with_relative_a_demonstration_seen_at_rest_begins_at_the_hub_not_where_the_last_movement_ended(arms):
+    """After ``out`` the wrists' subsystem is in ``out``'s end node. A demonstration that begins at rest (the body
+    went back without being followed) begins at the hub with ``relative`` too, as with positions: another stance is
+    off one's own states by centimetres, the end of ``out`` by 30 cm. Seen at ``out``'s end, it begins there."""
+    motor = arms.motor
+    end = motor.edge(arms.out).target
+    rest = motor.rest[2]
+    for start, expected in ((rest + [0.0, 0.02, 0.0], "hub"), (rest + [0.3, 0.02, 0.0], end)):
+        motor.reset()
+        motor.move_to("wrists", end)
+        matcher = use(arms, **{**NEW, "learn": False})
+        list(feed(matcher, demonstration(arms, stroke_path(start, [0.0, 0.2, 0.0]))))
+        assert matcher.inspect()["start_node"] == expected
