@@ -77,6 +77,25 @@ spread between takes (:meth:`ForwardModel.spreads`: the median over its takes of
 under the nearest other take's commands), in place of ``threshold`` or ``ceiling``, as ``path-search``'s ``spread``
 does for its ``max_distance``. A movement people perform alike is held tight, one they perform in many ways loosely.
 
+Across styles (issue 18; K&G §4.1, §4.4, §6), three more settings, each off by default (the paper):
+
+- ``error = "moving"``: K&G follow the subsystems that move (§4.1). A whole-body subsystem (a repertoire of
+  clips) has many parts that take no part in a movement, and their errors (a head held otherwise, another stance)
+  outweigh those of the few that do. Each part's error is weighted by the path it has been seen to cover since the
+  onset, over the parts' sum (:func:`moving_weights`): the weights have no unit and sum to 1, a still part weighs
+  nothing, and the error stays in metres.
+- ``clock = "lead"``: one motor command has one time (§4.4 re-parameterises it by the path its movement covers,
+  and a hand's fingers share one clock, §4.2). Every part is predicted at the time at which the command's lead part
+  has covered the lead's observed path (:func:`lead_clock`), rather than each part at its own observed path length,
+  so a command that moves parts the demonstrator keeps still (or keeps still parts that move) predicts them where
+  they are not. With ``relative``, displacements are then taken from where the lead joined the command.
+- ``unexplained`` (a share, unit-free; with ``dropout = "relative"``): "unknown" without metres. A candidate is
+  committed to, or wins the race at the end, only while its mean prediction error since the onset is at most
+  ``unexplained`` times the demonstration's own mean extent, the error of predicting that nothing moves
+  (:func:`explained`); the ceiling in metres is then not used. 1 means "predicts better than standing still":
+  the ratio is unchanged when the demonstration and the prediction are scaled or moved together, so it holds for
+  any body and skeleton.
+
 Working memory: the matcher reads the segment from the
 :class:`~toolkit.watching.WorkingMemory` the watching loop gives it (root-relative,
 in the observer's parts, hidden parts held) and keeps no frames of its own; what it
@@ -121,7 +140,7 @@ from toolkit import Match, Matcher, Motion, Parameter, hookimpl
 from toolkit.components import provides
 from toolkit.watching import WorkingMemory, follow
 
-__all__ = ["ForwardModel", "Track", "CommandGraphs"]
+__all__ = ["ForwardModel", "Track", "CommandGraphs", "moving_weights", "explained", "lead_clock"]
 
 
 def _distances(x: np.ndarray, y: np.ndarray, z: np.ndarray, first: np.ndarray) -> np.ndarray:
@@ -185,6 +204,46 @@ class CommandGraphs(Protocol):
         """The body's rest pose, local frame (P, 3)."""
 
 
+def moving_weights(lengths: np.ndarray) -> np.ndarray:
+    """Each part's share of the path the parts have been seen to cover (k,): ``lengths / lengths.sum()``, the
+    parts alike (``1 / k``) when none has moved (or a length is not finite). The weights sum to 1 and have no unit,
+    so a weighted error is in the units of the distances, and a still part weighs nothing."""
+    lengths = np.asarray(lengths, dtype=float)
+    total = float(lengths.sum())
+    if not np.isfinite(total) or total <= 0.0:
+        return np.full(len(lengths), 1.0 / max(len(lengths), 1))
+    return lengths / total
+
+
+def explained(error: float, extent: float, unexplained: float, floor: float = 0.0) -> bool:
+    """Whether a prediction whose mean error is ``error`` explains the demonstration: ``error <= unexplained *
+    max(extent, floor)``, where ``extent`` is the mean error of predicting that nothing moves (the demonstration's
+    own extent of movement, in the same units) and ``floor`` the smallest extent that counts as a movement. The
+    ratio ``error / extent`` has no unit: it is unchanged when the demonstration and the prediction are scaled
+    together (another body size) or moved together (another place), so the same ``unexplained`` holds for a mouse
+    and a person."""
+    return bool(error <= unexplained * max(extent, floor))
+
+
+def lead_clock(arcs: np.ndarray, lead: int, length: float) -> np.ndarray:
+    """Every part's path length (k,) at the time at which part ``lead`` has covered ``length`` of its stroke.
+
+    ``arcs`` (k, G) are the cumulative path lengths of one command's strokes on a grid uniform in time (the parts of
+    one command share its duration), so the time is a fractional grid index: where ``arcs[lead]`` reaches
+    ``length`` (its first point there when the lead pauses), clipped to the stroke; each part is read there. A
+    lead that does not move (every length 0) holds every part at its start."""
+    arcs = np.asarray(arcs, dtype=float)
+    g = arcs.shape[1]
+    row = arcs[lead]
+    if not np.isfinite(length) or row[-1] <= 0.0:
+        return arcs[:, 0].copy()
+    length = min(max(length, 0.0), float(row[-1]))
+    j = int(np.clip(np.searchsorted(row, length, side="left") - 1, 0, g - 2))
+    step = row[j + 1] - row[j]
+    w = 0.0 if step <= 0 else min(max((length - row[j]) / step, 0.0), 1.0)
+    return arcs[:, j] + w * (arcs[:, j + 1] - arcs[:, j])
+
+
 def _arc(points: np.ndarray) -> np.ndarray:
     """Cumulative path length along points (N, 3)."""
     return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
@@ -231,6 +290,11 @@ class Track:
     sums: dict[tuple[str, ...], tuple[float, int]] = field(default_factory=dict)
     """Per candidate path, its summed prediction errors and the frames summed (a path extended from another
     inherits its sums): the race of ``race``."""
+    weights: np.ndarray | None = None
+    """With ``error = "moving"``: the parts' weights (k,) at the frame followed last (:func:`moving_weights`)."""
+    extent: tuple[float, int] = (0.0, 0)
+    """With ``unexplained``: the summed error of predicting no movement (the demonstration's extent) and the frames
+    summed."""
     stopped: bool = False
     """The imitation of a commitment was stopped at a deviation (once a segment; the body went back to ``home``)."""
     home: str | None = None
@@ -674,16 +738,30 @@ class ForwardModel(Matcher):
         Parameter("stillness", bool, False, "Also drop a candidate whose prediction error exceeds, by more than "
                   "min_move, that of predicting no movement at all (every part staying where it was at the onset): "
                   "it explains nothing of what is seen. Meant with relative = true (both then compare displacements)."),
+        Parameter("unexplained", float, 0.0, "With dropout = relative: a unit-free limit in place of the ceiling. "
+                  "A candidate is committed to, or wins the race at the end, only while its mean prediction error "
+                  "since the onset is at most this many times the demonstration's own mean extent (the error of "
+                  "predicting that nothing moves, combined over the parts as error says); else the answer is "
+                  "unknown. 0: not used (the ceiling in metres decides).", minimum=0.0),
         Parameter("spread", float, 0.0, "A movement with several takes: its candidates drop out beyond this many "
                   "times its spread between takes (each take's mean prediction error under the nearest other take's "
                   "commands) instead of threshold (absolute) or ceiling (relative); 0: not used (the paper).",
                   minimum=0.0),
         Parameter("max_candidates", int, 24, "Most candidate command paths followed at once (the best predictions).", minimum=1),
         Parameter("error", str, "max", "How the prediction errors of a subsystem's parts combine: the largest "
-                  "(a wrist subsystem, §4.4) or the mean (eq. 1 of B&B 2005, for whole-body subsystems).",
-                  choices=("max", "mean")),
+                  "(a wrist subsystem, §4.4), the mean (eq. 1 of B&B 2005, for whole-body subsystems), or 'moving': "
+                  "the mean weighted by the path length each part has been seen to cover since the onset, so the "
+                  "parts that move carry the error and a still body does not (K&G §4.1 follow the moving "
+                  "subsystems; see the module).", choices=("max", "mean", "moving")),
         Parameter("relative", bool, False, "Compare displacements since the onset instead of positions, so that a "
                   "demonstrator whose posture differs from the observer's own (another style's stance) still fits."),
+        Parameter("clock", str, "parts", "Where along a command each part is predicted: 'parts', each at the path "
+                  "length it has been seen to cover (the default); 'lead', every part at the time at which the "
+                  "command's lead part has covered the lead's observed path (one motor command, one time, as a "
+                  "hand's fingers share one; §4.4's re-parameterisation), so a command that moves parts the "
+                  "demonstrator keeps still, or keeps still parts that move, predicts them where they are not. "
+                  "With relative, displacements are then taken from where the lead joined the command.",
+                  choices=("parts", "lead")),
         Parameter("together", bool, True, "Follow every subsystem that moves during a demonstration, each with its "
                   "own candidates, and imitate them at once (a hand-arm movement, §4.2); off: only the first to move."),
         Parameter("learn", bool, True, "Learn new edges by the inverse model when no edge predicts the demonstration."),
@@ -973,11 +1051,13 @@ class ForwardModel(Matcher):
 
         The active node is where the last movement the matcher followed ended; a demonstrator who went back to
         the hub without being followed (a movement that was not recognised, a posture that differed from the
-        observer's own at its end) begins his next movement there. With ``relative`` the observed posture is not
-        comparable with the states, and the active node is kept.
+        observer's own at its end) begins his next movement there. With ``relative`` too (issue 18): another
+        stance is off one's own states by centimetres, while a movement's end is off the hub by the movement; keeping
+        the active node whatever is seen (as this did before) let one unrecognised movement's end node start every
+        later segment of a stream from the wrong node (the generated streams' error 0.778 against 0.333).
         """
         active = self.motor.active_node(name)
-        if active == "hub" or self.params["relative"] or not np.isfinite(seen).any():
+        if active == "hub" or not np.isfinite(seen).any():
             return active
         far = [self._distance_to(name, self.motor.state(name, n), seen) for n in (active, "hub")]
         return active if far[0] <= far[1] else "hub"
@@ -985,6 +1065,7 @@ class ForwardModel(Matcher):
     def _distance_to(self, name: str, state: np.ndarray, seen: np.ndarray) -> float:
         """How far the parts seen (k, 3) are from a state of subsystem ``name``, combined as ``error`` says."""
         d = np.linalg.norm(state - seen, axis=-1) * self._scale_of(name)
+        # "moving" is the plain mean here: a state is compared at the onset, before any part has moved
         return float(np.nanmax(d) if self.params["error"] == "max" else np.nanmean(d))
 
     def _observed(self, track: Track, memory: np.ndarray) -> np.ndarray:
@@ -1048,8 +1129,13 @@ class ForwardModel(Matcher):
         else:
             errors = {path: self._error(track, path, self._clock(track, path, lengths, n), last) for path in paths}
         track.trace.append((frame, errors))
-        still = self._distance(track, observed[0], last) if self.params["stillness"] else None
-        alive = self._survivors(errors, self._evidence(track, errors), still)
+        unexplained = self.params["unexplained"] > 0 and self.params["dropout"] == "relative"
+        still = self._distance(track, observed[0], last) if self.params["stillness"] or unexplained else None
+        evidence = self._evidence(track, errors)
+        if unexplained:
+            total, frames = track.extent
+            track.extent = (total + still, frames + 1)
+        alive = self._survivors(errors, evidence, still if self.params["stillness"] else None)
         if len(alive) > self.params["max_candidates"]:  # keep the best predictions
             alive = dict(sorted(alive.items(), key=lambda kv: kv[1])[: self.params["max_candidates"]])
         track.candidates = alive
@@ -1057,7 +1143,8 @@ class ForwardModel(Matcher):
             path = min(alive, key=alive.get)
             along = self._along(track, path[0], self._clock(track, path, lengths, n))
             progress = self._progress(path[0], along)
-            if (progress >= self.params["min_progress"] or len(path) > 1) and self._timed(track, observed):
+            if (progress >= self.params["min_progress"] or len(path) > 1) and self._timed(track, observed) and \
+                    self._explained(track, path):
                 self._commit(track, path, along, progress, len(observed), alive[path])
         return None
 
@@ -1081,6 +1168,8 @@ class ForwardModel(Matcher):
         score = ({p: t / n for p, (t, n) in track.sums.items() if p in track.candidates} if self.params["race"]
                  else {}) or track.candidates
         path = min(score, key=score.get)
+        if not self._explained(track, path):  # even the best explains too little of the movement: unknown
+            return False
         observed = self._observed(track, memory)
         along = self._along(track, path[0], _lengths(observed))
         self._commit(track, path, along, self._progress(path[0], along), len(observed), track.candidates[path])
@@ -1114,14 +1203,27 @@ class ForwardModel(Matcher):
     def _evidence(self, track: Track, errors: Mapping[tuple[str, ...], float]) -> Mapping[tuple[str, ...], float]:
         """What the relative drop-out compares: this frame's errors, or with ``race`` each candidate's mean error
         since the onset (its sums updated here; a path extended this frame inherits its parent's)."""
-        if not self.params["race"]:
+        if not self.params["race"] and not (self.params["unexplained"] > 0 and self.params["dropout"] == "relative"):
             return errors
         sums = {}
         for path, error in errors.items():
             total, n = track.sums.get(path) or track.sums.get(path[:-1]) or (0.0, 0)
             sums[path] = (total + error, n + 1)
         track.sums = sums
+        if not self.params["race"]:
+            return errors
         return {path: total / n for path, (total, n) in sums.items()}
+
+    def _explained(self, track: Track, path: tuple[str, ...]) -> bool:
+        """With ``unexplained`` (and ``dropout = relative``): whether candidate ``path``'s mean prediction error since
+        the onset is at most ``unexplained`` times the demonstration's mean extent (:func:`explained`); always true
+        without it."""
+        if not (self.params["unexplained"] > 0 and self.params["dropout"] == "relative"):
+            return True
+        total, n = track.sums.get(path, (0.0, 0))
+        extent, frames = track.extent
+        return explained(total / max(n, 1), extent / max(frames, 1), self.params["unexplained"],
+                         self.params["min_move"])
 
     def _limit(self, path: tuple[str, ...]) -> float:
         """The prediction error above which candidate ``path`` drops out whatever the others do: ``spread`` times
@@ -1131,6 +1233,8 @@ class ForwardModel(Matcher):
             spread = self.spreads().get(self._movement_key(path))
             if spread is not None:
                 return self.params["spread"] * spread
+        if self.params["dropout"] == "relative" and self.params["unexplained"] > 0:
+            return float("inf")  # unknown is decided against the demonstration's own extent (:meth:`_explained`)
         return self.params["threshold" if self.params["dropout"] == "absolute" else "ceiling"]
 
     def spreads(self) -> dict[str, float]:
@@ -1166,7 +1270,7 @@ class ForwardModel(Matcher):
         smooth = uniform_filter1d(observed, size=3, axis=0, mode="nearest") if len(observed) >= 3 else observed
         walked = np.concatenate([np.zeros((1, observed.shape[1])),
                                  np.cumsum(np.linalg.norm(np.diff(smooth, axis=0), axis=-1), axis=0)])
-        if track.hand or not len(path):  # a hand's fingers share one clock: frame by frame, as followed
+        if track.hand or not len(path) or self.params["clock"] == "lead":  # one clock: frame by frame, as followed
             return np.array([self._error(track, path, walked[t], observed[t]) for t in range(1, len(observed))])
         # every frame at once: each part along its strokes of the whole path, laid end to end (what _predict does
         # edge by edge: a part past the end of one edge's stroke goes on along the next, and stops at the last end)
@@ -1179,6 +1283,8 @@ class ForwardModel(Matcher):
         predicted = np.stack([np.stack([np.interp(along[:, p], arcs[p], positions[p, :, c]) for c in range(3)],
                                        axis=-1) for p in range(len(arcs))], axis=1)  # (T, k, 3)
         d = np.linalg.norm(predicted + self._onset_offset(track, path[0]) - observed[1:], axis=-1) * track.scale
+        if self.params["error"] == "moving":
+            return (d * np.apply_along_axis(moving_weights, 1, walked[1:])).sum(axis=1)
         return d.max(axis=1) if self.params["error"] == "max" else d.mean(axis=1)
 
     def _last_correct(self, track: Track, lengths: np.ndarray, memory: np.ndarray) -> None:
@@ -1360,7 +1466,12 @@ class ForwardModel(Matcher):
         The largest over the parts, or their mean (``error``); with ``relative`` the prediction is moved by
         the offset between the observed onset posture and the path's start.
         """
-        predicted = self._predict(track, path, self._along(track, path[0], lengths))
+        along = self._along(track, path[0], lengths)
+        if self.params["clock"] == "lead" and not track.hand:
+            along = self._lead_clock(path, along)
+        predicted = self._predict(track, path, along)
+        if self.params["error"] == "moving":
+            self._weights(track, lengths)
         return self._distance(track, predicted + self._onset_offset(track, path[0]), last)
 
     def _errors(self, track: Track, paths: list[tuple[str, ...]], lengths: np.ndarray,
@@ -1373,12 +1484,22 @@ class ForwardModel(Matcher):
         if len(batch) > 1:
             rows, totals, _, anchors, offsets = self._stacked(track, tuple(path[0] for path in batch))
             k = len(lengths)
-            along = np.minimum(lengths + anchors, totals).reshape(-1)  # (C * k,): _along, then _predict's minimum
+            along = np.minimum(lengths + anchors, totals)  # (C, k): _along, then _predict's minimum
+            if self.params["clock"] == "lead":
+                along = np.stack([self._lead_clock((path[0],), a) for path, a in zip(batch, along)])
+            along = along.reshape(-1)
             predicted = self._stroke_rows.along(rows, along).reshape(len(batch), k, 3) + offsets
             d = _norms(predicted - last) * track.scale
-            combined = d.max(axis=1) if self.params["error"] == "max" else d.mean(axis=1)
+            combined = self._combine(track, d, lengths)
             errors = dict(zip(batch, combined.tolist()))
         return {path: errors[path] if path in errors else self._error(track, path, lengths, last) for path in paths}
+
+    def _combine(self, track: Track, d: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+        """Per-part distances (C, k) of C predictions combined as ``error`` says (C,)."""
+        error = self.params["error"]
+        if error == "moving":
+            return d @ self._weights(track, lengths)
+        return d.max(axis=1) if error == "max" else d.mean(axis=1)
 
     def _stacked(self, track: Track, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
         """For commands ``names`` followed by ``track``: their strokes' rows in the table of every stroke
@@ -1478,8 +1599,25 @@ class ForwardModel(Matcher):
         """With ``relative``: the observed onset posture minus where command ``name`` starts (k, 3); else 0."""
         if not self.params["relative"]:
             return 0.0
-        start = self._edge(name).positions[:, 0]
-        return self._first(track) - start
+        edge = self._edge(name)
+        if self.params["clock"] == "lead" and not track.hand:  # from where the lead joined the command
+            joined = self._lead_clock((name,), self._anchor(track, name))
+            return self._first(track) - _along_rows(edge.arcs, edge.positions, np.minimum(joined, edge.arcs[:, -1]))
+        return self._first(track) - edge.positions[:, 0]
+
+    def _lead_clock(self, path: tuple[str, ...], along: np.ndarray) -> np.ndarray:
+        """With ``clock = "lead"``: how far along ``path`` each part is (k,) at the time at which the lead part of
+        its first command is ``along[lead]`` along it (:func:`lead_clock`, edge by edge: a lead past the end of one
+        edge goes on along the next, every part with it)."""
+        lead = self._lead(path[0])
+        left, before = float(along[lead]), np.zeros(len(along))
+        for i, name in enumerate(path):
+            edge = self._edge(name)
+            if left <= edge.arcs[lead, -1] or i == len(path) - 1:
+                return before + lead_clock(edge.arcs, lead, left)
+            left -= float(edge.arcs[lead, -1])
+            before = before + edge.arcs[:, -1]
+        return before
 
     def _first(self, track: Track) -> np.ndarray:
         """The subsystem's parts where they were seen at the track's onset (k, 3)."""
@@ -1490,7 +1628,19 @@ class ForwardModel(Matcher):
     def _distance(self, track: Track, predicted: np.ndarray, observed: np.ndarray) -> float:
         """Per-part distances (k, 3 each) combined as ``error`` says: the largest or the mean (radians of a hand scaled)."""
         d = _norms(predicted - observed) * track.scale
+        if self.params["error"] == "moving":
+            return float(d @ self._weights(track))
         return float(d.max() if self.params["error"] == "max" else d.mean())
+
+    def _weights(self, track: Track, lengths: np.ndarray | None = None) -> np.ndarray:
+        """With ``error = "moving"``: each part's weight (k,), its observed path length since the onset over the
+        parts' sum (:func:`moving_weights`); ``lengths`` given, they are kept on the track for the frame's other
+        comparisons."""
+        if lengths is not None:
+            track.weights = moving_weights(lengths)
+        elif track.weights is None:
+            track.weights = moving_weights(np.zeros(len(self.motor.subsystems[track.subsystem])))
+        return track.weights
 
     def _progress(self, name: str, along: np.ndarray) -> float:
         """The share of command ``name``'s time its lead part has covered, ``along`` its path."""
