@@ -13,6 +13,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from tests.test_relative_lengths import generated  # noqa: F401  (the generated recordings, a module fixture)
 from toolkit import create_plugin_manager
 from toolkit.observe import Observer
 from toolkit.observe import compose_observer
@@ -22,14 +23,6 @@ MOVEMENTS = ("wave", "reach", "clap", "bow", "knock")
 LEFT_OUT = "knock"
 DECISION = {"posture": "still", "amplitude": 2.0, "still_spread": True, "spread_quantile": 1.0, "spread": 1.0}
 """The styled comparison with each movement accepted as far as its own farthest take lies from the others."""
-
-
-@pytest.fixture(scope="module")
-def generated(tmp_path_factory):
-    from plugins.bench.data import make_data
-
-    pm = create_plugin_manager(autoload=False, trace=False)
-    return make_data(pm, tmp_path_factory.mktemp("generated"), seed=7, streams=1, per_stream=3)
 
 
 @pytest.fixture(scope="module")
