@@ -135,3 +135,28 @@ def test_a_styled_known_movement_is_accepted_and_a_movement_left_out_is_unknown(
         kept[movement] = Observer(paper, profile.body, motion.fps).classify(motion).movement
     assert answers == {m: (None if m == LEFT_OUT else m) for m in MOVEMENTS}
     assert all(m is None for m in kept.values())
+
+
+def test_with_still_spread_a_takes_distance_is_the_take_compared_as_a_demonstration(generated, takes):
+    """By hand: the take loses its own stillness's share of each part's take posture (plugins.lib.style), every node
+    loses the same share of its take's posture, and the take's distance is eq. 3 per sample along the best path that
+    avoids its own nodes."""
+    from plugins.lib.pose_distance import path_distance
+    from plugins.lib.style import stillness
+
+    character = observer(generated, takes, spread=1.0, posture="still", still_spread=True)
+    motor, matcher = character.motor, character.matcher
+    body = character.body.n_parts
+    rows = np.array([matcher.node_names.index(n) for n in motor.takes()["clap"][1]])
+    kept, posture = matcher._nodes_kept, matcher._take_posture
+    share = stillness(kept[rows, :body], np.ones((len(rows), body), bool), posture[rows[0]])
+    assert share.min() == pytest.approx(0.0) and share.max() <= 1.0  # the most moving part keeps its posture
+    nodes = kept.copy()
+    nodes[:, :body] -= share[None, :, None] * posture
+    exclude = np.zeros(len(nodes), bool)
+    exclude[rows] = True
+    matcher.nodes_compared = nodes
+    path, _, evidence = matcher.search(nodes[rows], np.ones(nodes[rows].shape[:2], bool), None, exclude)
+    matcher.nodes_compared = kept
+    by_hand = path_distance(nodes[rows], nodes[path], np.ones(nodes[rows].shape[:2], bool)) / evidence
+    assert matcher.take_distances["clap"][1] == pytest.approx(by_hand, rel=1e-12)
