@@ -274,6 +274,8 @@ CASES = [
     # -- path search across styles: posture, amplitude (issue 18, ps18)
     ("path-posture", "path search's posture misnamed", {"c.toml": CHILD + '[matcher]\nplugin = "path-search"\nposture = "centred"\n'}, ["validate", "c.toml"], ["c.toml:6: key matcher.posture", "value 'centred' not allowed", "available: kept, removed, still"]),
     ("path-amplitude", "an amplitude limit below 1", {"c.toml": CHILD + '[matcher]\nplugin = "path-search"\namplitude = 0.5\n'}, ["validate", "c.toml"], ["c.toml:6: key matcher.amplitude", "0 (off) or a factor of at least 1"]),
+    # -- path search's decision with the styled comparison: spread_quantile (issue 18, ps18b)
+    ("path-spread-quantile", "a spread quantile above 1", {"c.toml": CHILD + '[matcher]\nplugin = "path-search"\nspread_quantile = 1.5\n'}, ["validate", "c.toml"], ["c.toml:6: key matcher.spread_quantile", "value 1.5 out of range", "expected a number in [0, 1]"]),
 ]
 
 

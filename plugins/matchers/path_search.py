@@ -177,6 +177,13 @@ class PathSearch(Matcher):
                   "best path through the other movements' nodes): 0.5 accepts a demonstration nearer to the movement "
                   "than halfway to its nearest neighbour; with spread, the smaller limit holds; 0: max_distance (the "
                   "paper).", minimum=0.0),
+        Parameter("spread_quantile", float, 0.5, "Which quantile of a movement's take distances (each take's mean "
+                  "eq. 1 distance to the rest of the graph) is its spread: 0.5 the median take, 1 the take farthest "
+                  "from the others, so with spread = 1 a new take is accepted as far as the repertoire's own most "
+                  "different take lies.", minimum=0.0, maximum=1.0),
+        Parameter("still_spread", bool, False, "With posture = 'still', measure the spreads and separations as "
+                  "matches are compared: each take about the same share of its parts' postures as its own stillness "
+                  "asks for (false: with every posture kept, as built)."),
         Parameter("attention", float, 0.0, "How much the parts that move in the segment count over the still ones "
                   "(plugins.lib.attention): 0 is eq. 1's plain mean over the visible parts, 1 counts only what "
                   "moves.", minimum=0.0, maximum=1.0),
@@ -244,6 +251,7 @@ class PathSearch(Matcher):
         self._cache_version = n
         self._index = None  # the spatial index of the nodes, built by the first search that uses it
         self._scan = PoseScan(self.nodes_compared)  # the scan of every node (the planes, built once per graph)
+        self.take_distances = {}
         self.spreads = self._spreads(index) if self.params["spread"] > 0 else {}
         self.separations = self._separations(index) if self.params["separation"] > 0 else {}
 
@@ -305,15 +313,29 @@ class PathSearch(Matcher):
 
     def _take_distance(self, own: np.ndarray, exclude: np.ndarray) -> float:
         """The mean eq. 1 distance of the take of nodes ``own`` to the best path through the graph that avoids the
-        nodes ``exclude`` (NaN when there is none)."""
-        nodes = self.nodes_compared
+        nodes ``exclude`` (NaN when there is none). With ``posture = "still"`` the take is compared as a
+        demonstration is (``still_spread``): its own stillness removes the same share of each part's posture from it
+        and from every take, so a spread is measured in the units the matches are."""
+        kept = self._nodes_kept
+        nodes = kept
+        if self.params["posture"] == "still" and self.params["still_spread"]:
+            body = self._take_posture.shape[1]
+            share = stillness(kept[own][:, :body], np.ones(kept[own].shape[:2], dtype=bool)[:, :body],
+                              self._take_posture[own[0]])
+            nodes = kept.copy()
+            nodes[:, :body] -= share[None, :, None] * self._take_posture
         obs, vis = nodes[own], np.ones(nodes[own].shape[:2], dtype=bool)
-        path, _, evidence = self.search(obs, vis, None, exclude)
+        self.nodes_compared = nodes
+        try:
+            path, _, evidence = self.search(obs, vis, None, exclude)
+        finally:
+            self.nodes_compared = kept
         return np.nan if path is None else path_distance(obs, nodes[path], vis) / max(evidence, 1)
 
     def _spreads(self, index: dict[str, int]) -> dict[str, float]:
-        """Each movement's spread between takes (movements of several takes only): the median over its takes of the
-        take's mean eq. 1 distance to the best path through the graph without that take's nodes."""
+        """Each movement's spread between takes (movements of several takes only): the ``spread_quantile`` (0.5: the
+        median) over its takes of the take's mean eq. 1 distance to the best path through the graph without that
+        take's nodes. Each movement's take distances are kept in :attr:`take_distances`."""
         out = {}
         for movement, takes in self._takes(index).items():
             if len(takes) < 2:
@@ -327,7 +349,8 @@ class PathSearch(Matcher):
                 distances.append(self._take_distance(own, exclude))
             finite = [d for d in distances if np.isfinite(d)]
             if len(finite) >= 2:
-                out[movement] = float(np.median(finite))
+                self.take_distances[movement] = tuple(float(d) for d in finite)
+                out[movement] = float(np.quantile(finite, self.params["spread_quantile"]))
         return out
 
     def _separations(self, index: dict[str, int]) -> dict[str, float]:
