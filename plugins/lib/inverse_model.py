@@ -56,6 +56,10 @@ def trajectory_error(stroke: GuidingStroke | HandTransition, positions: np.ndarr
     return float(np.linalg.norm(stroke.position(t) - positions, axis=1).max())
 
 
+_PEAK_CLIP = (0.1, 0.9)
+"""Where the moment of peak velocity read from the speed profile is clipped (a share of the duration)."""
+
+
 def _timing(p: np.ndarray, fps: float) -> tuple[float, float]:
     """The moment of peak velocity and the end gain, from the (smoothed) speed profile of positions ``p``."""
     return _timings([p], fps)[0]
@@ -79,7 +83,7 @@ def _timings(parts: list[np.ndarray], fps: float) -> list[tuple[float, float]]:
     out = []
     for j in range(speeds.shape[1]):
         speed = speeds[:, j]
-        peak = float(np.clip((np.argmax(speed) + 0.5) / max(len(speed), 1), 0.1, 0.9))
+        peak = float(np.clip((np.argmax(speed) + 0.5) / max(len(speed), 1), *_PEAK_CLIP))
         end_gain = float(np.clip(speed[-1] / max(speed.max(), 1e-12), 0.0, 0.9))
         out.append((peak, end_gain))
     return out
@@ -161,11 +165,16 @@ def _stroke(p: np.ndarray, fps: float, straight: float, refine: bool, timing: tu
     est = _closed_form(p, fps, straight, timing=timing)
     if not refine:
         return GuidingStroke(**est)
+    # the speed profile's peak in the first or last tenth (clipped there) is noise, not a bell: a slow stroke seen
+    # with tracker noise whose frame-to-frame speed is as large as the stroke's own. The fit then also starts from
+    # a symmetric bell (peak 0.5, no end gain), and the start that reproduces the observation better is kept.
+    timings = [timing] + ([(0.5, 0.0)] if timing[0] in (_PEAK_CLIP[0], _PEAK_CLIP[1]) else [])
     if est["shape"] == "linear":
-        return _refined(est, p, fps)
+        fits = [_refined({**est, "peak": peak, "end_gain": gain}, p, fps) for peak, gain in timings]
+        return min(fits, key=lambda stroke: trajectory_error(stroke, p, fps))
     # C or S: observation noise at the ends can make a C's residual change sides; both families are fitted and
     # the one that reproduces the observation better is kept (the speed profile is the same: filtered once)
-    fits = [_refined(_closed_form(p, fps, straight, family, timing), p, fps) for family in ("c", "s")]
+    fits = [_refined(_closed_form(p, fps, straight, family, t), p, fps) for t in timings for family in ("c", "s")]
     return min(fits, key=lambda stroke: (trajectory_error(stroke, p, fps), stroke.shape != est["shape"]))
 
 
