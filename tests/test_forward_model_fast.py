@@ -27,7 +27,7 @@ import plugins.matchers.forward_model as fm
 from plugins.lib.guiding_stroke import GuidingStroke
 from plugins.matchers.forward_model import ForwardModel, Track, _along_rows, _distances, _row_keys
 from tests.test_forward_model_incremental import _arms
-from tests.test_forward_model_replay import play_fig3_games
+from tests.test_forward_model_replay import both_ways, play_fig3_games
 from toolkit import Motion
 from toolkit.watching import follow
 
@@ -143,10 +143,7 @@ def _demonstrations(write, pm, monkeypatch, fast: bool):
 
 
 def test_the_shortcuts_give_the_same_answers_on_demonstrations(write, pm):
-    with pytest.MonkeyPatch.context() as monkeypatch:
-        fast, used = _demonstrations(write, pm, monkeypatch, True)
-    with pytest.MonkeyPatch.context() as monkeypatch:
-        plain, _ = _demonstrations(write, pm, monkeypatch, False)
+    (fast, used), (plain, _) = both_ways(lambda monkeypatch, on: _demonstrations(write, pm, monkeypatch, on))
     assert used["quiet"] > 0 and used["at_once"] > 0  # both shortcuts were taken
     assert fast == plain
 
@@ -193,11 +190,7 @@ def _play(monkeypatch, fast: bool):
 
 @pytest.fixture(scope="module")
 def plays():
-    with pytest.MonkeyPatch.context() as monkeypatch:
-        fast = _play(monkeypatch, True)
-    with pytest.MonkeyPatch.context() as monkeypatch:
-        plain = _play(monkeypatch, False)
-    return fast, plain
+    return both_ways(_play)  # with the shortcuts, then without
 
 
 def test_the_shortcuts_give_the_same_answers_and_traces_to_the_bit(plays):

@@ -12,6 +12,15 @@ from tests.conftest import CHARACTERS
 from toolkit import create_plugin_manager, hookimpl, load_scenario
 
 
+def both_ways(play, *args):
+    """``play(monkeypatch, *args, on)`` with a shortcut on, then off, each under a monkeypatch of its own."""
+    out = []
+    for on in (True, False):
+        with pytest.MonkeyPatch.context() as monkeypatch:
+            out.append(play(monkeypatch, *args, on))
+    return tuple(out)
+
+
 def play_fig3_games(snapshot):
     """Fig. 3's games played once: every answer Max gives, and ``snapshot(view)`` of the forward model's
     ``inspect()`` after each world step in which it holds a segment."""
@@ -53,11 +62,7 @@ def _play(monkeypatch, incremental: bool):
 
 @pytest.fixture(scope="module")
 def plays():
-    with pytest.MonkeyPatch.context() as monkeypatch:
-        incremental = _play(monkeypatch, True)
-    with pytest.MonkeyPatch.context() as monkeypatch:
-        whole = _play(monkeypatch, False)
-    return incremental, whole
+    return both_ways(_play)  # incremental, then whole
 
 
 def test_the_replay_follows_the_new_track_incrementally(plays):
