@@ -44,6 +44,15 @@ never falls below and a large body's sway may exceed. Each of these is a paramet
   so a movement begins and ends only at a *real rest* of about ``p`` seconds: a velocity minimum between two
   strokes lasts about a tenth of a second (the sensory memory, §4.1) and no longer ends the movement. ``p = 0.3``
   s: three sensory memories, shorter than the pauses people make between gestures.
+- ``end = "rest"``: a rest ends the movement under way only where the demonstrator is back near the pose it began
+  from (within ``rest_radius`` body sizes, eq. 1's mean distance of the chosen parts; the pose is the first of the
+  working memory, so a stooped or wide-legged stance is their own rest), or once they have rested ``settle``
+  seconds elsewhere (a new stance; the movement then ends where that rest began). A gesture that holds a pose
+  half-way (a salute, a bow, a pointing hand) is one movement, not two: B&B's hubs are the poses movements leave and
+  come back to, and K&G's forward model follows the whole performance between rests through the motor command
+  graph. ``rest_radius = 0.1``: B&B's hub threshold (0.02 m on Max, 0.20 m body size); ``settle = 2`` s: longer
+  than a gesture holds a pose (about a second), as ``hub-threshold``'s ``settle``. The paper's ``"still"`` (any
+  rest ends it) is the default.
 
 Memory: the visual working memory holds the movement under way, so a movement that never ends (a demonstrator who
 never comes to rest) is closed after ``max_movement`` seconds, where it is, and the next one begins at once there:
