@@ -276,6 +276,9 @@ CASES = [
     ("path-amplitude", "an amplitude limit below 1", {"c.toml": CHILD + '[matcher]\nplugin = "path-search"\namplitude = 0.5\n'}, ["validate", "c.toml"], ["c.toml:6: key matcher.amplitude", "0 (off) or a factor of at least 1"]),
     # -- path search's decision with the styled comparison: spread_quantile (issue 18, ps18b)
     ("path-spread-quantile", "a spread quantile above 1", {"c.toml": CHILD + '[matcher]\nplugin = "path-search"\nspread_quantile = 1.5\n'}, ["validate", "c.toml"], ["c.toml:6: key matcher.spread_quantile", "value 1.5 out of range", "expected a number in [0, 1]"]),
+    # -- velocity-direction's end of a movement: end, rest_radius (issue 18, vd18)
+    ("observe-vd-end", "velocity-direction's end misnamed", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "velocity-direction", "--set", "segmenter.end=home", "m.bvh"], ["key --set.segmenter.end", "value 'home' not allowed", "available: still, rest"]),
+    ("observe-vd-rest-radius", "velocity-direction with a negative rest radius", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "velocity-direction", "--set", "segmenter.rest_radius=-1", "m.bvh"], ["key --set.segmenter.rest_radius", "value -1.0 out of range"]),
 ]
 
 

@@ -238,7 +238,9 @@ def _frames_and_blocks(params, parts, poses, visible, cuts):
 
 @given(seed=st.integers(0, 10_000), cuts=st.lists(st.integers(1, 40), min_size=1, max_size=12),
        params=st.sampled_from([{}, {"level": "movement"}, {"units": "body", "noise": 2.0, "pause": 0.3},
-                               {"max_movement": 1.0, "memory": 0.2}, {"parts": ["wrist"], "rest_speed": 0.05}]),
+                               {"max_movement": 1.0, "memory": 0.2}, {"parts": ["wrist"], "rest_speed": 0.05},
+                               {"level": "movement", "end": "rest", "units": "body", "noise": 2.0},
+                               {"end": "rest", "settle": 0.5, "max_movement": 1.0}]),
        hidden=st.booleans())
 @settings(max_examples=40, deadline=None)
 def test_a_block_pushed_at_once_is_its_frames_pushed_one_by_one(seed, cuts, params, hidden):

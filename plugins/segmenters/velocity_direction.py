@@ -44,6 +44,15 @@ never falls below and a large body's sway may exceed. Each of these is a paramet
   so a movement begins and ends only at a *real rest* of about ``p`` seconds: a velocity minimum between two
   strokes lasts about a tenth of a second (the sensory memory, §4.1) and no longer ends the movement. ``p = 0.3``
   s: three sensory memories, shorter than the pauses people make between gestures.
+- ``end = "rest"``: a rest ends the movement under way only where the demonstrator is back near the pose it began
+  from (within ``rest_radius`` body sizes, eq. 1's mean distance of the chosen parts; the pose is the first of the
+  working memory, so a stooped or wide-legged stance is their own rest), or once they have rested ``settle``
+  seconds elsewhere (a new stance; the movement then ends where that rest began). A gesture that holds a pose
+  half-way (a salute, a bow, a pointing hand) is one movement, not two: B&B's hubs are the poses movements leave and
+  come back to, and K&G's forward model follows the whole performance between rests through the motor command
+  graph. ``rest_radius = 0.1``: B&B's hub threshold (0.02 m on Max, 0.20 m body size); ``settle = 2`` s: longer
+  than a gesture holds a pose (about a second), as ``hub-threshold``'s ``settle``. The paper's ``"still"`` (any
+  rest ends it) is the default.
 
 Memory: the visual working memory holds the movement under way, so a movement that never ends (a demonstrator who
 never comes to rest) is closed after ``max_movement`` seconds, where it is, and the next one begins at once there:
@@ -107,6 +116,14 @@ class VelocityDirection(Segmenter):
         Parameter("pause", float, 0.0, "Seconds the speed is averaged over before it is compared with the rest "
                   "speed: a movement begins and ends at a rest of about this long (0: the sensory memory, the "
                   "paper).", minimum=0.0),
+        Parameter("end", str, "still", "Where a movement ends: at any rest (`still`, the paper) or only at a rest "
+                  "near the pose it began from, or after `settle` seconds of rest elsewhere (`rest`).",
+                  choices=("still", "rest")),
+        Parameter("rest_radius", float, 0.1, "With end = rest: how near (eq. 1's mean distance of the chosen parts, "
+                  "in the demonstrator's body sizes) the pose must be to the one the movement began from for a rest "
+                  "to end it (0.1: B&B's hub threshold, 0.02 m on Max).", minimum=0.0),
+        Parameter("settle", float, 2.0, "With end = rest: seconds of rest away from where the movement began after "
+                  "which it ends anyway (a new stance: longer than a gesture holds a pose).", minimum=0.0),
         Parameter("max_movement", float, 60.0, "Seconds after which a movement that has not ended is closed there and "
                   "the next begins at once (the working memory's bound; 0: none).", minimum=0.0),
     )
@@ -153,6 +170,9 @@ class VelocityDirection(Segmenter):
         self._floor = max(1, int(round(self.params["floor"] * self._fps)))
         self._positions = ~np.array([p in angles for p in parts]) if parts else np.zeros(0, bool)
         self._size_sum, self._size_n = 0.0, 0
+        self._origin: tuple[np.ndarray, float] | None = None  # end = rest: the chosen parts where the movement began,
+        # and the body's size then
+        self._settle = max(1, int(round(self.params["settle"] * self._fps)))
 
     @property
     def active_since(self) -> int | None:
@@ -199,7 +219,8 @@ class VelocityDirection(Segmenter):
             best = np.where(finite, step, -np.inf).max(axis=1)
             speeds[i] = np.where(finite.any(axis=1), best * self._fps / m, np.nan)
         p = self.params
-        if p["units"] == "metres" and not self._pause and not p["noise"] > 0:  # a fixed rest speed
+        if p["units"] == "metres" and not self._pause and not p["noise"] > 0 and p["end"] == "still":  # a fixed rest
+            # speed, and any rest ends a movement
             return self._follow(flat, speeds)
         for f in range(n):
             self._frame += 1
@@ -293,6 +314,7 @@ class VelocityDirection(Segmenter):
             if longest and self._frame - self._start >= max(longest, 2):  # never ended: closed, the next one begun
                 cut = self._close(self._frame)
                 self._start, self._buffer = self._frame, []
+                self._origin = self._began(pose, points)
             self._buffer.append(points)
         rest = self._rest_speed(pose, speed)
         if self._pause:
@@ -309,13 +331,37 @@ class VelocityDirection(Segmenter):
                 # `max_movement` just before a rest too short to report)
                 self._start = max(self._done, self._frame - 2 * self._memory - self._pause // 2)
                 self._buffer = list(self._history)[-(self._frame - self._start + 1):]
+                self._origin = self._began(pose, self._buffer[0])
         else:
             self._resting += 1
             self._moving = 0
-            if self._start is not None and self._resting >= max(self._memory, self._pause):
+            if (self._start is not None and self._resting >= max(self._memory, self._pause)
+                    and (self.params["end"] == "still" or self._returned(pose, points))):
                 lag = self._memory // 2 + self._pause // 2
                 return cut + self._close(max(self._start + 1, self._frame - self._resting + 1 - lag))
         return cut
+
+    def _began(self, pose: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, float] | None:
+        """With ``end = "rest"``: where a movement begins (the chosen parts ``points``, (3m,)) and the body's size
+        then (from ``pose``); ``None`` otherwise."""
+        if self.params["end"] != "rest":
+            return None
+        size = body_scale(pose, self._positions) if len(self._positions) == len(pose) else body_scale(pose)
+        return np.array(points, dtype=float), float(size)
+
+    def _returned(self, pose: np.ndarray, points: np.ndarray) -> bool:
+        """With ``end = "rest"``: whether the rest now ends the movement under way, because the chosen parts
+        (``points``, (3m,)) are back within ``rest_radius`` body sizes (eq. 1: the mean distance over the parts seen
+        in both) of where the movement began, or have rested ``settle`` seconds. Where it began is the first pose of
+        its working memory (the onset, back-dated to where the motion began), taken with the body's size then."""
+        if self._resting >= self._settle or self._origin is None:
+            return True
+        first, size = self._origin
+        apart = np.linalg.norm((points - first).reshape(-1, 3), axis=1)
+        apart = apart[np.isfinite(apart)]
+        if not apart.size or not size > 0:  # nothing to compare: the paper's rule
+            return True
+        return float(apart.mean()) <= self.params["rest_radius"] * size
 
     def _rest_speed(self, pose: np.ndarray, speed: float) -> float:
         """The speed below which the parts are at rest now: ``rest_speed`` (m/s), or ``size_rest_speed`` body sizes
