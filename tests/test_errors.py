@@ -279,6 +279,10 @@ CASES = [
     # -- velocity-direction's end of a movement: end, rest_radius (issue 18, vd18)
     ("observe-vd-end", "velocity-direction's end misnamed", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "velocity-direction", "--set", "segmenter.end=home", "m.bvh"], ["key --set.segmenter.end", "value 'home' not allowed", "available: still, rest"]),
     ("observe-vd-rest-radius", "velocity-direction with a negative rest radius", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "velocity-direction", "--set", "segmenter.rest_radius=-1", "m.bvh"], ["key --set.segmenter.rest_radius", "value -1.0 out of range"]),
+    # -- an observer template's tables for plugins named instead of its own: [segmenters.NAME] (issue 18)
+    ("template-alternative-key", "an unknown parameter in a named plugin's own table", {"o.toml": '[observer]\nname = "o"\n[segmenters.velocity-direction]\nlevl = "movement"\n'}, ["validate", "o.toml"], ["o.toml:4: key segmenters.velocity-direction.levl", "unknown parameter 'levl' for segmenter 'velocity-direction'", "available: angle"]),
+    ("template-alternative-plugin", "a table for a plugin that does not exist", {"o.toml": '[observer]\nname = "o"\n[matchers.nearest]\nk = 1\n'}, ["validate", "o.toml"], ["o.toml:3: key matchers.nearest", "unknown matcher 'nearest'", "available: dtw, forward-model, path-search"]),
+    ("template-alternative-named", "a plugin named inside a plugin's own table", {"o.toml": '[observer]\nname = "o"\n[segmenters.ruptures]\nplugin = "hub-threshold"\n'}, ["validate", "o.toml"], ["o.toml:4: key segmenters.ruptures.plugin", "a plugin named inside a plugin's own table"]),
 ]
 
 

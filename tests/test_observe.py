@@ -373,6 +373,42 @@ def test_an_observer_takes_what_it_is_not_told_from_the_observer_template(data, 
         compose_observer(pm, profile, data / "repertoire", template=mine.parent / "bad.toml")
 
 
+def test_a_plugin_named_instead_takes_its_own_table_of_the_template(data, profile, pm, write):
+    """`[segmenters.NAME]`: the parameters NAME gets when a command names it instead of the template's own plugin
+    (the recordings template cuts whole movements with velocity-direction, not strokes); a table for a plugin that is
+    not named changes nothing, and `--set` still wins."""
+    from toolkit.character import read_toml, resolve_file
+
+    own = read_toml(resolve_file("observers/recordings.toml", None, pm))["segmenters"]["velocity-direction"]
+    named = compose_observer(pm, profile, data / "repertoire", segmenter="velocity-direction")
+    assert own["level"] == "movement" and all(named.segmenter.declared[k] == v for k, v in own.items())
+    assert compose_observer(pm, profile, data / "repertoire").segmenter.name == "hub-threshold"
+    stroke = compose_observer(pm, profile, data / "repertoire", segmenter="velocity-direction",
+                              settings={"segmenter": {"level": "stroke"}})
+    assert stroke.segmenter.params["level"] == "stroke" and stroke.segmenter.params["units"] == own["units"]
+    mine = write("alternatives.toml", """
+        [observer]
+        name = "mine"
+        [motor]
+        plugin = "posegraph"
+        [perception]
+        plugin = "motion-capture"
+        [segmenter]
+        plugin = "hub-threshold"
+        [matcher]
+        plugin = "path-search"
+        [matchers.dtw]
+        window = 0.25
+        [motors.motor-command-graph]
+        drop = 0.4
+        """)
+    dtw = compose_observer(pm, profile, data / "repertoire", matcher="dtw", template=mine)
+    assert dtw.matcher.params["window"] == 0.25
+    assert compose_observer(pm, profile, data / "repertoire", template=mine).matcher.name == "path-search"
+    follows = compose_observer(pm, profile, data / "repertoire", matcher="forward-model", template=mine)
+    assert follows.motor.name == "motor-command-graph" and follows.motor.params["drop"] == 0.4  # brought along
+
+
 def test_naming_the_templates_own_matcher_keeps_its_parameters_and_another_starts_afresh(data, profile, pm):
     """The observer template sets path-search's parameters for recordings; `--matcher path-search` must not drop
     them (it did: every benchmark that named the matcher ran the plugin's defaults), `--matcher dtw` gets dtw's."""

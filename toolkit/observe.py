@@ -240,8 +240,9 @@ def observer_tables(pm: Any, *, segmenter: str | None = None, matcher: str | Non
     base = read_toml(path)
     tables: dict[str, dict[str, Any]] = {k: dict(v) for k, v in base.items() if k in COMPONENT_TABLES}
     for key, name in (("segmenter", segmenter), ("matcher", matcher), ("motor", motor)):
-        if name and tables.get(key, {}).get("plugin") != name:  # another plugin: none of the template's parameters
-            tables[key] = {"plugin": name}
+        if name and tables.get(key, {}).get("plugin") != name:  # another plugin: none of the template's parameters,
+            # but its own from the template's [ALTERNATIVES.NAME] table, if any
+            tables[key] = {"plugin": name, **base.get(ALTERNATIVES[key], {}).get(name, {})}
     if matcher is None:
         tables.pop("matcher", None)
     if correspondence is None or correspondence == NO_CORRESPONDENCE:
@@ -253,7 +254,7 @@ def observer_tables(pm: Any, *, segmenter: str | None = None, matcher: str | Non
         cls = pm.registry.get("matcher", tables["matcher"]["plugin"])
         wanted = cls.motor_systems
         if not motor and wanted and tables.get("motor", {}).get("plugin") not in wanted:
-            tables["motor"] = {"plugin": wanted[0]}
+            tables["motor"] = {"plugin": wanted[0], **base.get(ALTERNATIVES["motor"], {}).get(wanted[0], {})}
         if any(p.name == "learn" for p in cls.parameters):
             settings.setdefault("matcher", {}).setdefault("learn", False)
     for key, extra in settings.items():
@@ -294,6 +295,9 @@ def observer_plugins(pm: Any, *, segmenters: Sequence[str] = (), matchers: Seque
 
 
 OBSERVER_KEYS = ("name", "description", "lengths_for_height")
+# Tables of an observer template holding, per plugin, the parameters it gets when named instead of the template's own
+# (`--segmenter NAME`): [segmenters.NAME], [matchers.NAME], [motors.NAME].
+ALTERNATIVES = {"segmenter": "segmenters", "matcher": "matchers", "motor": "motors"}
 
 
 def is_observer_template(table: Mapping[str, Any]) -> bool:
@@ -312,9 +316,22 @@ def check_observer_template(path: str | Path, pm: Any) -> dict[str, str]:
     plugins = {}
     try:
         for key in table:
-            if key not in ("observer", *COMPONENT_TABLES):
+            if key not in ("observer", *COMPONENT_TABLES, *ALTERNATIVES.values()):
                 raise ConfigError(f"unknown table {key!r}", key=(key,), expected="an observer template table",
-                                  available=("observer", *COMPONENT_TABLES))
+                                  available=("observer", *COMPONENT_TABLES, *ALTERNATIVES.values()))
+        for kind, key in ALTERNATIVES.items():  # [segmenters.NAME]: NAME's parameters when it is named instead
+            for name, params in table.get(key, {}).items():
+                if not isinstance(params, Mapping):
+                    raise ConfigError("not a table", key=(key, name), expected=f"a [{key}.{name}] table")
+                if "plugin" in params:
+                    raise ConfigError("a plugin named inside a plugin's own table", key=(key, name, "plugin"),
+                                      expected=f"{name}'s parameters only (the table's name is the plugin)")
+                try:
+                    build_component(kind, {"plugin": name, **params}, pm)
+                except ConfigError as err:  # named as written: [segmenters.NAME], not [segmenter]
+                    inner = err.key[1:] if err.key and err.key[0] == kind and err.key[1:] != ("plugin",) else ()
+                    where = (key, name, *inner)
+                    raise ConfigError(err.problem, key=where, expected=err.expected, available=err.available) from None
         head = table["observer"]
         if not isinstance(head, Mapping):
             raise ConfigError("not a table", key=("observer",), expected="an [observer] table")
