@@ -91,7 +91,7 @@ import numpy as np
 from plugins.lib.attention import movement_weights
 from plugins.lib.pose_distance import PoseScan, path_distance, pose_distance
 from plugins.lib.pose_index import PoseIndex
-from plugins.lib.style import extent, mean_posture, rescale, stillness, take_means
+from plugins.lib.style import direction_part, extent, mean_posture, rescale, speed, stillness, take_means, velocity
 from plugins.lib.travel import body_velocity, travel_part
 from toolkit import Match, Matcher, Motion, Parameter, hookimpl
 from toolkit.components import provides
@@ -199,6 +199,11 @@ class PathSearch(Matcher):
                   "of the parts from the mean posture, plugins.lib.style), by at most this factor either way, so an "
                   "exaggerated or timid style compares close; 0: as performed (the paper).", minimum=0.0,
                   check=lambda v: None if v == 0 or v >= 1 else "0 (off) or a factor of at least 1"),
+        Parameter("direction", float, 0.0, "How much where each part is going counts beside where it is: each "
+                  "part's velocity, in units of the movement's own RMS speed (so the same movement larger, smaller, "
+                  "faster or slower goes the same ways), is compared as one more part per part, this many times the "
+                  "size of the positions about their mean posture (plugins.lib.style's direction_part); 1: as much "
+                  "as the positions; 0: positions only (the paper).", minimum=0.0),
         Parameter("travel", float, 0.0, "Seconds over which where the body goes counts as one more part: the root's "
                   "displacement over this time, in the body's frame (plugins.lib.travel); 0: root-relative poses "
                   "only (the paper).", minimum=0.0, maximum=10.0),
@@ -242,6 +247,8 @@ class PathSearch(Matcher):
         self._label_starts = np.flatnonzero(np.diff(self.label_ids[self._by_label], prepend=-1))
         self._label_sizes = np.diff(self._label_starts, append=len(nodes))
         self.nodes_compared = self._styled_nodes(motor.node_root_relative, index)
+        if self.params["direction"] > 0:  # directions: one more part per part of every node
+            self.nodes_compared = np.concatenate([self.nodes_compared, self._node_directions(index)], axis=1)
         if self.params["travel"] > 0:  # travel: one more part of every node
             self.nodes_compared = np.concatenate(
                 [self.nodes_compared, travel_part(motor.node_travel, self.params["travel"])[:, None]], axis=1)
@@ -276,6 +283,40 @@ class PathSearch(Matcher):
             factor = np.array([rescale(z, self.reference_amplitude, self.params["amplitude"]) for z in size])
         base = 0.0 if self.params["posture"] == "removed" else posture
         return base + (poses - posture) * factor[:, None, None]
+
+    def _direction_limit(self) -> float:
+        """How far a movement's own speed is brought to the repertoire's (:func:`plugins.lib.style.direction_part`):
+        the speeds the search itself takes for the same movement, ``max_skip`` times the tempo and, with
+        ``amplitude``, that many times the size."""
+        return float(self.params["max_skip"] * max(self.params["amplitude"], 1.0))
+
+    def _node_directions(self, index: dict[str, int]) -> np.ndarray:
+        """Every node's direction parts (N, P, 3): its velocity along its take (the take's nodes in order at
+        ``node_rate``, from the poses as performed), in units of the take's RMS speed brought to the repertoire's
+        median take speed (:attr:`reference_speed`), times the repertoire's median take extent over that speed
+        (:attr:`reference_extent`). A hub is held still: zero."""
+        poses = self.motor.node_root_relative
+        rate = self.motor.node_rate
+        takes = [np.asarray(t, dtype=np.intp) for clips in self._takes(index).values() for t in clips if len(t)]
+        every = np.ones(poses.shape[:2], dtype=bool)
+        moving = [velocity(poses[t], every[t], rate) for t in takes]
+        speeds = [speed(v) for v in moving]
+        _, size = take_means(poses, takes)
+        self.reference_speed = float(np.median(speeds)) if speeds else 0.0
+        self.reference_extent = float(np.median([size[t[0]] for t in takes])) if takes else 0.0
+        out = np.zeros(poses.shape)
+        for t, v, s in zip(takes, moving, speeds):
+            part = direction_part(v, s, self.reference_speed, self.reference_extent, self._direction_limit())
+            out[t] = np.nan_to_num(part) * self.params["direction"]  # a take of one node: no velocity, held still
+        return out
+
+    def _sample_directions(self, poses: np.ndarray, visible: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The demonstration's direction parts (n, P, 3) and where they are known (n, P), from its samples as
+        performed, as :meth:`_node_directions` treats each take."""
+        v = velocity(poses, visible, self.motor.node_rate)
+        part = direction_part(v, speed(v), self.reference_speed, self.reference_extent, self._direction_limit())
+        known = np.isfinite(part).all(axis=-1)
+        return np.where(known[..., None], part * self.params["direction"], 0.0), known
 
     def _styled_samples(self, poses: np.ndarray, visible: np.ndarray) -> np.ndarray:
         """The demonstration's sampled poses as compared: about their own mean posture over the segment, as
@@ -383,8 +424,9 @@ class PathSearch(Matcher):
 
     def samples(self, motion: Motion, styled: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """The observed motion (in the observer's own parts) at the posegraph's node rate: poses (n, P, 3), visible
-        (n, P); with ``travel``, the travel as one more part (n, P + 1, 3), hidden where the motion has no world
-        positions. ``styled``: about the segment's own posture and amplitude as ``posture`` and ``amplitude`` say
+        (n, P); with ``direction``, each part's direction as one more part per part (n, 2P, 3), hidden where the
+        velocity is not known; with ``travel``, the travel as one more part after those, hidden where the motion has
+        no world positions. ``styled``: about the segment's own posture and amplitude as ``posture`` and ``amplitude`` say
         (False: the poses as performed, which learning keeps)."""
         if motion.parts != self.owner.body.parts:
             raise ValueError(f"path-search matches motions of the observer's own parts {list(self.owner.body.parts)}, "
@@ -393,8 +435,12 @@ class PathSearch(Matcher):
         n = max(1, int(round(motion.duration * rate)))
         idx = np.minimum(np.round(np.arange(n) * motion.fps / rate).astype(int), motion.n_frames - 1)
         poses, visible = motion.positions[idx], motion.visible[idx]
+        directions = self._sample_directions(poses, visible) if self.params["direction"] > 0 else None
         if styled:
             poses = self._styled_samples(poses, visible)
+        if directions is not None:
+            poses = np.concatenate([poses, directions[0]], axis=1)
+            visible = np.concatenate([visible, directions[1]], axis=1)
         if self.params["travel"] <= 0:
             return poses, visible
         if motion.world is None:
@@ -416,6 +462,8 @@ class PathSearch(Matcher):
         weights = None
         if self.params["attention"] > 0:
             positions = ~self.owner.body.angle_mask
+            if self.params["direction"] > 0:  # a part's direction parts are of its kind
+                positions = np.concatenate([positions, positions])
             if obs.shape[1] > len(positions):  # the travel part is a position too
                 positions = np.append(positions, True)
             weights = movement_weights(obs, vis, self.params["attention"], positions)
