@@ -88,7 +88,7 @@ from typing import Any, NamedTuple, Protocol
 import networkx as nx
 import numpy as np
 
-from plugins.lib.attention import movement_weights
+from plugins.lib.attention import movement as part_movement, movement_weights, mutual_weights
 from plugins.lib.pose_distance import PoseScan, path_distance, pose_distance
 from plugins.lib.pose_index import PoseIndex
 from plugins.lib.style import direction_part, extent, mean_posture, rescale, speed, stillness, take_means, velocity
@@ -166,6 +166,9 @@ class PathSearch(Matcher):
         Parameter("max_stay", int, 0, "Most samples in a row a path may stay on one node; 1 tolerates movements "
                   "down to half one's own speed, as max_skip = 2 tolerates twice it. 0: no limit (a path may stand "
                   "on one pose that resembles a whole movement's average, as a long varied clip has).", minimum=0),
+        Parameter("hub_stay", bool, False, "With max_stay, a path may stay on a hub (the rest posture every movement "
+                  "leaves from and returns to) for as many samples as the demonstrator rests: max_stay limits the "
+                  "stays on the movements' own poses only (false: on every node alike)."),
         Parameter("max_distance", float, 0.03, "Mean eq. 1 distance (m) per sample above which the answer is "
                   "'unknown'. Must stay above the noise of the input (about 1.8 x its standard deviation).", minimum=0.0, length=True),
         Parameter("scale", float, 0.02, "Distance (m) at which confidence falls to 1/e.", minimum=1e-6, length=True),
@@ -187,6 +190,10 @@ class PathSearch(Matcher):
         Parameter("attention", float, 0.0, "How much the parts that move in the segment count over the still ones "
                   "(plugins.lib.attention): 0 is eq. 1's plain mean over the visible parts, 1 counts only what "
                   "moves.", minimum=0.0, maximum=1.0),
+        Parameter("attend", str, "demonstration", "Whose movement attention follows: 'demonstration', the parts "
+                  "that move in the segment watched; 'both', also the parts that move in each candidate node's own "
+                  "take (plugins.lib.attention's mutual_weights), so a movement of one's own that moves other parts "
+                  "is compared on them too.", choices=("demonstration", "both")),
         Parameter("posture", str, "kept", "'removed': compare each movement about its own held posture, the "
                   "demonstration's poses centred on their mean over the segment and each node's on its take's mean "
                   "(plugins.lib.style), so a stooped or proud performer's stance cancels, and where a hand is held "
@@ -259,6 +266,13 @@ class PathSearch(Matcher):
         self._index = None  # the spatial index of the nodes, built by the first search that uses it
         self._scan = PoseScan(self.nodes_compared)  # the scan of every node (the planes, built once per graph)
         self.take_distances = {}
+        if self.params["attention"] > 0 and self.params["attend"] == "both":  # each node's take's movement
+            self._take_movement = np.zeros(self.nodes_compared.shape[:2])
+            for clips in self._takes(index).values():
+                for take in clips:
+                    if len(take):
+                        self._take_movement[take] = part_movement(self.nodes_compared[take],
+                                                             np.ones(self.nodes_compared[take].shape[:2], bool))
         self.spreads = self._spreads(index) if self.params["spread"] > 0 else {}
         self.separations = self._separations(index) if self.params["separation"] > 0 else {}
 
@@ -423,8 +437,9 @@ class PathSearch(Matcher):
     # -- matching ----------------------------------------------------------------------------
 
     def samples(self, motion: Motion, styled: bool = True) -> tuple[np.ndarray, np.ndarray]:
-        """The observed motion (in the observer's own parts) at the posegraph's node rate: poses (n, P, 3), visible
-        (n, P); with ``direction``, each part's direction as one more part per part (n, 2P, 3), hidden where the
+        """The observed motion (in the observer's own parts) at the posegraph's node rate (with the posegraph's
+        ``tempo``, at the node rate times the motion's own frequency over the repertoire's, as each clip of the graph
+        is sampled): poses (n, P, 3), visible (n, P); with ``direction``, each part's direction as one more part per part (n, 2P, 3), hidden where the
         velocity is not known; with ``travel``, the travel as one more part after those, hidden where the motion has
         no world positions. ``styled``: about the segment's own posture and amplitude as ``posture`` and ``amplitude`` say
         (False: the poses as performed, which learning keeps)."""
@@ -432,6 +447,10 @@ class PathSearch(Matcher):
             raise ValueError(f"path-search matches motions of the observer's own parts {list(self.owner.body.parts)}, "
                              f"not {list(motion.parts)} (Motion.onto maps them by name)")
         rate = self.motor.node_rate
+        if getattr(self.motor, "reference_frequency", 0.0) > 0:  # the graph's clips sampled at their own tempo
+            at = np.unique(np.minimum(np.round(np.arange(max(1, int(round(motion.duration * rate)))) * motion.fps
+                                               / rate).astype(int), motion.n_frames - 1))
+            rate = rate * self.motor.tempo_factor(self.motor.frequency(at, motion.positions, motion.visible))
         n = max(1, int(round(motion.duration * rate)))
         idx = np.minimum(np.round(np.arange(n) * motion.fps / rate).astype(int), motion.n_frames - 1)
         poses, visible = motion.positions[idx], motion.visible[idx]
@@ -466,13 +485,16 @@ class PathSearch(Matcher):
                 positions = np.concatenate([positions, positions])
             if obs.shape[1] > len(positions):  # the travel part is a position too
                 positions = np.append(positions, True)
-            weights = movement_weights(obs, vis, self.params["attention"], positions)
+            if self.params["attend"] == "both":
+                weights = mutual_weights(part_movement(obs, vis), self._take_movement, self.params["attention"], positions)
+            else:
+                weights = movement_weights(obs, vis, self.params["attention"], positions)
         path, _, evidence = self.search(obs, vis, weights)  # the beam's eq. 3 cost: recomputed below by the one formula
         if path is None:
             return Match.unknown(reason="nothing visible")
         ids = self.label_ids[path]
         voting = ids[ids != self._hub_id]  # the movements' numbers: hubs do not vote
-        mean = path_distance(obs, self.nodes_compared[path], vis, weights) / max(evidence, 1)  # eq. 3 per sample
+        mean = path_distance(obs, self.nodes_compared[path], vis, _at(weights, path)) / max(evidence, 1)  # eq. 3
         details: dict[str, Any] = {"mean_distance": mean, "samples": len(path)}
         if voting.size == 0:
             return Match.unknown(reason="only hub poses", path=tuple(self.node_names[i] for i in path), **details)
@@ -517,7 +539,8 @@ class PathSearch(Matcher):
                 break
             names, counts = np.unique(voting, return_counts=True)
             other = str(names[int(np.argmax(counts))])
-            found.append((other, float(path_distance(obs, self.nodes_compared[path], vis, weights) / max(evidence, 1))))
+            found.append((other, float(path_distance(obs, self.nodes_compared[path], vis, _at(weights, path))
+                                       / max(evidence, 1))))
             exclude = exclude | (self.labels == other)
         return (found[0], *sorted(found[1:], key=lambda c: c[1]))
 
@@ -526,7 +549,7 @@ class PathSearch(Matcher):
         """The best path (node indices, one per sample), its eq. 3 cost and the number of samples with evidence.
 
         ``obs`` and ``vis`` are samples as :meth:`samples` gives them, compared with :attr:`nodes_compared` (with
-        ``travel``, one part more than the body); ``weights``: attention to each of those parts (``None``: eq. 1's
+        ``travel``, one part more than the body); ``weights``: attention to each of those parts, (P,) or per node (N, P) (``None``: eq. 1's
         plain mean); ``exclude`` (N,): nodes no path may use."""
         has = vis.any(axis=1)
         if not has.any():
@@ -584,11 +607,11 @@ class PathSearch(Matcher):
                 if every and weights is None:  # the hot loop of the search: eq. 1 over every part, inline
                     return scan(obs[t], cand)  # (pose_distance's arithmetic without its checks: the same numbers)
                 if every:
-                    return pose_distance(nodes[cand], obs[t], None, weights)
+                    return pose_distance(nodes[cand], obs[t], None, _at(weights, cand))
                 if seen.any():  # eq. 1 over the parts seen in this sample: the mask is the same for every candidate,
                     # so the seen parts are taken first and pose_distance needs no mask
                     return pose_distance(nodes[cand][:, seen], obs[t, seen], None,
-                                         None if weights is None else weights[seen])
+                                         None if weights is None else _at(weights, cand)[..., seen])
                 return np.zeros(len(cand))
 
             beam, cand = _candidates(table, ends, costs, score)
@@ -597,7 +620,10 @@ class PathSearch(Matcher):
             if exclude is not None:
                 step = np.where(exclude[cand], np.inf, step)
             if limit > 0:
-                step = np.where(stay > limit, np.inf, step)
+                barred = stay > limit
+                if self.params["hub_stay"]:  # resting at a hub is not held to max_stay
+                    barred &= self.label_ids[cand] != self._hub_id
+                step = np.where(barred, np.inf, step)
             total = costs[beam] + step
             order = total.argsort(kind="stable")
             # k best, one path per end node (distinct hypotheses): the first time each end node comes in the order
@@ -701,6 +727,14 @@ class PathSearch(Matcher):
         path = self.motor.learn(name, obs[:, :parts], vis[:, :parts], source="path-search")
         self._refresh()
         return Match(name, 1.0, None, tuple(path), {"learned": True, **details})
+
+
+def _at(weights: np.ndarray | None, nodes: np.ndarray) -> np.ndarray | None:
+    """Attention's weights for the poses of ``nodes``: the same (P,) for every node, or each node's row of (N, P)
+    (``attend = "both"``)."""
+    if weights is None or weights.ndim == 1:
+        return weights
+    return weights[nodes]
 
 
 def _reach(graph, nodes, index, max_skip: int, *, forward: bool) -> tuple[np.ndarray, np.ndarray]:
