@@ -276,6 +276,8 @@ CASES = [
     ("path-amplitude", "an amplitude limit below 1", {"c.toml": CHILD + '[matcher]\nplugin = "path-search"\namplitude = 0.5\n'}, ["validate", "c.toml"], ["c.toml:6: key matcher.amplitude", "0 (off) or a factor of at least 1"]),
     # -- path search's decision with the styled comparison: spread_quantile (issue 18, ps18b)
     ("path-spread-quantile", "a spread quantile above 1", {"c.toml": CHILD + '[matcher]\nplugin = "path-search"\nspread_quantile = 1.5\n'}, ["validate", "c.toml"], ["c.toml:6: key matcher.spread_quantile", "value 1.5 out of range", "expected a number in [0, 1]"]),
+    # -- path search's comparison: the posegraph's tempo (issue 18, gesture18)
+    ("posegraph-tempo", "a tempo limit below 1", {"c.toml": CHILD + '[motor]\nplugin = "posegraph"\ntempo = 0.5\n'}, ["validate", "c.toml"], ["c.toml:6: key motor.tempo", "0 (off) or a factor of at least 1"]),
 ]
 
 

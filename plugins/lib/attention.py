@@ -11,56 +11,13 @@ mean position over the segment (visible frames),
 
 so ``attention = 0`` is eq. 1's plain mean and ``attention = 1`` counts only what moves. The weights sum to 1 and
 need no unit: the same setting holds for any body size.
-
-Both ways (:func:`mutual_weights`): a part counts as much as it moves in the demonstration *or* in the candidate's
-own take (what the observer knows of its own movement), each relative to its own most moving part,
-
-``w_np = (1 - attention) / P + attention * s_np / sum_q(s_nq)``,  ``s_np = max(m_p / max(m), t_np / max(t_n))``,
-
-``t_n`` the movement of the parts in the take node ``n`` comes from. A wave of the right hand is then compared with
-a wave of both hands on the left hand too, which the demonstration holds still, and with a guide whose performer
-shifts a little on his feet mostly on the hand.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["movement", "movement_weights", "mutual_weights"]
-
-
-def movement(poses: np.ndarray, visible: np.ndarray) -> np.ndarray:
-    """Each part's movement (P,): its root-mean-square deviation from its mean position over the frames it is seen
-    in poses (n, P, 3) with masks (n, P); 0 for a part never seen."""
-    poses = np.asarray(poses, dtype=float)
-    visible = np.asarray(visible, dtype=bool) & np.isfinite(poses).all(axis=-1)
-    count = visible.sum(axis=0)
-    x = np.where(visible[..., None], poses, 0.0)
-    mean = x.sum(axis=0) / np.maximum(count, 1)[:, None]
-    dev = np.where(visible[..., None], poses - mean, 0.0)
-    return np.where(count > 0, np.sqrt((dev ** 2).sum(axis=(0, 2)) / np.maximum(count, 1)), 0.0)
-
-
-def mutual_weights(own: np.ndarray, takes: np.ndarray, attention: float, parts: np.ndarray | None = None
-                   ) -> np.ndarray:
-    """Per-node, per-part weights (N, P) from the demonstration's movement ``own`` (P,) and each node's take's
-    movement ``takes`` (N, P) (:func:`movement`), both ways (see the module). ``parts`` (bool (P,)) selects the
-    parts that may count; the others weigh 0. A node whose take and the demonstration both do not move weighs every
-    part alike."""
-    own = np.asarray(own, dtype=float)
-    takes = np.asarray(takes, dtype=float)
-    use = np.ones(own.shape[0], dtype=bool) if parts is None else np.asarray(parts, dtype=bool)
-    n = max(int(use.sum()), 1)
-
-    def relative(m):
-        m = np.where(use, m, 0.0)
-        top = m.max(axis=-1, keepdims=True)
-        return np.where(top > 0, m / np.where(top > 0, top, 1.0), 0.0)
-
-    s = np.maximum(relative(own)[None, :], relative(takes))
-    total = s.sum(axis=1, keepdims=True)
-    share = np.where(total > 0, s / np.where(total > 0, total, 1.0), np.where(use, 1.0 / n, 0.0))
-    return np.where(use, (1.0 - attention) / n + attention * share, 0.0)
+__all__ = ["movement_weights"]
 
 
 def movement_weights(poses: np.ndarray, visible: np.ndarray, attention: float, parts: np.ndarray | None = None

@@ -15,10 +15,9 @@ from), each on its own:
   parts that move is also *where* the movement happens (a hand to the mouth, or to the face). Removing each part's
   mean in proportion to its stillness in the demonstration, from the demonstration and from every take alike,
   cancels the stance and keeps where the moving parts go.
-- **directions**: where each part is going, its velocity (:func:`velocity`), in units of the segment's own
-  root-mean-square speed (:func:`speed`): a wave sideways and a guide forward go different ways wherever the hand is
-  held, and the same gesture performed larger, smaller, faster or slower goes the same ways (Kopp & Graeser §4.3
-  normalise their movement vectors for the same reason). :func:`direction_part` puts them in metres.
+- **tempo**: the movement's *frequency* (:func:`frequency`), its root-mean-square speed over its extent (below): the
+  same movement performed twice as fast has twice the frequency, at any size and from any held posture, so a clip
+  or a demonstration can be sampled in its own time (the posegraph's ``tempo``).
 - **amplitude**: the root-mean-square distance of the parts from that mean posture (:func:`extent`), one length for
   the whole segment. Scaling the movement about its posture by ``reference / extent`` (:func:`rescale`) compares
   the movement's shape at a common size: the same gesture made twice as large or half as large compares close.
@@ -31,8 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["direction_part", "extent", "frequency", "mean_posture", "rescale", "speed", "stillness", "take_means",
-           "velocity"]
+__all__ = ["extent", "frequency", "mean_posture", "rescale", "stillness", "take_means"]
 
 
 def mean_posture(poses: np.ndarray, visible: np.ndarray) -> np.ndarray:
@@ -102,41 +100,6 @@ def take_means(poses: np.ndarray, takes: list[np.ndarray]) -> tuple[np.ndarray, 
         posture[take] = np.where(np.isfinite(mean), mean, poses[take])
         size[take] = extent(poses[take], seen, mean)
     return posture, size
-
-
-def velocity(poses: np.ndarray, visible: np.ndarray, rate: float) -> np.ndarray:
-    """Each part's velocity (n, P, 3), in units per second, of poses (n, P, 3) sampled ``rate`` times a second:
-    centred differences between a sample's neighbours, one-sided at the ends (:func:`numpy.gradient`). NaN where a
-    part is not seen (or not finite) at a sample the difference uses, and everywhere for fewer than two samples."""
-    poses = np.asarray(poses, dtype=float)
-    seen = np.asarray(visible, dtype=bool) & np.isfinite(poses).all(axis=-1)
-    if len(poses) < 2:
-        return np.full(poses.shape, np.nan)
-    return np.gradient(np.where(seen[..., None], poses, np.nan), 1.0 / rate, axis=0)
-
-
-def speed(velocities: np.ndarray) -> float:
-    """The root-mean-square speed of a segment's velocities (n, P, 3) over every finite (sample, part); 0 when none
-    is finite."""
-    v = np.asarray(velocities, dtype=float)
-    known = np.isfinite(v).all(axis=-1)
-    if not known.any():
-        return 0.0
-    return float(np.sqrt(np.einsum("ij,ij->i", v[known], v[known]).mean()))
-
-
-def direction_part(velocities: np.ndarray, own_speed: float, reference_speed: float, reference_extent: float,
-                   limit: float) -> np.ndarray:
-    """A segment's velocities (n, P, 3) as lengths to compare: in units of the segment's own RMS speed
-    ``own_speed`` (brought to ``reference_speed`` within ``limit`` times either way, :func:`rescale`, so the noise
-    of a segment that hardly moves is not blown up to a movement), times ``reference_extent / reference_speed``
-    seconds (the repertoire's typical amplitude over its typical speed). A segment moving at the reference speed
-    about the reference extent then has velocity parts of the same RMS size as its positions about its mean
-    posture. Zeros when the reference speed is 0 (nothing in the repertoire moves)."""
-    v = np.asarray(velocities, dtype=float)
-    if not (reference_speed > 0 and np.isfinite(reference_speed) and np.isfinite(reference_extent)):
-        return np.zeros_like(v)
-    return v * (rescale(own_speed, reference_speed, limit) * reference_extent / reference_speed)
 
 
 def frequency(poses: np.ndarray, visible: np.ndarray, rate: float) -> float:

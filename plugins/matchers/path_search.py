@@ -47,6 +47,12 @@ scaled about their posture to the repertoire's median take amplitude, at most a 
 (:mod:`plugins.lib.style`). With ``separation`` = s a movement is unknown beyond s times its distance to the
 repertoire's other movements.
 
+Tempo (issue 18; not in the paper, whose nodes are taken at one rate, §4.1): with the posegraph's ``tempo``, each
+clip is sampled at the node rate times its own *frequency* (its RMS speed over its RMS distance from its mean posture,
+:func:`plugins.lib.style.frequency`) over the repertoire's median, so a node is a step of the movement's own time;
+the demonstration is sampled the same way, so a movement performed much slower or faster than one's own (a tired
+guide, a brisk wave) still aligns one sample to one node, as ``max_skip`` and ``max_stay`` allow for up to twice.
+
 Two limits on the search itself (issue 18; both off by default, the paper's search). ``per_movement`` keeps, besides
 the k best paths, the best path ending in each movement at every sample (and starts from each movement's nearest
 pose too): §5.2 starts from the k poses nearest the middle frame over the whole graph, and a repertoire of real
@@ -88,10 +94,10 @@ from typing import Any, NamedTuple, Protocol
 import networkx as nx
 import numpy as np
 
-from plugins.lib.attention import movement as part_movement, movement_weights, mutual_weights
+from plugins.lib.attention import movement_weights
 from plugins.lib.pose_distance import PoseScan, path_distance, pose_distance
 from plugins.lib.pose_index import PoseIndex
-from plugins.lib.style import direction_part, extent, mean_posture, rescale, speed, stillness, take_means, velocity
+from plugins.lib.style import extent, mean_posture, rescale, stillness, take_means
 from plugins.lib.travel import body_velocity, travel_part
 from toolkit import Match, Matcher, Motion, Parameter, hookimpl
 from toolkit.components import provides
@@ -166,9 +172,6 @@ class PathSearch(Matcher):
         Parameter("max_stay", int, 0, "Most samples in a row a path may stay on one node; 1 tolerates movements "
                   "down to half one's own speed, as max_skip = 2 tolerates twice it. 0: no limit (a path may stand "
                   "on one pose that resembles a whole movement's average, as a long varied clip has).", minimum=0),
-        Parameter("hub_stay", bool, False, "With max_stay, a path may stay on a hub (the rest posture every movement "
-                  "leaves from and returns to) for as many samples as the demonstrator rests: max_stay limits the "
-                  "stays on the movements' own poses only (false: on every node alike)."),
         Parameter("max_distance", float, 0.03, "Mean eq. 1 distance (m) per sample above which the answer is "
                   "'unknown'. Must stay above the noise of the input (about 1.8 x its standard deviation).", minimum=0.0, length=True),
         Parameter("scale", float, 0.02, "Distance (m) at which confidence falls to 1/e.", minimum=1e-6, length=True),
@@ -190,10 +193,6 @@ class PathSearch(Matcher):
         Parameter("attention", float, 0.0, "How much the parts that move in the segment count over the still ones "
                   "(plugins.lib.attention): 0 is eq. 1's plain mean over the visible parts, 1 counts only what "
                   "moves.", minimum=0.0, maximum=1.0),
-        Parameter("attend", str, "demonstration", "Whose movement attention follows: 'demonstration', the parts "
-                  "that move in the segment watched; 'both', also the parts that move in each candidate node's own "
-                  "take (plugins.lib.attention's mutual_weights), so a movement of one's own that moves other parts "
-                  "is compared on them too.", choices=("demonstration", "both")),
         Parameter("posture", str, "kept", "'removed': compare each movement about its own held posture, the "
                   "demonstration's poses centred on their mean over the segment and each node's on its take's mean "
                   "(plugins.lib.style), so a stooped or proud performer's stance cancels, and where a hand is held "
@@ -206,11 +205,6 @@ class PathSearch(Matcher):
                   "of the parts from the mean posture, plugins.lib.style), by at most this factor either way, so an "
                   "exaggerated or timid style compares close; 0: as performed (the paper).", minimum=0.0,
                   check=lambda v: None if v == 0 or v >= 1 else "0 (off) or a factor of at least 1"),
-        Parameter("direction", float, 0.0, "How much where each part is going counts beside where it is: each "
-                  "part's velocity, in units of the movement's own RMS speed (so the same movement larger, smaller, "
-                  "faster or slower goes the same ways), is compared as one more part per part, this many times the "
-                  "size of the positions about their mean posture (plugins.lib.style's direction_part); 1: as much "
-                  "as the positions; 0: positions only (the paper).", minimum=0.0),
         Parameter("travel", float, 0.0, "Seconds over which where the body goes counts as one more part: the root's "
                   "displacement over this time, in the body's frame (plugins.lib.travel); 0: root-relative poses "
                   "only (the paper).", minimum=0.0, maximum=10.0),
@@ -254,8 +248,6 @@ class PathSearch(Matcher):
         self._label_starts = np.flatnonzero(np.diff(self.label_ids[self._by_label], prepend=-1))
         self._label_sizes = np.diff(self._label_starts, append=len(nodes))
         self.nodes_compared = self._styled_nodes(motor.node_root_relative, index)
-        if self.params["direction"] > 0:  # directions: one more part per part of every node
-            self.nodes_compared = np.concatenate([self.nodes_compared, self._node_directions(index)], axis=1)
         if self.params["travel"] > 0:  # travel: one more part of every node
             self.nodes_compared = np.concatenate(
                 [self.nodes_compared, travel_part(motor.node_travel, self.params["travel"])[:, None]], axis=1)
@@ -266,13 +258,6 @@ class PathSearch(Matcher):
         self._index = None  # the spatial index of the nodes, built by the first search that uses it
         self._scan = PoseScan(self.nodes_compared)  # the scan of every node (the planes, built once per graph)
         self.take_distances = {}
-        if self.params["attention"] > 0 and self.params["attend"] == "both":  # each node's take's movement
-            self._take_movement = np.zeros(self.nodes_compared.shape[:2])
-            for clips in self._takes(index).values():
-                for take in clips:
-                    if len(take):
-                        self._take_movement[take] = part_movement(self.nodes_compared[take],
-                                                             np.ones(self.nodes_compared[take].shape[:2], bool))
         self.spreads = self._spreads(index) if self.params["spread"] > 0 else {}
         self.separations = self._separations(index) if self.params["separation"] > 0 else {}
 
@@ -297,40 +282,6 @@ class PathSearch(Matcher):
             factor = np.array([rescale(z, self.reference_amplitude, self.params["amplitude"]) for z in size])
         base = 0.0 if self.params["posture"] == "removed" else posture
         return base + (poses - posture) * factor[:, None, None]
-
-    def _direction_limit(self) -> float:
-        """How far a movement's own speed is brought to the repertoire's (:func:`plugins.lib.style.direction_part`):
-        the speeds the search itself takes for the same movement, ``max_skip`` times the tempo and, with
-        ``amplitude``, that many times the size."""
-        return float(self.params["max_skip"] * max(self.params["amplitude"], 1.0))
-
-    def _node_directions(self, index: dict[str, int]) -> np.ndarray:
-        """Every node's direction parts (N, P, 3): its velocity along its take (the take's nodes in order at
-        ``node_rate``, from the poses as performed), in units of the take's RMS speed brought to the repertoire's
-        median take speed (:attr:`reference_speed`), times the repertoire's median take extent over that speed
-        (:attr:`reference_extent`). A hub is held still: zero."""
-        poses = self.motor.node_root_relative
-        rate = self.motor.node_rate
-        takes = [np.asarray(t, dtype=np.intp) for clips in self._takes(index).values() for t in clips if len(t)]
-        every = np.ones(poses.shape[:2], dtype=bool)
-        moving = [velocity(poses[t], every[t], rate) for t in takes]
-        speeds = [speed(v) for v in moving]
-        _, size = take_means(poses, takes)
-        self.reference_speed = float(np.median(speeds)) if speeds else 0.0
-        self.reference_extent = float(np.median([size[t[0]] for t in takes])) if takes else 0.0
-        out = np.zeros(poses.shape)
-        for t, v, s in zip(takes, moving, speeds):
-            part = direction_part(v, s, self.reference_speed, self.reference_extent, self._direction_limit())
-            out[t] = np.nan_to_num(part) * self.params["direction"]  # a take of one node: no velocity, held still
-        return out
-
-    def _sample_directions(self, poses: np.ndarray, visible: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The demonstration's direction parts (n, P, 3) and where they are known (n, P), from its samples as
-        performed, as :meth:`_node_directions` treats each take."""
-        v = velocity(poses, visible, self.motor.node_rate)
-        part = direction_part(v, speed(v), self.reference_speed, self.reference_extent, self._direction_limit())
-        known = np.isfinite(part).all(axis=-1)
-        return np.where(known[..., None], part * self.params["direction"], 0.0), known
 
     def _styled_samples(self, poses: np.ndarray, visible: np.ndarray) -> np.ndarray:
         """The demonstration's sampled poses as compared: about their own mean posture over the segment, as
@@ -438,10 +389,9 @@ class PathSearch(Matcher):
 
     def samples(self, motion: Motion, styled: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """The observed motion (in the observer's own parts) at the posegraph's node rate (with the posegraph's
-        ``tempo``, at the node rate times the motion's own frequency over the repertoire's, as each clip of the graph
-        is sampled): poses (n, P, 3), visible (n, P); with ``direction``, each part's direction as one more part per part (n, 2P, 3), hidden where the
-        velocity is not known; with ``travel``, the travel as one more part after those, hidden where the motion has
-        no world positions. ``styled``: about the segment's own posture and amplitude as ``posture`` and ``amplitude`` say
+        ``tempo``, at the node rate times the motion's own frequency over the repertoire's median clip frequency, as
+        each clip of the graph is sampled): poses (n, P, 3), visible (n, P); with ``travel``, the travel as one more part (n, P + 1, 3), hidden where the motion has no world
+        positions. ``styled``: about the segment's own posture and amplitude as ``posture`` and ``amplitude`` say
         (False: the poses as performed, which learning keeps)."""
         if motion.parts != self.owner.body.parts:
             raise ValueError(f"path-search matches motions of the observer's own parts {list(self.owner.body.parts)}, "
@@ -454,12 +404,8 @@ class PathSearch(Matcher):
         n = max(1, int(round(motion.duration * rate)))
         idx = np.minimum(np.round(np.arange(n) * motion.fps / rate).astype(int), motion.n_frames - 1)
         poses, visible = motion.positions[idx], motion.visible[idx]
-        directions = self._sample_directions(poses, visible) if self.params["direction"] > 0 else None
         if styled:
             poses = self._styled_samples(poses, visible)
-        if directions is not None:
-            poses = np.concatenate([poses, directions[0]], axis=1)
-            visible = np.concatenate([visible, directions[1]], axis=1)
         if self.params["travel"] <= 0:
             return poses, visible
         if motion.world is None:
@@ -481,20 +427,15 @@ class PathSearch(Matcher):
         weights = None
         if self.params["attention"] > 0:
             positions = ~self.owner.body.angle_mask
-            if self.params["direction"] > 0:  # a part's direction parts are of its kind
-                positions = np.concatenate([positions, positions])
             if obs.shape[1] > len(positions):  # the travel part is a position too
                 positions = np.append(positions, True)
-            if self.params["attend"] == "both":
-                weights = mutual_weights(part_movement(obs, vis), self._take_movement, self.params["attention"], positions)
-            else:
-                weights = movement_weights(obs, vis, self.params["attention"], positions)
+            weights = movement_weights(obs, vis, self.params["attention"], positions)
         path, _, evidence = self.search(obs, vis, weights)  # the beam's eq. 3 cost: recomputed below by the one formula
         if path is None:
             return Match.unknown(reason="nothing visible")
         ids = self.label_ids[path]
         voting = ids[ids != self._hub_id]  # the movements' numbers: hubs do not vote
-        mean = path_distance(obs, self.nodes_compared[path], vis, _at(weights, path)) / max(evidence, 1)  # eq. 3
+        mean = path_distance(obs, self.nodes_compared[path], vis, weights) / max(evidence, 1)  # eq. 3 per sample
         details: dict[str, Any] = {"mean_distance": mean, "samples": len(path)}
         if voting.size == 0:
             return Match.unknown(reason="only hub poses", path=tuple(self.node_names[i] for i in path), **details)
@@ -539,8 +480,7 @@ class PathSearch(Matcher):
                 break
             names, counts = np.unique(voting, return_counts=True)
             other = str(names[int(np.argmax(counts))])
-            found.append((other, float(path_distance(obs, self.nodes_compared[path], vis, _at(weights, path))
-                                       / max(evidence, 1))))
+            found.append((other, float(path_distance(obs, self.nodes_compared[path], vis, weights) / max(evidence, 1))))
             exclude = exclude | (self.labels == other)
         return (found[0], *sorted(found[1:], key=lambda c: c[1]))
 
@@ -549,7 +489,7 @@ class PathSearch(Matcher):
         """The best path (node indices, one per sample), its eq. 3 cost and the number of samples with evidence.
 
         ``obs`` and ``vis`` are samples as :meth:`samples` gives them, compared with :attr:`nodes_compared` (with
-        ``travel``, one part more than the body); ``weights``: attention to each of those parts, (P,) or per node (N, P) (``None``: eq. 1's
+        ``travel``, one part more than the body); ``weights``: attention to each of those parts (``None``: eq. 1's
         plain mean); ``exclude`` (N,): nodes no path may use."""
         has = vis.any(axis=1)
         if not has.any():
@@ -607,11 +547,11 @@ class PathSearch(Matcher):
                 if every and weights is None:  # the hot loop of the search: eq. 1 over every part, inline
                     return scan(obs[t], cand)  # (pose_distance's arithmetic without its checks: the same numbers)
                 if every:
-                    return pose_distance(nodes[cand], obs[t], None, _at(weights, cand))
+                    return pose_distance(nodes[cand], obs[t], None, weights)
                 if seen.any():  # eq. 1 over the parts seen in this sample: the mask is the same for every candidate,
                     # so the seen parts are taken first and pose_distance needs no mask
                     return pose_distance(nodes[cand][:, seen], obs[t, seen], None,
-                                         None if weights is None else _at(weights, cand)[..., seen])
+                                         None if weights is None else weights[seen])
                 return np.zeros(len(cand))
 
             beam, cand = _candidates(table, ends, costs, score)
@@ -620,10 +560,7 @@ class PathSearch(Matcher):
             if exclude is not None:
                 step = np.where(exclude[cand], np.inf, step)
             if limit > 0:
-                barred = stay > limit
-                if self.params["hub_stay"]:  # resting at a hub is not held to max_stay
-                    barred &= self.label_ids[cand] != self._hub_id
-                step = np.where(barred, np.inf, step)
+                step = np.where(stay > limit, np.inf, step)
             total = costs[beam] + step
             order = total.argsort(kind="stable")
             # k best, one path per end node (distinct hypotheses): the first time each end node comes in the order
@@ -727,14 +664,6 @@ class PathSearch(Matcher):
         path = self.motor.learn(name, obs[:, :parts], vis[:, :parts], source="path-search")
         self._refresh()
         return Match(name, 1.0, None, tuple(path), {"learned": True, **details})
-
-
-def _at(weights: np.ndarray | None, nodes: np.ndarray) -> np.ndarray | None:
-    """Attention's weights for the poses of ``nodes``: the same (P,) for every node, or each node's row of (N, P)
-    (``attend = "both"``)."""
-    if weights is None or weights.ndim == 1:
-        return weights
-    return weights[nodes]
 
 
 def _reach(graph, nodes, index, max_skip: int, *, forward: bool) -> tuple[np.ndarray, np.ndarray]:
