@@ -283,6 +283,8 @@ CASES = [
     ("template-alternative-key", "an unknown parameter in a named plugin's own table", {"o.toml": '[observer]\nname = "o"\n[segmenters.velocity-direction]\nlevl = "movement"\n'}, ["validate", "o.toml"], ["o.toml:4: key segmenters.velocity-direction.levl", "unknown parameter 'levl' for segmenter 'velocity-direction'", "available: angle"]),
     ("template-alternative-plugin", "a table for a plugin that does not exist", {"o.toml": '[observer]\nname = "o"\n[matchers.nearest]\nk = 1\n'}, ["validate", "o.toml"], ["o.toml:3: key matchers.nearest", "unknown matcher 'nearest'", "available: dtw, forward-model, path-search"]),
     ("template-alternative-named", "a plugin named inside a plugin's own table", {"o.toml": '[observer]\nname = "o"\n[segmenters.ruptures]\nplugin = "hub-threshold"\n'}, ["validate", "o.toml"], ["o.toml:4: key segmenters.ruptures.plugin", "a plugin named inside a plugin's own table"]),
+    # -- path search's comparison: the posegraph's tempo (issue 18, gesture18)
+    ("posegraph-tempo", "a tempo limit below 1", {"c.toml": CHILD + '[motor]\nplugin = "posegraph"\ntempo = 0.5\n'}, ["validate", "c.toml"], ["c.toml:6: key motor.tempo", "0 (off) or a factor of at least 1"]),
 ]
 
 

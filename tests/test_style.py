@@ -8,7 +8,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from plugins.lib.style import extent, mean_posture, rescale, stillness, take_means
+from plugins.lib.style import extent, frequency, mean_posture, rescale, stillness, take_means
 
 
 def test_the_mean_posture_is_each_parts_mean_over_the_frames_it_is_seen():
@@ -83,3 +83,28 @@ def test_stillness_does_not_change_with_a_held_offset_or_the_movements_size(x, c
     assume(extent(x, visible) > 1e-3)  # a movement, not rounding
     mean = mean_posture(x, visible)
     assert stillness(mean + (x - mean) * c + offset, visible) == pytest.approx(stillness(x, visible), abs=1e-6)
+
+
+def test_the_frequency_is_the_rms_step_speed_over_the_extent():
+    """One part steps 0, 1, 0, 1 (m) at 10 samples a second: every step is 1 m, 10 m/s; its extent about its mean
+    (0.5) is 0.5 m, so 20 per second. A part seen at one end of a step only leaves that step out."""
+    x = np.zeros((4, 1, 3))
+    x[[1, 3], 0, 0] = 1.0
+    assert frequency(x, np.ones((4, 1), bool), 10.0) == pytest.approx(20.0)
+    assert frequency(np.zeros((4, 1, 3)), np.ones((4, 1), bool), 10.0) == 0.0  # nothing moves
+    assert frequency(x[:1], np.ones((1, 1), bool), 10.0) == 0.0  # no step
+    seen = np.array([[True], [True], [False], [True]])  # steps 0-1 only; extent over frames 0, 1, 3 (mean 2/3)
+    assert frequency(x, seen, 10.0) == pytest.approx(10.0 / extent(x, seen))
+
+
+@settings(max_examples=50, deadline=None)
+@given(poses, st.floats(0.1, 10), st.data())
+def test_the_frequency_does_not_change_with_the_size_or_a_held_posture_and_scales_with_the_rate(x, c, data):
+    """The same movement larger or smaller about any posture, or from another held posture, has the same frequency;
+    the same samples taken twice as often (the movement twice as fast) have twice the frequency."""
+    assume(extent(x, np.ones(x.shape[:2], bool)) > 1e-3)
+    offset = data.draw(arrays(float, (x.shape[1], 3), elements=st.floats(-1, 1, allow_nan=False)))
+    visible = np.ones(x.shape[:2], bool)
+    f = frequency(x, visible, 10.0)
+    assert frequency(x * c + offset, visible, 10.0) == pytest.approx(f, rel=1e-9)
+    assert frequency(x, visible, 20.0) == pytest.approx(2 * f, rel=1e-12)

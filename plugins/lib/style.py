@@ -15,6 +15,9 @@ from), each on its own:
   parts that move is also *where* the movement happens (a hand to the mouth, or to the face). Removing each part's
   mean in proportion to its stillness in the demonstration, from the demonstration and from every take alike,
   cancels the stance and keeps where the moving parts go.
+- **tempo**: the movement's *frequency* (:func:`frequency`), its root-mean-square speed over its extent (below): the
+  same movement performed twice as fast has twice the frequency, at any size and from any held posture, so a clip
+  or a demonstration can be sampled in its own time (the posegraph's ``tempo``).
 - **amplitude**: the root-mean-square distance of the parts from that mean posture (:func:`extent`), one length for
   the whole segment. Scaling the movement about its posture by ``reference / extent`` (:func:`rescale`) compares
   the movement's shape at a common size: the same gesture made twice as large or half as large compares close.
@@ -27,7 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["extent", "mean_posture", "rescale", "stillness", "take_means"]
+__all__ = ["extent", "frequency", "mean_posture", "rescale", "stillness", "take_means"]
 
 
 def mean_posture(poses: np.ndarray, visible: np.ndarray) -> np.ndarray:
@@ -97,3 +100,20 @@ def take_means(poses: np.ndarray, takes: list[np.ndarray]) -> tuple[np.ndarray, 
         posture[take] = np.where(np.isfinite(mean), mean, poses[take])
         size[take] = extent(poses[take], seen, mean)
     return posture, size
+
+
+def frequency(poses: np.ndarray, visible: np.ndarray, rate: float) -> float:
+    """A movement's frequency (1/s): the root-mean-square speed of its parts between successive samples (poses (n, P,
+    3) sampled ``rate`` times a second, masks (n, P); the steps where a part is seen at both ends) over their RMS
+    distance from their mean posture (:func:`extent`). The same movement performed ``c`` times as fast has ``c``
+    times the frequency, at any size and from any held posture; a sinusoid of angular frequency ``w`` reads
+    ``2 rate sin(w / (2 rate))``, within 1% of ``w`` up to ``w = rate / 2``. 0 when it does not move."""
+    poses = np.asarray(poses, dtype=float)
+    seen = np.asarray(visible, dtype=bool) & np.isfinite(poses).all(axis=-1)
+    size = extent(poses, seen)
+    both = seen[1:] & seen[:-1]
+    if not (size > 0 and both.any()):
+        return 0.0
+    step = np.where(both[..., None], np.diff(np.where(seen[..., None], poses, 0.0), axis=0), 0.0)
+    moving = float(np.sqrt((step ** 2).sum() / both.sum())) * rate
+    return moving / size

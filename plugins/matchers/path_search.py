@@ -47,6 +47,12 @@ scaled about their posture to the repertoire's median take amplitude, at most a 
 (:mod:`plugins.lib.style`). With ``separation`` = s a movement is unknown beyond s times its distance to the
 repertoire's other movements.
 
+Tempo (issue 18; not in the paper, whose nodes are taken at one rate, §4.1): with the posegraph's ``tempo``, each
+clip is sampled at the node rate times its own *frequency* (its RMS speed over its RMS distance from its mean posture,
+:func:`plugins.lib.style.frequency`) over the repertoire's median, so a node is a step of the movement's own time;
+the demonstration is sampled the same way, so a movement performed much slower or faster than one's own (a tired
+guide, a brisk wave) still aligns one sample to one node, as ``max_skip`` and ``max_stay`` allow for up to twice.
+
 Two limits on the search itself (issue 18; both off by default, the paper's search). ``per_movement`` keeps, besides
 the k best paths, the best path ending in each movement at every sample (and starts from each movement's nearest
 pose too): §5.2 starts from the k poses nearest the middle frame over the whole graph, and a repertoire of real
@@ -382,14 +388,19 @@ class PathSearch(Matcher):
     # -- matching ----------------------------------------------------------------------------
 
     def samples(self, motion: Motion, styled: bool = True) -> tuple[np.ndarray, np.ndarray]:
-        """The observed motion (in the observer's own parts) at the posegraph's node rate: poses (n, P, 3), visible
-        (n, P); with ``travel``, the travel as one more part (n, P + 1, 3), hidden where the motion has no world
+        """The observed motion (in the observer's own parts) at the posegraph's node rate (with the posegraph's
+        ``tempo``, at the node rate times the motion's own frequency over the repertoire's median clip frequency, as
+        each clip of the graph is sampled): poses (n, P, 3), visible (n, P); with ``travel``, the travel as one more part (n, P + 1, 3), hidden where the motion has no world
         positions. ``styled``: about the segment's own posture and amplitude as ``posture`` and ``amplitude`` say
         (False: the poses as performed, which learning keeps)."""
         if motion.parts != self.owner.body.parts:
             raise ValueError(f"path-search matches motions of the observer's own parts {list(self.owner.body.parts)}, "
                              f"not {list(motion.parts)} (Motion.onto maps them by name)")
         rate = self.motor.node_rate
+        if getattr(self.motor, "reference_frequency", 0.0) > 0:  # the graph's clips sampled at their own tempo
+            at = np.unique(np.minimum(np.round(np.arange(max(1, int(round(motion.duration * rate)))) * motion.fps
+                                               / rate).astype(int), motion.n_frames - 1))
+            rate = rate * self.motor.tempo_factor(self.motor.frequency(at, motion.positions, motion.visible))
         n = max(1, int(round(motion.duration * rate)))
         idx = np.minimum(np.round(np.arange(n) * motion.fps / rate).astype(int), motion.n_frames - 1)
         poses, visible = motion.positions[idx], motion.visible[idx]

@@ -32,6 +32,7 @@ import numpy as np
 from plugins.lib.clip_repertoire import CLIP_PARAMETERS, example_name, repertoire_for
 from plugins.motor.key_poses import REPERTOIRE_PARAMETERS, KeyPoses, interpolate, play, read_repertoire
 from plugins.lib.pose_distance import pose_distance
+from plugins.lib.style import frequency, rescale
 from plugins.lib.travel import body_velocity
 from toolkit import ConfigError, Motion, MotorSystem, Parameter, hookimpl
 
@@ -50,6 +51,12 @@ class Posegraph(MotorSystem):
                   "(one cycle of a walk or a run, cropped from a longer recording), loops: an edge leads from its "
                   "last pose back to its first, so a path can follow the movement for as many cycles as it is seen "
                   "(false: every path leaves through a hub, the paper's posegraph)."),
+        Parameter("tempo", float, 0.0, "Sample each clip at its own tempo: a clip's nodes come at node_rate times "
+                  "its frequency (its RMS speed over its RMS distance from its mean posture, plugins.lib.style) over "
+                  "the repertoire's median clip frequency, kept within this factor either way, so a node is a step of "
+                  "the movement's own time rather than a tenth of a second; path search samples a demonstration the "
+                  "same way. 0: every clip at node_rate (the paper).", minimum=0.0,
+                  check=lambda v: None if v == 0 or v >= 1 else "0 (off) or a factor of at least 1"),
         Parameter("node_rate", float, 10.0, "Pose nodes per second of movement: the graph's resolution. Higher "
                   "recognises finer timing at the cost of search time.", minimum=1.0, maximum=120.0),
     )
@@ -86,11 +93,46 @@ class Posegraph(MotorSystem):
             sampled = play(self.key_poses, m, self.body.parts, fps=rate).positions
             self._add_path(name, m.poses[0], sampled[1:-1], m.poses[-1], poses, travel,
                            self._key_pose_travel(m, len(sampled))[1:-1])
-        for clip in self.clips.clips if self.clips is not None else ():
-            self._add_clip(clip.movement, clip.motion, poses, travel)
+        clips = self.clips.clips if self.clips is not None else ()
+        self.reference_frequency = 0.0
+        rates = [rate] * len(clips)
+        if self.params["tempo"] > 0 and clips:
+            found = [self.frequency(*self._sampled(clip.motion)) for clip in clips]
+            moving = [f for f in found if f > 0]
+            self.reference_frequency = float(np.median(moving)) if moving else 0.0
+            rates = [rate * self.tempo_factor(f) for f in found]
+        for clip, at in zip(clips, rates):
+            self._add_clip(clip.movement, clip.motion, poses, travel, at)
         self.node_poses = np.stack(poses)
         self.node_travel = np.stack(travel)
         self.node_root_relative = self.node_poses - self.node_poses[:, root : root + 1]
+
+    def _sampled(self, motion: Motion, rate: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """A clip's frames kept at ``rate`` per second (default ``node_rate``) and its filled positions (hidden parts
+        held, docs/conventions.md)."""
+        rate = self.params["node_rate"] if rate is None else rate
+        t = np.arange(motion.n_frames) / motion.fps
+        keep = np.unique(np.clip(np.round(np.arange(0.0, t[-1] + 1e-9, 1.0 / rate) * motion.fps), 0,
+                                 motion.n_frames - 1).astype(int))
+        filled = motion.filled(default=self.rest_pose()).positions
+        return keep, filled
+
+    def frequency(self, keep: np.ndarray, positions: np.ndarray, visible: np.ndarray | None = None) -> float:
+        """A movement's frequency (1/s, :func:`plugins.lib.style.frequency`): the RMS speed of its root-relative parts
+        over their RMS distance from their mean posture, from its frames ``keep`` taken ``node_rate`` times a second;
+        0 when it does not move. The same movement performed twice as fast has twice the frequency, at any size."""
+        root = self.body.root_index
+        rel = positions[keep] - positions[keep][:, root : root + 1]
+        seen = np.ones(rel.shape[:2], dtype=bool) if visible is None else np.asarray(visible, dtype=bool)[keep]
+        return frequency(rel, seen, self.params["node_rate"])
+
+    def tempo_factor(self, frequency: float) -> float:
+        """How many times ``node_rate`` a movement of ``frequency`` is sampled at with ``tempo``: its frequency over
+        the repertoire's median clip frequency, kept within ``tempo`` times either way; 1 without ``tempo`` or when
+        either frequency is 0."""
+        if not (self.params["tempo"] > 0 and self.reference_frequency > 0 and frequency > 0):
+            return 1.0
+        return 1.0 / rescale(frequency, self.reference_frequency, self.params["tempo"])
 
     def _key_pose_travel(self, movement: Any, n: int, fps: float = 30.0) -> np.ndarray:
         """The travel of a key-pose movement at its ``n`` nodes (n, 3): key poses are in the body's own frame, so
@@ -101,14 +143,11 @@ class Posegraph(MotorSystem):
         at = np.minimum(np.round(np.arange(n) * fps / self.params["node_rate"]).astype(int), len(fine) - 1)
         return np.nan_to_num(velocity[at])
 
-    def _add_clip(self, movement: str, motion: Motion, poses: list[np.ndarray], travel: list[np.ndarray]) -> None:
-        """One example clip as a path between the hubs nearest its ends, sampled at ``node_rate``; its travel from
-        its world positions (none known: at rest)."""
-        rate = self.params["node_rate"]
-        t = np.arange(motion.n_frames) / motion.fps
-        keep = np.unique(np.clip(np.round(np.arange(0.0, t[-1] + 1e-9, 1.0 / rate) * motion.fps), 0,
-                                 motion.n_frames - 1).astype(int))
-        filled = motion.filled(default=self.rest_pose()).positions  # hidden parts held (docs/conventions.md)
+    def _add_clip(self, movement: str, motion: Motion, poses: list[np.ndarray], travel: list[np.ndarray],
+                  rate: float | None = None) -> None:
+        """One example clip as a path between the hubs nearest its ends, sampled at ``rate`` (default
+        ``node_rate``); its travel from its world positions (none known: at rest)."""
+        keep, filled = self._sampled(motion, rate)  # hidden parts held (docs/conventions.md)
         sampled = filled[keep]
         hub_rel = self.key_poses.array - self.key_poses.array[:, self.body.root_index : self.body.root_index + 1]
         root = self.body.root_index
