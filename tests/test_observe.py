@@ -342,17 +342,22 @@ def test_a_clip_built_motor_command_graph_saves_and_loads_its_labels_without_dou
     assert unlabelled.labels == commands.labels and sorted(unlabelled.movements()) == sorted(commands.movements())
 
 
-def test_an_observer_takes_what_it_is_not_told_from_the_observer_template(data, profile, pm, write, capsys):
-    default = compose_observer(pm, profile, data / "repertoire")
-    assert [default.perception.name, default.segmenter.name, default.matcher.name, default.motor.name] == [
-        "motion-capture", "hub-threshold", "path-search", "posegraph"]  # characters/observers/recordings.toml
-    mine = write("mine.toml", """
+# the head of the observer templates the tests below write: a motor system and perception, as the recordings template
+MINE = """
         [observer]
         name = "mine"
         [motor]
         plugin = "posegraph"
         [perception]
         plugin = "motion-capture"
+"""
+
+
+def test_an_observer_takes_what_it_is_not_told_from_the_observer_template(data, profile, pm, write, capsys):
+    default = compose_observer(pm, profile, data / "repertoire")
+    assert [default.perception.name, default.segmenter.name, default.matcher.name, default.motor.name] == [
+        "motion-capture", "hub-threshold", "path-search", "posegraph"]  # characters/observers/recordings.toml
+    mine = write("mine.toml", MINE + """
         [segmenter]
         plugin = "velocity-direction"
         level = "movement"
@@ -386,13 +391,7 @@ def test_a_plugin_named_instead_takes_its_own_table_of_the_template(data, profil
     stroke = compose_observer(pm, profile, data / "repertoire", segmenter="velocity-direction",
                               settings={"segmenter": {"level": "stroke"}})
     assert stroke.segmenter.params["level"] == "stroke" and stroke.segmenter.params["units"] == own["units"]
-    mine = write("alternatives.toml", """
-        [observer]
-        name = "mine"
-        [motor]
-        plugin = "posegraph"
-        [perception]
-        plugin = "motion-capture"
+    mine = write("alternatives.toml", MINE + """
         [segmenter]
         plugin = "hub-threshold"
         [matcher]
