@@ -96,6 +96,20 @@ Across styles (issue 18; K&G §4.1, §4.4, §6), three more settings, each off b
   the ratio is unchanged when the demonstration and the prediction are scaled or moved together, so it holds for
   any body and skeleton.
 
+Travel (issue 18; B&B §7.1, K&G §6): the commands move parts relative to the root (B&B §5.1's root-relative
+coordinates), so a walk to the left, to the right, backwards and forwards, whose leg swings are alike, are alike to
+them. With ``travel`` = τ > 0 where the body goes is one more part, as ``path-search``'s ``travel``: the root's
+displacement over τ seconds in the body's own frame (:mod:`plugins.lib.travel`). It is *observed* from the working
+memory's world positions, at each frame from the frames up to it; *predicted* from where the body went while the
+command was shown (``Edge.travel``, kept by the motor command graph for clips and for what it learns by watching),
+read at the point of the command where its lead part is predicted (K&G §4.1: the forward model predicts from the
+command); and *compared* as one more part of ``error``: the largest, one more in the mean, or weighted by how far
+it has been seen to go (the root's path in the world since the onset) with ``moving``. It is compared as it is,
+also with ``relative``: travel is a velocity, which another person's stance does not offset. Where the world
+positions are not known the travel part is left out; a command without travel is performed on the spot. The
+drop-out, ``stillness`` (the body on the spot) and ``unexplained`` (the extent includes the travel) see it; the
+end check (:meth:`ForwardModel._ended`), the start node and the spreads between takes compare the parts alone.
+
 Working memory: the matcher reads the segment from the
 :class:`~toolkit.watching.WorkingMemory` the watching loop gives it (root-relative,
 in the observer's parts, hidden parts held) and keeps no frames of its own; what it
@@ -197,8 +211,9 @@ class CommandGraphs(Protocol):
         """The labelled movement a path of edges stands for, if one."""
 
     def learn_observed(self, subsystem: str, start: str, observed: np.ndarray, fps: float, *,
-                       criteria: StrokeCriteria = StrokeCriteria()) -> list[str]:
-        """Learn an observed movement as new edges from ``start`` (true imitation); their names."""
+                       criteria: StrokeCriteria = StrokeCriteria(), travel: np.ndarray | None = None) -> list[str]:
+        """Learn an observed movement as new edges from ``start`` (true imitation); their names. ``travel`` (n, 3):
+        where the body went at each frame (the root's velocity in the body's frame), kept with the edges."""
 
     def rest_pose(self) -> np.ndarray:
         """The body's rest pose, local frame (P, 3)."""
@@ -310,6 +325,12 @@ class Track:
     begun: Track | None = None
     """After a deviation, predicted again: the segment's first track of the subsystem (what :meth:`ForwardModel.inspect`
     shows of the segment's start)."""
+    travel_seen: np.ndarray | None = None
+    """With ``travel``: the travel part seen at the frame followed last (3,), the root's displacement over ``travel``
+    seconds in the body's frame; ``None`` when not known (no world positions, fewer than two frames)."""
+    travel_weights: np.ndarray | None = None
+    """With ``travel`` and ``error = "moving"``: the weights (k + 1,) of the parts and of the travel part at the frame
+    followed last (:func:`moving_weights` of the parts' path lengths and the root's path in the world)."""
     placed: tuple[dict[str, int], np.ndarray] | None = None
     """The anchors placed at once when the track began (:meth:`ForwardModel._anchor`): each command's row in them and
     the array (C, k) whose rows are those of ``anchors``."""
@@ -324,6 +345,8 @@ class _EdgeTable:
     positions: np.ndarray
     arcs: np.ndarray
     lead: int
+    travel: np.ndarray | None = None
+    """With ``travel``: where the body went (m/s, body frame) at each point of the lead part's grid (G, 3)."""
 
 
 def _row_keys(arcs: np.ndarray, first: int = 0) -> np.ndarray | None:
@@ -762,6 +785,10 @@ class ForwardModel(Matcher):
                   "demonstrator keeps still, or keeps still parts that move, predicts them where they are not. "
                   "With relative, displacements are then taken from where the lead joined the command.",
                   choices=("parts", "lead")),
+        Parameter("travel", float, 0.0, "Seconds over which where the body goes counts as one more part: the root's "
+                  "displacement over this time in the body's own frame (plugins.lib.travel), observed from the world "
+                  "positions and predicted from the travel each command was shown with (Edge.travel), at the point of "
+                  "the command the parts are predicted at. 0: root-relative parts only (the paper).", minimum=0.0),
         Parameter("together", bool, True, "Follow every subsystem that moves during a demonstration, each with its "
                   "own candidates, and imitate them at once (a hand-arm movement, §4.2); off: only the first to move."),
         Parameter("learn", bool, True, "Learn new edges by the inverse model when no edge predicts the demonstration."),
@@ -788,6 +815,10 @@ class ForwardModel(Matcher):
         # observed root-relative positions are placed at the observer's own root height; finger angles stay as they are
         self._root_height = np.where(owner.body.angle_mask[:, None], 0.0, motor.rest_pose()[owner.body.root_index])
         self._criteria = StrokeCriteria(drop=self.params["drop"], angle=self.params["angle"])
+        self._root = owner.body.root_index
+        self._travel_stacks: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
+        if self.params["travel"] > 0:
+            import scipy.ndimage  # noqa: F401  (travel's filter: imported at set-up, not in the first match)
         _kernels()  # compiled (or loaded from numba's cache) now, not in the first demonstration
         self._tables: dict[int, tuple] = {}
         self._edges: dict[str, _EdgeTable] = {}
@@ -1113,6 +1144,8 @@ class ForwardModel(Matcher):
         lengths = self._walked(track, observed)  # once per frame (incremental)
         last = observed[-1]
         frame = self._memory.n - 1
+        if self.params["travel"] > 0 and not track.hand:
+            self._travel_seen(track, len(memory), lengths)
         if track.committed is not None:
             error = self._error(track, track.committed_path,
                                 self._clock(track, track.committed_path, lengths, len(observed)), last)
@@ -1130,7 +1163,11 @@ class ForwardModel(Matcher):
             errors = {path: self._error(track, path, self._clock(track, path, lengths, n), last) for path in paths}
         track.trace.append((frame, errors))
         unexplained = self.params["unexplained"] > 0 and self.params["dropout"] == "relative"
-        still = self._distance(track, observed[0], last) if self.params["stillness"] or unexplained else None
+        still = None
+        if self.params["stillness"] or unexplained:  # predicting no movement: every part still, the body on the spot
+            still = self._distance(track, observed[0], last) if not self._traveling(track) else float(
+                self._with_travel(track, (_norms(observed[0] - last) * track.scale)[None],
+                                  np.array([_norms(track.travel_seen)]))[0])
         evidence = self._evidence(track, errors)
         if unexplained:
             total, frames = track.extent
@@ -1346,10 +1383,97 @@ class ForwardModel(Matcher):
         if table is None or table.commands is not commands:
             tables = [self._table(stroke) for stroke in commands]
             arcs = np.stack([arc for _, _, arc in tables])
-            table = _EdgeTable(commands, np.stack([positions for _, positions, _ in tables]), arcs,
-                               int(np.argmax(arcs[:, -1])))
+            lead = int(np.argmax(arcs[:, -1]))
+            travel = self._travel_grid(name, tables[lead][0]) if self.params["travel"] > 0 else None
+            table = _EdgeTable(commands, np.stack([positions for _, positions, _ in tables]), arcs, lead, travel)
             self._edges[name] = table
         return table
+
+    def _travel_grid(self, name: str, times: np.ndarray) -> np.ndarray:
+        """Where the body went (m/s, body frame) while command ``name`` was shown, at the times ``times`` of its lead
+        part's grid (G, 3): the edge's travel (``Edge.travel``, one row per frame shown) read at the same share of
+        the command's time (the command was fitted to those frames, so its start is the first and its end the last);
+        none known: on the spot (0)."""
+        travel = getattr(self.motor.edge(name), "travel", None)
+        if travel is None or not len(travel):
+            return np.zeros((len(times), 3))
+        travel = np.asarray(travel, dtype=float)
+        if len(travel) == 1:
+            return np.repeat(travel, len(times), axis=0)
+        at = times / max(float(times[-1]), 1e-12) * (len(travel) - 1)
+        steps = np.arange(len(travel))
+        return np.stack([np.interp(at, steps, travel[:, c]) for c in range(3)], axis=1)
+
+    def _travel_seen(self, track: Track, n: int, lengths: np.ndarray) -> None:
+        """With ``travel``: the travel part seen at row ``n - 1`` of the segment (:attr:`Track.travel_seen`), the
+        root's velocity in the body's frame as an observer knows it then (from the rows up to it,
+        :func:`plugins.lib.travel.body_velocity`) times ``travel`` seconds; with ``error = "moving"``, the weights of
+        the parts and the travel part (:attr:`Track.travel_weights`), the travel's path the root's path in the world
+        since the onset, the parts' their paths relative to the root: each as far as it has been seen to go."""
+        from plugins.lib.travel import body_velocity, travel_part
+
+        memory, root = self._memory, self._root
+        window = 0.25
+        lo = max(0, n - (int(round(window * memory.fps)) + 3))
+        track.travel_seen = None
+        if n - lo >= 2:
+            world = memory.world
+            v = body_velocity(world[lo:n], memory.positions[lo:n], memory.visible[lo:n], root, memory.fps,
+                              window=window, frames=np.array([n - lo - 1]))[0]
+            if np.isfinite(v).all():
+                track.travel_seen = travel_part(v, self.params["travel"])
+        if self.params["error"] == "moving":
+            walked = _lengths(memory.world[track.onset:n, root][:, None])[0] if n - track.onset > 1 else 0.0
+            track.travel_weights = moving_weights(np.append(lengths, walked if np.isfinite(walked) else 0.0))
+
+    def _travel_predicted(self, path: tuple[str, ...], along: np.ndarray) -> np.ndarray:
+        """With ``travel``: the travel part path ``path`` predicts (3,) when its parts are ``along`` it: the travel
+        the command was shown with where its first command's lead part is (edge by edge: a lead past the end of
+        one edge goes on along the next), times ``travel`` seconds."""
+        lead = self._lead(path[0])
+        left = float(along[lead])
+        for i, name in enumerate(path):
+            edge = self._edge(name)
+            total = float(edge.arcs[lead, -1])
+            if left <= total or i == len(path) - 1:
+                point = _along_rows(edge.arcs[lead][None], edge.travel[None], np.array([min(left, total)]))[0]
+                return point * self.params["travel"]
+            left -= total
+        return np.zeros(3)  # no command (not reached)
+
+    def _travel_batch(self, names: tuple[str, ...], along: np.ndarray, leads: np.ndarray) -> np.ndarray:
+        """:meth:`_travel_predicted` of one-command paths ``names`` at once (C, 3), ``along`` (C, k) their parts'
+        places along them (already within their strokes) and ``leads`` (C,) their lead parts."""
+        edges = [self._edge(name) for name in names]
+        kept = self._travel_stacks.get(names)
+        if kept is None or not all(a is b for a, b in zip(kept[0], edges)):
+            kept = (edges, (np.stack([e.arcs[e.lead] for e in edges]), np.stack([e.travel for e in edges])))
+            self._travel_stacks[names] = kept
+            if len(self._travel_stacks) > 64:
+                self._travel_stacks.popitem(last=False)
+        else:
+            self._travel_stacks.move_to_end(names)
+        arcs, travel = kept[1]
+        x = along[np.arange(len(names)), leads]
+        return _along_rows(arcs, travel, np.minimum(x, arcs[:, -1])) * self.params["travel"]
+
+    def _with_travel(self, track: Track, d: np.ndarray, dt: np.ndarray) -> np.ndarray:
+        """Per-part distances (C, k) and the travel part's (C,) combined as ``error`` says, the travel one more
+        part (C,): the largest, the mean over k + 1 parts, or weighted by how far each has been seen to go
+        (:attr:`Track.travel_weights`)."""
+        error = self.params["error"]
+        if error == "moving":
+            w = track.travel_weights
+            if w is None:
+                w = moving_weights(np.zeros(d.shape[1] + 1))
+            return d @ w[:-1] + dt * w[-1]
+        if error == "max":
+            return np.maximum(d.max(axis=1), dt)
+        return (d.sum(axis=1) + dt) / (d.shape[1] + 1)
+
+    def _traveling(self, track: Track) -> bool:
+        """Whether the travel part is compared this frame: ``travel`` on, a positional subsystem, travel seen."""
+        return self.params["travel"] > 0 and not track.hand and track.travel_seen is not None
 
     def _table(self, stroke: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(times, positions, cumulative path length) of a stroke on a fine grid, computed once per stroke."""
@@ -1472,6 +1596,10 @@ class ForwardModel(Matcher):
         predicted = self._predict(track, path, along)
         if self.params["error"] == "moving":
             self._weights(track, lengths)
+        if self._traveling(track):
+            d = _norms(predicted + self._onset_offset(track, path[0]) - last) * track.scale
+            dt = _norms(self._travel_predicted(path, along) - track.travel_seen)
+            return float(self._with_travel(track, d[None], np.array([dt]))[0])
         return self._distance(track, predicted + self._onset_offset(track, path[0]), last)
 
     def _errors(self, track: Track, paths: list[tuple[str, ...]], lengths: np.ndarray,
@@ -1482,15 +1610,18 @@ class ForwardModel(Matcher):
         batch = [] if track.hand else [path for path in paths if len(path) == 1]
         errors: dict[tuple[str, ...], float] = {}
         if len(batch) > 1:
-            rows, totals, _, anchors, offsets = self._stacked(track, tuple(path[0] for path in batch))
+            rows, totals, leads, anchors, offsets = self._stacked(track, tuple(path[0] for path in batch))
             k = len(lengths)
             along = np.minimum(lengths + anchors, totals)  # (C, k): _along, then _predict's minimum
             if self.params["clock"] == "lead":
                 along = np.stack([self._lead_clock((path[0],), a) for path, a in zip(batch, along)])
-            along = along.reshape(-1)
-            predicted = self._stroke_rows.along(rows, along).reshape(len(batch), k, 3) + offsets
+            predicted = self._stroke_rows.along(rows, along.reshape(-1)).reshape(len(batch), k, 3) + offsets
             d = _norms(predicted - last) * track.scale
-            combined = self._combine(track, d, lengths)
+            if self._traveling(track):
+                travel = self._travel_batch(tuple(path[0] for path in batch), along, leads)
+                combined = self._with_travel(track, d, _norms(travel - track.travel_seen))
+            else:
+                combined = self._combine(track, d, lengths)
             errors = dict(zip(batch, combined.tolist()))
         return {path: errors[path] if path in errors else self._error(track, path, lengths, last) for path in paths}
 
@@ -1835,6 +1966,15 @@ class ForwardModel(Matcher):
             observed = observed[: (int(moving[-1]) + 2 if len(moving) else len(observed))]
         if len(observed) < 3:
             return []
+        if self.params["travel"] > 0 and not track.hand:  # where the body went, kept with the new edges
+            from plugins.lib.travel import body_velocity
+
+            memory = self._memory
+            if np.isfinite(memory.world[:, self._root]).any():
+                travel = np.nan_to_num(body_velocity(memory.world, memory.positions, memory.visible, self._root,
+                                                     memory.fps))[track.learn_from: track.learn_from + len(observed)]
+                return self.motor.learn_observed(track.subsystem, track.last_correct, observed, self.fps,
+                                                 criteria=self._criteria, travel=travel)
         return self.motor.learn_observed(track.subsystem, track.last_correct, observed, self.fps, criteria=self._criteria)
 
     def match(self, motion: Motion) -> Match:
