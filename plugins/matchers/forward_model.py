@@ -110,6 +110,13 @@ positions are not known the travel part is left out; a command without travel is
 drop-out, ``stillness`` (the body on the spot) and ``unexplained`` (the extent includes the travel) see it; the
 end check (:meth:`ForwardModel._ended`), the start node and the spreads between takes compare the parts alone.
 
+Ranked candidates (B&B Fig. 13; K&G §4.4, Fig. 3's candidates): every answer of one followed subsystem carries
+``Match.candidates``, the movements the forward models considered in the segment with their prediction errors,
+the answer first and the others best first (:meth:`ForwardModel._ranked`): each movement's error is the mean over
+the frames followed of its best path's error in each frame, a movement that dropped out held at the error it
+dropped out with, so all are measured over the same frames. An unknown answer ranks them all (and still names,
+in ``details``, the candidate predicted longest).
+
 Working memory: the matcher reads the segment from the
 :class:`~toolkit.watching.WorkingMemory` the watching loop gives it (root-relative,
 in the observer's parts, hidden parts held) and keeps no frames of its own; what it
@@ -892,6 +899,41 @@ class ForwardModel(Matcher):
         label = self._movement_key(tuple(path)) if path else None
         return {"nearest": label, "predicted_frames": int(frame), "error_when_dropped": float(error)}
 
+    def _ranked(self, track: Track | None, answer: str | None = None,
+                path: tuple[str, ...] = ()) -> tuple[tuple[str, float], ...]:
+        """The movements a subsystem's forward models considered in this segment, with their prediction errors,
+        best first (``Match.candidates``; B&B Fig. 13's ranked candidates, K&G §4.4's candidates of Fig. 3): each
+        movement's error is the mean, over the frames the subsystem has been followed, of the error of its best
+        candidate path in each frame; from the frame it dropped out on, the error it dropped out with (it is
+        taken to be as far off from then as when it was last predicted), so every movement is measured over the
+        same frames. ``answer`` (the movement of the committed ``path``) comes first, with its movement's error;
+        the others follow by error. Empty when nothing was predicted."""
+        if track is None or not track.trace:
+            return ()
+        keys: dict[tuple[str, ...], str] = {}
+        sums: dict[str, float] = {}
+        seen: dict[str, tuple[int, int, float, int]] = {}  # movement -> (first frame index, frames, last, last index)
+        for i, (_, errors) in enumerate(track.trace):
+            best: dict[str, float] = {}
+            for candidate, error in errors.items():
+                key = keys.get(candidate)
+                if key is None:
+                    key = keys[candidate] = self._movement_key(tuple(candidate)) if candidate else ""
+                if error < best.get(key, np.inf):
+                    best[key] = error
+            for key, error in best.items():
+                first, count, _, _ = seen.get(key, (i, 0, 0.0, i))
+                seen[key] = (first, count + 1, error, i)
+                sums[key] = sums.get(key, 0.0) + error
+        n = len(track.trace)
+        value = {key: (sums[key] + last * (n - 1 - at)) / (n - first) for key, (first, _, last, at) in seen.items()
+                 if key and np.isfinite(sums[key])}
+        own = self._movement_key(tuple(path)) if path else None
+        ranked = sorted(((key, float(v)) for key, v in value.items() if key != own), key=lambda kv: (kv[1], kv[0]))
+        if answer is None:
+            return tuple(ranked)
+        return ((answer, float(value.get(own, np.nan))), *ranked)
+
     def _local(self) -> np.ndarray:
         """The working memory in the observer's motor frame (n, P, 3): root-relative positions placed at its own
         root height (finger angles as seen); hidden parts held, never-seen parts NaN.
@@ -946,7 +988,8 @@ class ForwardModel(Matcher):
             details["subsystems"] = {t.subsystem: {"candidates": t.initial, "path": list(t.committed_path),
                                                     "speed": t.speed, "progress": t.progress} for t in tracks}
         return Match(labels[0] if len(tracks) == 1 else movement, min(t.confidence for t in tracks), memory.n,
-                     path=tuple(e for t in tracks for e in t.committed_path), details=details)
+                     path=tuple(e for t in tracks for e in t.committed_path), details=details,
+                     candidates=self._ranked(main, labels[0], main.committed_path) if len(tracks) == 1 else ())
 
     def replay(self, memory: WorkingMemory, stop: int) -> list[tuple[int, Match]]:
         """:meth:`Matcher.replay <toolkit.components.Matcher.replay>`: the rows up to ``stop`` given at once, with the
@@ -1933,7 +1976,8 @@ class ForwardModel(Matcher):
         if not perform:
             if self.reported:
                 return None  # already reported when it committed
-            return Match.unknown(reason="no edge predicts the demonstration", **self._nearest())
+            details = {"reason": "no edge predicts the demonstration", **self._nearest()}
+            return Match(None, 0.0, None, (), details, candidates=self._ranked(self.main))
         movement = self.motor.add_together(perform)
         main = self.main
         tracks = list(self.tracks.values())
@@ -1950,8 +1994,10 @@ class ForwardModel(Matcher):
         if len(perform) > 1:
             details["subsystems"] = {self.motor.subsystem_of(m): m for m in perform}
         label = movement if len(perform) > 1 else (self._path_label(tuple(route)) or self.motor.label(movement))
+        ranked = self._ranked(main, label, main.committed_path) if len(tracks) == 1 and not learned and \
+            main.committed is not None else ()
         return Match(label, 1.0 if learned else min(t.confidence for t in tracks if t.committed),
-                     None, tuple(paths), details=details)
+                     None, tuple(paths), details=details, candidates=ranked)
 
     def _learn(self, track: Track, memory: np.ndarray) -> list[str]:
         """Cut a subsystem's working memory since its last correct node into strokes, one edge each, chained from it.
