@@ -120,8 +120,9 @@ def test_travel_is_compared_as_one_more_part_of_the_error(clips):
                     key = (travel, frame, observer.motor.label_of_path(path))
                     best[key] = min(best.get(key, np.inf), error)
     k = len(observer.motor.subsystems["body"])
-    frames = sorted({frame for _, frame, label in best if label == "right"} &
-                    {frame for _, frame, label in best if label == "left"})[5:]  # once the travel is seen
+    frames = [frame for frame in sorted({frame for _, frame, label in best if label == "right"} &
+                                        {frame for _, frame, label in best if label == "left"})
+              if frame >= 8]  # once the travel is seen: a quarter of a second (8 frames) after the onset
     assert frames
     for frame in frames:
         for label, expected in (("left", 0.0), ("right", 2 * SIDE * 0.5 / (k + 1))):
@@ -165,3 +166,16 @@ def test_an_edges_travel_must_match_its_demonstration(clips):
     observed = _raise(24)[:, 1:]
     with pytest.raises(ValueError, match="travel"):
         motor.learn("body", "hub", [], shown=observed, shown_fps=30.0, travel=np.zeros((3, 3)))
+
+
+def test_the_travel_seen_is_the_mean_over_a_quarter_second_and_unknown_before(clips):
+    """One or two frames' velocity is mostly observation noise: the travel is left out until the segment has lasted
+    the window, then it is the root's mean velocity over it, in the body's frame (the body here faces +z)."""
+    profile, observer = _observer(clips, dropout="relative", travel=0.5)
+    watch = Observer(observer, profile.body, 30.0)
+    steps = _side_steps(44, SIDE)
+    watch.classify(Motion(steps[:8], 30.0, PARTS))
+    assert observer.matcher.main.travel_seen is None
+    noisy = steps + np.random.default_rng(0).normal(0.0, 0.003, steps.shape)  # 3 mm of observation noise
+    watch.classify(Motion(noisy[:20], 30.0, PARTS))
+    assert np.allclose(observer.matcher.main.travel_seen, [SIDE * 0.5, 0.0, 0.0], atol=0.02)

@@ -100,7 +100,8 @@ Travel (issue 18; B&B §7.1, K&G §6): the commands move parts relative to the r
 coordinates), so a walk to the left, to the right, backwards and forwards, whose leg swings are alike, are alike to
 them. With ``travel`` = τ > 0 where the body goes is one more part, as ``path-search``'s ``travel``: the root's
 displacement over τ seconds in the body's own frame (:mod:`plugins.lib.travel`). It is *observed* from the working
-memory's world positions, at each frame from the frames up to it; *predicted* from where the body went while the
+memory's world positions, at each frame from the frames up to it (the mean velocity over the last quarter second,
+not known before the segment has lasted that long); *predicted* from where the body went while the
 command was shown (``Edge.travel``, kept by the motor command graph for clips and for what it learns by watching),
 read at the point of the command where its lead part is predicted (K&G §4.1: the forward model predicts from the
 command); and *compared* as one more part of ``error``: the largest, one more in the mean, or weighted by how far
@@ -1447,26 +1448,35 @@ class ForwardModel(Matcher):
         steps = np.arange(len(travel))
         return np.stack([np.interp(at, steps, travel[:, c]) for c in range(3)], axis=1)
 
+    TRAVEL_WINDOW = 0.25
+    """Seconds over which the travel seen is averaged (:mod:`plugins.lib.travel`'s window: a step's sway left and
+    right cancels)."""
+
     def _travel_seen(self, track: Track, n: int, lengths: np.ndarray) -> None:
-        """With ``travel``: the travel part seen at row ``n - 1`` of the segment (:attr:`Track.travel_seen`), the
-        root's velocity in the body's frame as an observer knows it then (from the rows up to it,
-        :func:`plugins.lib.travel.body_velocity`) times ``travel`` seconds; with ``error = "moving"``, the weights of
-        the parts and the travel part (:attr:`Track.travel_weights`), the travel's path the root's path in the world
-        since the onset, the parts' their paths relative to the root: each as far as it has been seen to go."""
-        from plugins.lib.travel import body_velocity, travel_part
+        """With ``travel``: the travel part seen at row ``n - 1`` of the segment (:attr:`Track.travel_seen`) as an
+        observer knows it then: the root's mean velocity over the last :attr:`TRAVEL_WINDOW` seconds (its world
+        displacement over them, divided by their time; the same average as :func:`plugins.lib.travel.body_velocity`
+        takes, from the frames seen so far), turned into the body's frame by the facing at that row
+        (:func:`plugins.lib.travel.frame_rotation`), times ``travel`` seconds. Not known (``None``, the travel part
+        left out) before the segment has lasted the window: a velocity from one or two frames is mostly
+        observation noise. With ``error = "moving"``, the weights of the parts and the travel part
+        (:attr:`Track.travel_weights`): the travel's path is the root's path in the world since the onset, the
+        parts' their paths relative to the root, each as far as it has been seen to go."""
+        from plugins.lib.travel import frame_rotation
 
         memory, root = self._memory, self._root
-        window = 0.25
-        lo = max(0, n - (int(round(window * memory.fps)) + 3))
+        taps = max(1, int(round(self.TRAVEL_WINDOW * memory.fps)))
         track.travel_seen = None
-        if n - lo >= 2:
-            world = memory.world
-            v = body_velocity(world[lo:n], memory.positions[lo:n], memory.visible[lo:n], root, memory.fps,
-                              window=window, frames=np.array([n - lo - 1]))[0]
-            if np.isfinite(v).all():
-                track.travel_seen = travel_part(v, self.params["travel"])
+        world = memory.world
+        if n - 1 - taps >= 0:
+            moved = world[n - 1, root] - world[n - 1 - taps, root]
+            angle = frame_rotation(world[n - 1: n], memory.positions[n - 1: n], memory.visible[n - 1: n], root)[0]
+            if np.isfinite(moved).all() and np.isfinite(angle):
+                v = moved * (memory.fps / taps)
+                turned = (v[0] + 1j * v[2]) * np.exp(1j * angle)
+                track.travel_seen = np.array([turned.real, v[1], turned.imag]) * self.params["travel"]
         if self.params["error"] == "moving":
-            walked = _lengths(memory.world[track.onset:n, root][:, None])[0] if n - track.onset > 1 else 0.0
+            walked = _lengths(world[track.onset:n, root][:, None])[0] if n - track.onset > 1 else 0.0
             track.travel_weights = moving_weights(np.append(lengths, walked if np.isfinite(walked) else 0.0))
 
     def _travel_predicted(self, path: tuple[str, ...], along: np.ndarray) -> np.ndarray:
