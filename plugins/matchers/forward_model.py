@@ -148,6 +148,7 @@ angular-velocity minima and direction changes (§4.3).
 from __future__ import annotations
 
 import functools
+import math
 from collections import OrderedDict
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -824,6 +825,8 @@ class ForwardModel(Matcher):
         self._root_height = np.where(owner.body.angle_mask[:, None], 0.0, motor.rest_pose()[owner.body.root_index])
         self._criteria = StrokeCriteria(drop=self.params["drop"], angle=self.params["angle"])
         self._root = owner.body.root_index
+        self._keys: dict[tuple[str, ...], str] = {}  # path -> movement (:meth:`_movement_key`)
+        self._key_version: tuple | None = None
         self._travel_stacks: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
         if self.params["travel"] > 0:
             import scipy.ndimage  # noqa: F401  (travel's filter: imported at set-up, not in the first match)
@@ -928,7 +931,7 @@ class ForwardModel(Matcher):
                 sums[key] = sums.get(key, 0.0) + error
         n = len(track.trace)
         value = {key: (sums[key] + last * (n - 1 - at)) / (n - first) for key, (first, _, last, at) in seen.items()
-                 if key and np.isfinite(sums[key])}
+                 if key and math.isfinite(sums[key])}
         own = self._movement_key(tuple(path)) if path else None
         ranked = sorted(((key, float(v)) for key, v in value.items() if key != own), key=lambda kv: (kv[1], kv[0]))
         if answer is None:
@@ -1585,9 +1588,23 @@ class ForwardModel(Matcher):
         return self.motor.label_of_path(path)
 
     def _movement_key(self, path: tuple[str, ...]) -> str:
-        """What a candidate stands for: the labelled movement its sequences are examples of, else its first command."""
-        label = self._path_label(path)
-        return label if label is not None else path[0]
+        """What a candidate stands for: the labelled movement its sequences are examples of, else its first command.
+
+        Kept per path while the motor system's labels are the same table of the same size (only labelled sequences
+        name a movement, and a labelled sequence is added with its label; :meth:`_ranked` asks for every path a
+        segment predicted)."""
+        labels = getattr(self.motor, "labels", None)
+        if not isinstance(labels, dict):
+            label = self._path_label(path)
+            return label if label is not None else path[0]
+        version = (id(labels), len(labels))
+        if self._key_version != version:
+            self._keys, self._key_version = {}, version
+        key = self._keys.get(path)
+        if key is None:
+            label = self._path_label(path)
+            key = self._keys[path] = label if label is not None else path[0]
+        return key
 
     def _known_continuation(self, path: tuple[str, ...]) -> tuple[str, ...]:
         """The whole learned command sequence that ``path`` begins, else ``path`` itself."""
