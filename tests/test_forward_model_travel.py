@@ -179,3 +179,15 @@ def test_the_travel_seen_is_the_mean_over_a_quarter_second_and_unknown_before(cl
     noisy = steps + np.random.default_rng(0).normal(0.0, 0.003, steps.shape)  # 3 mm of observation noise
     watch.classify(Motion(noisy[:20], 30.0, PARTS))
     assert np.allclose(observer.matcher.main.travel_seen, [SIDE * 0.5, 0.0, 0.0], atol=0.02)
+
+
+def test_a_movement_learned_by_watching_keeps_where_the_body_went(clips):
+    """True imitation (K&G §4.3) with travel: what no edge predicts is learned with the travel seen meanwhile."""
+    profile, observer = _observer(clips, travel=0.5, learn=True, threshold=0.001)  # nothing fits: learned
+    before = set(observer.motor._edges)
+    match = Observer(observer, profile.body, 30.0).classify(Motion(_side_steps(44, SIDE), 30.0, PARTS)).match
+    learned = [observer.motor.edge(n) for n in match.details["learned"]]
+    assert learned and not before & {e.name for e in learned}
+    for edge in learned:
+        assert edge.travel.shape == (len(edge.shown), 3)
+        assert np.allclose(edge.travel[2:-2, 0], SIDE, atol=0.05) and np.allclose(edge.travel[:, [1, 2]], 0, atol=0.05)

@@ -2042,10 +2042,10 @@ class ForwardModel(Matcher):
         if self.params["travel"] > 0 and not track.hand:  # where the body went, kept with the new edges
             from plugins.lib.travel import body_velocity
 
-            memory = self._memory
-            if np.isfinite(memory.world[:, self._root]).any():
-                travel = np.nan_to_num(body_velocity(memory.world, memory.positions, memory.visible, self._root,
-                                                     memory.fps))[track.learn_from: track.learn_from + len(observed)]
+            seen = self._memory
+            if np.isfinite(seen.world[:, self._root]).any():
+                travel = np.nan_to_num(body_velocity(seen.world, seen.positions, seen.visible, self._root,
+                                                     seen.fps))[track.learn_from: track.learn_from + len(observed)]
                 return self.motor.learn_observed(track.subsystem, track.last_correct, observed, self.fps,
                                                  criteria=self._criteria, travel=travel)
         return self.motor.learn_observed(track.subsystem, track.last_correct, observed, self.fps, criteria=self._criteria)
