@@ -96,6 +96,28 @@ Across styles (issue 18; K&G §4.1, §4.4, §6), three more settings, each off b
   the ratio is unchanged when the demonstration and the prediction are scaled or moved together, so it holds for
   any body and skeleton.
 
+Travel (issue 18; B&B §7.1, K&G §6): the commands move parts relative to the root (B&B §5.1's root-relative
+coordinates), so a walk to the left, to the right, backwards and forwards, whose leg swings are alike, are alike to
+them. With ``travel`` = τ > 0 where the body goes is one more part, as ``path-search``'s ``travel``: the root's
+displacement over τ seconds in the body's own frame (:mod:`plugins.lib.travel`). It is *observed* from the working
+memory's world positions, at each frame from the frames up to it (the mean velocity over the last quarter second,
+not known before the segment has lasted that long); *predicted* from where the body went while the
+command was shown (``Edge.travel``, kept by the motor command graph for clips and for what it learns by watching),
+read at the point of the command where its lead part is predicted (K&G §4.1: the forward model predicts from the
+command); and *compared* as one more part of ``error``: the largest, one more in the mean, or weighted by how far
+it has been seen to go (the root's path in the world since the onset) with ``moving``. It is compared as it is,
+also with ``relative``: travel is a velocity, which another person's stance does not offset. Where the world
+positions are not known the travel part is left out; a command without travel is performed on the spot. The
+drop-out, ``stillness`` (the body on the spot) and ``unexplained`` (the extent includes the travel) see it; the
+end check (:meth:`ForwardModel._ended`), the start node and the spreads between takes compare the parts alone.
+
+Ranked candidates (B&B Fig. 13; K&G §4.4, Fig. 3's candidates): every answer of one followed subsystem carries
+``Match.candidates``, the movements the forward models considered in the segment with their prediction errors,
+the answer first and the others best first (:meth:`ForwardModel._ranked`): each movement's error is the mean over
+the frames followed of its best path's error in each frame, a movement that dropped out held at the error it
+dropped out with, so all are measured over the same frames. An unknown answer ranks them all (and still names,
+in ``details``, the candidate predicted longest).
+
 Working memory: the matcher reads the segment from the
 :class:`~toolkit.watching.WorkingMemory` the watching loop gives it (root-relative,
 in the observer's parts, hidden parts held) and keeps no frames of its own; what it
@@ -126,6 +148,7 @@ angular-velocity minima and direction changes (§4.3).
 from __future__ import annotations
 
 import functools
+import math
 from collections import OrderedDict
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -197,8 +220,9 @@ class CommandGraphs(Protocol):
         """The labelled movement a path of edges stands for, if one."""
 
     def learn_observed(self, subsystem: str, start: str, observed: np.ndarray, fps: float, *,
-                       criteria: StrokeCriteria = StrokeCriteria()) -> list[str]:
-        """Learn an observed movement as new edges from ``start`` (true imitation); their names."""
+                       criteria: StrokeCriteria = StrokeCriteria(), travel: np.ndarray | None = None) -> list[str]:
+        """Learn an observed movement as new edges from ``start`` (true imitation); their names. ``travel`` (n, 3):
+        where the body went at each frame (the root's velocity in the body's frame), kept with the edges."""
 
     def rest_pose(self) -> np.ndarray:
         """The body's rest pose, local frame (P, 3)."""
@@ -310,6 +334,12 @@ class Track:
     begun: Track | None = None
     """After a deviation, predicted again: the segment's first track of the subsystem (what :meth:`ForwardModel.inspect`
     shows of the segment's start)."""
+    travel_seen: np.ndarray | None = None
+    """With ``travel``: the travel part seen at the frame followed last (3,), the root's displacement over ``travel``
+    seconds in the body's frame; ``None`` when not known (no world positions, fewer than two frames)."""
+    travel_weights: np.ndarray | None = None
+    """With ``travel`` and ``error = "moving"``: the weights (k + 1,) of the parts and of the travel part at the frame
+    followed last (:func:`moving_weights` of the parts' path lengths and the root's path in the world)."""
     placed: tuple[dict[str, int], np.ndarray] | None = None
     """The anchors placed at once when the track began (:meth:`ForwardModel._anchor`): each command's row in them and
     the array (C, k) whose rows are those of ``anchors``."""
@@ -324,6 +354,8 @@ class _EdgeTable:
     positions: np.ndarray
     arcs: np.ndarray
     lead: int
+    travel: np.ndarray | None = None
+    """With ``travel``: where the body went (m/s, body frame) at each point of the lead part's grid (G, 3)."""
 
 
 def _row_keys(arcs: np.ndarray, first: int = 0) -> np.ndarray | None:
@@ -762,6 +794,10 @@ class ForwardModel(Matcher):
                   "demonstrator keeps still, or keeps still parts that move, predicts them where they are not. "
                   "With relative, displacements are then taken from where the lead joined the command.",
                   choices=("parts", "lead")),
+        Parameter("travel", float, 0.0, "Seconds over which where the body goes counts as one more part: the root's "
+                  "displacement over this time in the body's own frame (plugins.lib.travel), observed from the world "
+                  "positions and predicted from the travel each command was shown with (Edge.travel), at the point of "
+                  "the command the parts are predicted at. 0: root-relative parts only (the paper).", minimum=0.0),
         Parameter("together", bool, True, "Follow every subsystem that moves during a demonstration, each with its "
                   "own candidates, and imitate them at once (a hand-arm movement, §4.2); off: only the first to move."),
         Parameter("learn", bool, True, "Learn new edges by the inverse model when no edge predicts the demonstration."),
@@ -788,6 +824,12 @@ class ForwardModel(Matcher):
         # observed root-relative positions are placed at the observer's own root height; finger angles stay as they are
         self._root_height = np.where(owner.body.angle_mask[:, None], 0.0, motor.rest_pose()[owner.body.root_index])
         self._criteria = StrokeCriteria(drop=self.params["drop"], angle=self.params["angle"])
+        self._root = owner.body.root_index
+        self._keys: dict[tuple[str, ...], str] = {}  # path -> movement (:meth:`_movement_key`)
+        self._key_version: tuple | None = None
+        self._travel_stacks: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
+        if self.params["travel"] > 0:
+            import scipy.ndimage  # noqa: F401  (travel's filter: imported at set-up, not in the first match)
         _kernels()  # compiled (or loaded from numba's cache) now, not in the first demonstration
         self._tables: dict[int, tuple] = {}
         self._edges: dict[str, _EdgeTable] = {}
@@ -861,6 +903,41 @@ class ForwardModel(Matcher):
         label = self._movement_key(tuple(path)) if path else None
         return {"nearest": label, "predicted_frames": int(frame), "error_when_dropped": float(error)}
 
+    def _ranked(self, track: Track | None, answer: str | None = None,
+                path: tuple[str, ...] = ()) -> tuple[tuple[str, float], ...]:
+        """The movements a subsystem's forward models considered in this segment, with their prediction errors,
+        best first (``Match.candidates``; B&B Fig. 13's ranked candidates, K&G §4.4's candidates of Fig. 3): each
+        movement's error is the mean, over the frames the subsystem has been followed, of the error of its best
+        candidate path in each frame; from the frame it dropped out on, the error it dropped out with (it is
+        taken to be as far off from then as when it was last predicted), so every movement is measured over the
+        same frames. ``answer`` (the movement of the committed ``path``) comes first, with its movement's error;
+        the others follow by error. Empty when nothing was predicted."""
+        if track is None or not track.trace:
+            return ()
+        keys: dict[tuple[str, ...], str] = {}
+        sums: dict[str, float] = {}
+        seen: dict[str, tuple[int, int, float, int]] = {}  # movement -> (first frame index, frames, last, last index)
+        for i, (_, errors) in enumerate(track.trace):
+            best: dict[str, float] = {}
+            for candidate, error in errors.items():
+                key = keys.get(candidate)
+                if key is None:
+                    key = keys[candidate] = self._movement_key(tuple(candidate)) if candidate else ""
+                if error < best.get(key, np.inf):
+                    best[key] = error
+            for key, error in best.items():
+                first, count, _, _ = seen.get(key, (i, 0, 0.0, i))
+                seen[key] = (first, count + 1, error, i)
+                sums[key] = sums.get(key, 0.0) + error
+        n = len(track.trace)
+        value = {key: (sums[key] + last * (n - 1 - at)) / (n - first) for key, (first, _, last, at) in seen.items()
+                 if key and math.isfinite(sums[key])}
+        own = self._movement_key(tuple(path)) if path else None
+        ranked = sorted(((key, float(v)) for key, v in value.items() if key != own), key=lambda kv: (kv[1], kv[0]))
+        if answer is None:
+            return tuple(ranked)
+        return ((answer, float(value.get(own, np.nan))), *ranked)
+
     def _local(self) -> np.ndarray:
         """The working memory in the observer's motor frame (n, P, 3): root-relative positions placed at its own
         root height (finger angles as seen); hidden parts held, never-seen parts NaN.
@@ -915,7 +992,8 @@ class ForwardModel(Matcher):
             details["subsystems"] = {t.subsystem: {"candidates": t.initial, "path": list(t.committed_path),
                                                     "speed": t.speed, "progress": t.progress} for t in tracks}
         return Match(labels[0] if len(tracks) == 1 else movement, min(t.confidence for t in tracks), memory.n,
-                     path=tuple(e for t in tracks for e in t.committed_path), details=details)
+                     path=tuple(e for t in tracks for e in t.committed_path), details=details,
+                     candidates=self._ranked(main, labels[0], main.committed_path) if len(tracks) == 1 else ())
 
     def replay(self, memory: WorkingMemory, stop: int) -> list[tuple[int, Match]]:
         """:meth:`Matcher.replay <toolkit.components.Matcher.replay>`: the rows up to ``stop`` given at once, with the
@@ -1113,6 +1191,8 @@ class ForwardModel(Matcher):
         lengths = self._walked(track, observed)  # once per frame (incremental)
         last = observed[-1]
         frame = self._memory.n - 1
+        if self.params["travel"] > 0 and not track.hand:
+            self._travel_seen(track, len(memory), lengths)
         if track.committed is not None:
             error = self._error(track, track.committed_path,
                                 self._clock(track, track.committed_path, lengths, len(observed)), last)
@@ -1130,7 +1210,11 @@ class ForwardModel(Matcher):
             errors = {path: self._error(track, path, self._clock(track, path, lengths, n), last) for path in paths}
         track.trace.append((frame, errors))
         unexplained = self.params["unexplained"] > 0 and self.params["dropout"] == "relative"
-        still = self._distance(track, observed[0], last) if self.params["stillness"] or unexplained else None
+        still = None
+        if self.params["stillness"] or unexplained:  # predicting no movement: every part still, the body on the spot
+            still = self._distance(track, observed[0], last) if not self._traveling(track) else float(
+                self._with_travel(track, (_norms(observed[0] - last) * track.scale)[None],
+                                  np.array([_norms(track.travel_seen)]))[0])
         evidence = self._evidence(track, errors)
         if unexplained:
             total, frames = track.extent
@@ -1346,10 +1430,106 @@ class ForwardModel(Matcher):
         if table is None or table.commands is not commands:
             tables = [self._table(stroke) for stroke in commands]
             arcs = np.stack([arc for _, _, arc in tables])
-            table = _EdgeTable(commands, np.stack([positions for _, positions, _ in tables]), arcs,
-                               int(np.argmax(arcs[:, -1])))
+            lead = int(np.argmax(arcs[:, -1]))
+            travel = self._travel_grid(name, tables[lead][0]) if self.params["travel"] > 0 else None
+            table = _EdgeTable(commands, np.stack([positions for _, positions, _ in tables]), arcs, lead, travel)
             self._edges[name] = table
         return table
+
+    def _travel_grid(self, name: str, times: np.ndarray) -> np.ndarray:
+        """Where the body went (m/s, body frame) while command ``name`` was shown, at the times ``times`` of its lead
+        part's grid (G, 3): the edge's travel (``Edge.travel``, one row per frame shown) read at the same share of
+        the command's time (the command was fitted to those frames, so its start is the first and its end the last);
+        none known: on the spot (0)."""
+        travel = getattr(self.motor.edge(name), "travel", None)
+        if travel is None or not len(travel):
+            return np.zeros((len(times), 3))
+        travel = np.asarray(travel, dtype=float)
+        if len(travel) == 1:
+            return np.repeat(travel, len(times), axis=0)
+        at = times / max(float(times[-1]), 1e-12) * (len(travel) - 1)
+        steps = np.arange(len(travel))
+        return np.stack([np.interp(at, steps, travel[:, c]) for c in range(3)], axis=1)
+
+    TRAVEL_WINDOW = 0.25
+    """Seconds over which the travel seen is averaged (:mod:`plugins.lib.travel`'s window: a step's sway left and
+    right cancels)."""
+
+    def _travel_seen(self, track: Track, n: int, lengths: np.ndarray) -> None:
+        """With ``travel``: the travel part seen at row ``n - 1`` of the segment (:attr:`Track.travel_seen`) as an
+        observer knows it then: the root's mean velocity over the last :attr:`TRAVEL_WINDOW` seconds (its world
+        displacement over them, divided by their time; the same average as :func:`plugins.lib.travel.body_velocity`
+        takes, from the frames seen so far), turned into the body's frame by the facing at that row
+        (:func:`plugins.lib.travel.frame_rotation`), times ``travel`` seconds. Not known (``None``, the travel part
+        left out) before the segment has lasted the window: a velocity from one or two frames is mostly
+        observation noise. With ``error = "moving"``, the weights of the parts and the travel part
+        (:attr:`Track.travel_weights`): the travel's path is the root's path in the world since the onset, the
+        parts' their paths relative to the root, each as far as it has been seen to go."""
+        from plugins.lib.travel import frame_rotation
+
+        memory, root = self._memory, self._root
+        taps = max(1, int(round(self.TRAVEL_WINDOW * memory.fps)))
+        track.travel_seen = None
+        world = memory.world
+        if n - 1 - taps >= 0:
+            moved = world[n - 1, root] - world[n - 1 - taps, root]
+            angle = frame_rotation(world[n - 1: n], memory.positions[n - 1: n], memory.visible[n - 1: n], root)[0]
+            if np.isfinite(moved).all() and np.isfinite(angle):
+                v = moved * (memory.fps / taps)
+                turned = (v[0] + 1j * v[2]) * np.exp(1j * angle)
+                track.travel_seen = np.array([turned.real, v[1], turned.imag]) * self.params["travel"]
+        if self.params["error"] == "moving":
+            walked = _lengths(world[track.onset:n, root][:, None])[0] if n - track.onset > 1 else 0.0
+            track.travel_weights = moving_weights(np.append(lengths, walked if np.isfinite(walked) else 0.0))
+
+    def _travel_predicted(self, path: tuple[str, ...], along: np.ndarray) -> np.ndarray:
+        """With ``travel``: the travel part path ``path`` predicts (3,) when its parts are ``along`` it: the travel
+        the command was shown with where its first command's lead part is (edge by edge: a lead past the end of
+        one edge goes on along the next), times ``travel`` seconds."""
+        lead = self._lead(path[0])
+        left = float(along[lead])
+        for i, name in enumerate(path):
+            edge = self._edge(name)
+            total = float(edge.arcs[lead, -1])
+            if left <= total or i == len(path) - 1:
+                point = _along_rows(edge.arcs[lead][None], edge.travel[None], np.array([min(left, total)]))[0]
+                return point * self.params["travel"]
+            left -= total
+        return np.zeros(3)  # no command (not reached)
+
+    def _travel_batch(self, names: tuple[str, ...], along: np.ndarray, leads: np.ndarray) -> np.ndarray:
+        """:meth:`_travel_predicted` of one-command paths ``names`` at once (C, 3), ``along`` (C, k) their parts'
+        places along them (already within their strokes) and ``leads`` (C,) their lead parts."""
+        edges = [self._edge(name) for name in names]
+        kept = self._travel_stacks.get(names)
+        if kept is None or not all(a is b for a, b in zip(kept[0], edges)):
+            kept = (edges, (np.stack([e.arcs[e.lead] for e in edges]), np.stack([e.travel for e in edges])))
+            self._travel_stacks[names] = kept
+            if len(self._travel_stacks) > 64:
+                self._travel_stacks.popitem(last=False)
+        else:
+            self._travel_stacks.move_to_end(names)
+        arcs, travel = kept[1]
+        x = along[np.arange(len(names)), leads]
+        return _along_rows(arcs, travel, np.minimum(x, arcs[:, -1])) * self.params["travel"]
+
+    def _with_travel(self, track: Track, d: np.ndarray, dt: np.ndarray) -> np.ndarray:
+        """Per-part distances (C, k) and the travel part's (C,) combined as ``error`` says, the travel one more
+        part (C,): the largest, the mean over k + 1 parts, or weighted by how far each has been seen to go
+        (:attr:`Track.travel_weights`)."""
+        error = self.params["error"]
+        if error == "moving":
+            w = track.travel_weights
+            if w is None:
+                w = moving_weights(np.zeros(d.shape[1] + 1))
+            return d @ w[:-1] + dt * w[-1]
+        if error == "max":
+            return np.maximum(d.max(axis=1), dt)
+        return (d.sum(axis=1) + dt) / (d.shape[1] + 1)
+
+    def _traveling(self, track: Track) -> bool:
+        """Whether the travel part is compared this frame: ``travel`` on, a positional subsystem, travel seen."""
+        return self.params["travel"] > 0 and not track.hand and track.travel_seen is not None
 
     def _table(self, stroke: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(times, positions, cumulative path length) of a stroke on a fine grid, computed once per stroke."""
@@ -1408,9 +1588,23 @@ class ForwardModel(Matcher):
         return self.motor.label_of_path(path)
 
     def _movement_key(self, path: tuple[str, ...]) -> str:
-        """What a candidate stands for: the labelled movement its sequences are examples of, else its first command."""
-        label = self._path_label(path)
-        return label if label is not None else path[0]
+        """What a candidate stands for: the labelled movement its sequences are examples of, else its first command.
+
+        Kept per path while the motor system's labels are the same table of the same size (only labelled sequences
+        name a movement, and a labelled sequence is added with its label; :meth:`_ranked` asks for every path a
+        segment predicted)."""
+        labels = getattr(self.motor, "labels", None)
+        if not isinstance(labels, dict):
+            label = self._path_label(path)
+            return label if label is not None else path[0]
+        version = (id(labels), len(labels))
+        if self._key_version != version:
+            self._keys, self._key_version = {}, version
+        key = self._keys.get(path)
+        if key is None:
+            label = self._path_label(path)
+            key = self._keys[path] = label if label is not None else path[0]
+        return key
 
     def _known_continuation(self, path: tuple[str, ...]) -> tuple[str, ...]:
         """The whole learned command sequence that ``path`` begins, else ``path`` itself."""
@@ -1472,6 +1666,10 @@ class ForwardModel(Matcher):
         predicted = self._predict(track, path, along)
         if self.params["error"] == "moving":
             self._weights(track, lengths)
+        if self._traveling(track):
+            d = _norms(predicted + self._onset_offset(track, path[0]) - last) * track.scale
+            dt = _norms(self._travel_predicted(path, along) - track.travel_seen)
+            return float(self._with_travel(track, d[None], np.array([dt]))[0])
         return self._distance(track, predicted + self._onset_offset(track, path[0]), last)
 
     def _errors(self, track: Track, paths: list[tuple[str, ...]], lengths: np.ndarray,
@@ -1482,15 +1680,18 @@ class ForwardModel(Matcher):
         batch = [] if track.hand else [path for path in paths if len(path) == 1]
         errors: dict[tuple[str, ...], float] = {}
         if len(batch) > 1:
-            rows, totals, _, anchors, offsets = self._stacked(track, tuple(path[0] for path in batch))
+            rows, totals, leads, anchors, offsets = self._stacked(track, tuple(path[0] for path in batch))
             k = len(lengths)
             along = np.minimum(lengths + anchors, totals)  # (C, k): _along, then _predict's minimum
             if self.params["clock"] == "lead":
                 along = np.stack([self._lead_clock((path[0],), a) for path, a in zip(batch, along)])
-            along = along.reshape(-1)
-            predicted = self._stroke_rows.along(rows, along).reshape(len(batch), k, 3) + offsets
+            predicted = self._stroke_rows.along(rows, along.reshape(-1)).reshape(len(batch), k, 3) + offsets
             d = _norms(predicted - last) * track.scale
-            combined = self._combine(track, d, lengths)
+            if self._traveling(track):
+                travel = self._travel_batch(tuple(path[0] for path in batch), along, leads)
+                combined = self._with_travel(track, d, _norms(travel - track.travel_seen))
+            else:
+                combined = self._combine(track, d, lengths)
             errors = dict(zip(batch, combined.tolist()))
         return {path: errors[path] if path in errors else self._error(track, path, lengths, last) for path in paths}
 
@@ -1802,7 +2003,8 @@ class ForwardModel(Matcher):
         if not perform:
             if self.reported:
                 return None  # already reported when it committed
-            return Match.unknown(reason="no edge predicts the demonstration", **self._nearest())
+            details = {"reason": "no edge predicts the demonstration", **self._nearest()}
+            return Match(None, 0.0, None, (), details, candidates=self._ranked(self.main))
         movement = self.motor.add_together(perform)
         main = self.main
         tracks = list(self.tracks.values())
@@ -1819,8 +2021,10 @@ class ForwardModel(Matcher):
         if len(perform) > 1:
             details["subsystems"] = {self.motor.subsystem_of(m): m for m in perform}
         label = movement if len(perform) > 1 else (self._path_label(tuple(route)) or self.motor.label(movement))
+        ranked = self._ranked(main, label, main.committed_path) if len(tracks) == 1 and not learned and \
+            main.committed is not None else ()
         return Match(label, 1.0 if learned else min(t.confidence for t in tracks if t.committed),
-                     None, tuple(paths), details=details)
+                     None, tuple(paths), details=details, candidates=ranked)
 
     def _learn(self, track: Track, memory: np.ndarray) -> list[str]:
         """Cut a subsystem's working memory since its last correct node into strokes, one edge each, chained from it.
@@ -1835,6 +2039,15 @@ class ForwardModel(Matcher):
             observed = observed[: (int(moving[-1]) + 2 if len(moving) else len(observed))]
         if len(observed) < 3:
             return []
+        if self.params["travel"] > 0 and not track.hand:  # where the body went, kept with the new edges
+            from plugins.lib.travel import body_velocity
+
+            seen = self._memory
+            if np.isfinite(seen.world[:, self._root]).any():
+                travel = np.nan_to_num(body_velocity(seen.world, seen.positions, seen.visible, self._root,
+                                                     seen.fps))[track.learn_from: track.learn_from + len(observed)]
+                return self.motor.learn_observed(track.subsystem, track.last_correct, observed, self.fps,
+                                                 criteria=self._criteria, travel=travel)
         return self.motor.learn_observed(track.subsystem, track.last_correct, observed, self.fps, criteria=self._criteria)
 
     def match(self, motion: Motion) -> Match:

@@ -45,11 +45,12 @@ from plugins.lib.guiding_stroke import GuidingStroke, progress
 from plugins.lib.hand_transition import HandTransition
 from plugins.lib.inverse_model import commands_from_segment
 from plugins.lib.strokes import StrokeCriteria, breaks
+from plugins.lib.travel import body_velocity
 from plugins.motor.key_poses import parse_poses
 from toolkit import ConfigError, Motion, MotorSystem, Parameter, hookimpl
 from toolkit.motion import fill_hidden
 
-__all__ = ["MotorCommandGraph", "Edge", "place_elbows", "command_from_dict"]
+__all__ = ["MotorCommandGraph", "Edge", "place_elbows", "command_from_dict", "clip_travel"]
 
 Command = GuidingStroke | HandTransition
 
@@ -68,6 +69,15 @@ class Edge:
     movement is performed against it. ``None`` (a command written by hand, or saved without it): the commands'
     own timing stands for it. :meth:`MotorCommandGraph.get_state` saves it for edges learned by watching, not for
     those learned from clips (rebuilt from the clips; a loaded edge keeps the clip's).
+
+    ``travel`` (issue 18; not in the paper): where the demonstrator's body went while the command was shown, the
+    root's velocity in the body's own frame (m/s, +z forward, +x the body's left; :mod:`plugins.lib.travel`), one
+    row per frame of ``shown`` (m, 3). The commands move parts relative to the root (B&B §5.1's root-relative
+    coordinates, which both papers use), so they say nothing of where the body goes; a take of a walk to the left
+    and one to the right give the same strokes. The forward model (``forward-model``'s ``travel``) predicts the
+    travel at the point of the command it predicts the parts at (K&G §4.1's forward model, extended to the root as
+    the correspondence problem of K&G §6 and B&B §7.1 asks). ``None``: not known (no world positions were seen);
+    the command is then taken as performed on the spot.
     """
 
     name: str
@@ -78,11 +88,21 @@ class Edge:
     origin: str = ""
     shown: np.ndarray | None = None
     shown_fps: float = 0.0
+    travel: np.ndarray | None = None
 
     @property
     def duration(self) -> float:
         """Seconds the edge takes: its longest command's."""
         return max(c.duration for c in self.commands)
+
+
+def clip_travel(motion: Motion, root: int) -> np.ndarray | None:
+    """Where the body of a clip went at each frame (F, 3): the root's velocity in the body's own frame, m/s
+    (:func:`plugins.lib.travel.body_velocity`), frames where it is not known at rest (0); ``None`` without world
+    positions (:attr:`Motion.world`)."""
+    if motion.world is None:
+        return None
+    return np.nan_to_num(body_velocity(motion.world, motion.positions, motion.visible, root, motion.fps))
 
 
 def command_from_dict(entry: dict[str, Any]) -> GuidingStroke | HandTransition:
@@ -194,7 +214,8 @@ class MotorCommandGraph(MotorSystem):
             m = clip.motion
             observed = fill_hidden(m.positions[:, idx], m.visible[:, idx], default=self.rest[idx])
             names = self.learn_observed(subsystem, "hub", observed, m.fps, criteria=criteria, origin=str(clip.source),
-                                        hub_tolerance=self.params["hub_radius"], refine=False)
+                                        hub_tolerance=self.params["hub_radius"], refine=False,
+                                        travel=clip_travel(m, self.body.root_index))
             if not names:
                 continue
             n = sum(1 for label in self.labels.values() if label == clip.movement)
@@ -243,19 +264,27 @@ class MotorCommandGraph(MotorSystem):
         return self.params["hand_tolerance"] if self.is_hand(subsystem) else self.params["tolerance"]
 
     def learn(self, subsystem: str, start: str, commands: list[Command], *, end: str | None = None,
-              origin: str = "", shown: np.ndarray | None = None, shown_fps: float = 0.0) -> str:
+              origin: str = "", shown: np.ndarray | None = None, shown_fps: float = 0.0,
+              travel: np.ndarray | None = None) -> str:
         """Add an edge of ``commands`` (one per part of the subsystem) from node ``start``; returns its movement name.
 
         Guiding strokes for a wrist subsystem, hand transitions for a hand. The edge ends in ``end`` if given
         (a hub, say), else in the node at the commands' targets (an existing one within :meth:`tolerance`, or a new one).
-        ``shown`` and ``shown_fps``: the piece of the demonstration it was learned from (:attr:`Edge.shown`).
+        ``shown`` and ``shown_fps``: the piece of the demonstration it was learned from (:attr:`Edge.shown`);
+        ``travel``: where the body went meanwhile, one row per frame of ``shown`` (:attr:`Edge.travel`).
         """
+        if travel is not None:
+            travel = np.array(travel, dtype=float)
+            if shown is None or travel.shape != (len(shown), 3):
+                raise ValueError(f"an edge's travel needs one [x, y, z] per frame of its demonstration, not shape "
+                                 f"{travel.shape}")
         if end is None:
             target = np.stack([c.target for c in commands])
             end = self._near_node(subsystem, target) or self._new_node(subsystem, target)
         self._counter += 1
         edge = Edge(f"{subsystem}:e{self._counter}", subsystem, start, end, tuple(commands), origin,
-                    None if shown is None else np.array(shown, dtype=float), float(shown_fps) if shown is not None else 0.0)
+                    None if shown is None else np.array(shown, dtype=float), float(shown_fps) if shown is not None else 0.0,
+                    travel)
         self._add(edge)
         if self.owner is not None:
             self.owner.announce("likeme_movement_learned", character=self.owner, movement=edge.name,
@@ -268,7 +297,8 @@ class MotorCommandGraph(MotorSystem):
 
     def learn_observed(self, subsystem: str, start: str, observed: np.ndarray, fps: float, *,
                        criteria: StrokeCriteria = StrokeCriteria(), origin: str = "inverse model",
-                       hub_tolerance: float = 0.05, refine: bool = True) -> list[str]:
+                       hub_tolerance: float = 0.05, refine: bool = True,
+                       travel: np.ndarray | None = None) -> list[str]:
         """True imitation (K&G §4.3): an observed movement of the subsystem's parts becomes new edges from ``start``.
 
         ``observed`` (n, k, 3) holds the positions (a hand: the fingers' joint angles) of the subsystem's k parts.
@@ -276,7 +306,8 @@ class MotorCommandGraph(MotorSystem):
         inverse model turns each into a command (:func:`plugins.lib.inverse_model.commands_from_segment`), and
         the commands become a chain of edges from ``start``; the last ends in the hub when the movement came back
         within ``hub_tolerance`` metres of it (a hand: within :meth:`tolerance`). Each edge keeps its piece of the
-        demonstration (:attr:`Edge.shown`). Returns the new edges' names.
+        demonstration (:attr:`Edge.shown`) and, with ``travel`` (n, 3: the root's velocity in the body's frame at
+        each frame of ``observed``), where the body went meanwhile (:attr:`Edge.travel`). Returns the new edges' names.
         """
         n, k, _ = observed.shape
         hand = self.is_hand(subsystem)
@@ -291,7 +322,8 @@ class MotorCommandGraph(MotorSystem):
         names, node = [], start
         for (commands, last), (a, b) in zip(pieces, spans):
             name = self.learn(subsystem, node, commands, end="hub" if last and home else None, origin=origin,
-                              shown=observed[a: b + 1], shown_fps=fps)
+                              shown=observed[a: b + 1], shown_fps=fps,
+                              travel=None if travel is None else travel[a: b + 1])
             names.append(name)
             node = self.edge(name).target
         return names
@@ -477,7 +509,10 @@ class MotorCommandGraph(MotorSystem):
                 "nodes": {n: d["state"].round(6).tolist() for n, d in g.nodes(data=True) if n != "hub"},
                 "edges": [{"from": e.source, "to": e.target, "name": e.name, "commands": [c.to_dict() for c in e.commands],
                            **({"shown": e.shown.round(6).tolist(), "shown_fps": e.shown_fps}
-                              if e.shown is not None and e.origin in ("inverse model", "loaded") else {})}
+                              if e.shown is not None and e.origin in ("inverse model", "loaded") else {}),
+                           **({"travel": e.travel.round(6).tolist()}
+                              if e.travel is not None and e.shown is not None
+                              and e.origin in ("inverse model", "loaded") else {})}
                           for e in self.edges(name)],
                 "sequences": sequences,
                 "labels": {m: label for m, label in self.labels.items() if m in sequences},
@@ -570,8 +605,18 @@ class MotorCommandGraph(MotorSystem):
                     if not (isinstance(shown_fps, (int, float)) and 0 < shown_fps <= 1000):
                         raise bad(f"invalid shown_fps {shown_fps!r}"[:200], (*key, "shown_fps"),
                                   "frames per second of shown, above 0 and at most 1000")
+                travel = e.get("travel")
+                if travel is not None:
+                    try:
+                        travel = np.asarray(travel, dtype=float)
+                    except (TypeError, ValueError, OverflowError):
+                        travel = np.zeros(0)
+                    if (shown is None or travel.shape != (len(shown), 3) or not np.isfinite(travel).all()
+                            or np.abs(travel).max() >= 1e6):
+                        raise bad("invalid travel", (*key, "travel"), "where the body went at each frame of shown "
+                                  "(an edge with shown): one [x, y, z] of finite m/s per frame")
                 edges[e["name"]] = (Edge(e["name"], name, e["from"], e["to"], built, "loaded", shown,
-                                           float(shown_fps) if shown is not None else 0.0), int(number))
+                                           float(shown_fps) if shown is not None else 0.0, travel), int(number))
         known_edges = set(self._edges) | set(edges)
         sequences, labels, together = {}, {}, {}
         for name, entry in state.items():
@@ -599,7 +644,7 @@ class MotorCommandGraph(MotorSystem):
                 if edge.shown is None and known.shown is not None:  # a clip's demonstration is not saved: kept,
                     # and the edge is still the clip's
                     edge = Edge(edge.name, edge.subsystem, edge.source, edge.target, edge.commands, known.origin,
-                                known.shown, known.shown_fps)
+                                known.shown, known.shown_fps, known.travel)
             self._add(edge)
             self._counter = max(self._counter, number)
         self.sequences.update(sequences)
