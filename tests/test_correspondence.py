@@ -262,6 +262,28 @@ def test_observe_says_why_a_segment_is_unknown(generated, capsys):
     assert "rejected: too far from every path (mean_distance" in capsys.readouterr().out
 
 
+def test_observe_json_ranks_the_forward_models_candidates(generated, capsys):
+    """`likeme observe --json` gives the matcher's ranked candidates (Fig. 13): the forward model's movements by
+    their prediction error, the answer first and the others from the nearest, known or not."""
+    import json
+
+    from toolkit.cli import main
+
+    demo = sorted((generated / "demos").glob("*/*.bvh"))[0]
+    args = ["observe", str(demo), "--body", str(generated / "profile.toml"), "--repertoire",
+            str(generated / "repertoire"), "--matcher", "forward-model", "--json"]
+    assert main(args) == 0
+    segments = json.loads(capsys.readouterr().out)[0]["segments"]
+    ranked = [s for s in segments if s.get("candidates")]
+    assert ranked, "the forward model ranked nothing"
+    for s in ranked:
+        names, errors = [c[0] for c in s["candidates"]], [c[1] for c in s["candidates"]]
+        assert len(set(names)) == len(names) and all(e >= 0 for e in errors)
+        assert errors[1:] == sorted(errors[1:])
+        if s["movement"] != "unknown":
+            assert names[0] == s["movement"]
+
+
 def test_likeme_show_draws_a_recording_as_perceived_and_as_mapped(generated, tmp_path, capsys):
     from PIL import Image
 

@@ -626,7 +626,16 @@ def _segment_row(o: Any) -> dict[str, Any]:
             "end_s": round(o.segment.end_time, 3), "movement": o.movement or "unknown",
             "confidence": round(o.match.confidence, 3) if o.match else 0.0,
             "decided_at_frame": o.segment.start + (o.decided_at if o.decided_at is not None else o.segment.n_frames),
-            "decision_fraction": round(o.decision_fraction, 3), **_why_unknown(o)}
+            "decision_fraction": round(o.decision_fraction, 3), **_why_unknown(o), **_candidates(o)}
+
+
+def _candidates(observation: Any) -> dict[str, Any]:
+    """The matcher's ranked candidates (B&B Fig. 13), ``[[movement, distance], ...]`` best first, when it gave any:
+    path search's runners-up, the forward model's movements by prediction error (``--json`` only)."""
+    match = observation.match
+    if match is None or not match.candidates:
+        return {}
+    return {"candidates": [[str(name), round(float(d), 4)] for name, d in match.candidates]}
 
 
 def _segment_text(seg: dict[str, Any]) -> str:

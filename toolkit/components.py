@@ -176,7 +176,8 @@ class Match:
     candidates : tuple of (str, float)
         Ranked candidates, best first (B&B Fig. 13): each movement the matcher found near the segment with its
         distance (lower is closer; the matcher's own measure, so only ratios between candidates of one match mean
-        anything). Empty when the matcher ranks nothing; when given, the first is ``movement``.
+        anything). Empty when the matcher ranks nothing; when given with a known answer, the first is
+        ``movement``; with an unknown one, the movements it considered and rejected, nearest first.
     """
 
     movement: str | None
