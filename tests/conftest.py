@@ -130,6 +130,28 @@ def play_recording_postures(path: Path | str, actor: str = "max", **matcher_para
     return world
 
 
+STICK_PARTS = ("root", "head", "lk", "rk", "hand", "lf", "rf")
+"""The parts of the stick figure whose clips the travel tests write: root, head, knees, a hand and the feet."""
+
+
+def write_stick_clip(path: Path, positions: np.ndarray, fps: float = 30.0) -> None:
+    """A BVH clip of the stick figure: world positions (frames, 7, 3) of :data:`STICK_PARTS`, every part a child of
+    the root."""
+    from toolkit.bvh import from_joint_positions, write_bvh
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_bvh(from_joint_positions(list(STICK_PARTS), [-1] + [0] * (len(STICK_PARTS) - 1), positions, fps), path)
+
+
+def write_stick_profile(root: Path) -> Path:
+    """``root/profile.toml``: the stick figure's body profile (metres, +y up, facing from the knees and the head)."""
+    parts = "\n".join(f'{p} = "{p}"' for p in STICK_PARTS)
+    path = root / "profile.toml"
+    path.write_text(f'[profile]\nname = "stick"\nunits = "metre"\nup = "+y"\n\n[parts]\n{parts}\n\n'
+                    '[facing]\nleft = "lk"\nright = "rk"\nforward = "head"\n', encoding="utf-8")
+    return path
+
+
 STICK = """
 [character]
 name = "Stick"

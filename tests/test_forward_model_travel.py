@@ -14,20 +14,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from tests.conftest import STICK_PARTS, write_stick_clip, write_stick_profile
 from toolkit import ConfigError, Motion, create_plugin_manager
-from toolkit.bvh import from_joint_positions, write_bvh
 from toolkit.observe import Observer, compose_observer
 from toolkit.profile import load_profile
 
-PARTS = ("root", "head", "lk", "rk", "hand", "lf", "rf")
+PARTS = STICK_PARTS
 STAND = np.array([[0.0, 1.0, 0.0], [0.0, 1.6, 0.1], [0.1, 0.5, 0.0], [-0.1, 0.5, 0.0], [0.3, 1.0, 0.0],
                   [0.1, 0.0, 0.0], [-0.1, 0.0, 0.0]])
 SIDE = 0.6  # m/s: a side step's pace
 
-
-def _write_clip(path, positions, fps=30.0):
-    path.parent.mkdir(parents=True, exist_ok=True)
-    write_bvh(from_joint_positions(list(PARTS), [-1] + [0] * (len(PARTS) - 1), positions, fps), path)
 
 
 def _side_steps(frames: int, vx: float, fps: float = 30.0) -> np.ndarray:
@@ -57,12 +53,10 @@ def clips(tmp_path_factory):
     """A repertoire: ``left`` and ``right`` (the same side steps, the body travelling to its left and to its right)
     and ``raise`` (a gesture on the spot); and a profile."""
     root = tmp_path_factory.mktemp("fmtravel")
-    _write_clip(root / "repertoire" / "left" / "a.bvh", _side_steps(40, SIDE))
-    _write_clip(root / "repertoire" / "right" / "a.bvh", _side_steps(40, -SIDE))
-    _write_clip(root / "repertoire" / "raise" / "a.bvh", _raise())
-    parts = "\n".join(f'{p} = "{p}"' for p in PARTS)
-    (root / "profile.toml").write_text(f'[profile]\nname = "stick"\nunits = "metre"\nup = "+y"\n\n[parts]\n{parts}\n\n'
-                                       '[facing]\nleft = "lk"\nright = "rk"\nforward = "head"\n', encoding="utf-8")
+    write_stick_clip(root / "repertoire" / "left" / "a.bvh", _side_steps(40, SIDE))
+    write_stick_clip(root / "repertoire" / "right" / "a.bvh", _side_steps(40, -SIDE))
+    write_stick_clip(root / "repertoire" / "raise" / "a.bvh", _raise())
+    write_stick_profile(root)
     return root
 
 

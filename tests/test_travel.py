@@ -16,15 +16,14 @@ from hypothesis import strategies as st
 
 from plugins.lib.root_frame import root_relative
 from plugins.lib.travel import body_velocity, frame_rotation, travel_part
+from tests.conftest import STICK, STICK_PARTS, write_stick_clip, write_stick_profile
 from toolkit import Motion, create_plugin_manager, load_character
-from toolkit.bvh import from_joint_positions, write_bvh
 from toolkit.motion import local_to_world
 from toolkit.observe import compose_observer
 from toolkit.profile import load_profile
 from toolkit.watching import ObservationLog
-from tests.conftest import STICK
 
-PARTS = ("root", "head", "lk", "rk", "hand", "lf", "rf")
+PARTS = STICK_PARTS
 STAND = np.array([[0.0, 1.0, 0.0], [0.0, 1.6, 0.1], [0.1, 0.5, 0.0], [-0.1, 0.5, 0.0], [0.3, 1.0, 0.0],
                   [0.1, 0.0, 0.0], [-0.1, 0.0, 0.0]])
 
@@ -95,10 +94,6 @@ def test_world_positions_stay_with_a_motion_through_every_operation_and_working_
 
 # -- the posegraph: travel per node, cycles ----------------------------------------------------------------------
 
-def _write_clip(path, positions, fps=30.0):
-    path.parent.mkdir(parents=True, exist_ok=True)
-    write_bvh(from_joint_positions(list(PARTS), [-1] + [0] * (len(PARTS) - 1), positions, fps), path)
-
 
 def _step_cycle(frames: int, direction: float, fps: float = 30.0, cycles: int = 1, phase: float = 0.0) -> np.ndarray:
     """``cycles`` gait cycles of ``frames`` frames each, and the first frame of the next: the stick's feet swing
@@ -127,12 +122,10 @@ def clips(tmp_path_factory):
     too few to make a hub), and a profile."""
     root = tmp_path_factory.mktemp("travel")
     for take, frames in enumerate((30, 36, 42, 48)):
-        _write_clip(root / "repertoire" / "raise" / f"{take}.bvh", _raise_hand(frames))
-    _write_clip(root / "repertoire" / "walk" / "a.bvh", _step_cycle(30, 1.2)[:-1])
-    _write_clip(root / "repertoire" / "back" / "a.bvh", _step_cycle(30, -1.2, phase=np.pi)[:-1])
-    parts = "\n".join(f'{p} = "{p}"' for p in PARTS)
-    (root / "profile.toml").write_text(f'[profile]\nname = "stick"\nunits = "metre"\nup = "+y"\n\n[parts]\n{parts}\n\n'
-                                       '[facing]\nleft = "lk"\nright = "rk"\nforward = "head"\n', encoding="utf-8")
+        write_stick_clip(root / "repertoire" / "raise" / f"{take}.bvh", _raise_hand(frames))
+    write_stick_clip(root / "repertoire" / "walk" / "a.bvh", _step_cycle(30, 1.2)[:-1])
+    write_stick_clip(root / "repertoire" / "back" / "a.bvh", _step_cycle(30, -1.2, phase=np.pi)[:-1])
+    write_stick_profile(root)
     return root
 
 
