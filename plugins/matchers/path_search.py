@@ -390,9 +390,10 @@ class PathSearch(Matcher):
     def samples(self, motion: Motion, styled: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """The observed motion (in the observer's own parts) at the posegraph's node rate (with the posegraph's
         ``tempo``, at the node rate times the motion's own frequency over the repertoire's median clip frequency, as
-        each clip of the graph is sampled): poses (n, P, 3), visible (n, P); with ``travel``, the travel as one more part (n, P + 1, 3), hidden where the motion has no world
-        positions. ``styled``: about the segment's own posture and amplitude as ``posture`` and ``amplitude`` say
-        (False: the poses as performed, which learning keeps)."""
+        each clip of the graph is sampled): poses (n, P, 3), visible (n, P); with ``travel``, the travel as one more
+        part (n, P + 1, 3), hidden where the motion has no world positions. ``styled``: about the segment's own
+        posture and amplitude as ``posture`` and ``amplitude`` say (False: the poses as performed, which learning
+        keeps)."""
         if motion.parts != self.owner.body.parts:
             raise ValueError(f"path-search matches motions of the observer's own parts {list(self.owner.body.parts)}, "
                              f"not {list(motion.parts)} (Motion.onto maps them by name)")
