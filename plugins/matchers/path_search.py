@@ -334,8 +334,8 @@ class PathSearch(Matcher):
 
     def _take_path(self, own: np.ndarray, exclude: np.ndarray, weights: np.ndarray | None = None):
         """The take of nodes ``own`` as a demonstration (poses ``obs``, masks ``vis``), the nodes it is compared with
-        (see :meth:`_take_distance`), its best path avoiding ``exclude`` (``None`` when there is none) and the
-        number of samples with evidence."""
+        (see :meth:`_take_distance`), its best path avoiding ``exclude`` (``None`` when nothing is visible), the
+        path's eq. 3 cost (infinite where no path avoids ``exclude``) and the number of samples with evidence."""
         kept = self._nodes_kept
         nodes = kept
         if self.params["posture"] == "still" and self.params["still_spread"]:
@@ -350,9 +350,7 @@ class PathSearch(Matcher):
             path, cost, evidence = self.search(obs, vis, weights, exclude)
         finally:
             self.nodes_compared = kept
-        if path is not None and not np.isfinite(cost):
-            path = None
-        return obs, vis, nodes, path, evidence
+        return obs, vis, nodes, path, cost, evidence
 
     def _consistency(self, index: dict[str, int]) -> np.ndarray:
         """Each node's weight of each compared part (N, P) from how consistent the part is between its movement's
@@ -370,8 +368,8 @@ class PathSearch(Matcher):
             for own in takes:
                 exclude = self.labels != movement
                 exclude[own] = True
-                obs, vis, nodes, path, _ = self._take_path(own, exclude)
-                if path is not None:
+                obs, vis, nodes, path, cost, _ = self._take_path(own, exclude)
+                if path is not None and np.isfinite(cost):  # a path through the other takes only
                     variations.append(part_distances(obs, nodes[path]))
             if not variations:
                 continue
@@ -391,7 +389,7 @@ class PathSearch(Matcher):
         and from every take, so a spread is measured in the units the matches are. With ``consistency`` the parts
         are weighed as matches weigh them (:attr:`part_weights`)."""
         weights = getattr(self, "part_weights", None)
-        obs, vis, nodes, path, evidence = self._take_path(own, exclude, weights)
+        obs, vis, nodes, path, _, evidence = self._take_path(own, exclude, weights)
         return np.nan if path is None else path_distance(obs, nodes[path], vis, _at(weights, path)) / max(evidence, 1)
 
     def _spreads(self, index: dict[str, int]) -> dict[str, float]:
