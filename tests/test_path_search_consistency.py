@@ -110,7 +110,8 @@ def test_the_weights_do_not_change_when_every_take_and_the_demonstration_are_sca
         matcher = character.matcher
         rows = {m: matcher.part_weights[nodes_of(matcher, m)] for m in (*SWINGS, "nod")}
         assert all(np.allclose(r, r[0]) for r in rows.values())  # one row per movement
-        answers.append(({m: r[0] for m, r in rows.items()}, Observer(character, profile.body, 30.0).classify(demo).match))
+        match = Observer(character, profile.body, 30.0).classify(demo).match
+        answers.append(({m: r[0] for m, r in rows.items()}, match))
     (w1, m1), (w2, m2) = answers
     for movement in w1:
         assert np.allclose(w1[movement], w2[movement], rtol=1e-6)
