@@ -31,14 +31,6 @@ repertoire holds several takes of (several clips: performers, styles) is accepte
 through the rest of the graph when that take's own nodes are left out. A movement people perform alike is then held
 to a tight threshold, one they perform in many ways to a loose one; a movement of one take keeps ``max_distance``.
 
-Consistency between takes (issue 18; not in the paper, whose eq. 1 counts every part alike): with ``consistency``
-= c > 0, a movement the repertoire holds several takes of weighs each part in eq. 1, for its own nodes, by how
-consistent the part is between its takes: each take's best path through the movement's *other* takes only gives
-each part's mean distance along it, the part's variation ``v_p`` is the median over the takes, and its weight
-``1 / (v_p + c * mean(v))`` normalised to mean 1 over the parts. What one performer did besides the movement (his
-feet, his head) then counts less where other takes do it otherwise. Hubs and movements of one take weigh every part
-1; the spreads and separations are measured with the same weights.
-
 Travel (issue 18; not in the paper, which compares root-relative poses only, §5.1): with ``travel`` = τ > 0
 seconds, where the body goes is compared as one more part: the root's displacement over τ at its current velocity
 in the body's own frame (:mod:`plugins.lib.travel`), observed from the motion's world positions and, for the
@@ -198,12 +190,6 @@ class PathSearch(Matcher):
         Parameter("still_spread", bool, False, "With posture = 'still', measure the spreads and separations as "
                   "matches are compared: each take about the same share of its parts' postures as its own stillness "
                   "asks for (false: with every posture kept, as built)."),
-        Parameter("consistency", float, 0.0, "With several takes of a movement, weigh each part in eq. 1 for that "
-                  "movement's nodes by how consistent it is between the takes: 1 / (its variation + this share of "
-                  "the mean variation over parts), normalised to mean 1 (a part's variation: the median over takes of "
-                  "its mean distance along the take's best path through the movement's other takes); 1: a part twice "
-                  "as variable as the mean weighs about 2/3 of one that never varies; 0: every part alike (the "
-                  "paper).", minimum=0.0),
         Parameter("attention", float, 0.0, "How much the parts that move in the segment count over the still ones "
                   "(plugins.lib.attention): 0 is eq. 1's plain mean over the visible parts, 1 counts only what "
                   "moves.", minimum=0.0, maximum=1.0),
@@ -272,7 +258,6 @@ class PathSearch(Matcher):
         self._index = None  # the spatial index of the nodes, built by the first search that uses it
         self._scan = PoseScan(self.nodes_compared)  # the scan of every node (the planes, built once per graph)
         self.take_distances = {}
-        self.part_weights = self._consistency(index) if self.params["consistency"] > 0 else None
         self.spreads = self._spreads(index) if self.params["spread"] > 0 else {}
         self.separations = self._separations(index) if self.params["separation"] > 0 else {}
 
@@ -332,10 +317,11 @@ class PathSearch(Matcher):
                     for m, takes in self.motor.takes().items()}
         return {m: [np.flatnonzero(self.labels == m)] for m in self.motor.movements()}
 
-    def _take_path(self, own: np.ndarray, exclude: np.ndarray, weights: np.ndarray | None = None):
-        """The take of nodes ``own`` as a demonstration (poses ``obs``, masks ``vis``), the nodes it is compared with
-        (see :meth:`_take_distance`), its best path avoiding ``exclude`` (``None`` when nothing is visible), the
-        path's eq. 3 cost (infinite where no path avoids ``exclude``) and the number of samples with evidence."""
+    def _take_distance(self, own: np.ndarray, exclude: np.ndarray) -> float:
+        """The mean eq. 1 distance of the take of nodes ``own`` to the best path through the graph that avoids the
+        nodes ``exclude`` (NaN when there is none). With ``posture = "still"`` the take is compared as a
+        demonstration is (``still_spread``): its own stillness removes the same share of each part's posture from it
+        and from every take, so a spread is measured in the units the matches are."""
         kept = self._nodes_kept
         nodes = kept
         if self.params["posture"] == "still" and self.params["still_spread"]:
@@ -347,50 +333,10 @@ class PathSearch(Matcher):
         obs, vis = nodes[own], np.ones(nodes[own].shape[:2], dtype=bool)
         self.nodes_compared = nodes
         try:
-            path, cost, evidence = self.search(obs, vis, weights, exclude)
+            path, _, evidence = self.search(obs, vis, None, exclude)
         finally:
             self.nodes_compared = kept
-        return obs, vis, nodes, path, cost, evidence
-
-    def _consistency(self, index: dict[str, int]) -> np.ndarray:
-        """Each node's weight of each compared part (N, P) from how consistent the part is between its movement's
-        takes (``consistency`` > 0): for each take, the best path through the movement's *other* takes' nodes only
-        and each part's mean distance along it; a part's variation ``v_p`` is the median over the takes; its weight
-        ``1 / (v_p + consistency * mean(v))``, normalised to mean 1 over the parts, so eq. 1 keeps its scale.
-        Hubs, movements of one take (or whose takes find no path) and takes that do not vary weigh every part 1."""
-        weights = np.ones(self.nodes_compared.shape[:2])
-        floor = self.params["consistency"]
-        for movement, takes in self._takes(index).items():
-            takes = [own for own in takes if len(own)]
-            if len(takes) < 2:
-                continue
-            variations = []
-            for own in takes:
-                exclude = self.labels != movement
-                exclude[own] = True
-                obs, vis, nodes, path, cost, _ = self._take_path(own, exclude)
-                if path is not None and np.isfinite(cost):  # a path through the other takes only
-                    variations.append(part_distances(obs, nodes[path]))
-            if not variations:
-                continue
-            v = np.nanmedian(np.array(variations), axis=0) if np.isfinite(variations).any(axis=0).all() else \
-                np.full(len(weights[0]), np.nan)
-            mean = float(v.mean())
-            if not mean > 0:
-                continue
-            w = 1.0 / (v + floor * mean)
-            weights[self.labels == movement] = w / w.mean()
-        return weights
-
-    def _take_distance(self, own: np.ndarray, exclude: np.ndarray) -> float:
-        """The mean eq. 1 distance of the take of nodes ``own`` to the best path through the graph that avoids the
-        nodes ``exclude`` (NaN when there is none). With ``posture = "still"`` the take is compared as a
-        demonstration is (``still_spread``): its own stillness removes the same share of each part's posture from it
-        and from every take, so a spread is measured in the units the matches are. With ``consistency`` the parts
-        are weighed as matches weigh them (:attr:`part_weights`)."""
-        weights = getattr(self, "part_weights", None)
-        obs, vis, nodes, path, _, evidence = self._take_path(own, exclude, weights)
-        return np.nan if path is None else path_distance(obs, nodes[path], vis, _at(weights, path)) / max(evidence, 1)
+        return np.nan if path is None else path_distance(obs, nodes[path], vis) / max(evidence, 1)
 
     def _spreads(self, index: dict[str, int]) -> dict[str, float]:
         """Each movement's spread between takes (movements of several takes only): the ``spread_quantile`` (0.5: the
@@ -485,14 +431,12 @@ class PathSearch(Matcher):
             if obs.shape[1] > len(positions):  # the travel part is a position too
                 positions = np.append(positions, True)
             weights = movement_weights(obs, vis, self.params["attention"], positions)
-        if self.part_weights is not None:  # each node's parts as consistent as they are between its takes
-            weights = self.part_weights if weights is None else self.part_weights * weights[None, :]
         path, _, evidence = self.search(obs, vis, weights)  # the beam's eq. 3 cost: recomputed below by the one formula
         if path is None:
             return Match.unknown(reason="nothing visible")
         ids = self.label_ids[path]
         voting = ids[ids != self._hub_id]  # the movements' numbers: hubs do not vote
-        mean = path_distance(obs, self.nodes_compared[path], vis, _at(weights, path)) / max(evidence, 1)  # eq. 3
+        mean = path_distance(obs, self.nodes_compared[path], vis, weights) / max(evidence, 1)  # eq. 3 per sample
         details: dict[str, Any] = {"mean_distance": mean, "samples": len(path)}
         if voting.size == 0:
             return Match.unknown(reason="only hub poses", path=tuple(self.node_names[i] for i in path), **details)
@@ -537,8 +481,7 @@ class PathSearch(Matcher):
                 break
             names, counts = np.unique(voting, return_counts=True)
             other = str(names[int(np.argmax(counts))])
-            found.append((other, float(path_distance(obs, self.nodes_compared[path], vis, _at(weights, path))
-                                       / max(evidence, 1))))
+            found.append((other, float(path_distance(obs, self.nodes_compared[path], vis, weights) / max(evidence, 1))))
             exclude = exclude | (self.labels == other)
         return (found[0], *sorted(found[1:], key=lambda c: c[1]))
 
@@ -547,8 +490,8 @@ class PathSearch(Matcher):
         """The best path (node indices, one per sample), its eq. 3 cost and the number of samples with evidence.
 
         ``obs`` and ``vis`` are samples as :meth:`samples` gives them, compared with :attr:`nodes_compared` (with
-        ``travel``, one part more than the body); ``weights``: how much each of those parts counts, (P,) or per node
-        (N, P) (``None``: eq. 1's plain mean); ``exclude`` (N,): nodes no path may use."""
+        ``travel``, one part more than the body); ``weights``: attention to each of those parts (``None``: eq. 1's
+        plain mean); ``exclude`` (N,): nodes no path may use."""
         has = vis.any(axis=1)
         if not has.any():
             return None, 0.0, 0
@@ -605,11 +548,11 @@ class PathSearch(Matcher):
                 if every and weights is None:  # the hot loop of the search: eq. 1 over every part, inline
                     return scan(obs[t], cand)  # (pose_distance's arithmetic without its checks: the same numbers)
                 if every:
-                    return pose_distance(nodes[cand], obs[t], None, _at(weights, cand))
+                    return pose_distance(nodes[cand], obs[t], None, weights)
                 if seen.any():  # eq. 1 over the parts seen in this sample: the mask is the same for every candidate,
                     # so the seen parts are taken first and pose_distance needs no mask
                     return pose_distance(nodes[cand][:, seen], obs[t, seen], None,
-                                         None if weights is None else _at(weights, cand)[..., seen])
+                                         None if weights is None else weights[seen])
                 return np.zeros(len(cand))
 
             beam, cand = _candidates(table, ends, costs, score)
@@ -722,22 +665,6 @@ class PathSearch(Matcher):
         path = self.motor.learn(name, obs[:, :parts], vis[:, :parts], source="path-search")
         self._refresh()
         return Match(name, 1.0, None, tuple(path), {"learned": True, **details})
-
-
-def _at(weights: np.ndarray | None, nodes: np.ndarray) -> np.ndarray | None:
-    """The weights of the parts for the poses of ``nodes``: the same (P,) for every node, or each node's row of
-    (N, P) (``consistency``)."""
-    if weights is None or weights.ndim == 1:
-        return weights
-    return weights[nodes]
-
-
-def part_distances(observed: np.ndarray, path: np.ndarray) -> np.ndarray:
-    """Each part's mean eq. 2 distance (P,) between poses ``observed`` and the aligned ``path`` (n, P, 3), over the
-    samples where both are finite (NaN for a part never so)."""
-    d = np.linalg.norm(np.asarray(observed, dtype=float) - np.asarray(path, dtype=float), axis=-1)
-    with np.errstate(invalid="ignore"):
-        return np.nanmean(np.where(np.isfinite(d), d, np.nan), axis=0)
 
 
 def _reach(graph, nodes, index, max_skip: int, *, forward: bool) -> tuple[np.ndarray, np.ndarray]:
