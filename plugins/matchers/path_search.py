@@ -399,18 +399,16 @@ class PathSearch(Matcher):
                              f"not {list(motion.parts)} (Motion.onto maps them by name)")
         rate = self.motor.node_rate
         if getattr(self.motor, "reference_frequency", 0.0) > 0:  # the graph's clips sampled at their own tempo
-            at = np.unique(np.minimum(np.round(np.arange(max(1, int(round(motion.duration * rate)))) * motion.fps
-                                               / rate).astype(int), motion.n_frames - 1))
+            at = np.unique(_sample_frames(motion, rate))
             rate = rate * self.motor.tempo_factor(self.motor.frequency(at, motion.positions, motion.visible))
-        n = max(1, int(round(motion.duration * rate)))
-        idx = np.minimum(np.round(np.arange(n) * motion.fps / rate).astype(int), motion.n_frames - 1)
+        idx = _sample_frames(motion, rate)
         poses, visible = motion.positions[idx], motion.visible[idx]
         if styled:
             poses = self._styled_samples(poses, visible)
         if self.params["travel"] <= 0:
             return poses, visible
         if motion.world is None:
-            velocity = np.full((n, 3), np.nan)
+            velocity = np.full((len(idx), 3), np.nan)
         else:
             velocity = body_velocity(motion.world, motion.positions, motion.visible, self.owner.body.root_index,
                                      motion.fps, frames=idx)
@@ -863,6 +861,12 @@ def _gather(table: tuple[np.ndarray, np.ndarray], ends: np.ndarray) -> tuple[np.
     beam = np.repeat(np.arange(len(ends)), counts)
     within = np.arange(len(beam)) - np.repeat(np.cumsum(counts) - counts, counts)
     return beam, indices[indptr[ends][beam] + within]
+
+
+def _sample_frames(motion: Motion, rate: float) -> np.ndarray:
+    """The frames of ``motion`` taken ``rate`` times a second (at least one; the last frame repeated past its end)."""
+    n = max(1, int(round(motion.duration * rate)))
+    return np.minimum(np.round(np.arange(n) * motion.fps / rate).astype(int), motion.n_frames - 1)
 
 
 @hookimpl
