@@ -165,6 +165,19 @@ def check_outputs(args: argparse.Namespace) -> None:
             check_output_dir(value, option)
 
 
+def observer_options(p: argparse.ArgumentParser) -> None:
+    """The options that change the observer composed from the template, shared by ``likeme observe`` and
+    ``likeme bench``: ``--correspondence``, ``--lengths-for-height`` and ``--set``."""
+    p.add_argument("--correspondence", metavar="NAME", default="", help="correspondence (default: the observer "
+                   "template's; none: the papers' plain observer)")
+    p.add_argument("--lengths-for-height", type=number_type(0.0, 1000.0, "metres"), default=None, metavar="M",
+                   dest="lengths_for_height",
+                   help="the height (m) the length parameters were written for, scaled to the observer's own height "
+                   "(default: the observer template's; 0: metres as written, the papers)")
+    p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
+                   help="override a parameter of the observer, e.g. --set matcher.k=4 (repeatable)")
+
+
 def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     parser = _Parser(prog="likeme", description="Characters that understand others by simulating them with their own bodies.")
     parser.add_argument("--version", action="version", version=f"likeme {__version__}")
@@ -243,14 +256,7 @@ def build_parser(pm: PluginManager) -> argparse.ArgumentParser:
     p.add_argument("--segmenter", metavar="NAME", help="segmenter (default: the observer template's, "
                    "characters/observers/recordings.toml)")
     p.add_argument("--matcher", metavar="NAME", help="matcher (default: the observer template's)")
-    p.add_argument("--correspondence", metavar="NAME", help="correspondence (default: the observer template's; "
-                   "none: the papers' plain observer)")
-    p.add_argument("--lengths-for-height", type=number_type(0.0, 1000.0, "metres"), default=None, metavar="M",
-                   dest="lengths_for_height",
-                   help="the height (m) the length parameters were written for, scaled to the observer's own height "
-                   "(default: the observer template's; 0: metres as written, the papers)")
-    p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
-                   help="override a parameter of the observer, e.g. --set matcher.k=4 (repeatable)")
+    observer_options(p)
     p.add_argument("--json", action="store_true", help="print JSON instead of text")
     p.set_defaults(handler=cmd_observe)
 
@@ -679,7 +685,7 @@ def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
     if failed and not files:
         return 1
     for name, kind in ((args.segmenter, "segmenter"), (args.matcher, "matcher"), (args.correspondence, "correspondence")):
-        if name is not None and name != NO_CORRESPONDENCE:
+        if name and name != NO_CORRESPONDENCE:
             pm.registry.get(kind, name)  # an unknown name fails here, listing the registered ones
     settings = parse_settings(list(args.set))
     if args.fps is not None:  # the repertoire's clips are recordings too: the same rate, unless --set says otherwise

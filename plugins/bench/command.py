@@ -11,7 +11,7 @@ from importlib import import_module
 from typing import Any
 
 from toolkit import hookimpl
-from toolkit.cli import count_type, fps_type, number_type, seed_type
+from toolkit.cli import count_type, fps_type, number_type, observer_options, seed_type
 
 MATCHERS = ("path-search", "forward-model", "dtw")
 """The matchers ``likeme bench recognition`` and ``stream`` compare when none is named."""
@@ -98,14 +98,7 @@ def _jobs_options(p: argparse.ArgumentParser, items: str = "", timing: bool = Fa
 def _common(p: argparse.ArgumentParser) -> None:
     _jobs_options(p)
     p.add_argument("--body", required=True, metavar="PROFILE", help="body profile TOML of the files")
-    p.add_argument("--correspondence", metavar="NAME", default="", help="correspondence (default: the observer "
-                   "template's; none: the papers' plain observer)")
-    p.add_argument("--lengths-for-height", type=number_type(0.0, 1000.0, "metres"), default=None, metavar="M",
-                   dest="lengths_for_height",
-                   help="the height (m) the length parameters were written for, scaled to the observer's own height "
-                   "(default: the observer template's; 0: metres as written, the papers)")
-    p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
-                   help="override a parameter of the observer, e.g. --set matcher.k=4 (repeatable)")
+    observer_options(p)
     p.add_argument("--fps", type=fps_type, default=None, metavar="HZ",
                    help="frame rate of the demos, streams and repertoire clips without one of their own (CSV "
                    "without a time column, .npy); wins over the profile's fps; a BVH's Frame Time and a CSV's "
