@@ -287,9 +287,6 @@ CASES = [
     ("posegraph-tempo", "a tempo limit below 1", {"c.toml": CHILD + '[motor]\nplugin = "posegraph"\ntempo = 0.5\n'}, ["validate", "c.toml"], ["c.toml:6: key motor.tempo", "0 (off) or a factor of at least 1"]),
     # -- the forward model's travel: an edge's travel in a state file (issue 18, fmtravel)
     ("state-edge-travel", "a learned edge whose travel is not one row per frame of its demonstration", {"st.json": state(actors={"max": {"character": "Max", "components": {"motor": {"plugin": "motor-command-graph", "state": {"left_wrist": {"nodes": {"n1": [[0.26, 1.4, 0.4]]}, "edges": [{"from": "hub", "to": "n1", "name": "left_wrist:e1", "commands": [{"start": [0.25, 0.92, 0.06], "target": [0.26, 1.4, 0.4], "duration": 0.9}], "shown": [[[0.25, 0.92, 0.06]], [[0.26, 1.4, 0.4]]], "shown_fps": 30.0, "travel": [[0.0, 0.0, 1.0]]}]}}}}}})}, ["run", "imitation_games", "--duration", "0.1", "--load", "st.json"], ["key actors.max.components.motor.state.left_wrist.edges[0].travel: invalid travel", "expected where the body went at each frame of shown"]),
-    # -- path search attending to what tells one's own movements apart: contrast, rivals (issue 18, distinct18)
-    ("path-contrast", "a contrast share above 1", {"c.toml": CHILD + '[matcher]\nplugin = "path-search"\ncontrast = 1.5\n'}, ["validate", "c.toml"], ["c.toml:6: key matcher.contrast", "value 1.5 out of range", "expected a number in [0, 1]"]),
-    ("path-rivals-one", "one rival, nothing to compare it with", {"c.toml": CHILD + '[matcher]\nplugin = "path-search"\nrivals = 1\n'}, ["validate", "c.toml"], ["c.toml:6: key matcher.rivals", "0 (off) or at least 2 movements"]),
 ]
 
 
