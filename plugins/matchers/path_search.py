@@ -94,7 +94,7 @@ from typing import Any, NamedTuple, Protocol
 import networkx as nx
 import numpy as np
 
-from plugins.lib.attention import contrast_weights, movement_weights, part_distances
+from plugins.lib.attention import movement_weights
 from plugins.lib.pose_distance import PoseScan, path_distance, pose_distance
 from plugins.lib.pose_index import PoseIndex
 from plugins.lib.style import extent, mean_posture, rescale, stillness, take_means
@@ -211,19 +211,6 @@ class PathSearch(Matcher):
         Parameter("candidates", int, 0, "Ranked candidates to report besides the best (B&B Fig. 13): each is the "
                   "best path through the other movements' nodes (a search with the movements found so far left "
                   "out), with its mean eq. 3 distance; 0: the best only (one search).", minimum=0, maximum=10),
-        Parameter("contrast", float, 0.0, "How much each movement's nodes weigh the parts on which the movement "
-                  "differs from the repertoire's other movements: each part's weight in eq. 1 for a movement's nodes "
-                  "is (1 - contrast) / P plus contrast times the part's share of the distance from the movement's "
-                  "takes to the best path through the other movements' nodes (plugins.lib.attention); 0: eq. 1's "
-                  "plain mean (the paper), 1: only the parts that differ.", minimum=0.0, maximum=1.0),
-        Parameter("rivals", int, 0, "Compare the best movement and its runners-up, this many in all, again pair by "
-                  "pair on the parts that tell each pair apart (each part weighed by its share of the distance "
-                  "between the two movements' takes), and answer the one that wins most pairs (ties: the earlier); "
-                  "0: the best path's movement (the paper).", minimum=0, maximum=10,
-                  check=lambda v: None if v == 0 or v >= 2 else "0 (off) or at least 2 movements"),
-        Parameter("rivals_on", str, "takes", "What rivals compares each pair on: 'takes', the parts where the two "
-                  "movements' takes differ; 'aligned', the samples and parts where the two candidates' best paths, "
-                  "aligned on this demonstration, differ.", choices=("takes", "aligned")),
         Parameter("learn", bool, False, "Add an unknown movement's path to the posegraph as a new movement."),
         Parameter("learn_prefix", str, "learned", "Name prefix of learned movements (learned-1, learned-2...)."),
     )
@@ -271,11 +258,6 @@ class PathSearch(Matcher):
         self._index = None  # the spatial index of the nodes, built by the first search that uses it
         self._scan = PoseScan(self.nodes_compared)  # the scan of every node (the planes, built once per graph)
         self.take_distances = {}
-        self.node_weights = None  # (N, P) each node's weights in eq. 1 (contrast); None: the plain mean
-        self.contrasts: dict[str, np.ndarray] = {}
-        self._pair_contrasts: dict[tuple[str, str], np.ndarray] = {}
-        if self.params["contrast"] > 0:
-            self.node_weights = self._contrast_weights(index)
         self.spreads = self._spreads(index) if self.params["spread"] > 0 else {}
         self.separations = self._separations(index) if self.params["separation"] > 0 else {}
 
@@ -339,25 +321,7 @@ class PathSearch(Matcher):
         """The mean eq. 1 distance of the take of nodes ``own`` to the best path through the graph that avoids the
         nodes ``exclude`` (NaN when there is none). With ``posture = "still"`` the take is compared as a
         demonstration is (``still_spread``): its own stillness removes the same share of each part's posture from it
-        and from every take, so a spread is measured in the units the matches are. With ``contrast`` the nodes'
-        weights count as in a match."""
-        obs, vis, nodes, path, _, evidence = self._take_path(own, exclude, self.node_weights)
-        if path is None:
-            return np.nan
-        return path_distance(obs, nodes[path], vis, _weights_at(self.node_weights, path)) / max(evidence, 1)
-
-    def _take_parts(self, own: np.ndarray, exclude: np.ndarray) -> np.ndarray | None:
-        """Each part's mean eq. 2 distance (:func:`plugins.lib.attention.part_distances`) of the take of nodes
-        ``own`` along its best path (eq. 1's plain mean) through the graph without the nodes ``exclude``; ``None``
-        when there is no such path."""
-        obs, vis, nodes, path, cost, _ = self._take_path(own, exclude, None)
-        return None if path is None or not np.isfinite(cost) else part_distances(obs, nodes[path], vis)
-
-    def _take_path(self, own: np.ndarray, exclude: np.ndarray, weights: np.ndarray | None):
-        """The take of nodes ``own`` as compared (see :meth:`_take_distance`), all its parts seen, the nodes it was
-        compared with, its best path through them avoiding ``exclude``, the path's eq. 3 cost (infinite when every
-        way leads through an excluded node) and its evidence: (obs, vis, nodes, path, cost, evidence); the path
-        ``None`` when nothing is seen."""
+        and from every take, so a spread is measured in the units the matches are."""
         kept = self._nodes_kept
         nodes = kept
         if self.params["posture"] == "still" and self.params["still_spread"]:
@@ -367,53 +331,12 @@ class PathSearch(Matcher):
             nodes = kept.copy()
             nodes[:, :body] -= share[None, :, None] * self._take_posture
         obs, vis = nodes[own], np.ones(nodes[own].shape[:2], dtype=bool)
-        saved = self.nodes_compared
         self.nodes_compared = nodes
         try:
-            path, cost, evidence = self.search(obs, vis, weights, exclude)
+            path, _, evidence = self.search(obs, vis, None, exclude)
         finally:
-            self.nodes_compared = saved
-        return obs, vis, nodes, path, cost, evidence
-
-    def _contrast_weights(self, index: dict[str, int]) -> np.ndarray:
-        """``contrast``: each node's weights in eq. 1, (N, P) (P with the travel part, if any). A movement's nodes
-        weigh each part by :func:`plugins.lib.attention.contrast_weights` of its *contrast*: the mean over the
-        movement's takes of the part's mean distance along the take's best path through the graph without the
-        movement's nodes (the path :attr:`separations` measure, part by part), kept in :attr:`contrasts`. Hubs, and
-        a movement with no other movement beside it, weigh every part alike (``1 / P``)."""
-        n, p = self._nodes_kept.shape[:2]
-        weights = np.full((n, p), 1.0 / p)
-        for movement, takes in self._takes(index).items():
-            exclude = self.labels == movement
-            if not (self.labels[~exclude] != "").any():
-                continue
-            found = [self._take_parts(own, exclude) for own in takes if len(own)]
-            found = [f for f in found if f is not None]
-            if not found:
-                continue
-            self.contrasts[movement] = np.mean(found, axis=0)
-            weights[exclude] = contrast_weights(self.contrasts[movement], self.params["contrast"])
-        return weights
-
-    def pair_contrast(self, a: str, b: str) -> np.ndarray:
-        """``rivals``: what tells movements ``a`` and ``b`` apart, part by part, (P,): the mean of each one's
-        contrast to the other, a movement's contrast to another being the mean over its takes of each part's mean
-        distance along the take's best path through the other's nodes (and the hubs) only. Measured on the nodes as
-        built (as :attr:`separations` are), once per pair."""
-        key = (a, b) if a <= b else (b, a)
-        if key not in self._pair_contrasts:
-            index = {node: i for i, node in enumerate(self.node_names)}
-            takes = self._takes(index)
-            sides = []
-            for one, other in (key, key[::-1]):
-                exclude = (self.labels != other) & (self.labels != "")
-                found = [self._take_parts(own, exclude) for own in takes.get(one, []) if len(own)]
-                found = [f for f in found if f is not None]
-                if found:
-                    sides.append(np.mean(found, axis=0))
-            p = self._nodes_kept.shape[1]
-            self._pair_contrasts[key] = np.mean(sides, axis=0) if sides else np.zeros(p)
-        return self._pair_contrasts[key]
+            self.nodes_compared = kept
+        return np.nan if path is None else path_distance(obs, nodes[path], vis) / max(evidence, 1)
 
     def _spreads(self, index: dict[str, int]) -> dict[str, float]:
         """Each movement's spread between takes (movements of several takes only): the ``spread_quantile`` (0.5: the
@@ -506,14 +429,12 @@ class PathSearch(Matcher):
             if obs.shape[1] > len(positions):  # the travel part is a position too
                 positions = np.append(positions, True)
             weights = movement_weights(obs, vis, self.params["attention"], positions)
-        if self.node_weights is not None:  # contrast: each node weighs the parts its movement differs on
-            weights = self.node_weights if weights is None else self.node_weights * weights
         path, _, evidence = self.search(obs, vis, weights)  # the beam's eq. 3 cost: recomputed below by the one formula
         if path is None:
             return Match.unknown(reason="nothing visible")
         ids = self.label_ids[path]
         voting = ids[ids != self._hub_id]  # the movements' numbers: hubs do not vote
-        mean = path_distance(obs, self.nodes_compared[path], vis, _weights_at(weights, path)) / max(evidence, 1)
+        mean = path_distance(obs, self.nodes_compared[path], vis, weights) / max(evidence, 1)  # eq. 3 per sample
         details: dict[str, Any] = {"mean_distance": mean, "samples": len(path)}
         if voting.size == 0:
             return Match.unknown(reason="only hub poses", path=tuple(self.node_names[i] for i in path), **details)
@@ -524,11 +445,6 @@ class PathSearch(Matcher):
         best = int(np.argmax(counts))
         movement, share = str(names[best]), counts[best] / voting.size
         details["votes"] = {str(n): int(c) for n, c in zip(names, counts)}
-        if self.params["rivals"] >= 2:
-            rival = self._rivals(obs, vis, weights, movement, mean, details)
-            if rival is not None:
-                movement, path, mean, evidence = rival
-                details["mean_distance"], share = mean, 1.0
         node_path = tuple(self.node_names[i] for i in path)
         if movement in self.spreads:
             details["spread"] = self.spreads[movement]
@@ -545,74 +461,6 @@ class PathSearch(Matcher):
         return Match(movement, confidence, None, node_path, details,
                      candidates=self._candidates(obs, vis, weights, movement, mean))
 
-    def _rivals(self, obs: np.ndarray, vis: np.ndarray, weights: np.ndarray | None, movement: str, mean: float,
-                details: dict[str, Any]) -> tuple[str, np.ndarray, float, int] | None:
-        """``rivals``: the best movement and its runners-up (:meth:`_ranked`, ``rivals`` in all) compared again pair
-        by pair, each pair on the parts that tell the two apart (:meth:`pair_contrast`, weights in proportion to it,
-        :func:`plugins.lib.attention.contrast_weights` with share 1): in each pair the one whose best path through its
-        own nodes and the hubs has the smaller weighted mean eq. 3 distance wins. The movement of most wins is the
-        answer (ties: the earlier in the ranking). Returns, when that is not ``movement``, the answer, its best path
-        through its own nodes and the hubs (the match's weights), its mean eq. 3 distance per sample and evidence;
-        else ``None``. ``details["rivals"]``: each candidate's wins, in the order ranked."""
-        ranked = [m for m, _ in self._ranked(obs, vis, weights, movement, mean, self.params["rivals"] - 1)]
-        wins = dict.fromkeys(ranked, 0)
-        own = {m: (self.labels != m) & (self.labels != "") for m in ranked}  # the nodes each may not use
-        if self.params["rivals_on"] == "aligned":
-            return self._rivals_aligned(obs, vis, weights, movement, ranked, own, details)
-        for i, a in enumerate(ranked):
-            for b in ranked[i + 1:]:
-                pair = contrast_weights(self.pair_contrast(a, b), 1.0)
-                if weights is not None and weights.ndim == 1:  # attention's weights count as well
-                    pair = pair * weights
-                d = {}
-                for m in (a, b):
-                    path, cost, evidence = self.search(obs, vis, pair, own[m])
-                    d[m] = cost / max(evidence, 1) if path is not None and np.isfinite(cost) else np.inf
-                wins[b if d[b] < d[a] else a] += 1
-        details["rivals"] = dict(wins)
-        winner = max(ranked, key=lambda m: (wins[m], -ranked.index(m)))
-        if winner == movement:
-            return None
-        path, cost, evidence = self.search(obs, vis, weights, own[winner])
-        if path is None or not np.isfinite(cost):
-            return None
-        return winner, path, path_distance(obs, self.nodes_compared[path], vis, _weights_at(weights, path)) / \
-            max(evidence, 1), evidence
-
-    def _rivals_aligned(self, obs, vis, weights, movement, ranked, own, details):
-        """``rivals_on = "aligned"``: each candidate's best path through its own nodes and the hubs (the match's
-        weights), and each pair compared on the samples and parts where the two paths, aligned on this
-        demonstration, differ: weight ``|a_tp - b_tp|`` (sample t, part p, seen), normalised; the one of the smaller
-        weighted sum of eq. 2 distances to the demonstration wins the pair."""
-        paths, found = {}, {}
-        for m in ranked:
-            path, cost, evidence = self.search(obs, vis, weights, own[m])
-            if path is not None and np.isfinite(cost):
-                paths[m], found[m] = path, (cost, evidence)
-        ranked = [m for m in ranked if m in paths]
-        wins = dict.fromkeys(ranked, 0)
-        nodes = self.nodes_compared
-        seen = vis & np.isfinite(obs).all(axis=-1)
-        error = {m: np.where(seen, np.linalg.norm(np.nan_to_num(obs) - nodes[paths[m]], axis=-1), 0.0) for m in ranked}
-        for i, a in enumerate(ranked):
-            for b in ranked[i + 1:]:
-                apart = np.where(seen, np.linalg.norm(nodes[paths[a]] - nodes[paths[b]], axis=-1), 0.0)
-                total = apart.sum()
-                if not total > 0:
-                    wins[a] += 1
-                    continue
-                da, db = (apart * error[a]).sum() / total, (apart * error[b]).sum() / total
-                wins[b if db < da else a] += 1
-        details["rivals"] = dict(wins)
-        if not ranked:
-            return None
-        winner = max(ranked, key=lambda m: (wins[m], -ranked.index(m)))
-        if winner == movement:
-            return None
-        path, evidence = paths[winner], found[winner][1]
-        return winner, path, path_distance(obs, nodes[path], vis, _weights_at(weights, path)) / max(evidence, 1), \
-            evidence
-
     def _candidates(self, obs: np.ndarray, vis: np.ndarray, weights: np.ndarray | None, movement: str,
                     mean: float) -> tuple[tuple[str, float], ...]:
         """The recognised movement and up to ``candidates`` runners-up (Fig. 13), by mean eq. 3 distance, best
@@ -620,14 +468,9 @@ class PathSearch(Matcher):
         it. Empty when ``candidates`` is 0."""
         if self.params["candidates"] <= 0:
             return ()
-        return self._ranked(obs, vis, weights, movement, mean, self.params["candidates"])
-
-    def _ranked(self, obs: np.ndarray, vis: np.ndarray, weights: np.ndarray | None, movement: str, mean: float,
-                more: int) -> tuple[tuple[str, float], ...]:
-        """``movement`` (at ``mean``) and up to ``more`` runners-up, best first (see :meth:`_candidates`)."""
         found = [(movement, float(mean))]
         exclude = self.labels == movement
-        for _ in range(more):
+        for _ in range(self.params["candidates"]):
             path, cost, evidence = self.search(obs, vis, weights, exclude)
             if path is None or not np.isfinite(cost):  # no path through the movements left
                 break
@@ -636,8 +479,7 @@ class PathSearch(Matcher):
                 break
             names, counts = np.unique(voting, return_counts=True)
             other = str(names[int(np.argmax(counts))])
-            found.append((other, float(path_distance(obs, self.nodes_compared[path], vis, _weights_at(weights, path)) /
-                                       max(evidence, 1))))
+            found.append((other, float(path_distance(obs, self.nodes_compared[path], vis, weights) / max(evidence, 1))))
             exclude = exclude | (self.labels == other)
         return (found[0], *sorted(found[1:], key=lambda c: c[1]))
 
@@ -647,8 +489,7 @@ class PathSearch(Matcher):
 
         ``obs`` and ``vis`` are samples as :meth:`samples` gives them, compared with :attr:`nodes_compared` (with
         ``travel``, one part more than the body); ``weights``: attention to each of those parts (``None``: eq. 1's
-        plain mean; (N, P): each node's own, as ``contrast`` gives them); ``exclude`` (N,): nodes no path may
-        use."""
+        plain mean); ``exclude`` (N,): nodes no path may use."""
         has = vis.any(axis=1)
         if not has.any():
             return None, 0.0, 0
@@ -705,11 +546,11 @@ class PathSearch(Matcher):
                 if every and weights is None:  # the hot loop of the search: eq. 1 over every part, inline
                     return scan(obs[t], cand)  # (pose_distance's arithmetic without its checks: the same numbers)
                 if every:
-                    return pose_distance(nodes[cand], obs[t], None, _weights_at(weights, cand))
+                    return pose_distance(nodes[cand], obs[t], None, weights)
                 if seen.any():  # eq. 1 over the parts seen in this sample: the mask is the same for every candidate,
                     # so the seen parts are taken first and pose_distance needs no mask
                     return pose_distance(nodes[cand][:, seen], obs[t, seen], None,
-                                         None if weights is None else _weights_at(weights, cand)[..., seen])
+                                         None if weights is None else weights[seen])
                 return np.zeros(len(cand))
 
             beam, cand = _candidates(table, ends, costs, score)
@@ -1020,14 +861,6 @@ def _gather(table: tuple[np.ndarray, np.ndarray], ends: np.ndarray) -> tuple[np.
     beam = np.repeat(np.arange(len(ends)), counts)
     within = np.arange(len(beam)) - np.repeat(np.cumsum(counts) - counts, counts)
     return beam, indices[indptr[ends][beam] + within]
-
-
-def _weights_at(weights: np.ndarray | None, rows: np.ndarray) -> np.ndarray | None:
-    """The weights that go with the nodes ``rows``: per-part weights (P,) as they are, each node's own (N, P) taken
-    at ``rows``; ``None`` stays ``None`` (eq. 1's plain mean)."""
-    if weights is None or weights.ndim == 1:
-        return weights
-    return weights[rows]
 
 
 def _sample_frames(motion: Motion, rate: float) -> np.ndarray:
