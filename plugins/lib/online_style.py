@@ -1,0 +1,122 @@
+"""The styled comparison estimated online: a prediction fitted to the frames seen so far by posture, amplitude, pace.
+
+Path search compares a whole segment about its own held posture, at a common amplitude and sampled at its own tempo
+(:mod:`plugins.lib.style`). The forward model (Kopp & Graeser 2006, §4.4) commits while the movement is still going
+on, so it cannot measure these over the whole segment: here each is estimated from the frames seen so far, for each
+candidate command apart (its prediction for every frame seen, ``P_i``, against the observation ``O_i``, (k, 3)
+each), from running sums, so a frame costs the same at any length of segment:
+
+- **posture** (``centred``): each side centred on its own mean over the frames seen, ``O_i - mean(O)`` against
+  ``P_i - mean(P)``: a constant offset of a part over the movement (a stance held otherwise, a hand held higher)
+  cancels on both sides alike, as :func:`plugins.lib.style.mean_posture` removed does over a segment;
+- **amplitude** (``limit`` > 0): the observation is divided by ``A``, the least-squares factor of the prediction that
+  best explains it, ``A = sum(O . P) / sum(P . P)`` over the frames seen (centred or not, as above), kept within
+  ``[1 / limit, limit]``: the observed extent so far against the command's over the same progress, taken as the same
+  movement made larger or smaller up to ``limit`` times (path search's ``amplitude``). Errors are then in the units of
+  the command (one's own body), as path search scales the demonstration to the repertoire;
+- **tempo** (several ``P`` rows, one per pace): the command is predicted at ``S`` paces (command seconds per second
+  seen, :func:`paces`); the pace whose fit (with the two above) leaves the least squared residual over the frames
+  seen is the demonstrator's, and the prediction follows it.
+
+The sums are per pace (S): ``sp`` (S, k, 3) the summed predictions, ``spp`` and ``sop`` (S,) the summed squares
+``P . P`` and products ``O . P``; and of the observation ``so`` (k, 3), ``soo`` and the frames ``n``. Every quantity
+is the same when the demonstration and the commands are scaled or moved together, so no length enters.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["Observed", "Fit", "paces", "residuals", "fitted", "STEP"]
+
+STEP = 1.12
+"""Ratio of successive paces (:func:`paces`): 12%, the steps of the forward model's speed grid (``_speed``)."""
+
+
+def paces(limit: float) -> np.ndarray:
+    """The paces tried for a tempo kept within ``limit`` either way: geometric from ``1 / limit`` to ``limit`` in
+    steps of at most :data:`STEP` (13 for 2), with 1 among them; ``[1.0]`` for a limit of 0 or 1 (tempo off)."""
+    if not limit > 1.0:
+        return np.array([1.0])
+    half = int(np.ceil(np.log(limit) / np.log(STEP)))
+    return np.exp(np.linspace(-np.log(limit), np.log(limit), 2 * half + 1))
+
+
+@dataclass
+class Observed:
+    """Running sums of the observation over the frames seen: ``n``, ``so`` (k, 3) and ``soo``."""
+
+    n: int
+    so: np.ndarray
+    soo: float = 0.0
+
+    @classmethod
+    def empty(cls, k: int) -> Observed:
+        return cls(0, np.zeros((k, 3)))
+
+    def add(self, o: np.ndarray) -> None:
+        """Frames ``o`` (m, k, 3) seen."""
+        o = np.nan_to_num(np.asarray(o, dtype=float))
+        self.n += len(o)
+        self.so = self.so + o.sum(axis=0)
+        self.soo += float((o * o).sum())
+
+
+@dataclass
+class Fit:
+    """One candidate's running sums over the frames seen, at each of S paces (see the module)."""
+
+    sp: np.ndarray
+    spp: np.ndarray
+    sop: np.ndarray
+    n: int = 0
+    extra: dict = field(default_factory=dict)
+
+    @classmethod
+    def empty(cls, s: int, k: int) -> Fit:
+        return cls(np.zeros((s, k, 3)), np.zeros(s), np.zeros(s))
+
+    def copy(self) -> Fit:
+        return Fit(self.sp.copy(), self.spp.copy(), self.sop.copy(), self.n, dict(self.extra))
+
+    def add(self, o: np.ndarray, p: np.ndarray) -> None:
+        """Frames ``o`` (m, k, 3) seen and the candidate's predictions of them ``p`` (S, m, k, 3)."""
+        o = np.nan_to_num(np.asarray(o, dtype=float))
+        p = np.nan_to_num(np.asarray(p, dtype=float))
+        self.n += o.shape[0]
+        self.sp = self.sp + p.sum(axis=1)
+        self.spp = self.spp + (p * p).sum(axis=(1, 2, 3))
+        self.sop = self.sop + np.einsum("mkc,smkc->s", o, p)
+
+
+def fitted(obs: Observed, fit: Fit, centred: bool, limit: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per pace (S,): the amplitude factor ``A``, the residual sum of squares over the frames seen (in the command's
+    units: divided by ``A ** 2``) and the centring terms' scale (``1 / n`` when centred, else 0)."""
+    n = max(obs.n, 1)
+    c = 1.0 / n if centred else 0.0
+    soo = obs.soo - c * float((obs.so * obs.so).sum())
+    sop = fit.sop - c * np.einsum("kc,skc->s", obs.so, fit.sp)
+    spp = fit.spp - c * (fit.sp * fit.sp).sum(axis=(1, 2))
+    if limit > 0:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            a = np.where(spp > 0, sop / np.where(spp > 0, spp, 1.0), 1.0)
+        a = np.clip(np.where(np.isfinite(a) & (a > 0), a, 1.0 / limit if limit > 0 else 1.0), 1.0 / limit, limit)
+    else:
+        a = np.ones(len(spp))
+    rss = np.maximum(soo - 2.0 * a * sop + a * a * spp, 0.0) / (a * a)
+    return a, rss, np.full(len(spp), c)
+
+
+def residuals(obs: Observed, fit: Fit, o: np.ndarray, p: np.ndarray, centred: bool, limit: float
+              ) -> tuple[np.ndarray, int, float]:
+    """This frame's per-part distances (k,) between the observation ``o`` (k, 3) and the prediction ``p`` (S, k, 3)
+    at the best pace (the least residual over the frames seen, this one included), after posture and amplitude:
+    ``|(o - mean O) / A - (p - mean P)|``; with the best pace's index and ``A``."""
+    a, rss, c = fitted(obs, fit, centred, limit)
+    best = int(np.argmin(rss))
+    mo = obs.so * c[best]
+    mp = fit.sp[best] * c[best]
+    d = np.linalg.norm((np.asarray(o, dtype=float) - mo) / a[best] - (p[best] - mp), axis=-1)
+    return d, best, float(a[best])
