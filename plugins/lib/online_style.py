@@ -1,4 +1,4 @@
-"""The styled comparison estimated online: a prediction fitted to the frames seen so far by posture, amplitude, pace.
+"""The styled comparison estimated online: a prediction fitted to the frames seen so far by held posture and pace.
 
 Path search compares a whole segment about its own held posture, at a common amplitude and sampled at its own tempo
 (:mod:`plugins.lib.style`). The forward model (Kopp & Graeser 2006, §4.4) commits while the movement is still going
@@ -9,18 +9,19 @@ each), from running sums, so a frame costs the same at any length of segment:
 - **posture** (``centred``): each side centred on its own mean over the frames seen, ``O_i - mean(O)`` against
   ``P_i - mean(P)``: a constant offset of a part over the movement (a stance held otherwise, a hand held higher)
   cancels on both sides alike, as :func:`plugins.lib.style.mean_posture` removed does over a segment;
-- **amplitude** (``limit`` > 0): the observation is divided by ``A``, the least-squares factor of the prediction that
-  best explains it, ``A = sum(O . P) / sum(P . P)`` over the frames seen (centred or not, as above), kept within
-  ``[1 / limit, limit]``: the observed extent so far against the command's over the same progress, taken as the same
-  movement made larger or smaller up to ``limit`` times (path search's ``amplitude``). Errors are then in the units of
-  the command (one's own body), as path search scales the demonstration to the repertoire;
 - **tempo** (several ``P`` rows, one per pace): the command is predicted at ``S`` paces (command seconds per second
-  seen, :func:`paces`); the pace whose fit (with the two above) leaves the least squared residual over the frames
+  seen, :func:`paces`); the pace whose fit (with the posture above) leaves the least squared residual over the frames
   seen is the demonstrator's, and the prediction follows it.
 
+Amplitude (the observation divided by its extent over the command's, within a factor 2, as path search's
+``amplitude``) was built here too and measured, as the least-squares factor ``sum(O . P) / sum(P . P)`` and as the
+ratio of the root-mean-square extents: it lowered the forward model's accuracy on the Bandai-Namco clips in every
+combination, and was removed (docs/benchmarks.md, "The forward model's styled comparison (issue 18, fmstyled)").
+
 The sums are per pace (S): ``sp`` (S, k, 3) the summed predictions, ``spp`` and ``sop`` (S,) the summed squares
-``P . P`` and products ``O . P``; and of the observation ``so`` (k, 3), ``soo`` and the frames ``n``. Every quantity
-is the same when the demonstration and the commands are scaled or moved together, so no length enters.
+``P . P`` and products ``O . P``; and of the observation ``so`` (k, 3), ``soo`` and the frames ``n``. The pace chosen
+is the same when the demonstration and the commands are scaled together (the residuals scale with them), and, with
+the posture removed, when either is moved: no length enters.
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ STEP = 1.12
 
 def paces(limit: float) -> np.ndarray:
     """The paces tried for a tempo kept within ``limit`` either way: geometric from ``1 / limit`` to ``limit`` in
-    steps of at most :data:`STEP` (13 for 2), with 1 among them; ``[1.0]`` for a limit of 0 or 1 (tempo off)."""
+    equal steps of at most :data:`STEP` (15 for 2: 10.4% apart), with 1 among them; ``[1.0]`` for a limit of 0 or 1 (tempo off)."""
     if not limit > 1.0:
         return np.array([1.0])
     half = int(np.ceil(np.log(limit) / np.log(STEP)))
@@ -91,32 +92,22 @@ class Fit:
         self.sop = self.sop + np.einsum("mkc,smkc->s", o, p)
 
 
-def fitted(obs: Observed, fit: Fit, centred: bool, limit: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Per pace (S,): the amplitude factor ``A``, the residual sum of squares over the frames seen (in the command's
-    units: divided by ``A ** 2``) and the centring terms' scale (``1 / n`` when centred, else 0)."""
-    n = max(obs.n, 1)
-    c = 1.0 / n if centred else 0.0
+def fitted(obs: Observed, fit: Fit, centred: bool) -> np.ndarray:
+    """Per pace (S,): the residual sum of squares over the frames seen of the observation against the prediction,
+    each centred on its own mean over them when ``centred``."""
+    c = 1.0 / max(obs.n, 1) if centred else 0.0
     soo = obs.soo - c * float((obs.so * obs.so).sum())
     sop = fit.sop - c * np.einsum("kc,skc->s", obs.so, fit.sp)
     spp = fit.spp - c * (fit.sp * fit.sp).sum(axis=(1, 2))
-    if limit > 0:
-        with np.errstate(invalid="ignore", divide="ignore"):
-            a = np.where(spp > 0, sop / np.where(spp > 0, spp, 1.0), 1.0)
-        a = np.clip(np.where(np.isfinite(a) & (a > 0), a, 1.0 / limit if limit > 0 else 1.0), 1.0 / limit, limit)
-    else:
-        a = np.ones(len(spp))
-    rss = np.maximum(soo - 2.0 * a * sop + a * a * spp, 0.0) / (a * a)
-    return a, rss, np.full(len(spp), c)
+    return np.maximum(soo - 2.0 * sop + spp, 0.0)
 
 
-def residuals(obs: Observed, fit: Fit, o: np.ndarray, p: np.ndarray, centred: bool, limit: float
-              ) -> tuple[np.ndarray, int, float]:
+def residuals(obs: Observed, fit: Fit, o: np.ndarray, p: np.ndarray, centred: bool) -> tuple[np.ndarray, int]:
     """This frame's per-part distances (k,) between the observation ``o`` (k, 3) and the prediction ``p`` (S, k, 3)
-    at the best pace (the least residual over the frames seen, this one included), after posture and amplitude:
-    ``|(o - mean O) / A - (p - mean P)|``; with the best pace's index and ``A``."""
-    a, rss, c = fitted(obs, fit, centred, limit)
+    at the best pace (the least residual over the frames seen, this one included), each side centred on its mean
+    over the frames seen when ``centred``: ``|(o - mean O) - (p - mean P)|``; with the best pace's index."""
+    rss = fitted(obs, fit, centred)
     best = int(np.argmin(rss))
-    mo = obs.so * c[best]
-    mp = fit.sp[best] * c[best]
-    d = np.linalg.norm((np.asarray(o, dtype=float) - mo) / a[best] - (p[best] - mp), axis=-1)
-    return d, best, float(a[best])
+    c = 1.0 / max(obs.n, 1) if centred else 0.0
+    d = np.linalg.norm((np.asarray(o, dtype=float) - obs.so * c) - (p[best] - fit.sp[best] * c), axis=-1)
+    return d, best

@@ -111,6 +111,26 @@ positions are not known the travel part is left out; a command without travel is
 drop-out, ``stillness`` (the body on the spot) and ``unexplained`` (the extent includes the travel) see it; the
 end check (:meth:`ForwardModel._ended`), the start node and the spreads between takes compare the parts alone.
 
+The styled comparison (issue 18; K&G §4.4, §6; B&B §7.1), path search's ``posture``, ``amplitude`` and the
+posegraph's ``tempo`` estimated online (:mod:`plugins.lib.online_style`): the forward model commits early, so it
+cannot measure a style over the whole segment; each candidate is fitted to the frames seen so far, from running sums
+(the same work a frame at any length of segment), each setting off by default (the paper):
+
+- ``posture = "removed"``: each candidate's prediction and the observation are compared each about its own mean
+  over the frames seen so far, so a part held otherwise through the movement (a stance, a hand held higher) cancels
+  on both sides alike, rather than only the onset's posture as ``relative`` removes it;
+- ``tempo`` = a factor (2, the posegraph's): the command is predicted at the time it reaches at a pace (command
+  seconds per second seen) among paces at most 12% apart within the factor either way, the pace whose prediction
+  leaves the least squared residual over the frames seen (with the posture above); K&G §4.4 re-parameterise each
+  part by the path length it has covered, which lets a command that moves a part the demonstrator keeps still
+  predict it where it is seen, and a movement made larger run ahead along its command. A candidate path goes on
+  along the next edges once its pace's time passes the path's end; the end check compares the fitted prediction.
+
+Amplitude (the observation scaled by its extent over the command's over the same progress, within a factor 2) was
+built and measured too, and lowered the accuracy on the Bandai-Namco clips in every combination: not kept
+(docs/benchmarks.md, "The forward model's styled comparison (issue 18, fmstyled)"). The spreads between takes
+(``spread``) and :meth:`ForwardModel.take_errors` keep the comparison of the settings above them.
+
 Ranked candidates (B&B Fig. 13; K&G §4.4, Fig. 3's candidates): every answer of one followed subsystem carries
 ``Match.candidates``, the movements the forward models considered in the segment with their prediction errors,
 the answer first and the others best first (:meth:`ForwardModel._ranked`): each movement's error is the mean over
@@ -342,8 +362,8 @@ class Track:
     """With ``travel`` and ``error = "moving"``: the weights (k + 1,) of the parts and of the travel part at the frame
     followed last (:func:`moving_weights` of the parts' path lengths and the root's path in the world)."""
     styled: dict[tuple[str, ...], Any] = field(default_factory=dict)
-    """With the styled comparison (``posture``, ``amplitude``, ``tempo``): per candidate path, its running fit
-    (:class:`plugins.lib.online_style.Fit`; its ``extra`` holds the last frame's ``along``, ``amplitude``, ``pace``,
+    """With the styled comparison (``posture``, ``tempo``): per candidate path, its running fit
+    (:class:`plugins.lib.online_style.Fit`; its ``extra`` holds the last frame's ``along``, ``pace``,
     whether the best pace has passed the path's end (``past``), and the ``error``)."""
     seen: Any = None
     """With the styled comparison: the running sums of the observation (:class:`plugins.lib.online_style.Observed`)."""
@@ -811,11 +831,6 @@ class ForwardModel(Matcher):
                   "candidate's prediction and the observation each about its own mean over the frames seen so far "
                   "(plugins.lib.online_style), so a stance or a hand held otherwise through the movement cancels; "
                   "'kept': as relative says (the paper).", choices=("kept", "removed")),
-        Parameter("amplitude", float, 0.0, "Styled comparison: the observation is divided by the least-squares "
-                  "factor of each candidate's prediction that best explains the frames seen so far (the observed "
-                  "extent against the command's over the same progress), kept within this factor either way, as "
-                  "path-search's amplitude; errors are then in one's own units. 0: as performed (the paper).",
-                  minimum=0.0, check=lambda v: None if v == 0 or v >= 1 else "0 (off) or a factor of at least 1"),
         Parameter("tempo", float, 0.0, "Styled comparison: each candidate is predicted at the time its command "
                   "reaches at a pace (command seconds per second seen) fitted to the frames seen so far, among paces at "
                   "most 12% apart within this factor either way (posegraph's tempo), so predictions follow the "
@@ -1292,16 +1307,16 @@ class ForwardModel(Matcher):
     # -- the styled comparison (issue 18; K&G §6, B&B §7.1) ------------------------------------------
 
     def _styled(self, track: Track) -> bool:
-        """Whether ``track`` is compared in the demonstrator's own style (``posture``, ``amplitude``, ``tempo``;
+        """Whether ``track`` is compared in the demonstrator's own style (``posture``, ``tempo``;
         :mod:`plugins.lib.online_style`): any of them on, for a positional subsystem (a hand's fingers share one
         clock and keep the paper's comparison)."""
         p = self.params
-        return not track.hand and (p["posture"] == "removed" or p["amplitude"] > 0 or p["tempo"] > 0)
+        return not track.hand and (p["posture"] == "removed" or p["tempo"] > 0)
 
     def _styled_extended(self, track: Track) -> list[tuple[str, ...]]:
         """:meth:`_extended` for the styled comparison: a candidate path continues along the edges of its end node
         once, at the last frame, its fitted prediction passed the path's end (the best pace's time past the path's
-        duration; with the path-length clock, the lead part's length, divided by the amplitude, past its stroke)."""
+        duration; with the path-length clock, the lead part's length past its stroke)."""
         out = []
         for path in track.candidates:
             fit = track.styled.get(path)
@@ -1314,8 +1329,8 @@ class ForwardModel(Matcher):
         (:mod:`plugins.lib.online_style`): the rows seen since the last call added to the observation's running
         sums and to each path's (a path extended this frame goes on from its parent's sums: its predictions of
         the frames before are the same), each path's prediction at the pace that fits the frames seen best,
-        compared about each side's own mean (``posture``), the observation divided by the fitted amplitude
-        (``amplitude``), the parts (and the travel part) combined as ``error`` says. With ``relative`` both sides
+        compared about each side's own mean (``posture``), the parts (and the travel part) combined as ``error``
+        says. With ``relative`` both sides
         are displacements since the onset."""
         n, start = len(observed), track.fitted
         k = observed.shape[1]
@@ -1326,7 +1341,7 @@ class ForwardModel(Matcher):
         if n > start:
             track.seen.add(o)
         paces = online_style.paces(self.params["tempo"])
-        centred, limit = self.params["posture"] == "removed", self.params["amplitude"]
+        centred = self.params["posture"] == "removed"
         fits = {}
         errors = {}
         for path in paths:
@@ -1335,18 +1350,16 @@ class ForwardModel(Matcher):
                 parent = track.styled.get(path[:-1])
                 fit = parent.copy() if parent is not None else online_style.Fit.empty(len(paces), k)
             if n > start:
-                p, along, past = self._styled_predict(track, path, observed, start, n, paces,
-                                                      fit.extra.get("amplitude", 1.0))
+                p, along, past = self._styled_predict(track, path, observed, start, n, paces)
                 fit.add(o, p)
-                d, best, a = online_style.residuals(track.seen, fit, o[-1], p[:, -1], centred, limit)
+                d, best = online_style.residuals(track.seen, fit, o[-1], p[:, -1], centred)
                 d = d * track.scale
                 if self._traveling(track):
                     dt = _norms(self._travel_predicted(path, along[best]) - track.travel_seen)
                     error = float(self._with_travel(track, d[None], np.array([dt]))[0])
                 else:
                     error = float(self._combine(track, d[None], lengths)[0])
-                fit.extra.update(along=along[best], amplitude=a, pace=float(paces[best]), past=bool(past[best]),
-                                 error=error)
+                fit.extra.update(along=along[best], pace=float(paces[best]), past=bool(past[best]), error=error)
             errors[path] = fit.extra.get("error", np.inf)
             fits[path] = fit
         if track.committed is None:
@@ -1357,15 +1370,13 @@ class ForwardModel(Matcher):
         return errors
 
     def _styled_predict(self, track: Track, path: tuple[str, ...], observed: np.ndarray, start: int, n: int,
-                        paces: np.ndarray, amplitude: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                        paces: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Path ``path``'s predictions of rows ``start .. n - 1`` since the onset, (S, m, k, 3) at each of the S
         ``paces`` (displacements from the path's point at the onset with ``relative``), with each pace's place
         along the path at the last row (S, k) and whether it has passed the path's end (S,).
 
         With ``tempo``: at command time ``t0 + pace * i / fps`` for row ``i``, ``t0`` where the lead part joined the
-        command (:meth:`_anchor`; 0 with ``relative``). Without: the path-length clock (:meth:`_clock`), the lengths
-        divided by the amplitude fitted at the last frame (a movement made twice as large covers its command in
-        half the length), one pace."""
+        command (:meth:`_anchor`; 0 with ``relative``). Without: the path-length clock (:meth:`_clock`), one pace."""
         anchor = self._anchor(track, path[0])
         rows = np.arange(start, n)
         if self.params["tempo"] > 0:
@@ -1381,7 +1392,7 @@ class ForwardModel(Matcher):
         ls = [lengths_ for lengths_ in (_lengths(observed[: i + 1]) for i in rows)]
         alongs = []
         for lengths_ in ls:
-            along = anchor + lengths_ / amplitude
+            along = anchor + lengths_
             if self.params["clock"] == "lead":
                 along = self._lead_clock(path, along)
             alongs.append(along)
