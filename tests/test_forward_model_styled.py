@@ -96,3 +96,20 @@ def test_the_paper_settings_leave_the_styled_fits_empty(arms):
     matcher = use(arms, dropout="absolute", error="max", relative=False, posture="kept", tempo=0.0, learn=False)
     list(feed(matcher, demonstration(arms, stroke_path(arms.motor.rest[2], [0.3, 0.0, 0.0]))))
     assert matcher.tracks["wrists"].styled == {} and matcher.tracks["wrists"].seen is None
+
+
+def test_unexplained_compares_with_standing_still_in_the_same_styled_way(arms):
+    """With the posture removed, predicting that nothing moves is compared as the candidates are (each part about
+    its mean over the frames seen): a movement inwards and down, 135 degrees from both edges, is explained by
+    neither (unknown, whatever the ceiling), and ``out`` itself is explained and committed to early."""
+    rest = arms.motor.rest[2]
+    params = {**STYLED, "unexplained": 1.0, "ceiling": 10.0}
+    answers, matcher = follow(arms, stroke_path(rest, [-0.25, -0.25, 0.0]), **params)
+    assert not answers
+    away = demonstration(arms, stroke_path(rest, [-0.25, -0.25, 0.0]))
+    arms.motor.reset()
+    matcher = use(arms, **{**E, **params})
+    list(feed(matcher, away))
+    assert matcher.conclude(away).movement is None
+    answers, _ = follow(arms, stroke_path(rest, [0.3, 0.0, 0.0]), **params)
+    assert [a.path for a in answers] == [(arms.out,)] and answers[0].decided_at <= 0.5 * 31

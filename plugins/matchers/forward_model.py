@@ -118,7 +118,8 @@ cannot measure a style over the whole segment; each candidate is fitted to the f
 
 - ``posture = "removed"``: each candidate's prediction and the observation are compared each about its own mean
   over the frames seen so far, so a part held otherwise through the movement (a stance, a hand held higher) cancels
-  on both sides alike, rather than only the onset's posture as ``relative`` removes it;
+  on both sides alike, rather than only the onset's posture as ``relative`` removes it; ``unexplained`` and
+  ``stillness`` then compare with predicting that nothing moves in the same way (each part about its own mean);
 - ``tempo`` = a factor (2, the posegraph's): the command is predicted at the time it reaches at a pace (command
   seconds per second seen) among paces at most 12% apart within the factor either way, the pace whose prediction
   leaves the least squared residual over the frames seen (with the posture above); K&G §4.4 re-parameterise each
@@ -1253,7 +1254,9 @@ class ForwardModel(Matcher):
         track.trace.append((frame, errors))
         unexplained = self.params["unexplained"] > 0 and self.params["dropout"] == "relative"
         still = None
-        if self.params["stillness"] or unexplained:  # predicting no movement: every part still, the body on the spot
+        if (self.params["stillness"] or unexplained) and styled and self.params["posture"] == "removed":
+            still = self._styled_still(track, observed, lengths)
+        elif self.params["stillness"] or unexplained:  # predicting no movement: every part still, the body on the spot
             still = self._distance(track, observed[0], last) if not self._traveling(track) else float(
                 self._with_travel(track, (_norms(observed[0] - last) * track.scale)[None],
                                   np.array([_norms(track.travel_seen)]))[0])
@@ -1368,6 +1371,18 @@ class ForwardModel(Matcher):
             track.styled.update(fits)
         track.fitted = n
         return errors
+
+    def _styled_still(self, track: Track, observed: np.ndarray, lengths: np.ndarray) -> float:
+        """With ``posture = "removed"``: the error of predicting that nothing moves, compared as the candidates are
+        (``stillness``, ``unexplained``): a prediction that holds every part still is its own mean, so each part's
+        distance is the observation's from its mean over the frames seen (:meth:`_styled_errors` has added this
+        frame); the body on the spot for the travel part."""
+        seen = track.seen
+        o = observed[-1] - observed[0] if self.params["relative"] else observed[-1]
+        d = _norms(o - seen.so / max(seen.n, 1)) * track.scale
+        if self._traveling(track):
+            return float(self._with_travel(track, d[None], np.array([_norms(track.travel_seen)]))[0])
+        return float(self._combine(track, d[None], lengths)[0])
 
     def _styled_predict(self, track: Track, path: tuple[str, ...], observed: np.ndarray, start: int, n: int,
                         paces: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
