@@ -77,7 +77,7 @@ def test_a_command_moving_a_part_held_still_is_told_apart_on_the_paces_clock_and
     assert matcher.inspect()["trace"][-1][1][(both,)] < 0.02
     answers, matcher = follow(arms, path, tempo=2.0)
     assert [a.path for a in answers] == [(arms.out,)] and answers[0].decided_at <= 0.5 * len(path)
-    assert matcher.inspect()["trace"][-1][1].get((both,), 1.0) > 0.02 or (both,) not in matcher.tracks["wrists"].candidates
+    assert (both,) not in matcher.tracks["wrists"].candidates  # dropped out
 
 
 def test_out_as_learned_keeps_its_answer_under_every_setting(arms):

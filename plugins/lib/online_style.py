@@ -38,7 +38,8 @@ STEP = 1.12
 
 def paces(limit: float) -> np.ndarray:
     """The paces tried for a tempo kept within ``limit`` either way: geometric from ``1 / limit`` to ``limit`` in
-    equal steps of at most :data:`STEP` (15 for 2: 10.4% apart), with 1 among them; ``[1.0]`` for a limit of 0 or 1 (tempo off)."""
+    equal steps of at most :data:`STEP` (15 for 2: 10.4% apart), with 1 among them; ``[1.0]`` for a limit of 0 or 1
+    (tempo off)."""
     if not limit > 1.0:
         return np.array([1.0])
     half = int(np.ceil(np.log(limit) / np.log(STEP)))

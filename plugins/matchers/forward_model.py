@@ -111,8 +111,8 @@ positions are not known the travel part is left out; a command without travel is
 drop-out, ``stillness`` (the body on the spot) and ``unexplained`` (the extent includes the travel) see it; the
 end check (:meth:`ForwardModel._ended`), the start node and the spreads between takes compare the parts alone.
 
-The styled comparison (issue 18; K&G §4.4, §6; B&B §7.1), path search's ``posture``, ``amplitude`` and the
-posegraph's ``tempo`` estimated online (:mod:`plugins.lib.online_style`): the forward model commits early, so it
+The styled comparison (issue 18; K&G §4.4, §6; B&B §7.1), path search's ``posture`` and the posegraph's
+``tempo`` estimated online (:mod:`plugins.lib.online_style`): the forward model commits early, so it
 cannot measure a style over the whole segment; each candidate is fitted to the frames seen so far, from running sums
 (the same work a frame at any length of segment), each setting off by default (the paper):
 
@@ -833,9 +833,9 @@ class ForwardModel(Matcher):
                   "(plugins.lib.online_style), so a stance or a hand held otherwise through the movement cancels; "
                   "'kept': as relative says (the paper).", choices=("kept", "removed")),
         Parameter("tempo", float, 0.0, "Styled comparison: each candidate is predicted at the time its command "
-                  "reaches at a pace (command seconds per second seen) fitted to the frames seen so far, among paces at "
-                  "most 12% apart within this factor either way (posegraph's tempo), so predictions follow the "
-                  "demonstrator's own pace. 0: the path-length clock of reparameterise (the paper, §4.4).",
+                  "reaches at a pace (command seconds per second seen) fitted to the frames seen so far, among "
+                  "paces at most 12% apart within this factor either way (posegraph's tempo), so predictions follow "
+                  "the demonstrator's own pace. 0: the path-length clock of reparameterise (the paper, §4.4).",
                   minimum=0.0, check=lambda v: None if v == 0 or v >= 1 else "0 (off) or a factor of at least 1"),
         Parameter("together", bool, True, "Follow every subsystem that moves during a demonstration, each with its "
                   "own candidates, and imitate them at once (a hand-arm movement, §4.2); off: only the first to move."),
