@@ -68,7 +68,10 @@ class Observed:
 
 @dataclass
 class Fit:
-    """One candidate's running sums over the frames seen, at each of S paces (see the module)."""
+    """One candidate's running sums over the frames seen, at each of S paces (see the module): ``sp``, ``spp``,
+    ``sop`` and the frames ``n``; ``extra``, what its user keeps with it (the forward model: the last frame's place
+    along the path, pace, whether it passed the path's end, and error). A path extended from another goes on from a
+    :meth:`copy` of its sums: its predictions of the frames before are the same."""
 
     sp: np.ndarray
     spp: np.ndarray
