@@ -287,6 +287,10 @@ CASES = [
     ("posegraph-tempo", "a tempo limit below 1", {"c.toml": CHILD + '[motor]\nplugin = "posegraph"\ntempo = 0.5\n'}, ["validate", "c.toml"], ["c.toml:6: key motor.tempo", "0 (off) or a factor of at least 1"]),
     # -- the forward model's travel: an edge's travel in a state file (issue 18, fmtravel)
     ("state-edge-travel", "a learned edge whose travel is not one row per frame of its demonstration", {"st.json": state(actors={"max": {"character": "Max", "components": {"motor": {"plugin": "motor-command-graph", "state": {"left_wrist": {"nodes": {"n1": [[0.26, 1.4, 0.4]]}, "edges": [{"from": "hub", "to": "n1", "name": "left_wrist:e1", "commands": [{"start": [0.25, 0.92, 0.06], "target": [0.26, 1.4, 0.4], "duration": 0.9}], "shown": [[[0.25, 0.92, 0.06]], [[0.26, 1.4, 0.4]]], "shown_fps": 30.0, "travel": [[0.0, 0.0, 1.0]]}]}}}}}})}, ["run", "imitation_games", "--duration", "0.1", "--load", "st.json"], ["key actors.max.components.motor.state.left_wrist.edges[0].travel: invalid travel", "expected where the body went at each frame of shown"]),
+    # -- fmstyled: the forward model's styled comparison: posture, tempo (issue 18, fmstyled)
+    ("fm-posture", "the forward model's posture misnamed", {"c.toml": CHILD + '[matcher]\nplugin = "forward-model"\nposture = "still"\n'}, ["validate", "c.toml"], ["c.toml:6: key matcher.posture", "value 'still' not allowed", "available: kept, removed"]),
+    ("fm-tempo-below-one", "the forward model's tempo limit between 0 and 1", {"c.toml": CHILD + '[matcher]\nplugin = "forward-model"\ntempo = 0.5\n'}, ["validate", "c.toml"], ["c.toml:6: key matcher.tempo", "0 (off) or a factor of at least 1"]),
+    ("fm-tempo", "the forward model's tempo limit negative, on the command line", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--matcher", "forward-model", "--set", "matcher.tempo=-2", "m.bvh"], ["key --set.matcher.tempo", "value -2.0 out of range"]),
 ]
 
 

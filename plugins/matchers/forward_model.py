@@ -111,6 +111,27 @@ positions are not known the travel part is left out; a command without travel is
 drop-out, ``stillness`` (the body on the spot) and ``unexplained`` (the extent includes the travel) see it; the
 end check (:meth:`ForwardModel._ended`), the start node and the spreads between takes compare the parts alone.
 
+The styled comparison (issue 18; K&G §4.4, §6; B&B §7.1), path search's ``posture`` and the posegraph's
+``tempo`` estimated online (:mod:`plugins.lib.online_style`): the forward model commits early, so it
+cannot measure a style over the whole segment; each candidate is fitted to the frames seen so far, from running sums
+(the same work a frame at any length of segment), each setting off by default (the paper):
+
+- ``posture = "removed"``: each candidate's prediction and the observation are compared each about its own mean
+  over the frames seen so far, so a part held otherwise through the movement (a stance, a hand held higher) cancels
+  on both sides alike, rather than only the onset's posture as ``relative`` removes it; ``unexplained`` and
+  ``stillness`` then compare with predicting that nothing moves in the same way (each part about its own mean);
+- ``tempo`` = a factor (2, the posegraph's): the command is predicted at the time it reaches at a pace (command
+  seconds per second seen) among paces at most 12% apart within the factor either way, the pace whose prediction
+  leaves the least squared residual over the frames seen (with the posture above); K&G §4.4 re-parameterise each
+  part by the path length it has covered, which lets a command that moves a part the demonstrator keeps still
+  predict it where it is seen, and a movement made larger run ahead along its command. A candidate path goes on
+  along the next edges once its pace's time passes the path's end; the end check compares the fitted prediction.
+
+Amplitude (the observation scaled by its extent over the command's over the same progress, within a factor 2) was
+built and measured too, and lowered the accuracy on the Bandai-Namco clips in every combination: not kept
+(docs/benchmarks.md, "The forward model's styled comparison (issue 18, fmstyled)"). The spreads between takes
+(``spread``) and :meth:`ForwardModel.take_errors` keep the comparison of the settings above them.
+
 Ranked candidates (B&B Fig. 13; K&G §4.4, Fig. 3's candidates): every answer of one followed subsystem carries
 ``Match.candidates``, the movements the forward models considered in the segment with their prediction errors,
 the answer first and the others best first (:meth:`ForwardModel._ranked`): each movement's error is the mean over
@@ -157,6 +178,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from plugins.lib import online_style
 from plugins.lib.compiled import compiled
 from plugins.lib.strokes import StrokeCriteria
 from toolkit import Match, Matcher, Motion, Parameter, hookimpl
@@ -340,6 +362,14 @@ class Track:
     travel_weights: np.ndarray | None = None
     """With ``travel`` and ``error = "moving"``: the weights (k + 1,) of the parts and of the travel part at the frame
     followed last (:func:`moving_weights` of the parts' path lengths and the root's path in the world)."""
+    styled: dict[tuple[str, ...], Any] = field(default_factory=dict)
+    """With the styled comparison (``posture``, ``tempo``): per candidate path, its running fit
+    (:class:`plugins.lib.online_style.Fit`; its ``extra`` holds the last frame's ``along``, ``pace``,
+    whether the best pace has passed the path's end (``past``), and the ``error``)."""
+    seen: Any = None
+    """With the styled comparison: the running sums of the observation (:class:`plugins.lib.online_style.Observed`)."""
+    fitted: int = 0
+    """With the styled comparison: the rows since the onset added to the fits."""
     placed: tuple[dict[str, int], np.ndarray] | None = None
     """The anchors placed at once when the track began (:meth:`ForwardModel._anchor`): each command's row in them and
     the array (C, k) whose rows are those of ``anchors``."""
@@ -798,6 +828,15 @@ class ForwardModel(Matcher):
                   "displacement over this time in the body's own frame (plugins.lib.travel), observed from the world "
                   "positions and predicted from the travel each command was shown with (Edge.travel), at the point of "
                   "the command the parts are predicted at. 0: root-relative parts only (the paper).", minimum=0.0),
+        Parameter("posture", str, "kept", "Styled comparison (issue 18; K&G §6, B&B §7.1): 'removed' compares each "
+                  "candidate's prediction and the observation each about its own mean over the frames seen so far "
+                  "(plugins.lib.online_style), so a stance or a hand held otherwise through the movement cancels; "
+                  "'kept': as relative says (the paper).", choices=("kept", "removed")),
+        Parameter("tempo", float, 0.0, "Styled comparison: each candidate is predicted at the time its command "
+                  "reaches at a pace (command seconds per second seen) fitted to the frames seen so far, among "
+                  "paces at most 12% apart within this factor either way (posegraph's tempo), so predictions follow "
+                  "the demonstrator's own pace. 0: the path-length clock of reparameterise (the paper, §4.4).",
+                  minimum=0.0, check=lambda v: None if v == 0 or v >= 1 else "0 (off) or a factor of at least 1"),
         Parameter("together", bool, True, "Follow every subsystem that moves during a demonstration, each with its "
                   "own candidates, and imitate them at once (a hand-arm movement, §4.2); off: only the first to move."),
         Parameter("learn", bool, True, "Learn new edges by the inverse model when no edge predicts the demonstration."),
@@ -1193,9 +1232,11 @@ class ForwardModel(Matcher):
         frame = self._memory.n - 1
         if self.params["travel"] > 0 and not track.hand:
             self._travel_seen(track, len(memory), lengths)
+        styled = self._styled(track)
         if track.committed is not None:
-            error = self._error(track, track.committed_path,
-                                self._clock(track, track.committed_path, lengths, len(observed)), last)
+            error = self._styled_errors(track, [track.committed_path], observed, lengths)[track.committed_path] \
+                if styled else self._error(track, track.committed_path,
+                                           self._clock(track, track.committed_path, lengths, len(observed)), last)
             track.trace.append((frame, {track.committed_path: error}))
             if error <= self.params["deviation"]:
                 return None
@@ -1203,15 +1244,19 @@ class ForwardModel(Matcher):
         if not track.candidates:
             return None
         n = len(observed)
-        paths = self._extended(track, lengths, n)
-        if self.params["reparameterise"]:  # the clock is the path length observed: every candidate at once
+        paths = self._styled_extended(track) if styled else self._extended(track, lengths, n)
+        if styled:
+            errors = self._styled_errors(track, paths, observed, lengths)
+        elif self.params["reparameterise"]:  # the clock is the path length observed: every candidate at once
             errors = self._errors(track, paths, lengths, last)
         else:
             errors = {path: self._error(track, path, self._clock(track, path, lengths, n), last) for path in paths}
         track.trace.append((frame, errors))
         unexplained = self.params["unexplained"] > 0 and self.params["dropout"] == "relative"
         still = None
-        if self.params["stillness"] or unexplained:  # predicting no movement: every part still, the body on the spot
+        if (self.params["stillness"] or unexplained) and styled and self.params["posture"] == "removed":
+            still = self._styled_still(track, observed, lengths)
+        elif self.params["stillness"] or unexplained:  # predicting no movement: every part still, the body on the spot
             still = self._distance(track, observed[0], last) if not self._traveling(track) else float(
                 self._with_travel(track, (_norms(observed[0] - last) * track.scale)[None],
                                   np.array([_norms(track.travel_seen)]))[0])
@@ -1225,7 +1270,8 @@ class ForwardModel(Matcher):
         track.candidates = alive
         if alive and len({self._movement_key(p) for p in alive}) == 1:  # one first command (or movement) prevails
             path = min(alive, key=alive.get)
-            along = self._along(track, path[0], self._clock(track, path, lengths, n))
+            along = track.styled[path].extra["along"] if styled else \
+                self._along(track, path[0], self._clock(track, path, lengths, n))
             progress = self._progress(path[0], along)
             if (progress >= self.params["min_progress"] or len(path) > 1) and self._timed(track, observed) and \
                     self._explained(track, path):
@@ -1236,6 +1282,8 @@ class ForwardModel(Matcher):
                 error: float) -> None:
         """Commit a subsystem to candidate ``path`` (the whole learned sequence it begins), at the speed seen."""
         track.committed_path = self._known_continuation(path)
+        if path in track.styled:  # the whole sequence predicts the frames seen as its beginning did
+            track.styled[track.committed_path] = track.styled[path]
         track.committed = self.motor.add_sequence(list(track.committed_path))
         track.committed_at = self._memory.n
         track.speed = self._speed(track, path, n_observed)
@@ -1258,6 +1306,145 @@ class ForwardModel(Matcher):
         along = self._along(track, path[0], _lengths(observed))
         self._commit(track, path, along, self._progress(path[0], along), len(observed), track.candidates[path])
         return True
+
+    # -- the styled comparison (issue 18; K&G §6, B&B §7.1) ------------------------------------------
+
+    def _styled(self, track: Track) -> bool:
+        """Whether ``track`` is compared in the demonstrator's own style (``posture``, ``tempo``;
+        :mod:`plugins.lib.online_style`): any of them on, for a positional subsystem (a hand's fingers share one
+        clock and keep the paper's comparison)."""
+        p = self.params
+        return not track.hand and (p["posture"] == "removed" or p["tempo"] > 0)
+
+    def _styled_extended(self, track: Track) -> list[tuple[str, ...]]:
+        """:meth:`_extended` for the styled comparison: a candidate path continues along the edges of its end node
+        once, at the last frame, its fitted prediction passed the path's end (the best pace's time past the path's
+        duration; with the path-length clock, the lead part's length past its stroke)."""
+        out = []
+        for path in track.candidates:
+            fit = track.styled.get(path)
+            out.extend(self._next(track, path) if fit is not None and fit.extra.get("past") else [path])
+        return out
+
+    def _styled_errors(self, track: Track, paths: list[tuple[str, ...]], observed: np.ndarray,
+                       lengths: np.ndarray) -> dict[tuple[str, ...], float]:
+        """This frame's prediction error of each candidate path in the demonstrator's own style
+        (:mod:`plugins.lib.online_style`): the rows seen since the last call added to the observation's running
+        sums and to each path's (a path extended this frame goes on from its parent's sums: its predictions of
+        the frames before are the same), each path's prediction at the pace that fits the frames seen best,
+        compared about each side's own mean (``posture``), the parts (and the travel part) combined as ``error``
+        says. With ``relative`` both sides
+        are displacements since the onset."""
+        n, start = len(observed), track.fitted
+        k = observed.shape[1]
+        rel = self.params["relative"]
+        o = observed[start:n] - observed[0] if rel else observed[start:n]
+        if track.seen is None:
+            track.seen = online_style.Observed.empty(k)
+        if n > start:
+            track.seen.add(o)
+        paces = online_style.paces(self.params["tempo"])
+        centred = self.params["posture"] == "removed"
+        fits = {}
+        errors = {}
+        for path in paths:
+            fit = track.styled.get(path)
+            if fit is None:
+                parent = track.styled.get(path[:-1])
+                fit = parent.copy() if parent is not None else online_style.Fit.empty(len(paces), k)
+            if n > start:
+                p, along, past = self._styled_predict(track, path, observed, start, n, paces)
+                fit.add(o, p)
+                d, best = online_style.residuals(track.seen, fit, o[-1], p[:, -1], centred)
+                d = d * track.scale
+                if self._traveling(track):
+                    dt = _norms(self._travel_predicted(path, along[best]) - track.travel_seen)
+                    error = float(self._with_travel(track, d[None], np.array([dt]))[0])
+                else:
+                    error = float(self._combine(track, d[None], lengths)[0])
+                fit.extra.update(along=along[best], pace=float(paces[best]), past=bool(past[best]), error=error)
+            errors[path] = fit.extra.get("error", np.inf)
+            fits[path] = fit
+        if track.committed is None:
+            track.styled = fits
+        else:
+            track.styled.update(fits)
+        track.fitted = n
+        return errors
+
+    def _styled_still(self, track: Track, observed: np.ndarray, lengths: np.ndarray) -> float:
+        """With ``posture = "removed"``: the error of predicting that nothing moves, compared as the candidates are
+        (``stillness``, ``unexplained``): a prediction that holds every part still is its own mean, so each part's
+        distance is the observation's from its mean over the frames seen (:meth:`_styled_errors` has added this
+        frame); the body on the spot for the travel part."""
+        seen = track.seen
+        o = observed[-1] - observed[0] if self.params["relative"] else observed[-1]
+        d = _norms(o - seen.so / max(seen.n, 1)) * track.scale
+        if self._traveling(track):
+            return float(self._with_travel(track, d[None], np.array([_norms(track.travel_seen)]))[0])
+        return float(self._combine(track, d[None], lengths)[0])
+
+    def _styled_predict(self, track: Track, path: tuple[str, ...], observed: np.ndarray, start: int, n: int,
+                        paces: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Path ``path``'s predictions of rows ``start .. n - 1`` since the onset, (S, m, k, 3) at each of the S
+        ``paces`` (displacements from the path's point at the onset with ``relative``), with each pace's place
+        along the path at the last row (S, k) and whether it has passed the path's end (S,).
+
+        With ``tempo``: at command time ``t0 + pace * i / fps`` for row ``i``, ``t0`` where the lead part joined the
+        command (:meth:`_anchor`; 0 with ``relative``). Without: the path-length clock (:meth:`_clock`), one pace."""
+        anchor = self._anchor(track, path[0])
+        rows = np.arange(start, n)
+        if self.params["tempo"] > 0:
+            lead = self._lead(path[0])
+            t0 = self._mapped_time(self._strokes_of(path[0])[lead], float(anchor[lead]))
+            times = t0 + paces[:, None] * (np.append(rows, 0) / self.fps)[None]  # (S, m + 1): the onset's last
+            points, along, past = self._at_times(path, times.ravel())
+            points = points.reshape(len(paces), len(rows) + 1, *points.shape[1:])
+            along = along.reshape(len(paces), len(rows) + 1, -1)[:, -2]
+            past = past.reshape(len(paces), len(rows) + 1)[:, -2]
+            p = points[:, :-1] - points[:, -1:] if self.params["relative"] else points[:, :-1]
+            return p, along, past
+        ls = [lengths_ for lengths_ in (_lengths(observed[: i + 1]) for i in rows)]
+        alongs = []
+        for lengths_ in ls:
+            along = anchor + lengths_
+            if self.params["clock"] == "lead":
+                along = self._lead_clock(path, along)
+            alongs.append(along)
+        p = np.stack([self._predict(track, path, a) for a in alongs])[None]
+        if self.params["relative"]:
+            p = p - self._predict(track, path, anchor)
+        lead = self._lead(path[0])
+        total = sum(self._edge(e).arcs[lead, -1] for e in path)
+        return p, alongs[-1][None], np.array([alongs[-1][lead] > total + 0.01 / track.scale])
+
+    def _at_times(self, path: tuple[str, ...], times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Every part of path ``path`` at command times ``times`` (N,): positions (N, k, 3), places along the path
+        (N, k: path length from its start, edge after edge, as :meth:`_along` counts) and whether the time is past
+        the path's end (N,). Each part's stroke is tabled uniformly in its own time (:meth:`_table`) and holds its
+        end once it has ended; the edges follow one another after each edge's duration."""
+        start, before = 0.0, None
+        out_p = out_a = None
+        for name in path:
+            edge, table = self.motor.edge(name), self._edge(name)
+            k, g, _ = table.positions.shape
+            duration = np.array([c.duration for c in edge.commands])
+            local = times - start
+            u = np.clip(local[:, None] / duration[None], 0.0, 1.0) * (g - 1)
+            j = np.clip(np.floor(u).astype(np.intp), 0, g - 2)
+            w = u - j
+            cols = np.arange(k)[None]
+            points = table.positions[cols, j] * (1 - w[..., None]) + table.positions[cols, j + 1] * w[..., None]
+            arcs = table.arcs[cols, j] * (1 - w) + table.arcs[cols, j + 1] * w
+            if before is None:
+                out_p, out_a, before = points, arcs, np.zeros(k)
+            else:
+                here = local >= 0
+                out_p[here] = points[here]
+                out_a[here] = arcs[here] + before
+            before = before + table.arcs[:, -1]
+            start += edge.duration
+        return out_p, out_a, times > start
 
     # -- drop-out (K&G §4.4, Fig. 3) ----------------------------------------------------------------
 
@@ -2128,6 +2315,9 @@ class ForwardModel(Matcher):
 
     def _ended(self, track: Track, memory: np.ndarray) -> bool:
         """Whether the demonstration ended (the last row of ``memory``) where the committed path does."""
+        fit = track.styled.get(track.committed_path)
+        if self._styled(track) and fit is not None and "error" in fit.extra:  # where the fitted prediction is now
+            return fit.extra["error"] <= self.params["deviation"]
         end = self.motor.edge(track.committed_path[-1]).target
         expected = self.motor.state(track.subsystem, end) + self._onset_offset(track, track.committed_path[0])
         seen = memory[-1, self.motor.subsystems[track.subsystem]]
