@@ -65,8 +65,11 @@ def test_explained_has_no_unit(error, extent, unexplained, scale):
 
 
 @settings(max_examples=200, deadline=None)
-@given(lengths=st.lists(st.floats(0.0, 10.0), min_size=1, max_size=12), scale=st.floats(1e-3, 1e3))
+@given(lengths=st.lists(st.one_of(st.just(0.0), st.floats(1e-6, 10.0)), min_size=1, max_size=12),
+       scale=st.floats(1e-3, 1e3))
 def test_moving_weights_have_no_unit_and_sum_to_one(lengths, scale):
+    """Path lengths of 0 or of a micrometre and more (below that a part has not moved, and a length of 5e-324 m
+    halved is 0: a part that moved would become one that did not)."""
     lengths = np.array(lengths)
     weights = moving_weights(lengths)
     assert weights.sum() == pytest.approx(1.0) and (weights >= 0).all()
