@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Observed", "Fit", "paces", "residuals", "fitted", "STEP"]
+__all__ = ["Observed", "Fit", "paces", "residuals", "fitted", "distances_all", "STEP"]
 
 STEP = 1.12
 """Ratio of successive paces (:func:`paces`): 12%, the steps of the forward model's speed grid (``_speed``)."""
@@ -115,3 +115,26 @@ def residuals(obs: Observed, fit: Fit, o: np.ndarray, p: np.ndarray, centred: bo
     c = 1.0 / max(obs.n, 1) if centred else 0.0
     d = np.linalg.norm((np.asarray(o, dtype=float) - obs.so * c) - (p[best] - fit.sp[best] * c), axis=-1)
     return d, best
+
+
+def distances_all(o: np.ndarray, p: np.ndarray, centred: bool) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`residuals` at every frame of a whole movement at once, as following it frame by frame gives them: the
+    observation ``o`` (n, k, 3) and a candidate's predictions ``p`` (S, n, k, 3) at S paces; the running sums over
+    rows 0 .. t are cumulative sums. Returns each frame's per-part distances (n, k) at the pace whose fit over the
+    frames up to it leaves the least squared residual, and that pace's index (n,)."""
+    o = np.nan_to_num(np.asarray(o, dtype=float))
+    p = np.nan_to_num(np.asarray(p, dtype=float))
+    n = np.arange(1, len(o) + 1)
+    c = 1.0 / n if centred else np.zeros(len(o))
+    so = np.cumsum(o, axis=0)  # (n, k, 3)
+    soo = np.cumsum((o * o).sum(axis=(1, 2)))
+    sp = np.cumsum(p, axis=1)  # (S, n, k, 3)
+    spp = np.cumsum((p * p).sum(axis=(2, 3)), axis=1)  # (S, n)
+    sop = np.cumsum(np.einsum("nkc,snkc->sn", o, p), axis=1)
+    rss = (soo - c * (so * so).sum(axis=(1, 2)))[None] - 2.0 * (sop - c * np.einsum("nkc,snkc->sn", so, sp)) \
+        + spp - c * (sp * sp).sum(axis=(2, 3))
+    best = np.argmin(np.maximum(rss, 0.0), axis=0)  # (n,)
+    at = np.arange(len(o))
+    mo = so * c[:, None, None]
+    mp = sp[best, at] * c[:, None, None]
+    return np.linalg.norm((o - mo) - (p[best, at] - mp), axis=-1), best

@@ -1520,20 +1520,26 @@ class ForwardModel(Matcher):
                 if len(examples) < 2:
                     continue
                 distances = []
-                for i, (_, subsystem, observed, _) in enumerate(examples):
+                for i, (_, subsystem, observed, fps) in enumerate(examples):
                     others = [tuple(edges) for j, (edges, *_) in enumerate(examples) if j != i]
-                    errors = [self.take_errors(subsystem, observed, path) for path in others]
+                    errors = [self.take_errors(subsystem, observed, path, fps) for path in others]
                     distances.append(min((float(np.mean(e)) for e in errors if len(e)), default=float("nan")))
                 finite = [d for d in distances if np.isfinite(d)]
                 if len(finite) >= 2:
                     self._spreads[movement] = float(np.median(finite))
         return self._spreads
 
-    def take_errors(self, subsystem: str, observed: np.ndarray, path: tuple[str, ...]) -> np.ndarray:
+    def take_errors(self, subsystem: str, observed: np.ndarray, path: tuple[str, ...],
+                    fps: float | None = None) -> np.ndarray:
         """The prediction error, frame by frame, of command path ``path`` on a subsystem's observed movement
         ``observed`` (n, k, 3) followed from its first frame: the forward model's own prediction (:meth:`_error`,
         anchors and ``relative`` included) with the observed path lengths up to each frame (the positions
-        averaged over three frames, as :func:`_lengths` does, over the whole take at once)."""
+        averaged over three frames, as :func:`_lengths` does, over the whole take at once).
+
+        With the styled comparison (``posture``, ``tempo``; :meth:`_styled`) the take is compared as a
+        demonstration is (:meth:`_take_errors_styled`), so that a spread between takes and the errors of the
+        candidates it bounds compare like with like. ``fps``: the take's frame rate (the pace's clock; by default
+        the segment's, else 30)."""
         from scipy.ndimage import uniform_filter1d
 
         track = Track(subsystem, self._scale_of(subsystem), self.motor.is_hand(subsystem), "hub", 0, {}, [],
@@ -1541,6 +1547,9 @@ class ForwardModel(Matcher):
         smooth = uniform_filter1d(observed, size=3, axis=0, mode="nearest") if len(observed) >= 3 else observed
         walked = np.concatenate([np.zeros((1, observed.shape[1])),
                                  np.cumsum(np.linalg.norm(np.diff(smooth, axis=0), axis=-1), axis=0)])
+        if self._styled(track) and len(path):
+            return self._take_errors_styled(track, observed, path, walked,
+                                            fps if fps else getattr(self, "fps", None) or 30.0)
         if track.hand or not len(path) or self.params["clock"] == "lead":  # one clock: frame by frame, as followed
             return np.array([self._error(track, path, walked[t], observed[t]) for t in range(1, len(observed))])
         # every frame at once: each part along its strokes of the whole path, laid end to end (what _predict does
@@ -1554,6 +1563,37 @@ class ForwardModel(Matcher):
         predicted = np.stack([np.stack([np.interp(along[:, p], arcs[p], positions[p, :, c]) for c in range(3)],
                                        axis=-1) for p in range(len(arcs))], axis=1)  # (T, k, 3)
         d = np.linalg.norm(predicted + self._onset_offset(track, path[0]) - observed[1:], axis=-1) * track.scale
+        if self.params["error"] == "moving":
+            return (d * np.apply_along_axis(moving_weights, 1, walked[1:])).sum(axis=1)
+        return d.max(axis=1) if self.params["error"] == "max" else d.mean(axis=1)
+
+    def _take_errors_styled(self, track: Track, observed: np.ndarray, path: tuple[str, ...], walked: np.ndarray,
+                            fps: float) -> np.ndarray:
+        """:meth:`take_errors` in the demonstrator's own style: at each frame ``t`` of the take (1 .. n - 1) the
+        error :meth:`_styled_errors` gives when following it, every frame at once. The running sums of
+        :mod:`plugins.lib.online_style` over rows 0 .. t are cumulative sums over the take: per pace the residual
+        over the frames up to ``t`` (:func:`online_style.distances_all`), the best pace at each frame, and that pace's
+        per-part distance at ``t``, each side about its own mean up to ``t`` with ``posture = "removed"``. The parts
+        are compared alone (the spreads leave travel out), combined as ``error`` says with the path lengths walked
+        up to ``t`` (:func:`moving_weights`)."""
+        rows = np.arange(len(observed))
+        if self.params["tempo"] > 0:
+            paces = online_style.paces(self.params["tempo"])
+            anchor = self._anchor(track, path[0])
+            lead = self._lead(path[0])
+            t0 = self._mapped_time(self._strokes_of(path[0])[lead], float(anchor[lead]))
+            times = t0 + paces[:, None] * (rows / fps)[None]  # (S, n): row 0 is the onset
+            points = self._at_times(path, times.ravel())[0].reshape(len(paces), len(rows), -1, 3)
+            p = points - points[:, :1] if self.params["relative"] else points
+        else:  # the path-length clock, one pace: each part along its strokes after the path walked (as _predict)
+            anchor = self._anchor(track, path[0])
+            clock = self._lead_clock if self.params["clock"] == "lead" else (lambda _, along: along)
+            p = np.stack([self._predict(track, path, clock(path, anchor + w)) for w in walked])[None]
+            if self.params["relative"]:
+                p = p - self._predict(track, path, anchor)
+        o = observed - observed[0] if self.params["relative"] else observed
+        d, _ = online_style.distances_all(o, p, self.params["posture"] == "removed")
+        d = d[1:] * track.scale  # (n - 1, k)
         if self.params["error"] == "moving":
             return (d * np.apply_along_axis(moving_weights, 1, walked[1:])).sum(axis=1)
         return d.max(axis=1) if self.params["error"] == "max" else d.mean(axis=1)
