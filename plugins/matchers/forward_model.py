@@ -470,6 +470,44 @@ class _StrokeRows:
         return p0 + np.clip(w, 0.0, 1.0)[:, None] * (self.positions[rows, j + 1] - p0)
 
 
+class _TimedTables:
+    """Every command of one subsystem the styled comparison has predicted, stacked for :meth:`ForwardModel._at_times_all`:
+    each command's strokes on the fine grid, positions (T, k, G, 3) and cumulative path lengths (T, k, G), with each
+    part's stroke duration (T, k) and the command's duration (T,). A command met for the first time, or whose table
+    changed, is added (the stack is rebuilt then, once per new command; every command is uniform in its own time)."""
+
+    __slots__ = ("index", "tables", "positions", "arcs", "durations", "edge_durations", "totals")
+
+    def __init__(self) -> None:
+        self.index: dict[str, tuple[Any, int]] = {}
+        self.tables: list[tuple[np.ndarray, np.ndarray, np.ndarray, float]] = []
+        self.positions = self.arcs = self.durations = self.edge_durations = self.totals = None
+
+    def rows(self, names: list[str], model: ForwardModel) -> np.ndarray | None:
+        """The row of each command in the stack (added when new or changed); ``None`` when they cannot be stacked
+        (grids of other sizes)."""
+        out, grew = [], False
+        for name in names:
+            table = model._edge(name)
+            kept = self.index.get(name)
+            if kept is None or kept[0] is not table:
+                edge = model.motor.edge(name)
+                duration = np.array([c.duration for c in edge.commands])
+                if self.tables and table.positions.shape != self.tables[0][0].shape:
+                    return None
+                self.index[name] = kept = (table, len(self.tables))
+                self.tables.append((table.positions, table.arcs, duration, edge.duration))
+                grew = True
+            out.append(kept[1])
+        if grew or self.positions is None:
+            self.positions = np.stack([t[0] for t in self.tables])
+            self.arcs = np.stack([t[1] for t in self.tables])
+            self.durations = np.stack([t[2] for t in self.tables])
+            self.edge_durations = np.array([t[3] for t in self.tables], dtype=float)
+            self.totals = self.arcs[:, :, -1]
+        return np.array(out, dtype=np.intp)
+
+
 def _along_rows(arcs: np.ndarray, positions: np.ndarray, x: np.ndarray, keys: np.ndarray | None = None) -> np.ndarray:
     """Per row r, the point of ``positions[r]`` (G, 3) at path length ``x[r]`` along ``arcs[r]`` (G,), linearly
     interpolated (``np.interp`` row by row); 0 <= x[r] <= arcs[r, -1].
@@ -875,6 +913,7 @@ class ForwardModel(Matcher):
         self._half_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
         self._stroke_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
         self._stroke_rows = _StrokeRows(self.GRID)
+        self._time_tables: dict[str, _TimedTables] = {}  # subsystem -> the commands the styled comparison predicted
         self._scales: dict[str, tuple[Any, float]] = {}
         self._placed: OrderedDict[tuple[tuple[str, ...], bytes], tuple[tuple, np.ndarray]] = OrderedDict()
         self._memory: WorkingMemory | None = None
@@ -1347,13 +1386,16 @@ class ForwardModel(Matcher):
         centred = self.params["posture"] == "removed"
         fits = {}
         errors = {}
-        for path in paths:
+        batch = self._styled_predict_all(track, paths, start, n, paces) if n > start and self.params["tempo"] > 0 \
+            else None
+        for c, path in enumerate(paths):
             fit = track.styled.get(path)
             if fit is None:
                 parent = track.styled.get(path[:-1])
                 fit = parent.copy() if parent is not None else online_style.Fit.empty(len(paces), k)
             if n > start:
-                p, along, past = self._styled_predict(track, path, observed, start, n, paces)
+                p, along, past = (batch[0][c], batch[1][c], batch[2][c]) if batch is not None else \
+                    self._styled_predict(track, path, observed, start, n, paces)
                 fit.add(o, p)
                 d, best = online_style.residuals(track.seen, fit, o[-1], p[:, -1], centred)
                 d = d * track.scale
@@ -1417,6 +1459,76 @@ class ForwardModel(Matcher):
         lead = self._lead(path[0])
         total = sum(self._edge(e).arcs[lead, -1] for e in path)
         return p, alongs[-1][None], np.array([alongs[-1][lead] > total + 0.01 / track.scale])
+
+    def _styled_predict_all(self, track: Track, paths: list[tuple[str, ...]], start: int, n: int,
+                            paces: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """:meth:`_styled_predict` with ``tempo`` for every candidate path at once (the same values): predictions
+        (C, S, m, k, 3), places along the paths at the last row (C, S, k) and whether past their ends (C, S);
+        ``None`` when the paths' commands cannot be stacked (:class:`_TimedTables`)."""
+        if not paths:
+            return None
+        rows = np.arange(start, n)
+        clock = np.append(rows, 0) / self.fps  # (m + 1,): the onset's last
+        t0 = np.empty(len(paths))
+        for c, path in enumerate(paths):
+            anchor = self._anchor(track, path[0])
+            lead = self._lead(path[0])
+            t0[c] = self._mapped_time(self._strokes_of(path[0])[lead], float(anchor[lead]))
+        times = t0[:, None, None] + paces[None, :, None] * clock[None, None]  # (C, S, m + 1)
+        out = self._at_times_all(track.subsystem, paths, times.reshape(len(paths), -1))
+        if out is None:
+            return None
+        points, along, past = out
+        points = points.reshape(len(paths), len(paces), len(rows) + 1, *points.shape[2:])
+        along = along.reshape(len(paths), len(paces), len(rows) + 1, -1)[:, :, -2]
+        past = past.reshape(len(paths), len(paces), len(rows) + 1)[:, :, -2]
+        p = points[:, :, :-1] - points[:, :, -1:] if self.params["relative"] else points[:, :, :-1]
+        return p, along, past
+
+    def _at_times_all(self, subsystem: str, paths: list[tuple[str, ...]],
+                      times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """:meth:`_at_times` of C paths at once, path ``c`` at command times ``times[c]`` ((C, N); the same values):
+        positions (C, N, k, 3), places along (C, N, k) and past the end (C, N). Each time is on the last edge of its
+        path that has begun by then (the first edge before it begins), as :meth:`_at_times` overwrites edge after
+        edge; the edges' starts and the places before them are the same running sums."""
+        timed = self._time_tables.get(subsystem)
+        if timed is None:
+            timed = self._time_tables[subsystem] = _TimedTables()
+        longest = max(len(path) for path in paths)
+        ids = timed.rows([name for path in paths for name in path], self)
+        if ids is None:
+            return None
+        c_n = len(paths)
+        slots = np.zeros((c_n, longest), dtype=np.intp)
+        used = np.zeros((c_n, longest), dtype=bool)
+        at = 0
+        for c, path in enumerate(paths):
+            slots[c, : len(path)] = ids[at : at + len(path)]
+            used[c, : len(path)] = True
+            at += len(path)
+        # per path, each edge's start (s) and the path length before it, part by part: running sums in path order
+        durations = np.where(used, timed.edge_durations[slots], 0.0)
+        starts = np.zeros((c_n, longest + 1))
+        np.cumsum(durations, axis=1, out=starts[:, 1:])
+        before = np.zeros((c_n, longest + 1, timed.totals.shape[1]))
+        np.cumsum(np.where(used[..., None], timed.totals[slots], 0.0), axis=1, out=before[:, 1:])
+        ends = starts[np.arange(c_n), np.array([len(path) for path in paths])]  # (C,): each path's duration
+        begun = (times[:, :, None] - starts[:, None, :longest] >= 0) & used[:, None, :]  # (C, N, L)
+        slot = np.maximum(longest - 1 - np.argmax(begun[:, :, ::-1], axis=2), 0)
+        slot = np.where(begun.any(axis=2), slot, 0)  # (C, N): the edge of the path each time is on
+        cc = np.arange(c_n)[:, None]
+        table = slots[cc, slot]  # (C, N)
+        local = times - starts[cc, slot]
+        g = timed.positions.shape[2]
+        u = np.clip(local[..., None] / timed.durations[table], 0.0, 1.0) * (g - 1)  # (C, N, k)
+        j = np.clip(np.floor(u).astype(np.intp), 0, g - 2)
+        w = u - j
+        t, cols = table[..., None], np.arange(timed.positions.shape[1])
+        points = timed.positions[t, cols, j] * (1 - w[..., None]) + timed.positions[t, cols, j + 1] * w[..., None]
+        arcs = timed.arcs[t, cols, j] * (1 - w) + timed.arcs[t, cols, j + 1] * w
+        first = slot == 0
+        along = np.where(first[..., None], arcs, arcs + before[cc, slot])
+        return points, along, times > ends[:, None]
 
     def _at_times(self, path: tuple[str, ...], times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Every part of path ``path`` at command times ``times`` (N,): positions (N, k, 3), places along the path
