@@ -81,3 +81,30 @@ def test_a_followed_demonstration_fits_the_same_paces_and_errors_batched_as_path
     batched = run(chained, path, True, monkeypatch, posture=posture)
     alone = run(chained, path, False, monkeypatch, posture=posture)
     assert batched == alone
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), c=st.integers(1, 6), s=st.integers(1, 15), m=st.integers(1, 4),
+       k=st.integers(1, 5), frames=st.integers(1, 4), centred=st.booleans())
+def test_every_candidates_sums_at_once_are_each_candidates_bit_for_bit(seed, c, s, m, k, frames, centred):
+    """:func:`online_style.residuals_all` against :meth:`Fit.add` and :func:`residuals` candidate by candidate, over a
+    few calls of ``m`` rows each (random data, NaNs among the predictions): the same sums, best paces and distances."""
+    from plugins.lib import online_style
+
+    rng = np.random.default_rng(seed)
+    obs_a, obs_b = online_style.Observed.empty(k), online_style.Observed.empty(k)
+    alone = [online_style.Fit.empty(s, k) for _ in range(c)]
+    at_once = [f.copy() for f in alone]
+    for _ in range(frames):
+        o, p = rng.normal(size=(m, k, 3)), rng.normal(size=(c, s, m, k, 3))
+        p[rng.random(p.shape[:-1]) < 0.05] = np.nan
+        obs_a.add(o)
+        obs_b.add(o)
+        d, best = online_style.residuals_all(obs_b, at_once, o, p, centred)
+        for i, fit in enumerate(alone):
+            fit.add(o, p[i])
+            di, bi = online_style.residuals(obs_a, fit, o[-1], p[i, :, -1], centred)
+            assert bi == best[i]
+            np.testing.assert_array_equal(di, d[i])
+            for name in ("sp", "spp", "sop", "n"):
+                np.testing.assert_array_equal(getattr(fit, name), getattr(at_once[i], name))

@@ -1388,16 +1388,25 @@ class ForwardModel(Matcher):
         errors = {}
         batch = self._styled_predict_all(track, paths, start, n, paces) if n > start and self.params["tempo"] > 0 \
             else None
-        for c, path in enumerate(paths):
+        for path in paths:
             fit = track.styled.get(path)
             if fit is None:
                 parent = track.styled.get(path[:-1])
                 fit = parent.copy() if parent is not None else online_style.Fit.empty(len(paces), k)
+            fits[path] = fit
+        if batch is not None and len(fits) == len(paths):  # every candidate's sums at once
+            ds, bests = online_style.residuals_all(track.seen, list(fits.values()), o, batch[0], centred)
+        for c, path in enumerate(paths):
+            fit = fits[path]
             if n > start:
-                p, along, past = (batch[0][c], batch[1][c], batch[2][c]) if batch is not None else \
-                    self._styled_predict(track, path, observed, start, n, paces)
-                fit.add(o, p)
-                d, best = online_style.residuals(track.seen, fit, o[-1], p[:, -1], centred)
+                if batch is not None and len(fits) == len(paths):
+                    p, along, past = batch[0][c], batch[1][c], batch[2][c]
+                    d, best = ds[c], int(bests[c])
+                else:
+                    p, along, past = (batch[0][c], batch[1][c], batch[2][c]) if batch is not None else \
+                        self._styled_predict(track, path, observed, start, n, paces)
+                    fit.add(o, p)
+                    d, best = online_style.residuals(track.seen, fit, o[-1], p[:, -1], centred)
                 d = d * track.scale
                 if self._traveling(track):
                     dt = _norms(self._travel_predicted(path, along[best]) - track.travel_seen)
@@ -1406,7 +1415,6 @@ class ForwardModel(Matcher):
                     error = float(self._combine(track, d[None], lengths)[0])
                 fit.extra.update(along=along[best], pace=float(paces[best]), past=bool(past[best]), error=error)
             errors[path] = fit.extra.get("error", np.inf)
-            fits[path] = fit
         if track.committed is None:
             track.styled = fits
         else:
