@@ -476,12 +476,12 @@ class _TimedTables:
     part's stroke duration (T, k) and the command's duration (T,). A command met for the first time, or whose table
     changed, is added (the stack is rebuilt then, once per new command; every command is uniform in its own time)."""
 
-    __slots__ = ("index", "tables", "positions", "arcs", "durations", "edge_durations", "totals")
+    __slots__ = ("index", "tables", "positions", "arcs", "durations", "edge_durations", "totals", "travel")
 
     def __init__(self) -> None:
         self.index: dict[str, tuple[Any, int]] = {}
-        self.tables: list[tuple[np.ndarray, np.ndarray, np.ndarray, float]] = []
-        self.positions = self.arcs = self.durations = self.edge_durations = self.totals = None
+        self.tables: list[tuple[np.ndarray, np.ndarray, np.ndarray, float, np.ndarray | None]] = []
+        self.positions = self.arcs = self.durations = self.edge_durations = self.totals = self.travel = None
 
     def rows(self, names: list[str], model: ForwardModel) -> np.ndarray | None:
         """The row of each command in the stack (added when new or changed); ``None`` when they cannot be stacked
@@ -496,7 +496,7 @@ class _TimedTables:
                 if self.tables and table.positions.shape != self.tables[0][0].shape:
                     return None
                 self.index[name] = kept = (table, len(self.tables))
-                self.tables.append((table.positions, table.arcs, duration, edge.duration))
+                self.tables.append((table.positions, table.arcs, duration, edge.duration, table.travel))
                 grew = True
             out.append(kept[1])
         if grew or self.positions is None:
@@ -505,6 +505,8 @@ class _TimedTables:
             self.durations = np.stack([t[2] for t in self.tables])
             self.edge_durations = np.array([t[3] for t in self.tables], dtype=float)
             self.totals = self.arcs[:, :, -1]
+            travel = [t[4] for t in self.tables]
+            self.travel = np.stack(travel) if all(t is not None for t in travel) else None  # (T, G, 3)
         return np.array(out, dtype=np.intp)
 
 
@@ -1394,8 +1396,11 @@ class ForwardModel(Matcher):
                 parent = track.styled.get(path[:-1])
                 fit = parent.copy() if parent is not None else online_style.Fit.empty(len(paces), k)
             fits[path] = fit
+        travel = None
         if batch is not None and len(fits) == len(paths):  # every candidate's sums at once
             ds, bests = online_style.residuals_all(track.seen, list(fits.values()), o, batch[0], centred)
+            if self._traveling(track):
+                travel = self._travel_all(track.subsystem, paths, batch[1][np.arange(len(paths)), bests])
         for c, path in enumerate(paths):
             fit = fits[path]
             if n > start:
@@ -1409,7 +1414,8 @@ class ForwardModel(Matcher):
                     d, best = online_style.residuals(track.seen, fit, o[-1], p[:, -1], centred)
                 d = d * track.scale
                 if self._traveling(track):
-                    dt = _norms(self._travel_predicted(path, along[best]) - track.travel_seen)
+                    dt = _norms((self._travel_predicted(path, along[best]) if travel is None else travel[c])
+                                - track.travel_seen)
                     error = float(self._with_travel(track, d[None], np.array([dt]))[0])
                 else:
                     error = float(self._combine(track, d[None], lengths)[0])
@@ -1531,9 +1537,11 @@ class ForwardModel(Matcher):
         u = np.clip(local[..., None] / timed.durations[table], 0.0, 1.0) * (g - 1)  # (C, N, k)
         j = np.clip(np.floor(u).astype(np.intp), 0, g - 2)
         w = u - j
-        t, cols = table[..., None], np.arange(timed.positions.shape[1])
-        points = timed.positions[t, cols, j] * (1 - w[..., None]) + timed.positions[t, cols, j + 1] * w[..., None]
-        arcs = timed.arcs[t, cols, j] * (1 - w) + timed.arcs[t, cols, j + 1] * w
+        k = timed.positions.shape[1]
+        at = (table[..., None] * k + np.arange(k)) * g + j  # flat index of [table, part, j] (a gather: the same values)
+        flat_p, flat_a = timed.positions.reshape(-1, 3), timed.arcs.reshape(-1)
+        points = flat_p[at] * (1 - w[..., None]) + flat_p[at + 1] * w[..., None]
+        arcs = flat_a[at] * (1 - w) + flat_a[at + 1] * w
         first = slot == 0
         along = np.where(first[..., None], arcs, arcs + before[cc, slot])
         return points, along, times > ends[:, None]
@@ -1843,6 +1851,28 @@ class ForwardModel(Matcher):
                 return point * self.params["travel"]
             left -= total
         return np.zeros(3)  # no command (not reached)
+
+    def _travel_all(self, subsystem: str, paths: list[tuple[str, ...]], along: np.ndarray) -> np.ndarray | None:
+        """:meth:`_travel_predicted` of C paths at once (C, 3; the same values), ``along`` (C, k) their parts' places
+        along them, from the commands :meth:`_at_times_all` stacked this frame; ``None`` without their travel."""
+        timed = self._time_tables.get(subsystem)
+        if timed is None or timed.travel is None:
+            return None
+        ids, leads, xs = [], [], []
+        for c, path in enumerate(paths):  # the edge each lead is on, as _travel_predicted walks them
+            lead = self._lead(path[0])
+            left = float(along[c, lead])
+            for i, name in enumerate(path):
+                total = float(timed.totals[timed.index[name][1], lead])
+                if left <= total or i == len(path) - 1:
+                    ids.append(timed.index[name][1])
+                    xs.append(min(left, total))
+                    break
+                left -= total
+            leads.append(lead)
+        ids = np.array(ids, dtype=np.intp)
+        return _along_rows(timed.arcs[ids, np.array(leads, dtype=np.intp)], timed.travel[ids],
+                           np.array(xs)) * self.params["travel"]
 
     def _travel_batch(self, names: tuple[str, ...], along: np.ndarray, leads: np.ndarray) -> np.ndarray:
         """:meth:`_travel_predicted` of one-command paths ``names`` at once (C, 3), ``along`` (C, k) their parts'
