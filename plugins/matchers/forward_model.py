@@ -129,8 +129,18 @@ cannot measure a style over the whole segment; each candidate is fitted to the f
 
 Amplitude (the observation scaled by its extent over the command's over the same progress, within a factor 2) was
 built and measured too, and lowered the accuracy on the Bandai-Namco clips in every combination: not kept
-(docs/benchmarks.md, "The forward model's styled comparison (issue 18, fmstyled)"). The spreads between takes
-(``spread``) and :meth:`ForwardModel.take_errors` keep the comparison of the settings above them.
+(docs/benchmarks.md, "The forward model's styled comparison (issue 18, fmstyled)").
+
+The spreads between takes (``spread``; :meth:`ForwardModel.take_errors`) use the styled comparison too when it is on
+(issue 18, fmstyled2): each take is followed by another take's commands as a demonstration is, about each side's own
+mean and at the pace fitted to the frames seen so far (the running sums as cumulative sums over the take,
+:func:`plugins.lib.online_style.distances_all`), so the limit ``spread`` times the spread and the candidates' errors it
+bounds compare like with like: two takes that differ only by a held stance, or by their pace, have no spread.
+
+Cost (K&G §4.4 predict every candidate in parallel): with ``tempo`` every candidate's prediction at every pace is one
+gather over the commands stacked once per subsystem (:meth:`ForwardModel._at_times_all`), the running sums and best
+paces of all candidates at once (:func:`plugins.lib.online_style.residuals_all`), and their travel parts at once; the
+same values as candidate by candidate (``tests/test_forward_model_styled_batch.py``).
 
 Ranked candidates (B&B Fig. 13; K&G §4.4, Fig. 3's candidates): every answer of one followed subsystem carries
 ``Match.candidates``, the movements the forward models considered in the segment with their prediction errors,
