@@ -1721,7 +1721,9 @@ class ForwardModel(Matcher):
             lead = self._lead(path[0])
             t0 = self._mapped_time(self._strokes_of(path[0])[lead], float(anchor[lead]))
             times = t0 + paces[:, None] * (rows / fps)[None]  # (S, n): row 0 is the onset
-            points = self._at_times(path, times.ravel())[0].reshape(len(paces), len(rows), -1, 3)
+            at_once = self._at_times_all(track.subsystem, [path], times.reshape(1, -1))  # each time on its edge only
+            points = (at_once[0][0] if at_once is not None else self._at_times(path, times.ravel())[0]).reshape(
+                len(paces), len(rows), -1, 3)
             p = points - points[:, :1] if self.params["relative"] else points
         else:  # the path-length clock, one pace: each part along its strokes after the path walked (as _predict)
             anchor = self._anchor(track, path[0])
