@@ -482,9 +482,10 @@ class _StrokeRows:
 
 class _TimedTables:
     """Every command of one subsystem the styled comparison has predicted, stacked for
-    :meth:`ForwardModel._at_times_all`: each command's strokes on the fine grid, positions (T, k, G, 3) and cumulative path lengths (T, k, G), with each
-    part's stroke duration (T, k) and the command's duration (T,). A command met for the first time, or whose table
-    changed, is added (the stack is rebuilt then, once per new command; every command is uniform in its own time)."""
+    :meth:`ForwardModel._at_times_all`: each command's strokes on the fine grid, positions (T, k, G, 3) and
+    cumulative path lengths (T, k, G), with each part's stroke duration (T, k), the command's duration (T,) and, with
+    ``travel``, its travel grid (T, G, 3). A command met for the first time, or whose table changed, is added (the
+    stack is rebuilt then, once per new command; every command is uniform in its own time)."""
 
     __slots__ = ("index", "tables", "positions", "arcs", "durations", "edge_durations", "totals", "travel")
 
