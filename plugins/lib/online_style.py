@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Observed", "Fit", "paces", "residuals", "fitted", "STEP"]
+__all__ = ["Observed", "Fit", "paces", "residuals", "fitted", "residuals_all", "distances_all", "STEP"]
 
 STEP = 1.12
 """Ratio of successive paces (:func:`paces`): 12%, the steps of the forward model's speed grid (``_speed``)."""
@@ -115,3 +115,51 @@ def residuals(obs: Observed, fit: Fit, o: np.ndarray, p: np.ndarray, centred: bo
     c = 1.0 / max(obs.n, 1) if centred else 0.0
     d = np.linalg.norm((np.asarray(o, dtype=float) - obs.so * c) - (p[best] - fit.sp[best] * c), axis=-1)
     return d, best
+
+
+def residuals_all(obs: Observed, fits: list[Fit], o: np.ndarray, p: np.ndarray,
+                  centred: bool) -> tuple[np.ndarray, np.ndarray]:
+    """:meth:`Fit.add` and :func:`residuals` of C candidates at once (the same values as one by one): the frames
+    ``o`` (m, k, 3) seen and the candidates' predictions of them ``p`` (C, S, m, k, 3) added to ``fits``' sums
+    (each fit's arrays replaced by its row of the stacked sums), then each candidate's per-part distances at its
+    best pace for the last frame (C, k) and that pace's index (C,). ``obs`` has had ``o`` added."""
+    on = np.nan_to_num(np.asarray(o, dtype=float))
+    pn = np.nan_to_num(np.asarray(p, dtype=float))
+    sp = np.stack([f.sp for f in fits]) + pn.sum(axis=2)  # (C, S, k, 3)
+    spp = np.stack([f.spp for f in fits]) + (pn * pn).sum(axis=(2, 3, 4))  # (C, S)
+    sop = np.stack([f.sop for f in fits]) + np.einsum("mkx,csmkx->cs", on, pn)
+    for i, f in enumerate(fits):
+        f.n += on.shape[0]
+        f.sp, f.spp, f.sop = sp[i], spp[i], sop[i]
+    c = 1.0 / max(obs.n, 1) if centred else 0.0
+    soo = obs.soo - c * float((obs.so * obs.so).sum())
+    rss = np.maximum(soo - 2.0 * (sop - c * np.einsum("kx,cskx->cs", obs.so, sp))
+                     + (spp - c * (sp * sp).sum(axis=(2, 3))), 0.0)
+    best = np.argmin(rss, axis=1)
+    at = np.arange(len(fits))
+    last = np.asarray(p, dtype=float)[at, best, -1]  # (C, k, 3)
+    d = np.linalg.norm((np.asarray(o[-1], dtype=float) - obs.so * c) - (last - sp[at, best] * c), axis=-1)
+    return d, best
+
+
+def distances_all(o: np.ndarray, p: np.ndarray, centred: bool) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`residuals` at every frame of a whole movement at once, as following it frame by frame gives them: the
+    observation ``o`` (n, k, 3) and a candidate's predictions ``p`` (S, n, k, 3) at S paces; the running sums over
+    rows 0 .. t are cumulative sums. Returns each frame's per-part distances (n, k) at the pace whose fit over the
+    frames up to it leaves the least squared residual, and that pace's index (n,)."""
+    o = np.nan_to_num(np.asarray(o, dtype=float))
+    p = np.nan_to_num(np.asarray(p, dtype=float))
+    n = np.arange(1, len(o) + 1)
+    c = 1.0 / n if centred else np.zeros(len(o))
+    so = np.cumsum(o, axis=0)  # (n, k, 3)
+    soo = np.cumsum((o * o).sum(axis=(1, 2)))
+    sp = np.cumsum(p, axis=1)  # (S, n, k, 3)
+    spp = np.cumsum((p * p).sum(axis=(2, 3)), axis=1)  # (S, n)
+    sop = np.cumsum(np.einsum("nkc,snkc->sn", o, p), axis=1)
+    rss = (soo - c * (so * so).sum(axis=(1, 2)))[None] - 2.0 * (sop - c * np.einsum("nkc,snkc->sn", so, sp)) \
+        + spp - c * (sp * sp).sum(axis=(2, 3))
+    best = np.argmin(np.maximum(rss, 0.0), axis=0)  # (n,)
+    at = np.arange(len(o))
+    mo = so * c[:, None, None]
+    mp = sp[best, at] * c[:, None, None]
+    return np.linalg.norm((o - mo) - (p[best, at] - mp), axis=-1), best

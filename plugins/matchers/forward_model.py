@@ -129,8 +129,18 @@ cannot measure a style over the whole segment; each candidate is fitted to the f
 
 Amplitude (the observation scaled by its extent over the command's over the same progress, within a factor 2) was
 built and measured too, and lowered the accuracy on the Bandai-Namco clips in every combination: not kept
-(docs/benchmarks.md, "The forward model's styled comparison (issue 18, fmstyled)"). The spreads between takes
-(``spread``) and :meth:`ForwardModel.take_errors` keep the comparison of the settings above them.
+(docs/benchmarks.md, "The forward model's styled comparison (issue 18, fmstyled)").
+
+The spreads between takes (``spread``; :meth:`ForwardModel.take_errors`) use the styled comparison too when it is on
+(issue 18, fmstyled2): each take is followed by another take's commands as a demonstration is, about each side's own
+mean and at the pace fitted to the frames seen so far (the running sums as cumulative sums over the take,
+:func:`plugins.lib.online_style.distances_all`), so the limit ``spread`` times the spread and the candidates' errors it
+bounds compare like with like: two takes that differ only by a held stance, or by their pace, have no spread.
+
+Cost (K&G §4.4 predict every candidate in parallel): with ``tempo`` every candidate's prediction at every pace is one
+gather over the commands stacked once per subsystem (:meth:`ForwardModel._at_times_all`), the running sums and best
+paces of all candidates at once (:func:`plugins.lib.online_style.residuals_all`), and their travel parts at once; the
+same values as candidate by candidate (``tests/test_forward_model_styled_batch.py``).
 
 Ranked candidates (B&B Fig. 13; K&G §4.4, Fig. 3's candidates): every answer of one followed subsystem carries
 ``Match.candidates``, the movements the forward models considered in the segment with their prediction errors,
@@ -468,6 +478,47 @@ class _StrokeRows:
         w = np.divide(x - a0, step, out=np.zeros_like(x), where=step > 0)
         p0 = self.positions[rows, j]
         return p0 + np.clip(w, 0.0, 1.0)[:, None] * (self.positions[rows, j + 1] - p0)
+
+
+class _TimedTables:
+    """Every command of one subsystem the styled comparison has predicted, stacked for
+    :meth:`ForwardModel._at_times_all`: each command's strokes on the fine grid, positions (T, k, G, 3) and
+    cumulative path lengths (T, k, G), with each part's stroke duration (T, k), the command's duration (T,) and, with
+    ``travel``, its travel grid (T, G, 3). A command met for the first time, or whose table changed, is added (the
+    stack is rebuilt then, once per new command; every command is uniform in its own time)."""
+
+    __slots__ = ("index", "tables", "positions", "arcs", "durations", "edge_durations", "totals", "travel")
+
+    def __init__(self) -> None:
+        self.index: dict[str, tuple[Any, int]] = {}
+        self.tables: list[tuple[np.ndarray, np.ndarray, np.ndarray, float, np.ndarray | None]] = []
+        self.positions = self.arcs = self.durations = self.edge_durations = self.totals = self.travel = None
+
+    def rows(self, names: list[str], model: ForwardModel) -> np.ndarray | None:
+        """The row of each command in the stack (added when new or changed); ``None`` when they cannot be stacked
+        (grids of other sizes)."""
+        out, grew = [], False
+        for name in names:
+            table = model._edge(name)
+            kept = self.index.get(name)
+            if kept is None or kept[0] is not table:
+                edge = model.motor.edge(name)
+                duration = np.array([c.duration for c in edge.commands])
+                if self.tables and table.positions.shape != self.tables[0][0].shape:
+                    return None
+                self.index[name] = kept = (table, len(self.tables))
+                self.tables.append((table.positions, table.arcs, duration, edge.duration, table.travel))
+                grew = True
+            out.append(kept[1])
+        if grew or self.positions is None:
+            self.positions = np.stack([t[0] for t in self.tables])
+            self.arcs = np.stack([t[1] for t in self.tables])
+            self.durations = np.stack([t[2] for t in self.tables])
+            self.edge_durations = np.array([t[3] for t in self.tables], dtype=float)
+            self.totals = self.arcs[:, :, -1]
+            travel = [t[4] for t in self.tables]
+            self.travel = np.stack(travel) if all(t is not None for t in travel) else None  # (T, G, 3)
+        return np.array(out, dtype=np.intp)
 
 
 def _along_rows(arcs: np.ndarray, positions: np.ndarray, x: np.ndarray, keys: np.ndarray | None = None) -> np.ndarray:
@@ -875,6 +926,7 @@ class ForwardModel(Matcher):
         self._half_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
         self._stroke_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
         self._stroke_rows = _StrokeRows(self.GRID)
+        self._time_tables: dict[str, _TimedTables] = {}  # subsystem -> the commands the styled comparison predicted
         self._scales: dict[str, tuple[Any, float]] = {}
         self._placed: OrderedDict[tuple[tuple[str, ...], bytes], tuple[tuple, np.ndarray]] = OrderedDict()
         self._memory: WorkingMemory | None = None
@@ -1347,24 +1399,39 @@ class ForwardModel(Matcher):
         centred = self.params["posture"] == "removed"
         fits = {}
         errors = {}
+        batch = self._styled_predict_all(track, paths, start, n, paces) if n > start and self.params["tempo"] > 0 \
+            else None
         for path in paths:
             fit = track.styled.get(path)
             if fit is None:
                 parent = track.styled.get(path[:-1])
                 fit = parent.copy() if parent is not None else online_style.Fit.empty(len(paces), k)
+            fits[path] = fit
+        travel = None
+        if batch is not None and len(fits) == len(paths):  # every candidate's sums at once
+            ds, bests = online_style.residuals_all(track.seen, list(fits.values()), o, batch[0], centred)
+            if self._traveling(track):
+                travel = self._travel_all(track.subsystem, paths, batch[1][np.arange(len(paths)), bests])
+        for c, path in enumerate(paths):
+            fit = fits[path]
             if n > start:
-                p, along, past = self._styled_predict(track, path, observed, start, n, paces)
-                fit.add(o, p)
-                d, best = online_style.residuals(track.seen, fit, o[-1], p[:, -1], centred)
+                if batch is not None and len(fits) == len(paths):
+                    p, along, past = batch[0][c], batch[1][c], batch[2][c]
+                    d, best = ds[c], int(bests[c])
+                else:
+                    p, along, past = (batch[0][c], batch[1][c], batch[2][c]) if batch is not None else \
+                        self._styled_predict(track, path, observed, start, n, paces)
+                    fit.add(o, p)
+                    d, best = online_style.residuals(track.seen, fit, o[-1], p[:, -1], centred)
                 d = d * track.scale
                 if self._traveling(track):
-                    dt = _norms(self._travel_predicted(path, along[best]) - track.travel_seen)
+                    dt = _norms((self._travel_predicted(path, along[best]) if travel is None else travel[c])
+                                - track.travel_seen)
                     error = float(self._with_travel(track, d[None], np.array([dt]))[0])
                 else:
                     error = float(self._combine(track, d[None], lengths)[0])
                 fit.extra.update(along=along[best], pace=float(paces[best]), past=bool(past[best]), error=error)
             errors[path] = fit.extra.get("error", np.inf)
-            fits[path] = fit
         if track.committed is None:
             track.styled = fits
         else:
@@ -1417,6 +1484,78 @@ class ForwardModel(Matcher):
         lead = self._lead(path[0])
         total = sum(self._edge(e).arcs[lead, -1] for e in path)
         return p, alongs[-1][None], np.array([alongs[-1][lead] > total + 0.01 / track.scale])
+
+    def _styled_predict_all(self, track: Track, paths: list[tuple[str, ...]], start: int, n: int,
+                            paces: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """:meth:`_styled_predict` with ``tempo`` for every candidate path at once (the same values): predictions
+        (C, S, m, k, 3), places along the paths at the last row (C, S, k) and whether past their ends (C, S);
+        ``None`` when the paths' commands cannot be stacked (:class:`_TimedTables`)."""
+        if not paths:
+            return None
+        rows = np.arange(start, n)
+        clock = np.append(rows, 0) / self.fps  # (m + 1,): the onset's last
+        t0 = np.empty(len(paths))
+        for c, path in enumerate(paths):
+            anchor = self._anchor(track, path[0])
+            lead = self._lead(path[0])
+            t0[c] = self._mapped_time(self._strokes_of(path[0])[lead], float(anchor[lead]))
+        times = t0[:, None, None] + paces[None, :, None] * clock[None, None]  # (C, S, m + 1)
+        out = self._at_times_all(track.subsystem, paths, times.reshape(len(paths), -1))
+        if out is None:
+            return None
+        points, along, past = out
+        points = points.reshape(len(paths), len(paces), len(rows) + 1, *points.shape[2:])
+        along = along.reshape(len(paths), len(paces), len(rows) + 1, -1)[:, :, -2]
+        past = past.reshape(len(paths), len(paces), len(rows) + 1)[:, :, -2]
+        p = points[:, :, :-1] - points[:, :, -1:] if self.params["relative"] else points[:, :, :-1]
+        return p, along, past
+
+    def _at_times_all(self, subsystem: str, paths: list[tuple[str, ...]],
+                      times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """:meth:`_at_times` of C paths at once, path ``c`` at command times ``times[c]`` ((C, N); the same values):
+        positions (C, N, k, 3), places along (C, N, k) and past the end (C, N). Each time is on the last edge of its
+        path that has begun by then (the first edge before it begins), as :meth:`_at_times` overwrites edge after
+        edge; the edges' starts and the places before them are the same running sums."""
+        timed = self._time_tables.get(subsystem)
+        if timed is None:
+            timed = self._time_tables[subsystem] = _TimedTables()
+        longest = max(len(path) for path in paths)
+        ids = timed.rows([name for path in paths for name in path], self)
+        if ids is None:
+            return None
+        c_n = len(paths)
+        slots = np.zeros((c_n, longest), dtype=np.intp)
+        used = np.zeros((c_n, longest), dtype=bool)
+        at = 0
+        for c, path in enumerate(paths):
+            slots[c, : len(path)] = ids[at : at + len(path)]
+            used[c, : len(path)] = True
+            at += len(path)
+        # per path, each edge's start (s) and the path length before it, part by part: running sums in path order
+        durations = np.where(used, timed.edge_durations[slots], 0.0)
+        starts = np.zeros((c_n, longest + 1))
+        np.cumsum(durations, axis=1, out=starts[:, 1:])
+        before = np.zeros((c_n, longest + 1, timed.totals.shape[1]))
+        np.cumsum(np.where(used[..., None], timed.totals[slots], 0.0), axis=1, out=before[:, 1:])
+        ends = starts[np.arange(c_n), np.array([len(path) for path in paths])]  # (C,): each path's duration
+        begun = (times[:, :, None] - starts[:, None, :longest] >= 0) & used[:, None, :]  # (C, N, L)
+        slot = np.maximum(longest - 1 - np.argmax(begun[:, :, ::-1], axis=2), 0)
+        slot = np.where(begun.any(axis=2), slot, 0)  # (C, N): the edge of the path each time is on
+        cc = np.arange(c_n)[:, None]
+        table = slots[cc, slot]  # (C, N)
+        local = times - starts[cc, slot]
+        g = timed.positions.shape[2]
+        u = np.clip(local[..., None] / timed.durations[table], 0.0, 1.0) * (g - 1)  # (C, N, k)
+        j = np.clip(np.floor(u).astype(np.intp), 0, g - 2)
+        w = u - j
+        k = timed.positions.shape[1]
+        at = (table[..., None] * k + np.arange(k)) * g + j  # flat index of [table, part, j] (a gather: the same values)
+        flat_p, flat_a = timed.positions.reshape(-1, 3), timed.arcs.reshape(-1)
+        points = flat_p[at] * (1 - w[..., None]) + flat_p[at + 1] * w[..., None]
+        arcs = flat_a[at] * (1 - w) + flat_a[at + 1] * w
+        first = slot == 0
+        along = np.where(first[..., None], arcs, arcs + before[cc, slot])
+        return points, along, times > ends[:, None]
 
     def _at_times(self, path: tuple[str, ...], times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Every part of path ``path`` at command times ``times`` (N,): positions (N, k, 3), places along the path
@@ -1520,20 +1659,26 @@ class ForwardModel(Matcher):
                 if len(examples) < 2:
                     continue
                 distances = []
-                for i, (_, subsystem, observed, _) in enumerate(examples):
+                for i, (_, subsystem, observed, fps) in enumerate(examples):
                     others = [tuple(edges) for j, (edges, *_) in enumerate(examples) if j != i]
-                    errors = [self.take_errors(subsystem, observed, path) for path in others]
+                    errors = [self.take_errors(subsystem, observed, path, fps) for path in others]
                     distances.append(min((float(np.mean(e)) for e in errors if len(e)), default=float("nan")))
                 finite = [d for d in distances if np.isfinite(d)]
                 if len(finite) >= 2:
                     self._spreads[movement] = float(np.median(finite))
         return self._spreads
 
-    def take_errors(self, subsystem: str, observed: np.ndarray, path: tuple[str, ...]) -> np.ndarray:
+    def take_errors(self, subsystem: str, observed: np.ndarray, path: tuple[str, ...],
+                    fps: float | None = None) -> np.ndarray:
         """The prediction error, frame by frame, of command path ``path`` on a subsystem's observed movement
         ``observed`` (n, k, 3) followed from its first frame: the forward model's own prediction (:meth:`_error`,
         anchors and ``relative`` included) with the observed path lengths up to each frame (the positions
-        averaged over three frames, as :func:`_lengths` does, over the whole take at once)."""
+        averaged over three frames, as :func:`_lengths` does, over the whole take at once).
+
+        With the styled comparison (``posture``, ``tempo``; :meth:`_styled`) the take is compared as a
+        demonstration is (:meth:`_take_errors_styled`), so that a spread between takes and the errors of the
+        candidates it bounds compare like with like. ``fps``: the take's frame rate (the pace's clock; by default
+        the segment's, else 30)."""
         from scipy.ndimage import uniform_filter1d
 
         track = Track(subsystem, self._scale_of(subsystem), self.motor.is_hand(subsystem), "hub", 0, {}, [],
@@ -1541,6 +1686,9 @@ class ForwardModel(Matcher):
         smooth = uniform_filter1d(observed, size=3, axis=0, mode="nearest") if len(observed) >= 3 else observed
         walked = np.concatenate([np.zeros((1, observed.shape[1])),
                                  np.cumsum(np.linalg.norm(np.diff(smooth, axis=0), axis=-1), axis=0)])
+        if self._styled(track) and len(path):
+            return self._take_errors_styled(track, observed, path, walked,
+                                            fps if fps else getattr(self, "fps", None) or 30.0)
         if track.hand or not len(path) or self.params["clock"] == "lead":  # one clock: frame by frame, as followed
             return np.array([self._error(track, path, walked[t], observed[t]) for t in range(1, len(observed))])
         # every frame at once: each part along its strokes of the whole path, laid end to end (what _predict does
@@ -1554,6 +1702,39 @@ class ForwardModel(Matcher):
         predicted = np.stack([np.stack([np.interp(along[:, p], arcs[p], positions[p, :, c]) for c in range(3)],
                                        axis=-1) for p in range(len(arcs))], axis=1)  # (T, k, 3)
         d = np.linalg.norm(predicted + self._onset_offset(track, path[0]) - observed[1:], axis=-1) * track.scale
+        if self.params["error"] == "moving":
+            return (d * np.apply_along_axis(moving_weights, 1, walked[1:])).sum(axis=1)
+        return d.max(axis=1) if self.params["error"] == "max" else d.mean(axis=1)
+
+    def _take_errors_styled(self, track: Track, observed: np.ndarray, path: tuple[str, ...], walked: np.ndarray,
+                            fps: float) -> np.ndarray:
+        """:meth:`take_errors` in the demonstrator's own style: at each frame ``t`` of the take (1 .. n - 1) the
+        error :meth:`_styled_errors` gives when following it, every frame at once. The running sums of
+        :mod:`plugins.lib.online_style` over rows 0 .. t are cumulative sums over the take: per pace the residual
+        over the frames up to ``t`` (:func:`online_style.distances_all`), the best pace at each frame, and that pace's
+        per-part distance at ``t``, each side about its own mean up to ``t`` with ``posture = "removed"``. The parts
+        are compared alone (the spreads leave travel out), combined as ``error`` says with the path lengths walked
+        up to ``t`` (:func:`moving_weights`)."""
+        rows = np.arange(len(observed))
+        if self.params["tempo"] > 0:
+            paces = online_style.paces(self.params["tempo"])
+            anchor = self._anchor(track, path[0])
+            lead = self._lead(path[0])
+            t0 = self._mapped_time(self._strokes_of(path[0])[lead], float(anchor[lead]))
+            times = t0 + paces[:, None] * (rows / fps)[None]  # (S, n): row 0 is the onset
+            at_once = self._at_times_all(track.subsystem, [path], times.reshape(1, -1))  # each time on its edge only
+            points = (at_once[0][0] if at_once is not None else self._at_times(path, times.ravel())[0]).reshape(
+                len(paces), len(rows), -1, 3)
+            p = points - points[:, :1] if self.params["relative"] else points
+        else:  # the path-length clock, one pace: each part along its strokes after the path walked (as _predict)
+            anchor = self._anchor(track, path[0])
+            clock = self._lead_clock if self.params["clock"] == "lead" else (lambda _, along: along)
+            p = np.stack([self._predict(track, path, clock(path, anchor + w)) for w in walked])[None]
+            if self.params["relative"]:
+                p = p - self._predict(track, path, anchor)
+        o = observed - observed[0] if self.params["relative"] else observed
+        d, _ = online_style.distances_all(o, p, self.params["posture"] == "removed")
+        d = d[1:] * track.scale  # (n - 1, k)
         if self.params["error"] == "moving":
             return (d * np.apply_along_axis(moving_weights, 1, walked[1:])).sum(axis=1)
         return d.max(axis=1) if self.params["error"] == "max" else d.mean(axis=1)
@@ -1683,6 +1864,28 @@ class ForwardModel(Matcher):
                 return point * self.params["travel"]
             left -= total
         return np.zeros(3)  # no command (not reached)
+
+    def _travel_all(self, subsystem: str, paths: list[tuple[str, ...]], along: np.ndarray) -> np.ndarray | None:
+        """:meth:`_travel_predicted` of C paths at once (C, 3; the same values), ``along`` (C, k) their parts' places
+        along them, from the commands :meth:`_at_times_all` stacked this frame; ``None`` without their travel."""
+        timed = self._time_tables.get(subsystem)
+        if timed is None or timed.travel is None:
+            return None
+        ids, leads, xs = [], [], []
+        for c, path in enumerate(paths):  # the edge each lead is on, as _travel_predicted walks them
+            lead = self._lead(path[0])
+            left = float(along[c, lead])
+            for i, name in enumerate(path):
+                total = float(timed.totals[timed.index[name][1], lead])
+                if left <= total or i == len(path) - 1:
+                    ids.append(timed.index[name][1])
+                    xs.append(min(left, total))
+                    break
+                left -= total
+            leads.append(lead)
+        ids = np.array(ids, dtype=np.intp)
+        return _along_rows(timed.arcs[ids, np.array(leads, dtype=np.intp)], timed.travel[ids],
+                           np.array(xs)) * self.params["travel"]
 
     def _travel_batch(self, names: tuple[str, ...], along: np.ndarray, leads: np.ndarray) -> np.ndarray:
         """:meth:`_travel_predicted` of one-command paths ``names`` at once (C, 3), ``along`` (C, k) their parts'
