@@ -1408,14 +1408,15 @@ class ForwardModel(Matcher):
                 fit = parent.copy() if parent is not None else online_style.Fit.empty(len(paces), k)
             fits[path] = fit
         travel = None
-        if batch is not None and len(fits) == len(paths):  # every candidate's sums at once
+        together = batch is not None and len(fits) == len(paths)  # every candidate's sums at once
+        if together:
             ds, bests = online_style.residuals_all(track.seen, list(fits.values()), o, batch[0], centred)
             if self._traveling(track):
                 travel = self._travel_all(track.subsystem, paths, batch[1][np.arange(len(paths)), bests])
         for c, path in enumerate(paths):
             fit = fits[path]
             if n > start:
-                if batch is not None and len(fits) == len(paths):
+                if together:
                     p, along, past = batch[0][c], batch[1][c], batch[2][c]
                     d, best = ds[c], int(bests[c])
                 else:
@@ -1451,6 +1452,12 @@ class ForwardModel(Matcher):
             return float(self._with_travel(track, d[None], np.array([_norms(track.travel_seen)]))[0])
         return float(self._combine(track, d[None], lengths)[0])
 
+    def _onset_time(self, track: Track, path: tuple[str, ...]) -> float:
+        """With ``tempo``: the command time of path ``path`` at the onset, where its lead part joined its first
+        command (:meth:`_anchor`; 0 with ``relative``)."""
+        lead = self._lead(path[0])
+        return self._mapped_time(self._strokes_of(path[0])[lead], float(self._anchor(track, path[0])[lead]))
+
     def _styled_predict(self, track: Track, path: tuple[str, ...], observed: np.ndarray, start: int, n: int,
                         paces: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Path ``path``'s predictions of rows ``start .. n - 1`` since the onset, (S, m, k, 3) at each of the S
@@ -1462,9 +1469,7 @@ class ForwardModel(Matcher):
         anchor = self._anchor(track, path[0])
         rows = np.arange(start, n)
         if self.params["tempo"] > 0:
-            lead = self._lead(path[0])
-            t0 = self._mapped_time(self._strokes_of(path[0])[lead], float(anchor[lead]))
-            times = t0 + paces[:, None] * (np.append(rows, 0) / self.fps)[None]  # (S, m + 1): the onset's last
+            times = self._onset_time(track, path) + paces[:, None] * (np.append(rows, 0) / self.fps)[None]  # (S, m + 1): the onset's last
             points, along, past = self._at_times(path, times.ravel())
             points = points.reshape(len(paces), len(rows) + 1, *points.shape[1:])
             along = along.reshape(len(paces), len(rows) + 1, -1)[:, -2]
@@ -1494,11 +1499,7 @@ class ForwardModel(Matcher):
             return None
         rows = np.arange(start, n)
         clock = np.append(rows, 0) / self.fps  # (m + 1,): the onset's last
-        t0 = np.empty(len(paths))
-        for c, path in enumerate(paths):
-            anchor = self._anchor(track, path[0])
-            lead = self._lead(path[0])
-            t0[c] = self._mapped_time(self._strokes_of(path[0])[lead], float(anchor[lead]))
+        t0 = np.array([self._onset_time(track, path) for path in paths])
         times = t0[:, None, None] + paces[None, :, None] * clock[None, None]  # (C, S, m + 1)
         out = self._at_times_all(track.subsystem, paths, times.reshape(len(paths), -1))
         if out is None:
@@ -1702,6 +1703,11 @@ class ForwardModel(Matcher):
         predicted = np.stack([np.stack([np.interp(along[:, p], arcs[p], positions[p, :, c]) for c in range(3)],
                                        axis=-1) for p in range(len(arcs))], axis=1)  # (T, k, 3)
         d = np.linalg.norm(predicted + self._onset_offset(track, path[0]) - observed[1:], axis=-1) * track.scale
+        return self._take_combined(d, walked)
+
+    def _take_combined(self, d: np.ndarray, walked: np.ndarray) -> np.ndarray:
+        """A take's per-part errors at frames 1 .. n - 1 (n - 1, k) combined as ``error`` says, ``moving`` with the
+        path lengths ``walked`` (n, k) up to each frame (:func:`moving_weights`)."""
         if self.params["error"] == "moving":
             return (d * np.apply_along_axis(moving_weights, 1, walked[1:])).sum(axis=1)
         return d.max(axis=1) if self.params["error"] == "max" else d.mean(axis=1)
@@ -1718,10 +1724,7 @@ class ForwardModel(Matcher):
         rows = np.arange(len(observed))
         if self.params["tempo"] > 0:
             paces = online_style.paces(self.params["tempo"])
-            anchor = self._anchor(track, path[0])
-            lead = self._lead(path[0])
-            t0 = self._mapped_time(self._strokes_of(path[0])[lead], float(anchor[lead]))
-            times = t0 + paces[:, None] * (rows / fps)[None]  # (S, n): row 0 is the onset
+            times = self._onset_time(track, path) + paces[:, None] * (rows / fps)[None]  # (S, n): row 0 is the onset
             at_once = self._at_times_all(track.subsystem, [path], times.reshape(1, -1))  # each time on its edge only
             points = (at_once[0][0] if at_once is not None else self._at_times(path, times.ravel())[0]).reshape(
                 len(paces), len(rows), -1, 3)
@@ -1734,10 +1737,7 @@ class ForwardModel(Matcher):
                 p = p - self._predict(track, path, anchor)
         o = observed - observed[0] if self.params["relative"] else observed
         d, _ = online_style.distances_all(o, p, self.params["posture"] == "removed")
-        d = d[1:] * track.scale  # (n - 1, k)
-        if self.params["error"] == "moving":
-            return (d * np.apply_along_axis(moving_weights, 1, walked[1:])).sum(axis=1)
-        return d.max(axis=1) if self.params["error"] == "max" else d.mean(axis=1)
+        return self._take_combined(d[1:] * track.scale, walked)
 
     def _last_correct(self, track: Track, lengths: np.ndarray, memory: np.ndarray) -> None:
         """The node at which the demonstration last agreed with the committed path: the start of the edge it was on.
