@@ -291,6 +291,10 @@ CASES = [
     ("fm-posture", "the forward model's posture misnamed", {"c.toml": CHILD + '[matcher]\nplugin = "forward-model"\nposture = "still"\n'}, ["validate", "c.toml"], ["c.toml:6: key matcher.posture", "value 'still' not allowed", "available: kept, removed"]),
     ("fm-tempo-below-one", "the forward model's tempo limit between 0 and 1", {"c.toml": CHILD + '[matcher]\nplugin = "forward-model"\ntempo = 0.5\n'}, ["validate", "c.toml"], ["c.toml:6: key matcher.tempo", "0 (off) or a factor of at least 1"]),
     ("fm-tempo", "the forward model's tempo limit negative, on the command line", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--matcher", "forward-model", "--set", "matcher.tempo=-2", "m.bvh"], ["key --set.matcher.tempo", "value -2.0 out of range"]),
+    # -- observer templates: --observer, [observer] extends (issue 18)
+    ("observer-unknown", "an observer template that cannot be found", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--observer", "several-take", "m.bvh"], ["key --observer: cannot find observer template 'several-take'", "available: recordings, several-takes"]),
+    ("observer-extends-cycle", "observer templates extending each other", {"a.toml": '[observer]\nname = "a"\nextends = "b.toml"\n', "b.toml": '[observer]\nname = "b"\nextends = "a.toml"\n'}, ["validate", "a.toml"], ["key observer.extends", "extends cycle: a.toml -> b.toml -> a.toml"]),
+    ("observer-extends-parent", "a mistake in the template extended", {"base.toml": '[observer]\nname = "base"\n[matcher]\nplugin = "path-search"\nk = 0\n', "o.toml": '[observer]\nextends = "base.toml"\nname = "o"\n'}, ["validate", "o.toml"], ["base.toml:5: key matcher.k", "value 0 out of range"]),
 ]
 
 

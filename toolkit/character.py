@@ -292,31 +292,36 @@ def merge_tables(base: Mapping[str, Any], over: Mapping[str, Any]) -> dict[str, 
     return out
 
 
-def _load_chain(path: Path, pm: PluginManager | None, stack: tuple[Path, ...] = ()) -> tuple[dict[str, Any], tuple[Path, ...]]:
-    """The merged table of ``path`` and everything it extends, and the files involved (outermost first)."""
+def _load_chain(path: Path, pm: PluginManager | None, stack: tuple[Path, ...] = (), *,
+                head_key: str = "character") -> tuple[dict[str, Any], tuple[Path, ...]]:
+    """The merged table of ``path`` and everything it extends, and the files involved (outermost first).
+
+    ``head_key`` names the table holding ``extends`` (and the ``name`` a file does not pass on): ``[character]``
+    for characters, ``[observer]`` for observer templates (:func:`toolkit.observe.read_observer_template`)."""
     path = path.resolve()
     if len(stack) >= MAX_EXTENDS:
         raise ConfigError(f"extends chain longer than {MAX_EXTENDS} files", file=stack[-1],
-                          key=("character", "extends"),
+                          key=(head_key, "extends"),
                           expected=f"at most {MAX_EXTENDS} files, each extending the next")
     if path in stack:
         cycle = " -> ".join(p.name for p in (*stack, path))
-        raise ConfigError(f"extends cycle: {cycle}", file=stack[-1], key=("character", "extends"), expected="no cycle")
+        raise ConfigError(f"extends cycle: {cycle}", file=stack[-1], key=(head_key, "extends"), expected="no cycle")
     table = read_toml(path)
-    head = table.get("character", {})
+    head = table.get(head_key, {})
     if not isinstance(head, Mapping):
-        raise ConfigError("not a table", file=path, key=("character",), expected="a [character] table")
+        raise ConfigError("not a table", file=path, key=(head_key,), expected=f"a [{head_key}] table")
     ref = head.get("extends")
     if ref is None:
         return table, (path,)
     if not isinstance(ref, str):
-        raise ConfigError(f"wrong type {type(ref).__name__}", file=path, key=("character", "extends"), expected="a file path or character name")
-    parent_path = resolve_file(ref, path.parent, pm, key=("character", "extends"), file=path)
-    parent, files = _load_chain(parent_path, pm, (*stack, path))
+        raise ConfigError(f"wrong type {type(ref).__name__}", file=path, key=(head_key, "extends"),
+                          expected=f"a file path or {head_key} name")
+    parent_path = resolve_file(ref, path.parent, pm, key=(head_key, "extends"), file=path)
+    parent, files = _load_chain(parent_path, pm, (*stack, path), head_key=head_key)
     own = dict(table)
-    own["character"] = {k: v for k, v in head.items() if k != "extends"}
+    own[head_key] = {k: v for k, v in head.items() if k != "extends"}
     parent = dict(parent)
-    parent["character"] = {k: v for k, v in parent.get("character", {}).items() if k != "name"}
+    parent[head_key] = {k: v for k, v in parent.get(head_key, {}).items() if k != "name"}
     return merge_tables(parent, own), (path, *files)
 
 

@@ -167,7 +167,11 @@ def check_outputs(args: argparse.Namespace) -> None:
 
 def observer_options(p: argparse.ArgumentParser) -> None:
     """The options that change the observer composed from the template, shared by ``likeme observe`` and
-    ``likeme bench``: ``--correspondence``, ``--lengths-for-height`` and ``--set``."""
+    ``likeme bench``: ``--observer``, ``--correspondence``, ``--lengths-for-height`` and ``--set``."""
+    p.add_argument("--observer", metavar="TEMPLATE", default=None,
+                   help="the observer template: a TOML file or the name of one in characters/observers/ (default: "
+                   "recordings, the papers' observer; several-takes: real people, a repertoire of several takes "
+                   "of each movement; docs/correspondence.md)")
     p.add_argument("--correspondence", metavar="NAME", default="", help="correspondence (default: the observer "
                    "template's; none: the papers' plain observer)")
     p.add_argument("--lengths-for-height", type=number_type(0.0, 1000.0, "metres"), default=None, metavar="M",
@@ -666,7 +670,7 @@ def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
     Each file is reported when it has been watched; a file that fails is reported as one ``likeme: error:`` line
     on standard error naming it, the others are still watched, and the command exits with status 1 at the end.
     """
-    from toolkit.observe import NO_CORRESPONDENCE, Observer, compose_observer, observer_plugins
+    from toolkit.observe import NO_CORRESPONDENCE, OBSERVER_TEMPLATE, Observer, compose_observer, observer_plugins
     from toolkit.params import check_settings, parse_settings
     from toolkit.profile import load_profile
 
@@ -690,13 +694,14 @@ def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
     settings = parse_settings(list(args.set))
     if args.fps is not None:  # the repertoire's clips are recordings too: the same rate, unless --set says otherwise
         settings.setdefault("motor", {}).setdefault("fps", args.fps)
+    template = args.observer or OBSERVER_TEMPLATE
     check_settings(settings, pm, observer_plugins(pm, segmenters=[args.segmenter] if args.segmenter else (),
                                                   matchers=[args.matcher] if args.matcher else (),
-                                                  correspondence=args.correspondence or ""))
+                                                  correspondence=args.correspondence or "", template=template))
     character = compose_observer(pm, profile, args.repertoire, segmenter=args.segmenter, matcher=args.matcher or "",
                                  correspondence=args.correspondence or "",
                                  lengths_for_height="" if args.lengths_for_height is None else args.lengths_for_height,
-                                 settings=settings)
+                                 settings=settings, template=template)
     if args.files == ["-"]:
         return _observe_live(args, character, profile, Observer)
     report = []

@@ -27,7 +27,8 @@ from typing import Any
 
 import numpy as np
 
-from toolkit.character import COMPONENT_TABLES, Character, compose_character, read_toml, resolve_file
+from toolkit.character import (COMPONENT_TABLES, Character, _load_chain, character_paths, compose_character,
+                               resolve_file)
 from toolkit.components import Perception
 from toolkit.errors import ConfigError, PluginError
 from toolkit.motion import Motion
@@ -35,13 +36,49 @@ from toolkit.profile import BodyProfile
 from toolkit.watching import KEEP_SECONDS, MAX_SEGMENT_SECONDS, Observation, WatchingLoop, guarded
 
 __all__ = ["Observation", "Observer", "compose_observer", "observer_tables", "OBSERVER_TEMPLATE", "NO_CORRESPONDENCE",
-           "is_observer_template", "check_observer_template", "observer_plugins"]
+           "is_observer_template", "check_observer_template", "observer_plugins", "observer_template_path",
+           "observer_templates", "read_observer_template"]
 
 NO_CORRESPONDENCE = "none"
 """The correspondence name that means none (``--correspondence none``): the papers' plain observer."""
 
 OBSERVER_TEMPLATE = "observers/recordings.toml"
 """The observer template on the character path: the components an observer of recordings has by default."""
+
+OBSERVER_FOLDER = "observers"
+"""The folder of observer templates in each folder of the character path (:func:`toolkit.character.character_paths`):
+a template named without a path (``--observer several-takes``) is looked up there."""
+
+
+def observer_templates(pm: Any = None) -> list[str]:
+    """The names of the observer templates on the character path (``characters/observers/*.toml``), sorted."""
+    return sorted({f.stem for p in character_paths(pm) for f in (p / OBSERVER_FOLDER).glob("*.toml")})
+
+
+def observer_template_path(template: str | Path, pm: Any = None, *, key: tuple = ("--observer",)) -> Path:
+    """The file of an observer template: a path, a name on the character path (``observers/recordings``), or the
+    name of a template in an ``observers`` folder of the character path (``recordings``, ``several-takes``).
+    A :class:`ConfigError` naming ``key`` and listing the templates found otherwise."""
+    ref = str(template)
+    if Path(ref).is_file():
+        return Path(ref).resolve()
+    tries = [ref] if "/" in ref or "\\" in ref else [f"{OBSERVER_FOLDER}/{ref}", ref]
+    for attempt in tries:
+        try:
+            return resolve_file(attempt, None, pm, key=key)
+        except ConfigError:
+            continue
+    raise ConfigError(f"cannot find observer template {ref[:80]!r}", key=key,
+                      expected="an observer template's file, or the name of one in characters/observers/",
+                      available=observer_templates(pm))
+
+
+def read_observer_template(template: str | Path, pm: Any = None) -> tuple[dict[str, Any], tuple[Path, ...]]:
+    """The table of an observer template and the files it was read from (outermost first): a template may extend
+    another (``[observer] extends = "recordings.toml"``, a path relative to it or a name on the character path), as
+    a character file does; its tables are merged onto the other's, a table naming another ``plugin`` replacing it
+    whole (:func:`toolkit.character.merge_tables`)."""
+    return _load_chain(observer_template_path(template, pm), pm, head_key="observer")
 
 
 class Observer:
@@ -235,9 +272,8 @@ def observer_tables(pm: Any, *, segmenter: str | None = None, matcher: str | Non
     """The ``[observer]`` table of ``template`` and the component tables (``plugin`` and parameters) an observer
     composed with these arguments has, as :func:`compose_observer` takes them (its arguments, the same meaning)."""
     settings = {k: dict(v) for k, v in (settings or {}).items()}
-    path = Path(template) if Path(template).is_file() else resolve_file(str(template), None, pm)
-    check_observer_template(path, pm)
-    base = read_toml(path)
+    check_observer_template(template, pm)
+    base = read_observer_template(template, pm)[0]
     tables: dict[str, dict[str, Any]] = {k: dict(v) for k, v in base.items() if k in COMPONENT_TABLES}
     for key, name in (("segmenter", segmenter), ("matcher", matcher), ("motor", motor)):
         if name and tables.get(key, {}).get("plugin") != name:  # another plugin: none of the template's parameters,
@@ -270,8 +306,7 @@ def observer_plugins(pm: Any, *, segmenters: Sequence[str] = (), matchers: Seque
     with the ``segmenters``, ``matchers`` and ``correspondence`` named instead of its own, and the motor system each
     of those matchers needs. What ``--set TABLE.KEY=VALUE`` is checked against before any work
     (:func:`toolkit.params.check_settings`)."""
-    path = Path(template) if Path(template).is_file() else resolve_file(str(template), None, pm)
-    plugins: dict[str, list[str]] = {k: [v["plugin"]] for k, v in read_toml(path).items()
+    plugins: dict[str, list[str]] = {k: [v["plugin"]] for k, v in read_observer_template(template, pm)[0].items()
                                      if isinstance(v, Mapping) and isinstance(v.get("plugin"), str)}
     if segmenters:
         plugins["segmenter"] = list(segmenters)
@@ -294,7 +329,7 @@ def observer_plugins(pm: Any, *, segmenters: Sequence[str] = (), matchers: Seque
     return plugins
 
 
-OBSERVER_KEYS = ("name", "description", "lengths_for_height")
+OBSERVER_KEYS = ("name", "description", "lengths_for_height", "extends")
 # Tables of an observer template holding, per plugin, the parameters it gets when named instead of the template's own
 # (`--segmenter NAME`): [segmenters.NAME], [matchers.NAME], [motors.NAME].
 ALTERNATIVES = {"segmenter": "segmenters", "matcher": "matchers", "motor": "motors"}
@@ -307,12 +342,14 @@ def is_observer_template(table: Mapping[str, Any]) -> bool:
 
 
 def check_observer_template(path: str | Path, pm: Any) -> dict[str, str]:
-    """The plugin of each component table of an observer template, every name and parameter checked (a
-    :class:`ConfigError` naming the file, key and line otherwise); attaching waits for a body and clips."""
+    """The plugin of each component table of an observer template (and of those it extends), every name and
+    parameter checked (a :class:`ConfigError` naming the file, key and line otherwise: the outermost file that
+    writes the key); attaching waits for a body and clips."""
     from toolkit.character import build_component, find_key_line
 
-    path = Path(path)
-    table = read_toml(path)
+    table, files = read_observer_template(path, pm)
+    if Path(path).is_file():  # the outermost file named as the caller named it
+        files = (Path(path), *files[1:])
     plugins = {}
     try:
         for key in table:
@@ -345,7 +382,12 @@ def check_observer_template(path: str | Path, pm: Any) -> dict[str, str]:
                     raise ConfigError("not a table", key=(key,), expected=f"a [{key}] table")
                 plugins[key] = build_component(key, table[key], pm).name
     except ConfigError as err:
-        line = find_key_line(path, err.key) if err.key else None
-        raise ConfigError(err.problem, file=path, key=err.key, line=line, expected=err.expected,
+        where, line = files[0], None
+        for file in files if err.key else ():
+            line = find_key_line(file, err.key)
+            if line is not None:
+                where = file
+                break
+        raise ConfigError(err.problem, file=where, key=err.key, line=line, expected=err.expected,
                           available=err.available) from None
     return plugins

@@ -44,7 +44,7 @@ from plugins.bench.data import read_segments
 from plugins.bench.metrics import confusion_matrix, macro_f1, movement_error_rate, segmentation_scores
 from plugins.lib.clip_repertoire import clip_files
 from toolkit import ConfigError
-from toolkit.observe import Observer, compose_observer
+from toolkit.observe import OBSERVER_TEMPLATE, Observer, compose_observer
 from toolkit.profile import RECORDING_SUFFIXES, load_profile
 
 __all__ = ["MATCHERS", "SEGMENTERS", "recognition", "segmentation", "stream", "cell", "merge", "table",
@@ -149,7 +149,7 @@ def recognition(pm, profile, repertoire: Path, demos: Path | None, matchers: Seq
     group out, no ``demos``) takes the repertoire's own clips, groups them by the first capture group of the
     regular expression ``group`` searched in each file's name (a style, a performer, a session), and classifies
     each group's clips against a repertoire of every other group's clips. ``observer``: further arguments of
-    :func:`toolkit.observe.compose_observer` (``correspondence``, ``lengths_for_height``).
+    :func:`toolkit.observe.compose_observer` (``correspondence``, ``lengths_for_height``, ``template``).
     """
     observer, settings = dict(observer or {}), _with_clip_rate(settings, fps)
     runs = _runs(profile, Path(repertoire), demos, protocol, group, fps)
@@ -449,7 +449,8 @@ def run(kind: str, args: Any, pm: Any) -> int:
     profile = load_profile(args.body)
     settings = _settings(args.set)
     observer = {"correspondence": args.correspondence,
-                "lengths_for_height": "" if args.lengths_for_height is None else args.lengths_for_height}
+                "lengths_for_height": "" if args.lengths_for_height is None else args.lengths_for_height,
+                "template": args.observer or OBSERVER_TEMPLATE}
     if getattr(args, "jobs", 1) > 1 or getattr(args, "scheduler", None):
         result = _parallel(kind, args, observer)
     elif kind == "recognition":
