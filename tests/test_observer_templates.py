@@ -12,25 +12,13 @@ import json
 
 import pytest
 
-from plugins.bench.data import make_data
 from plugins.bench.sweep import cells, load_grid
-from toolkit import ConfigError, create_plugin_manager
+from tests.test_observe import data, profile  # noqa: F401  (the generated data, made once for this module)
+from toolkit import ConfigError
 from toolkit.character import read_toml, resolve_file
 from toolkit.cli import main
 from toolkit.observe import (check_observer_template, compose_observer, observer_template_path, observer_templates,
                              read_observer_template)
-from toolkit.profile import load_profile
-
-
-@pytest.fixture(scope="module")
-def data(tmp_path_factory):
-    pm = create_plugin_manager(autoload=False, trace=False)
-    return make_data(pm, tmp_path_factory.mktemp("generated"), seed=5, streams=1, per_stream=3)
-
-
-@pytest.fixture(scope="module")
-def profile(data):
-    return load_profile(data / "profile.toml")
 
 
 def test_a_template_extending_another_gets_its_tables_and_changes_only_what_it_writes(data, profile, pm, write):
