@@ -294,6 +294,8 @@ CASES = [
     # -- observer templates: --observer, [observer] extends (issue 18)
     ("observer-unknown", "an observer template that cannot be found", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--observer", "several-take", "m.bvh"], ["key --observer: cannot find observer template 'several-take'", "available: recordings, several-takes"]),
     ("observer-extends-cycle", "observer templates extending each other", {"a.toml": '[observer]\nname = "a"\nextends = "b.toml"\n', "b.toml": '[observer]\nname = "b"\nextends = "a.toml"\n'}, ["validate", "a.toml"], ["key observer.extends", "extends cycle: a.toml -> b.toml -> a.toml"]),
+    ("observer-extends-character", "an observer template extending a character file", {"o.toml": '[observer]\nname = "o"\nextends = "max"\n'}, ["validate", "o.toml"], ["o.toml: key observer.extends: max.toml is not an observer template (a character file)", "available: recordings, several-takes"]),
+    ("observer-is-character", "a character file named as the observer template", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--observer", "max", "m.bvh"], ["key --observer: max.toml is not an observer template (a character file)"]),
     ("observer-extends-parent", "a mistake in the template extended", {"base.toml": '[observer]\nname = "base"\n[matcher]\nplugin = "path-search"\nk = 0\n', "o.toml": '[observer]\nextends = "base.toml"\nname = "o"\n'}, ["validate", "o.toml"], ["base.toml:5: key matcher.k", "value 0 out of range"]),
 ]
 

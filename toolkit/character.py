@@ -309,7 +309,8 @@ def _load_chain(path: Path, pm: PluginManager | None, stack: tuple[Path, ...] = 
     table = read_toml(path)
     head = table.get(head_key, {})
     if not isinstance(head, Mapping):
-        raise ConfigError("not a table", file=path, key=(head_key,), expected=f"a [{head_key}] table")
+        raise ConfigError("not a table", file=path, key=(head_key,),
+                          expected=f"{'an' if head_key[0] in 'aeiou' else 'a'} [{head_key}] table")
     ref = head.get("extends")
     if ref is None:
         return table, (path,)

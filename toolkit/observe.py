@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from toolkit.character import (COMPONENT_TABLES, Character, _load_chain, character_paths, compose_character,
-                               resolve_file)
+                               read_toml, resolve_file)
 from toolkit.components import Perception
 from toolkit.errors import ConfigError, PluginError
 from toolkit.motion import Motion
@@ -73,12 +73,23 @@ def observer_template_path(template: str | Path, pm: Any = None, *, key: tuple =
                       available=observer_templates(pm))
 
 
-def read_observer_template(template: str | Path, pm: Any = None) -> tuple[dict[str, Any], tuple[Path, ...]]:
+def read_observer_template(template: str | Path, pm: Any = None, *, key: tuple = ("--observer",)
+                           ) -> tuple[dict[str, Any], tuple[Path, ...]]:
     """The table of an observer template and the files it was read from (outermost first): a template may extend
     another (``[observer] extends = "recordings.toml"``, a path relative to it or a name on the character path), as
     a character file does; its tables are merged onto the other's, a table naming another ``plugin`` replacing it
-    whole (:func:`toolkit.character.merge_tables`)."""
-    return _load_chain(observer_template_path(template, pm), pm, head_key="observer")
+    whole (:func:`toolkit.character.merge_tables`). A file that is not an observer template (a character file, a
+    body profile) is a :class:`ConfigError` naming ``key`` (the template itself) or the ``extends`` that names it."""
+    table, files = _load_chain(observer_template_path(template, pm, key=key), pm, head_key="observer")
+    for k, file in enumerate(files):
+        own = read_toml(file)
+        if not is_observer_template(own):
+            what = "a character file" if "character" in own else "no [observer] table"
+            raise ConfigError(f"{file.name} is not an observer template ({what})", file=files[k - 1] if k else None,
+                              key=("observer", "extends") if k else key,
+                              expected="an observer template: an [observer] table and component tables, no "
+                              "[character] or [body]", available=observer_templates(pm))
+    return table, files
 
 
 class Observer:
