@@ -140,7 +140,10 @@ bounds compare like with like: two takes that differ only by a held stance, or b
 Cost (K&G §4.4 predict every candidate in parallel): with ``tempo`` every candidate's prediction at every pace is one
 gather over the commands stacked once per subsystem (:meth:`ForwardModel._at_times_all`), the running sums and best
 paces of all candidates at once (:func:`plugins.lib.online_style.residuals_all`), and their travel parts at once; the
-same values as candidate by candidate (``tests/test_forward_model_styled_batch.py``).
+same values as candidate by candidate (``tests/test_forward_model_styled_batch.py``). Without ``tempo`` (``posture``
+alone) the same batch runs with one pace, every one-command candidate placed along its strokes at once on the
+path-length clock (:meth:`ForwardModel._styled_clock_all`); :meth:`ForwardModel._styled_predict`, path by path, is the
+tests' reference (and what runs when the commands cannot be stacked).
 
 Ranked candidates (B&B Fig. 13; K&G §4.4, Fig. 3's candidates): every answer of one followed subsystem carries
 ``Match.candidates``, the movements the forward models considered in the segment with their prediction errors,
@@ -1399,8 +1402,7 @@ class ForwardModel(Matcher):
         centred = self.params["posture"] == "removed"
         fits = {}
         errors = {}
-        batch = self._styled_predict_all(track, paths, start, n, paces) if n > start and self.params["tempo"] > 0 \
-            else None
+        batch = self._styled_predict_all(track, paths, observed, start, n, paces) if n > start else None
         for path in paths:
             fit = track.styled.get(path)
             if fit is None:
@@ -1411,7 +1413,7 @@ class ForwardModel(Matcher):
         together = batch is not None and len(fits) == len(paths)  # every candidate's sums at once
         if together:
             ds, bests = online_style.residuals_all(track.seen, list(fits.values()), o, batch[0], centred)
-            if self._traveling(track):
+            if self._traveling(track) and self.params["tempo"] > 0:  # from the commands stacked for the paces
                 travel = self._travel_all(track.subsystem, paths, batch[1][np.arange(len(paths)), bests])
         for c, path in enumerate(paths):
             fit = fits[path]
@@ -1490,13 +1492,16 @@ class ForwardModel(Matcher):
         total = sum(self._edge(e).arcs[lead, -1] for e in path)
         return p, alongs[-1][None], np.array([alongs[-1][lead] > total + 0.01 / track.scale])
 
-    def _styled_predict_all(self, track: Track, paths: list[tuple[str, ...]], start: int, n: int,
-                            paces: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-        """:meth:`_styled_predict` with ``tempo`` for every candidate path at once (the same values): predictions
-        (C, S, m, k, 3), places along the paths at the last row (C, S, k) and whether past their ends (C, S);
-        ``None`` when the paths' commands cannot be stacked (:class:`_TimedTables`)."""
+    def _styled_predict_all(self, track: Track, paths: list[tuple[str, ...]], observed: np.ndarray, start: int,
+                            n: int, paces: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """:meth:`_styled_predict` for every candidate path at once (the same values): predictions (C, S, m, k, 3),
+        places along the paths at the last row (C, S, k) and whether past their ends (C, S); ``None`` when the
+        paths' commands cannot be stacked (:class:`_TimedTables`). Without ``tempo``, one pace on the path-length
+        clock (:meth:`_styled_clock_all`)."""
         if not paths:
             return None
+        if not self.params["tempo"] > 0:
+            return self._styled_clock_all(track, paths, observed, start, n)
         rows = np.arange(start, n)
         clock = np.append(rows, 0) / self.fps  # (m + 1,): the onset's last
         t0 = np.array([self._onset_time(track, path) for path in paths])
@@ -1510,6 +1515,38 @@ class ForwardModel(Matcher):
         past = past.reshape(len(paths), len(paces), len(rows) + 1)[:, :, -2]
         p = points[:, :, :-1] - points[:, :, -1:] if self.params["relative"] else points[:, :, :-1]
         return p, along, past
+
+    def _styled_clock_all(self, track: Track, paths: list[tuple[str, ...]], observed: np.ndarray, start: int,
+                          n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`_styled_predict` without ``tempo`` (one pace, the path-length clock) for every candidate path at
+        once, the same values: rows ``start .. n - 1``'s path lengths (:func:`_lengths` of the rows up to each) are
+        computed once for all paths; the one-command paths (the common case) are placed along their strokes at once
+        (:meth:`_StrokeRows.along`, as :meth:`_errors` places them: the same points as :meth:`_predict`), the others
+        and ``clock = "lead"`` path by path. Predictions (C, 1, m, k, 3), places along at the last row (C, 1, k),
+        past the end (C, 1)."""
+        rows = range(start, n)
+        walked = np.stack([_lengths(observed[: i + 1]) for i in rows])  # (m, k)
+        c_n, m, k = len(paths), len(rows), observed.shape[1]
+        p = np.empty((c_n, m, k, 3))
+        along = np.empty((c_n, k))
+        past = np.empty(c_n, dtype=bool)
+        one = [c for c, path in enumerate(paths) if len(path) == 1] if self.params["clock"] != "lead" else []
+        if one:
+            strokes, totals, leads, anchors, _ = self._stacked(track, tuple(paths[c][0] for c in one))
+            x = anchors[None] + walked[:, None]  # (m, C1, k): _along's anchor + lengths
+            at = self._stroke_rows.along(np.tile(strokes, m), np.minimum(x, totals[None]).reshape(-1))
+            p[one] = at.reshape(m, len(one), k, 3).transpose(1, 0, 2, 3)
+            if self.params["relative"]:
+                p[one] -= self._stroke_rows.along(strokes, np.minimum(anchors, totals).reshape(-1)).reshape(
+                    len(one), 1, k, 3)
+            along[one] = x[-1]
+            past[one] = x[-1, np.arange(len(one)), leads] > totals[np.arange(len(one)), leads] + 0.01 / track.scale
+        chosen = set(one)
+        for c, path in enumerate(paths):
+            if c not in chosen:
+                pc, ac, ec = self._styled_predict(track, path, observed, start, n, np.array([1.0]))
+                p[c], along[c], past[c] = pc[0], ac[0], ec[0]
+        return p[:, None], along[:, None], past[:, None]
 
     def _at_times_all(self, subsystem: str, paths: list[tuple[str, ...]],
                       times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
