@@ -9,11 +9,6 @@ each), from running sums, so a frame costs the same at any length of segment:
 - **posture** (``centred``): each side centred on its own mean over the frames seen, ``O_i - mean(O)`` against
   ``P_i - mean(P)``: a constant offset of a part over the movement (a stance held otherwise, a hand held higher)
   cancels on both sides alike, as :func:`plugins.lib.style.mean_posture` removed does over a segment;
-- **posture by stillness** (``centred = "still"``): each part's mean removed from both sides in proportion to its
-  stillness over the frames seen (:func:`stillness`, the definition of :func:`plugins.lib.style.stillness` from
-  running sums): ``O_i - w mean(O)`` against ``P_i - w mean(P)``, ``w`` (k,) 1 for a part that has not moved, 0 for
-  the one that moved most. The stance of the parts that take no part cancels; where the moving parts are held still
-  counts (path search's ``posture = "still"``, estimated online);
 - **tempo** (several ``P`` rows, one per pace): the command is predicted at ``S`` paces (command seconds per second
   seen, :func:`paces`); the pace whose fit (with the posture above) leaves the least squared residual over the frames
   seen is the demonstrator's, and the prediction follows it.
@@ -35,7 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Observed", "Fit", "paces", "residuals", "fitted", "residuals_all", "distances_all", "stillness", "STEP"]
+__all__ = ["Observed", "Fit", "paces", "residuals", "fitted", "residuals_all", "distances_all", "STEP"]
 
 STEP = 1.12
 """Ratio of successive paces (:func:`paces`): 12%, the steps of the forward model's speed grid (``_speed``)."""
@@ -53,21 +48,15 @@ def paces(limit: float) -> np.ndarray:
 
 @dataclass
 class Observed:
-    """Running sums of the observation over the frames seen: ``n``, ``so`` (k, 3) and ``soo``; for
-    :func:`stillness`, each part's sums about the first frame seen ``ref`` (k, 3), ``sd`` (k, 3) and ``sdd`` (k,)
-    (a part that has not moved sums exact zeros), and the largest coordinate seen ``big``."""
+    """Running sums of the observation over the frames seen: ``n``, ``so`` (k, 3) and ``soo``."""
 
     n: int
     so: np.ndarray
     soo: float = 0.0
-    ref: np.ndarray | None = None
-    sd: np.ndarray | None = None
-    sdd: np.ndarray | None = None
-    big: float = 0.0
 
     @classmethod
     def empty(cls, k: int) -> Observed:
-        return cls(0, np.zeros((k, 3)), 0.0, None, np.zeros((k, 3)), np.zeros(k))
+        return cls(0, np.zeros((k, 3)))
 
     def add(self, o: np.ndarray) -> None:
         """Frames ``o`` (m, k, 3) seen."""
@@ -75,33 +64,6 @@ class Observed:
         self.n += len(o)
         self.so = self.so + o.sum(axis=0)
         self.soo += float((o * o).sum())
-        if len(o):
-            if self.ref is None:
-                self.ref = o[0].copy()
-            d = o - self.ref
-            self.sd = self.sd + d.sum(axis=0)
-            self.sdd = self.sdd + (d * d).sum(axis=(0, 2))
-            self.big = max(self.big, float(np.abs(o).max(initial=0.0)))
-
-
-def _still(move: np.ndarray, big: np.ndarray | float) -> np.ndarray:
-    """:func:`plugins.lib.style.stillness` from the parts' root-mean-square movements ``move`` (..., k) and the
-    largest coordinates ``big`` (...): 1 minus each over the largest of its row; every part 1 where nothing moves
-    beyond 1e-9 of the largest coordinate (rounding)."""
-    top = move.max(axis=-1, keepdims=True)
-    moves = top > 1e-9 * np.maximum(np.asarray(big, dtype=float), 1.0)[..., None]
-    return np.where(moves, 1.0 - move / np.where(moves, top, 1.0), 1.0)
-
-
-def stillness(obs: Observed) -> np.ndarray:
-    """How still each part has been over the frames seen (k,) in [0, 1], as :func:`plugins.lib.style.stillness`
-    defines it over a segment: 1 minus its root-mean-square distance from its mean over that of the part that moved
-    most (from the running sums about the first frame: ``sdd / n - |sd / n|^2``); every part 1 before anything
-    moved."""
-    if obs.n == 0:
-        return np.ones(len(obs.so))
-    move = np.sqrt(np.maximum(obs.sdd / obs.n - (obs.sd * obs.sd).sum(axis=-1) / obs.n ** 2, 0.0))
-    return _still(move, obs.big)
 
 
 @dataclass
@@ -134,22 +96,9 @@ class Fit:
         self.sop = self.sop + np.einsum("mkc,smkc->s", o, p)
 
 
-def _shares(obs: Observed) -> np.ndarray:
-    """With ``centred = "still"``: how much of the residual's per-part sum of squares about the means is removed,
-    ``(2 w - w^2) / n`` (k,) for stillness ``w``: ``sum_i |r_i - w mean(r)|^2 = sum_i |r_i|^2 - (2 w - w^2) n
-    |mean(r)|^2`` for the residuals ``r = O - P`` of a part."""
-    w = stillness(obs)
-    return (2.0 * w - w * w) / max(obs.n, 1)
-
-
-def fitted(obs: Observed, fit: Fit, centred: bool | str) -> np.ndarray:
+def fitted(obs: Observed, fit: Fit, centred: bool) -> np.ndarray:
     """Per pace (S,): the residual sum of squares over the frames seen of the observation against the prediction,
-    each centred on its own mean over them when ``centred`` (each part's mean in proportion to its stillness with
-    ``"still"``)."""
-    if isinstance(centred, str):
-        a = _shares(obs)
-        r = obs.so[None] - fit.sp  # (S, k, 3)
-        return np.maximum(obs.soo - 2.0 * fit.sop + fit.spp - (r * r).sum(axis=-1) @ a, 0.0)
+    each centred on its own mean over them when ``centred``."""
     c = 1.0 / max(obs.n, 1) if centred else 0.0
     soo = obs.soo - c * float((obs.so * obs.so).sum())
     sop = fit.sop - c * np.einsum("kc,skc->s", obs.so, fit.sp)
@@ -157,23 +106,19 @@ def fitted(obs: Observed, fit: Fit, centred: bool | str) -> np.ndarray:
     return np.maximum(soo - 2.0 * sop + spp, 0.0)
 
 
-def residuals(obs: Observed, fit: Fit, o: np.ndarray, p: np.ndarray, centred: bool | str) -> tuple[np.ndarray, int]:
+def residuals(obs: Observed, fit: Fit, o: np.ndarray, p: np.ndarray, centred: bool) -> tuple[np.ndarray, int]:
     """This frame's per-part distances (k,) between the observation ``o`` (k, 3) and the prediction ``p`` (S, k, 3)
     at the best pace (the least residual over the frames seen, this one included), each side centred on its mean
-    over the frames seen when ``centred``: ``|(o - mean O) - (p - mean P)|`` (``"still"``: each part's mean times
-    its :func:`stillness`); with the best pace's index."""
+    over the frames seen when ``centred``: ``|(o - mean O) - (p - mean P)|``; with the best pace's index."""
     rss = fitted(obs, fit, centred)
     best = int(np.argmin(rss))
-    if isinstance(centred, str):
-        w = stillness(obs)[:, None] / max(obs.n, 1)
-        return np.linalg.norm((np.asarray(o, dtype=float) - obs.so * w) - (p[best] - fit.sp[best] * w), axis=-1), best
     c = 1.0 / max(obs.n, 1) if centred else 0.0
     d = np.linalg.norm((np.asarray(o, dtype=float) - obs.so * c) - (p[best] - fit.sp[best] * c), axis=-1)
     return d, best
 
 
 def residuals_all(obs: Observed, fits: list[Fit], o: np.ndarray, p: np.ndarray,
-                  centred: bool | str) -> tuple[np.ndarray, np.ndarray]:
+                  centred: bool) -> tuple[np.ndarray, np.ndarray]:
     """:meth:`Fit.add` and :func:`residuals` of C candidates at once (the same values as one by one): the frames
     ``o`` (m, k, 3) seen and the candidates' predictions of them ``p`` (C, S, m, k, 3) added to ``fits``' sums
     (each fit's arrays replaced by its row of the stacked sums), then each candidate's per-part distances at its
@@ -186,26 +131,18 @@ def residuals_all(obs: Observed, fits: list[Fit], o: np.ndarray, p: np.ndarray,
     for i, f in enumerate(fits):
         f.n += on.shape[0]
         f.sp, f.spp, f.sop = sp[i], spp[i], sop[i]
-    at = np.arange(len(fits))
-    if isinstance(centred, str):  # "still": each part's mean in proportion to its stillness (see :func:`_shares`)
-        r = obs.so - sp  # (C, S, k, 3)
-        rss = np.maximum(obs.soo - 2.0 * sop + spp - (r * r).sum(axis=-1) @ _shares(obs), 0.0)
-        best = np.argmin(rss, axis=1)
-        w = stillness(obs)[:, None] / max(obs.n, 1)
-        last = np.asarray(p, dtype=float)[at, best, -1]
-        d = np.linalg.norm((np.asarray(o[-1], dtype=float) - obs.so * w) - (last - sp[at, best] * w), axis=-1)
-        return d, best
     c = 1.0 / max(obs.n, 1) if centred else 0.0
     soo = obs.soo - c * float((obs.so * obs.so).sum())
     rss = np.maximum(soo - 2.0 * (sop - c * np.einsum("kx,cskx->cs", obs.so, sp))
                      + (spp - c * (sp * sp).sum(axis=(2, 3))), 0.0)
     best = np.argmin(rss, axis=1)
+    at = np.arange(len(fits))
     last = np.asarray(p, dtype=float)[at, best, -1]  # (C, k, 3)
     d = np.linalg.norm((np.asarray(o[-1], dtype=float) - obs.so * c) - (last - sp[at, best] * c), axis=-1)
     return d, best
 
 
-def distances_all(o: np.ndarray, p: np.ndarray, centred: bool | str) -> tuple[np.ndarray, np.ndarray]:
+def distances_all(o: np.ndarray, p: np.ndarray, centred: bool) -> tuple[np.ndarray, np.ndarray]:
     """:func:`residuals` at every frame of a whole movement at once, as following it frame by frame gives them: the
     observation ``o`` (n, k, 3) and a candidate's predictions ``p`` (S, n, k, 3) at S paces; the running sums over
     rows 0 .. t are cumulative sums. Returns each frame's per-part distances (n, k) at the pace whose fit over the
@@ -213,20 +150,6 @@ def distances_all(o: np.ndarray, p: np.ndarray, centred: bool | str) -> tuple[np
     o = np.nan_to_num(np.asarray(o, dtype=float))
     p = np.nan_to_num(np.asarray(p, dtype=float))
     n = np.arange(1, len(o) + 1)
-    if isinstance(centred, str):  # "still": the stillness over rows 0 .. t from cumulative sums about row 0
-        d0 = o - o[:1]
-        sd, sdd = np.cumsum(d0, axis=0), np.cumsum((d0 * d0).sum(axis=-1), axis=0)  # (n, k, 3), (n, k)
-        move = np.sqrt(np.maximum(sdd / n[:, None] - (sd * sd).sum(axis=-1) / (n ** 2)[:, None], 0.0))
-        w = _still(move, np.maximum.accumulate(np.abs(o).max(axis=(1, 2))))  # (n, k)
-        so, sp = np.cumsum(o, axis=0), np.cumsum(p, axis=1)
-        r = so[None] - sp  # (S, n, k, 3)
-        raw = np.cumsum((o * o).sum(axis=(1, 2)))[None] - 2.0 * np.cumsum(np.einsum("nkc,snkc->sn", o, p), axis=1) \
-            + np.cumsum((p * p).sum(axis=(2, 3)), axis=1)
-        rss = raw - np.einsum("snk,nk->sn", (r * r).sum(axis=-1), (2.0 * w - w * w) / n[:, None])
-        best = np.argmin(np.maximum(rss, 0.0), axis=0)
-        at = np.arange(len(o))
-        wn = (w / n[:, None])[..., None]
-        return np.linalg.norm((o - so * wn) - (p[best, at] - sp[best, at] * wn), axis=-1), best
     c = 1.0 / n if centred else np.zeros(len(o))
     so = np.cumsum(o, axis=0)  # (n, k, 3)
     soo = np.cumsum((o * o).sum(axis=(1, 2)))

@@ -120,9 +120,6 @@ cannot measure a style over the whole segment; each candidate is fitted to the f
   over the frames seen so far, so a part held otherwise through the movement (a stance, a hand held higher) cancels
   on both sides alike, rather than only the onset's posture as ``relative`` removes it; ``unexplained`` and
   ``stillness`` then compare with predicting that nothing moves in the same way (each part about its own mean);
-- ``posture = "still"``: each part's mean over the frames seen removed from both sides in proportion to its
-  stillness over them (:func:`plugins.lib.online_style.stillness`, path search's ``still`` from running sums): the
-  stance of the parts that take no part cancels, while where the moving parts are held counts;
 - ``tempo`` = a factor (2, the posegraph's): the command is predicted at the time it reaches at a pace (command
   seconds per second seen) among paces at most 12% apart within the factor either way, the pace whose prediction
   leaves the least squared residual over the frames seen (with the posture above); K&G §4.4 re-parameterise each
@@ -888,10 +885,7 @@ class ForwardModel(Matcher):
         Parameter("posture", str, "kept", "Styled comparison (issue 18; K&G §6, B&B §7.1): 'removed' compares each "
                   "candidate's prediction and the observation each about its own mean over the frames seen so far "
                   "(plugins.lib.online_style), so a stance or a hand held otherwise through the movement cancels; "
-                  "'still': each part's mean removed in proportion to its stillness over the frames seen (path "
-                  "search's 'still', online), so the stance of parts that take no part cancels and where the moving "
-                  "parts are held counts; 'kept': as relative says (the paper).",
-                  choices=("kept", "removed", "still")),
+                  "'kept': as relative says (the paper).", choices=("kept", "removed")),
         Parameter("tempo", float, 0.0, "Styled comparison: each candidate is predicted at the time its command "
                   "reaches at a pace (command seconds per second seen) fitted to the frames seen so far, among "
                   "paces at most 12% apart within this factor either way (posegraph's tempo), so predictions follow "
@@ -1315,7 +1309,7 @@ class ForwardModel(Matcher):
         track.trace.append((frame, errors))
         unexplained = self.params["unexplained"] > 0 and self.params["dropout"] == "relative"
         still = None
-        if (self.params["stillness"] or unexplained) and styled and self.params["posture"] != "kept":
+        if (self.params["stillness"] or unexplained) and styled and self.params["posture"] == "removed":
             still = self._styled_still(track, observed, lengths)
         elif self.params["stillness"] or unexplained:  # predicting no movement: every part still, the body on the spot
             still = self._distance(track, observed[0], last) if not self._traveling(track) else float(
@@ -1375,7 +1369,7 @@ class ForwardModel(Matcher):
         :mod:`plugins.lib.online_style`): any of them on, for a positional subsystem (a hand's fingers share one
         clock and keep the paper's comparison)."""
         p = self.params
-        return not track.hand and (p["posture"] != "kept" or p["tempo"] > 0)
+        return not track.hand and (p["posture"] == "removed" or p["tempo"] > 0)
 
     def _styled_extended(self, track: Track) -> list[tuple[str, ...]]:
         """:meth:`_extended` for the styled comparison: a candidate path continues along the edges of its end node
@@ -1405,7 +1399,7 @@ class ForwardModel(Matcher):
         if n > start:
             track.seen.add(o)
         paces = online_style.paces(self.params["tempo"])
-        centred = self._centred()
+        centred = self.params["posture"] == "removed"
         fits = {}
         errors = {}
         batch = self._styled_predict_all(track, paths, observed, start, n, paces) if n > start else None
@@ -1448,28 +1442,14 @@ class ForwardModel(Matcher):
         track.fitted = n
         return errors
 
-    def _centred(self) -> bool | str:
-        """What the styled comparison removes of each side's mean (:mod:`plugins.lib.online_style`'s ``centred``):
-        all of it (``posture = "removed"``), none (``"kept"``), or each part's in proportion to its stillness over
-        the frames seen (``"still"``)."""
-        posture = self.params["posture"]
-        return "still" if posture == "still" else posture == "removed"
-
     def _styled_still(self, track: Track, observed: np.ndarray, lengths: np.ndarray) -> float:
         """With ``posture = "removed"``: the error of predicting that nothing moves, compared as the candidates are
         (``stillness``, ``unexplained``): a prediction that holds every part still is its own mean, so each part's
         distance is the observation's from its mean over the frames seen (:meth:`_styled_errors` has added this
-        frame); the body on the spot for the travel part. With ``"still"``: every part held where it was at the
-        onset (a displacement of 0 with ``relative``), each side less its mean times the part's stillness
-        (:func:`plugins.lib.online_style.stillness`): ``|(o - w mean O) - (1 - w) onset|``."""
+        frame); the body on the spot for the travel part."""
         seen = track.seen
         o = observed[-1] - observed[0] if self.params["relative"] else observed[-1]
-        if self.params["posture"] == "still":
-            w = online_style.stillness(seen)[:, None]
-            held = 0.0 if self.params["relative"] else observed[0]
-            d = _norms((o - seen.so * (w / max(seen.n, 1))) - (1.0 - w) * held) * track.scale
-        else:
-            d = _norms(o - seen.so / max(seen.n, 1)) * track.scale
+        d = _norms(o - seen.so / max(seen.n, 1)) * track.scale
         if self._traveling(track):
             return float(self._with_travel(track, d[None], np.array([_norms(track.travel_seen)]))[0])
         return float(self._combine(track, d[None], lengths)[0])
@@ -1793,7 +1773,7 @@ class ForwardModel(Matcher):
             if self.params["relative"]:
                 p = p - self._predict(track, path, anchor)
         o = observed - observed[0] if self.params["relative"] else observed
-        d, _ = online_style.distances_all(o, p, self._centred())
+        d, _ = online_style.distances_all(o, p, self.params["posture"] == "removed")
         return self._take_combined(d[1:] * track.scale, walked)
 
     def _last_correct(self, track: Track, lengths: np.ndarray, memory: np.ndarray) -> None:
