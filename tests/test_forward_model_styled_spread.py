@@ -141,3 +141,18 @@ def test_the_spreads_kept_between_takes_are_each_take_computed_alone_bit_for_bit
         assert any(key[0] == "points" for key in kept if isinstance(key, tuple))  # predictions were kept
     matcher._spreads = None
     assert matcher.spreads()["reach"] == float(np.median(minima))
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), n=st.integers(1, 12), more=st.integers(0, 8), s=st.integers(1, 5),
+       centred=st.booleans())
+def test_the_sums_of_a_longer_prediction_give_the_distances_of_its_first_rows_bit_for_bit(seed, n, more, s, centred):
+    """:func:`online_style.distances_all` with :func:`online_style.prediction_sums` of a prediction ``more`` rows longer
+    than the observation (NaNs among them) against the prediction cut to the observation's rows."""
+    rng = np.random.default_rng(seed)
+    o, p = rng.normal(size=(n, 3, 3)), rng.normal(size=(s, n + more, 3, 3))
+    p[rng.random(p.shape[:-1]) < 0.05] = np.nan
+    d, best = online_style.distances_all(o, p[:, :n], centred)
+    dk, bk = online_style.distances_all(o, None, centred, online_style.prediction_sums(p))
+    np.testing.assert_array_equal(d, dk)
+    np.testing.assert_array_equal(best, bk)

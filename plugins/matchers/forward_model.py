@@ -1785,26 +1785,28 @@ class ForwardModel(Matcher):
             # of a movement, kept, hold those over a shorter one as their first rows (the same bits)
             t0 = self._onset_time(track, path)
             key = ("points", path, fps, t0)
-            p = kept.get(key) if kept is not None else None
-            if p is None or p.shape[1] < len(observed):
+            sums = kept.get(key) if kept is not None else None
+            if sums is None or sums[0].shape[1] < len(observed):
                 rows = np.arange(max(len(observed), kept["longest"]) if kept is not None else len(observed))
                 paces = online_style.paces(self.params["tempo"])
                 times = t0 + paces[:, None] * (rows / fps)[None]  # (S, n): row 0 is the onset
                 at_once = self._at_times_all(track.subsystem, [path], times.reshape(1, -1))  # each time on its edge
                 points = (at_once[0][0] if at_once is not None else self._at_times(path, times.ravel())[0]).reshape(
                     len(paces), len(rows), -1, 3)
-                p = points - points[:, :1] if self.params["relative"] else points
+                # with their own running sums (online_style.prediction_sums: a shorter take's are their first rows)
+                sums = online_style.prediction_sums(points - points[:, :1] if self.params["relative"] else points)
                 if kept is not None:
-                    kept[key] = p
-            p = np.ascontiguousarray(p[:, : len(observed)])  # the layout computed whole (the same sums)
+                    kept[key] = sums
+            p = None
         else:  # the path-length clock, one pace: each part along its strokes after the path walked (as _predict)
             anchor = self._anchor(track, path[0])
             clock = self._lead_clock if self.params["clock"] == "lead" else (lambda _, along: along)
             p = np.stack([self._predict(track, path, clock(path, anchor + w)) for w in walked])[None]
             if self.params["relative"]:
                 p = p - self._predict(track, path, anchor)
+            sums = None
         o = observed - observed[0] if self.params["relative"] else observed
-        d, _ = online_style.distances_all(o, p, self.params["posture"] == "removed")
+        d, _ = online_style.distances_all(o, p, self.params["posture"] == "removed", sums)
         return self._take_combined(d[1:] * track.scale, walked, kept)
 
     def _last_correct(self, track: Track, lengths: np.ndarray, memory: np.ndarray) -> None:
