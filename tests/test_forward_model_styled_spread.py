@@ -105,3 +105,54 @@ def test_cumulative_distances_are_the_running_sums_frame_by_frame(seed, n, s, ce
         assert rss[best[i]] == pytest.approx(rss[bi], abs=1e-9)  # the same least residual (ties: either)
         if best[i] == bi:
             np.testing.assert_allclose(d[i], di, atol=1e-9)
+
+
+@pytest.mark.parametrize("styled", [{"tempo": 2.0, "posture": "removed"}, {"tempo": 2.0, "relative": True},
+                                    {"posture": "removed"}, {}])
+def test_the_spreads_kept_between_takes_are_each_take_computed_alone_bit_for_bit(arms, styled):
+    """:meth:`ForwardModel.spreads` keeps, between the takes of a movement, each path's predictions at the paces over
+    the longest take (sliced for a shorter one), each take's path lengths and weights, and stacks every take's commands
+    once: three takes of different lengths (1, 1.6 and 0.7 s, the third moved) give the same errors, take by take and
+    path by path, as :meth:`ForwardModel.take_errors` computed alone, and the spread their median of minima."""
+    motor = arms.motor
+    (a, b), (obs_a, obs_b) = offset_takes(arms, [0.0, -0.05, 0.02], seconds=(1.0, 1.6))
+    left, right = motor.rest[2] + [0.01, 0.03, 0.0], motor.rest[3] + [0.01, 0.03, 0.0]
+    c = motor.learn("wrists", "hub", [GuidingStroke(left, left + [0.25, 0.05, 0.0], 0.7),
+                                      GuidingStroke(right, right, 0.7)])
+    obs_c = np.repeat(np.stack([left, right])[None], 22, axis=0)
+    obs_c[:, 0] = stroke_path(left, [0.25, 0.05, 0.0], 0.7)
+    obs_c = obs_c + np.random.default_rng(3).normal(0.0, 0.002, obs_c.shape)
+    examples = [((a,), "wrists", obs_a, FPS), ((b,), "wrists", obs_b, FPS), ((c,), "wrists", obs_c, FPS)]
+    motor._takes = {"reach": examples}
+    matcher = use(arms, **{**E, "spread": 2.0, **styled})
+    matcher._time_tables = {}
+    kept = {"longest": max(len(o) for _, _, o, _ in examples)}
+    minima = []
+    for i, (_, subsystem, observed, fps) in enumerate(examples):
+        means = []
+        for j, (edges, *_) in enumerate(examples):
+            if j != i:
+                alone = matcher.take_errors(subsystem, observed, edges, fps)
+                with_kept = matcher.take_errors(subsystem, observed, edges, fps, kept=kept)
+                np.testing.assert_array_equal(with_kept, alone)
+                means.append(float(np.mean(alone)))
+        minima.append(min(means))
+    if "tempo" in styled:
+        assert any(key[0] == "points" for key in kept if isinstance(key, tuple))  # predictions were kept
+    matcher._spreads = None
+    assert matcher.spreads()["reach"] == float(np.median(minima))
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), n=st.integers(1, 12), more=st.integers(0, 8), s=st.integers(1, 5),
+       centred=st.booleans())
+def test_the_sums_of_a_longer_prediction_give_the_distances_of_its_first_rows_bit_for_bit(seed, n, more, s, centred):
+    """:func:`online_style.distances_all` with :func:`online_style.prediction_sums` of a prediction ``more`` rows longer
+    than the observation (NaNs among them) against the prediction cut to the observation's rows."""
+    rng = np.random.default_rng(seed)
+    o, p = rng.normal(size=(n, 3, 3)), rng.normal(size=(s, n + more, 3, 3))
+    p[rng.random(p.shape[:-1]) < 0.05] = np.nan
+    d, best = online_style.distances_all(o, p[:, :n], centred)
+    dk, bk = online_style.distances_all(o, None, centred, online_style.prediction_sums(p))
+    np.testing.assert_array_equal(d, dk)
+    np.testing.assert_array_equal(best, bk)

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Observed", "Fit", "paces", "residuals", "fitted", "residuals_all", "distances_all", "STEP"]
+__all__ = ["Observed", "Fit", "paces", "residuals", "fitted", "residuals_all", "distances_all", "prediction_sums", "STEP"]
 
 STEP = 1.12
 """Ratio of successive paces (:func:`paces`): 12%, the steps of the forward model's speed grid (``_speed``)."""
@@ -142,24 +142,41 @@ def residuals_all(obs: Observed, fits: list[Fit], o: np.ndarray, p: np.ndarray,
     return d, best
 
 
-def distances_all(o: np.ndarray, p: np.ndarray, centred: bool) -> tuple[np.ndarray, np.ndarray]:
+def prediction_sums(p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A candidate's own running sums for :func:`distances_all`, from its predictions ``p`` (S, n, k, 3) at S paces:
+    the predictions (NaN as 0), their cumulative sums over the rows ``sp`` (S, n, k, 3), the cumulative sums of their
+    squares ``spp`` (S, n) and the squares of ``sp`` summed ``(sp * sp).sum(axis=(2, 3))`` (S, n). Each row's values
+    depend on the rows up to it only (cumulative sums run row after row; the other sums are per row), so the sums of a
+    longer prediction hold those of its first rows: a prediction used with several observations of different lengths
+    is summed once."""
+    p = np.nan_to_num(np.asarray(p, dtype=float))
+    sp = np.cumsum(p, axis=1)  # (S, n, k, 3)
+    return p, sp, np.cumsum((p * p).sum(axis=(2, 3)), axis=1), (sp * sp).sum(axis=(2, 3))
+
+
+def distances_all(o: np.ndarray, p: np.ndarray | None, centred: bool,
+                  sums: tuple[np.ndarray, ...] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """:func:`residuals` at every frame of a whole movement at once, as following it frame by frame gives them: the
     observation ``o`` (n, k, 3) and a candidate's predictions ``p`` (S, n, k, 3) at S paces; the running sums over
     rows 0 .. t are cumulative sums. Returns each frame's per-part distances (n, k) at the pace whose fit over the
-    frames up to it leaves the least squared residual, and that pace's index (n,)."""
+    frames up to it leaves the least squared residual, and that pace's index (n,). ``sums``: :func:`prediction_sums`
+    of ``p`` or of a longer prediction whose first n rows are ``p`` (``p`` is then not read): the same values."""
     o = np.nan_to_num(np.asarray(o, dtype=float))
-    p = np.nan_to_num(np.asarray(p, dtype=float))
-    n = np.arange(1, len(o) + 1)
-    c = 1.0 / n if centred else np.zeros(len(o))
+    m = len(o)
+    if sums is None:
+        sums = prediction_sums(p)
+    # the first m rows, laid out as computed whole (the same sums below)
+    p, sp = np.ascontiguousarray(sums[0][:, :m]), np.ascontiguousarray(sums[1][:, :m])
+    spp, spsp = sums[2][:, :m], sums[3][:, :m]
+    n = np.arange(1, m + 1)
+    c = 1.0 / n if centred else np.zeros(m)
     so = np.cumsum(o, axis=0)  # (n, k, 3)
     soo = np.cumsum((o * o).sum(axis=(1, 2)))
-    sp = np.cumsum(p, axis=1)  # (S, n, k, 3)
-    spp = np.cumsum((p * p).sum(axis=(2, 3)), axis=1)  # (S, n)
     sop = np.cumsum(np.einsum("nkc,snkc->sn", o, p), axis=1)
     rss = (soo - c * (so * so).sum(axis=(1, 2)))[None] - 2.0 * (sop - c * np.einsum("nkc,snkc->sn", so, sp)) \
-        + spp - c * (sp * sp).sum(axis=(2, 3))
+        + spp - c * spsp
     best = np.argmin(np.maximum(rss, 0.0), axis=0)  # (n,)
-    at = np.arange(len(o))
+    at = np.arange(m)
     mo = so * c[:, None, None]
     mp = sp[best, at] * c[:, None, None]
     return np.linalg.norm((o - mo) - (p[best, at] - mp), axis=-1), best

@@ -140,7 +140,10 @@ bounds compare like with like: two takes that differ only by a held stance, or b
 Cost (K&G §4.4 predict every candidate in parallel): with ``tempo`` every candidate's prediction at every pace is one
 gather over the commands stacked once per subsystem (:meth:`ForwardModel._at_times_all`), the running sums and best
 paces of all candidates at once (:func:`plugins.lib.online_style.residuals_all`), and their travel parts at once; the
-same values as candidate by candidate (``tests/test_forward_model_styled_batch.py``).
+same values as candidate by candidate (``tests/test_forward_model_styled_batch.py``). Without ``tempo`` (``posture``
+alone) the same batch runs with one pace, every one-command candidate placed along its strokes at once on the
+path-length clock (:meth:`ForwardModel._styled_clock_all`); :meth:`ForwardModel._styled_predict`, path by path, is the
+tests' reference (and what runs when the commands cannot be stacked).
 
 Ranked candidates (B&B Fig. 13; K&G §4.4, Fig. 3's candidates): every answer of one followed subsystem carries
 ``Match.candidates``, the movements the forward models considered in the segment with their prediction errors,
@@ -1399,8 +1402,7 @@ class ForwardModel(Matcher):
         centred = self.params["posture"] == "removed"
         fits = {}
         errors = {}
-        batch = self._styled_predict_all(track, paths, start, n, paces) if n > start and self.params["tempo"] > 0 \
-            else None
+        batch = self._styled_predict_all(track, paths, observed, start, n, paces) if n > start else None
         for path in paths:
             fit = track.styled.get(path)
             if fit is None:
@@ -1411,7 +1413,7 @@ class ForwardModel(Matcher):
         together = batch is not None and len(fits) == len(paths)  # every candidate's sums at once
         if together:
             ds, bests = online_style.residuals_all(track.seen, list(fits.values()), o, batch[0], centred)
-            if self._traveling(track):
+            if self._traveling(track) and self.params["tempo"] > 0:  # from the commands stacked for the paces
                 travel = self._travel_all(track.subsystem, paths, batch[1][np.arange(len(paths)), bests])
         for c, path in enumerate(paths):
             fit = fits[path]
@@ -1490,13 +1492,16 @@ class ForwardModel(Matcher):
         total = sum(self._edge(e).arcs[lead, -1] for e in path)
         return p, alongs[-1][None], np.array([alongs[-1][lead] > total + 0.01 / track.scale])
 
-    def _styled_predict_all(self, track: Track, paths: list[tuple[str, ...]], start: int, n: int,
-                            paces: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-        """:meth:`_styled_predict` with ``tempo`` for every candidate path at once (the same values): predictions
-        (C, S, m, k, 3), places along the paths at the last row (C, S, k) and whether past their ends (C, S);
-        ``None`` when the paths' commands cannot be stacked (:class:`_TimedTables`)."""
+    def _styled_predict_all(self, track: Track, paths: list[tuple[str, ...]], observed: np.ndarray, start: int,
+                            n: int, paces: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """:meth:`_styled_predict` for every candidate path at once (the same values): predictions (C, S, m, k, 3),
+        places along the paths at the last row (C, S, k) and whether past their ends (C, S); ``None`` when the
+        paths' commands cannot be stacked (:class:`_TimedTables`). Without ``tempo``, one pace on the path-length
+        clock (:meth:`_styled_clock_all`)."""
         if not paths:
             return None
+        if not self.params["tempo"] > 0:
+            return self._styled_clock_all(track, paths, observed, start, n)
         rows = np.arange(start, n)
         clock = np.append(rows, 0) / self.fps  # (m + 1,): the onset's last
         t0 = np.array([self._onset_time(track, path) for path in paths])
@@ -1510,6 +1515,38 @@ class ForwardModel(Matcher):
         past = past.reshape(len(paths), len(paces), len(rows) + 1)[:, :, -2]
         p = points[:, :, :-1] - points[:, :, -1:] if self.params["relative"] else points[:, :, :-1]
         return p, along, past
+
+    def _styled_clock_all(self, track: Track, paths: list[tuple[str, ...]], observed: np.ndarray, start: int,
+                          n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`_styled_predict` without ``tempo`` (one pace, the path-length clock) for every candidate path at
+        once, the same values: rows ``start .. n - 1``'s path lengths (:func:`_lengths` of the rows up to each) are
+        computed once for all paths; the one-command paths (the common case) are placed along their strokes at once
+        (:meth:`_StrokeRows.along`, as :meth:`_errors` places them: the same points as :meth:`_predict`), the others
+        and ``clock = "lead"`` path by path. Predictions (C, 1, m, k, 3), places along at the last row (C, 1, k),
+        past the end (C, 1)."""
+        rows = range(start, n)
+        walked = np.stack([_lengths(observed[: i + 1]) for i in rows])  # (m, k)
+        c_n, m, k = len(paths), len(rows), observed.shape[1]
+        p = np.empty((c_n, m, k, 3))
+        along = np.empty((c_n, k))
+        past = np.empty(c_n, dtype=bool)
+        one = [c for c, path in enumerate(paths) if len(path) == 1] if self.params["clock"] != "lead" else []
+        if one:
+            strokes, totals, leads, anchors, _ = self._stacked(track, tuple(paths[c][0] for c in one))
+            x = anchors[None] + walked[:, None]  # (m, C1, k): _along's anchor + lengths
+            at = self._stroke_rows.along(np.tile(strokes, m), np.minimum(x, totals[None]).reshape(-1))
+            p[one] = at.reshape(m, len(one), k, 3).transpose(1, 0, 2, 3)
+            if self.params["relative"]:
+                p[one] -= self._stroke_rows.along(strokes, np.minimum(anchors, totals).reshape(-1)).reshape(
+                    len(one), 1, k, 3)
+            along[one] = x[-1]
+            past[one] = x[-1, np.arange(len(one)), leads] > totals[np.arange(len(one)), leads] + 0.01 / track.scale
+        chosen = set(one)
+        for c, path in enumerate(paths):
+            if c not in chosen:
+                pc, ac, ec = self._styled_predict(track, path, observed, start, n, np.array([1.0]))
+                p[c], along[c], past[c] = pc[0], ac[0], ec[0]
+        return p[:, None], along[:, None], past[:, None]
 
     def _at_times_all(self, subsystem: str, paths: list[tuple[str, ...]],
                       times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
@@ -1656,13 +1693,24 @@ class ForwardModel(Matcher):
         if self._spreads is None:
             takes = self.motor.takes() if hasattr(self.motor, "takes") else {}
             self._spreads = {}
+            if self.params["tempo"] > 0:  # every take's commands stacked once (_at_times_all), not once per new take
+                names: dict[str, list[str]] = {}
+                for examples in takes.values():
+                    for edges, subsystem, *_ in examples:
+                        names.setdefault(subsystem, []).extend(edges)
+                for subsystem, every in names.items():
+                    timed = self._time_tables.get(subsystem)
+                    if timed is None:
+                        timed = self._time_tables[subsystem] = _TimedTables()
+                    timed.rows(list(dict.fromkeys(every)), self)
             for movement, examples in takes.items():
                 if len(examples) < 2:
                     continue
                 distances = []
+                kept: dict[Any, Any] = {"longest": max(len(observed) for _, _, observed, _ in examples)}
                 for i, (_, subsystem, observed, fps) in enumerate(examples):
                     others = [tuple(edges) for j, (edges, *_) in enumerate(examples) if j != i]
-                    errors = [self.take_errors(subsystem, observed, path, fps) for path in others]
+                    errors = [self.take_errors(subsystem, observed, path, fps, kept=kept) for path in others]
                     distances.append(min((float(np.mean(e)) for e in errors if len(e)), default=float("nan")))
                 finite = [d for d in distances if np.isfinite(d)]
                 if len(finite) >= 2:
@@ -1670,7 +1718,7 @@ class ForwardModel(Matcher):
         return self._spreads
 
     def take_errors(self, subsystem: str, observed: np.ndarray, path: tuple[str, ...],
-                    fps: float | None = None) -> np.ndarray:
+                    fps: float | None = None, kept: dict | None = None) -> np.ndarray:
         """The prediction error, frame by frame, of command path ``path`` on a subsystem's observed movement
         ``observed`` (n, k, 3) followed from its first frame: the forward model's own prediction (:meth:`_error`,
         anchors and ``relative`` included) with the observed path lengths up to each frame (the positions
@@ -1679,17 +1727,23 @@ class ForwardModel(Matcher):
         With the styled comparison (``posture``, ``tempo``; :meth:`_styled`) the take is compared as a
         demonstration is (:meth:`_take_errors_styled`), so that a spread between takes and the errors of the
         candidates it bounds compare like with like. ``fps``: the take's frame rate (the pace's clock; by default
-        the segment's, else 30)."""
+        the segment's, else 30). ``kept``: what :meth:`spreads` keeps between the calls of one movement's takes (each
+        take's path lengths and weights, each path's predictions at the paces over the longest take, ``"longest"``
+        rows), the same values computed once."""
         from scipy.ndimage import uniform_filter1d
 
         track = Track(subsystem, self._scale_of(subsystem), self.motor.is_hand(subsystem), "hub", 0, {}, [],
                       first=observed[0])
-        smooth = uniform_filter1d(observed, size=3, axis=0, mode="nearest") if len(observed) >= 3 else observed
-        walked = np.concatenate([np.zeros((1, observed.shape[1])),
-                                 np.cumsum(np.linalg.norm(np.diff(smooth, axis=0), axis=-1), axis=0)])
+        walked = kept.get(("walked", id(observed))) if kept is not None else None
+        if walked is None:
+            smooth = uniform_filter1d(observed, size=3, axis=0, mode="nearest") if len(observed) >= 3 else observed
+            walked = np.concatenate([np.zeros((1, observed.shape[1])),
+                                     np.cumsum(np.linalg.norm(np.diff(smooth, axis=0), axis=-1), axis=0)])
+            if kept is not None:  # the take's array is alive while spreads() runs: its id is its own
+                kept[("walked", id(observed))] = walked
         if self._styled(track) and len(path):
             return self._take_errors_styled(track, observed, path, walked,
-                                            fps if fps else getattr(self, "fps", None) or 30.0)
+                                            fps if fps else getattr(self, "fps", None) or 30.0, kept)
         if track.hand or not len(path) or self.params["clock"] == "lead":  # one clock: frame by frame, as followed
             return np.array([self._error(track, path, walked[t], observed[t]) for t in range(1, len(observed))])
         # every frame at once: each part along its strokes of the whole path, laid end to end (what _predict does
@@ -1703,17 +1757,22 @@ class ForwardModel(Matcher):
         predicted = np.stack([np.stack([np.interp(along[:, p], arcs[p], positions[p, :, c]) for c in range(3)],
                                        axis=-1) for p in range(len(arcs))], axis=1)  # (T, k, 3)
         d = np.linalg.norm(predicted + self._onset_offset(track, path[0]) - observed[1:], axis=-1) * track.scale
-        return self._take_combined(d, walked)
+        return self._take_combined(d, walked, kept)
 
-    def _take_combined(self, d: np.ndarray, walked: np.ndarray) -> np.ndarray:
+    def _take_combined(self, d: np.ndarray, walked: np.ndarray, kept: dict | None = None) -> np.ndarray:
         """A take's per-part errors at frames 1 .. n - 1 (n - 1, k) combined as ``error`` says, ``moving`` with the
-        path lengths ``walked`` (n, k) up to each frame (:func:`moving_weights`)."""
+        path lengths ``walked`` (n, k) up to each frame (:func:`moving_weights`; kept in ``kept`` per take)."""
         if self.params["error"] == "moving":
-            return (d * np.apply_along_axis(moving_weights, 1, walked[1:])).sum(axis=1)
+            weights = kept.get(("weights", id(walked))) if kept is not None else None
+            if weights is None:
+                weights = np.apply_along_axis(moving_weights, 1, walked[1:])
+                if kept is not None:
+                    kept[("weights", id(walked))] = weights
+            return (d * weights).sum(axis=1)
         return d.max(axis=1) if self.params["error"] == "max" else d.mean(axis=1)
 
     def _take_errors_styled(self, track: Track, observed: np.ndarray, path: tuple[str, ...], walked: np.ndarray,
-                            fps: float) -> np.ndarray:
+                            fps: float, kept: dict | None = None) -> np.ndarray:
         """:meth:`take_errors` in the demonstrator's own style: at each frame ``t`` of the take (1 .. n - 1) the
         error :meth:`_styled_errors` gives when following it, every frame at once. The running sums of
         :mod:`plugins.lib.online_style` over rows 0 .. t are cumulative sums over the take: per pace the residual
@@ -1721,23 +1780,34 @@ class ForwardModel(Matcher):
         per-part distance at ``t``, each side about its own mean up to ``t`` with ``posture = "removed"``. The parts
         are compared alone (the spreads leave travel out), combined as ``error`` says with the path lengths walked
         up to ``t`` (:func:`moving_weights`)."""
-        rows = np.arange(len(observed))
         if self.params["tempo"] > 0:
-            paces = online_style.paces(self.params["tempo"])
-            times = self._onset_time(track, path) + paces[:, None] * (rows / fps)[None]  # (S, n): row 0 is the onset
-            at_once = self._at_times_all(track.subsystem, [path], times.reshape(1, -1))  # each time on its edge only
-            points = (at_once[0][0] if at_once is not None else self._at_times(path, times.ravel())[0]).reshape(
-                len(paces), len(rows), -1, 3)
-            p = points - points[:, :1] if self.params["relative"] else points
+            # each value is computed by itself (element by element): the predictions of a path over the longest take
+            # of a movement, kept, hold those over a shorter one as their first rows (the same bits)
+            t0 = self._onset_time(track, path)
+            key = ("points", path, fps, t0)
+            sums = kept.get(key) if kept is not None else None
+            if sums is None or sums[0].shape[1] < len(observed):
+                rows = np.arange(max(len(observed), kept["longest"]) if kept is not None else len(observed))
+                paces = online_style.paces(self.params["tempo"])
+                times = t0 + paces[:, None] * (rows / fps)[None]  # (S, n): row 0 is the onset
+                at_once = self._at_times_all(track.subsystem, [path], times.reshape(1, -1))  # each time on its edge
+                points = (at_once[0][0] if at_once is not None else self._at_times(path, times.ravel())[0]).reshape(
+                    len(paces), len(rows), -1, 3)
+                # with their own running sums (online_style.prediction_sums: a shorter take's are their first rows)
+                sums = online_style.prediction_sums(points - points[:, :1] if self.params["relative"] else points)
+                if kept is not None:
+                    kept[key] = sums
+            p = None
         else:  # the path-length clock, one pace: each part along its strokes after the path walked (as _predict)
             anchor = self._anchor(track, path[0])
             clock = self._lead_clock if self.params["clock"] == "lead" else (lambda _, along: along)
             p = np.stack([self._predict(track, path, clock(path, anchor + w)) for w in walked])[None]
             if self.params["relative"]:
                 p = p - self._predict(track, path, anchor)
+            sums = None
         o = observed - observed[0] if self.params["relative"] else observed
-        d, _ = online_style.distances_all(o, p, self.params["posture"] == "removed")
-        return self._take_combined(d[1:] * track.scale, walked)
+        d, _ = online_style.distances_all(o, p, self.params["posture"] == "removed", sums)
+        return self._take_combined(d[1:] * track.scale, walked, kept)
 
     def _last_correct(self, track: Track, lengths: np.ndarray, memory: np.ndarray) -> None:
         """The node at which the demonstration last agreed with the committed path: the start of the edge it was on.
