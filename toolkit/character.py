@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import re
 import tomllib
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -293,11 +293,14 @@ def merge_tables(base: Mapping[str, Any], over: Mapping[str, Any]) -> dict[str, 
 
 
 def _load_chain(path: Path, pm: PluginManager | None, stack: tuple[Path, ...] = (), *,
-                head_key: str = "character") -> tuple[dict[str, Any], tuple[Path, ...]]:
+                head_key: str = "character", check: Callable[[Path, dict, Path | None], None] | None = None
+                ) -> tuple[dict[str, Any], tuple[Path, ...]]:
     """The merged table of ``path`` and everything it extends, and the files involved (outermost first).
 
     ``head_key`` names the table holding ``extends`` (and the ``name`` a file does not pass on): ``[character]``
-    for characters, ``[observer]`` for observer templates (:func:`toolkit.observe.read_observer_template`)."""
+    for characters, ``[observer]`` for observer templates (:func:`toolkit.observe.read_observer_template`).
+    ``check(file, table, extended_by)``, if given, sees each file's own table as it is read (``extended_by``: the
+    file whose ``extends`` named it, None for ``path``)."""
     path = path.resolve()
     if len(stack) >= MAX_EXTENDS:
         raise ConfigError(f"extends chain longer than {MAX_EXTENDS} files", file=stack[-1],
@@ -307,6 +310,8 @@ def _load_chain(path: Path, pm: PluginManager | None, stack: tuple[Path, ...] = 
         cycle = " -> ".join(p.name for p in (*stack, path))
         raise ConfigError(f"extends cycle: {cycle}", file=stack[-1], key=(head_key, "extends"), expected="no cycle")
     table = read_toml(path)
+    if check is not None:
+        check(path, table, stack[-1] if stack else None)
     head = table.get(head_key, {})
     if not isinstance(head, Mapping):
         raise ConfigError("not a table", file=path, key=(head_key,),
@@ -318,7 +323,7 @@ def _load_chain(path: Path, pm: PluginManager | None, stack: tuple[Path, ...] = 
         raise ConfigError(f"wrong type {type(ref).__name__}", file=path, key=(head_key, "extends"),
                           expected=f"a file path or {head_key} name")
     parent_path = resolve_file(ref, path.parent, pm, key=(head_key, "extends"), file=path)
-    parent, files = _load_chain(parent_path, pm, (*stack, path), head_key=head_key)
+    parent, files = _load_chain(parent_path, pm, (*stack, path), head_key=head_key, check=check)
     own = dict(table)
     own[head_key] = {k: v for k, v in head.items() if k != "extends"}
     parent = dict(parent)

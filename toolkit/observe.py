@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from toolkit.character import (COMPONENT_TABLES, Character, _load_chain, character_paths, compose_character,
-                               read_toml, resolve_file)
+                               resolve_file)
 from toolkit.components import Perception
 from toolkit.errors import ConfigError, PluginError
 from toolkit.motion import Motion
@@ -80,16 +80,15 @@ def read_observer_template(template: str | Path, pm: Any = None, *, key: tuple =
     a character file does; its tables are merged onto the other's, a table naming another ``plugin`` replacing it
     whole (:func:`toolkit.character.merge_tables`). A file that is not an observer template (a character file, a
     body profile) is a :class:`ConfigError` naming ``key`` (the template itself) or the ``extends`` that names it."""
-    table, files = _load_chain(observer_template_path(template, pm, key=key), pm, head_key="observer")
-    for k, file in enumerate(files):
-        own = read_toml(file)
+    def check(file: Path, own: dict, extended_by: Path | None) -> None:
         if not is_observer_template(own):
             what = "a character file" if "character" in own else "no [observer] table"
-            raise ConfigError(f"{file.name} is not an observer template ({what})", file=files[k - 1] if k else None,
-                              key=("observer", "extends") if k else key,
+            raise ConfigError(f"{file.name} is not an observer template ({what})", file=extended_by,
+                              key=("observer", "extends") if extended_by else key,
                               expected="an observer template: an [observer] table and component tables, no "
                               "[character] or [body]", available=observer_templates(pm))
-    return table, files
+
+    return _load_chain(observer_template_path(template, pm, key=key), pm, head_key="observer", check=check)
 
 
 class Observer:
@@ -283,8 +282,7 @@ def observer_tables(pm: Any, *, segmenter: str | None = None, matcher: str | Non
     """The ``[observer]`` table of ``template`` and the component tables (``plugin`` and parameters) an observer
     composed with these arguments has, as :func:`compose_observer` takes them (its arguments, the same meaning)."""
     settings = {k: dict(v) for k, v in (settings or {}).items()}
-    check_observer_template(template, pm)
-    base = read_observer_template(template, pm)[0]
+    base = _checked_template(template, pm)[0]
     tables: dict[str, dict[str, Any]] = {k: dict(v) for k, v in base.items() if k in COMPONENT_TABLES}
     for key, name in (("segmenter", segmenter), ("matcher", matcher), ("motor", motor)):
         if name and tables.get(key, {}).get("plugin") != name:  # another plugin: none of the template's parameters,
@@ -356,6 +354,12 @@ def check_observer_template(path: str | Path, pm: Any) -> dict[str, str]:
     """The plugin of each component table of an observer template (and of those it extends), every name and
     parameter checked (a :class:`ConfigError` naming the file, key and line otherwise: the outermost file that
     writes the key); attaching waits for a body and clips."""
+    return _checked_template(path, pm)[1]
+
+
+def _checked_template(path: str | Path, pm: Any) -> tuple[dict[str, Any], dict[str, str]]:
+    """The merged table of an observer template, read once, and the plugin of each component table, as
+    :func:`check_observer_template` checks them."""
     from toolkit.character import build_component, find_key_line
 
     table, files = read_observer_template(path, pm)
@@ -401,4 +405,4 @@ def check_observer_template(path: str | Path, pm: Any) -> dict[str, str]:
                 break
         raise ConfigError(err.problem, file=where, key=err.key, line=line, expected=err.expected,
                           available=err.available) from None
-    return plugins
+    return table, plugins
