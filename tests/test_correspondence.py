@@ -225,7 +225,7 @@ def test_body_mapping_in_the_observer_and_the_template_is_the_papers_observer(ge
     plain_observer.watch(motion)
     assert plain_observer.loop.perceived is None
     np.testing.assert_allclose(loop.perceived.positions, plain_observer.memory.positions)  # what was perceived
-    # Max watching Morris (the same body): no rigid link in a key-posed mouse, so no rescaling; his rest is Max's
+    # Max watching Morris (the same body): his four rigid links are Max's lengths, so little changes; his rest is Max's
     assert np.nanmax(np.abs(loop.memory.positions - plain_observer.memory.positions)) < 0.05
 
 
@@ -301,3 +301,40 @@ def test_likeme_show_draws_a_recording_as_perceived_and_as_mapped(generated, tmp
     assert "has no correspondence" in capsys.readouterr().err
     assert main(["show", "observers/recordings", "--body", str(generated / "profile.toml")]) == 1
     assert "--body and --repertoire go together" in capsys.readouterr().err
+
+
+def test_the_pictures_larger_stooped_demonstrator_is_mapped_onto_maxs_size_and_rest(generated, pm, tmp_path,
+                                                                                    monkeypatch):
+    """docs/correspondence.md's picture on the project's own data: its Python block (run as written, on this
+    module's generated data) makes Morris's wave larger and stooped; body-mapping maps the demonstrator's standing
+    onto Max's hub and his rigid links onto Max's lengths, and ``likeme show`` draws it."""
+    import re
+    from pathlib import Path
+
+    from toolkit.cli import main
+    from toolkit.observe import Observer, compose_observer
+    from toolkit.profile import load_profile
+
+    text = (Path(__file__).resolve().parent.parent / "docs" / "correspondence.md").read_text(encoding="utf-8")
+    block = re.search(r"On the project's own data.*?```python\n(.*?)```", text, re.S).group(1)
+    monkeypatch.chdir(tmp_path)
+    exec(block.replace("/tmp/gen", str(generated)), {})  # writes wave_stooped.csv here
+    profile = load_profile(generated / "profile.toml")
+    seen = profile.read(tmp_path / "wave_stooped.csv")
+    mapped = {}
+    for name in ("body-mapping", "none"):
+        character = compose_observer(pm, profile, generated / "repertoire", correspondence=name)
+        observer = Observer(character, profile.body, seen.fps)
+        observer.watch(seen)
+        mapped[name] = observer.loop.memory.positions
+    rest = character.motor.rest_pose()
+    hub = rest - rest[profile.body.root_index]  # Max's own hub, root-relative
+    standing = slice(20, 30)  # the second of standing before the wave, after the rest has been seen
+    plain = np.mean([pose_distance(p, hub) for p in mapped["none"][standing]])
+    after = np.mean([pose_distance(p, hub) for p in mapped["body-mapping"][standing]])
+    assert plain > 0.02 and after < 0.2 * plain  # the stoop and the size read as Max's own rest
+    out = tmp_path / "picture.png"
+    assert main(["show", "observers/recordings", "--body", str(generated / "profile.toml"), "--repertoire",
+                 str(generated / "repertoire"), "--correspondence", "body-mapping", "--view", "correspondence",
+                 "--set", f"recording={tmp_path / 'wave_stooped.csv'}", "--out", str(out)]) == 0
+    assert out.stat().st_size > 10_000

@@ -106,8 +106,9 @@ def make_data(pm, dest: Path, *, seed: int = 0, streams: int = 6, per_stream: in
     parts = "\n".join(f'{p} = "{p}"' for p in body.parts)
     f = body.facing
     facing = f'left = "{f.left}"\nright = "{f.right}"' + (f'\nforward = "{f.forward}"' if f.forward else "")
-    (dest / "profile.toml").write_text(f'[profile]\nname = "max"\nunits = "metre"\nup = "+y"\n\n[parts]\n{parts}\n\n'
-                                       f"[facing]\n{facing}\n", encoding="utf-8")
+    bones = json.dumps([list(b) for b in body.bones])  # Max's, so views draw the skeleton (a TOML array as JSON)
+    (dest / "profile.toml").write_text(f'bones = {bones}\n\n[profile]\nname = "max"\nunits = "metre"\nup = "+y"\n\n'
+                                       f"[parts]\n{parts}\n\n[facing]\n{facing}\n", encoding="utf-8")
     return convert_recordings(dest, fmt)
 
 
