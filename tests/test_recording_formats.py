@@ -229,10 +229,12 @@ def test_an_npy_array_takes_the_mapped_joints_without_a_joints_key(data, tmp_pat
 ])
 def test_bad_fps_and_joints_keys_name_the_key(data, tmp_path, line, expected):
     path = tmp_path / "p.toml"
-    path.write_text((data / "bvh" / "profile.toml").read_text().replace("[profile]\n", f"[profile]\n{line}\n"))
+    text = (data / "bvh" / "profile.toml").read_text().replace("[profile]\n", f"[profile]\n{line}\n")
+    path.write_text(text)
+    at = text.splitlines().index(line) + 1  # the line written, under [profile]
     with pytest.raises(ConfigError) as info:
         load_profile(path)
-    assert str(info.value).startswith(f"{path}:2:") and expected in str(info.value)
+    assert str(info.value).startswith(f"{path}:{at}:") and expected in str(info.value)
 
 
 def test_validate_reads_csv_and_npy_with_and_without_a_profile(data, capsys):
