@@ -585,7 +585,7 @@ def _show_recordings(args: argparse.Namespace, pm: PluginManager, template: str 
     import tempfile
 
     from plugins.views.demonstration import recording
-    from toolkit.observe import OBSERVER_TEMPLATE, compose_observer
+    from toolkit.observe import compose_observer
     from toolkit.profile import load_profile
 
     if not args.view:
@@ -613,7 +613,7 @@ def _show_recordings(args: argparse.Namespace, pm: PluginManager, template: str 
                 folder = repertoire / f"{k:03d}-{Path(f).stem}"  # one movement per file, the same file twice too
                 folder.mkdir()
                 (folder / Path(f).name).symlink_to(Path(f).resolve())
-        character = compose_observer(pm, profile, repertoire, template=template or OBSERVER_TEMPLATE,
+        character = compose_observer(pm, profile, repertoire, template=template,
                                      segmenter=segmenter, matcher=matcher, correspondence=args.correspondence or "")
         if each == "all":
             written = view.draw(character, outs[0], recordings=demos)
@@ -670,7 +670,7 @@ def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
     Each file is reported when it has been watched; a file that fails is reported as one ``likeme: error:`` line
     on standard error naming it, the others are still watched, and the command exits with status 1 at the end.
     """
-    from toolkit.observe import NO_CORRESPONDENCE, OBSERVER_TEMPLATE, Observer, compose_observer, observer_plugins
+    from toolkit.observe import NO_CORRESPONDENCE, Observer, compose_observer, observer_plugins
     from toolkit.params import check_settings, parse_settings
     from toolkit.profile import load_profile
 
@@ -694,7 +694,7 @@ def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
     settings = parse_settings(list(args.set))
     if args.fps is not None:  # the repertoire's clips are recordings too: the same rate, unless --set says otherwise
         settings.setdefault("motor", {}).setdefault("fps", args.fps)
-    template = args.observer or OBSERVER_TEMPLATE
+    template = args.observer  # None: the observer template (toolkit.observe.OBSERVER_TEMPLATE)
     check_settings(settings, pm, observer_plugins(pm, segmenters=[args.segmenter] if args.segmenter else (),
                                                   matchers=[args.matcher] if args.matcher else (),
                                                   correspondence=args.correspondence or "", template=template))

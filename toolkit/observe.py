@@ -55,11 +55,12 @@ def observer_templates(pm: Any = None) -> list[str]:
     return sorted({f.stem for p in character_paths(pm) for f in (p / OBSERVER_FOLDER).glob("*.toml")})
 
 
-def observer_template_path(template: str | Path, pm: Any = None, *, key: tuple = ("--observer",)) -> Path:
+def observer_template_path(template: str | Path | None, pm: Any = None, *, key: tuple = ("--observer",)) -> Path:
     """The file of an observer template: a path, a name on the character path (``observers/recordings``), or the
-    name of a template in an ``observers`` folder of the character path (``recordings``, ``several-takes``).
-    A :class:`ConfigError` naming ``key`` and listing the templates found otherwise."""
-    ref = str(template)
+    name of a template in an ``observers`` folder of the character path (``recordings``, ``several-takes``);
+    ``None`` or ``""``: :data:`OBSERVER_TEMPLATE`. A :class:`ConfigError` naming ``key`` and listing the templates
+    found otherwise."""
+    ref = str(template or OBSERVER_TEMPLATE)
     if Path(ref).is_file():
         return Path(ref).resolve()
     tries = [ref] if "/" in ref or "\\" in ref else [f"{OBSERVER_FOLDER}/{ref}", ref]
@@ -73,7 +74,7 @@ def observer_template_path(template: str | Path, pm: Any = None, *, key: tuple =
                       available=observer_templates(pm))
 
 
-def read_observer_template(template: str | Path, pm: Any = None, *, key: tuple = ("--observer",)
+def read_observer_template(template: str | Path | None, pm: Any = None, *, key: tuple = ("--observer",)
                            ) -> tuple[dict[str, Any], tuple[Path, ...]]:
     """The table of an observer template and the files it was read from (outermost first): a template may extend
     another (``[observer] extends = "recordings.toml"``, a path relative to it or a name on the character path), as
@@ -225,7 +226,7 @@ def compose_observer(pm: Any, profile: BodyProfile, repertoire: Any, *, segmente
                      matcher: str | None = "", settings: Mapping[str, Mapping[str, Any]] | None = None,
                      motor: str | None = None, correspondence: str | None = "",
                      lengths_for_height: float | None | str = "",
-                     template: str | Path = OBSERVER_TEMPLATE) -> Character:
+                     template: str | Path | None = OBSERVER_TEMPLATE) -> Character:
     """The observing character: ``profile``'s body, a repertoire from the clips in ``repertoire``, its components
     from ``template`` (an observer template: an ``[observer]`` table and component tables, no body) unless named
     here.
@@ -277,7 +278,7 @@ def compose_observer(pm: Any, profile: BodyProfile, repertoire: Any, *, segmente
 
 def observer_tables(pm: Any, *, segmenter: str | None = None, matcher: str | None = "",
                     settings: Mapping[str, Mapping[str, Any]] | None = None, motor: str | None = None,
-                    correspondence: str | None = "", template: str | Path = OBSERVER_TEMPLATE
+                    correspondence: str | None = "", template: str | Path | None = OBSERVER_TEMPLATE
                     ) -> tuple[dict[str, Any], dict[str, dict[str, Any]]]:
     """The ``[observer]`` table of ``template`` and the component tables (``plugin`` and parameters) an observer
     composed with these arguments has, as :func:`compose_observer` takes them (its arguments, the same meaning)."""
@@ -310,7 +311,8 @@ def observer_tables(pm: Any, *, segmenter: str | None = None, matcher: str | Non
 
 
 def observer_plugins(pm: Any, *, segmenters: Sequence[str] = (), matchers: Sequence[str] = (),
-                     correspondence: str | None = "", template: str | Path = OBSERVER_TEMPLATE) -> dict[str, list[str]]:
+                     correspondence: str | None = "", template: str | Path | None = OBSERVER_TEMPLATE
+                     ) -> dict[str, list[str]]:
     """The plugins each component table of an observer composed from ``template`` may have, by table: the template's,
     with the ``segmenters``, ``matchers`` and ``correspondence`` named instead of its own, and the motor system each
     of those matchers needs. What ``--set TABLE.KEY=VALUE`` is checked against before any work
@@ -357,13 +359,13 @@ def check_observer_template(path: str | Path, pm: Any) -> dict[str, str]:
     return _checked_template(path, pm)[1]
 
 
-def _checked_template(path: str | Path, pm: Any) -> tuple[dict[str, Any], dict[str, str]]:
+def _checked_template(path: str | Path | None, pm: Any) -> tuple[dict[str, Any], dict[str, str]]:
     """The merged table of an observer template, read once, and the plugin of each component table, as
     :func:`check_observer_template` checks them."""
     from toolkit.character import build_component, find_key_line
 
     table, files = read_observer_template(path, pm)
-    if Path(path).is_file():  # the outermost file named as the caller named it
+    if path and Path(path).is_file():  # the outermost file named as the caller named it
         files = (Path(path), *files[1:])
     plugins = {}
     try:

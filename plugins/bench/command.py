@@ -56,14 +56,14 @@ def _check_set(args: argparse.Namespace, pm: Any) -> None:
         base = merge_tables(_load_chain(path, pm)[0], {"perception": {"plugin": "synthetic-vision"}})
         plugins = {k: [v["plugin"]] for k, v in base.items() if isinstance(v, dict) and isinstance(v.get("plugin"), str)}
     else:  # an observer composed from the observer template (toolkit.observe.compose_observer)
-        from toolkit.observe import OBSERVER_TEMPLATE, observer_plugins
+        from toolkit.observe import observer_plugins
 
         segmenters = (list(args.segmenter or SEGMENTERS) if args.benchmark == "segmentation" else
                       list(args.segmenter or SEGMENTERS[:2]) if args.benchmark == "stream" else ())
         matchers = list(args.matcher or MATCHERS) if args.benchmark in ("recognition", "stream") else ()
         plugins = observer_plugins(pm, segmenters=segmenters, matchers=matchers,
                                    correspondence=getattr(args, "correspondence", ""),
-                                   template=getattr(args, "observer", None) or OBSERVER_TEMPLATE)
+                                   template=getattr(args, "observer", None))
     check_settings(settings, pm, plugins)
 
 

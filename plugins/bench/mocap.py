@@ -44,7 +44,7 @@ from plugins.bench.data import read_segments
 from plugins.bench.metrics import confusion_matrix, macro_f1, movement_error_rate, segmentation_scores
 from plugins.lib.clip_repertoire import clip_files
 from toolkit import ConfigError
-from toolkit.observe import OBSERVER_TEMPLATE, Observer, compose_observer
+from toolkit.observe import Observer, compose_observer
 from toolkit.profile import RECORDING_SUFFIXES, load_profile
 
 __all__ = ["MATCHERS", "SEGMENTERS", "recognition", "segmentation", "stream", "cell", "merge", "table",
@@ -450,7 +450,7 @@ def run(kind: str, args: Any, pm: Any) -> int:
     settings = _settings(args.set)
     observer = {"correspondence": args.correspondence,
                 "lengths_for_height": "" if args.lengths_for_height is None else args.lengths_for_height,
-                "template": args.observer or OBSERVER_TEMPLATE}
+                "template": args.observer}
     if getattr(args, "jobs", 1) > 1 or getattr(args, "scheduler", None):
         result = _parallel(kind, args, observer)
     elif kind == "recognition":

@@ -106,14 +106,12 @@ def load_grid(path: str | Path) -> dict[str, Any]:
         if "." not in key or not isinstance(values, list) or not values:
             raise ConfigError(f"set key {key!r}", file=path, key=("set", key),
                               expected='"TABLE.KEY" = [one or more values], like "segmenter.floor" = [0.0, 0.1]')
-    from toolkit.observe import OBSERVER_TEMPLATE
-
-    observer = grid.get("observer", OBSERVER_TEMPLATE)
-    if not isinstance(observer, str):
+    observer = grid.get("observer")  # None: the observer template
+    if observer is not None and not isinstance(observer, str):
         raise ConfigError(f"observer is {type(observer).__name__}", file=path, key=("observer",),
                           expected="an observer template: a TOML file (relative to the grid file) or the name of one "
                           "in characters/observers/")
-    if (path.parent / observer).is_file():
+    if observer and (path.parent / observer).is_file():
         observer = str((path.parent / observer).resolve())
     return {"file": str(path), "benchmark": benchmark, "data": folders, "observer": observer,
             "matchers": list(plugins.get("matchers", MATCHERS)),
@@ -126,8 +124,6 @@ def load_grid(path: str | Path) -> dict[str, Any]:
 def cells(grid: dict[str, Any]) -> list[dict[str, Any]]:
     """The grid's cells in a fixed order (data set, plugin or pairing, settings): specs of
     :func:`plugins.bench.mocap.cell`, with ``data`` and ``values`` (the cell's ``set`` values) for the table."""
-    from toolkit.observe import OBSERVER_TEMPLATE
-
     kind = grid["benchmark"]
     if kind == "recognition":
         plugins = [{"matchers": [m]} for m in grid["matchers"]]
@@ -138,7 +134,7 @@ def cells(grid: dict[str, Any]) -> list[dict[str, Any]]:
     keys = list(grid["set"])
     observer = {"correspondence": grid.get("correspondence", ""),
                 "lengths_for_height": grid.get("lengths_for_height", ""),
-                "template": grid.get("observer", OBSERVER_TEMPLATE)}
+                "template": grid.get("observer")}
     out = []
     for name, folders in grid["data"].items():
         for plugin in plugins:
@@ -153,14 +149,14 @@ def cells(grid: dict[str, Any]) -> list[dict[str, Any]]:
 
 def _check(grid: dict[str, Any], pm: Any) -> None:
     """Every ``set`` key and value against every plugin it reaches, before any cell runs."""
-    from toolkit.observe import OBSERVER_TEMPLATE, observer_plugins
+    from toolkit.observe import observer_plugins
     from toolkit.params import check_settings, parse_settings
 
     kind = grid["benchmark"]
     plugins = observer_plugins(pm, segmenters=grid["segmenters"] if kind != "recognition" else (),
                                matchers=grid["matchers"] if kind != "segmentation" else (),
                                correspondence=grid.get("correspondence", ""),
-                               template=grid.get("observer", OBSERVER_TEMPLATE))
+                               template=grid.get("observer"))
     for values in itertools.product(*grid["set"].values()):
         check_settings(parse_settings([f"{k}={_literal(v)}" for k, v in zip(grid["set"], values)]), pm, plugins)
 
