@@ -272,6 +272,10 @@ def test_observe_prints_segments_and_json(data, capsys):
     assert [s["movement"] for s in report[0]["segments"]][: len(truth)].count("unknown") <= 1
     assert {"start_frame", "end_frame", "start_s", "end_s", "confidence", "decision_fraction"} <= set(
         report[0]["segments"][0])
+    # why each segment ends, as the segmenter said (Segment.reason): hub-threshold's hub, or the stream's end
+    ends = [s["ends"] for s in report[0]["segments"]]
+    assert ends and set(ends) <= {"back near a hub pose", "came to rest", "the stream ended"}
+    assert text.count("\n    ends: ") == len(ends)
 
 
 @pytest.mark.parametrize(

@@ -631,12 +631,16 @@ def _recording_views(pm: PluginManager) -> list[str]:
 
 
 def _segment_row(o: Any) -> dict[str, Any]:
-    """One observation as ``likeme observe`` reports it."""
-    return {"start_frame": o.segment.start, "end_frame": o.segment.end, "start_s": round(o.segment.start_time, 3),
-            "end_s": round(o.segment.end_time, 3), "movement": o.movement or "unknown",
-            "confidence": round(o.match.confidence, 3) if o.match else 0.0,
-            "decided_at_frame": o.segment.start + (o.decided_at if o.decided_at is not None else o.segment.n_frames),
-            "decision_fraction": round(o.decision_fraction, 3), **_why_unknown(o), **_candidates(o)}
+    """One observation as ``likeme observe`` reports it: the segment (and why it ends, if the segmenter says), the
+    answer, and why it is unknown, as the matcher says (:class:`toolkit.components.Match`'s typed fields)."""
+    row = {"start_frame": o.segment.start, "end_frame": o.segment.end, "start_s": round(o.segment.start_time, 3),
+           "end_s": round(o.segment.end_time, 3), "movement": o.movement or "unknown",
+           "confidence": round(o.match.confidence, 3) if o.match else 0.0,
+           "decided_at_frame": o.segment.start + (o.decided_at if o.decided_at is not None else o.segment.n_frames),
+           "decision_fraction": round(o.decision_fraction, 3)}
+    if o.segment.reason:
+        row["ends"] = o.segment.reason
+    return {**row, **_why_unknown(o), **_candidates(o)}
 
 
 def _candidates(observation: Any) -> dict[str, Any]:
@@ -649,10 +653,12 @@ def _candidates(observation: Any) -> dict[str, Any]:
 
 
 def _segment_text(seg: dict[str, Any]) -> str:
-    """One segment as ``likeme observe`` prints it (two lines for an unknown one with its reason)."""
+    """One segment as ``likeme observe`` prints it: a line, then why it ends and, for an unknown one, why."""
     line = (f"  frames {seg['start_frame']:5d}-{seg['end_frame']:<5d} ({seg['start_s']:6.2f}-{seg['end_s']:6.2f} s)  "
             f"{seg['movement']:<16} confidence {seg['confidence']:.2f}  decided at frame {seg['decided_at_frame']} "
             f"({seg['decision_fraction']:.0%} of the segment)")
+    if "ends" in seg:
+        line += f"\n    ends: {seg['ends']}"
     if "nearest" in seg or "reason" in seg:
         line += f"\n    {_why_text(seg)}"
     return line
@@ -779,29 +785,33 @@ def _observe_live(args: argparse.Namespace, character: Any, profile: Any, observ
     return 0
 
 
-_WHY_NUMBERS = ("mean_distance", "max_distance", "spread", "predicted_frames", "error_when_dropped", "distance")
-"""The numbers a matcher gives with an unknown answer that say why it rejected the nearest movement."""
-
-
 def _why_unknown(observation: Any) -> dict[str, Any]:
-    """For an unknown segment: the nearest movement and why it was rejected, as the matcher told (else nothing)."""
+    """For an unknown segment: why, as the matcher said (the nearest movement, the reason, the score it was rejected
+    on and the threshold it exceeded, with what they measure), else nothing."""
     match = observation.match
     if match is None or match.movement is not None:
         return {}
-    d = match.details
     out: dict[str, Any] = {}
-    if d.get("nearest"):
-        out["nearest"] = str(d["nearest"])
-    if d.get("reason"):
-        out["reason"] = str(d["reason"])
-    out.update({k: round(float(d[k]), 4) for k in _WHY_NUMBERS if isinstance(d.get(k), (int, float))})
+    if match.nearest:
+        out["nearest"] = str(match.nearest)
+    if match.reason:
+        out["reason"] = str(match.reason)
+    for key in ("score", "threshold"):
+        value = getattr(match, key)
+        if isinstance(value, (int, float)) and math.isfinite(value):
+            out[key] = round(float(value), 4)
+    if match.measure and ("score" in out or "threshold" in out):
+        out["measure"] = str(match.measure)
     return out
 
 
 def _why_text(seg: dict[str, Any]) -> str:
-    """One line: 'nearest bow, rejected: too far from every path (mean_distance 0.081 > max_distance 0.03)'."""
-    numbers = ", ".join(f"{k} {seg[k]:g}" for k in _WHY_NUMBERS if k in seg)
+    """One line: 'nearest bow, rejected: too far from every path (mean pose distance ... 0.081 > 0.03)'."""
     nearest = f"nearest {seg['nearest']}" if "nearest" in seg else "no nearest movement"
+    numbers = ""
+    if "score" in seg:
+        numbers = f"{seg.get('measure', 'score')} {seg['score']:g}" + (f" > {seg['threshold']:g}" if "threshold" in
+                                                                       seg else "")
     return f"{nearest}, rejected: {seg.get('reason', 'no reason given')}" + (f" ({numbers})" if numbers else "")
 
 
