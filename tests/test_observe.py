@@ -402,14 +402,15 @@ def test_a_plugin_named_instead_takes_its_own_table_of_the_template(data, profil
         plugin = "path-search"
         [matchers.dtw]
         window = 0.25
-        [motors.motor-command-graph]
+        [motors.motor-command-graph.strokes]
         drop = 0.4
         """)
     dtw = compose_observer(pm, profile, data / "repertoire", matcher="dtw", template=mine)
     assert dtw.matcher.params["window"] == 0.25
     assert compose_observer(pm, profile, data / "repertoire", template=mine).matcher.name == "path-search"
     follows = compose_observer(pm, profile, data / "repertoire", matcher="forward-model", template=mine)
-    assert follows.motor.name == "motor-command-graph" and follows.motor.params["drop"] == 0.4  # brought along
+    assert follows.motor.name == "motor-command-graph" and follows.motor.params["strokes"] == {"drop": 0.4,
+                                                                                                "angle": 50.0}
 
 
 def test_naming_the_templates_own_matcher_keeps_its_parameters_and_another_starts_afresh(data, profile, pm):

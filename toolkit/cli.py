@@ -428,7 +428,7 @@ def plugins_table(pm: PluginManager, *, params: bool = False) -> dict[str, Any]:
                 "version": info.plugin.version,
             }
             if params:
-                row["parameters"] = [{"name": p.name, "type": p.describe(), "doc": p.doc} for p in info.cls.parameters]
+                row["parameters"] = _parameter_rows(info.cls.parameters)
             rows.append(row)
         components[kind] = rows
     plugins = []
@@ -450,9 +450,29 @@ def plugins_table(pm: PluginManager, *, params: bool = False) -> dict[str, Any]:
     return {"components": components, "plugins": plugins, "skipped": skipped, "failed": failed}
 
 
+def _parameter_rows(parameters: Sequence[Any]) -> list[dict[str, Any]]:
+    """Each parameter's name, type and default, and what it does; a table's parameters nested in its row."""
+    rows = []
+    for p in parameters:
+        row: dict[str, Any] = {"name": p.name, "type": p.describe(), "doc": p.doc}
+        if p.table:
+            row["parameters"] = _parameter_rows(p.parameters)
+        rows.append(row)
+    return rows
+
+
+def _print_parameters(rows: list[dict[str, Any]], indent: str = "      ") -> None:
+    """``likeme plugins --params``: one line per parameter, a table's parameters indented under it."""
+    for p in rows:
+        print(f"{indent}{p['name']}: {p['type']}. {p['doc']}")
+        _print_parameters(p.get("parameters", []), indent + "    ")
+
+
 def components_markdown(pm: PluginManager) -> str:
-    """Every registered component with its summary and parameter table, as Markdown (``docs/components.md``)."""
+    """Every registered component with its summary and parameter table, as Markdown (``docs/components.md``); a
+    table's parameters are rows of their own, keyed ``TABLE.KEY``."""
     from toolkit.components import KINDS
+    from toolkit.params import flat_parameters
 
     lines = [
         "# Component reference",
@@ -469,7 +489,7 @@ def components_markdown(pm: PluginManager) -> str:
                 lines += ["No parameters.", ""]
                 continue
             lines += ["| key | type and default | effect |", "| --- | --- | --- |"]
-            lines += [f"| `{p.name}` | {p.describe()} | {p.doc} |" for p in cls.parameters]
+            lines += [f"| `{'.'.join(key)}` | {p.describe()} | {p.doc} |" for key, p in flat_parameters(cls.parameters)]
             lines.append("")
     return "\n".join(lines)
 
@@ -493,8 +513,7 @@ def cmd_plugins(args: argparse.Namespace, pm: PluginManager) -> int:
         for r in rows:
             dist = f"{r['distribution']} {r['version']}".strip()
             print(f"  {r['name']:<{width}}  {r['summary']}  [{dist}: {r['plugin']}]")
-            for p in r.get("parameters", []):
-                print(f"      {p['name']}: {p['type']}. {p['doc']}")
+            _print_parameters(r.get("parameters", []))
         print()
     print("plugins:")
     for p in table["plugins"]:

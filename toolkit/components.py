@@ -45,7 +45,7 @@ import numpy as np
 
 from toolkit.errors import ConfigError
 from toolkit.motion import Motion, fill_hidden
-from toolkit.params import Parameter, validate_params
+from toolkit.params import Parameter, length_names, scaled, validate_params
 
 if TYPE_CHECKING:  # pragma: no cover - imports for annotations only
     from pathlib import Path
@@ -340,8 +340,7 @@ class Component(ABC):
         """Multiply every parameter declared a ``length`` by ``factor`` (the character's own height over the height
         its lengths were meant for). Called by the character before :meth:`attach`; ``declared`` keeps the values
         as written, which every call scales from."""
-        lengths = {p.name for p in self.parameters if p.length}
-        self.params = MappingProxyType({k: v * factor if k in lengths else v for k, v in self.declared.items()})
+        self.params = MappingProxyType(scaled(self.declared, length_names(self.parameters), factor))
 
     def inspect(self) -> Mapping[str, Any]:
         """What the component holds now, read-only, for views and tests (its signals: a segmenter's last
