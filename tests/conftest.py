@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import textwrap
 from pathlib import Path
 
@@ -14,8 +15,9 @@ from toolkit.manager import PluginManager
 
 ROOT = Path(__file__).resolve().parent.parent
 CHARACTERS = ROOT / "characters"
-BANDAI = ROOT.parent / "shared" / "data" / "bandai-namco-1"
-"""Real motion capture (CC BY-NC, never copied into the repository); tests that read it skip where it is absent."""
+BANDAI = Path(os.environ.get("LIKEME_DATA") or ROOT.parent / "shared" / "data") / "bandai-namco-1"
+"""Real motion capture (CC BY-NC, never copied into the repository): ``bandai-namco-1`` in the folder
+``$LIKEME_DATA`` names, else in ``../shared/data`` beside the clone; tests that read it skip where it is absent."""
 
 settings.register_profile("likeme", deadline=None)
 settings.load_profile("likeme")
@@ -137,8 +139,7 @@ STICK_PARTS = ("root", "head", "lk", "rk", "hand", "lf", "rf")
 def write_stick_clip(path: Path, positions: np.ndarray, fps: float = 30.0) -> None:
     """A BVH clip of the stick figure: world positions (frames, 7, 3) of :data:`STICK_PARTS`, every part a child of
     the root."""
-    from toolkit.bvh import from_joint_positions, write_bvh
-
+    from toolkit.recordings.bvh_writer import from_joint_positions, write_bvh
     path.parent.mkdir(parents=True, exist_ok=True)
     write_bvh(from_joint_positions(list(STICK_PARTS), [-1] + [0] * (len(STICK_PARTS) - 1), positions, fps), path)
 

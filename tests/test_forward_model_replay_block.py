@@ -25,7 +25,7 @@ from tests.toolkit.test_watching_settled import frozen, watched
 from toolkit import Match, Matcher, create_plugin_manager
 from toolkit.errors import PluginError
 from toolkit.observe import Observer, compose_observer
-from toolkit.profile import load_profile
+from toolkit.recordings.profile import load_profile
 from toolkit.watching import WatchingLoop
 
 SETTINGS = ({}, {"threshold": 0.02}, {"threshold": 0.01, "learn": False}, {"together": False},

@@ -164,7 +164,7 @@ def generated(tmp_path_factory):
     from plugins.bench.data import make_data
     from toolkit import create_plugin_manager
     from toolkit.observe import compose_observer
-    from toolkit.profile import load_profile
+    from toolkit.recordings.profile import load_profile
 
     pm = create_plugin_manager(autoload=False, trace=False)
     data = make_data(pm, tmp_path_factory.mktemp("styles"), seed=5, streams=1, per_stream=2)

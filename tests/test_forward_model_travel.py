@@ -17,7 +17,7 @@ import pytest
 from tests.conftest import STICK_PARTS, write_stick_clip, write_stick_profile
 from toolkit import ConfigError, Motion, create_plugin_manager
 from toolkit.observe import Observer, compose_observer
-from toolkit.profile import load_profile
+from toolkit.recordings.profile import load_profile
 
 PARTS = STICK_PARTS
 STAND = np.array([[0.0, 1.0, 0.0], [0.0, 1.6, 0.1], [0.1, 0.5, 0.0], [-0.1, 0.5, 0.0], [0.3, 1.0, 0.0],

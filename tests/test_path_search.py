@@ -235,7 +235,7 @@ def test_a_beam_step_through_hubs_keeps_the_same_paths_as_listing_every_pair(tmp
     from toolkit.manager import create_plugin_manager
     from toolkit.observe import Observer, compose_observer
     from toolkit.params import parse_settings
-    from toolkit.profile import load_profile
+    from toolkit.recordings.profile import load_profile
 
     pm = create_plugin_manager()
     profile = load_profile(_data(pm, tmp_path / "data") / "profile.toml")

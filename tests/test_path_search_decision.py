@@ -17,7 +17,7 @@ from tests.toolkit.test_relative_lengths import generated  # noqa: F401  (the ge
 from toolkit import create_plugin_manager
 from toolkit.observe import Observer
 from toolkit.observe import compose_observer
-from toolkit.profile import load_profile
+from toolkit.recordings.profile import load_profile
 
 MOVEMENTS = ("wave", "reach", "clap", "bow", "knock")
 LEFT_OUT = "knock"

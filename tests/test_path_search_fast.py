@@ -147,7 +147,7 @@ def generated(tmp_path_factory):
     from plugins.bench.data import make_data
     from plugins.bench.mocap import _streams
     from toolkit.manager import create_plugin_manager
-    from toolkit.profile import load_profile
+    from toolkit.recordings.profile import load_profile
 
     pm = create_plugin_manager()
     folder = make_data(pm, tmp_path_factory.mktemp("gen"), seed=4, streams=2, per_stream=4)

@@ -90,8 +90,8 @@ def count_type(low: int, high: int) -> Any:
 
 
 def fps_type(text: str) -> float:
-    """``--fps``: a frame rate in (0, :data:`toolkit.positions.MAX_FPS`] Hz, the range every reader accepts."""
-    from toolkit.positions import MAX_FPS
+    """``--fps``: a frame rate in (0, :data:`toolkit.recordings.MAX_FPS`] Hz, the range every reader accepts."""
+    from toolkit.recordings import MAX_FPS
 
     try:
         value = float(text)
@@ -527,10 +527,6 @@ def cmd_plugins(args: argparse.Namespace, pm: PluginManager) -> int:
     return 0
 
 
-RECORDING_SUFFIXES = (".bvh", ".csv", ".npy", ".c3d")
-"""File names that ``likeme show --body PROFILE FILE ...`` takes for recordings, not for a character or template."""
-
-
 def cmd_show(args: argparse.Namespace, pm: PluginManager) -> int:
     from toolkit.character import load_character
     from toolkit.report import describe_character
@@ -539,12 +535,14 @@ def cmd_show(args: argparse.Namespace, pm: PluginManager) -> int:
         if value and not args.view:  # a view's settings and picture: nothing to apply them to
             raise ConfigError(f"{option} without --view", key=(option,),
                               expected="--view NAME with the view's settings and where it writes its picture")
-    files = [f for f in args.character if Path(f).suffix.lower() in RECORDING_SUFFIXES]
+    from toolkit.recordings import SUFFIXES, is_recording
+
+    files = [f for f in args.character if is_recording(f)]
     names = [f for f in args.character if f not in files]
     if len(names) > 1 or (files and args.after) or (files and not args.body):
         raise ConfigError(f"cannot show {' and '.join(names) if len(names) > 1 else ' '.join(args.character)}",
                           key=("character",), expected="one character (or observer template), or with --body PROFILE "
-                          f"recordings ({', '.join(RECORDING_SUFFIXES)}) after an optional observer template")
+                          f"recordings ({', '.join(SUFFIXES)}) after an optional observer template")
     if files:
         return _show_recordings(args, pm, names[0] if names else None, files)
     args.character = names[0]
@@ -558,7 +556,7 @@ def cmd_show(args: argparse.Namespace, pm: PluginManager) -> int:
         character = world.actors[args.character].character
     elif args.body or args.repertoire:
         from toolkit.observe import compose_observer
-        from toolkit.profile import load_profile
+        from toolkit.recordings.profile import load_profile
 
         if not (args.body and args.repertoire):
             raise ConfigError("--body and --repertoire go together", key=("--repertoire" if args.body else "--body",),
@@ -605,7 +603,7 @@ def _show_recordings(args: argparse.Namespace, pm: PluginManager, template: str 
 
     from plugins.views.demonstration import recording
     from toolkit.observe import compose_observer
-    from toolkit.profile import load_profile
+    from toolkit.recordings.profile import load_profile
 
     if not args.view:
         raise ConfigError("recordings without --view", key=("--view",), expected="--view NAME: a view that draws "
@@ -697,7 +695,7 @@ def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
     """
     from toolkit.observe import NO_CORRESPONDENCE, Observer, compose_observer, observer_plugins
     from toolkit.params import check_settings, parse_settings
-    from toolkit.profile import load_profile
+    from toolkit.recordings.profile import load_profile
 
     profile = load_profile(args.body)
     if "-" in args.files and len(args.files) > 1:
@@ -753,7 +751,7 @@ def cmd_observe(args: argparse.Namespace, pm: PluginManager) -> int:
 def _check_recording_path(path: str) -> None:
     """A recording named on the command line: a regular file (not a FIFO, a device or a folder) of a known format."""
     from toolkit.files import check_regular_file
-    from toolkit.profile import recording_format
+    from toolkit.recordings import recording_format
 
     check_regular_file(path, "BVH file" if Path(path).suffix.lower() not in (".csv", ".npy") else
                        "recording of joint positions", "motion")
@@ -778,7 +776,7 @@ def _observe_live(args: argparse.Namespace, character: Any, profile: Any, observ
     """``likeme observe -``: frames on standard input, each observation printed (and flushed) as its segment closes."""
     import numpy as np
 
-    from toolkit.live import SOURCE, LiveInput
+    from toolkit.recordings.live import SOURCE, LiveInput
 
     live = LiveInput(sys.stdin.buffer, profile, args.fps if args.fps is not None else profile.fps)
     observer = observer_class(character, profile.body, live.fps)
@@ -835,11 +833,11 @@ def _why_text(seg: dict[str, Any]) -> str:
 
 
 def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
-    from toolkit.bvh import open_bvh
     from toolkit.character import COMPONENT_TABLES, load_character, read_toml
     from toolkit.files import check_regular_file
     from toolkit.observe import check_observer_template, is_observer_template
-    from toolkit.profile import is_profile, load_profile
+    from toolkit.recordings import SUFFIXES, recording_format
+    from toolkit.recordings.profile import is_profile, load_profile
     from toolkit.report import describe_character
     from toolkit.scenario import is_scenario, load_scenario
 
@@ -854,21 +852,10 @@ def cmd_validate(args: argparse.Namespace, pm: PluginManager) -> int:
         warned += _warn(args.body, _profile_warnings(profile))
     for path in args.files:
         try:
-            suffix = Path(path).suffix.lower()
-            if suffix == ".bvh":
-                with open_bvh(path) as bvh:  # every frame read and checked, a block at a time
-                    for _ in bvh.blocks():
-                        pass
-                line = f"ok    {path}: BVH: {len(bvh.names)} joints, {bvh.n_frames} frames at {bvh.fps:g} fps"
-                if profile is not None:
-                    unmapped = profile.check(bvh.header)
-                    line += f"; profile {profile.name!r} maps {len(profile.joints)}, leaves {len(unmapped)} unmapped"
-                print(line)
-                if profile is not None:  # where the profile is probably wrong for this file (plugins/lib/profile_check)
-                    warned += _warn(path, _recording_warnings(profile, path, flips))
-                continue
-            if suffix in (".csv", ".npy"):
-                print(_validate_positions(path, profile, args.fps))
+            if Path(path).suffix.lower() in SUFFIXES:
+                print(_validate_recording(path, profile, args.fps))
+                if profile is not None and recording_format(path) == ".bvh":  # where the profile is probably wrong
+                    warned += _warn(path, _recording_warnings(profile, path, flips))  # for it (profile_check)
                 continue
             table = read_toml(check_regular_file(path, "TOML file", "config"))
             if is_scenario(table):
@@ -933,41 +920,24 @@ def _read_recording(path: str) -> tuple[list[str], Any, list[int] | None, float 
     hierarchy (BVH) or None, frame rate (None: the file does not tell) and number of frames."""
     import numpy as np
 
+    from toolkit.recordings import open_recording
+
     suffix = Path(path).suffix.lower()
-    if suffix == ".bvh":
-        from toolkit.bvh import open_bvh
-
-        with open_bvh(path) as bvh:
-            header, kept, count = bvh.header, [], 0
-            for values in bvh.blocks():
-                kept.append(header._kinematics(values[: PROFILE_FRAMES - count])[0])
-                count += len(kept[-1])
-                if count >= PROFILE_FRAMES:
-                    break
-            positions = np.concatenate(kept) if kept else np.zeros((0, len(bvh.names), 3))
-            return list(bvh.names), positions, [j.parent for j in bvh.joints], bvh.fps, bvh.n_frames
-    if suffix in (".csv", ".c3d"):  # joint positions with their names (a C3D file: its labelled points)
-        from toolkit.positions import iter_position_blocks
-
-        fps: float | None = None
-        try:
-            header, blocks = iter_position_blocks(path)
-            fps = header.fps
-        except ConfigError as err:
-            if "frame rate" not in str(err):
-                raise
-            header, blocks = iter_position_blocks(path, fps=1.0)  # no time column: the proposal needs no frame rate
+    if suffix not in (".bvh", ".csv", ".c3d"):  # a .npy array has no joint names to propose parts from
+        raise ConfigError(f"cannot propose a profile for a {suffix or 'suffix-less'} file", file=path, key=("FILE",),
+                          expected="a BVH file, a CSV of joint positions or a C3D file (a .npy array has no joint "
+                                   "names)", available=(".bvh", ".csv", ".c3d"))
+    with open_recording(path, need_fps=False) as recording:  # the proposal needs no frame rate
         kept, count = [], 0
-        for block in blocks:
+        for block in recording.blocks():
             kept.append(block[: PROFILE_FRAMES - count])
             count += len(kept[-1])
             if count >= PROFILE_FRAMES:
                 break
-        positions = np.concatenate(kept) if kept else header.positions
-        return list(header.names), positions, None, fps, len(positions)
-    raise ConfigError(f"cannot propose a profile for a {suffix or 'suffix-less'} file", file=path, key=("FILE",),
-                      expected="a BVH file, a CSV of joint positions or a C3D file (a .npy array has no joint "
-                               "names)", available=(".bvh", ".csv", ".c3d"))
+    positions = np.concatenate(kept) if kept else np.zeros((0, len(recording.names), 3))
+    frames = recording.n_frames if recording.n_frames is not None else len(positions)
+    parents = list(recording.parents) if recording.parents is not None else None
+    return list(recording.names), positions, parents, recording.fps, frames
 
 
 def cmd_profile(args: argparse.Namespace, pm: PluginManager) -> int:
@@ -979,7 +949,7 @@ def cmd_profile(args: argparse.Namespace, pm: PluginManager) -> int:
 
     from plugins.lib.profile_check import propose_profile, recording_warnings
     from toolkit.files import check_regular_file
-    from toolkit.profile import load_profile
+    from toolkit.recordings.profile import load_profile
     from toolkit.state import write_atomic
 
     check_regular_file(args.file, "recording", "motion")
@@ -1008,29 +978,29 @@ def cmd_profile(args: argparse.Namespace, pm: PluginManager) -> int:
     return 0
 
 
-def _validate_positions(path: str, profile: Any, fps: float | None) -> str:
-    """``likeme validate`` of a CSV or ``.npy`` recording: every frame read and checked, a block at a time; with a
-    profile, its joints checked against the profile's and read as it reads them."""
+def _validate_recording(path: str, profile: Any, fps: float | None) -> str:
+    """``likeme validate`` of a recording: every frame read and checked, a block at a time; with a profile, its
+    joints checked against the profile's and read as it reads them."""
     import numpy as np
 
-    from toolkit.positions import iter_position_blocks
+    from toolkit.recordings import open_recording, recording_format
 
-    kind = "CSV" if Path(path).suffix.lower() == ".csv" else "NumPy array"
+    fmt = recording_format(path)
     rate = fps if fps is not None or profile is None else profile.fps
-    if profile is not None:
-        names = profile.npy_joints if kind != "CSV" else None
-    elif kind != "CSV":
-        names = _npy_joint_names(path)
+    names = None
+    if fmt == ".npy":
+        names = profile.npy_joints if profile is not None else _npy_joint_names(path)
+    with open_recording(path, names=names, fps=rate) as recording:
+        unmapped = profile.check(recording) if profile is not None else []
+        frames = hidden = 0
+        for block in recording.blocks():
+            frames += len(block)
+            hidden += int((~np.isfinite(block).all(axis=-1)).sum())
+    if fmt == ".bvh":
+        line = f"ok    {path}: BVH: {len(recording.names)} joints, {recording.n_frames} frames at {recording.fps:g} fps"
     else:
-        names = None
-    header, blocks = iter_position_blocks(path, names=names, fps=rate)
-    unmapped = profile.check(header) if profile is not None else []
-    frames = hidden = 0
-    for block in blocks:
-        frames += len(block)
-        hidden += int((~np.isfinite(block).all(axis=-1)).sum())
-    line = (f"ok    {path}: {kind}: {len(header.names)} joints, {frames} frames at {header.fps:g} fps, "
-            f"{hidden} missing joint positions")
+        line = (f"ok    {path}: {recording.kind}: {len(recording.names)} joints, {frames} frames at "
+                f"{recording.fps:g} fps, {hidden} missing joint positions")
     if profile is not None:
         line += f"; profile {profile.name!r} maps {len(profile.joints)}, leaves {len(unmapped)} unmapped"
     return line

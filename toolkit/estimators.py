@@ -38,7 +38,7 @@ from toolkit.errors import ConfigError
 from toolkit.motion import Motion
 from toolkit.observe import OBSERVER_TEMPLATE, Observation, Observer, compose_observer, observer_tables
 from toolkit.params import flat_parameters
-from toolkit.profile import BodyProfile, load_profile
+from toolkit.recordings.profile import BodyProfile, load_profile
 
 __all__ = ["MovementClassifier", "MovementSegmenter", "EstimatorInputError", "load_recordings", "load_streams",
            "to_breakpoints", "UNKNOWN"]
@@ -486,11 +486,10 @@ def load_streams(folder: str | Path, profile: str | Path | BodyProfile) -> tuple
     """The streams of ``folder`` (``NAME.bvh`` with ``NAME.segments.csv`` beside it, as ``likeme bench
     segmentation`` reads them) through ``profile``: (motions, true segments as (start, end, movement) rows)."""
     from plugins.bench.data import read_segments
-    from plugins.lib.clip_repertoire import CLIP_SUFFIXES
+    from toolkit.recordings import is_recording
 
     profile = profile if isinstance(profile, BodyProfile) else load_profile(profile)
-    files = sorted(p for p in Path(folder).iterdir()
-                   if p.suffix.lower() in CLIP_SUFFIXES and not p.name.endswith(".segments.csv"))
+    files = sorted(p for p in Path(folder).iterdir() if is_recording(p))
     if not files:
         raise EstimatorInputError("no streams found", file=folder,
                                   expected="NAME.bvh files with NAME.segments.csv beside them")

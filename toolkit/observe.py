@@ -32,7 +32,7 @@ from toolkit.character import (COMPONENT_TABLES, Character, _load_chain, charact
 from toolkit.components import Perception
 from toolkit.errors import ConfigError, PluginError
 from toolkit.motion import Motion
-from toolkit.profile import BodyProfile
+from toolkit.recordings.profile import BodyProfile
 from toolkit.watching import KEEP_SECONDS, MAX_SEGMENT_SECONDS, Observation, WatchingLoop, guarded
 
 __all__ = ["Observation", "Observer", "compose_observer", "observer_tables", "OBSERVER_TEMPLATE", "NO_CORRESPONDENCE",

@@ -114,8 +114,7 @@ def make_data(pm, dest: Path, *, seed: int = 0, streams: int = 6, per_stream: in
 
 def _write_recording(item: dict[str, Any]) -> str:
     """One BVH file of :func:`make_data`: ``item["positions"]`` of the joints ``item["names"]``."""
-    from toolkit.bvh import from_joint_positions, write_bvh
-
+    from toolkit.recordings.bvh_writer import from_joint_positions, write_bvh
     path = Path(item["path"])
     path.parent.mkdir(parents=True, exist_ok=True)
     write_bvh(from_joint_positions(item["names"], item["parents"], item["positions"], item["fps"]), path)
@@ -127,7 +126,7 @@ FORMATS = ("bvh", "csv", "npy", "c3d")
 
 
 def write_positions(path: Path, names: list[str], positions: np.ndarray, fps: float | None = None) -> Path:
-    """Joint positions (F, J, 3) as a recording :mod:`toolkit.positions` reads, by the suffix of ``path``.
+    """Joint positions (F, J, 3) as a recording :mod:`toolkit.recordings` reads, by the suffix of ``path``.
 
     ``.csv``: a header ``JOINT_x,JOINT_y,JOINT_z...`` (and ``time`` first when ``fps`` is given: frame k at k / fps
     seconds), numbers written exactly (shortest round-trip form), NaN as an empty cell; ``.npy``: the array;
@@ -173,8 +172,7 @@ def convert_recordings(folder: Path, fmt: str, *, time: bool = False) -> Path:
     motion from either. ``time``: a CSV gets a time column (else the frame rate goes in ``profile.toml``). The
     ``profile.toml`` beside them gets ``fps`` (and ``joints``, the arrays' joint order, for ``.npy``).
     """
-    from toolkit.bvh import read_bvh
-
+    from toolkit.recordings.bvh import read_bvh
     folder = Path(folder)
     if fmt not in FORMATS:
         raise ConfigError(f"unknown format {fmt!r}", key=("--format",), expected="a recording format",
@@ -250,8 +248,8 @@ def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams:
 def _bandai_stream(item: dict[str, Any]) -> str:
     """One stream of :func:`bandai`: the clips ``item["clips"]`` one after another, written to ``item["path"]``
     with its ``.segments.csv`` beside it."""
-    from toolkit.bvh import BVH, read_bvh, write_bvh
-
+    from toolkit.recordings.bvh import BVH, read_bvh
+    from toolkit.recordings.bvh_writer import write_bvh
     chosen = [Path(p) for p in item["clips"]]
     parts = [read_bvh(p) for p in chosen]
     rows, at = [], 0

@@ -13,7 +13,7 @@ joint-position files. Case ``i`` of seed ``s`` mutates one seed with :func:`plug
   BVH file it maps, or ``observe --body F``);
 - ``scenario``: ``likeme run F --duration 1`` or ``likeme validate F``;
 - ``state``: ``likeme run learn_windmill --load F --duration 1``;
-- ``csv``: ``toolkit.positions.read_positions(F, fps=30.0)`` (skipped with a note while that module is absent).
+- ``csv``: ``toolkit.recordings.positions.read_positions(F, fps=30.0)``.
 
 Cases run one after another in one long-lived worker process that calls ``toolkit.cli.main`` in-process, under
 ``RLIMIT_AS`` of ``--memory`` MB; the parent kills and restarts it on a timeout or a crash. With ``--jobs N`` (or
@@ -72,8 +72,8 @@ SUFFIX = {"bvh": ".bvh", "toml": ".toml", "json": ".json", "csv": ".csv"}
 
 def _hand_bvh() -> str:
     """A small hand-written hierarchy: root with six channels, rotation-only children, End Sites; 12 frames."""
-    from toolkit.bvh import BVH, Joint, format_bvh
-
+    from toolkit.recordings.bvh import BVH, Joint
+    from toolkit.recordings.bvh_writer import format_bvh
     joints = [Joint("hips", -1, (0.0, 0.0, 0.0), ("Xposition", "Yposition", "Zposition", "Zrotation", "Xrotation",
                                                   "Yrotation")),
               Joint("spine", 0, (0.0, 10.0, 0.0), ("Zrotation", "Xrotation", "Yrotation")),
@@ -97,8 +97,8 @@ BANDAI_TREE = (("Hips", None), ("Chest", "Hips"), ("Neck", "Chest"), ("Head", "N
 
 def _bandai_bvh(rng: np.random.Generator) -> str:
     """A skeleton with the Bandai-Namco joint names, six channels on every joint, End Sites; 20 frames at 30 fps."""
-    from toolkit.bvh import BVH, Joint, format_bvh
-
+    from toolkit.recordings.bvh import BVH, Joint
+    from toolkit.recordings.bvh_writer import format_bvh
     offsets = {"Chest": (0, 20, 0), "Neck": (0, 25, 0), "Head": (0, 10, 0), "UpperArm_L": (15, 20, 0),
                "UpperArm_R": (-15, 20, 0), "UpperLeg_L": (10, -5, 0), "UpperLeg_R": (-10, -5, 0),
                "Toes_L": (0, -5, 12), "Toes_R": (0, -5, 12)}
@@ -141,7 +141,7 @@ def make_seeds(dest: Path, pm: Any, *, seed: int = 0) -> dict[str, list[dict[str
     Each seed is a dict with ``path`` (the file to mutate) and, where a command needs them, ``profile`` (a profile
     that maps the BVH file), ``bvh`` (a BVH file a profile maps), ``repertoire`` (a folder of labelled clips).
     """
-    from toolkit.bvh import read_bvh
+    from toolkit.recordings.bvh import read_bvh
     from toolkit.cli import main
 
     from plugins.bench.data import make_data
@@ -279,7 +279,7 @@ def make_case(index: int, target: str, seeds: dict[str, list[dict[str, Any]]], s
     data, applied = mutate(Path(chosen["path"]).read_bytes(), fmt, rng)
     name = f"case{index:05d}{SUFFIX[fmt]}"
     if target == "csv":
-        return Case(index, target, Path(chosen["path"]).name, applied, data, name, call="toolkit.positions:read_positions")
+        return Case(index, target, Path(chosen["path"]).name, applied, data, name, call="toolkit.recordings.positions:read_positions")
     return Case(index, target, Path(chosen["path"]).name, applied, data, name, argv=_command(target, chosen, rng))
 
 
@@ -539,12 +539,6 @@ class Result:
 # -- the run ---------------------------------------------------------------------------------------------------------
 
 
-def _positions_available() -> bool:
-    from importlib.util import find_spec
-
-    return find_spec("toolkit.positions") is not None
-
-
 BLOCK = 100
 """Cases a block on a Dask cluster (``--scheduler``): an item of :func:`plugins.bench.jobs.run_items`."""
 
@@ -565,9 +559,6 @@ def run_fuzz(pm: Any, *, n: int = 2000, seed: int = 0, targets: tuple[str, ...] 
 
     notes = notes if notes is not None else []
     targets = tuple(targets)
-    if "csv" in targets and not _positions_available():
-        notes.append("csv skipped: toolkit.positions is absent (no read_positions to fuzz)")
-        targets = tuple(t for t in targets if t != "csv")
     if not targets:
         return []
     with tempfile.TemporaryDirectory(prefix="likeme-fuzz-") as tmp:

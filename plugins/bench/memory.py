@@ -107,7 +107,7 @@ def live_memory(pm: Any, data: Path, *, minutes: float, fps: float, every: float
     module; ``segmenter``, ``matcher``, ``correspondence``: plugins replacing the observer template's); returns the
     lines as dicts."""
     from toolkit.observe import Observer, compose_observer
-    from toolkit.profile import load_profile
+    from toolkit.recordings.profile import load_profile
 
     out = sys.stdout if out is None else out
     profile = load_profile(data / "profile.toml")
@@ -153,7 +153,7 @@ def write_stream(pm: Any, path: Path, *, minutes: float, fps: float, seed: int =
     """A BVH file of ``minutes`` of :func:`random_stream` at ``fps`` in Max's body (the layout ``make-data``
     writes: the root, every other part its child, position channels)."""
     from toolkit import load_character
-    from toolkit.bvh import from_joint_positions, write_bvh
+    from toolkit.recordings.bvh_writer import from_joint_positions, write_bvh
     from toolkit.character import resolve_file
 
     body = load_character(resolve_file("max.toml", None, pm), pm).body
@@ -212,7 +212,7 @@ def _memory_item(item: dict[str, Any], pm: Any) -> dict[str, Any]:
     import io
 
     from toolkit.observe import compose_observer
-    from toolkit.profile import load_profile
+    from toolkit.recordings.profile import load_profile
 
     data = process_data(pm)
     if item["what"] == "observe":

@@ -1,7 +1,7 @@
 """Benchmarks on motion-capture files: ``likeme bench recognition|segmentation|stream``.
 
 Every sub-command reads recordings (BVH, CSV joint positions or ``.npy`` arrays, by suffix; a folder may mix them)
-through a body profile (:mod:`toolkit.profile`) and watches them with
+through a body profile (:mod:`toolkit.recordings.profile`) and watches them with
 :class:`toolkit.observe.Observer`, so the toolkit's segmenters and matchers and the baselines (``dtw``,
 ``ruptures``) are measured on the same clips in the same loop:
 
@@ -45,7 +45,8 @@ from plugins.bench.metrics import confusion_matrix, macro_f1, movement_error_rat
 from plugins.lib.clip_repertoire import clip_files
 from toolkit import ConfigError
 from toolkit.observe import Observer, compose_observer
-from toolkit.profile import RECORDING_SUFFIXES, load_profile
+from toolkit.recordings import is_recording
+from toolkit.recordings.profile import load_profile
 
 __all__ = ["MATCHERS", "SEGMENTERS", "recognition", "segmentation", "stream", "cell", "merge", "table",
            "write_outputs", "plot", "run"]
@@ -61,8 +62,7 @@ def _labelled(folder: Path) -> list[tuple[str, Path]]:
 
 def _streams(folder: Path) -> list[tuple[Path, list[tuple[int, int, str]]]]:
     """The recordings of a streams folder (``NAME.bvh``, ``.csv`` or ``.npy``, any mix) with their true segments."""
-    files = sorted(p for p in Path(folder).iterdir() if p.suffix.lower() in RECORDING_SUFFIXES and
-                   not p.name.lower().endswith(".segments.csv")) if Path(folder).is_dir() else []
+    files = sorted(p for p in Path(folder).iterdir() if is_recording(p)) if Path(folder).is_dir() else []
     if not files:
         raise ConfigError("no streams found", file=folder,
                           expected="NAME.bvh (or NAME.csv, NAME.npy) files with NAME.segments.csv beside them")

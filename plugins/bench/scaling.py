@@ -114,7 +114,7 @@ def stream_axis(pm: Any, data: Path, minutes: Sequence[float], *, fps: float, se
     """Seconds of observing per minute of stream for each length in ``minutes`` (a fresh observer each)."""
     from plugins.bench.memory import random_stream
     from toolkit.observe import Observer, compose_observer
-    from toolkit.profile import load_profile
+    from toolkit.recordings.profile import load_profile
 
     profile = load_profile(data / "profile.toml")
     character = compose_observer(pm, profile, data / "repertoire", segmenter=segmenter, matcher=matcher or "",
@@ -204,7 +204,7 @@ def _axis_item(item: dict[str, Any], pm: Any) -> tuple[list[dict], str]:
     runs it, on the data folder of that process (:func:`plugins.bench.memory.process_data`, the same files
     everywhere)."""
     from plugins.bench.memory import process_data
-    from toolkit.profile import load_profile
+    from toolkit.recordings.profile import load_profile
 
     data, options = process_data(pm), {k: item[k] for k in ("fps", "seed", "segmenter", "matcher", "settings")}
     if item["axis"] == "stream":

@@ -1,7 +1,7 @@
 """A movement repertoire from labelled motion-capture clips, with hubs found from the clips.
 
 A folder with one sub-folder per movement name, each holding BVH clips of that
-movement, read through a body profile (:mod:`toolkit.profile`), becomes the
+movement, read through a body profile (:mod:`toolkit.recordings.profile`), becomes the
 repertoire of a motor system: the ``posegraph`` makes each clip a path of pose
 nodes (Buchsbaum & Blumberg 2005, §4.1), the ``motor-command-graph`` turns each
 clip into a chain of guiding-stroke commands by its inverse model (Kopp &
@@ -35,13 +35,12 @@ import numpy as np
 from plugins.lib.pose_distance import pose_distance
 from plugins.lib.root_frame import root_relative, smooth_heading
 from toolkit import ConfigError, Motion, Parameter
-from toolkit.profile import RECORDING_SUFFIXES, BodyProfile, load_profile
+from toolkit.recordings import is_recording
+from toolkit.recordings.profile import BodyProfile, load_profile
 
 __all__ = ["Clip", "ClipRepertoire", "load_clip_repertoire", "clip_repertoire", "find_hubs", "root_relative_motion",
            "clip_files", "example_name", "CLIP_PARAMETERS", "repertoire_for"]
 
-CLIP_SUFFIXES = RECORDING_SUFFIXES
-"""Clip files a repertoire folder holds (any mix): BVH, CSV joint positions, NumPy arrays (``docs/formats.md``)."""
 
 
 @dataclass(frozen=True)
@@ -102,12 +101,6 @@ def example_name(movement: str, earlier: int) -> str:
     return movement if earlier == 0 else f"{movement}{EXAMPLE_MARK}{earlier + 1}"
 
 
-def _is_clip(path: Path) -> bool:
-    """A clip by its suffix (:data:`CLIP_SUFFIXES`); a stream's true segments (``NAME.segments.csv``, beside it in a
-    benchmark's streams folder) is not one."""
-    return path.suffix.lower() in CLIP_SUFFIXES and not path.name.lower().endswith(".segments.csv")
-
-
 def clip_files(folder: Path) -> dict[str, list[Path]]:
     """Clip files by movement name (sub-folder name), sorted; a :class:`ConfigError` if there are none."""
     folder = Path(folder)
@@ -115,11 +108,11 @@ def clip_files(folder: Path) -> dict[str, list[Path]]:
         raise ConfigError("not a folder", file=folder, expected="a folder with one sub-folder of BVH clips per movement")
     out: dict[str, list[Path]] = {}
     for sub in sorted(p for p in folder.iterdir() if p.is_dir()):
-        files = sorted(p for p in sub.iterdir() if _is_clip(p))
+        files = sorted(p for p in sub.iterdir() if is_recording(p))
         if files:
             out[sub.name] = files
     if not out:  # a flat folder of recordings: each file on its own (its ends still give hubs)
-        for path in sorted(p for p in folder.iterdir() if _is_clip(p)):
+        for path in sorted(p for p in folder.iterdir() if is_recording(p)):
             out[path.stem] = [path]
     for movement, files in out.items():
         if EXAMPLE_MARK in movement:  # bow#2 is the name of bow's second example: it would replace that one
@@ -173,7 +166,7 @@ def load_clip_repertoire(folder: str | Path, profile: str | Path | BodyProfile, 
     """Read every clip of ``folder`` through ``profile`` and find the hubs (:func:`clip_repertoire`).
 
     ``fps``: the frame rate of clips without one of their own (a CSV without a ``time`` column, a ``.npy`` array),
-    as for :meth:`BodyProfile.read <toolkit.profile.BodyProfile.read>`; ``None``: the profile's.
+    as for :meth:`BodyProfile.read <toolkit.recordings.profile.BodyProfile.read>`; ``None``: the profile's.
     """
     profile = profile if isinstance(profile, BodyProfile) else load_profile(profile)
     labelled = [(movement, path) for movement, files in clip_files(Path(folder)).items() for path in files]

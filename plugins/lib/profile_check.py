@@ -41,7 +41,7 @@ UPRIGHT_RATIO = 0.5
 """A body stands upright when its vertical extent is at least this fraction of its span (the median frame)."""
 FLIP_RATE = 1e-3
 """The facing may flip (turn by more than :data:`FLIP_ANGLE` from one frame to the next) in at most this fraction of
-the frames (``tests/toolkit/test_profile.py`` holds the Bandai-Namco profile to it)."""
+the frames (``tests/toolkit/recordings/test_profile.py`` holds the Bandai-Namco profile to it)."""
 FLIP_ANGLE = 2.0
 """A turn (radians) between two consecutive frames that no body makes: a flip of the estimate."""
 UP_COSINE = 0.7
@@ -221,7 +221,7 @@ class RecordingCheck:
         return facing_flips(heading), len(heading)
 
     def _up_warnings(self) -> list[str]:
-        from toolkit.profile import UP_AXES
+        from toolkit.recordings.profile import UP_AXES
 
         why = []
         for name, values, text in (("root", self._root_below, "the root is below the feet"),
@@ -431,7 +431,7 @@ def propose_profile(names: Sequence[str], positions: np.ndarray, *, parents: Seq
     Returns
     -------
     Proposal
-        TOML that :func:`toolkit.profile.load_profile` reads.
+        TOML that :func:`toolkit.recordings.profile.load_profile` reads.
     """
     names = list(names)
     positions = np.asarray(positions, dtype=float)
@@ -486,7 +486,7 @@ def propose_profile(names: Sequence[str], positions: np.ndarray, *, parents: Seq
         up = f"+{'xyz'[int(np.argmax(extent))]}"
         todo.append("no head and feet to tell the up axis by: the axis of the largest extent, sign unknown")
         up_note = f"TODO: {todo[-1]}"
-    from toolkit.profile import UP_AXES
+    from toolkit.recordings.profile import UP_AXES
 
     rotate = UP_AXES[up]
     world = data @ rotate.T  # the file's units, +y up

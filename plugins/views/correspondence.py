@@ -38,7 +38,7 @@ class CorrespondenceView(View):
 
     def draw(self, subject: Any, out: Path) -> list[Path]:
         from toolkit.observe import Observer
-        from toolkit.profile import load_profile
+        from toolkit.recordings.profile import load_profile
 
         character = subject
         if character.correspondence is None:

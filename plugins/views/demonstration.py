@@ -100,7 +100,7 @@ def perform_sequence(character: Any, demonstrator: str, movements: Sequence[str]
 
 
 def recording(profile: Any, path: Any) -> Demonstration:
-    """A recording read through a body profile (:class:`~toolkit.profile.BodyProfile`) as a demonstration to watch:
+    """A recording read through a body profile (:class:`~toolkit.recordings.profile.BodyProfile`) as a demonstration to watch:
     its world positions, and its true segments from ``NAME.segments.csv`` beside it when there is one (the format
     of the benchmarks' streams, :func:`plugins.bench.data.read_segments`), else none."""
     from pathlib import Path

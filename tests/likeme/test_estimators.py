@@ -21,7 +21,7 @@ from toolkit import ConfigError, create_plugin_manager
 from toolkit.estimators import (UNKNOWN, EstimatorInputError, MovementClassifier, MovementSegmenter, load_recordings,
                                 load_streams, to_breakpoints)
 from toolkit.observe import Observer, compose_observer
-from toolkit.profile import load_profile
+from toolkit.recordings.profile import load_profile
 
 KEEP = ("bow", "clap", "kick", "nod", "point", "salute", "wave", "jump")
 """The movements the cross-validation tests use (a few, to stay quick)."""

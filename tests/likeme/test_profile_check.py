@@ -14,10 +14,10 @@ from tests.conftest import BANDAI, CHARACTERS
 from tests.fixtures.skeletons import BANDAI as BANDAI_SKELETON
 from tests.fixtures.skeletons import KINECT, human, performance, write_skeleton_bvh, write_skeleton_csv
 from toolkit import ConfigError
-from toolkit.bvh import parse_bvh
+from toolkit.recordings.bvh import parse_bvh
 from toolkit.cli import main
-from toolkit.positions import read_positions
-from toolkit.profile import load_profile
+from toolkit.recordings.positions import read_positions
+from toolkit.recordings.profile import load_profile
 
 
 def run(capsys, *args):

@@ -22,7 +22,7 @@ from tests.conftest import BANDAI, CHARACTERS
 from toolkit import ConfigError, Motion, create_plugin_manager, load_character
 from toolkit.cli import main
 from toolkit.observe import Observer, compose_observer
-from toolkit.profile import load_profile
+from toolkit.recordings.profile import load_profile
 from toolkit.watching import feed
 
 

@@ -11,7 +11,7 @@ import pytest
 
 from toolkit import ConfigError, create_plugin_manager
 from toolkit.observe import compose_observer
-from toolkit.profile import load_profile
+from toolkit.recordings.profile import load_profile
 
 
 @pytest.fixture(scope="module")

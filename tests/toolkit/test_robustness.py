@@ -260,8 +260,7 @@ def test_action_selection_always_gives_a_possible_path_or_nothing(objects, hunge
 # -- fuzzed motion-capture input: BVH files and body profiles fail only with a ConfigError
 
 def _small_bvh_text() -> str:
-    from toolkit.bvh import format_bvh, from_joint_positions
-
+    from toolkit.recordings.bvh_writer import format_bvh, from_joint_positions
     rng = np.random.default_rng(0)
     positions = np.cumsum(rng.normal(0, 1, (3, 4, 3)), axis=0) + np.array([[0, 90, 0], [0, 100, 0], [5, 100, 0], [0, 80, 5]])
     return format_bvh(from_joint_positions(["hips", "chest", "arm", "leg"], [-1, 0, 1, 0], positions, 30.0))
@@ -274,8 +273,7 @@ BVH_TOKENS = ["{", "}", "ROOT", "JOINT", "End", "Site", "OFFSET", "CHANNELS", "0
 
 
 def _read_all(text: str, profile=None):
-    from toolkit.bvh import parse_bvh
-
+    from toolkit.recordings.bvh import parse_bvh
     bvh = parse_bvh(text, "fuzz.bvh")
     positions = bvh.positions()
     assert positions.shape == (bvh.n_frames, len(bvh.names), 3)
@@ -325,7 +323,7 @@ def test_arbitrary_text_as_bvh_raises_only_config_errors(text):
 def test_mutated_profiles_raise_only_config_errors(tmp_path, data):
     """Take the Bandai-Namco profile, drop or rewrite lines: it loads (and reads a file) or fails with a ConfigError."""
     from toolkit import ConfigError
-    from toolkit.profile import load_profile
+    from toolkit.recordings.profile import load_profile
 
     lines = (CHARACTERS / "profiles" / "bandai-namco.toml").read_text().splitlines()
     for _ in range(data.draw(st.integers(1, 4))):
@@ -348,8 +346,7 @@ def test_mutated_profiles_raise_only_config_errors(tmp_path, data):
     except ConfigError as err:
         assert "mutant.toml" in str(err)
         return
-    from toolkit.bvh import format_bvh, from_joint_positions
-
+    from toolkit.recordings.bvh_writer import format_bvh, from_joint_positions
     rng = np.random.default_rng(1)
     names = list(dict.fromkeys(profile.joints))
     text = format_bvh(from_joint_positions(names, [-1] + [0] * (len(names) - 1), rng.normal(0, 50, (2, len(names), 3)), 30.0))

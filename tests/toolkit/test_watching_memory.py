@@ -21,7 +21,7 @@ from plugins.bench.memory import random_stream
 from tests.conftest import _info
 from toolkit import Motion, PluginError, create_plugin_manager
 from toolkit.observe import Observer, compose_observer
-from toolkit.profile import load_profile
+from toolkit.recordings.profile import load_profile
 from toolkit.watching import ObservationLog, WatchingLoop
 
 FPS = 30.0

@@ -17,7 +17,7 @@ from plugins.bench.mocap import _streams
 from plugins.matchers.forward_model import ForwardModel
 from toolkit import create_plugin_manager
 from toolkit.observe import Observer, compose_observer
-from toolkit.profile import load_profile
+from toolkit.recordings.profile import load_profile
 from toolkit.watching import WatchingLoop
 
 

@@ -32,8 +32,7 @@ _HEADER_END = re.compile(r"^Frame Time:[^\n]*\n", re.M)
 
 def _read_bvh_checked(data: bytes) -> None:
     """Read a BVH file from bytes; when it reads, its arrays must agree with its hierarchy."""
-    from toolkit.bvh import read_bvh
-
+    from toolkit.recordings.bvh import read_bvh
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder, "m.bvh")
         path.write_bytes(data)
@@ -99,15 +98,14 @@ def test_structurally_mutated_bvh_files_give_documented_errors_only(case, seed):
 
 def test_unmutated_seeds_read():
     """The seeds are good files: whatever fails is the mutation's doing."""
-    from toolkit.bvh import parse_bvh
-
+    from toolkit.recordings.bvh import parse_bvh
     for text, joints in ((HAND, 6), (BANDAI, 23)):
         bvh = parse_bvh(text)
         assert len(bvh.joints) == joints and bvh.n_frames > 1 and any(j.end_site for j in bvh.joints)
         assert any("rotation" in c for j in bvh.joints for c in j.channels)
 
 
-# -- CSV joint positions (toolkit.positions, written in parallel) ----------------------------------------------------
+# -- CSV joint positions (toolkit.recordings.positions) -------------------------------------------------------------
 
 
 def _csv_seed(with_time: bool) -> str:
@@ -116,8 +114,7 @@ def _csv_seed(with_time: bool) -> str:
 
 
 def _read_positions_checked(data: bytes) -> None:
-    positions = pytest.importorskip("toolkit.positions", reason="toolkit.positions (the CSV/.npy joint-position "
-                                    "reader of issue 21) is not in this tree yet")
+    from toolkit.recordings import positions
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder, "p.csv")
         path.write_bytes(data)

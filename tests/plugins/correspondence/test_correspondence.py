@@ -209,7 +209,7 @@ def generated(tmp_path_factory):
 
 def test_body_mapping_in_the_observer_and_the_template_is_the_papers_observer(generated, pm):
     from toolkit.observe import Observer, compose_observer
-    from toolkit.profile import load_profile
+    from toolkit.recordings.profile import load_profile
 
     profile = load_profile(generated / "profile.toml")
     mapped = compose_observer(pm, profile, generated / "repertoire", correspondence="body-mapping")
@@ -231,7 +231,7 @@ def test_body_mapping_in_the_observer_and_the_template_is_the_papers_observer(ge
 
 def test_open_protocol_counts_unknown_as_right_for_a_movement_left_out(generated, pm):
     from plugins.bench.mocap import recognition
-    from toolkit.profile import load_profile
+    from toolkit.recordings.profile import load_profile
 
     profile = load_profile(generated / "profile.toml")
     result = recognition(pm, profile, generated / "repertoire", generated / "demos", ["path-search"],
@@ -314,7 +314,7 @@ def test_the_pictures_larger_stooped_demonstrator_is_mapped_onto_maxs_size_and_r
 
     from toolkit.cli import main
     from toolkit.observe import Observer, compose_observer
-    from toolkit.profile import load_profile
+    from toolkit.recordings.profile import load_profile
 
     text = (Path(__file__).resolve().parents[3] / "docs" / "correspondence.md").read_text(encoding="utf-8")
     block = re.search(r"On the project's own data.*?```python\n(.*?)```", text, re.S).group(1)

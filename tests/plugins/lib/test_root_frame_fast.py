@@ -22,7 +22,7 @@ from plugins.perception.motion_capture import MotionCapture
 from tests.conftest import CHARACTERS, ROOT
 from toolkit import create_plugin_manager, load_character
 from toolkit.motion import local_to_world, world_to_local
-from toolkit.profile import load_profile
+from toolkit.recordings.profile import load_profile
 
 
 class Before:

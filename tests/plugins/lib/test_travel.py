@@ -20,7 +20,7 @@ from tests.conftest import STICK, STICK_PARTS, write_stick_clip, write_stick_pro
 from toolkit import Motion, create_plugin_manager, load_character
 from toolkit.motion import local_to_world
 from toolkit.observe import compose_observer
-from toolkit.profile import load_profile
+from toolkit.recordings.profile import load_profile
 from toolkit.watching import ObservationLog
 
 PARTS = STICK_PARTS

@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 from tests.toolkit.test_relative_lengths import generated  # noqa: F401  (the generated recordings, a module fixture)
 from toolkit import Motion, create_plugin_manager
 from toolkit.observe import Observer, compose_observer
-from toolkit.profile import load_profile
+from toolkit.recordings.profile import load_profile
 
 MOVEMENTS = ("wave", "reach", "clap", "bow", "knock")
 

@@ -10,9 +10,7 @@ from ruptures.costs import CostRbf
 import plugins.segmenters.ruptures_segmenter as module
 from plugins.segmenters.ruptures_segmenter import RupturesSegmenter, rbf_gamma
 from toolkit import Motion
-from toolkit.bvh import read_bvh
-
-
+from toolkit.recordings.bvh import read_bvh
 def _piecewise(n_pieces: int, frames: int, parts: int = 3, seed: int = 0) -> Motion:
     """A motion whose parts jump to a new place (and jitter around it) every ``frames`` frames."""
     rng = np.random.default_rng(seed)

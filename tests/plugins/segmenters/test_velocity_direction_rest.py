@@ -119,7 +119,7 @@ def test_end_rest_on_the_projects_generated_streams(tmp_path):
     from plugins.bench.data import make_data
     from plugins.bench.mocap import segmentation
     from toolkit import create_plugin_manager
-    from toolkit.profile import load_profile
+    from toolkit.recordings.profile import load_profile
 
     pm = create_plugin_manager()
     folder = make_data(pm, tmp_path / "gen", streams=2, per_stream=5)

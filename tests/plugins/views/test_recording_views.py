@@ -201,7 +201,7 @@ def test_show_draws_the_key_poses_of_several_recordings_in_one_picture(data, tmp
 
 def test_the_body_frame_of_a_recording_faces_forward_with_its_feet_on_the_ground(data):
     from plugins.views.body import body_frame
-    from toolkit.profile import load_profile
+    from toolkit.recordings.profile import load_profile
 
     profile = load_profile(data / "profile.toml")
     motion = profile.read(data / "streams" / "stream_1.bvh")
@@ -222,7 +222,7 @@ def test_the_segmentation_picture_is_a_timeline_of_true_and_found_segments_per_s
     from plugins.bench.metrics import match_segments
     from plugins.bench.mocap import segmentation
     from plugins.bench.plots import plot_result, timeline_figure
-    from toolkit.profile import load_profile
+    from toolkit.recordings.profile import load_profile
 
     pm = create_plugin_manager(autoload=False, trace=False)
     result = segmentation(pm, load_profile(data / "profile.toml"), data / "streams", ["hub-threshold", "ruptures"],

@@ -1,11 +1,11 @@
 """Live input: frames of joint positions arriving one line at a time on standard input (``likeme observe -``).
 
 Any tracker can pipe into the toolkit: each line is one frame, read as it arrives (nothing waits for the end of the
-input), converted through a body profile (:class:`~toolkit.profile.BodyProfile`) to part positions in metres with
+input), converted through a body profile (:class:`~toolkit.recordings.profile.BodyProfile`) to part positions in metres with
 ``+y`` up. Two shapes, told apart by the first line that is not blank (``docs/formats.md``, Live input):
 
 - **CSV lines**: the first line is a header as in a CSV file (``JOINT_x``, ``JOINT_y``, ``JOINT_z`` per joint, an
-  optional ``time`` column, other columns ignored; :mod:`toolkit.positions`), every further line one frame.
+  optional ``time`` column, other columns ignored; :mod:`toolkit.recordings.csv_positions`), every further line one frame.
 - **JSON lines**: one object per line and per frame, ``{"time": 0.033, "Hips": [x, y, z], "Head": [x, y, z], ...}``:
   a key per source joint (keys the profile does not map are ignored), ``time`` in seconds optional.
 
@@ -27,7 +27,8 @@ from typing import Any, BinaryIO
 import numpy as np
 
 from toolkit.errors import ConfigError
-from toolkit.positions import MAX_FPS, MAX_LINE_CHARS, _parse_header, _parse_slow
+from toolkit.recordings.csv_positions import MAX_LINE_CHARS, parse_header, parse_rows
+from toolkit.recordings.recording import MAX_FPS
 
 __all__ = ["LiveInput", "SOURCE"]
 
@@ -80,9 +81,8 @@ class LiveInput:
             self._pending.append(positions)
         else:
             self.kind = "csv"
-            self._layout = _parse_header(first + "\n", self.path, None)
+            self._layout = parse_header(first + "\n", self.path, None)
             profile.check(_Header(list(self._layout.joints)))
-        self._joints = list(dict.fromkeys(profile.joints))
         if self.fps is None:
             while len(self._pending) < 2:
                 frame = self._next_frame()
@@ -136,7 +136,7 @@ class LiveInput:
     def _csv(self, text: str) -> np.ndarray:
         layout = self._layout
         columns = layout.columns + ((layout.time,) if layout.time is not None else ())
-        values = _parse_slow([text], [self.line], layout, columns)[0]
+        values = parse_rows([text], [self.line], layout, columns)[0]
         if layout.time is not None:
             self._time(float(values[-1]), None)
             values = values[:-1]

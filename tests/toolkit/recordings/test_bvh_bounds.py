@@ -10,14 +10,16 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import toolkit.bvh as bvh_module
+import toolkit.recordings.bvh as bvh_module
 
-from tests.toolkit.test_bvh import SMALL
+from tests.toolkit.recordings.test_bvh import SMALL
+from tests.fixtures.bvh_reference import parse_reference
 from toolkit import ConfigError
-from toolkit.bvh import (MAX_DEPTH, MAX_FPS, MIN_FPS, BVH, BVHStream, Joint, format_bvh, iter_bvh_blocks, parse_bvh,
-                         read_bvh, write_bvh)
+from toolkit.recordings.bvh import (MAX_DEPTH, MAX_FPS, MIN_FPS, BVH, BVHStream, Joint, iter_bvh_blocks, parse_bvh,
+                                    read_bvh)
+from toolkit.recordings.bvh_writer import format_bvh, write_bvh
 from toolkit.files import check_regular_file, max_bytes
-from toolkit.profile import load_profile
+from toolkit.recordings.profile import load_profile
 
 
 def _chain(depth: int, frames: int = 2) -> str:
@@ -158,7 +160,7 @@ def test_mutated_files_read_or_fail_with_a_config_error_the_same_whole_and_strea
             text = text[:i]
     results = []
     for read in (lambda: parse_bvh(text, "m.bvh").values,
-                 lambda: bvh_module._parse(text, "m.bvh", fast=False).values,
+                 lambda: parse_reference(text, "m.bvh").values,
                  lambda: _stream_text(text, frames, chunk)):
         try:
             results.append(read().tobytes())

@@ -6,10 +6,11 @@ give the facing (a left/right pair and an optional forward marker, like the
 paper's knees and nose), the source's up axis and its units. Reading a recording
 through a profile gives a :class:`~toolkit.motion.Motion` of world positions in
 metres with ``+y`` up, one column per tracked part, and the :class:`Body` to
-perceive it with. Recordings are read by their suffix (:data:`RECORDING_SUFFIXES`,
-``docs/formats.md``): BVH files, CSV joint positions and ``.npy`` arrays
-(:mod:`toolkit.positions`); the optional ``fps`` key gives the frame rate of
-files without one of their own, ``joints`` the joint names of a ``.npy`` array.
+perceive it with. Recordings are opened by their suffix
+(:func:`toolkit.recordings.open_recording`, ``docs/formats.md``): BVH files, CSV
+joint positions, ``.npy`` arrays and C3D markers; the optional ``fps`` key gives
+the frame rate of files without one of their own, ``joints`` the joint names of a
+``.npy`` array.
 
 Example (the Bandai-Namco skeleton, ``characters/profiles/bandai-namco.toml``)::
 
@@ -39,15 +40,14 @@ from typing import Any
 import numpy as np
 
 from toolkit.body import Body
-import toolkit.bvh as bvh_module
-from toolkit.bvh import BVH, open_bvh, read_bvh
 from toolkit.errors import ConfigError
 from toolkit.files import check_regular_file
 from toolkit.motion import Motion
 from toolkit.params import finite_number
+from toolkit.recordings import BLOCK, MAX_FPS, open_recording, recording_format
+from toolkit.recordings.bvh import BVH
 
-__all__ = ["BodyProfile", "MotionStream", "is_profile", "load_profile", "recording_format", "RECORDING_SUFFIXES",
-           "UNITS", "UP_AXES"]
+__all__ = ["BodyProfile", "MotionStream", "is_profile", "load_profile", "UNITS", "UP_AXES"]
 
 UNITS: dict[str, float] = {"metre": 1.0, "meter": 1.0, "m": 1.0, "centimetre": 0.01, "centimeter": 0.01, "cm": 0.01,
                            "millimetre": 0.001, "millimeter": 0.001, "mm": 0.001, "inch": 0.0254, "in": 0.0254,
@@ -66,23 +66,6 @@ UP_AXES: dict[str, np.ndarray] = {
 
 _PROFILE_KEYS = ("name", "description", "units", "up", "fps", "joints")
 _TABLES = ("profile", "parts", "facing", "bones", "colours")
-
-
-RECORDING_SUFFIXES = (".bvh", ".csv", ".npy", ".c3d")
-"""The recording formats a profile reads, by file name suffix (any case): BVH, CSV joint positions, NumPy arrays,
-C3D markers (``docs/formats.md``)."""
-
-
-def recording_format(path: str | Path) -> str:
-    """A recording's format, its suffix in lower case (one of :data:`RECORDING_SUFFIXES`); a :class:`ConfigError`
-    listing the accepted suffixes for any other."""
-    suffix = Path(path).suffix.lower()
-    if suffix not in RECORDING_SUFFIXES:
-        raise ConfigError(f"unknown recording format {Path(path).suffix or '(no suffix)'!r}", file=path,
-                          expected="a recording named by its format: .bvh (BVH), .csv (joint positions), .npy "
-                                   "(NumPy array of joint positions) or .c3d (C3D markers)",
-                          available=RECORDING_SUFFIXES)
-    return suffix
 
 
 @dataclass(frozen=True)
@@ -136,8 +119,8 @@ class BodyProfile:
         """Raise a :class:`ConfigError` naming any mapped joint the recording lacks (with the joints it has); return
         the joints left unmapped.
 
-        ``recording`` has ``names`` (its joints) and ``source`` (its file name): a :class:`~toolkit.bvh.BVH` or a
-        :class:`~toolkit.positions.JointPositions` (a header is enough).
+        ``recording`` has ``names`` (its joints) and ``source`` (its file name): a
+        :class:`~toolkit.recordings.recording.Recording` or a :class:`~toolkit.recordings.bvh.BVH` (a header is enough).
         """
         names = list(recording.names)
         for part, joint in zip(self.body.parts, self.joints):
@@ -158,13 +141,12 @@ class BodyProfile:
         return Motion(self.convert(bvh.positions(), bvh.names), bvh.fps, self.body.parts)
 
     def read(self, path: str | Path, fps: float | None = None) -> Motion:
-        """Read a recording (``.bvh``, ``.csv`` or ``.npy``, by its suffix) and return its motion through this profile.
+        """Read a recording (by its suffix: :func:`toolkit.recordings.open_recording`) whole and return its motion
+        through this profile.
 
         ``fps``: the frame rate of a recording without one of its own (a CSV without a ``time`` column, a ``.npy``
         array); it wins over the profile's ``fps`` and is ignored for a BVH file and a CSV with a time column.
         """
-        if recording_format(path) == ".bvh":
-            return self.motion(read_bvh(path))
         with self.stream(path, fps=fps) as motion:
             blocks = [positions for positions, _ in motion]
         positions = np.concatenate(blocks) if blocks else np.empty((0, len(self.body.parts), 3))
@@ -173,32 +155,21 @@ class BodyProfile:
     def stream(self, path: str | Path, block: int | None = None, fps: float | None = None) -> MotionStream:
         """A recording's motion through this profile, ``block`` frames at a time (:class:`MotionStream`).
 
-        ``block`` defaults to :data:`toolkit.bvh.BLOCK`; ``fps`` as for :meth:`read`. The header is read and checked
-        against the profile at once (the joint names, the frame rate); the frames follow as they are iterated, a
-        block at a time (for a BVH file with forward kinematics run per block), so the memory does not grow with
-        the file. The blocks are ``profile.read(path)`` sliced, bit for bit, and a bad value raises the error
-        ``read`` raises.
+        ``block`` defaults to :data:`toolkit.recordings.BLOCK`; ``fps`` as for :meth:`read`. The header is read and
+        checked against the profile at once (the joint names, the frame rate); the frames follow as they are
+        iterated, a block at a time (for a BVH file with forward kinematics run per block), so the memory does not
+        grow with the file. A bad value raises the error reading the whole file raises.
         """
-        block = bvh_module.BLOCK if block is None else max(1, int(block))
-        if recording_format(path) == ".bvh":
-            bvh = open_bvh(path)
-            try:
-                self.check(bvh.header)
-            except BaseException:
-                bvh.close()
-                raise
-            header = bvh.header
-            return MotionStream(self, bvh.names, bvh.fps, (header._kinematics(v)[0] for v in bvh.blocks(block)),
-                                bvh.close, n_frames=bvh.n_frames)
-        from toolkit.positions import iter_position_blocks
-
-        rate = fps if fps is not None else self.fps
-        if recording_format(path) == ".npy":
-            header, blocks = iter_position_blocks(path, names=self.npy_joints, fps=rate, frames=block)
-        else:
-            header, blocks = iter_position_blocks(path, fps=rate, frames=block)
-        self.check(header)
-        return MotionStream(self, header.names, header.fps, blocks, getattr(blocks, "close", None))
+        block = BLOCK if block is None else max(1, int(block))
+        names = self.npy_joints if recording_format(path) == ".npy" else None  # an array has no names of its own
+        recording = open_recording(path, names=names, fps=fps if fps is not None else self.fps, frames=block)
+        try:
+            self.check(recording)
+        except BaseException:
+            recording.close()
+            raise
+        return MotionStream(self, recording.names, recording.fps, recording.blocks(), recording.close,
+                            n_frames=recording.n_frames)
 
 
 class MotionStream:
@@ -309,8 +280,6 @@ def load_profile(path: str | Path) -> BodyProfile:
         raise fail(exc.problem, key, expected=exc.expected, available=exc.available) from None
     fps = head.get("fps")
     if fps is not None:
-        from toolkit.positions import MAX_FPS
-
         if isinstance(fps, bool) or not isinstance(fps, int | float) or not 0 < fps <= MAX_FPS:  # NaN fails too
             raise fail(f"invalid fps {fps!r}", ("profile", "fps"),
                        expected=f"frames per second of recordings without a time of their own, a number in "

@@ -10,8 +10,8 @@ from scipy.spatial.transform import Rotation
 
 from tests.conftest import BANDAI
 from toolkit import ConfigError
-from toolkit.bvh import BVH, Joint, format_bvh, from_joint_positions, parse_bvh, read_bvh, write_bvh
-
+from toolkit.recordings.bvh import BVH, Joint, parse_bvh, read_bvh
+from toolkit.recordings.bvh_writer import format_bvh, from_joint_positions, write_bvh
 SMALL = """HIERARCHY\r
 ROOT hips\r
 {\r

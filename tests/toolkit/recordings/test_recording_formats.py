@@ -13,9 +13,9 @@ import pytest
 
 from plugins.bench.data import convert_recordings, make_data, write_positions
 from toolkit import ConfigError
-from toolkit.bvh import read_bvh
+from toolkit.recordings.bvh import read_bvh
 from toolkit.cli import main
-from toolkit.profile import load_profile
+from toolkit.recordings.profile import load_profile
 
 
 @pytest.fixture(scope="module")
@@ -278,7 +278,7 @@ def test_a_piped_benchmark_starts_with_its_table_and_its_files_are_0644_under_um
                "--repertoire", str(folder / "repertoire"), "--demos", str(folder / "demos"), "--matcher", "dtw",
                "--json", str(out_json), "--plot", str(out_png)]
     done = subprocess.run(command, capture_output=True, text=True, timeout=600,
-                          preexec_fn=lambda: os.umask(0o022), cwd=Path(__file__).resolve().parents[2])
+                          preexec_fn=lambda: os.umask(0o022), cwd=Path(__file__).resolve().parents[3])
     assert done.returncode == 0, done.stderr
     head = done.stdout.splitlines()[:3]
     assert head[0].startswith("| plugin |") and head[1].startswith("|---") and head[2].startswith("| dtw |")

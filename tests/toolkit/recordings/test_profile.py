@@ -7,8 +7,9 @@ import pytest
 
 from tests.conftest import BANDAI, CHARACTERS
 from toolkit import ConfigError
-from toolkit.bvh import from_joint_positions, read_bvh, write_bvh
-from toolkit.profile import load_profile
+from toolkit.recordings.bvh import read_bvh
+from toolkit.recordings.bvh_writer import from_joint_positions, write_bvh
+from toolkit.recordings.profile import load_profile
 
 PROFILE = """
 [profile]

@@ -17,11 +17,11 @@ from hypothesis import strategies as st
 
 from plugins.bench.data import make_data, write_positions
 from toolkit import ConfigError
-from toolkit.bvh import read_bvh
-from toolkit.live import LiveInput
-from toolkit.profile import load_profile
+from toolkit.recordings.bvh import read_bvh
+from toolkit.recordings.live import LiveInput
+from toolkit.recordings.profile import load_profile
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 
 
 @pytest.fixture(scope="module")

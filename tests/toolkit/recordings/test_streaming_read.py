@@ -9,13 +9,15 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-import toolkit.bvh as bvh_module
+import toolkit.recordings.bvh as bvh_module
 from plugins.lib import root_frame
-from tests.toolkit.test_bvh import SMALL, bvh_files
-from tests.toolkit.test_profile import PROFILE, _max_parts, _write_max_clip
+from tests.toolkit.recordings.test_bvh import SMALL, bvh_files
+from tests.toolkit.recordings.test_profile import PROFILE, _max_parts, _write_max_clip
+from tests.fixtures.bvh_reference import parse_reference
 from toolkit import ConfigError
-from toolkit.bvh import format_bvh, from_joint_positions, iter_bvh_blocks, open_bvh, parse_bvh, read_bvh
-from toolkit.profile import load_profile
+from toolkit.recordings.bvh import iter_bvh_blocks, open_bvh, parse_bvh, read_bvh
+from toolkit.recordings.bvh_writer import format_bvh, from_joint_positions
+from toolkit.recordings.profile import load_profile
 
 
 def _blocks(path, frames):
@@ -98,7 +100,7 @@ def test_a_bad_value_in_frame_5000_is_reported_at_the_same_line_and_column_by_bo
     for frames in (1, 7, 4096, 10000):
         assert _error(lambda: _blocks(path, frames)) == whole
     assert _error(lambda: parse_bvh(path.read_text(), str(path))) == whole
-    assert _error(lambda: bvh_module._parse(path.read_text(), str(path), fast=False)) == whole
+    assert _error(lambda: parse_reference(path.read_text(), str(path))) == whole
 
 
 def test_the_blocks_before_a_bad_value_come_out_and_then_the_error(tmp_path):
@@ -131,7 +133,7 @@ def test_edited_files_give_the_same_error_streamed_in_any_block_size(tmp_path, e
     path = tmp_path / "bad.bvh"
     path.write_text(edit(SMALL), newline="")
     whole = _error(lambda: read_bvh(path))
-    assert whole == _error(lambda: bvh_module._parse(edit(SMALL), str(path), fast=False))
+    assert whole == _error(lambda: parse_reference(edit(SMALL), str(path)))
     for frames in (1, 2, 3):
         assert _error(lambda: _blocks(path, frames)) == whole
 

@@ -1,4 +1,4 @@
-"""BVH motion files: read, write, and forward kinematics to joint positions.
+"""BVH motion files: read, and forward kinematics to joint positions (:mod:`toolkit.recordings.bvh_writer` writes them).
 
 A BVH file is a joint hierarchy followed by one line of channel values per
 frame. This reader accepts what real files contain (``docs/conventions.md``
@@ -14,7 +14,7 @@ is the full list of conventions):
 
 Rotation channels compose as *intrinsic* rotations in the order they are
 listed (``Zrotation Xrotation Yrotation`` is ``Rz @ Rx @ Ry``), in degrees.
-Positions are in the file's own units and axes; :mod:`toolkit.profile` maps
+Positions are in the file's own units and axes; :mod:`toolkit.recordings.profile` maps
 them to likeme's metres with ``+y`` up.
 
 Every problem is a :class:`~toolkit.errors.ConfigError` with the file, line and
@@ -35,13 +35,12 @@ import numpy as np
 
 from toolkit.errors import ConfigError
 from toolkit.files import check_regular_file, open_regular
+from toolkit.recordings.recording import BLOCK, MAX_FPS, MIN_FPS, Recording
 
-__all__ = ["Joint", "BVH", "BVHStream", "read_bvh", "open_bvh", "iter_bvh_blocks", "parse_bvh", "write_bvh",
-           "format_bvh", "from_joint_positions", "CHANNEL_NAMES", "MAX_FPS", "MIN_FPS", "MAX_DEPTH", "BLOCK"]
+__all__ = ["Joint", "BVH", "BVHStream", "read_bvh", "open_bvh", "open_file", "iter_bvh_blocks", "parse_bvh",
+           "CHANNEL_NAMES", "MAX_DEPTH"]
 
 CHANNEL_NAMES = ("Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zrotation")
-BLOCK = 4096
-"""Frames per block when a file is streamed (:func:`iter_bvh_blocks`) and forward kinematics is run."""
 
 
 @dataclass(frozen=True)
@@ -126,9 +125,9 @@ class BVH:
         one replaces the matching OFFSET component), else its OFFSET; its
         rotation is the intrinsic product of its rotation channels in order.
         """
-        return self._kinematics(self.values)
+        return self.kinematics(self.values)
 
-    def _kinematics(self, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def kinematics(self, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`forward_kinematics` of channel values (n, C); each frame on its own (the same bits in any block)."""
         from scipy.spatial.transform import Rotation
 
@@ -166,16 +165,12 @@ class BVH:
         """
         out = np.empty((self.n_frames, len(self.joints), 3))
         for f in range(0, self.n_frames, max(1, block)):
-            out[f : f + block] = self._kinematics(self.values[f : f + block])[0]
+            out[f : f + block] = self.kinematics(self.values[f : f + block])[0]
         return out
 
 
 # -- reading ----------------------------------------------------------------------------------------
 
-MAX_FPS = 10_000.0
-"""The highest frame rate read (``Frame Time`` of at least 0.1 ms): high-speed optical capture reaches a few kHz."""
-MIN_FPS = 1.0 / 60.0
-"""The lowest frame rate read (``Frame Time`` of at most 60 s)."""
 MAX_DEPTH = 256
 """The deepest nesting of joints read (real skeletons are under 30 deep, fingers included)."""
 MAX_CHANNELS = len(CHANNEL_NAMES)
@@ -727,54 +722,7 @@ def iter_bvh_blocks(path: str | Path, frames: int = BLOCK) -> Iterator[np.ndarra
 
 def parse_bvh(text: str, source: str = "<bvh>") -> BVH:
     """Parse the text of a BVH file; ``source`` names it in error messages."""
-    return _parse(text, source)
-
-
-def _parse(text: str, source: str, fast: bool = True) -> BVH:
-    """``parse_bvh``; ``fast=False`` reads the MOTION block token by token (the reference for the block reader)."""
-    stream = BVHStream(lambda: _text_chunks(text), source, len(text))
-    if fast:
-        return stream.read()
-    stream.close()
-    head = stream._head
-    lines = _Lines(_text_chunks(text))
-    for number, _ in lines:
-        if number == head.line:
-            break
-    values = _reference_values(head, iter(lines), stream.n_channels, source)
-    return BVH(head.joints, head.frame_time, values, source)
-
-
-def _reference_values(head: _Header, lines: Iterator[tuple[int, str]], n_channels: int, source: str) -> np.ndarray:
-    """The MOTION block's values from a token per value with its line and column: slow, the reference."""
-    rest = [(m.group(), number, m.start() + 1) for number, line in _motion_lines(head, lines)
-            for m in _TOKEN.finditer(line)]
-    n_frames = head.n_frames
-    if len(rest) != n_frames * n_channels:
-        counts: dict[int, int] = {}
-        for _, line, _ in rest:
-            counts[line] = counts.get(line, 0) + 1
-        for k, (line, count) in enumerate(sorted(counts.items())):
-            if count != n_channels:
-                raise ConfigError(f"frame {k + 1} has {count} values", file=source, line=line, column=1,
-                                  expected=f"{n_channels} channel values per frame line")
-        if len(counts) < n_frames:
-            line, column = (rest[-1][1] if rest else head.line) + 1, 1
-        else:
-            _, line, column = rest[n_frames * n_channels]
-        raise ConfigError(f"{len(counts)} frame lines after 'Frames: {n_frames}'", file=source, line=line,
-                          column=column, expected=f"{n_frames} frame lines")
-    for token, line, column in rest:
-        if not _is_number(token):
-            raise ConfigError(f"found {_shown(token)}", file=source, line=line, column=column,
-                              expected="a number (a channel value)")
-    values = np.array([t for t, _, _ in rest], dtype=float).reshape(n_frames, n_channels)
-    bad = ~np.isfinite(values)
-    if bad.any():
-        token, line, column = rest[int(np.flatnonzero(bad.reshape(-1))[0])]
-        raise ConfigError(f"found {_shown(token)}", file=source, line=line, column=column,
-                          expected="a finite channel value")
-    return values
+    return BVHStream(lambda: _text_chunks(text), source, len(text)).read()
 
 
 def read_bvh(path: str | Path) -> BVH:
@@ -783,64 +731,14 @@ def read_bvh(path: str | Path) -> BVH:
     return open_bvh(path).read()
 
 
-# -- writing ----------------------------------------------------------------------------------------
-
-
-def _number(x: float) -> str:
-    return format(float(x), ".9g")
-
-
-def format_bvh(bvh: BVH, *, precision: int = 6) -> str:
-    """The text of a BVH file for ``bvh`` (values to ``precision`` significant digits)."""
-    children: dict[int, list[int]] = {}
-    for i, j in enumerate(bvh.joints):
-        children.setdefault(j.parent, []).append(i)
-    out = ["HIERARCHY"]
-
-    stack: list[tuple[int, int, bool]] = [(root, 0, False) for root in reversed(children.get(-1, []))]
-    while stack:  # depth first, without recursion (a hierarchy may be deep)
-        i, depth, closing = stack.pop()
-        joint, pad = bvh.joints[i], "  " * depth
-        if closing:
-            out.append(f"{pad}}}")
-            continue
-        off = " ".join(_number(v) for v in joint.offset)
-        if joint.end_site:
-            out.extend([f"{pad}End Site", f"{pad}{{", f"{pad}  OFFSET {off}", f"{pad}}}"])
-            continue
-        out.append(f"{pad}{'ROOT' if joint.parent < 0 else 'JOINT'} {joint.name}")
-        out.append(f"{pad}{{")
-        out.append(f"{pad}  OFFSET {off}")
-        out.append(f"{pad}  CHANNELS {len(joint.channels)} {' '.join(joint.channels)}".rstrip())
-        stack.append((i, depth, True))
-        stack.extend((c, depth + 1, False) for c in reversed(children.get(i, [])))
-    out += ["MOTION", f"Frames: {bvh.n_frames}", f"Frame Time: {bvh.frame_time:.9g}"]
-    fmt = f"%.{precision}g"
-    out.extend(" ".join(fmt % v for v in row) for row in bvh.values)
-    return "\n".join(out) + "\n"
-
-
-def write_bvh(bvh: BVH, path: str | Path, *, precision: int = 6) -> Path:
-    """Write ``bvh`` to ``path`` atomically (temporary file, flush, rename); returns the path."""
-    from toolkit.state import write_atomic
-
-    path = Path(path)
-    write_atomic(path, format_bvh(bvh, precision=precision))
-    return path
-
-
-def from_joint_positions(names: Sequence[str], parents: Sequence[int], positions: np.ndarray, fps: float,
-                         source: str = "<generated>") -> BVH:
-    """A BVH that reproduces given joint positions (F, J, 3) with position channels only.
-
-    Every joint gets ``Xposition Yposition Zposition`` channels relative to its
-    parent (world-aligned, no rotations), which is how likeme writes its own
-    characters' motions: forward kinematics of the result gives back ``positions``.
-    """
-    positions = np.asarray(positions, dtype=float)
-    joints, columns = [], []
-    for j, (name, parent) in enumerate(zip(names, parents)):
-        local = positions[:, j] - (positions[:, parent] if parent >= 0 else 0.0)
-        joints.append(Joint(name, parent, tuple(float(v) for v in local[0]), ("Xposition", "Yposition", "Zposition")))
-        columns.append(local)
-    return BVH(joints, 1.0 / fps, np.concatenate(columns, axis=1), source)
+def open_file(path: Path, *, names: object = None, fps: float | None = None, frames: int = BLOCK,
+              need_fps: bool = True) -> Recording:
+    """A BVH file as a :class:`~toolkit.recordings.recording.Recording` (:func:`toolkit.recordings.open_recording`):
+    its joints and end sites in file order with their hierarchy, the rate from its Frame Time (``fps`` and ``names``
+    do not apply: the file has both), the positions of every joint by forward kinematics, a block of frames at a
+    time (each frame on its own: the same bits as :meth:`BVH.positions`)."""
+    stream = open_bvh(path)
+    header = stream.header
+    blocks = (header.kinematics(values)[0] for values in stream.blocks(frames))
+    return Recording(stream.names, stream.fps, stream.source, "BVH", blocks, stream.close, n_frames=stream.n_frames,
+                     parents=[j.parent for j in stream.joints])

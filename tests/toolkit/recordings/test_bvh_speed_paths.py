@@ -11,18 +11,18 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tests.conftest import BANDAI
-from tests.toolkit.test_bvh import SMALL, bvh_files
+from tests.toolkit.recordings.test_bvh import SMALL, bvh_files
 from toolkit import ConfigError
-from toolkit.bvh import BVH, _parse, format_bvh, from_joint_positions, open_bvh, read_bvh, write_bvh
-
-
+from tests.fixtures.bvh_reference import parse_reference
+from toolkit.recordings.bvh import BVH, open_bvh, parse_bvh, read_bvh
+from toolkit.recordings.bvh_writer import format_bvh, from_joint_positions, write_bvh
 def _both(text: str, source: str = "x.bvh"):
     """(fast result or error text, token-by-token result or error text); the file streamed in blocks of 1 and 2
     frames is checked against the fast result on the way."""
     out = []
     for fast in (True, False):
         try:
-            out.append(_parse(text, source, fast=fast))
+            out.append(parse_bvh(text, source) if fast else parse_reference(text, source))
         except ConfigError as exc:
             out.append(str(exc))
     with tempfile.TemporaryDirectory() as folder:
@@ -105,7 +105,7 @@ def test_real_clips_read_bit_for_bit_the_same_both_ways():
     for path in sorted(BANDAI.glob("*.bvh"))[:6]:
         text = path.read_text(encoding="utf-8", errors="replace")
         fast = read_bvh(path)
-        _same(fast, _parse(text, str(path), fast=False))
+        _same(fast, parse_reference(text, str(path)))
         for frames in (1, 50):
             with open_bvh(path) as stream:
                 _same(fast, BVH(stream.joints, stream.header.frame_time, np.concatenate(list(stream.blocks(frames))),
