@@ -485,7 +485,7 @@ def load_recordings(folder: str | Path, profile: str | Path | BodyProfile, *, gr
 def load_streams(folder: str | Path, profile: str | Path | BodyProfile) -> tuple[list[Motion], list[list[tuple]]]:
     """The streams of ``folder`` (``NAME.bvh`` with ``NAME.segments.csv`` beside it, as ``likeme bench
     segmentation`` reads them) through ``profile``: (motions, true segments as (start, end, movement) rows)."""
-    from plugins.bench.data import read_segments
+    from toolkit.recordings.segments import read_segments, segments_of
     from toolkit.recordings import is_recording
 
     profile = profile if isinstance(profile, BodyProfile) else load_profile(profile)
@@ -493,4 +493,4 @@ def load_streams(folder: str | Path, profile: str | Path | BodyProfile) -> tuple
     if not files:
         raise EstimatorInputError("no streams found", file=folder,
                                   expected="NAME.bvh files with NAME.segments.csv beside them")
-    return [profile.read(p) for p in files], [read_segments(p.with_suffix(".segments.csv")) for p in files]
+    return [profile.read(p) for p in files], [read_segments(segments_of(p)) for p in files]

@@ -3,12 +3,10 @@
 - ``make_data``: ``repertoire/NAME/max.bvh`` (Max's own movements), ``demos/NAME/morris_S.bvh`` (Morris's versions
   at three speeds, with noise), ``streams/stream_K.bvh`` with ``stream_K.segments.csv``, and ``profile.toml``;
 - ``bandai``: the same layout from the Bandai-Namco clips (links and generated streams; nothing is copied);
-- ``read_segments``: a stream's true segments (header ``start_frame,end_frame,movement``, end exclusive).
 """
 
 from __future__ import annotations
 
-import csv
 import json
 import warnings
 from pathlib import Path
@@ -17,32 +15,9 @@ from typing import Any
 import numpy as np
 
 from toolkit import ConfigError
+from toolkit.recordings.segments import segments_of, write_segments
 
-__all__ = ["read_segments", "make_data", "bandai", "write_positions", "convert_recordings", "FORMATS"]
-
-
-def read_segments(path: Path) -> list[tuple[int, int, str]]:
-    """A ``NAME.segments.csv`` file: (start, end exclusive, movement) rows, checked, with the line of any error."""
-    try:
-        lines = path.read_text(encoding="utf-8").splitlines()
-    except OSError as exc:
-        raise ConfigError(f"cannot read ({exc.strerror})", file=path, expected="start_frame,end_frame,movement rows") from None
-    if not lines or [h.strip() for h in lines[0].split(",")] != ["start_frame", "end_frame", "movement"]:
-        raise ConfigError(f"found header {lines[0] if lines else ''!r}", file=path, line=1,
-                          expected="the header start_frame,end_frame,movement")
-    out = []
-    for number, row in enumerate(csv.reader(lines[1:]), 2):
-        if not row:
-            continue
-        try:
-            start, end, label = int(row[0]), int(row[1]), row[2].strip()
-        except (ValueError, IndexError):
-            raise ConfigError(f"found {','.join(row)!r}", file=path, line=number,
-                              expected="two frame numbers and a movement name") from None
-        if not 0 <= start < end:
-            raise ConfigError(f"segment {start}..{end}", file=path, line=number, expected="0 <= start_frame < end_frame")
-        out.append((start, end, label))
-    return out
+__all__ = ["make_data", "bandai", "write_positions", "convert_recordings", "FORMATS"]
 
 
 def make_data(pm, dest: Path, *, seed: int = 0, streams: int = 6, per_stream: int = 6, noise: float = 0.003,
@@ -101,7 +76,7 @@ def make_data(pm, dest: Path, *, seed: int = 0, streams: int = 6, per_stream: in
         pieces.append(Motion(np.repeat(rest[None], 15, axis=0), 30.0, body.parts))
         save(concatenate(pieces), dest / "streams" / f"stream_{k + 1}.bvh", noise)
         (dest / "streams").mkdir(parents=True, exist_ok=True)
-        _write_segments(dest / "streams" / f"stream_{k + 1}.segments.csv", rows)
+        write_segments(segments_of(dest / "streams" / f"stream_{k + 1}.bvh"), rows)
     run_items(_write_recording, files, jobs=jobs, scheduler=scheduler)
     parts = "\n".join(f'{p} = "{p}"' for p in body.parts)
     f = body.facing
@@ -194,11 +169,6 @@ def convert_recordings(folder: Path, fmt: str, *, time: bool = False) -> Path:
     return folder
 
 
-def _write_segments(path: Path, rows: list[tuple[int, int, str]]) -> None:
-    path.write_text("start_frame,end_frame,movement\n" + "".join(f"{a},{b},{m}\n" for a, b, m in rows),
-                    encoding="utf-8")
-
-
 def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams: int = 12, per_stream: int = 5,
            gestures_only: bool = True, jobs: int = 1, scheduler: str | None = None) -> Path:
     """Benchmark folders from the Bandai-Namco clips (links and generated streams; nothing is copied).
@@ -259,7 +229,7 @@ def _bandai_stream(item: dict[str, Any]) -> str:
     first = parts[0]
     path = Path(item["path"])
     write_bvh(BVH(first.joints, first.frame_time, np.concatenate([b.values for b in parts]), "stream"), path)
-    _write_segments(path.with_name(path.name[: -len(".bvh")] + ".segments.csv"), rows)
+    write_segments(segments_of(path), rows)
     return item["path"]
 
 

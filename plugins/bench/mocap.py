@@ -12,7 +12,7 @@ through a body profile (:mod:`toolkit.recordings.profile`) and watches them with
   one group out: the repertoire folder's clips whose file names share a group, a style or a performer, are the
   demos of a repertoire made of all the other clips).
 - ``segmentation``: each stream ``NAME.bvh`` (or ``.csv``, ``.npy``) has ``NAME.segments.csv``
-  (:func:`plugins.bench.data.read_segments`).
+  (:mod:`toolkit.recordings.segments`).
   Precision, recall, F1 and boundary error (:mod:`plugins.bench.metrics`) per segmenter.
 - ``stream``: segment and recognise end to end for every pairing; the movement error rate (edit distance over the
   true count).
@@ -40,12 +40,12 @@ import numpy as np
 from plugins.bench import progress as progress_bar
 from plugins.bench import text_table
 from plugins.bench.command import MATCHERS, SEGMENTERS
-from plugins.bench.data import read_segments
 from plugins.bench.metrics import confusion_matrix, macro_f1, movement_error_rate, segmentation_scores
 from plugins.lib.clip_repertoire import clip_files
 from toolkit import ConfigError
 from toolkit.observe import Observer, compose_observer
 from toolkit.recordings import is_recording
+from toolkit.recordings.segments import read_segments, segments_of
 from toolkit.recordings.profile import load_profile
 
 __all__ = ["MATCHERS", "SEGMENTERS", "recognition", "segmentation", "stream", "cell", "merge", "table",
@@ -68,7 +68,7 @@ def _streams(folder: Path) -> list[tuple[Path, list[tuple[int, int, str]]]]:
                           expected="NAME.bvh (or NAME.csv, NAME.npy) files with NAME.segments.csv beside them")
     out = []
     for path in files:
-        csv_path = path.with_suffix(".segments.csv")
+        csv_path = segments_of(path)
         if not csv_path.exists():
             raise ConfigError("missing segment file", file=csv_path, expected=f"the true segments of {path.name}")
         out.append((path, read_segments(csv_path)))

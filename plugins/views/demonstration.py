@@ -12,12 +12,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from toolkit import ConfigError, Motion, load_character
 from toolkit.motion import concatenate
+from toolkit.recordings.segments import read_segments, segments_of
 
 __all__ = ["Demonstration", "demonstration", "perform_sequence", "recording", "require", "watch"]
 
@@ -102,14 +104,10 @@ def perform_sequence(character: Any, demonstrator: str, movements: Sequence[str]
 def recording(profile: Any, path: Any) -> Demonstration:
     """A recording read through a body profile (:class:`~toolkit.recordings.profile.BodyProfile`) as a demonstration to watch:
     its world positions, and its true segments from ``NAME.segments.csv`` beside it when there is one (the format
-    of the benchmarks' streams, :func:`plugins.bench.data.read_segments`), else none."""
-    from pathlib import Path
-
-    from plugins.bench.data import read_segments
-
+    of the benchmarks' streams, :mod:`toolkit.recordings.segments`), else none."""
     path = Path(path)
     motion = profile.read(path)
-    truth = path.with_suffix(".segments.csv")
+    truth = segments_of(path)
     segments = tuple((s, min(e, motion.n_frames), m) for s, e, m in read_segments(truth)
                      if s < motion.n_frames) if truth.is_file() else ()
     return Demonstration(path.name, motion, segments, profile.body)

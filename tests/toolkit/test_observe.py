@@ -16,7 +16,8 @@ from hypothesis import strategies as st
 from plugins.lib.clip_repertoire import load_clip_repertoire
 from plugins.matchers.dtw import frame_distance
 from plugins.bench.metrics import segmentation_scores
-from plugins.bench.data import make_data, read_segments
+from plugins.bench.data import make_data
+from toolkit.recordings.segments import read_segments
 from plugins.bench.mocap import recognition
 from tests.conftest import BANDAI, CHARACTERS
 from toolkit import ConfigError, Motion, create_plugin_manager, load_character

@@ -64,8 +64,10 @@ def recording_format(path: str | Path) -> str:
 
 def is_recording(path: str | Path) -> bool:
     """Whether a file is named as a recording (:data:`SUFFIXES`); a stream's ``NAME.segments.csv`` is not one."""
+    from toolkit.recordings.segments import SUFFIX
+
     name = Path(path).name.lower()
-    return Path(name).suffix in READERS and not name.endswith(".segments.csv")
+    return Path(name).suffix in READERS and not name.endswith(SUFFIX)
 
 
 def open_recording(path: str | Path, *, names: Sequence[str] | None = None, fps: float | None = None,

@@ -13,7 +13,8 @@ import json
 import numpy as np
 import pytest
 
-from plugins.bench.data import make_data, read_segments
+from plugins.bench.data import make_data
+from toolkit.recordings.segments import read_segments
 from toolkit import create_plugin_manager
 from toolkit.cli import main
 
