@@ -11,7 +11,7 @@ from importlib import import_module
 from typing import Any
 
 from toolkit import hookimpl
-from toolkit.cli import count_type, fps_type, number_type, observer_options, seed_type
+from toolkit.arguments import count_type, fps_type, number_type, observer_options, seed_type
 
 MATCHERS = ("path-search", "forward-model", "dtw")
 """The matchers ``likeme bench recognition`` and ``stream`` compare when none is named."""

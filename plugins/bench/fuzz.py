@@ -15,7 +15,7 @@ joint-position files. Case ``i`` of seed ``s`` mutates one seed with :func:`plug
 - ``state``: ``likeme run learn_windmill --load F --duration 1``;
 - ``csv``: ``toolkit.recordings.positions.read_positions(F, fps=30.0)``.
 
-Cases run one after another in one long-lived worker process that calls ``toolkit.cli.main`` in-process, under
+Cases run one after another in one long-lived worker process that calls the ``likeme`` command's ``main`` in-process (:func:`command_line`), under
 ``RLIMIT_AS`` of ``--memory`` MB; the parent kills and restarts it on a timeout or a crash. With ``--jobs N`` (or
 ``--scheduler``) blocks of cases run in N processes, each with a fuzz worker of its own; the results come back in
 the cases' order. Outcomes:
@@ -49,6 +49,7 @@ from typing import Any
 import numpy as np
 
 from toolkit.character import builtin_characters
+from toolkit.errors import PluginError
 
 __all__ = ["TARGETS", "OUTCOMES", "Case", "Result", "make_seeds", "make_case", "Worker", "classify", "run_fuzz",
            "cmd_fuzz"]
@@ -141,10 +142,10 @@ def make_seeds(dest: Path, pm: Any, *, seed: int = 0) -> dict[str, list[dict[str
     Each seed is a dict with ``path`` (the file to mutate) and, where a command needs them, ``profile`` (a profile
     that maps the BVH file), ``bvh`` (a BVH file a profile maps), ``repertoire`` (a folder of labelled clips).
     """
-    from toolkit.recordings.bvh import read_bvh
-    from toolkit.cli import main
-
     from plugins.bench.data import make_data
+    from toolkit.recordings.bvh import read_bvh
+
+    main = command_line()
 
     dest = Path(dest)
     rng = np.random.default_rng(seed)
@@ -308,10 +309,22 @@ def _where(tb: Any) -> str:
     return found
 
 
+def command_line() -> Any:
+    """The ``likeme`` command's ``main``, found as the installed ``likeme`` script finds it (its console-scripts entry
+    point): the command line is the floor above the plugins, so a benchmark of it starts it, never imports it."""
+    from importlib.metadata import entry_points
+
+    found = entry_points(group="console_scripts", name="likeme")
+    if not found:
+        raise PluginError("benchmark", "fuzz", "no likeme command installed (pip install -e .)")
+    return next(iter(found)).load()
+
+
 def run_one(request: dict[str, Any]) -> dict[str, Any]:
     """Run one case in this process (the worker's side): exit status, stderr, and any exception not handled."""
-    from toolkit.cli import main
     from toolkit.errors import LikemeError
+
+    main = command_line()
 
     out, err = io.StringIO(), io.StringIO()
     result: dict[str, Any] = {"rc": None, "exception": None, "message": "", "where": ""}

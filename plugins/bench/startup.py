@@ -29,9 +29,9 @@ COMMANDS: tuple[tuple[str, ...], ...] = (("--version",), ("--help",), ("plugins"
 
 
 def likeme_command() -> list[str]:
-    """How to start likeme: the ``likeme`` script installed beside this Python, else ``python -m toolkit.cli``."""
+    """How to start likeme: the ``likeme`` script installed beside this Python, else ``python -m likeme``."""
     script = Path(sys.executable).with_name("likeme")
-    return [str(script)] if script.is_file() else [sys.executable, "-m", "toolkit.cli"]
+    return [str(script)] if script.is_file() else [sys.executable, "-m", "likeme"]
 
 
 def time_commands(runs: int, command: list[str] | None = None, *, jobs: int = 1,

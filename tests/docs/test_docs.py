@@ -51,7 +51,7 @@ def test_readme_commands_are_what_ci_runs():
 
 
 def test_component_reference_is_current(pm):
-    from toolkit.cli import components_markdown
+    from likeme.cli.plugins import components_markdown
 
     assert (ROOT / "docs" / "components.md").read_text() == components_markdown(pm), (
         "regenerate with: LIKEME_DISABLE_PLUGIN_AUTOLOAD=1 likeme plugins --markdown > docs/components.md"
@@ -77,7 +77,7 @@ def test_the_layout_tables_match_the_rooms_of_plugins():
 
 def test_every_file_the_docs_name_exists():
     for doc in [ROOT / "README.md", *(ROOT / "docs").glob("*.md")]:
-        for path in re.findall(r"`((?:toolkit|plugins|characters|tests)/[\w/.-]+\.(?:py|toml))`", doc.read_text()):
+        for path in re.findall(r"`((?:toolkit|plugins|likeme|characters|tests)/[\w/.-]+\.(?:py|toml))`", doc.read_text()):
             assert (ROOT / path).is_file(), f"{doc.name} names {path}, which does not exist"
 
 

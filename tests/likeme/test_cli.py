@@ -16,7 +16,7 @@ from tests.conftest import CHARACTERS, ROOT
 def likeme(*args, env=None, cwd=ROOT):
     full_env = {**os.environ, "LIKEME_DISABLE_PLUGIN_AUTOLOAD": "1", **(env or {})}
     return subprocess.run(
-        [sys.executable, "-m", "toolkit.cli", *map(str, args)], capture_output=True, text=True, env=full_env, cwd=cwd, timeout=300
+        [sys.executable, "-m", "likeme", *map(str, args)], capture_output=True, text=True, env=full_env, cwd=cwd, timeout=300
     )
 
 
@@ -170,7 +170,7 @@ def test_bench_behaviour_runs(tmp_path):
 def test_seed_bounds():
     import argparse
 
-    from toolkit.cli import seed_type
+    from toolkit.arguments import seed_type
 
     assert seed_type("0") == 0 and seed_type(str(2**63 - 1)) == 2**63 - 1
     for text in ("-1", str(2**63), "x", "1.5"):
@@ -182,7 +182,7 @@ def test_seed_bounds():
 def test_duration_refuses_non_finite_and_out_of_range(text):
     import argparse
 
-    from toolkit.cli import number_type
+    from toolkit.arguments import number_type
 
     parse = number_type(0.0, 3600.0, "seconds")
     assert parse("0") == 0.0 and parse("3600") == 3600.0
@@ -192,7 +192,7 @@ def test_duration_refuses_non_finite_and_out_of_range(text):
 
 def test_output_file_checks(tmp_path):
     from toolkit import ConfigError
-    from toolkit.cli import check_output_file
+    from toolkit.arguments import check_output_file
 
     assert check_output_file(tmp_path / "new.json", "--json") == tmp_path / "new.json"
     assert not (tmp_path / "new.json").exists() and list(tmp_path.iterdir()) == []  # the probe leaves nothing
@@ -205,7 +205,7 @@ def test_output_file_checks(tmp_path):
 
 
 def test_render_folder_is_created_before_the_run(tmp_path):
-    from toolkit.cli import check_output_dir
+    from toolkit.arguments import check_output_dir
 
     folder = tmp_path / "a" / "b"
     assert check_output_dir(folder, "--render") == folder and folder.is_dir() and list(folder.iterdir()) == []

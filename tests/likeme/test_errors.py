@@ -303,7 +303,7 @@ CASES = [
 
 def run_case(files, args):
     """Run the likeme command in-process in a temporary folder; return (exit status, stderr, folder)."""
-    from toolkit.cli import main
+    from likeme.cli import main
 
     with tempfile.TemporaryDirectory() as folder:
         for name, text in files.items():

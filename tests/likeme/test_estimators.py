@@ -1,4 +1,4 @@
-"""The scikit-learn style estimators (toolkit.estimators) and repertoires built in memory, on generated data.
+"""The scikit-learn style estimators (likeme.estimators) and repertoires built in memory, on generated data.
 
 The same pipeline as ``likeme bench recognition|segmentation`` on the same clips must give the same answers; the
 estimators must behave as scikit-learn estimators (clone, cross_val_score, GridSearchCV, get/set_params).
@@ -18,7 +18,7 @@ from plugins.bench.data import make_data
 from plugins.bench.mocap import recognition, segmentation
 from plugins.lib.clip_repertoire import clip_repertoire, load_clip_repertoire
 from toolkit import ConfigError, create_plugin_manager
-from toolkit.estimators import (UNKNOWN, EstimatorInputError, MovementClassifier, MovementSegmenter, load_recordings,
+from likeme.estimators import (UNKNOWN, EstimatorInputError, MovementClassifier, MovementSegmenter, load_recordings,
                                 load_streams, to_breakpoints)
 from toolkit.observe import Observer, compose_observer
 from toolkit.recordings.profile import load_profile

@@ -9,13 +9,13 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from plugins.lib.profile_check import SCHEMES, propose_profile, recording_warnings
+from likeme.profiles import SCHEMES, propose_profile, recording_warnings
 from tests.conftest import BANDAI, CHARACTERS
 from tests.fixtures.skeletons import BANDAI as BANDAI_SKELETON
 from tests.fixtures.skeletons import KINECT, human, performance, write_skeleton_bvh, write_skeleton_csv
 from toolkit import ConfigError
 from toolkit.recordings.bvh import parse_bvh
-from toolkit.cli import main
+from likeme.cli import main
 from toolkit.recordings.positions import read_positions
 from toolkit.recordings.profile import load_profile
 
@@ -162,7 +162,7 @@ def test_validate_names_the_frames_where_the_facing_flips(tmp_path, capsys):
 
 def test_a_facing_that_flips_rarely_is_no_warning(tmp_path, capsys, bandai_like):
     """One flip in 1000 frames is allowed (the Bandai-Namco clips have 4 in 30,000)."""
-    from plugins.lib.profile_check import RecordingCheck
+    from likeme.profiles import RecordingCheck
 
     profile = load_profile(proposed(tmp_path, capsys, bandai_like))
     motion = profile.read(bandai_like)

@@ -20,7 +20,7 @@ HEAVY = ("numpy", "scipy", "networkx", "pyvista", "matplotlib", "rich", "dtaidis
 
 def _modules_after(*args: str) -> set[str]:
     """The modules imported by ``likeme ARGS`` run in a fresh interpreter (the built-ins only)."""
-    code = ("import sys, json\nfrom toolkit.cli import main\ntry:\n    main(sys.argv[1:])\nexcept SystemExit:\n    pass\n"
+    code = ("import sys, json\nfrom likeme.cli import main\ntry:\n    main(sys.argv[1:])\nexcept SystemExit:\n    pass\n"
             "sys.stderr.write('\\nMODULES ' + json.dumps(sorted(sys.modules)))\n")
     env = {"PYTHONPATH": str(ROOT), "LIKEME_DISABLE_PLUGIN_AUTOLOAD": "1", "PATH": "/usr/bin:/bin"}
     result = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True, env=env, timeout=120)
@@ -112,7 +112,7 @@ def test_the_toolkit_package_exports_its_names_when_used():
 
 
 def test_bench_startup_times_each_command_in_a_fresh_process(tmp_path, capsys):
-    from toolkit.cli import main
+    from likeme.cli import main
 
     out = tmp_path / "startup.json"
     assert main(["bench", "startup", "--runs", "2", "--json", str(out)]) == 0
@@ -155,7 +155,7 @@ def test_a_third_party_distribution_declares_its_command_plugins_or_has_all_impo
                                                                                       commands, early):
     import importlib
 
-    from toolkit.cli import build_parser
+    from likeme.cli import build_parser
 
     _fake_distribution(tmp_path, commands)
     monkeypatch.syspath_prepend(str(tmp_path))

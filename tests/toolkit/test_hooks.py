@@ -37,7 +37,7 @@ def test_plugin_adds_a_command(pm, monkeypatch, capsys):
         p.add_argument("who")
         p.set_defaults(handler=lambda args, pm: print(f"hello {args.who}") or 0)
 
-    from toolkit import cli
+    from likeme import cli
 
     monkeypatch.setattr(cli, "create_plugin_manager", lambda: pm)
     pm.register_plugin(make_plugin(likeme_register_commands=likeme_register_commands), PluginInfo("hello", "m", "(tests)", ""))

@@ -21,7 +21,7 @@ from toolkit.recordings.segments import read_segments
 from plugins.bench.mocap import recognition
 from tests.conftest import BANDAI, CHARACTERS
 from toolkit import ConfigError, Motion, create_plugin_manager, load_character
-from toolkit.cli import main
+from likeme.cli import main
 from toolkit.observe import Observer, compose_observer
 from toolkit.recordings.profile import load_profile
 from toolkit.watching import feed

@@ -16,7 +16,7 @@ from plugins.bench.sweep import cells, load_grid
 from tests.toolkit.test_observe import data, profile  # noqa: F401  (the generated data, made once for this module)
 from toolkit import ConfigError
 from toolkit.character import read_toml, resolve_file
-from toolkit.cli import main
+from likeme.cli import main
 from toolkit.observe import (check_observer_template, compose_observer, observer_template_path, observer_templates,
                              read_observer_template)
 

@@ -32,7 +32,7 @@ def _likeme(site, *args, **extra):
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(site), str(ROOT)])}
     env.pop("LIKEME_DISABLE_PLUGIN_AUTOLOAD", None)
     env.update(extra)
-    return subprocess.run([sys.executable, "-m", "toolkit.cli", *map(str, args)], capture_output=True, text=True,
+    return subprocess.run([sys.executable, "-m", "likeme", *map(str, args)], capture_output=True, text=True,
                           env=env, timeout=300)
 
 

@@ -26,7 +26,7 @@ def builtins_only(monkeypatch):
 
 def likeme(*args) -> tuple[int, str, str]:
     """Run the likeme command in-process; (exit status, stdout, stderr)."""
-    from toolkit.cli import main
+    from likeme.cli import main
 
     out, err = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):

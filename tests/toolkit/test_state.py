@@ -146,12 +146,12 @@ def test_checkpoint_saves_when_something_is_learned(tmp_path):
 def test_run_save_and_load_from_the_command_line(tmp_path):
     state = tmp_path / "s.json"
     env = {**os.environ, "LIKEME_DISABLE_PLUGIN_AUTOLOAD": "1"}
-    first = subprocess.run([sys.executable, "-m", "toolkit.cli", "run", "ice_cream", "--save", state],
+    first = subprocess.run([sys.executable, "-m", "likeme", "run", "ice_cream", "--save", state],
                            capture_output=True, text=True, env=env, cwd=ROOT, timeout=300)
     assert first.returncode == 0, first.stderr
     assert read_state(state)["actors"]["max"]["components"]["action"]["state"]["beliefs"]["ice_cream"] == "food"
     # a new run that loads it knows ice cream from the start: no shrug at the first reach
-    second = subprocess.run([sys.executable, "-m", "toolkit.cli", "run", "ice_cream", "--load", state, "--json"],
+    second = subprocess.run([sys.executable, "-m", "likeme", "run", "ice_cream", "--load", state, "--json"],
                             capture_output=True, text=True, env=env, cwd=ROOT, timeout=300)
     assert second.returncode == 0, second.stderr
     max_ = next(a for a in json.loads(second.stdout)["actors"] if a["id"] == "max")
@@ -188,7 +188,7 @@ learn = true
     state = tmp_path / "s.json"
     loaded = 0
     for attempt in range(6):
-        proc = subprocess.Popen([sys.executable, "-m", "toolkit.cli", "run", scene, "--save", state],
+        proc = subprocess.Popen([sys.executable, "-m", "likeme", "run", scene, "--save", state],
                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env, cwd=ROOT)
         if attempt == 0:  # the first run lives until its first checkpoint however loaded the machine, then a while
             deadline = time.monotonic() + 120.0

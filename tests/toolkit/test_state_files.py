@@ -43,7 +43,7 @@ ENV = {**os.environ, "LIKEME_DISABLE_PLUGIN_AUTOLOAD": "1"}
 
 def likeme(args, monkeypatch=None):
     """Run the likeme command in-process; (exit status, stderr)."""
-    from toolkit.cli import main
+    from likeme.cli import main
 
     err = io.StringIO()
     with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
@@ -255,7 +255,7 @@ def test_two_runs_saving_to_one_file_lose_nothing(tmp_path):
     lock = os.open(tmp_path / ".s.json.lock", os.O_RDWR | os.O_CREAT)
     fcntl.flock(lock, fcntl.LOCK_EX)
     try:
-        runs = {name: subprocess.Popen([sys.executable, "-m", "toolkit.cli", "run", name, "--save", path],
+        runs = {name: subprocess.Popen([sys.executable, "-m", "likeme", "run", name, "--save", path],
                                        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=ENV, cwd=ROOT)
                 for name in ("learn_windmill", "ice_cream")}
         pids = {proc.pid for proc in runs.values()}

@@ -36,7 +36,7 @@ def _env(site, **extra):
 
 def _likeme(site, *args, **extra):
     return subprocess.run(
-        [sys.executable, "-m", "toolkit.cli", *map(str, args)], capture_output=True, text=True, env=_env(site, **extra), timeout=300
+        [sys.executable, "-m", "likeme", *map(str, args)], capture_output=True, text=True, env=_env(site, **extra), timeout=300
     )
 
 

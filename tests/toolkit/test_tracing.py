@@ -10,7 +10,7 @@ import pytest
 from tests.conftest import make_plugin
 from tests.fixtures.recorder import Recorder
 from toolkit import PluginError, create_plugin_manager, hookimpl, load_scenario
-from toolkit.cli import main
+from likeme.cli import main
 from toolkit.manager import PluginInfo
 
 RUN_EVENTS = ("movement_started", "segment_found", "movement_recognised", "behaviour_identified", "imitation_started",
@@ -93,7 +93,7 @@ def test_keep_going_skips_a_hook_that_fails_inside_a_component(monkeypatch, caps
     hook plugin is dropped and the learning goes on (the matcher is not blamed, nor dropped)."""
     pm = create_plugin_manager(autoload=False, trace=False)
     pm.register_plugin(_Failing("movement_learned"), PluginInfo("failing", "m", "(tests)", ""))
-    monkeypatch.setattr("toolkit.cli.create_plugin_manager", lambda: pm)
+    monkeypatch.setattr("likeme.cli.create_plugin_manager", lambda: pm)
     assert main(["run", "learn_windmill", "--keep-going"]) == 0
     out = capsys.readouterr().out
     assert "went on without plugin 'failing' (likeme_movement_learned)" in out

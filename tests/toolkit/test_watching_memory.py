@@ -209,7 +209,7 @@ def test_bounds_are_finite_seconds(max_character, keep, max_segment, expected):
 def misbehaving(monkeypatch):
     """A plugin manager with the misbehaving fixture plugin, used by ``likeme`` in-process."""
     from tests.fixtures import misbehaving as module
-    from toolkit import cli
+    from likeme import cli
 
     pm = create_plugin_manager(autoload=False, trace=False)
     pm.register_plugin(module, _info("misbehaving"))
@@ -244,7 +244,7 @@ GUARDED = [
 
 @pytest.mark.parametrize("args, expected", GUARDED)
 def test_observe_reports_a_misbehaving_plugin_as_one_line(data, misbehaving, capsys, args, expected):
-    from toolkit.cli import main
+    from likeme.cli import main
 
     code = main(["observe", "--body", str(data / "profile.toml"), "--repertoire", str(data / "repertoire"), *args,
                  str(data / "streams" / "stream_1.bvh")])
@@ -279,7 +279,7 @@ def test_a_perception_that_raises_is_named(data, profile, pm_, monkeypatch):
      "likeme: error: plugin 'stranger' failed in Stranger.conclude: returned movement 'teleport'"),
 ])
 def test_bench_reports_a_misbehaving_plugin_as_one_line(data, misbehaving, capsys, args, expected):
-    from toolkit.cli import main
+    from likeme.cli import main
 
     args = [str(data / "repertoire") if a == "REPERTOIRE" else str(data / "demos") if a == "DEMOS" else a
             for a in args]
@@ -298,7 +298,7 @@ def test_bench_reports_a_misbehaving_plugin_as_one_line(data, misbehaving, capsy
 def test_the_memory_benchmark_prints_flat_rows_held_and_observes_a_written_stream(capsys):
     """``likeme bench memory``: a line per simulated interval whose rows held stop growing once the stream is longer
     than what working memory keeps, and a ``likeme observe`` subprocess on a written stream that exits cleanly."""
-    from toolkit.cli import main
+    from likeme.cli import main
 
     assert main(["bench", "memory", "--minutes", "2", "--every", "0.5", "--fps", "30", "--block", "45",
                  "--observe-minutes", "0.2"]) == 0

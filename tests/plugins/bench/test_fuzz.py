@@ -252,7 +252,7 @@ def test_seeds_are_good_inputs(seeds):
 def test_bench_fuzz_reports_and_fails_on_findings(tmp_path, capsys):
     """A short run through ``likeme bench fuzz``: the table, the closing line, status 1 exactly when something failed,
     and the failing inputs with their stderr in --out."""
-    from toolkit.cli import main
+    from likeme.cli import main
 
     status = main(["bench", "fuzz", "--n", "12", "--targets", "state,bvh", "--seed", "3", "--timeout", "20",
                    "--out", str(tmp_path / "cases"), "--quiet"])
@@ -270,7 +270,7 @@ def test_bench_fuzz_reports_and_fails_on_findings(tmp_path, capsys):
 
 
 def test_bench_fuzz_refuses_an_out_that_is_a_file(tmp_path, capsys):
-    from toolkit.cli import main
+    from likeme.cli import main
 
     (tmp_path / "f").write_text("x")
     assert main(["bench", "fuzz", "--n", "1", "--out", str(tmp_path / "f")]) == 1
@@ -279,7 +279,7 @@ def test_bench_fuzz_refuses_an_out_that_is_a_file(tmp_path, capsys):
 
 
 def test_bench_fuzz_refuses_unknown_targets(capsys):
-    from toolkit.cli import main
+    from likeme.cli import main
 
     assert main(["bench", "fuzz", "--targets", "bvh,yaml"]) == 1
     err = capsys.readouterr().err.strip().splitlines()

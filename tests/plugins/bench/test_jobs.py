@@ -15,7 +15,7 @@ import pytest
 
 from plugins.bench.command import TIMING_NOTE
 from plugins.bench.jobs import run_with_pm
-from toolkit.cli import main
+from likeme.cli import main
 from toolkit.manager import create_plugin_manager
 
 SUB_COMMANDS = ("recognition", "segmentation", "stream", "sweep", "make-data", "bandai", "watch", "facilitation",
@@ -57,7 +57,7 @@ def test_every_sub_command_takes_jobs_and_scheduler(name):
 
 
 def test_the_list_is_every_sub_command_of_bench():
-    from toolkit.cli import build_parser
+    from likeme.cli import build_parser
     from toolkit.manager import create_plugin_manager
 
     def choices(parser):

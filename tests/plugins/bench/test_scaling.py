@@ -56,7 +56,7 @@ def test_generated_clips_are_renamed_and_perturbed_but_meet_at_their_ends():
 
 
 def test_quick_run_prints_three_tables_with_slopes(tmp_path, capsys):
-    from toolkit.cli import main
+    from likeme.cli import main
 
     out = tmp_path / "scaling.json"
     assert main(["bench", "scaling", "--quick", "--json", str(out)]) == 0
@@ -82,7 +82,7 @@ def test_quick_run_prints_three_tables_with_slopes(tmp_path, capsys):
 
 
 def test_bad_sizes_are_refused_in_one_line(capsys):
-    from toolkit.cli import main
+    from likeme.cli import main
 
     with pytest.raises(SystemExit) as exit_:
         main(["bench", "scaling", "--quick", "--movements", "0"])
@@ -91,7 +91,7 @@ def test_bad_sizes_are_refused_in_one_line(capsys):
 
 
 def test_set_reaches_the_observer(tmp_path, capsys):
-    from toolkit.cli import main
+    from likeme.cli import main
 
     assert main(["bench", "scaling", "--quick", "--minutes", "0.05", "--minutes", "0.1", "--movements", "3",
                  "--movements", "6", "--set", "matcher.per_movement=false"]) == 0

@@ -11,7 +11,7 @@ from plugins.bench.data import make_data
 from plugins.bench.jobs import run_items
 from plugins.bench.sweep import TIMING, cells, load_grid
 from toolkit import ConfigError
-from toolkit.cli import main
+from likeme.cli import main
 from toolkit.manager import create_plugin_manager
 
 GRID = """benchmark = "segmentation"

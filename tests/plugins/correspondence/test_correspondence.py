@@ -246,7 +246,7 @@ def test_open_protocol_counts_unknown_as_right_for_a_movement_left_out(generated
 
 
 def test_observe_says_why_a_segment_is_unknown(generated, capsys):
-    from toolkit.cli import main
+    from likeme.cli import main
 
     profile = generated / "profile.toml"
     demo = sorted((generated / "demos").glob("*/*.bvh"))[0]
@@ -268,7 +268,7 @@ def test_observe_json_ranks_the_forward_models_candidates(generated, capsys):
     their prediction error, the answer first and the others from the nearest, known or not."""
     import json
 
-    from toolkit.cli import main
+    from likeme.cli import main
 
     demo = sorted((generated / "demos").glob("*/*.bvh"))[0]
     args = ["observe", str(demo), "--body", str(generated / "profile.toml"), "--repertoire",
@@ -288,7 +288,7 @@ def test_observe_json_ranks_the_forward_models_candidates(generated, capsys):
 def test_likeme_show_draws_a_recording_as_perceived_and_as_mapped(generated, tmp_path, capsys):
     from PIL import Image
 
-    from toolkit.cli import main
+    from likeme.cli import main
 
     demo = sorted((generated / "demos").glob("*/*.bvh"))[0]
     common = ["show", "observers/recordings", "--body", str(generated / "profile.toml"), "--repertoire",
@@ -312,7 +312,7 @@ def test_the_pictures_larger_stooped_demonstrator_is_mapped_onto_maxs_size_and_r
     import re
     from pathlib import Path
 
-    from toolkit.cli import main
+    from likeme.cli import main
     from toolkit.observe import Observer, compose_observer
     from toolkit.recordings.profile import load_profile
 

@@ -55,7 +55,7 @@ def test_the_same_change_points_as_the_bandwidth_from_all_pairs(monkeypatch, pie
 
 
 def test_the_same_segments_on_generated_streams(monkeypatch, tmp_path):
-    from toolkit.cli import main
+    from likeme.cli import main
 
     main(["bench", "make-data", str(tmp_path / "gen")])
     files = sorted((tmp_path / "gen" / "streams").glob("*.bvh"))

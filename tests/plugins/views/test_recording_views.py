@@ -16,7 +16,7 @@ import pytest
 from plugins.bench.data import make_data
 from toolkit.recordings.segments import read_segments
 from toolkit import create_plugin_manager
-from toolkit.cli import main
+from likeme.cli import main
 
 matplotlib = pytest.importorskip("matplotlib")
 

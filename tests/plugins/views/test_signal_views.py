@@ -13,7 +13,7 @@ import pytest
 from plugins.views.demonstration import perform_sequence, watch
 from plugins.lib.rendering import hex_to_rgb
 from toolkit import Motion, create_plugin_manager, load_character
-from toolkit.cli import main
+from likeme.cli import main
 
 imageio = pytest.importorskip("imageio.v2")
 

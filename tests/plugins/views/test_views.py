@@ -15,7 +15,7 @@ import pytest
 from plugins.lib.rendering import draw_bodies, frame_2d, hex_to_rgb, part_colours, plotter
 from tests.conftest import ROOT, STICK
 from toolkit import World, create_plugin_manager, load_character
-from toolkit.cli import main
+from likeme.cli import main
 from toolkit.scenario import load_scenario
 
 imageio = pytest.importorskip("imageio.v2")

@@ -40,7 +40,7 @@ def data(tmp_path_factory):
 
 
 def _command(data: Path, *extra: str) -> list[str]:
-    return [sys.executable, "-m", "toolkit.cli", "observe", "--body", str(data / "profile.toml"), "--repertoire",
+    return [sys.executable, "-m", "likeme", "observe", "--body", str(data / "profile.toml"), "--repertoire",
             str(data / "repertoire"), *extra]
 
 

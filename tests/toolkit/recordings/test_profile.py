@@ -115,7 +115,7 @@ def test_the_facing_of_every_bandai_namco_clip_is_steady():
 
 
 def test_validate_checks_a_profile_and_bvh_files_against_it(tmp_path, write, max_character, capsys):
-    from toolkit.cli import main
+    from likeme.cli import main
 
     _write_max_clip(max_character, tmp_path / "jump.bvh")
     profile = write("max.toml", PROFILE.format(units="cm", up="+y", parts=_max_parts(max_character)))

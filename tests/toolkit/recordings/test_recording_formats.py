@@ -14,7 +14,7 @@ import pytest
 from plugins.bench.data import convert_recordings, make_data, write_positions
 from toolkit import ConfigError
 from toolkit.recordings.bvh import read_bvh
-from toolkit.cli import main
+from likeme.cli import main
 from toolkit.recordings.profile import load_profile
 
 
@@ -274,7 +274,7 @@ def test_a_piped_benchmark_starts_with_its_table_and_its_files_are_0644_under_um
 
     folder = data / "bvh"
     out_json, out_png = tmp_path / "r.json", tmp_path / "r.png"
-    command = [sys.executable, "-m", "toolkit.cli", "bench", "recognition", "--body", str(folder / "profile.toml"),
+    command = [sys.executable, "-m", "likeme", "bench", "recognition", "--body", str(folder / "profile.toml"),
                "--repertoire", str(folder / "repertoire"), "--demos", str(folder / "demos"), "--matcher", "dtw",
                "--json", str(out_json), "--plot", str(out_png)]
     done = subprocess.run(command, capture_output=True, text=True, timeout=600,

@@ -208,7 +208,7 @@ def test_observe_streams_a_file_and_finds_what_watching_it_whole_finds(tmp_path,
     import io
     import json
 
-    from toolkit.cli import main
+    from likeme.cli import main
     from toolkit.observe import Observer, compose_observer
 
     monkeypatch.setenv("LIKEME_DISABLE_PLUGIN_AUTOLOAD", "1")

@@ -34,11 +34,15 @@ import numpy as np
 from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.utils.validation import check_is_fitted
 
+from plugins.bench.metrics import segmentation_scores
+from plugins.lib.clip_repertoire import ClipRepertoire, clip_files, clip_repertoire
 from toolkit.errors import ConfigError
 from toolkit.motion import Motion
 from toolkit.observe import OBSERVER_TEMPLATE, Observation, Observer, compose_observer, observer_tables
 from toolkit.params import flat_parameters
+from toolkit.recordings import is_recording
 from toolkit.recordings.profile import BodyProfile, load_profile
+from toolkit.recordings.segments import read_segments, segments_of
 
 __all__ = ["MovementClassifier", "MovementSegmenter", "EstimatorInputError", "load_recordings", "load_streams",
            "to_breakpoints", "UNKNOWN"]
@@ -102,8 +106,6 @@ class _ObserverEstimator(BaseEstimator):
 
     def _repertoire(self, motions: Sequence[Motion], labels: Sequence[str]) -> Any:
         """The clips as a repertoire in memory, its hubs found with the motor system's settings."""
-        from plugins.lib.clip_repertoire import clip_repertoire
-
         motor = self._tables().get("motor", {})
         defaults = {name: p.default for name, p in self._plugin_parameters().get("motor", {}).items()}
         radius = motor.get("hub_radius", defaults.get("hub_radius", 0.06))
@@ -335,8 +337,6 @@ class MovementSegmenter(_ObserverEstimator):
 
     def fit(self, X: Any, y: Any = None) -> MovementSegmenter:
         """Compose the observer, its hubs from ``repertoire`` or from the streams ``X`` (``y`` is not used)."""
-        from plugins.lib.clip_repertoire import ClipRepertoire
-
         streams = self._motions(X)
         if y is not None:
             _segments(y, streams)
@@ -377,8 +377,6 @@ class MovementSegmenter(_ObserverEstimator):
 
         ``y``: each stream's true segments, (start, end) or (start, end, movement) rows, end exclusive.
         """
-        from plugins.bench.metrics import segmentation_scores
-
         motions = self._motions(X)
         truth = _segments(y, motions)
         found = tp = true = 0
@@ -456,8 +454,6 @@ def load_recordings(folder: str | Path, profile: str | Path | BodyProfile, *, gr
     performer, a style, a session), for :class:`~sklearn.model_selection.LeaveOneGroupOut` or ``GroupKFold``;
     without one, each file's name (without its suffix) is its group.
     """
-    from plugins.lib.clip_repertoire import clip_files
-
     profile = profile if isinstance(profile, BodyProfile) else load_profile(profile)
     pattern = None
     if group is not None:
@@ -485,9 +481,6 @@ def load_recordings(folder: str | Path, profile: str | Path | BodyProfile, *, gr
 def load_streams(folder: str | Path, profile: str | Path | BodyProfile) -> tuple[list[Motion], list[list[tuple]]]:
     """The streams of ``folder`` (``NAME.bvh`` with ``NAME.segments.csv`` beside it, as ``likeme bench
     segmentation`` reads them) through ``profile``: (motions, true segments as (start, end, movement) rows)."""
-    from toolkit.recordings.segments import read_segments, segments_of
-    from toolkit.recordings import is_recording
-
     profile = profile if isinstance(profile, BodyProfile) else load_profile(profile)
     files = sorted(p for p in Path(folder).iterdir() if is_recording(p))
     if not files:

@@ -10,8 +10,8 @@ the facing is found, :mod:`plugins.lib.root_frame`):
   data, its parts from the common joint-naming schemes (:data:`SCHEMES`), facing markers, bones from the BVH
   hierarchy or the scheme, and ``# TODO`` comments where it could not decide.
 
-It lives in ``plugins/lib`` (not the core) because it is an algorithm: heuristics about bodies, and the facing
-estimate of §5.1 (Buchsbaum & Blumberg 2005), which is itself here.
+It lives on the top floor, beside the commands that use it, not in the core: it is an algorithm (heuristics about
+bodies, and the facing estimate of §5.1, Buchsbaum & Blumberg 2005, :mod:`plugins.lib.root_frame`).
 
 The kind of a body is read from its own proportions, not from one dataset: a body whose vertical extent is at least
 half its span (twice the largest distance of a part from the parts' centroid) stands upright, like a person, a
