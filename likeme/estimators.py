@@ -38,7 +38,8 @@ from plugins.bench.metrics import segmentation_scores
 from plugins.lib.clip_repertoire import ClipRepertoire, clip_files, clip_repertoire
 from toolkit.errors import ConfigError
 from toolkit.motion import Motion
-from toolkit.observe import OBSERVER_TEMPLATE, Observation, Observer, compose_observer, observer_tables
+from toolkit.config.observer_templates import OBSERVER_TEMPLATE
+from toolkit.observe import Observation, Observer, compose_observer, observer_tables
 from toolkit.params import flat_parameters
 from toolkit.recordings import is_recording
 from toolkit.recordings.profile import BodyProfile, load_profile

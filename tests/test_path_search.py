@@ -234,7 +234,7 @@ def test_a_beam_step_through_hubs_keeps_the_same_paths_as_listing_every_pair(tmp
     from plugins.lib.clip_repertoire import clip_repertoire
     from toolkit.manager import create_plugin_manager
     from toolkit.observe import Observer, compose_observer
-    from toolkit.params import parse_settings
+    from toolkit.config.settings import parse_settings
     from toolkit.recordings.profile import load_profile
 
     pm = create_plugin_manager()

@@ -166,7 +166,7 @@ def test_the_same_matches_with_the_fast_paths_off(generated, settings, segmenter
     """Every segment of the generated streams (the template's search: per_movement, travel, max_stay, spread; and
     the paper's): the same Match, field for field, with the screen, the padded tables and PoseScan's planes off."""
     from toolkit.observe import Observer, compose_observer
-    from toolkit.params import parse_settings
+    from toolkit.config.settings import parse_settings
 
     pm, profile, folder, streams = generated
 

@@ -14,7 +14,8 @@ A character file has these tables (``docs/character-format.md`` is the full refe
 
 ``extends`` names another character file; its tables are the defaults, the
 file's own tables are merged over them key by key (a component table whose
-``plugin`` changes replaces the inherited one whole).
+``plugin`` changes replaces the inherited one whole): :mod:`toolkit.config.search`
+finds and merges the files, :mod:`toolkit.config.toml` reads them.
 
 Every problem is a :class:`~toolkit.errors.ConfigError` naming the file, the
 key path (and the line where it can be found), what was expected and what is
@@ -23,9 +24,7 @@ available.
 
 from __future__ import annotations
 
-import re
-import tomllib
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -35,6 +34,8 @@ import numpy as np
 from toolkit.body import Body
 from toolkit.components import (ActionSystem, Component, Correspondence, Layer, Matcher, MotorSystem, Perception,
                                  Segmenter)
+from toolkit.config.search import load_chain, merge_tables, resolve_file
+from toolkit.config.toml import find_key_line
 from toolkit.errors import ConfigError, LikemeError, PluginError
 from toolkit.manager import PluginManager
 from toolkit.params import finite_number
@@ -43,10 +44,7 @@ __all__ = [
     "Character",
     "load_character",
     "compose_character",
-    "read_toml",
-    "resolve_file",
-    "character_paths",
-    "merge_tables",
+    "build_component",
     "COMPONENT_TABLES",
     "check_body",
 ]
@@ -148,189 +146,6 @@ class Character:
             self.pm.announce(hook, **kwargs)
 
 
-# -- reading files -------------------------------------------------------------------
-
-
-MAX_DEPTH = 32
-"""The deepest nesting of arrays and tables a declaration may have."""
-MAX_EXTENDS = 64
-"""The longest ``extends`` chain a character file may start."""
-
-
-def read_text(path: str | Path, what: str, *, kind: str = "config") -> str:
-    """A UTF-8 text file's content (a byte-order mark at its start is dropped); a missing, unreadable or not
-    regular file (a device, a FIFO, a directory), or one larger than the size cap of ``kind``
-    (:data:`toolkit.files.LIMITS`), is a :class:`ConfigError` expecting ``what``."""
-    from toolkit.files import open_regular
-
-    path = Path(path)
-    if not path.exists() and not path.is_symlink():
-        raise ConfigError("file not found", file=path, expected=f"an existing {what}")
-    try:
-        with open_regular(path, what, kind) as handle:
-            return handle.read().decode("utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"cannot read file ({exc})", file=path, expected=f"a readable UTF-8 {what}") from None
-
-
-def read_toml(path: str | Path) -> dict[str, Any]:
-    """Parse a TOML file; syntax errors become a :class:`ConfigError` with line and column."""
-    path = Path(path)
-    text = read_text(path, "TOML file")
-    try:
-        table = tomllib.loads(text)
-    except RecursionError:
-        table = None
-    except tomllib.TOMLDecodeError as exc:
-        msg = str(exc)
-        m = re.search(r"\(at line (\d+), column (\d+)\)", msg)
-        line, col = (int(m.group(1)), int(m.group(2))) if m else (None, None)
-        problem = re.sub(r"\s*\(at (line \d+, column \d+|end of document)\)", "", msg)
-        return _raise(ConfigError(f"TOML syntax error: {problem}", file=path, line=line, column=col))
-    if table is None or _too_deep(table):
-        return _raise(ConfigError(f"TOML nested more than {MAX_DEPTH} levels deep", file=path,
-                                  expected=f"arrays and tables nested at most {MAX_DEPTH} levels deep"))
-    return table
-
-
-def _too_deep(table: Mapping[str, Any]) -> bool:
-    """Whether arrays and tables nest deeper than :data:`MAX_DEPTH` (walked without recursion)."""
-    stack: list[tuple[Any, int]] = [(table, 1)]
-    while stack:
-        value, depth = stack.pop()
-        if depth > MAX_DEPTH:
-            return True
-        children = value.values() if isinstance(value, Mapping) else value
-        stack.extend((v, depth + 1) for v in children if isinstance(v, (Mapping, list)))
-    return False
-
-
-def _raise(err: Exception) -> Any:
-    raise err
-
-
-def builtin_characters() -> Path:
-    """The folder of the built-in characters (with ``scenarios/``, ``observers/`` and ``profiles/``): the project's
-    ``characters/`` in a source tree or an editable install, else the copy a regular install puts under
-    ``<prefix>/share/likeme/characters``."""
-    import sys
-
-    project = Path(__file__).resolve().parent.parent / "characters"
-    installed = Path(sys.prefix) / "share" / "likeme" / "characters"
-    return project if project.is_dir() or not installed.is_dir() else installed
-
-
-def character_paths(pm: PluginManager | None = None) -> list[Path]:
-    """Folders searched for character and scenario files named without a path.
-
-    In order: ``$LIKEME_CHARACTERS`` (``os.pathsep``-separated), the project's
-    ``characters/`` folder (source tree or editable install), the installed copy
-    under ``<prefix>/share/likeme/characters``, then folders from the
-    ``likeme_character_paths`` hook.
-    """
-    import os
-    import sys
-
-    paths: list[Path] = []
-    env = os.environ.get("LIKEME_CHARACTERS")
-    if env:
-        paths.extend(Path(p) for p in env.split(os.pathsep) if p)
-    paths.append(Path(__file__).resolve().parent.parent / "characters")
-    paths.append(Path(sys.prefix) / "share" / "likeme" / "characters")
-    if pm is not None:
-        for result in pm.hook.likeme_character_paths():
-            paths.extend(Path(p) for p in result or ())
-    out: list[Path] = []
-    for p in paths:
-        for candidate in (p, p / "scenarios"):
-            if candidate.is_dir() and candidate not in out:
-                out.append(candidate)
-    return out
-
-
-def resolve_file(ref: str, base: Path | None, pm: PluginManager | None, *, key: tuple = (), file: Path | None = None) -> Path:
-    """Find a referenced file: a path relative to ``base``, else a name on :func:`character_paths`."""
-    candidates: list[Path] = []
-    if base is not None:
-        candidates.append(base / ref)
-    candidates.append(Path(ref))
-    name = ref if ref.endswith(".toml") else ref + ".toml"
-    searched = character_paths(pm)
-    candidates.extend(p / name for p in searched)
-    for c in candidates:
-        try:
-            if c.is_file():
-                return c.resolve()
-        except OSError:  # a name too long for the file system, a loop of links: not a file that can be found
-            continue
-    known = sorted({f.stem for p in searched for f in p.glob("*.toml")})
-    raise ConfigError(
-        f"cannot find {ref[:80]!r}" + (f" ({len(ref)} characters)" if len(ref) > 80 else ""),
-        file=file,
-        key=key,
-        expected="a path relative to this file or the name of a character on the search path",
-        available=known,
-    )
-
-
-def merge_tables(base: Mapping[str, Any], over: Mapping[str, Any]) -> dict[str, Any]:
-    """Deep-merge ``over`` onto ``base``: tables merge, anything else is replaced.
-
-    A table whose ``plugin`` key differs from the inherited one replaces it whole,
-    so parameters of one plugin never leak into another.
-    """
-    out = dict(base)
-    for key, value in over.items():
-        old = out.get(key)
-        if isinstance(old, Mapping) and isinstance(value, Mapping):
-            if "plugin" in value and value.get("plugin") != old.get("plugin"):
-                out[key] = dict(value)
-            else:
-                out[key] = merge_tables(old, value)
-        else:
-            out[key] = value
-    return out
-
-
-def _load_chain(path: Path, pm: PluginManager | None, stack: tuple[Path, ...] = (), *,
-                head_key: str = "character", check: Callable[[Path, dict, Path | None], None] | None = None
-                ) -> tuple[dict[str, Any], tuple[Path, ...]]:
-    """The merged table of ``path`` and everything it extends, and the files involved (outermost first).
-
-    ``head_key`` names the table holding ``extends`` (and the ``name`` a file does not pass on): ``[character]``
-    for characters, ``[observer]`` for observer templates (:func:`toolkit.observe.read_observer_template`).
-    ``check(file, table, extended_by)``, if given, sees each file's own table as it is read (``extended_by``: the
-    file whose ``extends`` named it, None for ``path``)."""
-    path = path.resolve()
-    if len(stack) >= MAX_EXTENDS:
-        raise ConfigError(f"extends chain longer than {MAX_EXTENDS} files", file=stack[-1],
-                          key=(head_key, "extends"),
-                          expected=f"at most {MAX_EXTENDS} files, each extending the next")
-    if path in stack:
-        cycle = " -> ".join(p.name for p in (*stack, path))
-        raise ConfigError(f"extends cycle: {cycle}", file=stack[-1], key=(head_key, "extends"), expected="no cycle")
-    table = read_toml(path)
-    if check is not None:
-        check(path, table, stack[-1] if stack else None)
-    head = table.get(head_key, {})
-    if not isinstance(head, Mapping):
-        raise ConfigError("not a table", file=path, key=(head_key,),
-                          expected=f"{'an' if head_key[0] in 'aeiou' else 'a'} [{head_key}] table")
-    ref = head.get("extends")
-    if ref is None:
-        return table, (path,)
-    if not isinstance(ref, str):
-        raise ConfigError(f"wrong type {type(ref).__name__}", file=path, key=(head_key, "extends"),
-                          expected=f"a file path or {head_key} name")
-    parent_path = resolve_file(ref, path.parent, pm, key=(head_key, "extends"), file=path)
-    parent, files = _load_chain(parent_path, pm, (*stack, path), head_key=head_key, check=check)
-    own = dict(table)
-    own[head_key] = {k: v for k, v in head.items() if k != "extends"}
-    parent = dict(parent)
-    parent[head_key] = {k: v for k, v in parent.get(head_key, {}).items() if k != "name"}
-    return merge_tables(parent, own), (path, *files)
-
-
 def load_character(
     path: str | Path, pm: PluginManager | None = None, *, override: Mapping[str, Any] | None = None,
     override_at: tuple[str | Path | None, tuple[str | int, ...]] | None = None,
@@ -356,7 +171,7 @@ def load_character(
     p = Path(path)
     if not p.is_file():
         p = resolve_file(str(path), None, pm)
-    table, files = _load_chain(p, pm)
+    table, files = load_chain(p, pm)
     if override:
         table = merge_tables(table, override)
     try:
@@ -538,38 +353,3 @@ def _locate(err: ConfigError, files: Iterable[Path]) -> ConfigError:
     return err.within(file=files[0] if files else None)
 
 
-def find_key_line(path: Path, key: tuple) -> int | None:
-    """Best-effort line number of ``key`` in a TOML file (table headers and ``name =`` lines)."""
-    try:
-        lines = path.read_text(encoding="utf-8").splitlines()
-    except OSError:
-        return None
-    names = [k for k in key if isinstance(k, str)]
-    header = re.compile(r"^\s*\[\[?\s*([^\]]+?)\s*\]\]?\s*(#.*)?$")
-    current: list[str] = []
-    best: tuple[int, int] | None = None  # (matched depth, line)
-    for number, text in enumerate(lines, 1):
-        m = header.match(text)
-        if m:
-            current = [p.strip().strip('"') for p in m.group(1).split(".")]
-            depth = _prefix_depth(current, names)
-            if depth == len(current) and (best is None or depth > best[0]):
-                best = (depth, number)
-            continue
-        m = re.match(r"^\s*([A-Za-z0-9_\-\"\.]+)\s*=", text)
-        if m:
-            dotted = [p.strip().strip('"') for p in m.group(1).split(".")]
-            full = current + dotted
-            depth = _prefix_depth(full, names)
-            if depth == len(full) and (best is None or depth > best[0]):
-                best = (depth, number)
-    return best[1] if best is not None and best[0] > 0 else None
-
-
-def _prefix_depth(path: list[str], key: list[str]) -> int:
-    n = 0
-    for a, b in zip(path, key):
-        if a != b:
-            break
-        n += 1
-    return n

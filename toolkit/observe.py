@@ -27,69 +27,20 @@ from typing import Any
 
 import numpy as np
 
-from toolkit.character import (COMPONENT_TABLES, Character, _load_chain, character_paths, compose_character,
-                               merge_tables, resolve_file)
+from toolkit.character import COMPONENT_TABLES, Character, compose_character
+from toolkit.config.observer_templates import (ALTERNATIVES, OBSERVER_TEMPLATE, checked_template,
+                                               read_observer_template)
+from toolkit.config.search import merge_tables
 from toolkit.components import Perception
 from toolkit.errors import ConfigError, PluginError
 from toolkit.motion import Motion
 from toolkit.recordings.profile import BodyProfile
 from toolkit.watching import KEEP_SECONDS, MAX_SEGMENT_SECONDS, Observation, WatchingLoop, guarded
 
-__all__ = ["Observation", "Observer", "compose_observer", "observer_tables", "OBSERVER_TEMPLATE", "NO_CORRESPONDENCE",
-           "is_observer_template", "check_observer_template", "observer_plugins", "observer_template_path",
-           "observer_templates", "read_observer_template"]
+__all__ = ["Observation", "Observer", "compose_observer", "observer_tables", "observer_plugins", "NO_CORRESPONDENCE"]
 
 NO_CORRESPONDENCE = "none"
 """The correspondence name that means none (``--correspondence none``): the papers' plain observer."""
-
-OBSERVER_TEMPLATE = "observers/recordings.toml"
-"""The observer template on the character path: the components an observer of recordings has by default."""
-
-OBSERVER_FOLDER = "observers"
-"""The folder of observer templates in each folder of the character path (:func:`toolkit.character.character_paths`):
-a template named without a path (``--observer several-takes``) is looked up there."""
-
-
-def observer_templates(pm: Any = None) -> list[str]:
-    """The names of the observer templates on the character path (``characters/observers/*.toml``), sorted."""
-    return sorted({f.stem for p in character_paths(pm) for f in (p / OBSERVER_FOLDER).glob("*.toml")})
-
-
-def observer_template_path(template: str | Path | None, pm: Any = None, *, key: tuple = ("--observer",)) -> Path:
-    """The file of an observer template: a path, a name on the character path (``observers/recordings``), or the
-    name of a template in an ``observers`` folder of the character path (``recordings``, ``several-takes``);
-    ``None`` or ``""``: :data:`OBSERVER_TEMPLATE`. A :class:`ConfigError` naming ``key`` and listing the templates
-    found otherwise."""
-    ref = str(template or OBSERVER_TEMPLATE)
-    if Path(ref).is_file():
-        return Path(ref).resolve()
-    tries = [ref] if "/" in ref or "\\" in ref else [f"{OBSERVER_FOLDER}/{ref}", ref]
-    for attempt in tries:
-        try:
-            return resolve_file(attempt, None, pm, key=key)
-        except ConfigError:
-            continue
-    raise ConfigError(f"cannot find observer template {ref[:80]!r}", key=key,
-                      expected="an observer template's file, or the name of one in characters/observers/",
-                      available=observer_templates(pm))
-
-
-def read_observer_template(template: str | Path | None, pm: Any = None, *, key: tuple = ("--observer",)
-                           ) -> tuple[dict[str, Any], tuple[Path, ...]]:
-    """The table of an observer template and the files it was read from (outermost first): a template may extend
-    another (``[observer] extends = "recordings.toml"``, a path relative to it or a name on the character path), as
-    a character file does; its tables are merged onto the other's, a table naming another ``plugin`` replacing it
-    whole (:func:`toolkit.character.merge_tables`). A file that is not an observer template (a character file, a
-    body profile) is a :class:`ConfigError` naming ``key`` (the template itself) or the ``extends`` that names it."""
-    def check(file: Path, own: dict, extended_by: Path | None) -> None:
-        if not is_observer_template(own):
-            what = "a character file" if "character" in own else "no [observer] table"
-            raise ConfigError(f"{file.name} is not an observer template ({what})", file=extended_by,
-                              key=("observer", "extends") if extended_by else key,
-                              expected="an observer template: an [observer] table and component tables, no "
-                              "[character] or [body]", available=observer_templates(pm))
-
-    return _load_chain(observer_template_path(template, pm, key=key), pm, head_key="observer", check=check)
 
 
 class Observer:
@@ -283,7 +234,7 @@ def observer_tables(pm: Any, *, segmenter: str | None = None, matcher: str | Non
     """The ``[observer]`` table of ``template`` and the component tables (``plugin`` and parameters) an observer
     composed with these arguments has, as :func:`compose_observer` takes them (its arguments, the same meaning)."""
     settings = {k: dict(v) for k, v in (settings or {}).items()}
-    base = _checked_template(template, pm)[0]
+    base = checked_template(template, pm)[0]
     tables: dict[str, dict[str, Any]] = {k: dict(v) for k, v in base.items() if k in COMPONENT_TABLES}
     for key, name in (("segmenter", segmenter), ("matcher", matcher), ("motor", motor)):
         if name and tables.get(key, {}).get("plugin") != name:  # another plugin: none of the template's parameters,
@@ -316,7 +267,7 @@ def observer_plugins(pm: Any, *, segmenters: Sequence[str] = (), matchers: Seque
     """The plugins each component table of an observer composed from ``template`` may have, by table: the template's,
     with the ``segmenters``, ``matchers`` and ``correspondence`` named instead of its own, and the motor system each
     of those matchers needs. What ``--set TABLE.KEY=VALUE`` is checked against before any work
-    (:func:`toolkit.params.check_settings`)."""
+    (:func:`toolkit.config.settings.check_settings`)."""
     plugins: dict[str, list[str]] = {k: [v["plugin"]] for k, v in read_observer_template(template, pm)[0].items()
                                      if isinstance(v, Mapping) and isinstance(v.get("plugin"), str)}
     if segmenters:
@@ -340,71 +291,5 @@ def observer_plugins(pm: Any, *, segmenters: Sequence[str] = (), matchers: Seque
     return plugins
 
 
-OBSERVER_KEYS = ("name", "description", "lengths_for_height", "extends")
-# Tables of an observer template holding, per plugin, the parameters it gets when named instead of the template's own
-# (`--segmenter NAME`): [segmenters.NAME], [matchers.NAME], [motors.NAME].
-ALTERNATIVES = {"segmenter": "segmenters", "matcher": "matchers", "motor": "motors"}
 
 
-def is_observer_template(table: Mapping[str, Any]) -> bool:
-    """Whether a parsed TOML table is an observer template: an ``[observer]`` table (name, description) and a
-    character's component tables, without a ``[body]`` (a body profile gives it when the observer is composed)."""
-    return "observer" in table and "character" not in table
-
-
-def check_observer_template(path: str | Path, pm: Any) -> dict[str, str]:
-    """The plugin of each component table of an observer template (and of those it extends), every name and
-    parameter checked (a :class:`ConfigError` naming the file, key and line otherwise: the outermost file that
-    writes the key); attaching waits for a body and clips."""
-    return _checked_template(path, pm)[1]
-
-
-def _checked_template(path: str | Path | None, pm: Any) -> tuple[dict[str, Any], dict[str, str]]:
-    """The merged table of an observer template, read once, and the plugin of each component table, as
-    :func:`check_observer_template` checks them."""
-    from toolkit.character import build_component, find_key_line
-
-    table, files = read_observer_template(path, pm)
-    if path and Path(path).is_file():  # the outermost file named as the caller named it
-        files = (Path(path), *files[1:])
-    plugins = {}
-    try:
-        for key in table:
-            if key not in ("observer", *COMPONENT_TABLES, *ALTERNATIVES.values()):
-                raise ConfigError(f"unknown table {key!r}", key=(key,), expected="an observer template table",
-                                  available=("observer", *COMPONENT_TABLES, *ALTERNATIVES.values()))
-        for kind, key in ALTERNATIVES.items():  # [segmenters.NAME]: NAME's parameters when it is named instead
-            for name, params in table.get(key, {}).items():
-                if not isinstance(params, Mapping):
-                    raise ConfigError("not a table", key=(key, name), expected=f"a [{key}.{name}] table")
-                if "plugin" in params:
-                    raise ConfigError("a plugin named inside a plugin's own table", key=(key, name, "plugin"),
-                                      expected=f"{name}'s parameters only (the table's name is the plugin)")
-                try:
-                    build_component(kind, {"plugin": name, **params}, pm)
-                except ConfigError as err:  # named as written: [segmenters.NAME], not [segmenter]
-                    inner = err.key[1:] if err.key and err.key[0] == kind and err.key[1:] != ("plugin",) else ()
-                    where = (key, name, *inner)
-                    raise ConfigError(err.problem, key=where, expected=err.expected, available=err.available) from None
-        head = table["observer"]
-        if not isinstance(head, Mapping):
-            raise ConfigError("not a table", key=("observer",), expected="an [observer] table")
-        for key in head:
-            if key not in OBSERVER_KEYS:
-                raise ConfigError(f"unknown key {key!r}", key=("observer", key), expected="an [observer] key",
-                                  available=OBSERVER_KEYS)
-        for key in COMPONENT_TABLES:
-            if key in table:
-                if not isinstance(table[key], Mapping):
-                    raise ConfigError("not a table", key=(key,), expected=f"a [{key}] table")
-                plugins[key] = build_component(key, table[key], pm).name
-    except ConfigError as err:
-        where, line = files[0], None
-        for file in files if err.key else ():
-            line = find_key_line(file, err.key)
-            if line is not None:
-                where = file
-                break
-        raise ConfigError(err.problem, file=where, key=err.key, line=line, expected=err.expected,
-                          available=err.available) from None
-    return table, plugins

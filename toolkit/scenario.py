@@ -35,7 +35,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from toolkit.character import load_character, merge_tables, read_toml, resolve_file
+from toolkit.character import load_character
+from toolkit.config.search import merge_tables, resolve_file
+from toolkit.config.toml import read_toml
 from toolkit.errors import ConfigError
 from toolkit.manager import PluginManager
 from toolkit.params import finite_number
@@ -265,9 +267,10 @@ def _is_colour(value: Any) -> bool:
 
 def _seeded(override: Mapping[str, Any], seed: int, char_path: Path, pm: PluginManager) -> dict[str, Any]:
     """Give the scenario seed to every component of the character that takes a ``seed`` parameter."""
-    from toolkit.character import COMPONENT_TABLES, _load_chain
+    from toolkit.character import COMPONENT_TABLES
+    from toolkit.config.search import load_chain
 
-    table, _ = _load_chain(char_path, pm)
+    table, _ = load_chain(char_path, pm)
     merged = merge_tables(table, override)
     out = dict(override)
     for key in COMPONENT_TABLES:

@@ -16,7 +16,7 @@ __all__ = ["view_of", "warn"]
 
 def view_of(pm: PluginManager, name: str, subject: str, settings: list[str]) -> Any:
     """The view ``name`` made with ``--set KEY=VALUE`` settings; it must draw ``subject`` (character or scenario)."""
-    from toolkit.params import parse_settings
+    from toolkit.config.settings import parse_settings
 
     cls = pm.registry.get("view", name)
     if cls.subject != subject:

@@ -48,7 +48,7 @@ def handle(args: argparse.Namespace, pm: PluginManager) -> int:
     on standard error naming it, the others are still watched, and the command exits with status 1 at the end.
     """
     from toolkit.observe import NO_CORRESPONDENCE, Observer, compose_observer, observer_plugins
-    from toolkit.params import check_settings, parse_settings
+    from toolkit.config.settings import check_settings, parse_settings
     from toolkit.recordings.profile import load_profile
 
     profile = load_profile(args.body)
@@ -71,7 +71,7 @@ def handle(args: argparse.Namespace, pm: PluginManager) -> int:
     settings = parse_settings(list(args.set))
     if args.fps is not None:  # the repertoire's clips are recordings too: the same rate, unless --set says otherwise
         settings.setdefault("motor", {}).setdefault("fps", args.fps)
-    template = args.observer  # None: the observer template (toolkit.observe.OBSERVER_TEMPLATE)
+    template = args.observer  # None: the observer template (toolkit.config.observer_templates.OBSERVER_TEMPLATE)
     check_settings(settings, pm, observer_plugins(pm, segmenters=[args.segmenter] if args.segmenter else (),
                                                   matchers=[args.matcher] if args.matcher else (),
                                                   correspondence=args.correspondence or "", template=template))

@@ -33,9 +33,10 @@ def add_parser(sub: Any) -> None:
 
 
 def handle(args: argparse.Namespace, pm: PluginManager) -> int:
-    from toolkit.character import COMPONENT_TABLES, load_character, read_toml
+    from toolkit.character import COMPONENT_TABLES, load_character
+    from toolkit.config.toml import read_toml
     from toolkit.files import check_regular_file
-    from toolkit.observe import check_observer_template, is_observer_template
+    from toolkit.config.observer_templates import check_observer_template, is_observer_template
     from toolkit.recordings import SUFFIXES, recording_format
     from toolkit.recordings.profile import is_profile, load_profile
     from toolkit.report import describe_character

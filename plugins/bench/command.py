@@ -47,13 +47,13 @@ def _check_set(args: argparse.Namespace, pm: Any) -> None:
     """``--set TABLE.KEY=VALUE`` checked before anything runs: against the observer's component of each table, and
     against every segmenter and matcher the benchmark compares (a key one of them lacks fails at once, not after
     the others ran)."""
-    from toolkit.character import _load_chain, merge_tables, resolve_file
-    from toolkit.params import check_settings, parse_settings
+    from toolkit.config.search import load_chain, merge_tables, resolve_file
+    from toolkit.config.settings import check_settings, parse_settings
 
     settings = parse_settings(list(args.set))
     if args.benchmark == "watch":  # a character watching through synthetic vision (plugins/bench/watch.py)
         path = resolve_file(args.observer, None, pm, key=("--observer",))
-        base = merge_tables(_load_chain(path, pm)[0], {"perception": {"plugin": "synthetic-vision"}})
+        base = merge_tables(load_chain(path, pm)[0], {"perception": {"plugin": "synthetic-vision"}})
         plugins = {k: [v["plugin"]] for k, v in base.items() if isinstance(v, dict) and isinstance(v.get("plugin"), str)}
     else:  # an observer composed from the observer template (toolkit.observe.compose_observer)
         from toolkit.observe import observer_plugins

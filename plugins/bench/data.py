@@ -38,7 +38,7 @@ def make_data(pm, dest: Path, *, seed: int = 0, streams: int = 6, per_stream: in
                           available=FORMATS)
     from plugins.bench.jobs import run_items
     from toolkit import load_character
-    from toolkit.character import resolve_file
+    from toolkit.config.search import resolve_file
     from toolkit.motion import Motion, concatenate
 
     rng = np.random.default_rng(seed)
@@ -246,7 +246,7 @@ def cmd_make_data(args, pm) -> int:
 
 def cmd_bandai(args, pm) -> int:
     """``likeme bench bandai SRC DIR``."""
-    from toolkit.character import resolve_file
+    from toolkit.config.search import resolve_file
 
     profile = Path(args.profile) if args.profile else resolve_file("profiles/bandai-namco.toml", None, pm,
                                                                    key=("--profile",))

@@ -48,7 +48,7 @@ from typing import Any
 
 import numpy as np
 
-from toolkit.character import builtin_characters
+from toolkit.config.search import builtin_characters
 from toolkit.errors import PluginError
 
 __all__ = ["TARGETS", "OUTCOMES", "Case", "Result", "make_seeds", "make_case", "Worker", "classify", "run_fuzz",

@@ -59,7 +59,7 @@ def random_stream(pm: Any, fps: float, *, seed: int = 0, block: int = 120) -> It
     repertoire at speeds 0.8-1.25 from his rest pose, with 0.2-1 s of standing between them and ``NOISE`` metres of
     noise, forever (the caller stops)."""
     from toolkit import load_character
-    from toolkit.character import resolve_file
+    from toolkit.config.search import resolve_file
 
     rng = np.random.default_rng(seed)
     max_c = load_character(resolve_file("max.toml", None, pm), pm)
@@ -154,7 +154,7 @@ def write_stream(pm: Any, path: Path, *, minutes: float, fps: float, seed: int =
     writes: the root, every other part its child, position channels)."""
     from toolkit import load_character
     from toolkit.recordings.bvh_writer import from_joint_positions, write_bvh
-    from toolkit.character import resolve_file
+    from toolkit.config.search import resolve_file
 
     body = load_character(resolve_file("max.toml", None, pm), pm).body
     root = body.root_index
@@ -241,7 +241,7 @@ def _memory_item(item: dict[str, Any], pm: Any) -> dict[str, Any]:
 def cmd_memory(args: Any, pm: Any) -> int:
     """``likeme bench memory``."""
     from toolkit.errors import ConfigError
-    from toolkit.params import parse_settings
+    from toolkit.config.settings import parse_settings
 
     for name in ("minutes", "fps", "every", "limit"):
         value = getattr(args, name)

@@ -76,7 +76,7 @@ def _streams(folder: Path) -> list[tuple[Path, list[tuple[int, int, str]]]]:
 
 
 def _settings(values: Sequence[str]) -> dict[str, dict[str, Any]]:
-    from toolkit.params import parse_settings
+    from toolkit.config.settings import parse_settings
 
     return parse_settings(list(values))
 

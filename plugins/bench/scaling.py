@@ -57,7 +57,7 @@ def loglog_slope(sizes: Sequence[float], costs: Sequence[float]) -> float:
 
 def _characters(pm: Any):
     from toolkit import load_character
-    from toolkit.character import resolve_file
+    from toolkit.config.search import resolve_file
 
     max_c = load_character(resolve_file("max.toml", None, pm), pm)
     morris = load_character(resolve_file("morris.toml", None, pm), pm)
@@ -216,7 +216,7 @@ def cmd_scaling(args: Any, pm: Any) -> int:
     """``likeme bench scaling``."""
     from plugins.bench.jobs import run_with_pm
     from toolkit.errors import ConfigError
-    from toolkit.params import parse_settings
+    from toolkit.config.settings import parse_settings
 
     sizes = QUICK if args.quick else SIZES
     minutes = args.minutes or sizes["minutes"]

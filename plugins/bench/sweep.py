@@ -150,7 +150,7 @@ def cells(grid: dict[str, Any]) -> list[dict[str, Any]]:
 def _check(grid: dict[str, Any], pm: Any) -> None:
     """Every ``set`` key and value against every plugin it reaches, before any cell runs."""
     from toolkit.observe import observer_plugins
-    from toolkit.params import check_settings, parse_settings
+    from toolkit.config.settings import check_settings, parse_settings
 
     kind = grid["benchmark"]
     plugins = observer_plugins(pm, segmenters=grid["segmenters"] if kind != "recognition" else (),

@@ -30,8 +30,8 @@ from plugins.bench import text_table
 from plugins.bench.jobs import in_process, run_with_pm
 from plugins.bench.metrics import edit_distance, match_segments, movement_error_rate, segmentation_scores
 from toolkit import World, load_character
-from toolkit.character import merge_tables
-from toolkit.params import parse_settings
+from toolkit.config.search import merge_tables
+from toolkit.config.settings import parse_settings
 from toolkit.state import write_atomic
 from toolkit.watching import call_component, check_match
 

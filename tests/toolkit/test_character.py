@@ -7,7 +7,8 @@ import pytest
 
 from tests.conftest import CHARACTERS, STICK
 from toolkit import ConfigError, PluginError, load_character
-from toolkit.character import find_key_line, merge_tables
+from toolkit.config.search import merge_tables
+from toolkit.config.toml import find_key_line
 
 BODY = STICK
 

@@ -16,8 +16,9 @@ from hypothesis import strategies as st
 
 from tests.conftest import CHARACTERS
 from toolkit import ConfigError, load_character
-from toolkit.character import MAX_DEPTH, read_toml
-from toolkit.params import Parameter, check_settings
+from toolkit.config.toml import MAX_DEPTH, read_toml
+from toolkit.config.settings import check_settings
+from toolkit.params import Parameter
 
 MAX = CHARACTERS / "max.toml"
 
@@ -54,7 +55,7 @@ def test_a_fifo_or_a_device_is_refused_without_reading(tmp_path):
 
 
 def test_an_extends_chain_at_the_bound_loads_and_one_more_file_is_refused(tmp_path, pm):
-    from toolkit.character import MAX_EXTENDS
+    from toolkit.config.search import MAX_EXTENDS
 
     own = len(load_character(MAX, pm).files)  # max.toml and the files it extends
     front = MAX_EXTENDS - own

@@ -111,6 +111,6 @@ def test_character_paths_hook_adds_folders(pm, tmp_path, write):
     folder = tmp_path / "shipped"
     folder.mkdir()
     pm.register_plugin(make_plugin(likeme_character_paths=lambda: [folder]), PluginInfo("ships", "m", "(tests)", ""))
-    from toolkit.character import character_paths
+    from toolkit.config.search import character_paths
 
     assert folder in character_paths(pm)

@@ -387,7 +387,8 @@ def test_a_plugin_named_instead_takes_its_own_table_of_the_template(data, profil
     """`[segmenters.NAME]`: the parameters NAME gets when a command names it instead of the template's own plugin
     (the recordings template cuts whole movements with velocity-direction, not strokes); a table for a plugin that is
     not named changes nothing, and `--set` still wins."""
-    from toolkit.character import read_toml, resolve_file
+    from toolkit.config.search import resolve_file
+    from toolkit.config.toml import read_toml
 
     own = read_toml(resolve_file("observers/recordings.toml", None, pm))["segmenters"]["velocity-direction"]
     named = compose_observer(pm, profile, data / "repertoire", segmenter="velocity-direction")
@@ -417,7 +418,8 @@ def test_a_plugin_named_instead_takes_its_own_table_of_the_template(data, profil
 def test_naming_the_templates_own_matcher_keeps_its_parameters_and_another_starts_afresh(data, profile, pm):
     """The observer template sets path-search's parameters for recordings; `--matcher path-search` must not drop
     them (it did: every benchmark that named the matcher ran the plugin's defaults), `--matcher dtw` gets dtw's."""
-    from toolkit.character import read_toml, resolve_file
+    from toolkit.config.search import resolve_file
+    from toolkit.config.toml import read_toml
 
     template = read_toml(resolve_file("observers/recordings.toml", None, pm))["matcher"]
     named = compose_observer(pm, profile, data / "repertoire", matcher="path-search")

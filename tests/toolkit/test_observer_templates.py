@@ -15,10 +15,12 @@ import pytest
 from plugins.bench.sweep import cells, load_grid
 from tests.toolkit.test_observe import data, profile  # noqa: F401  (the generated data, made once for this module)
 from toolkit import ConfigError
-from toolkit.character import read_toml, resolve_file
+from toolkit.config.search import resolve_file
+from toolkit.config.toml import read_toml
 from likeme.cli import main
-from toolkit.observe import (check_observer_template, compose_observer, observer_template_path, observer_templates,
-                             read_observer_template)
+from toolkit.config.observer_templates import (check_observer_template, observer_template_path, observer_templates,
+                                               read_observer_template)
+from toolkit.observe import compose_observer
 
 
 def test_a_template_extending_another_gets_its_tables_and_changes_only_what_it_writes(data, profile, pm, write):

@@ -54,7 +54,7 @@ def test_describe_is_readable():
 
 @pytest.mark.parametrize("value", ["nan", "inf", "-inf"])
 def test_non_finite_numbers_are_refused_with_the_key(value):
-    from toolkit.params import parse_settings
+    from toolkit.config.settings import parse_settings
 
     settings = parse_settings([f"matcher.k={value}", f"segmenter.floor={value}"])
     with pytest.raises(ConfigError, match=rf"key floor: value -?{value.lstrip('-')} is not a finite number"):
@@ -62,7 +62,7 @@ def test_non_finite_numbers_are_refused_with_the_key(value):
 
 
 def test_a_setting_nested_too_deep_is_refused():
-    from toolkit.params import parse_settings
+    from toolkit.config.settings import parse_settings
 
     value = parse_settings(["keys=" + "[" * 31 + "]" * 31], tables=False)["keys"]  # with its table: 32 levels
     depth = 0
@@ -114,7 +114,7 @@ def test_lengths_inside_a_table_are_scaled_with_the_body():
 
 
 def test_set_reaches_inside_a_table_and_is_checked_there(pm):
-    from toolkit.params import check_settings, parse_settings
+    from toolkit.config.settings import check_settings, parse_settings
 
     settings = parse_settings(["correspondence.dwell.speed=0.2", "correspondence.dwell.window=1", "correspondence.rest=none"])
     assert settings == {"correspondence": {"dwell": {"speed": 0.2, "window": 1}, "rest": "none"}}

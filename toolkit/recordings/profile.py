@@ -104,7 +104,7 @@ class BodyProfile:
     array_joints: tuple[str, ...] | None = None
 
     def _where(self, part: str) -> dict[str, Any]:
-        from toolkit.character import find_key_line
+        from toolkit.config.toml import find_key_line
 
         key = ("parts", part)
         return {"file": self.file, "key": key, "line": find_key_line(self.file, key) if self.file else None}
@@ -222,7 +222,8 @@ def is_profile(table: Mapping[str, Any]) -> bool:
 
 def load_profile(path: str | Path) -> BodyProfile:
     """Read a body profile TOML file; every problem is a :class:`ConfigError` naming the file, key and line."""
-    from toolkit.character import check_body, find_key_line, read_toml
+    from toolkit.character import check_body
+    from toolkit.config.toml import find_key_line, read_toml
 
     path = check_regular_file(path, "body profile", "config")  # not a FIFO or /dev/zero, not a huge file
     table = read_toml(path)

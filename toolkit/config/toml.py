@@ -1,0 +1,112 @@
+"""Declarations read from TOML, bounded: a file's text, its table, and the line a key was written on.
+
+Every character, scenario, observer template and body profile is read here: only a regular UTF-8 file within the
+size cap (:mod:`toolkit.files`), arrays and tables nested at most :data:`MAX_DEPTH` deep; a syntax error is a
+:class:`~toolkit.errors.ConfigError` with the file, line and column. :func:`find_key_line` finds the line of a key
+path, so that an error found later (a value a component refuses) names where it was written.
+"""
+
+from __future__ import annotations
+
+import re
+import tomllib
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from toolkit.errors import ConfigError
+
+__all__ = ["MAX_DEPTH", "read_text", "read_toml", "too_deep", "find_key_line"]
+
+
+MAX_DEPTH = 32
+"""The deepest nesting of arrays and tables a declaration may have."""
+
+
+def read_text(path: str | Path, what: str, *, kind: str = "config") -> str:
+    """A UTF-8 text file's content (a byte-order mark at its start is dropped); a missing, unreadable or not
+    regular file (a device, a FIFO, a directory), or one larger than the size cap of ``kind``
+    (:data:`toolkit.files.LIMITS`), is a :class:`ConfigError` expecting ``what``."""
+    from toolkit.files import open_regular
+
+    path = Path(path)
+    if not path.exists() and not path.is_symlink():
+        raise ConfigError("file not found", file=path, expected=f"an existing {what}")
+    try:
+        with open_regular(path, what, kind) as handle:
+            return handle.read().decode("utf-8-sig")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ConfigError(f"cannot read file ({exc})", file=path, expected=f"a readable UTF-8 {what}") from None
+
+
+def read_toml(path: str | Path) -> dict[str, Any]:
+    """Parse a TOML file; syntax errors become a :class:`ConfigError` with line and column."""
+    path = Path(path)
+    text = read_text(path, "TOML file")
+    try:
+        table = tomllib.loads(text)
+    except RecursionError:
+        table = None
+    except tomllib.TOMLDecodeError as exc:
+        msg = str(exc)
+        m = re.search(r"\(at line (\d+), column (\d+)\)", msg)
+        line, col = (int(m.group(1)), int(m.group(2))) if m else (None, None)
+        problem = re.sub(r"\s*\(at (line \d+, column \d+|end of document)\)", "", msg)
+        return _raise(ConfigError(f"TOML syntax error: {problem}", file=path, line=line, column=col))
+    if table is None or too_deep(table):
+        return _raise(ConfigError(f"TOML nested more than {MAX_DEPTH} levels deep", file=path,
+                                  expected=f"arrays and tables nested at most {MAX_DEPTH} levels deep"))
+    return table
+
+
+def too_deep(table: Mapping[str, Any]) -> bool:
+    """Whether arrays and tables nest deeper than :data:`MAX_DEPTH` (walked without recursion)."""
+    stack: list[tuple[Any, int]] = [(table, 1)]
+    while stack:
+        value, depth = stack.pop()
+        if depth > MAX_DEPTH:
+            return True
+        children = value.values() if isinstance(value, Mapping) else value
+        stack.extend((v, depth + 1) for v in children if isinstance(v, (Mapping, list)))
+    return False
+
+
+def _raise(err: Exception) -> Any:
+    raise err
+
+
+def find_key_line(path: Path, key: tuple) -> int | None:
+    """Best-effort line number of ``key`` in a TOML file (table headers and ``name =`` lines)."""
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except OSError:
+        return None
+    names = [k for k in key if isinstance(k, str)]
+    header = re.compile(r"^\s*\[\[?\s*([^\]]+?)\s*\]\]?\s*(#.*)?$")
+    current: list[str] = []
+    best: tuple[int, int] | None = None  # (matched depth, line)
+    for number, text in enumerate(lines, 1):
+        m = header.match(text)
+        if m:
+            current = [p.strip().strip('"') for p in m.group(1).split(".")]
+            depth = _prefix_depth(current, names)
+            if depth == len(current) and (best is None or depth > best[0]):
+                best = (depth, number)
+            continue
+        m = re.match(r"^\s*([A-Za-z0-9_\-\"\.]+)\s*=", text)
+        if m:
+            dotted = [p.strip().strip('"') for p in m.group(1).split(".")]
+            full = current + dotted
+            depth = _prefix_depth(full, names)
+            if depth == len(full) and (best is None or depth > best[0]):
+                best = (depth, number)
+    return best[1] if best is not None and best[0] > 0 else None
+
+
+def _prefix_depth(path: list[str], key: list[str]) -> int:
+    n = 0
+    for a, b in zip(path, key):
+        if a != b:
+            break
+        n += 1
+    return n
