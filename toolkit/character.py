@@ -85,9 +85,10 @@ class Character:
     pm : PluginManager or None
         The plugin manager it was composed with; components announce events through ``pm.hook``.
     repertoire : object or None
-        A repertoire given in memory when it was composed (:func:`compose_character`'s ``repertoire``), which its
-        motor system builds from instead of a folder named in its table (a
-        :class:`plugins.lib.clip_repertoire.ClipRepertoire` for ``posegraph`` and ``motor-command-graph``).
+        A repertoire given when it was composed (:func:`compose_character`'s ``repertoire``), which its motor
+        system builds from instead of a folder named in its table: a :class:`toolkit.recordings.clips.ClipFolder`
+        (clips and the profile they are read with) or, for ``posegraph`` and ``motor-command-graph``, a
+        :class:`plugins.lib.clip_repertoire.ClipRepertoire` built in memory.
     """
 
     name: str
@@ -203,8 +204,8 @@ def compose_character(table: Mapping[str, Any], pm: PluginManager, *, files: tup
                       repertoire: Any = None) -> Character:
     """Validate a merged character table and build its components.
 
-    ``repertoire``: a repertoire in memory for the motor system (:attr:`Character.repertoire`), read when it is
-    attached, instead of a folder its table names (``[motor] clips``).
+    ``repertoire``: what the motor system builds its repertoire from (:attr:`Character.repertoire`), read when it
+    is attached, instead of a folder its table names (``[motor] clips``).
 
     Raises :class:`ConfigError` with the key path (file placement is done by
     :func:`load_character`) or :class:`PluginError` if a component fails to build.

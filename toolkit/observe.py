@@ -34,6 +34,7 @@ from toolkit.config.search import merge_tables
 from toolkit.components import Perception
 from toolkit.errors import ConfigError, PluginError
 from toolkit.motion import Motion
+from toolkit.recordings.clips import ClipFolder
 from toolkit.recordings.profile import BodyProfile
 from toolkit.watching import KEEP_SECONDS, MAX_SEGMENT_SECONDS, Observation, WatchingLoop, guarded
 
@@ -184,10 +185,11 @@ def compose_observer(pm: Any, profile: BodyProfile, repertoire: Any, *, segmente
 
     Parameters
     ----------
-    repertoire : str, Path or ClipRepertoire
-        A folder of labelled clips read through ``profile``, or a repertoire built in memory
-        (:func:`plugins.lib.clip_repertoire.clip_repertoire`), which the motor system receives when it is attached
-        (:attr:`Character.repertoire`); both give the same character.
+    repertoire : str, Path, ClipFolder or ClipRepertoire
+        A folder of labelled clips, read through ``profile`` (a :class:`~toolkit.recordings.clips.ClipFolder`: give
+        one object to several observers and the folder is read once), or a repertoire built in memory
+        (:func:`plugins.lib.clip_repertoire.clip_repertoire`). The motor system receives it when it is attached
+        (:attr:`Character.repertoire`) and reads it with its own settings; both give the same character.
     segmenter, matcher, motor : str, optional
         Plugin names replacing the template's (the template's own plugin, named, keeps its parameters);
         ``matcher=None`` composes no matcher (segmentation only). The motor
@@ -220,11 +222,9 @@ def compose_observer(pm: Any, profile: BodyProfile, repertoire: Any, *, segmente
                  "bones": [list(b) for b in profile.body.bones]},
         **tables,
     }
-    if not isinstance(repertoire, (str, Path)):  # in memory: handed to the motor system as it is attached
-        return compose_character(table, pm, repertoire=repertoire)
-    table["motor"] = {**table.get("motor", {}), "clips": str(Path(repertoire).resolve()),
-                      "profile": str(profile.file.resolve()) if profile.file else ""}
-    return compose_character(table, pm)
+    if isinstance(repertoire, (str, Path)):  # a folder, read through the profile given (never loaded again)
+        repertoire = ClipFolder(Path(repertoire).resolve(), profile)
+    return compose_character(table, pm, repertoire=repertoire)  # handed to the motor system as it is attached
 
 
 def observer_tables(pm: Any, *, segmenter: str | None = None, matcher: str | None = "",

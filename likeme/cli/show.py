@@ -124,8 +124,7 @@ def _show_out(out: str | None, name: str, view: str, several: bool = False) -> P
 def _show_recordings(args: argparse.Namespace, pm: PluginManager, template: str | None, files: list[str]) -> int:
     """``likeme show --body PROFILE FILE ... --view NAME``: the view's picture of the recordings, watched by the
     observer composed from the template (and ``--repertoire``, or the recordings themselves), as observe does."""
-    import tempfile
-
+    from plugins.lib.clip_repertoire import clip_repertoire
     from plugins.views.demonstration import recording
     from toolkit.observe import compose_observer
     from toolkit.recordings.profile import load_profile
@@ -147,22 +146,19 @@ def _show_recordings(args: argparse.Namespace, pm: PluginManager, template: str 
     demos = [recording(profile, f) for f in files]  # each read (and checked) before anything is composed
     segmenter = args.segmenter or needs.get("segmenter")
     matcher = args.matcher or needs.get("matcher") or ("" if args.repertoire else None)
-    with tempfile.TemporaryDirectory(prefix="likeme-show-") as tmp:
-        repertoire = args.repertoire
-        if not repertoire:  # the recordings themselves, a movement each: their hub poses, their paths
-            repertoire = Path(tmp)
-            for k, f in enumerate(files):
-                folder = repertoire / f"{k:03d}-{Path(f).stem}"  # one movement per file, the same file twice too
-                folder.mkdir()
-                (folder / Path(f).name).symlink_to(Path(f).resolve())
-        character = compose_observer(pm, profile, repertoire, template=template,
-                                     segmenter=segmenter, matcher=matcher, correspondence=args.correspondence or "")
-        if each == "all":
-            written = view.draw(character, outs[0], recordings=demos)
-        else:
-            written = []
-            for out, demo in zip(outs, demos):
-                written += view.draw(character, out, recording=demo)
+    repertoire = args.repertoire
+    if not repertoire:  # the recordings themselves, a movement each (the same file twice too): their hubs, their paths
+        repertoire = clip_repertoire([demo.motion for demo in demos],
+                                     [f"{k:03d}-{Path(f).stem}" for k, f in enumerate(files)], profile,
+                                     sources=[Path(f) for f in files])
+    character = compose_observer(pm, profile, repertoire, template=template,
+                                 segmenter=segmenter, matcher=matcher, correspondence=args.correspondence or "")
+    if each == "all":
+        written = view.draw(character, outs[0], recordings=demos)
+    else:
+        written = []
+        for out, demo in zip(outs, demos):
+            written += view.draw(character, out, recording=demo)
     for path in written:
         print(f"wrote {path}")
     return 0

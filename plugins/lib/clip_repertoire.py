@@ -35,7 +35,7 @@ import numpy as np
 from plugins.lib.pose_distance import pose_distance
 from plugins.lib.root_frame import root_relative, smooth_heading
 from toolkit import ConfigError, Motion, Parameter
-from toolkit.recordings import is_recording
+from toolkit.recordings.clips import ClipFolder, clip_files, example_name
 from toolkit.recordings.profile import BodyProfile, load_profile
 
 __all__ = ["Clip", "ClipRepertoire", "load_clip_repertoire", "clip_repertoire", "find_hubs", "root_relative_motion",
@@ -90,42 +90,6 @@ def root_relative_motion(world: Motion, profile: BodyProfile, facing_window: flo
     window = max(1, int(round(facing_window * world.fps)))
     pose, mask, _, _ = root_relative(world.positions, world.visible, profile.body, lambda h: smooth_heading(h, window))
     return Motion(pose, world.fps, world.parts, mask, world.positions).filled()
-
-
-EXAMPLE_MARK = "#"
-"""What joins a movement's name and the number of its further examples (``bow#2``): never in a movement's name."""
-
-
-def example_name(movement: str, earlier: int) -> str:
-    """The name of a movement's next example clip, after ``earlier`` ones: ``bow``, ``bow#2``, ``bow#3``..."""
-    return movement if earlier == 0 else f"{movement}{EXAMPLE_MARK}{earlier + 1}"
-
-
-def clip_files(folder: Path) -> dict[str, list[Path]]:
-    """Clip files by movement name (sub-folder name), sorted; a :class:`ConfigError` if there are none."""
-    folder = Path(folder)
-    if not folder.is_dir():
-        raise ConfigError("not a folder", file=folder, expected="a folder with one sub-folder of BVH clips per movement")
-    out: dict[str, list[Path]] = {}
-    for sub in sorted(p for p in folder.iterdir() if p.is_dir()):
-        files = sorted(p for p in sub.iterdir() if is_recording(p))
-        if files:
-            out[sub.name] = files
-    if not out:  # a flat folder of recordings: each file on its own (its ends still give hubs)
-        for path in sorted(p for p in folder.iterdir() if is_recording(p)):
-            out[path.stem] = [path]
-    for movement, files in out.items():
-        if EXAMPLE_MARK in movement:  # bow#2 is the name of bow's second example: it would replace that one
-            raise ConfigError(f"movement name {movement!r} contains {EXAMPLE_MARK!r}", file=files[0].parent
-                              if files[0].parent != folder else files[0],
-                              expected=f"movement names without {EXAMPLE_MARK!r} (it names a movement's further "
-                              f"examples: {example_name('bow', 1)}, {example_name('bow', 2)}...); rename the folder")
-    if not out:
-        raise ConfigError("no clips found", file=folder,
-                          expected="sub-folders named after movements holding .bvh, .csv or .npy clips "
-                                   "(walk/take1.bvh ...)",
-                          available=[p.name for p in folder.iterdir()])
-    return out
 
 
 PAIR_BLOCK = 2**22
@@ -255,40 +219,40 @@ CLIP_PARAMETERS = (
 )
 """The parameters of a motor system that can build its repertoire from clips."""
 
-_CACHE: dict[tuple, ClipRepertoire] = {}
-
-
 def repertoire_for(params: dict, owner: object) -> ClipRepertoire | None:
-    """The clip repertoire a motor system's ``clips`` and ``profile`` parameters name, or ``None`` without clips.
+    """The clip repertoire a motor system builds from, or ``None`` when it has no clips.
 
-    Paths are relative to the owner's character file; a repertoire read once is shared (by path and settings).
-    A repertoire given in memory when the owner was composed (its ``repertoire``, a :class:`ClipRepertoire`) is
-    used instead of a folder, its hubs found with these parameters' ``hub_radius`` and ``hub_share``.
+    The owner's ``repertoire`` (given when it was composed, :attr:`toolkit.character.Character.repertoire`) comes
+    first: a :class:`~toolkit.recordings.clips.ClipFolder` is read with these parameters' ``hub_radius``,
+    ``hub_share`` and ``fps`` (once per settings: what was read is kept in the folder object), a
+    :class:`ClipRepertoire` built in memory gets its hubs found with them. Otherwise the ``clips`` folder and
+    ``profile`` file the parameters name, relative to the owner's character file, are read.
     """
     given = getattr(owner, "repertoire", None)
+    settings = {"hub_radius": params["hub_radius"], "hub_share": params["hub_share"]}
     if given is not None:
         if params["clips"]:
             raise ConfigError("clips given twice", key=("clips",),
-                              expected="either a clips folder or a repertoire in memory, not both")
+                              expected="either a clips folder or a repertoire given to the character, not both")
+        if isinstance(given, ClipFolder):
+            key = (params["hub_radius"], params["hub_share"], params.get("fps") or None)
+            if key not in given.read:
+                given.read[key] = load_clip_repertoire(given.folder, given.profile, fps=key[2], **settings)
+            return _same_parts(owner, given.read[key])
         if not isinstance(given, ClipRepertoire):
             raise ConfigError(f"a repertoire of type {type(given).__name__}", key=("clips",),
-                              expected="a plugins.lib.clip_repertoire.ClipRepertoire")
-        return _same_parts(owner, given.with_hubs(params["hub_radius"], params["hub_share"]))
+                              expected="a toolkit.recordings.clips.ClipFolder or a "
+                                       "plugins.lib.clip_repertoire.ClipRepertoire")
+        return _same_parts(owner, given.with_hubs(**settings))
     if not params["clips"]:
         return None
     if not params["profile"]:
         raise ConfigError("clips without a profile", key=("profile",), expected="the body profile the clips are read with")
     file = getattr(owner, "file", None)
     base = file.parent if file is not None else Path.cwd()
-    folder, profile_path = (base / params["clips"]).resolve(), (base / params["profile"]).resolve()
-    fps = params.get("fps") or None
-    key = (folder, profile_path, params["hub_radius"], params["hub_share"], fps)
-    if key not in _CACHE:
-        if len(_CACHE) > 8:
-            _CACHE.clear()
-        _CACHE[key] = load_clip_repertoire(folder, profile_path, hub_radius=params["hub_radius"],
-                                           hub_share=params["hub_share"], fps=fps)
-    return _same_parts(owner, _CACHE[key])
+    return _same_parts(owner, load_clip_repertoire((base / params["clips"]).resolve(),
+                                                   (base / params["profile"]).resolve(),
+                                                   fps=params.get("fps") or None, **settings))
 
 
 def _same_parts(owner: object, repertoire: ClipRepertoire) -> ClipRepertoire:

@@ -427,3 +427,24 @@ def test_naming_the_templates_own_matcher_keeps_its_parameters_and_another_start
     assert all(named.matcher.declared[k] == v for k, v in template.items() if k != "plugin")
     other = compose_observer(pm, profile, data / "repertoire", matcher="dtw")
     assert other.matcher.name == "dtw" and other.matcher.params == other.matcher.declared
+
+
+def test_the_profile_given_is_the_one_used_and_a_folder_is_read_once_per_settings(data, profile, pm, tmp_path):
+    """Objects, not paths: compose_observer hands the motor system the profile object it was given (a profile whose
+    file is gone composes as well), and one ClipFolder given to several observers is read once per motor settings."""
+    import shutil
+
+    from toolkit.recordings.clips import ClipFolder
+
+    moved = tmp_path / "profile.toml"
+    shutil.copy(data / "profile.toml", moved)
+    gone = load_profile(moved)
+    moved.unlink()  # nothing may read the profile again from its file
+    first = compose_observer(pm, gone, data / "repertoire")
+    assert first.repertoire.profile is gone and first.motor.clips.profile is gone
+    folder = ClipFolder(data / "repertoire", profile)
+    a, b = compose_observer(pm, profile, folder), compose_observer(pm, profile, folder, matcher="dtw")
+    wider = compose_observer(pm, profile, folder, settings={"motor": {"hub_radius": 0.2}})
+    assert a.motor.clips is b.motor.clips and wider.motor.clips is not a.motor.clips
+    assert len(folder.read) == 2 and wider.motor.clips.hub_radius == 0.2
+    np.testing.assert_array_equal(a.motor.clips.hubs, first.motor.clips.hubs)
