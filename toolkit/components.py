@@ -445,12 +445,6 @@ class Correspondence(Component):
         """``n`` perceived root-relative poses (n, P, 3) with masks (n, P), in arrival order, mapped onto the
         observer's body (n, P, 3). Rows of parts never seen are NaN in and may be NaN out."""
 
-    def map_motion(self, motion: Motion) -> Motion:
-        """A whole root-relative motion mapped as one stream (reset first)."""
-        self.reset(motion.parts, motion.fps)
-        filled = fill_hidden(motion.positions, motion.visible)
-        return Motion(self.map_block(filled, motion.visible), motion.fps, motion.parts, motion.visible)
-
 
 class Segmenter(Component):
     """Divides a stream of observed poses into segments, one frame at a time or in batch.

@@ -204,11 +204,6 @@ class Motion:
         return Motion(fill_hidden(self.positions, self.visible, default), self.fps, self.parts, self.visible,
                       self.world)
 
-    def with_visibility(self, visible: np.ndarray) -> Motion:
-        """The same positions with a further mask applied (logical and)."""
-        return Motion(self.positions, self.fps, self.parts, self.visible & np.asarray(visible, dtype=bool),
-                      self.world)
-
     def visible_fraction(self) -> float:
         """Share of (frame, part) cells that are visible; 0.0 for an empty motion."""
         return float(self.visible.mean()) if self.visible.size else 0.0

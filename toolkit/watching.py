@@ -42,8 +42,8 @@ whole motion) every row is kept and nothing is cut.
 
 What plugins return is checked here, for every watcher alike: segments lie inside the stream, are ordered, disjoint
 and non-empty; a match names a movement of the observer's own repertoire (its motor system's) or none (unknown),
-with a finite confidence in [0, 1]. Anything else is a :class:`~toolkit.errors.PluginError` naming the plugin, the
-method, what it returned and what was expected.
+with a finite confidence in [0, 1] (:func:`toolkit.answers.check_match`). Anything else is a
+:class:`~toolkit.errors.PluginError` naming the plugin, the method, what it returned and what was expected.
 """
 
 from __future__ import annotations
@@ -54,6 +54,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from toolkit.answers import check_match, shown
 from toolkit.components import Match, Segment
 from toolkit.errors import ConfigError, LikemeError, PluginError
 from toolkit.motion import Motion, fill_hidden, part_index
@@ -62,7 +63,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from toolkit.character import Character
 
 __all__ = ["ObservationLog", "WorkingMemory", "Observation", "Listener", "WatchingLoop", "call_component", "guarded",
-           "check_match", "feed", "follow", "KEEP_SECONDS", "MAX_SEGMENT_SECONDS"]
+           "feed", "follow", "KEEP_SECONDS", "MAX_SEGMENT_SECONDS"]
 
 KEEP_SECONDS = 10.0
 """Seconds of the newest rows a bounded working memory keeps beyond what open segments need (a live observer's
@@ -402,8 +403,6 @@ class WatchingLoop:
         self._known: set[str] = set()  # movements found in the motor system's repertoire
         self._keep_frames: int | None = None
         self._max_frames: int | None = None
-        self.needed_from = 0  # with ``keep``: the oldest row still needed, as of the last packet (memory holds at
-        # most twice the rows from there on: ObservationLog.forget)
 
     # -- the stream ----------------------------------------------------------------------------------------
 
@@ -420,7 +419,6 @@ class WatchingLoop:
         self.perceived = ObservationLog(own, fps, capacity=capacity) if self.character.correspondence else None
         self._open, self._view, self._early = None, None, None
         self._since, self._floor, self._last_end, self._known = -1, 0, 0, set()
-        self.needed_from = 0
         bounded = self.keep is not None
         self._keep_frames = int(round(self.keep * float(fps))) if bounded else None
         self._max_frames = max(1, int(round(self.max_segment * float(fps)))) if bounded and self.max_segment else None
@@ -455,7 +453,7 @@ class WatchingLoop:
                     mapped = np.asarray(None)
                 if mapped.shape != held.shape:
                     raise PluginError(self.character.correspondence.name, "Correspondence.map_block",
-                                      f"returned {_shown(mapped)}, expected an array of shape {held.shape}")
+                                      f"returned {shown(mapped)}, expected an array of shape {held.shape}")
                 poses, visible = mapped, seen
         self.memory.extend(poses, visible, world)
         return first
@@ -547,8 +545,7 @@ class WatchingLoop:
         holds = getattr(self.character.segmenter, "holds_since", None)
         if isinstance(holds, (int, np.integer)) and holds >= 0:
             need = min(need, max(int(holds), self._floor, n - self._max_frames if self._max_frames else 0))
-        self.needed_from = need
-        self.memory.forget(need)
+        self.memory.forget(need)  # it holds at most twice the rows from there on (ObservationLog.forget)
         if self.perceived is not None:
             self.perceived.forget(need)
 
@@ -613,7 +610,7 @@ class WatchingLoop:
         try:
             events = [(int(row), match) for row, match in events]
         except (TypeError, ValueError):
-            raise PluginError(self._name("matcher"), f"{type(matcher).__name__}.replay", f"returned {_shown(events)}, "
+            raise PluginError(self._name("matcher"), f"{type(matcher).__name__}.replay", f"returned {shown(events)}, "
                               f"expected [(row, Match), ...]") from None
         if view.n != stop - view.start:
             raise PluginError(self._name("matcher"), f"{type(matcher).__name__}.replay", f"left {view.n} rows of the segment "
@@ -677,7 +674,7 @@ class WatchingLoop:
             since = since.astype(np.int64).reshape(n)
             pairs = [(int(i), s) for i, s in closed]
         except (TypeError, ValueError, OverflowError):
-            raise PluginError(name, where, f"returned {_shown(result)}, expected ([(frame in block, Segment), ...], "
+            raise PluginError(name, where, f"returned {shown(result)}, expected ([(frame in block, Segment), ...], "
                               f"onsets ({n},))") from None
         rows = first + np.arange(n)
         bad = np.flatnonzero((since > rows) | (since < -1))
@@ -700,13 +697,13 @@ class WatchingLoop:
         try:
             segments = list(segments)
         except TypeError:
-            raise PluginError(name, where, f"returned {_shown(segments)}, expected a list of Segments") from None
+            raise PluginError(name, where, f"returned {shown(segments)}, expected a list of Segments") from None
         for segment in segments:
             if not isinstance(segment, Segment):
-                raise PluginError(name, where, f"returned {_shown(segment)}, expected Segment objects")
+                raise PluginError(name, where, f"returned {shown(segment)}, expected Segment objects")
             start, end = segment.start, segment.end
             if not (isinstance(start, (int, np.integer)) and isinstance(end, (int, np.integer))):
-                raise PluginError(name, where, f"returned {_shown(segment)}, expected whole frame numbers")
+                raise PluginError(name, where, f"returned {shown(segment)}, expected whole frame numbers")
             if not 0 <= start < end:
                 raise PluginError(name, where, f"returned an empty segment {start}..{end}, expected 0 <= start < end")
             if end > frames:
@@ -728,71 +725,6 @@ class WatchingLoop:
     def _type(self, key: str) -> str:
         component = getattr(self.character, key)
         return type(component).__name__ if component is not None else key.capitalize()
-
-
-def check_match(character: Character, match: Any, method: str, known: set[str] | None = None) -> Match:
-    """``character``'s matcher's answer from ``method``, checked: a :class:`Match` naming a movement of the
-    character's repertoire (its motor system's) or none (unknown), with a finite confidence in [0, 1]; else a
-    :class:`PluginError` naming the matcher, the method, what it returned and what was expected. ``known``: names
-    found in the repertoire already (a cache the caller keeps)."""
-    component = character.matcher
-    name = component.name if component is not None else "matcher"
-    where = f"{type(component).__name__ if component is not None else 'Matcher'}.{method}"
-    known = set() if known is None else known
-    if not isinstance(match, Match):
-        raise PluginError(name, where, f"returned {_shown(match)}, expected a Match or None")
-    try:
-        confidence = float(match.confidence)
-    except (TypeError, ValueError):
-        confidence = float("nan")
-    if not (np.isfinite(confidence) and 0.0 <= confidence <= 1.0):
-        raise PluginError(name, where, f"returned confidence {match.confidence!r} for {match.movement!r}, "
-                          f"expected a finite number in [0, 1]")
-    movement = match.movement
-    if movement is None or movement in known:
-        return match
-    motor = character.motor
-    if not isinstance(movement, str):
-        raise PluginError(name, where, f"returned movement {movement!r}, expected a movement name or None")
-    if motor is None or _knows(motor, movement):
-        known.add(movement)
-        return match
-    names = list(motor.movements())
-    raise PluginError(name, where, f"returned movement {movement!r}, expected a movement of the observer's "
-                      f"repertoire or None (unknown); available: {', '.join(map(str, names[:20]))}"
-                      + (f" and {len(names) - 20} more" if len(names) > 20 else ""))
-
-
-def _knows(motor: Any, movement: str) -> bool:
-    """Whether ``movement`` is one the motor system can name: one of its ``movements()``, a performable name of one
-    (``label``), one it says it ``knows`` (an optional method), else one of the names a motor command graph gives
-    what it learns without a label (its ``sequences``, ``together`` movements and ``edge`` names)."""
-    known = set(motor.movements())
-    if movement in known or motor.label(movement) in known:
-        return True
-    knows = getattr(motor, "knows", None)
-    if callable(knows):
-        return bool(knows(movement))
-    names = (*getattr(motor, "sequences", {}), *getattr(motor, "together", {}))
-    if movement in names:
-        return True
-    edge = getattr(motor, "edge", None)
-    if callable(edge):
-        try:
-            edge(movement)
-            return True
-        except (KeyError, LikemeError):
-            return False
-    return False
-
-
-def _shown(value: Any, limit: int = 120) -> str:
-    """``repr(value)``, shortened to ``limit`` characters."""
-    try:
-        text = repr(value)
-    except Exception:  # a plugin's object whose repr fails
-        text = f"<{type(value).__name__}>"
-    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def feed(matcher: Any, motion: Motion) -> Iterator[Match | None]:

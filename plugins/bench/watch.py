@@ -33,7 +33,8 @@ from toolkit import World, load_character
 from toolkit.config.search import merge_tables
 from toolkit.config.settings import parse_settings
 from toolkit.state import write_atomic
-from toolkit.watching import call_component, check_match
+from toolkit.answers import check_match
+from toolkit.watching import call_component
 
 __all__ = ["watch_benchmark", "watch_runs", "pool_runs", "render_watch", "cmd_watch"]
 

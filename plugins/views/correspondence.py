@@ -44,11 +44,13 @@ class CorrespondenceView(View):
         if character.correspondence is None:
             raise ConfigError(f"{character.name} has no correspondence", key=("correspondence",),
                               expected="an observer with a [correspondence] (likeme show ... --correspondence NAME)")
-        profile_path = self.params["profile"] or character.motor.params.get("profile", "")
-        if not profile_path:
+        # the profile the observer's clips were read with (given to it when it was composed, never found again from
+        # a path), unless the view is told another
+        profile = load_profile(self.params["profile"]) if self.params["profile"] else \
+            getattr(character.repertoire, "profile", None)
+        if profile is None:
             raise ConfigError("no body profile for the recording", key=("profile",),
                               expected="--set profile=PROFILE.toml, or an observer composed with --body")
-        profile = load_profile(profile_path)
         motion = profile.read(self.params["recording"])
         observer = Observer(character, profile.body, motion.fps)
         observer.watch(motion)

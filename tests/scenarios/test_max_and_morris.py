@@ -7,6 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.fixtures.motions import with_visibility
 from tests.conftest import CHARACTERS
 from toolkit import Motion, World, create_plugin_manager, load_character, load_scenario
 
@@ -62,7 +63,7 @@ def test_jump_with_its_first_third_unseen_is_still_a_jump(chars):
     assert max_.matcher.match(jump.slice(third)).movement == "jump"  # beginning missed
     hidden = np.ones(jump.visible.shape, bool)
     hidden[:third] = False
-    assert max_.matcher.match(jump.with_visibility(hidden)).movement == "jump"  # beginning not visible
+    assert max_.matcher.match(with_visibility(jump, hidden)).movement == "jump"  # beginning not visible
 
 
 def test_extra_standing_frames_before_and_after_do_not_matter(chars):
@@ -83,7 +84,7 @@ def test_cover_face_with_hands_and_nose_hidden_part_of_the_time(chars):
         i = m.parts.index(part)
         visible[m.n_frames // 4 : 3 * m.n_frames // 4 : 2, i] = False  # every other frame in the middle half
         visible[m.n_frames // 3 : m.n_frames // 2, i] = False
-    assert max_.matcher.match(m.with_visibility(visible)).movement == "cover_face"
+    assert max_.matcher.match(with_visibility(m, visible)).movement == "cover_face"
 
 
 @pytest.mark.parametrize("group", [("wave", "knock", "thumbs_up"), ("reach_high", "jump"), ("wave", "wave_left", "wave_both")])
@@ -180,7 +181,7 @@ def test_segments_are_ordered_disjoint_and_streaming_equals_batch(chars, moves, 
     max_, morris = chars
     motion, truth = _stream(morris, moves, noise, seed)
     mask = np.random.default_rng(seed).random(motion.visible.shape) >= drop
-    motion = motion.with_visibility(mask)
+    motion = with_visibility(motion, mask)
     batch = max_.segmenter.segment(motion)
     streaming = []
     max_.segmenter.reset(motion.parts, motion.fps)

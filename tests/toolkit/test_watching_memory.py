@@ -49,6 +49,22 @@ def stream(pm_):
 
 
 @contextlib.contextmanager
+def told_to_forget():
+    """The rows working memory is told it no longer needs (ObservationLog.forget's argument), in the order told."""
+    told, forget = [], ObservationLog.forget
+
+    def recording(log, row):
+        told.append(row)
+        return forget(log, row)
+
+    ObservationLog.forget = recording
+    try:
+        yield told
+    finally:
+        ObservationLog.forget = forget
+
+
+@contextlib.contextmanager
 def slack(rows: int):
     """ObservationLog.slack set to ``rows`` (0: drop what is not needed at once, so short streams are trimmed)."""
     before = ObservationLog.slack
@@ -142,12 +158,12 @@ def test_a_bounded_working_memory_gives_the_observations_an_unbounded_one_gives(
         positions[a : a + 20, int(rng.integers(0, positions.shape[1]))] = np.nan
     cuts = np.sort(rng.choice(np.arange(1, len(positions)), size=8, replace=False)).tolist()
     whole = fed(Observer(character, profile.body, FPS, keep=None), positions, cuts)
-    with slack(0):
+    with slack(0), told_to_forget() as told:
         bounded = Observer(character, profile.body, FPS, keep=keep)
         got = fed(bounded, positions, cuts)
     assert key(got) == key(whole)
     held = bounded.memory.n - bounded.memory.offset
-    needed = bounded.memory.n - bounded.loop.needed_from  # the rows from the oldest one still needed
+    needed = bounded.memory.n - told[-1]  # the rows from the oldest one still needed, as of the last packet
     assert 1 <= needed <= len(positions)
     assert held <= max(2 * needed, 1)  # never more than twice what it needs (ObservationLog.forget)
 

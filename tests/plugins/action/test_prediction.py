@@ -3,6 +3,7 @@ identified and the observer's own transition map (plugins/action/prediction.py).
 
 from __future__ import annotations
 
+import copy
 from types import SimpleNamespace
 
 import pytest
@@ -32,7 +33,8 @@ def setting(observer_file=CHARACTERS / "max.toml", tmp_path=None, extra=""):
 
 
 def then(world):
-    return SimpleNamespace(objects=world.objects_at(world.frame))
+    """The objects as they are now, copied: what the action system evaluates against."""
+    return SimpleNamespace(objects=copy.deepcopy(world.objects))
 
 
 def test_after_a_reach_for_food_eat_after_a_reach_for_a_toy_dance():

@@ -7,6 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.fixtures.motions import with_visibility
 from plugins.lib.guiding_stroke import SHAPES, GuidingStroke
 from plugins.bench.metrics import segmentation_scores
 from plugins.lib.strokes import direction_breaks, direction_clusters, speed_breaks
@@ -91,7 +92,7 @@ def test_hidden_parts_do_not_move_and_unknown_parts_are_refused():
     motion, truth = stroke_sequence(rng, 1)
     visible = np.ones(motion.visible.shape, bool)
     visible[:, 1] = False
-    assert VelocityDirection(parts=["wrist"]).segment(motion.with_visibility(visible)) == []
+    assert VelocityDirection(parts=["wrist"]).segment(with_visibility(motion, visible)) == []
     with pytest.raises(ConfigError, match=r"key parts: parts \['left_wrist'\] are not in the observed body.*available: root, wrist"):
         VelocityDirection(parts=["left_wrist"]).reset(motion.parts, FPS)
 
