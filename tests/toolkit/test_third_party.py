@@ -90,3 +90,22 @@ def test_loaded_in_process_through_the_same_loader(installed, monkeypatch):
     info = pm.registry.info("segmenter", "stillness")
     assert info.plugin.distribution == "likeme-stillness" and info.plugin.version == "1.0.0"
     assert pm.plugin_infos["stillness"].module == "likeme_stillness"
+
+
+def test_the_walk_through_of_writing_a_plugin_prints_what_it_shows(installed, tmp_path):
+    """docs/writing-a-plugin.md shows `likeme plugins` and `likeme validate still_max.toml` with the plugin installed:
+    run here, with the page's own character file, they print what it shows."""
+    import re
+
+    from tests.docs.test_shown_output import agrees, shown
+
+    page = ROOT / "docs" / "writing-a-plugin.md"
+    character = next(block for block in re.findall(r"^```toml\n(.*?)^```", page.read_text(), re.S | re.M)
+                     if 'plugin = "stillness"' in block)
+    (tmp_path / "still_max.toml").write_text(character)
+    commands = dict(shown(page))
+    for command in ("likeme plugins", "likeme validate still_max.toml"):
+        result = subprocess.run([sys.executable, "-m", "likeme", *command.split()[1:]], capture_output=True, text=True,
+                                env=_env(installed), cwd=tmp_path, timeout=300)
+        assert result.returncode == 0, result.stderr
+        assert agrees(commands[command], result.stdout.rstrip("\n").split("\n")), f"`{command}` prints something else"
