@@ -49,17 +49,25 @@ HOOK_CHECK = "test_every_hook_is_called_by_a_test"
 """tests/docs/test_docs.py's check that every hook was called by some test: it needs every other test to have run."""
 
 
+BENCHMARK = "benchmark"
+"""The mark of a test that runs a whole benchmark (pyproject.toml): README's test command leaves them out
+(``-m "not benchmark"``), ``.ci/run`` runs them as a second step."""
+
+
 def pytest_collection_modifyitems(session, config, items):
     """The check that every hook was called runs last, when every other test has run; ``config.whole_suite`` says
-    whether every test module was collected (run alone, that check cannot know).
+    whether every test module was collected and nothing but the whole benchmarks left out (README's command): run
+    alone, or with ``-k``, that check cannot know.
 
     Under pytest-xdist (``pytest -n auto``) no worker sees every test run: the workers leave that check out and
     send the hooks they saw called to the controller, which makes the check when every worker is done
     (:func:`pytest_sessionfinish`)."""
     last = [i for i in items if i.name.startswith(HOOK_CHECK)]
     items[:] = [i for i in items if i not in last] + last
-    collected = {Path(str(i.fspath)).name for i in items}
-    config.whole_suite = {p.name for p in (ROOT / "tests").glob("test_*.py")} <= collected
+    collected = {Path(str(i.fspath)).resolve() for i in items}
+    modules = {p.resolve() for p in (ROOT / "tests").rglob("test_*.py") if "fixtures" not in p.parts}
+    chosen = (config.getoption("markexpr", "") or "").strip() in ("", f"not {BENCHMARK}")
+    config.whole_suite = modules <= collected and chosen and not config.getoption("keyword", "")
     if hasattr(config, "workerinput") and last:  # an xdist worker
         items[:] = [i for i in items if i not in last]
         config.hook.pytest_deselected(items=last)

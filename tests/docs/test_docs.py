@@ -121,3 +121,14 @@ def test_examples_table_names_real_scenarios_and_tests_and_every_scenario():
 def test_examples_doc_is_linked():
     assert "docs/examples.md" in (ROOT / "README.md").read_text()
     assert "examples.md" in (ROOT / "docs" / "architecture.md").read_text()
+
+
+def test_ci_runs_readmes_test_command_then_the_benchmarks_it_leaves_out():
+    readme = (ROOT / "README.md").read_text()
+    command = re.search(r"^python3 -m venv .*pytest[^\n]*$", readme, re.M).group(0)
+    assert command.endswith('pytest -n auto -m "not benchmark"')
+    steps = (ROOT / ".ci" / "run").read_text().splitlines()
+    at = steps.index(command)
+    assert steps[at + 1] == "pytest -n auto -m benchmark"
+    marker = re.search(r"^\s*\"benchmark: ", (ROOT / "pyproject.toml").read_text(), re.M)
+    assert marker, "the benchmark mark is registered in pyproject.toml"

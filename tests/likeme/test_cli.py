@@ -155,6 +155,7 @@ def test_show_actions_prints_the_hierarchy():
     assert "ice_cream is food" in plain.stdout
 
 
+@pytest.mark.benchmark
 def test_bench_behaviour_runs(tmp_path):
     out = tmp_path / "b.json"
     result = likeme("bench", "behaviour", "--episodes", "3", "--quiet", "--json", out)

@@ -111,6 +111,7 @@ def test_the_toolkit_package_exports_its_names_when_used():
     assert namespace["Motion"] is toolkit.Motion and namespace["create_plugin_manager"] is create_plugin_manager
 
 
+@pytest.mark.benchmark
 def test_bench_startup_times_each_command_in_a_fresh_process(tmp_path, capsys):
     from likeme.cli import main
 

@@ -236,6 +236,7 @@ def test_recognition_scores_every_matcher_on_the_same_demos(data, profile, pm):
     assert m.sum() == rows["dtw"]["items"] and np.trace(m) == round(rows["dtw"]["accuracy"] * m.sum())
 
 
+@pytest.mark.benchmark
 def test_the_bench_commands_print_tables_and_write_json_csv_and_png(data, tmp_path, capsys):
     common = ["--body", str(data / "profile.toml"), "--quiet"]
     out = tmp_path / "out"

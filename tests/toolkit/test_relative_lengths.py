@@ -84,6 +84,7 @@ def test_a_height_that_is_not_a_positive_number_is_refused_by_name(value, pm):
     assert "positive number" in err.value.expected
 
 
+@pytest.mark.benchmark
 def test_leave_one_group_out_classifies_each_group_against_the_others(generated, pm):
     """The demos at three speeds (morris_0.8, morris_1.0, morris_1.25) as three groups: each speed's clips are
     classified by a repertoire of the other two speeds' clips."""
@@ -152,6 +153,7 @@ def test_a_take_left_out_of_the_search_is_never_on_the_path(takes_observer):
         assert free_cost == pytest.approx(0.0, abs=1e-9) and cost > 1e-6  # without the exclusion it finds itself
 
 
+@pytest.mark.benchmark
 def test_spread_thresholds_accept_known_movements_and_reject_left_out_ones(generated, pm):
     """Max's own clips against three takes of Morris's: a movement in the repertoire is accepted within twice its
     spread between takes; with the movement left out, most are answered unknown."""

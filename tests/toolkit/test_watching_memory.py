@@ -311,6 +311,7 @@ def test_bench_reports_a_misbehaving_plugin_as_one_line(data, misbehaving, capsy
 # -- the memory benchmark --------------------------------------------------------------------------------------
 
 
+@pytest.mark.benchmark
 def test_the_memory_benchmark_prints_flat_rows_held_and_observes_a_written_stream(capsys):
     """``likeme bench memory``: a line per simulated interval whose rows held stop growing once the stream is longer
     than what working memory keeps, and a ``likeme observe`` subprocess on a written stream that exits cleanly."""

@@ -57,6 +57,7 @@ def test_objects_placed_at_random_within_reach(pm, seed):
     assert row["path"][0] == row["true_path"][0]  # the motivation: the top-level tuple
 
 
+@pytest.mark.benchmark
 def test_the_bench_is_the_same_whatever_runs_it(pm):
     """``likeme bench behaviour --jobs 2`` gives exactly the figures and episodes of one process."""
     one = behaviour_benchmark(pm, episodes=1, seed=3, conditions=("line-of-sight", "random-placement"))

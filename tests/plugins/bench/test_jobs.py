@@ -90,6 +90,7 @@ def _watch(tmp_path: Path, name: str, *options: str) -> dict:
     return _without(_json(out), WATCH_TIMING)
 
 
+@pytest.mark.benchmark
 def test_watch_runs_are_pooled_the_same_whatever_ran_them(tmp_path):
     one = _watch(tmp_path, "one")
     assert one == _watch(tmp_path, "two", "--jobs", "2")
@@ -101,11 +102,13 @@ def test_watch_runs_are_pooled_the_same_whatever_ran_them(tmp_path):
     assert _without(_json(alone)["segmentation"], set()) == one["per_run"][1]["segmentation"]
 
 
+@pytest.mark.benchmark
 def test_watch_on_a_dask_local_cluster(tmp_path):
     _dask()
     assert _watch(tmp_path, "dask", "--scheduler", "local:2") == _watch(tmp_path, "here")
 
 
+@pytest.mark.benchmark
 def test_facilitation_runs_the_same_whatever_ran_them(tmp_path):
     def run(name, *options):
         out = tmp_path / f"{name}.json"
@@ -118,6 +121,7 @@ def test_facilitation_runs_the_same_whatever_ran_them(tmp_path):
     assert one["demonstrations"] == 8 and [r["run"] for r in one["rows"]] == [0] * 4 + [1] * 4
 
 
+@pytest.mark.benchmark
 def test_vision_one_item_per_resolution(capsys):
     from plugins.bench.vision import vision_benchmark
 
@@ -142,6 +146,7 @@ def _memory(capsys, *options: str) -> list[list[str]]:
     return rows
 
 
+@pytest.mark.benchmark
 def test_memory_items_the_same_whatever_ran_them(capsys):
     one = _memory(capsys)
     assert one == _memory(capsys, "--jobs", "2")
@@ -155,17 +160,20 @@ def _posegraph(tmp_path: Path, name: str, *options: str) -> list[dict]:
     return [{k: r[k] for k in ("nodes", "parts", "k", "queries", "poses_mb", "agree")} for r in _json(out)]
 
 
+@pytest.mark.benchmark
 def test_posegraph_one_row_per_nodes_whatever_ran_them(tmp_path, capsys):
     one = _posegraph(tmp_path, "one")
     assert one == _posegraph(tmp_path, "two", "--jobs", "2")
     assert [r["nodes"] for r in one] == [600, 900] and all(r["agree"] == "4/4" for r in one)
 
 
+@pytest.mark.benchmark
 def test_posegraph_on_a_dask_local_cluster(tmp_path, capsys):
     _dask()
     assert _posegraph(tmp_path, "dask", "--scheduler", "local:2") == _posegraph(tmp_path, "here")
 
 
+@pytest.mark.benchmark
 def test_scaling_items_the_same_whatever_ran_them(tmp_path, capsys):
     def run(name, *options):
         out = tmp_path / f"{name}.json"
@@ -181,6 +189,7 @@ def test_scaling_items_the_same_whatever_ran_them(tmp_path, capsys):
     assert [r["minutes"] for r in one[0]] == [0.05, 0.1] and [r["movements"] for r in one[1]] == [3, 4]
 
 
+@pytest.mark.benchmark
 def test_startup_rounds_in_workers(tmp_path, capsys):
     out = tmp_path / "startup.json"
     assert main(["bench", "startup", "--runs", "2", "--jobs", "2", "--json", str(out)]) == 0
@@ -189,6 +198,7 @@ def test_startup_rounds_in_workers(tmp_path, capsys):
     assert all(r["runs"] == 2 and 0 < r["min_s"] <= r["median_s"] <= r["max_s"] for r in rows)
 
 
+@pytest.mark.benchmark
 def test_fuzz_cases_the_same_whatever_ran_them():
     from plugins.bench.fuzz import run_fuzz
 

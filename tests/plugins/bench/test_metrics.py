@@ -5,6 +5,8 @@ they replaced are kept here as references, and hypothesis checks the libraries g
 
 from __future__ import annotations
 
+import pytest
+
 import json
 
 import numpy as np
@@ -125,6 +127,7 @@ def test_movement_error_rate():
     assert movement_error_rate(["jump", "unknown", "wave"], ["jump", "cover_face"]) == 1.0
 
 
+@pytest.mark.benchmark
 def test_bench_watch_runs_and_writes_json(tmp_path):
     out = tmp_path / "watch.json"
     result = likeme("bench", "watch", "--movements", "12", "--quiet", "--json", out)
@@ -136,6 +139,7 @@ def test_bench_watch_runs_and_writes_json(tmp_path):
     assert data["frames_per_second"] > 0
 
 
+@pytest.mark.benchmark
 def test_bench_facilitation_runs(tmp_path):
     out = tmp_path / "f.json"
     result = likeme("bench", "facilitation", "--demonstrations", "12", "--repertoire", "3", "--quiet", "--json", out)

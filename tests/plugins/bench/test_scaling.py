@@ -55,6 +55,7 @@ def test_generated_clips_are_renamed_and_perturbed_but_meet_at_their_ends():
         assert np.abs(a.positions[middle] - b.positions[middle]).max() > 1e-3
 
 
+@pytest.mark.benchmark
 def test_quick_run_prints_three_tables_with_slopes(tmp_path, capsys):
     from likeme.cli import main
 
@@ -90,6 +91,7 @@ def test_bad_sizes_are_refused_in_one_line(capsys):
     assert "--movements" in capsys.readouterr().err
 
 
+@pytest.mark.benchmark
 def test_set_reaches_the_observer(tmp_path, capsys):
     from likeme.cli import main
 

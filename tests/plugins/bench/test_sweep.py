@@ -63,15 +63,18 @@ def test_sweep_rows_follow_the_settings(folder):
     assert rows[0]["recall"] > 0 and rows[2]["recall"] == 0
 
 
+@pytest.mark.benchmark
 def test_two_processes_give_the_same_table(folder):
     assert _sweep(folder, "jobs2", "--jobs", "2") == _sweep(folder, "jobs1", "--jobs", "1")
 
 
+@pytest.mark.benchmark
 def test_a_dask_local_cluster_gives_the_same_table(folder):
     pytest.importorskip("dask.distributed", reason="dask.distributed not installed: pip install 'likeme[dask]'")
     assert _sweep(folder, "dask", "--scheduler", "local:2") == _sweep(folder, "single")
 
 
+@pytest.mark.benchmark
 def test_recognition_with_jobs_prints_the_same_scores(folder, capsys):
     d = folder / "d"
     common = ["bench", "recognition", "--body", str(d / "profile.toml"), "--repertoire", str(d / "repertoire"),

@@ -229,6 +229,7 @@ def test_body_mapping_in_the_observer_and_the_template_is_the_papers_observer(ge
     assert np.nanmax(np.abs(loop.memory.positions - plain_observer.memory.positions)) < 0.05
 
 
+@pytest.mark.benchmark
 def test_open_protocol_counts_unknown_as_right_for_a_movement_left_out(generated, pm):
     from plugins.bench.mocap import recognition
     from toolkit.recordings.profile import load_profile

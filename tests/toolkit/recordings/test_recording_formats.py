@@ -86,6 +86,7 @@ def _table(text: str) -> list[list[str]]:
     return rows
 
 
+@pytest.mark.benchmark
 @pytest.mark.parametrize("benchmark", ["recognition", "segmentation", "stream"])
 def test_bench_gives_the_same_table_for_every_format(data, capsys, benchmark):
     def run(name: str) -> list[list[str]]:
