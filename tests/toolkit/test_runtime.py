@@ -74,16 +74,20 @@ def test_perceive_segment_match_respond(pm, watch_scene, recorder, scripted):
     assert 0 < (~nose).sum() < 0.5 * len(nose)
 
 
-def test_streaming_matcher_commits_before_the_segment_ends(pm, watch_scene, recorder, scripted):
+def _wave_watched_with(matcher: str, pm, watch_scene, recorder):
+    """Morris waves, Max watches: his segment is the wave's frames exactly (scripted), his [matcher] table is
+    ``matcher`` (TOML). The world run, and the wave's (start, end) world frames; ``recorder`` holds this run only."""
     _, spans = _performed_frames(pm, watch_scene, ["wave"])
     (s, e), = spans
     recorder.calls.clear()
-    path = watch_scene(
-        ["wave"],
-        f'[actors.override.segmenter]\nplugin = "scripted-cuts"\ncuts = [[{s - 1}, {e - 1}]]\n'
-        '[actors.override.matcher]\nplugin = "early-commit"\nmovement = "wave"\nafter = 5\n',
-    )
-    world = load_scenario(path, pm).run()
+    path = watch_scene(["wave"], f'[actors.override.segmenter]\nplugin = "scripted-cuts"\ncuts = [[{s - 1}, {e - 1}]]\n'
+                                 f'[actors.override.matcher]\n{matcher}')
+    return load_scenario(path, pm).run(), s, e
+
+
+def test_streaming_matcher_commits_before_the_segment_ends(pm, watch_scene, recorder, scripted):
+    world, s, e = _wave_watched_with('plugin = "early-commit"\nmovement = "wave"\nafter = 5\n', pm, watch_scene,
+                                     recorder)
     recognised = [(c["segment"], c["match"]) for n, c in recorder.calls if n == "movement_recognised"]
     assert len(recognised) == 1
     segment, match = recognised[0]
@@ -98,16 +102,8 @@ def test_streaming_matcher_commits_before_the_segment_ends(pm, watch_scene, reco
 def test_a_deviation_stops_the_imitation_with_the_matchers_reason(pm, watch_scene, recorder, scripted, typed):
     """K&G Fig. 3's "stop imitation": the runtime reads the typed ``Match.stop`` and ``Match.reason``; a "stop" in
     the matcher's own ``details`` is not an order."""
-    _, spans = _performed_frames(pm, watch_scene, ["wave"])
-    (s, e), = spans
-    recorder.calls.clear()
-    path = watch_scene(
-        ["wave"],
-        f'[actors.override.segmenter]\nplugin = "scripted-cuts"\ncuts = [[{s - 1}, {e - 1}]]\n'
-        f'[actors.override.matcher]\nplugin = "deviating"\nmovement = "wave"\nafter = 5\ndeviate = 8\n'
-        f'typed = {str(typed).lower()}\n',
-    )
-    load_scenario(path, pm).run()
+    _wave_watched_with(f'plugin = "deviating"\nmovement = "wave"\nafter = 5\ndeviate = 8\ntyped = {str(typed).lower()}\n',
+                       pm, watch_scene, recorder)
     stopped = [c["reason"] for n, c in recorder.calls if n == "imitation_stopped"]
     assert stopped == (["it sped up"] if typed else ["completed"])
 
