@@ -184,7 +184,7 @@ def test_max_perceives_morris_the_cheese_where_it_lay_and_then_in_his_hand():
     reach, eat = (e.data["segment"] for e in world.events_of("segment_found", "max"))
     before = perceived_objects(max_, morris, reach.start, reach.end - 1)
     assert set(before) == {"cheese"} and before["cheese"].held_by is None and before["cheese"].kind == "cheese"
-    assert np.allclose(before["cheese"].position, [0.08, 0.40, 1.26])  # where it lay (no noise in Max's vision)
+    assert np.allclose(before["cheese"].position, [0.08, 0.40, 1.26], atol=0.015)  # where it lay, as a camera sees
     during = perceived_objects(max_, morris, eat.start, eat.end - 1)
     assert during["cheese"].held_by == "morris"
     assert "cheese" not in max_.sightings.at(max_.memory.n - 1)  # eaten: not where Max should see it

@@ -25,7 +25,7 @@ from plugins.bench import progress as progress_bar
 from toolkit import World, load_character
 from toolkit.state import write_atomic
 
-__all__ = ["BEHAVIOUR_CONDITIONS", "behaviour_benchmark", "render_behaviour", "cmd_behaviour"]
+__all__ = ["BEHAVIOUR_CONDITIONS", "behaviour_benchmark", "render_behaviour", "cmd_behaviour", "world_name"]
 
 
 BEHAVIOUR_CONDITIONS = ("line-of-sight", "no-line-of-sight", "close-together", "random-placement")
@@ -39,6 +39,8 @@ REACH = (0.25, 0.42)
 SIDE = 90.0
 """``random-placement``: objects lie anywhere within reach on the side of Morris where his hands go, at azimuths
 (degrees from straight ahead) drawn uniformly in [-SIDE, SIDE]."""
+COLOURS = {"cheese": "#ffd700", "ball": "#ff4040", "baton": "#8040ff", "screen": "#808080"}
+"""What each object of an episode looks like (Max knows them by these looks, characters/max.toml)."""
 
 
 def _draw(rng: np.random.Generator, condition: str) -> dict[str, Any]:
@@ -73,6 +75,22 @@ def _draw(rng: np.random.Generator, condition: str) -> dict[str, Any]:
             "positions": {wanted: pos_wanted, other: pos_other}}
 
 
+def world_name(world: Any, observer: str, name: str | None) -> str | None:
+    """The world's name of the object ``observer`` calls ``name``: the world object nearest to where the observer
+    first saw it, as the world was then (ground truth, for judging an observer; the observer never reads it)."""
+    actor = world.actors[observer]
+    sightings = actor.sightings
+    if name is None or sightings is None:
+        return None
+    rows, positions = sightings.track(name, sightings.n - 1)
+    if not len(rows):
+        return None
+    then = world.objects_at(actor.watch_start + int(rows[0]))
+    if not then:
+        return None
+    return min(then, key=lambda n: float(np.linalg.norm(then[n].position - positions[0])))
+
+
 _WORKER_PM: Any = None
 
 
@@ -100,9 +118,9 @@ def _run_episode(item: dict[str, Any], pm: Any = None) -> dict[str, Any]:
     watcher = world.add_actor(max_, "max", (0.0, 0.0, 0.0), 0.0)
     watcher.watch(target)
     for name, position in item["positions"].items():
-        world.add_object(WorldObject(name, name, position, radius=0.035))
+        world.add_object(WorldObject(name, name, position, radius=0.035, colour=COLOURS[name]))
     if condition == "no-line-of-sight":
-        world.add_object(WorldObject("screen", "screen", (0.0, 0.62, 1.0), radius=0.12))
+        world.add_object(WorldObject("screen", "screen", (0.0, 0.62, 1.0), radius=0.12, colour=COLOURS["screen"]))
     world.run(until_idle=True, tail=1.0, max_duration=12.0)
     truth = target.character.action.history
     first = truth[0] if truth else None
@@ -119,8 +137,9 @@ def _run_episode(item: dict[str, Any], pm: Any = None) -> dict[str, Any]:
         "true_object": first[2] if first else None,
         "identified": bool(got is not None and got.known),
         "path": list(got.path) if got is not None and got.known else None,
-        "identified_object": got.object if got is not None and got.known else None,
-        "line_of_sight": got.details.get("line_of_sight") if got is not None else None,
+        "identified_object": world_name(world, "max", got.object) if got is not None and got.known else None,
+        "line_of_sight": world_name(world, "max", got.details.get("line_of_sight")) if got is not None else None,
+        "in_sight": sorted(world_name(world, "max", n) for n in got.details.get("in_sight", {})) if got is not None else [],
     }
 
 
