@@ -220,6 +220,24 @@ def likeme_register_commands(subparsers):
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(handler=_handler("behaviour", "cmd_behaviour"))
 
+    p = sub.add_parser("learning", help="a new movement learned from one demonstration against one learned from "
+                       "several (B&B §7.3): how often fresh takes of it are recognised")
+    _jobs_options(p, "one per new movement and trial")
+    p.add_argument("--takes", type=count_type(1, 50), action="append", metavar="K",
+                   help="takes the movement is learned from, repeatable (default: 1, 2, 3, 5)")
+    p.add_argument("--generated", type=count_type(0, 100), default=3, help="generated new movements besides "
+                   "Morris's windmill (default: 3)")
+    p.add_argument("--trials", type=count_type(1, 1000), default=5, help="trials per new movement (default: 5)")
+    p.add_argument("--tests", type=count_type(1, 1000), default=20, help="fresh takes watched per trial (default: 20)")
+    p.add_argument("--noise", type=number_type(0.0, 1.0, "metres"), default=0.005,
+                   help="observation noise, metres (default: 0.005)")
+    p.add_argument("--jitter", type=number_type(0.0, 1.0, "metres"), default=0.01,
+                   help="each take's posture offset per part, metres (default: 0.01)")
+    p.add_argument("--seed", type=seed_type, default=0)
+    p.add_argument("--plot", metavar="PNG", help="also draw recognition against the number of takes")
+    p.add_argument("--json", metavar="FILE", help="also write the results as JSON")
+    p.set_defaults(handler=_handler("learning", "cmd_learning"))
+
     p = sub.add_parser("memory", help="the observer's memory against stream length: a live observer fed for "
                        "--minutes, and likeme observe on generated BVH streams")
     _jobs_options(p, "the live observer and each --observe-minutes stream", timing=True)
