@@ -150,6 +150,28 @@ def test_a_cheese_above_a_ball_is_told_apart_by_the_height_of_the_gaze(write):
     assert reach.path == ("satisfy_hunger", "get", "reach") and reach.object == "cheese"
 
 
+def test_a_ball_painted_cheese_yellow_is_taken_for_cheese(write):
+    """B&B §4.2: Max knows things by their look, not by what they are. Playful Morris reaches for his ball, painted
+    cheese-yellow, and plays with it: Max takes it for a cheese (its colour is a cheese's and so is its size), says
+    why, and concludes hunger; the dance that follows, with no toy in sight, he cannot explain."""
+    world, (reach, dance) = _variant(write, "hungry_morris",
+                                     ("hunger = { level = 0.6, rate = 0.0 }\nplay = { level = 0.0, rate = 0.0 }",
+                                      "hunger = { level = 0.0, rate = 0.0 }\nplay = { level = 0.6, rate = 0.0 }"),
+                                     ('name = "cheese"\nkind = "cheese"', 'name = "ball"\nkind = "ball"'))
+    assert [(r.movement, r.object) for _, r in world.actors["morris"].performed] == [("reach", "ball"), ("dance", "ball")]
+    assert reach.known and reach.path == ("satisfy_hunger", "get", "reach") and reach.object == "cheese"
+    assert reach.details["seen_as"]["cheese"].startswith("cheese: colour #ffd700 is 0 from cheese (#ffd700")
+    assert world_name(world, "max", reach.object) == "ball"  # what it really was
+    assert dance.movement == "dance" and not dance.known
+    # painted as it is (red), the same ball is a ball, and Max is right
+    world, (reach, dance) = _variant(write, "hungry_morris",
+                                     ("hunger = { level = 0.6, rate = 0.0 }\nplay = { level = 0.0, rate = 0.0 }",
+                                      "hunger = { level = 0.0, rate = 0.0 }\nplay = { level = 0.6, rate = 0.0 }"),
+                                     ('name = "cheese"\nkind = "cheese"', 'name = "ball"\nkind = "ball"'),
+                                     ('colour = "#ffd700"', 'colour = "#ff4040"'))
+    assert reach.path == ("play", "get", "reach") and reach.object == "ball" and dance.known
+
+
 def test_failure_different_preferences_give_the_wrong_object():
     """§7.3.1: Morris goes for the biggest piece, Max identifies what he himself would do: the closest."""
     world, (reach, _) = run("different_preferences")

@@ -6,6 +6,9 @@ The lying world: while Max's action system interprets and answers what he saw, t
 
 from __future__ import annotations
 
+import dataclasses
+import functools
+
 import numpy as np
 import pytest
 
@@ -80,9 +83,15 @@ def lying(method):
     return wrapped
 
 
+@functools.lru_cache(maxsize=None)
+def honest_run(name):
+    """What Max concludes in scenario ``name`` when nothing lies (run once per test session and worker)."""
+    return run(name)[1]
+
+
 @pytest.mark.parametrize("name", SCENARIOS)
 def test_max_concludes_the_same_when_the_world_lies(monkeypatch, name):
-    _, honest = run(name)
+    honest = honest_run(name)
     interpret, respond = lying(Hierarchical.interpret), lying(Hierarchical.respond)
     monkeypatch.setattr(Hierarchical, "interpret", interpret)
     monkeypatch.setattr(Hierarchical, "respond", respond)
@@ -90,6 +99,39 @@ def test_max_concludes_the_same_when_the_world_lies(monkeypatch, name):
     assert interpret.calls > 0 and respond.calls > 0  # the lie was told
     assert lied_to == honest
     assert honest  # there was something to conclude
+
+
+def lying_names(method):
+    """``method`` of the perception, called while the world's objects carry names and kinds that lie (a cheese
+    called "o3", of kind "rock"): only where they are, how big and what colour is true."""
+
+    def wrapped(self, observer, target, world, *args):
+        target.world_pose()  # the pose Morris shows this frame, his head turned to what he wants, before the lie
+        objects = world.objects
+        world.objects = {f"o{i}": dataclasses.replace(o, name=f"o{i}", kind="rock")
+                         for i, o in enumerate(objects.values())}
+        try:
+            wrapped.calls += 1
+            return method(self, observer, target, world, *args)
+        finally:
+            world.objects = objects
+
+    wrapped.calls = 0
+    return wrapped
+
+
+@pytest.mark.parametrize("name", SCENARIOS)
+def test_max_sees_objects_by_their_look_never_by_their_names_or_kinds(monkeypatch, name):
+    """B&B §4.2: Max knows an object by its colour and its size as seen; while he looks, the world's names and kinds
+    of its objects lie, and he concludes exactly what he concludes when they do not."""
+    from plugins.perception.rendered_vision import RenderedVision
+
+    perceive, in_view = lying_names(RenderedVision.perceive), lying_names(RenderedVision.in_view)
+    monkeypatch.setattr(RenderedVision, "perceive", perceive)
+    monkeypatch.setattr(RenderedVision, "in_view", in_view)
+    _, lied_to = run(name)
+    assert perceive.calls > 0
+    assert lied_to == honest_run(name) and lied_to
 
 
 def test_the_lying_world_would_catch_a_reader(monkeypatch):
