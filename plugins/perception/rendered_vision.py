@@ -63,9 +63,10 @@ class RenderedVision(SyntheticVision):
     parameters = SyntheticVision.parameters + (
         Parameter("resolution", int, 480, "Width and height (pixels) of the rendered view.", minimum=16, maximum=2048),
         Parameter("min_pixels", int, 1, "Pixels of a part's colour needed to see it.", minimum=1),
-        Parameter("min_share", float, 0.4, "Share of the disc a part's sphere would fill in the picture, unhidden, "
+        Parameter("min_share", float, 0.0, "Share of the disc a part's sphere would fill in the picture, unhidden, "
                   "that must show for the part to be seen: a part mostly covered is taken as hidden (the centroid "
-                  "of the sliver that shows is not where the part is). 0: any pixel.", minimum=0.0, maximum=1.0),
+                  "of the sliver that shows is not where the part is). 0: any pixel of its colour, as the paper "
+                  "scans.", minimum=0.0, maximum=1.0),
         Parameter("pixel_noise", float, 0.25, "Standard deviation (pixels) of each centroid's jitter from frame to "
                   "frame: the camera's noise across the line of sight.", minimum=0.0, maximum=100.0),
         Parameter("depth_noise", float, 0.002, "Standard deviation of each depth reading, as a share of the depth: "
@@ -248,12 +249,12 @@ class RenderedVision(SyntheticVision):
 
     def _parts_seen(self, found: Scan, radii: np.ndarray, eye: np.ndarray, axes: np.ndarray
                     ) -> tuple[np.ndarray, np.ndarray]:
-        size = self.params["resolution"]
-        pixel = 2 * np.tan(np.radians(min(self.params["fov"], 170.0)) / 2) / size
-        with np.errstate(invalid="ignore", divide="ignore"):  # the disc it fills unhidden, at its depth
-            disc = np.pi * (self._drawn / (pixel * (found.part_near + self._drawn))) ** 2
-        seen = (found.part_pixels >= self.params["min_pixels"]) & \
-            (found.part_pixels >= self.params["min_share"] * np.nan_to_num(disc, nan=np.inf))
+        seen = found.part_pixels >= self.params["min_pixels"]
+        if self.params["min_share"] > 0:
+            pixel = 2 * np.tan(np.radians(min(self.params["fov"], 170.0)) / 2) / self.params["resolution"]
+            with np.errstate(invalid="ignore", divide="ignore"):  # the disc it fills unhidden, at its depth
+                disc = np.pi * (self._drawn / (pixel * (found.part_near + self._drawn))) ** 2
+            seen &= found.part_pixels >= self.params["min_share"] * np.where(np.isfinite(disc), disc, np.inf)
         positions = np.full((len(seen), 3), np.nan)
         if seen.any():
             u, v, z = self._noisy(found.part_u[seen], found.part_v[seen], found.part_near[seen] + self._drawn[seen])
