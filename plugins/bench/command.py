@@ -292,6 +292,12 @@ def likeme_register_commands(subparsers):
     p.add_argument("--resolution", type=int, action="append", help="rendered-vision resolution, repeatable "
                    "(default: 240, 480, 960)")
     p.add_argument("--frames", type=int, default=240, help="frames to compare (default: 240)")
+    p.add_argument("--scenarios", action="store_true", help="instead: run every scenario with a watcher (or each "
+                   "--scenario-name) with its perception and with synthetic vision, side by side: median seconds "
+                   "and whether the conclusions are the same")
+    p.add_argument("--scenario-name", action="append", metavar="NAME", help="with --scenarios: this scenario only "
+                   "(repeatable)")
+    p.add_argument("--repeats", type=count_type(1, 100), default=3, help="with --scenarios: runs of each (default: 3)")
     p.set_defaults(handler=_handler("vision", "cmd_vision"))
 
     p = sub.add_parser("fuzz", help="mutated real-looking inputs through the commands a user runs: only documented "

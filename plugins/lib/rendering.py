@@ -315,7 +315,7 @@ class SphereSet:
         The template sphere's theta and phi resolution.
     """
 
-    def __init__(self, pl: Any, n: int, resolution: tuple[int, int] = (16, 12)) -> None:
+    def __init__(self, pl: Any, n: int, resolution: tuple[int, int] = (12, 8)) -> None:
         import pyvista as pv
 
         template = pv.Sphere(radius=1.0, theta_resolution=resolution[0], phi_resolution=resolution[1])
@@ -359,7 +359,7 @@ class TubeSet:
         Sides of each tube.
     """
 
-    def __init__(self, pl: Any, n: int, colour: str, sides: int = 12) -> None:
+    def __init__(self, pl: Any, n: int, colour: str, sides: int = 8) -> None:
         import pyvista as pv
 
         angle = np.linspace(0.0, 2 * np.pi, sides, endpoint=False)
