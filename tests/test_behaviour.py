@@ -172,6 +172,20 @@ def test_a_ball_painted_cheese_yellow_is_taken_for_cheese(write):
     assert reach.path == ("play", "get", "reach") and reach.object == "ball" and dance.known
 
 
+def test_a_toy_max_has_never_seen_is_learned_as_a_toy_by_its_look(write):
+    """§6.3 with a look Max does not know: a silver toy (no colour given: the world's default) is a thing of its
+    colour to him; he shrugs at the reach for it and learns from the dance that follows that such a thing is a toy."""
+    world, (reach, dance) = _variant(write, "hungry_morris",
+                                     ("hunger = { level = 0.6, rate = 0.0 }\nplay = { level = 0.0, rate = 0.0 }",
+                                      "hunger = { level = 0.0, rate = 0.0 }\nplay = { level = 0.6, rate = 0.0 }"),
+                                     ('name = "cheese"\nkind = "cheese"', 'name = "top"\nkind = "baton"'),
+                                     ('colour = "#ffd700"\n', ""))
+    assert [r.movement for _, r in world.actors["morris"].performed] == ["reach", "dance"]
+    assert not reach.known and world.actors["max"].performed[0][1].movement == "shrug"
+    assert dance.known and dance.object == "thing #c0c0c0" and dance.details["learned"] == {"thing #c0c0c0": "toy"}
+    assert world.actors["max"].character.action.beliefs["thing #c0c0c0"] == "toy"
+
+
 def test_failure_different_preferences_give_the_wrong_object():
     """§7.3.1: Morris goes for the biggest piece, Max identifies what he himself would do: the closest."""
     world, (reach, _) = run("different_preferences")

@@ -215,6 +215,9 @@ def likeme_register_commands(subparsers):
     p = sub.add_parser("behaviour", help="an observer identifies the behaviour, motivation and object of a demonstrator (B&B §6)")
     _jobs_options(p)
     p.add_argument("--episodes", type=int, default=100, help="random episodes per condition (default: 100)")
+    p.add_argument("--perception", choices=("own", "synthetic-vision"), default="own", help="Max's perception as "
+                   "his file gives it (own: rendered vision) or synthetic vision in its place, the same eye and "
+                   "looks (default: own)")
     p.add_argument("--seed", type=seed_type, default=0)
     p.add_argument("--json", metavar="FILE", help="also write the results (every episode) as JSON")
     p.add_argument("--quiet", action="store_true", help="no progress bar")

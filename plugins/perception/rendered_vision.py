@@ -278,6 +278,17 @@ class RenderedVision(SyntheticVision):
         inside = np.linalg.norm(positions - eye, axis=1) <= self.params["range"]
         return Detections(positions[inside], radius[inside], found.blob_colours[keep][inside])
 
+    def picture(self) -> np.ndarray:
+        """What the eye saw in the last frame it rendered, as the observer scans it: (H, W, 3) RGB, top row first
+        (black where nothing is). Empty (0, 0, 3) before the first frame."""
+        from vtkmodules.util.numpy_support import vtk_to_numpy
+
+        if self._pl is None or self._last is None:
+            return np.zeros((0, 0, 3), dtype=np.uint8)
+        size = self.params["resolution"]
+        rgba = vtk_to_numpy(self._pixels).reshape(size, size, 4)  # the last frame's, as read
+        return rgba[::-1, :, :3].copy()
+
     # -- what the camera can tell ----------------------------------------------------------------------------------
 
     def position_uncertainty(self, distance: np.ndarray | float) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,93 @@
+"""Rendered vision (B&B §4.2): the picture Max's eye gets, scanned by colour; its docs block runs as written."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+from plugins.perception.colour_scan import pack, scan, unpack, unproject
+from plugins.perception.object_looks import Looks, rgb_of
+from plugins.perception.object_tracking import Detections, ObjectTracker
+from tests.conftest import CHARACTERS
+from toolkit import ConfigError
+
+ROOT = CHARACTERS.parent
+
+
+def test_the_vision_page_draws_what_max_sees(tmp_path, monkeypatch):
+    """docs/vision.md's Python block, run as written (its picture written here): Morris in his colours, the cheese's
+    gold and the ball's red beside his reaching hand."""
+    import imageio.v2 as imageio
+
+    block = re.search(r"```python\n(.*?)```", (ROOT / "docs" / "vision.md").read_text(), re.S).group(1)
+    out = tmp_path / "eye.png"
+    block = block.replace('"docs/images/max-eye-objects-close-together.png"', repr(str(out)))
+    exec(compile(block, "docs/vision.md", "exec"), {})
+    picture = imageio.imread(out)[::6, ::6, :3].reshape(-1, 3)
+    colours = {tuple(c) for c in picture}
+    for wanted in ("#ff00ff", "#ffff00", "#ff0000", "#ffd700", "#ff4040"):  # head, nose, right hand, cheese, ball
+        assert tuple(int(v) for v in rgb_of(wanted)) in colours, wanted
+
+
+def test_scan_finds_each_parts_pixels_and_each_blob_of_another_colour():
+    image = np.zeros((20, 20, 3), dtype=np.uint8)
+    depth = np.full((20, 20), np.inf)
+    image[2:5, 2:5] = (255, 0, 255)  # a part, 9 pixels
+    depth[2:5, 2:5] = 2.0
+    image[10:12, 3:5] = image[10:12, 15:17] = (255, 215, 0)  # two blobs of one colour, apart
+    depth[10:12, 3:5], depth[10:12, 15:17] = 1.5, 3.0
+    image[18, 0:3] = (80, 80, 80)  # limbs: body, not tracked
+    depth[18, 0:3] = 1.0
+    drawn = np.isfinite(depth)
+    rows, cols = np.nonzero(drawn)
+    keys = pack(image[rows, cols])
+    found = scan(keys, rows, cols, depth[rows, cols], {int(pack(np.array([255, 0, 255]))): 1,
+                                                       int(pack(np.array([80, 80, 80]))): -1}, 3)
+    assert found.part_pixels.tolist() == [0, 9, 0] and (found.part_u[1], found.part_v[1]) == (3.0, 3.0)
+    assert found.part_near[1] == 2.0 and np.isnan(found.part_near[0])
+    assert sorted(found.blob_pixels.tolist()) == [4, 4] and sorted(found.blob_near.tolist()) == [1.5, 3.0]
+    np.testing.assert_array_equal(found.blob_colours, [[255, 215, 0]] * 2)
+    np.testing.assert_array_equal(unpack(int(pack(np.array([1, 2, 3])))), [1, 2, 3])
+
+
+def test_unproject_puts_the_middle_pixel_straight_ahead():
+    point = unproject(np.array([49.5]), np.array([49.5]), np.array([2.0]), (100, 100), 90.0)
+    np.testing.assert_allclose(point, [[0.0, 0.0, 2.0]], atol=1e-12)
+    edge = unproject(np.array([-0.5]), np.array([49.5]), np.array([1.0]), (100, 100), 90.0)
+    np.testing.assert_allclose(edge, [[-1.0, 0.0, 1.0]], atol=1e-12)  # the left edge of a 90 degree view
+
+
+def test_a_look_tells_a_kind_by_its_colour_and_size_and_says_why():
+    looks = Looks({"cheese": {"colour": "#ffd700", "radius": [0.02, 0.1]}, "ball": {"colour": "#ff4040"}}, 60.0)
+    kind = looks.kind("#ffd000", 0.04)
+    assert kind == "cheese" and "colour #ffd000 is 7 from cheese" in kind.reason
+    assert looks.kind("#ffd700", 0.5) == "thing #ffd700"  # a cheese's colour, far too big
+    assert "outside cheese" in looks.kind("#ffd700", 0.5).reason
+    assert looks.kind("#0000ff", 0.04) == "thing #0000ff" and "tolerance 60" in looks.kind("#0000ff", 0.04).reason
+    assert Looks({}, 60.0).kind("#ffd700", 0.04) == "thing #ffd700"
+    for table, message in [({"cheese": "#ffd700"}, "key looks.cheese: invalid look"),
+                           ({"cheese": {"colour": "yellow"}}, "key looks.cheese.colour: invalid colour"),
+                           ({"cheese": {"colour": "#ffd700", "radius": [0.2, 0.1]}}, "key looks.cheese.radius"),
+                           ({"cheese": {"colour": "#ffd700", "size": 1}}, "key looks.cheese.size: unknown key")]:
+        with pytest.raises(ConfigError, match=message):
+            Looks(table, 60.0)
+
+
+def test_the_tracker_keeps_names_as_objects_move_and_names_new_ones_by_their_look():
+    looks = Looks({"cheese": {"colour": "#ffd700"}}, 60.0)
+    tracker = ObjectTracker(looks, gate=0.15)
+    gold = rgb_of("#ffd700")
+
+    def seen(*positions, colour=gold):
+        return Detections(np.array(positions, dtype=float), np.full(len(positions), 0.04), np.tile(colour, (len(positions), 1)))
+
+    names, kinds, _ = tracker.update(seen([0, 0, 1], [0.5, 0, 1]))
+    assert list(names) == ["cheese", "cheese 2"] and kinds["cheese 2"] == "cheese"
+    names, _, _ = tracker.update(seen([0.52, 0, 1], [0.03, 0, 1]))  # both moved a little, listed the other way
+    assert np.allclose(names["cheese"], [0.03, 0, 1]) and np.allclose(names["cheese 2"], [0.52, 0, 1])
+    names, _, _ = tracker.update(seen([0.03, 0, 1], [1.5, 0.3, 1.2]))  # the second vanished, one appeared: moved
+    assert set(names) == {"cheese", "cheese 2"} and np.allclose(names["cheese 2"], [1.5, 0.3, 1.2])
+    names, kinds, _ = tracker.update(seen([3, 0, 3], colour=rgb_of("#0000ff")))
+    assert list(names) == ["thing #0000ff"]
