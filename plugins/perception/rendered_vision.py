@@ -205,18 +205,20 @@ class RenderedVision(SyntheticVision):
         camera.SetViewUp(*up)
         camera.SetViewAngle(view_angle)
         camera.SetClippingRange(_NEAR, far)
+        axes = np.stack([right, up, forward])
         window = self._pl.ren_win
         window.Render()
-        window.GetRGBACharPixelData(0, 0, size - 1, size - 1, 0, self._pixels, 0)
-        window.GetZbufferData(0, 0, size - 1, size - 1, self._depths)
-        z = vtk_to_numpy(self._depths)  # OpenGL's rows: the bottom row first
-        drawn_at = np.flatnonzero(z < 1.0)
-        keys = vtk_to_numpy(self._pixels).reshape(-1).view(np.uint32)[drawn_at] & 0xFFFFFF
-        rows, cols = size - 1 - drawn_at // size, drawn_at % size
-        depth = _metres(z[drawn_at], far)
-        axes = np.stack([right, up, forward])
-        self._last = (eye, axes, z.reshape(size, size)[::-1], far)
-        return keys, rows, cols, depth, eye, axes
+        top, left, bottom, right_col = _window(centres, sizes, eye, axes, size, view_angle)
+        height, width = bottom - top + 1, right_col - left + 1
+        # read back only the rectangle everything drawn falls in (OpenGL counts rows from the bottom)
+        window.GetRGBACharPixelData(left, size - 1 - bottom, right_col, size - 1 - top, 0, self._pixels, 0)
+        window.GetZbufferData(left, size - 1 - bottom, right_col, size - 1 - top, self._depths)
+        z = vtk_to_numpy(self._depths).reshape(height, width)[::-1]  # top row first
+        at_row, at_col = np.nonzero(z < 1.0)
+        keys = vtk_to_numpy(self._pixels).reshape(height, width, 4)[::-1][at_row, at_col].copy().view(np.uint32)[:, 0]
+        depth = _metres(z[at_row, at_col], far)
+        self._last = (eye, axes, z.copy(), (top, left), far)
+        return keys & 0xFFFFFF, at_row + top, at_col + left, depth, eye, axes
 
     def _where_drawn(self, obj: Any, places: np.ndarray, drawn: np.ndarray) -> np.ndarray:
         """Where an object is drawn: where it is, but one held in the watched body's hand (the world keeps it at the
@@ -285,9 +287,12 @@ class RenderedVision(SyntheticVision):
 
         if self._pl is None or self._last is None:
             return np.zeros((0, 0, 3), dtype=np.uint8)
+        from vtkmodules.vtkCommonCore import vtkUnsignedCharArray
+
         size = self.params["resolution"]
-        rgba = vtk_to_numpy(self._pixels).reshape(size, size, 4)  # the last frame's, as read
-        return rgba[::-1, :, :3].copy()
+        pixels = vtkUnsignedCharArray()
+        self._pl.ren_win.GetRGBACharPixelData(0, 0, size - 1, size - 1, 0, pixels, 0)  # the last frame, whole
+        return vtk_to_numpy(pixels).reshape(size, size, 4)[::-1, :, :3].copy()
 
     # -- what the camera can tell ----------------------------------------------------------------------------------
 
@@ -311,9 +316,9 @@ class RenderedVision(SyntheticVision):
         points = np.asarray(points, dtype=float).reshape(-1, 3)
         if self._last is None:
             return np.zeros(len(points), dtype=bool)
-        eye, axes, z_buffer, far = self._last
+        eye, axes, z_buffer, (top, left), far = self._last
         local = (points - eye) @ axes.T  # right, up, forward
-        size = z_buffer.shape[0]
+        size = self.params["resolution"]
         tan = np.tan(np.radians(min(self.params["fov"], 170.0)) / 2)
         depth = local[:, 2]
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -323,10 +328,38 @@ class RenderedVision(SyntheticVision):
             (np.abs(v + 0.5 - size / 2) < size / 2) & (np.linalg.norm(points - eye, axis=1) <= self.params["range"])
         out = np.zeros(len(points), dtype=bool)
         if inside.any():
-            iu = np.clip(np.rint(u[inside]).astype(int), 0, size - 1)
-            iv = np.clip(np.rint(v[inside]).astype(int), 0, size - 1)
-            out[inside] = _metres(z_buffer[iv, iu].astype(float), far) > depth[inside] + self.params["gate"]
+            iu = np.clip(np.rint(u[inside]).astype(int), 0, size - 1) - left
+            iv = np.clip(np.rint(v[inside]).astype(int), 0, size - 1) - top
+            read = (iu >= 0) & (iu < z_buffer.shape[1]) & (iv >= 0) & (iv < z_buffer.shape[0])
+            z = np.ones(len(iu))  # outside the rectangle read back nothing was drawn
+            z[read] = z_buffer[iv[read], iu[read]]
+            out[inside] = _metres(z, far) > depth[inside] + self.params["gate"]
         return out
+
+
+def _window(centres: np.ndarray, radii: np.ndarray, eye: np.ndarray, axes: np.ndarray, size: int,
+            view_angle: float) -> tuple[int, int, int, int]:
+    """The rows and columns (top, left, bottom, right; rows from the top) of the rectangle of a ``size`` square
+    picture that every drawn sphere (``radii`` > 0) falls in, with two pixels to spare; the whole picture when one
+    reaches behind the eye. Limbs join spheres, so they fall in it too."""
+    on = radii > 0
+    if not on.any():
+        return 0, 0, 0, 0
+    local = (centres[on] - eye) @ axes.T  # right, up, forward
+    z = local[:, 2]
+    if (z - radii[on] <= _NEAR).any():
+        return 0, 0, size - 1, size - 1
+    tan = np.tan(np.radians(view_angle) / 2)
+    scale = size / (2 * tan)  # pixels per unit of x / z
+    reach = radii[on] / np.sqrt(np.maximum(z**2 - radii[on] ** 2, 1e-12))  # a sphere's angular half-width (tan)
+    u, v = local[:, 0] / z, local[:, 1] / z
+    grow = reach * (1 + u**2 + v**2)  # off the axis a sphere's image is wider
+    left = int(np.floor(((u - grow).min() + tan) * scale - 2))
+    right = int(np.ceil(((u + grow).max() + tan) * scale + 2))
+    top = int(np.floor((tan - (v + grow).max()) * scale - 2))
+    bottom = int(np.ceil((tan - (v - grow).min()) * scale + 2))
+    clip = lambda x: min(max(x, 0), size - 1)  # noqa: E731
+    return clip(top), clip(left), max(clip(bottom), clip(top)), max(clip(right), clip(left))
 
 
 def _metres(z: np.ndarray, far: float) -> np.ndarray:
