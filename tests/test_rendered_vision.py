@@ -91,3 +91,28 @@ def test_the_tracker_keeps_names_as_objects_move_and_names_new_ones_by_their_loo
     assert set(names) == {"cheese", "cheese 2"} and np.allclose(names["cheese 2"], [1.5, 0.3, 1.2])
     names, kinds, _ = tracker.update(seen([3, 0, 3], colour=rgb_of("#0000ff")))
     assert list(names) == ["thing #0000ff"]
+
+
+def test_reading_back_the_rectangle_of_what_is_drawn_gives_what_the_whole_picture_gives(monkeypatch):
+    """Only the rectangle every drawn sphere falls in is read back: the same parts, places and objects as reading
+    the whole picture, frame by frame (max_acts_then_watches: Max's own ball and cheese low in his view too)."""
+    import plugins.perception.rendered_vision as rv
+    from toolkit import create_plugin_manager, load_scenario
+
+    world = load_scenario("max_acts_then_watches", create_plugin_manager(autoload=False)).world
+    max_ = world.actors["max"]
+    vision, whole = max_.character.perception, (lambda centres, radii, eye, axes, size, angle: (0, 0, size - 1, size - 1))
+    for frame in range(0, 300):
+        world.step()
+        if frame % 10:
+            continue
+        looks = []
+        for window in (rv._window, whole):
+            with monkeypatch.context() as m:
+                m.setattr(rv, "_window", window)
+                vision._camera_rng = np.random.default_rng(frame)
+                looks.append(vision.look(max_, max_.target, world))
+        (p1, s1, d1), (p2, s2, d2) = looks
+        np.testing.assert_array_equal(s1, s2)
+        np.testing.assert_allclose(p1[s1], p2[s2], atol=1e-9)
+        np.testing.assert_allclose(d1.positions, d2.positions, atol=1e-9)
