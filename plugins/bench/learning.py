@@ -9,8 +9,8 @@ movement, allowing for more reliable comparisons to existing movement representa
 - a *take* of one is Morris performing it as people repeat a movement, never twice alike: at a speed drawn in
   [0.8, 1.25], its swing from the stand scaled by a factor in [0.85, 1.15], each part held ``--jitter`` metres off
   (one offset per part and take), and every position seen with ``--noise`` metres of Gaussian noise per frame;
-- for each new movement and trial, Max (his posegraph and path search, as in ``characters/max.toml``) learns it from
-  the first k takes (:meth:`plugins.motor.posegraph.Posegraph.learn_takes`: one take is the paper's learning;
+- for each new movement and trial, Max (his posegraph and path search, as in ``characters/max.toml``, keeping up to
+  the largest k takes) learns it from the first k takes (:meth:`plugins.motor.posegraph.Posegraph.learn_takes`: one take is the paper's learning;
   several make the mean path and stay takes of it), then watches ``--tests`` fresh takes; a take is *recognised*
   when path search answers the learned movement, *unknown* when it answers nothing, *other* when another movement.
   ``false`` is the share of Morris's versions of Max's own movements (the same variation) that path search takes
@@ -93,7 +93,7 @@ def _trial(item: dict[str, Any], pm: Any) -> dict[str, Any]:
     known = [take(*_movement_keys(morris, str(m)), morris, rng, **kw) for m in rng.choice(own, item["tests"])]
     rows = []
     for k in item["takes"]:
-        max_ = load_character("max", pm)
+        max_ = load_character("max", pm, override={"motor": {"takes": max(item["takes"])}})  # keeps every take given
         matcher = max_.matcher
         samples = [matcher.samples(t.onto(max_.body.parts), styled=False) for t in training[:k]]
         max_.motor.learn_takes(NAME, [s[0] for s in samples], [s[1] for s in samples], source="bench", announce=False)
