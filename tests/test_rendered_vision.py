@@ -116,3 +116,23 @@ def test_reading_back_the_rectangle_of_what_is_drawn_gives_what_the_whole_pictur
         np.testing.assert_array_equal(s1, s2)
         np.testing.assert_allclose(p1[s1], p2[s2], atol=1e-9)
         np.testing.assert_allclose(d1.positions, d2.positions, atol=1e-9)
+
+
+def test_a_parts_colour_in_two_places_is_the_part_where_it_was_and_an_object_elsewhere():
+    """A ball painted the left hand's blue: the hand is the blob of blue nearest where the hand was, the other a
+    thing of that colour."""
+    image = np.zeros((40, 40, 3), dtype=np.uint8)
+    depth = np.full((40, 40), np.inf)
+    image[10:14, 10:14] = image[30:36, 30:36] = (0, 0, 255)
+    depth[10:14, 10:14], depth[30:36, 30:36] = 1.6, 1.2
+    image[12:15, 20:23] = (255, 0, 255)  # another part, the rest of the body
+    depth[12:15, 20:23] = 1.6
+    rows, cols = np.nonzero(np.isfinite(depth))
+    known = {int(pack(np.array([0, 0, 255]))): 0, int(pack(np.array([255, 0, 255]))): 1}
+    args = (pack(image[rows, cols]), rows, cols, depth[rows, cols], known, 2)
+    for previous in (None, np.array([[11.0, 11.0], [np.nan, np.nan]])):  # near the body; where it was
+        found = scan(*args, previous=previous)
+        assert found.part_pixels[0] == 16 and (found.part_u[0], found.part_v[0]) == (11.5, 11.5)
+        assert found.blob_pixels.tolist() == [36.0] and found.blob_near.tolist() == [1.2]
+    found = scan(*args, previous=np.array([[33.0, 33.0], [np.nan, np.nan]]))  # the hand was over there
+    assert found.part_pixels[0] == 36 and found.blob_pixels.tolist() == [16.0]

@@ -9,7 +9,8 @@ flat colour packed into one integer (:func:`pack`), its row and column, and its 
 Each colour is looked up among the *known* colours (the watched body's parts, as the observer knows them, and its
 limbs); a known part's pixels, wherever they lie, give its pixel count, centroid and nearest depth. Every other colour
 is an object's: each 8-connected blob of one colour (:func:`scipy.ndimage.label`) is one object seen, with its pixel
-count, centroid, nearest depth and colour. Two things of one colour that touch in the picture are one blob, as they
+count, centroid, nearest depth and colour. A part's colour seen in two places (an object painted like the part) is
+the part where the part was, and an object elsewhere. Two things of one colour that touch in the picture are one blob, as they
 would be to an eye that knows things only by their colour. :func:`unproject` turns a centroid and a depth back into
 a point in the eye's frame (a pinhole camera).
 """
@@ -55,12 +56,15 @@ class Scan:
 
 
 def scan(keys: np.ndarray, rows: np.ndarray, cols: np.ndarray, depth: np.ndarray, known: dict[int, int],
-         n_parts: int, min_pixels: int = 1) -> Scan:
+         n_parts: int, min_pixels: int = 1, previous: np.ndarray | None = None) -> Scan:
     """Scan the drawn pixels of one frame (see the module): their packed colours ``keys`` (n,) (:func:`pack`), rows
     (from the top) and columns (n,), and depths (n,) in metres.
 
     ``known`` maps a packed colour to a part index in ``0..n_parts - 1``, or to -1 for a colour that is body but not
-    tracked (limbs). Blobs under ``min_pixels`` pixels are left out.
+    tracked (limbs). Blobs under ``min_pixels`` pixels are left out. A part's colour spread far wider than one
+    compact blob (something else of its colour in the picture: a ball painted the hand's red) is split into its
+    blobs: the part is the one nearest where the part was found in the last frame (``previous``, (P, 2) columns and
+    rows, NaN where unknown), else nearest the rest of the body; the others are objects of that colour.
     """
     values, which = np.unique(keys, return_inverse=True)  # the few colours in the picture
     part_of = np.array([known.get(int(c), -2) for c in values], dtype=np.int64)  # -2: an object's colour
@@ -73,11 +77,37 @@ def scan(keys: np.ndarray, rows: np.ndarray, cols: np.ndarray, depth: np.ndarray
         v = np.bincount(p, weights=rows[mine], minlength=n_parts) / count
     near = np.full(n_parts, np.inf)
     np.minimum.at(near, p, depth[mine])
-    near[~np.isfinite(near)] = np.nan
     blobs = [_blobs(rows[which == k], cols[which == k], depth[which == k], int(values[k]), min_pixels)
              for k in np.flatnonzero(part_of == -2)]
+    for k in _scattered(part_of, which, rows, cols, count):  # a part's colour in more than one place
+        i = int(part_of[k])
+        pieces = _blobs(rows[which == k], cols[which == k], depth[which == k], int(values[k]), 1)
+        if len(pieces) < 2:
+            continue
+        others = (count > 0) & (np.arange(n_parts) != i)
+        here = previous[i] if previous is not None and np.isfinite(previous[i]).all() else (
+            np.array([np.average(u[others], weights=count[others]), np.average(v[others], weights=count[others])])
+            if others.any() else pieces[np.argmax(pieces[:, 0]), 1:3])
+        chosen = int(np.argmin(np.hypot(pieces[:, 1] - here[0], pieces[:, 2] - here[1])))
+        count[i], u[i], v[i], near[i] = pieces[chosen, :4]
+        rest = np.delete(pieces, chosen, axis=0)
+        blobs.append(rest[rest[:, 0] >= min_pixels])
+    near[~np.isfinite(near)] = np.nan
     blob = np.concatenate(blobs, axis=0) if blobs else np.zeros((0, 7))
     return Scan(count, u, v, near, blob[:, 0], blob[:, 1], blob[:, 2], blob[:, 3], blob[:, 4:7])
+
+
+def _scattered(part_of: np.ndarray, which: np.ndarray, rows: np.ndarray, cols: np.ndarray,
+               count: np.ndarray) -> list[int]:
+    """The colours (indices into the picture's colours) of parts whose pixels spread over more than a compact blob
+    of their number could (a disc of n pixels is about 1.13 sqrt(n) across; 2.5 sqrt(n) + 4 is allowed)."""
+    out = []
+    for k in np.flatnonzero(part_of >= 0):
+        at = which == k
+        extent = max(int(np.ptp(rows[at])), int(np.ptp(cols[at]))) + 1
+        if extent > 2.5 * np.sqrt(count[part_of[k]]) + 4:
+            out.append(int(k))
+    return out
 
 
 def _blobs(rows: np.ndarray, cols: np.ndarray, depth: np.ndarray, key: int, min_pixels: int) -> np.ndarray:

@@ -16,7 +16,8 @@ pyvista, :func:`plugins.lib.rendering.plotter`):
 3. the image scanned (:mod:`plugins.perception.colour_scan`): the pixels of each body part's colour, as the observer
    knows it (Max starts out knowing which colour is which part, §5: his own ``[body.colours]``), give the part's
    centroid, and the nearest depth over them plus the part's radius its distance; every other colour is an
-   object's, each connected blob of it one object, whose size is its apparent radius. The centroid (u, v) and depth
+   object's, each connected blob of it one object, whose size is its apparent radius (a part's colour seen in two
+   places is the part where it was last found, and an object elsewhere). The centroid (u, v) and depth
    z turn back into a point in the world through the pinhole model.
 
 A camera is not exact: a part is found to within a fraction of a pixel (at 1.6 m a pixel of a 480 px, 140 degree
@@ -97,6 +98,7 @@ class RenderedVision(SyntheticVision):
             self._pl.close()
         self._pl = None
         self._body: Any = None
+        self._part_uv: np.ndarray | None = None
         self._last: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # eye, axes (3, 3), depth image
 
     def __del__(self) -> None:  # pragma: no cover - best effort on interpreter exit
@@ -165,7 +167,12 @@ class RenderedVision(SyntheticVision):
         radii = self._radii(target.body)
         places = self._places(target.body, truth)
         keys, rows, cols, depth, eye, axes = self._render(observer, places, radii, shown)
-        found = scan(keys, rows, cols, depth, self._codes, target.body.n_parts, self.params["min_pixels"])
+        n = target.body.n_parts
+        if getattr(self, "_part_uv", None) is None or len(self._part_uv) != n:
+            self._part_uv = np.full((n, 2), np.nan)  # where each part was last found in the picture
+        found = scan(keys, rows, cols, depth, self._codes, n, self.params["min_pixels"], self._part_uv)
+        at = found.part_pixels > 0
+        self._part_uv[at] = np.column_stack([found.part_u, found.part_v])[at]
         positions, seen = self._parts_seen(found, radii, eye, axes)
         parts, sees = self._hand_percepts(target.body, truth, positions, seen)
         return np.where(sees[:, None], parts, np.nan), sees, self._objects_seen(found, eye, axes)
