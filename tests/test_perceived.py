@@ -151,10 +151,13 @@ def test_sightings_remember_last_seen_positions_and_forget_gone_objects():
     s.record(1, 0.0, {})  # hidden: still where it was last seen
     assert set(s.at(1)) == {"cheese"} and s.at(1)["cheese"].row == 0 and s.at(1)["cheese"].kind == "cheese"
     assert s.at(-1) == {}  # never seen before row 0: it does not exist
-    s.record(2, 0.0, {}, missed=["cheese"])  # not there where it should have been seen: gone
-    assert s.at(2) == {} and set(s.at(1)) == {"cheese"}
-    s.record(3, 0.0, {"cheese": [0, 0.3, 1]})  # seen again
-    assert np.allclose(s.at(3)["cheese"].position, [0, 0.3, 1])
+    s.record(2, 0.0, {}, missed=["cheese"])  # missed a moment after it was seen: it may have been carried off
+    assert set(s.at(2)) == {"cheese"}
+    for row in range(3, 7):  # missed for more than CARRIED (0.5 s): gone from then on
+        s.record(row, 0.0, {}, missed=["cheese"])
+    assert s.at(6) == {} and set(s.at(5)) == {"cheese"} and set(s.at(1)) == {"cheese"}
+    s.record(7, 0.0, {"cheese": [0, 0.3, 1]})  # seen again
+    assert np.allclose(s.at(7)["cheese"].position, [0, 0.3, 1])
 
 
 def test_sightings_are_bounded_and_keep_each_objects_last_sighting():

@@ -77,8 +77,10 @@ MARGIN = 0.25
 candidate whose distance is within ``(1 + MARGIN)`` times the best's is close enough that the motion alone does not
 tell them apart, and the can-I triggers decide."""
 
-GRIP = 0.06
-"""Metres beyond an object's radius within which it is at the target's hand (seen held, with :func:`seen_held`)."""
+GRIP = 0.10
+"""Metres beyond an object's radius within which it is at the target's hand (seen held, with :func:`seen_held`): a
+hand's own size (the object sits in its grip, not at its centre) and what an eye may be off by, a hand seen half
+hidden behind what it holds."""
 
 MOVED = 0.02
 """Metres an object must have moved from where it was first seen to have been taken (not lying where it lay)."""

@@ -36,7 +36,7 @@ class MotionCapture(Perception):
 
     def reset(self, fps: float) -> None:
         self._facing = HeadingFilter(round(self.params["facing_window"] * fps))
-        self._objects = tracker_for(self.params)
+        self._objects = tracker_for(self.params, fps)
 
     def _smooth(self, headings: np.ndarray) -> np.ndarray:
         """The facing's running median over the frames so far (made by :meth:`reset`)."""

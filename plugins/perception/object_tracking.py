@@ -6,8 +6,9 @@ radius and a colour (a blob of one colour in the rendered image, or a sphere of 
 detections are matched to the objects seen before (*tracks*) of the same colour, all at once (least total distance,
 :func:`scipy.optimize.linear_sum_assignment`), in three rounds: the objects seen in the last frame, within ``gate``
 metres (plus the two radii) of where they were, so two cheeses side by side keep their names as they move; then an
-object that vanished this frame, wherever one of its colour appeared (the world moved it in one step: a grasp); then
-an object seen longer ago, within the gate of where it was (seen again after being hidden). A detection none of them
+object out of sight for at most ``recall`` seconds, wherever one of its colour appeared, the one that vanished last
+first (the world moved it in one step, a grasp, or it was moved while hidden); then an object seen longer ago, within the gate of where it was (seen
+again where it was). A detection none of them
 takes is a new object, named after the kind it looks like (:mod:`plugins.perception.object_looks`): the first
 cheese is ``"cheese"``, the next ``"cheese 2"``. An object's size is the median apparent radius of its recent
 sightings (a half-hidden object looks smaller, one merged with another of its colour bigger, but not for long), and
@@ -40,6 +41,9 @@ OBJECT_PARAMETERS = (
               "look's.", minimum=0.0, maximum=442.0),
     Parameter("gate", float, 0.15, "Metres an object may move between two sightings (beyond its radius) and keep "
               "its name.", minimum=0.0),
+    Parameter("recall", float, 2.0, "Seconds an object out of sight is still the one of its colour that appears "
+              "elsewhere (taken into a hand behind the body, it is seen again in the hand).", minimum=0.0,
+              maximum=3600.0),
 )
 """The parameters every perception that sees objects shares: looks, colour tolerance, tracking gate."""
 
@@ -47,9 +51,10 @@ RECENT = 15
 """Sightings whose median apparent radius is an object's size."""
 
 
-def tracker_for(params: dict) -> "ObjectTracker":
-    """A fresh tracker with the looks, tolerance and gate of a perception's ``params``."""
-    return ObjectTracker(Looks(params["looks"], params["tolerance"]), params["gate"])
+def tracker_for(params: dict, fps: float = 30.0) -> "ObjectTracker":
+    """A fresh tracker with the looks, tolerance, gate and recall of a perception's ``params``, at ``fps``."""
+    return ObjectTracker(Looks(params["looks"], params["tolerance"]), params["gate"],
+                         recall=int(round(params["recall"] * fps)))
 
 
 @dataclass
@@ -94,12 +99,14 @@ class ObjectTracker:
         What the observer knows things look like.
     gate : float
         Metres an object may have moved between two sightings (beyond the two radii) and still be the same.
+    recall : int
+        Frames an object out of sight is still the one of its colour that appears elsewhere.
     limit : int
         Most objects remembered.
     """
 
-    def __init__(self, looks: Looks, gate: float = 0.15, limit: int = 256) -> None:
-        self.looks, self.gate, self.limit = looks, float(gate), int(limit)
+    def __init__(self, looks: Looks, gate: float = 0.15, limit: int = 256, recall: int = 60) -> None:
+        self.looks, self.gate, self.limit, self.recall = looks, float(gate), int(limit), int(recall)
         self.tracks: list[_Track] = []
         self._counts: dict[str, int] = {}
         self._frame = 0
@@ -140,8 +147,9 @@ class ObjectTracker:
     def _match(self, seen: Detections) -> np.ndarray:
         """The track each detection is (-1: none), in three rounds, each the least total distance
         (:func:`scipy.optimize.linear_sum_assignment`) over the pairs it allows: the objects seen last frame, within
-        the gate; then those that vanished this frame, wherever one of their colour appeared (moved in one step);
-        then those seen longer ago, within the gate (seen again after being hidden)."""
+        the gate; then those out of sight for at most ``recall`` frames, wherever one of their colour appeared, the
+        one that vanished last first (moved in one step, or while hidden: taken into a hand behind the body); then
+        those seen longer ago, within the gate (seen again where they were)."""
         owner = np.full(len(seen), -1)
         if not self.tracks:
             return owner
@@ -149,11 +157,14 @@ class ObjectTracker:
         cost = np.linalg.norm(seen.positions[:, None, :] - last[None, :, :], axis=2)
         same = np.abs(seen.colours[:, None, :] - np.array([t.colour for t in self.tracks])[None]).max(axis=2) < 1.0
         near = cost <= self.gate + seen.radii[:, None] + np.array([t.radius for t in self.tracks])[None, :]
-        recent = np.array([t.seen == self._frame - 1 for t in self.tracks])
-        for allowed in (same & near & recent, same & recent, same & near & ~recent):
+        since = self._frame - np.array([t.seen for t in self.tracks])
+        recent, lately = since == 1, since <= self.recall
+        # out of sight lately: the one that vanished last first, wherever it is now (the nearest among those as long)
+        latest = since[None, :] * 1e3 + cost
+        for allowed, by in ((same & near & recent, cost), (same & lately, latest), (same & near, cost)):
             allowed = allowed & (owner < 0)[:, None] & ~np.isin(np.arange(len(self.tracks)), owner)[None, :]
             if allowed.any():
-                rows, cols = linear_sum_assignment(np.where(allowed, cost, 1e6))
+                rows, cols = linear_sum_assignment(np.where(allowed, by, 1e9))
                 ok = allowed[rows, cols]
                 owner[rows[ok]] = cols[ok]
         return owner

@@ -105,7 +105,7 @@ class SyntheticVision(Perception):
         self._fps = float(fps)
         self._buffer: SensoryBuffer | None = None
         self._facing = HeadingFilter(round(self.params["facing_window"] * fps))
-        self._objects = tracker_for(self.params)  # a new stream: the objects are named afresh
+        self._objects = tracker_for(self.params, fps)  # a new stream: the objects are named afresh
 
     def _radii(self, body: Any) -> np.ndarray:
         """Sphere radius of every part; 0 for fingers, which are joint angles carried by a wrist, not places."""
