@@ -234,8 +234,8 @@ def likeme_register_commands(subparsers):
     p.add_argument("--tests", type=count_type(1, 1000), default=20, help="fresh takes watched per trial (default: 20)")
     p.add_argument("--noise", type=number_type(0.0, 1.0, "metres"), default=0.005,
                    help="observation noise, metres (default: 0.005)")
-    p.add_argument("--jitter", type=number_type(0.0, 1.0, "metres"), default=0.01,
-                   help="each take's posture offset per part, metres (default: 0.01)")
+    p.add_argument("--jitter", type=number_type(0.0, 1.0, "metres"), default=0.015,
+                   help="each take's posture offset per part, metres (default: 0.015)")
     p.add_argument("--seed", type=seed_type, default=0)
     p.add_argument("--plot", metavar="PNG", help="also draw recognition against the number of takes")
     p.add_argument("--json", metavar="FILE", help="also write the results as JSON")

@@ -111,7 +111,7 @@ def _trial(item: dict[str, Any], pm: Any) -> dict[str, Any]:
 
 
 def learning_benchmark(pm: Any, *, takes: tuple[int, ...] = (1, 2, 3, 5), generated: int = 3, trials: int = 5,
-                       tests: int = 20, noise: float = 0.005, jitter: float = 0.01, seed: int = 0, jobs: int = 1,
+                       tests: int = 20, noise: float = 0.005, jitter: float = 0.015, seed: int = 0, jobs: int = 1,
                        scheduler: str | None = None) -> dict[str, Any]:
     """Recognition of held-out takes of new movements learned from k takes, for each k of ``takes`` (the module)."""
     from plugins.bench.jobs import run_with_pm
