@@ -6,6 +6,8 @@ import re
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from plugins.perception.colour_scan import pack, scan, unpack, unproject
 from plugins.perception.object_looks import Looks, rgb_of
@@ -136,3 +138,33 @@ def test_a_parts_colour_in_two_places_is_the_part_where_it_was_and_an_object_els
         assert found.blob_pixels.tolist() == [36.0] and found.blob_near.tolist() == [1.2]
     found = scan(*args, previous=np.array([[33.0, 33.0], [np.nan, np.nan]]))  # the hand was over there
     assert found.part_pixels[0] == 36 and found.blob_pixels.tolist() == [16.0]
+
+
+def test_a_character_whose_parts_look_alike_is_refused_when_it_is_loaded(write):
+    from toolkit import create_plugin_manager, load_character
+
+    path = write("alike.toml", f'[character]\nname = "Max"\nextends = "{CHARACTERS / "max.toml"}"\n'
+                               '[body.colours]\nnose = "#ff00ff"\n')
+    with pytest.raises(ConfigError, match=r"Max's \[body.colours\]: part 'nose' and 'head' look alike \(#ff00ff\)"):
+        load_character(path, create_plugin_manager(autoload=False))
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(1, 6), st.integers(0, 10_000))
+def test_objects_that_move_a_little_each_frame_keep_their_names(n, seed):
+    """Any number of objects of one colour, each moving a few centimetres a frame and at least 30 cm from the
+    others, keep the names they were first given, in whatever order the eye lists them."""
+    rng = np.random.default_rng(seed)
+    tracker = ObjectTracker(Looks({"cheese": {"colour": "#ffd700"}}, 60.0), gate=0.15)
+    where = np.array([[0.4 * i, 0.0, 1.0] for i in range(n)])
+    names = None
+    for frame in range(30):
+        where = where + rng.uniform(-0.03, 0.03, where.shape)  # a few centimetres each frame
+        order = rng.permutation(n)
+        seen, _, _ = tracker.update(Detections(where[order], np.full(n, 0.04), np.tile(rgb_of("#ffd700"), (n, 1))))
+        by_place = {tuple(np.round(p, 6)): name for name, p in seen.items()}
+        now = [by_place[tuple(np.round(p, 6))] for p in where]
+        if names is None:
+            names = now
+            assert sorted(names) == sorted(["cheese"] + [f"cheese {k}" for k in range(2, n + 1)])
+        assert now == names

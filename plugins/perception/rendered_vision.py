@@ -86,6 +86,7 @@ class RenderedVision(SyntheticVision):
                               expected='a colour "#rrggbb"')
         self._camera_rng = np.random.default_rng(self.params["seed"] + 1)
         self.close()
+        self._known_colours(owner, owner.body)  # the colours it knows its own parts by (and another's): distinct
 
     def reset(self, fps: float) -> None:
         super().reset(fps)
@@ -140,20 +141,19 @@ class RenderedVision(SyntheticVision):
         colours: its own part of that name wears it. -1 is the limbs' colour (body, not tracked)."""
         own = dict(zip(observer.body.parts, part_colours(observer.body)))
         codes: dict[int, int] = {int(pack(rgb_of(self.params["limb_colour"]))): -1}
-        for i in self._parts:
+        for i in np.flatnonzero(~body.angle_mask):
             name = body.parts[i]
             if name not in own:
                 continue  # a part the observer has not got: it does not know what to look for
             code = int(pack(rgb_of(own[name])))
-            whose = f"{observer.character.name}'s [body.colours]"
+            whose = f"{getattr(observer, 'character', observer).name}'s [body.colours]"
             if code == 0:
                 raise ConfigError(f"{whose}: part {name!r} is black, the colour of the empty background",
                                   expected="another colour for it")
             if code in codes:
                 other = "the limbs (limb_colour)" if codes[code] < 0 else repr(body.parts[codes[code]])
                 raise ConfigError(f"{whose}: part {name!r} and {other} look alike ({own[name]}), and colour-coded "
-                                  "vision tells parts apart by colour alone", expected="a colour of its own for each part",
-                                  available=sorted({c.lower() for c in part_colours(observer.body)}))
+                                  "vision tells parts apart by colour alone", expected="a colour of its own for each part")
             codes[code] = int(i)
         return codes
 
