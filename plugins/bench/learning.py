@@ -152,9 +152,9 @@ def plot_learning(r: dict[str, Any], out: str | Path) -> Path:
 
     fig, ax = plt.subplots(figsize=(6, 4))
     ks = [int(k) for k in r["table"]]
-    for m in r["movements"]:
+    for i, m in enumerate(r["movements"]):
         ax.plot(ks, [np.mean([x["recognised"] for x in r["rows"] if x["movement"] == m and x["k"] == k]) for k in ks],
-                color="#999999", lw=1, marker=".")
+                color="#999999", lw=1, marker=".", label="recognised, each new movement" if i == 0 else None)
     ax.plot(ks, [r["table"][str(k)]["recognised"] for k in ks], color="#1f77b4", lw=2.5, marker="o",
             label="recognised (mean)")
     ax.plot(ks, [r["table"][str(k)]["false"] for k in ks], color="#d62728", lw=2, marker="s",
