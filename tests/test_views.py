@@ -262,3 +262,13 @@ def test_the_vision_benchmark_compares_both_perceptions_on_the_same_frames():
     rows = vision_benchmark(create_plugin_manager(autoload=False), "jump_then_cover_face", "max", [240], 20)
     assert [r["perception"] for r in rows] == ["synthetic-vision", "rendered-vision 240 px"]
     assert rows[1]["agreement"] > 0.9 and 0 < rows[1]["median_mm"] < 30 and rows[1]["ms_per_frame"] > 0
+
+
+def test_every_scenario_runs_with_either_eye_and_concludes_the_same():
+    """``likeme bench vision --scenarios`` on one scenario: Max's rendered eye and the geometric one in its place
+    find the same movements and behaviours about the same objects of the world."""
+    from plugins.bench.vision import scenario_benchmark
+
+    (row,) = scenario_benchmark(create_plugin_manager(autoload=False), ["cheese_or_ball"], repeats=1)
+    assert row["perception"] == "rendered-vision" and row["same"]
+    assert row["seconds"] > 0 and row["synthetic_seconds"] > 0

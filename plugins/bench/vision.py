@@ -12,7 +12,7 @@ Two measurements, both side by side in one run:
 - *per scenario* (``--scenarios``): every scenario in which a character watches, run to its end with the watcher's
   perception as its file gives it and with synthetic vision in its place (the same eye, part radii and looks), each
   ``--repeats`` times, alternating; the median seconds of each, their ratio, and whether the watcher concluded the
-  same (the same movements recognised and behaviours identified).
+  same (the same movements recognised and behaviours identified, about the same objects of the world).
 """
 
 from __future__ import annotations
@@ -123,11 +123,15 @@ def _watchers(world: Any) -> list[Any]:
 
 
 def _conclusions(world: Any) -> list[tuple]:
-    """What every watcher concluded: the movements recognised and the behaviours identified, in order."""
+    """What every watcher concluded: the movements recognised and the behaviours identified, in order; an object by
+    the world's name of what the watcher saw (each perception names what it sees itself)."""
+    from plugins.bench.behaviour import world_name
+
     out = []
     for actor in _watchers(world):
         out += [(actor.id, "match", e.data["match"].movement) for e in world.events_of("movement_recognised", actor.id)]
-        out += [(actor.id, "behaviour", b.known, b.movement, b.path, b.object) for b in world.behaviours(actor.id)]
+        out += [(actor.id, "behaviour", b.known, b.movement, b.path, world_name(world, actor.id, b.object))
+                for b in world.behaviours(actor.id)]
     return out
 
 
