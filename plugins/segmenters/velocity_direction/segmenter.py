@@ -78,6 +78,9 @@ import numpy as np
 
 from plugins.lib.body_size import body_scale
 from plugins.lib.strokes import StrokeAnalysis, StrokeCriteria, _round_kernels, analyse, breaks
+from plugins.segmenters.velocity_direction.rests import Rests
+from plugins.segmenters.velocity_direction.rests import straight as rests_straight
+from plugins.segmenters.velocity_direction.speed import Jitter, line_speeds, line_weights, speed_noise
 from toolkit import ConfigError, Parameter, Segment, Segmenter, hookimpl
 
 __all__ = ["VelocityDirection"]
@@ -124,6 +127,12 @@ class VelocityDirection(Segmenter):
                   "to end it (0.1: B&B's hub threshold, 0.02 m on Max).", minimum=0.0),
         Parameter("settle", float, 2.0, "With end = rest: seconds of rest away from where the movement began after "
                   "which it ends anyway (a new stance: longer than a gesture holds a pose).", minimum=0.0),
+        Parameter("window", float, 0.0, "Seconds over which each part's velocity is the slope of a least-squares "
+                  "line through its positions (a tracker's jitter averaged out; 0: the displacement over the sensory "
+                  "memory, the paper).", minimum=0.0),
+        Parameter("jitter", float, 0.0, "The rest speed is at least this many times the root-mean-square speed the "
+                  "tracker's jitter alone gives a part standing still, the jitter measured from the positions' second "
+                  "differences over `floor` seconds (0: off, the paper).", minimum=0.0),
         Parameter("max_movement", float, 60.0, "Seconds after which a movement that has not ended is closed there and "
                   "the next begins at once (the working memory's bound; 0: none).", minimum=0.0),
     )
@@ -160,7 +169,10 @@ class VelocityDirection(Segmenter):
         self._resting = 0
         self._start: int | None = None
         self._buffer: list[np.ndarray] = []  # working memory: positions of the chosen parts since onset
-        self._history: deque[np.ndarray] = deque(maxlen=2 * self._memory + 2)  # the sensory memory
+        window = int(round(self.params["window"] * self._fps))
+        self._weights = line_weights(window, self._fps) if window >= 2 else None  # the line fit's, or displacement
+        self._lag = (window - 1) // 2 if self._weights is not None else 0  # the line fit's delay (frames)
+        self._history: deque[np.ndarray] = deque(maxlen=max(2 * self._memory + 2, window))  # the sensory memory
         self._last: tuple[int, int, np.ndarray] | None = None  # the last movement closed: start, end, working memory
         self._done = 0  # the end of the last movement reported: a movement begins no earlier
         self._analysis: StrokeAnalysis | None = None
@@ -168,10 +180,12 @@ class VelocityDirection(Segmenter):
         self._speeds: deque[float] = deque(maxlen=max(1, self._pause))  # for the mean over `pause`
         self._slowest: deque[tuple[int, float]] = deque()  # monotonic queue: the running minimum over `floor`
         self._floor = max(1, int(round(self.params["floor"] * self._fps)))
+        self._jitter = Jitter(len(self._idx), self._floor, max(1, int(round(0.5 * self._fps)))) \
+            if self.params["jitter"] > 0 else None  # measured again every half second
         self._positions = ~np.array([p in angles for p in parts]) if parts else np.zeros(0, bool)
         self._size_sum, self._size_n = 0.0, 0
-        self._origin: tuple[np.ndarray, float] | None = None  # end = rest: the chosen parts where the movement began,
-        # and the body's size then
+        self._rests = Rests() if self.params["end"] == "rest" else None  # end = rest: hubs and holds
+        self._holding = False  # end = rest: the rest under way is a hold (away from the hubs)
         self._settle = max(1, int(round(self.params["settle"] * self._fps)))
 
     @property
@@ -179,19 +193,8 @@ class VelocityDirection(Segmenter):
         return self._start
 
     def push(self, pose: np.ndarray, visible: np.ndarray) -> list[Segment]:
-        self._frame += 1
-        points = pose[self._idx] * self._scale  # hidden parts are held where last seen; never seen: NaN
-        points[~np.isfinite(points)] = np.nan  # an infinite value is not seen either (no inf - inf below)
-        seen = np.isfinite(points).all(axis=1)
-        self._history.append(points.ravel())
-        speed = np.nan
-        if len(self._history) > self._memory and seen.any():
-            # displacement over the sensory memory: steady against noise, as fast as the memory is short
-            moved = (self._history[-1] - self._history[-1 - self._memory]).reshape(-1, 3)
-            step = np.linalg.norm(moved, axis=1)
-            step = step[np.isfinite(step)]
-            speed = float(step.max()) * self._fps / self._memory if step.size else np.nan
-        return self._step(pose, points.ravel(), speed)
+        closed, _ = self.push_block(np.asarray(pose)[None], np.asarray(visible)[None])
+        return [segment for _, segment in closed]
 
     def push_block(self, poses: np.ndarray, visible: np.ndarray) -> tuple[list[tuple[int, Segment]], np.ndarray]:
         """What ``n`` calls of :meth:`push` give, with the per-frame evidence (the chosen parts' speeds over the
@@ -209,26 +212,43 @@ class VelocityDirection(Segmenter):
         m, before = self._memory, len(self._history)  # frames of the sensory memory before the block
         rows = np.concatenate([np.array(self._history).reshape(before, -1), flat]) if before else flat
         speeds = np.full(n, np.nan)
-        # frame i of the block has i + before + 1 frames of history (at most maxlen: enough for the memory)
-        ok = seen & (np.minimum(np.arange(n) + before + 1, self._history.maxlen) > m)
-        if ok.any():
-            i = np.flatnonzero(ok)
-            moved = (rows[i + before] - rows[i + before - m]).reshape(len(i), -1, 3)
-            step = np.linalg.norm(moved, axis=2)
-            finite = np.isfinite(step)
-            best = np.where(finite, step, -np.inf).max(axis=1)
-            speeds[i] = np.where(finite.any(axis=1), best * self._fps / m, np.nan)
+        if self._weights is not None:  # the slope of a line through the last `window` frames (.speed)
+            w = len(self._weights)
+            fitted = line_speeds(rows, self._weights)  # row i: the frame whose window ends at rows[i + w - 1]
+            at = np.arange(n) + before - (w - 1)  # each block frame's row in `fitted`
+            ok = seen & (at >= 0)
+            speeds[ok] = fitted[at[ok]]
+        else:
+            # frame i of the block has i + before + 1 frames of history (at most maxlen: enough for the memory)
+            ok = seen & (np.minimum(np.arange(n) + before + 1, self._history.maxlen) > m)
+            if ok.any():
+                i = np.flatnonzero(ok)
+                moved = (rows[i + before] - rows[i + before - m]).reshape(len(i), -1, 3)
+                step = np.linalg.norm(moved, axis=2)
+                finite = np.isfinite(step)
+                best = np.where(finite, step, -np.inf).max(axis=1)
+                speeds[i] = np.where(finite.any(axis=1), best * self._fps / m, np.nan)
         p = self.params
-        if p["units"] == "metres" and not self._pause and not p["noise"] > 0 and p["end"] == "still":  # a fixed rest
-            # speed, and any rest ends a movement
+        if (p["units"] == "metres" and not self._pause and not p["noise"] > 0 and p["end"] == "still"
+                and self._weights is None and self._jitter is None):  # a fixed rest speed, and any rest ends a movement
             return self._follow(flat, speeds)
+        noise = self._jitter.update(flat) if self._jitter is not None else None
         for f in range(n):
             self._frame += 1
             self._history.append(flat[f])
-            closed.extend((f, s) for s in self._step(poses[f], flat[f], float(speeds[f])))
+            floor = 0.0 if noise is None else p["jitter"] * speed_noise(noise[f], self._weights if self._weights
+                                                                         is not None else self._displacement)
+            closed.extend((f, s) for s in self._step(poses[f], flat[f], float(speeds[f]), floor))
             if self._start is not None:
                 since[f] = self._start
         return closed, since
+
+    @property
+    def _displacement(self) -> np.ndarray:
+        """The weights whose dot product with the positions over the sensory memory is the paper's speed."""
+        w = np.zeros(self._memory + 1)
+        w[0], w[-1] = -self._fps / self._memory, self._fps / self._memory
+        return w
 
     def _follow(self, flat: np.ndarray, speeds: np.ndarray) -> tuple[list[tuple[int, Segment]], np.ndarray]:
         """:meth:`_step` for every frame of a block (rows ``flat`` (n, 3m), ``speeds`` (n,)) with a fixed rest speed
@@ -305,63 +325,84 @@ class VelocityDirection(Segmenter):
             self._speeds.append(float(speeds[valid][-1]))
         return closed, since
 
-    def _step(self, pose: np.ndarray, points: np.ndarray, speed: float) -> list[Segment]:
+    def _step(self, pose: np.ndarray, points: np.ndarray, speed: float, floor: float = 0.0) -> list[Segment]:
         """One frame after its sensory memory was updated: ``points`` are the chosen parts (3m,), ``speed`` the
-        fastest one's over the sensory memory (NaN: none seen, or not enough frames yet). Segments it closes."""
+        fastest one's over the sensory memory (NaN: none seen, or not enough frames yet), ``floor`` the least rest
+        speed the tracker's jitter allows (``jitter``). Segments it closes."""
         cut: list[Segment] = []
         if self._start is not None:
             longest = int(round(self.params["max_movement"] * self._fps))
             if longest and self._frame - self._start >= max(longest, 2):  # never ended: closed, the next one begun
                 cut = self._close(self._frame)
                 self._start, self._buffer = self._frame, []
-                self._origin = self._began(pose, points)
+                self._began(pose, points)
             self._buffer.append(points)
-        rest = self._rest_speed(pose, speed)
+        rest = max(self._rest_speed(pose, speed), floor)
         if self._pause:
             if np.isnan(speed) or len(self._speeds) < self._pause:
                 return cut
             speed = sum(self._speeds) / len(self._speeds)
         if np.isnan(speed):
             return cut
+        lag = self._lag + self._pause // 2
         if speed > rest:
             self._moving += 1
             self._resting = 0
             if self._start is None and self._moving >= self._memory:
                 # back-dated to where the motion began, but not into a movement already reported (one closed by
                 # `max_movement` just before a rest too short to report)
-                self._start = max(self._done, self._frame - 2 * self._memory - self._pause // 2)
+                self._start = max(self._done, self._frame - 2 * self._memory - lag)
                 self._buffer = list(self._history)[-(self._frame - self._start + 1):]
-                self._origin = self._began(pose, self._buffer[0])
+                self._began(pose, self._buffer[0])
+            elif self._holding and self._moving >= self._memory:  # moving again after a hold
+                self._rests.left(max(self._start + 1, self._frame - 2 * self._memory - lag))
+                self._holding = False
         else:
             self._resting += 1
             self._moving = 0
-            if (self._start is not None and self._resting >= max(self._memory, self._pause)
-                    and (self.params["end"] == "still" or self._returned(pose, points))):
-                lag = self._memory // 2 + self._pause // 2
-                return cut + self._close(max(self._start + 1, self._frame - self._resting + 1 - lag))
+            if self._start is not None and self._resting >= max(self._memory, self._pause):
+                began = max(self._start + 1, self._frame - self._resting + 1 - self._memory // 2 - lag)
+                if self.params["end"] == "still":
+                    return cut + self._close(began)
+                return cut + self._rested(began, points)
         return cut
 
-    def _began(self, pose: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, float] | None:
-        """With ``end = "rest"``: where a movement begins (the chosen parts ``points``, (3m,)) and the body's size
-        then (from ``pose``); ``None`` otherwise."""
-        if self.params["end"] != "rest":
-            return None
+    def _began(self, pose: np.ndarray, points: np.ndarray) -> None:
+        """With ``end = "rest"``: a movement begins where the chosen parts are ``points`` (3m,), a rest of the
+        demonstrator's (:class:`.rests.Rests`), near which is ``rest_radius`` times the body's size (from
+        ``pose``)."""
+        if self._rests is None:
+            return
         size = body_scale(pose, self._positions) if len(self._positions) == len(pose) else body_scale(pose)
-        return np.array(points, dtype=float), float(size)
+        self._rests.began(points, self.params["rest_radius"] * float(size))
+        self._holding = False
 
-    def _returned(self, pose: np.ndarray, points: np.ndarray) -> bool:
-        """With ``end = "rest"``: whether the rest now ends the movement under way, because the chosen parts
-        (``points``, (3m,)) are back within ``rest_radius`` body sizes (eq. 1: the mean distance over the parts seen
-        in both) of where the movement began, or have rested ``settle`` seconds. Where it began is the first pose of
-        its working memory (the onset, back-dated to where the motion began), taken with the body's size then."""
-        if self._resting >= self._settle or self._origin is None:
-            return True
-        first, size = self._origin
-        apart = np.linalg.norm((points - first).reshape(-1, 3), axis=1)
-        apart = apart[np.isfinite(apart)]
-        if not apart.size or not size > 0:  # nothing to compare: the paper's rule
-            return True
-        return float(apart.mean()) <= self.params["rest_radius"] * size
+    def _rested(self, began: int, points: np.ndarray) -> list[Segment]:
+        """With ``end = "rest"``: the demonstrator has rested since ``began`` with the chosen parts at ``points``
+        (3m,) while a movement is under way. Near a hub, or after ``settle`` seconds, it ends there; back at a hold
+        of the movement's, the movement is cut where that hold began and the one from it back to it follows; else
+        the rest is a hold and the movement goes on (:mod:`.rests`)."""
+        rests = self._rests
+        start = self._start
+        window = np.array(self._buffer)
+        if rests.at_hub(points):
+            return self._close_pieces(rests.pieces(start, began, window), began)
+        back = None if self._holding else rests.returned(points, start, window)
+        if back is not None:
+            hold = rests.holds[back]
+            pieces = rests.pieces(start, hold.start, window, upto=back)
+            rests.hub(hold.pose)
+            second = window[hold.end - start : began - start]
+            pieces += [] if rests_straight(second, rests.radius) else [(hold.end, began)]
+            return self._close_pieces(pieces, began)
+        if self._resting >= self._settle:  # a new stance they stay in: the movement ends where they came to it
+            pieces = rests.pieces(start, began, window, shifts=False)
+            rests.hub(points)
+            return self._close_pieces(pieces, began)
+        if not self._holding:
+            rests.hold(began, points)
+            self._holding = True
+        return []
 
     def _rest_speed(self, pose: np.ndarray, speed: float) -> float:
         """The speed below which the parts are at rest now: ``rest_speed`` (m/s), or ``size_rest_speed`` body sizes
@@ -395,17 +436,30 @@ class VelocityDirection(Segmenter):
         return self._close(self._frame + 1)
 
     def _close(self, end: int) -> list[Segment]:
+        """The movement under way ends at ``end``: its segments (itself, or its strokes)."""
+        return self._close_pieces([(self._start, end)], end)
+
+    def _close_pieces(self, pieces: list[tuple[int, int]], end: int) -> list[Segment]:
+        """The movement under way ends at ``end`` as the movements ``pieces`` ((start, end) frames inside it; none:
+        it was no movement); their segments, each itself or its strokes."""
         start, self._start = self._start, None
         window = np.array(self._buffer[: end - start])
-        self._buffer = []
-        if end - start < 2:
-            return []
-        self._last, self._analysis, self._done = (start, end, window), None, end
-        if self.params["level"] == "movement":
-            return [Segment(start, end, self._fps)]
-        cuts = breaks(window, self._fps, self.criteria)  # analyse(window).breaks (inspect() analyses it in full)
-        edges = [0, *cuts, end - start]
-        return [Segment(start + a, start + b, self._fps) for a, b in zip(edges, edges[1:]) if b > a]
+        self._buffer, self._holding = [], False
+        out = []
+        for a, b in pieces:
+            if b - a < 2:
+                continue
+            piece = window[a - start : b - start]
+            self._last, self._analysis = (a, b, piece), None
+            if self.params["level"] == "movement":
+                out.append(Segment(a, b, self._fps))
+                continue
+            cuts = breaks(piece, self._fps, self.criteria)  # analyse(piece).breaks (inspect() analyses it in full)
+            edges = [0, *cuts, b - a]
+            out.extend(Segment(a + u, a + v, self._fps) for u, v in zip(edges, edges[1:]) if v > u)
+        if end - start >= 2:
+            self._done = end
+        return out
 
     def analyse(self, window: np.ndarray) -> StrokeAnalysis:
         """One movement's working memory (positions (N, 3k) of the chosen parts) cut into strokes by this
