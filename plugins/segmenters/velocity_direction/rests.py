@@ -8,14 +8,14 @@ movement under way only where it is a hub of this demonstrator:
 
 - near the pose the movement began from, or near any rest they have been seen in (``rest_radius`` body sizes, eq. 1's
   mean distance over the chosen parts): a rest there ends it where the rest began;
-- elsewhere the rest is a *hold* and the movement goes on, unless they leave it (farther than ``rest_radius``) and
-  come to rest near it again later: then it was a new stance (movements leave it and come back to it). The movement is cut where they first rested there,
+- elsewhere the rest is a *hold* and the movement goes on, unless they leave it (some part farther than twice
+  ``rest_radius``: a movement from it, not a hand fidgeting there) and come to rest near it again later: then it was a new stance (movements leave it and come back to it). The movement is cut where they first rested there,
   and the one from it back to it follows;
 - or they rest ``settle`` seconds in one place (a new stance they stay in): the movement ends where that rest began.
 
-A *shift* of stance is not a movement: a piece that goes straight from one rest to another (no pose farther from the
-straight line between its first and last poses than ``rest_radius`` body sizes plus a quarter of the way: an arc of
-up to about 100 degrees) is dropped, and one that ends away from where it began with such a shift after a hold ends at the hold. So two takes
+A *shift* of stance is not a movement: a piece that goes straight from one rest to another (no part farther from the
+straight line between its first and last positions than ``rest_radius`` body sizes plus a quarter of its way: an arc
+of up to about 100 degrees) is dropped, and one that ends away from where it began with such a shift after a hold ends at the hold. So two takes
 joined through a transition between their stances give the two takes, and a stance change between two gestures
 gives the two gestures.
 
@@ -43,9 +43,9 @@ def _apart(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def straight(window: np.ndarray, radius: float) -> bool:
-    """Whether poses ``window`` (N, 3m) go straight from the first to the last: no pose is farther (eq. 1's mean over
-    the parts of each part's distance from its own segment) from the straight line than ``radius`` plus
-    :data:`SHIFT_BOW` of the way's length (the mean over the parts of their displacements)."""
+    """Whether poses ``window`` (N, 3m) go straight from the first to the last: no part strays from the straight
+    line between its own first and last positions farther than ``radius`` plus :data:`SHIFT_BOW` of its own way's
+    length (a part not seen throughout is not counted)."""
     window = np.asarray(window, dtype=float)
     if len(window) < 2:
         return True
@@ -59,7 +59,7 @@ def straight(window: np.ndarray, radius: float) -> bool:
         seen = np.isfinite(off).all(axis=0) & np.isfinite(length)
     if not seen.any():
         return True
-    return float(off[:, seen].mean(axis=1).max()) <= radius + SHIFT_BOW * float(length[seen].mean())
+    return bool((off[:, seen].max(axis=0) <= radius + SHIFT_BOW * length[seen]).all())
 
 
 @dataclass
@@ -78,10 +78,12 @@ class Rests:
     back to, the latest ``keep``) and the holds of the movement under way.
 
     ``radius``: how near (in the units of the poses) a pose must be to a hub to be there; the segmenter sets it to
-    ``rest_radius`` times the body's size when a movement begins.
+    ``rest_radius`` times the body's size when a movement begins. ``stance``: the frames a hold must last to be a
+    stance that movements leave and come back to (shorter: a pause in a gesture, a hand fidgeting).
     """
 
     radius: float = 0.0
+    stance: int = 0
     keep: int = 8
     hubs: list[np.ndarray] = field(default_factory=list)
     holds: list[Hold] = field(default_factory=list)
@@ -104,17 +106,17 @@ class Rests:
         return not near or min(near) <= self.radius
 
     def returned(self, pose: np.ndarray, start: int, window: np.ndarray) -> int | None:
-        """The index of the last finished hold near ``pose`` that the demonstrator left (some pose since it ended
-        farther than the radius from it: a movement from it and back) and came back to rest at, or None.
+        """The index of the last finished hold near ``pose`` that the demonstrator left (some part farther than twice
+        the radius from it since it ended: a movement from it and back, not a hand fidgeting there) and came back to rest at, or None.
         ``window``: the movement's poses from frame ``start`` on."""
         for i in range(len(self.holds) - 1, -1, -1):
             h = self.holds[i]
-            if h.end is None or not _apart(h.pose, pose) <= self.radius:
+            if h.end is None or h.end - h.start < self.stance or not _apart(h.pose, pose) <= self.radius:
                 continue
             since = np.asarray(window[h.end - start :], dtype=float).reshape(-1, len(h.pose) // 3, 3)
             with np.errstate(all="ignore"):
-                away = np.nanmean(np.linalg.norm(since - h.pose.reshape(-1, 3), axis=2), axis=1)
-            if since.size and np.nanmax(np.append(away, -np.inf)) > self.radius:
+                away = np.linalg.norm(since - h.pose.reshape(-1, 3), axis=2)
+            if since.size and np.nanmax(np.append(away.ravel(), -np.inf)) > 2.0 * self.radius:
                 return i
         return None
 
@@ -134,10 +136,27 @@ class Rests:
         (unless not ``shifts``: a reach held for ``settle`` is as much a movement as a shift), or, when it ends away from where
         it began, ended at its last hold if what follows that hold is a shift (a return is no shift)."""
         holds = [h for h in self.holds[:upto] if h.end is not None and start < h.start and h.end < end]
-        if shifts and straight(window[: end - start], self.radius):
+        if not self.leaves(window[: end - start]):  # motion at rest (sway, a hand fidgeting): no movement
             return []
-        if holds and not _apart(window[0], window[end - start - 1]) <= self.radius:  # it ends elsewhere
+        if _apart(window[0], window[end - start - 1]) <= self.radius:  # back where it began: no shift
+            return [(start, end)]
+        if shifts and self.shift(window[: end - start]):
+            return []
+        if holds:
             last = holds[-1]
-            if straight(window[last.end - start : end - start], self.radius):
+            if self.shift(window[last.end - start : end - start]):
                 return [(start, last.start)]
         return [(start, end)]
+
+    def leaves(self, window: np.ndarray) -> bool:
+        """Whether poses ``window`` (N, 3m) leave where they began: some part farther than twice the radius from its
+        first position (a movement, not motion at rest)."""
+        points = np.asarray(window, dtype=float).reshape(len(window), -1, 3)
+        with np.errstate(all="ignore"):
+            away = np.linalg.norm(points - points[:1], axis=2)
+        return bool(np.nanmax(np.append(away.ravel(), -np.inf)) > 2.0 * self.radius)
+
+    def shift(self, window: np.ndarray) -> bool:
+        """Whether poses ``window`` (N, 3m) are a shift of stance: they end away from where they began (eq. 1 farther
+        than the radius) and go there :func:`straight`."""
+        return len(window) >= 2 and not _apart(window[0], window[-1]) <= self.radius and straight(window, self.radius)

@@ -79,11 +79,15 @@ import numpy as np
 from plugins.lib.body_size import body_scale
 from plugins.lib.strokes import StrokeAnalysis, StrokeCriteria, _round_kernels, analyse, breaks
 from plugins.segmenters.velocity_direction.rests import Rests
-from plugins.segmenters.velocity_direction.rests import straight as rests_straight
 from plugins.segmenters.velocity_direction.speed import Jitter, line_speeds, line_weights, speed_noise
 from toolkit import ConfigError, Parameter, Segment, Segmenter, hookimpl
 
-__all__ = ["VelocityDirection"]
+__all__ = ["VelocityDirection", "STANCE"]
+
+STANCE = 0.25
+"""Seconds a rest away from the hubs must last to be a stance that movements leave and come back to (``end =
+"rest"``): longer than a gesture's pauses (a tenth of a second, K&G's sensory memory), shorter than the pauses
+people make between gestures (a third of a second and more)."""
 
 
 class VelocityDirection(Segmenter):
@@ -184,7 +188,8 @@ class VelocityDirection(Segmenter):
             if self.params["jitter"] > 0 else None  # measured again every half second
         self._positions = ~np.array([p in angles for p in parts]) if parts else np.zeros(0, bool)
         self._size_sum, self._size_n = 0.0, 0
-        self._rests = Rests() if self.params["end"] == "rest" else None  # end = rest: hubs and holds
+        self._rests = Rests(stance=int(round(STANCE * self._fps))) if self.params["end"] == "rest" else None
+        # end = rest: the hubs and holds
         self._holding = False  # end = rest: the rest under way is a hold (away from the hubs)
         self._settle = max(1, int(round(self.params["settle"] * self._fps)))
 
@@ -393,7 +398,7 @@ class VelocityDirection(Segmenter):
             pieces = rests.pieces(start, hold.start, window, upto=back)
             rests.hub(hold.pose)
             second = window[hold.end - start : began - start]
-            pieces += [] if rests_straight(second, rests.radius) else [(hold.end, began)]
+            pieces += [] if rests.shift(second) else [(hold.end, began)]
             return self._close_pieces(pieces, began)
         if self._resting >= self._settle:  # a new stance they stay in: the movement ends where they came to it
             pieces = rests.pieces(start, began, window, shifts=False)
