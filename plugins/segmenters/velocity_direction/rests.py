@@ -13,6 +13,10 @@ movement under way only where it is a hub of this demonstrator:
   and the one from it back to it follows;
 - or they rest ``settle`` seconds in one place (a new stance they stay in): the movement ends where that rest began.
 
+- or, once they have rested ``STANCE`` seconds at a hold reached by a shift (below) from a hold before it that lasted
+  as long and where the movement had come at least half-way back to its first pose: the movement ended at that hold
+  (a take that ends in another stance than it began, then the shift to the next one's).
+
 A *shift* of stance is not a movement: a piece that goes straight from one rest to another (no part farther from the
 straight line between its first and last positions than ``rest_radius`` body sizes plus a quarter of its way: an arc
 of up to about 100 degrees) is dropped, and one that ends away from where it began with such a shift after a hold ends at the hold. So two takes
@@ -147,6 +151,21 @@ class Rests:
             if self.shift(window[last.end - start : end - start]):
                 return [(start, last.start)]
         return [(start, end)]
+
+    def ended_before(self, start: int, window: np.ndarray) -> bool:
+        """Whether the movement (from frame ``start``, poses ``window``) ended at its hold before the last one: that
+        hold lasted a stance's time, the movement had come at least half-way back there (eq. 1 from its first pose
+        at most half the farthest it had been), and it went from there to the last hold by a shift."""
+        if len(self.holds) < 2:
+            return False
+        before, now = self.holds[-2], self.holds[-1]
+        if before.end is None or before.end - before.start < self.stance:
+            return False
+        way = [_apart(window[0], x) for x in window[: before.start - start]]
+        way = [d for d in way if np.isfinite(d)]
+        if not way or not _apart(window[0], before.pose) <= 0.5 * max(way):
+            return False
+        return self.shift(window[before.end - start : now.start - start])
 
     def leaves(self, window: np.ndarray) -> bool:
         """Whether poses ``window`` (N, 3m) leave where they began: some part farther than twice the radius from its

@@ -385,8 +385,9 @@ class VelocityDirection(Segmenter):
     def _rested(self, began: int, points: np.ndarray) -> list[Segment]:
         """With ``end = "rest"``: the demonstrator has rested since ``began`` with the chosen parts at ``points``
         (3m,) while a movement is under way. Near a hub, or after ``settle`` seconds, it ends there; back at a hold
-        of the movement's, the movement is cut where that hold began and the one from it back to it follows; else
-        the rest is a hold and the movement goes on (:mod:`.rests`)."""
+        of the movement's, the movement is cut where that hold began and the one from it back to it follows; held a
+        stance's time after a shift from a hold where the movement had come most of the way back, it ended at that
+        hold; else the rest is a hold and the movement goes on (:mod:`.rests`)."""
         rests = self._rests
         start = self._start
         window = np.array(self._buffer)
@@ -407,6 +408,12 @@ class VelocityDirection(Segmenter):
         if not self._holding:
             rests.hold(began, points)
             self._holding = True
+        elif self._resting == max(self._memory, self._pause) + rests.stance and rests.ended_before(start, window):
+            # held a stance's time after a shift from a hold where the movement had come most of the way back
+            before = rests.holds[-2]
+            pieces = rests.pieces(start, before.start, window, upto=len(rests.holds) - 2)
+            rests.hub(points)
+            return self._close_pieces(pieces, began)
         return []
 
     def _rest_speed(self, pose: np.ndarray, speed: float) -> float:
