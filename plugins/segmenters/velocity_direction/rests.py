@@ -105,9 +105,13 @@ class Rests:
 
     def at_hub(self, pose: np.ndarray) -> bool:
         """Whether ``pose`` is near one of the hubs (nothing to compare with: the paper's rule, any rest)."""
-        near = [_apart(h, pose) for h in self.hubs]
-        near = [d for d in near if np.isfinite(d)]
-        return not near or min(near) <= self.radius
+        if not self.hubs:
+            return True
+        d = np.linalg.norm((np.array(self.hubs) - np.asarray(pose)).reshape(len(self.hubs), -1, 3), axis=2)
+        with np.errstate(all="ignore"):
+            near = np.nanmean(np.where(np.isfinite(d), d, np.nan), axis=1)  # eq. 1 over the parts seen in both
+        near = near[np.isfinite(near)]
+        return not near.size or float(near.min()) <= self.radius
 
     def returned(self, pose: np.ndarray, start: int, window: np.ndarray) -> int | None:
         """The index of the last finished hold near ``pose`` that the demonstrator left (some part farther than twice
@@ -161,9 +165,11 @@ class Rests:
         before, now = self.holds[-2], self.holds[-1]
         if before.end is None or before.end - before.start < self.stance:
             return False
-        way = [_apart(window[0], x) for x in window[: before.start - start]]
-        way = [d for d in way if np.isfinite(d)]
-        if not way or not _apart(window[0], before.pose) <= 0.5 * max(way):
+        points = np.asarray(window[: before.start - start], dtype=float).reshape(before.start - start, -1, 3)
+        with np.errstate(all="ignore"):
+            way = np.nanmean(np.linalg.norm(points - points[:1], axis=2), axis=1)  # eq. 1 from the first pose
+        way = way[np.isfinite(way)]
+        if not way.size or not _apart(window[0], before.pose) <= 0.5 * float(way.max()):
             return False
         return self.shift(window[before.end - start : now.start - start])
 

@@ -237,13 +237,17 @@ class VelocityDirection(Segmenter):
         if (p["units"] == "metres" and not self._pause and not p["noise"] > 0 and p["end"] == "still"
                 and self._weights is None and self._jitter is None):  # a fixed rest speed, and any rest ends a movement
             return self._follow(flat, speeds)
-        noise = self._jitter.update(flat) if self._jitter is not None else None
-        for f in range(n):
+        floors = (p["jitter"] * speed_noise(self._jitter.update(flat), self._weights if self._weights is not None
+                                             else self._displacement) if self._jitter is not None else np.zeros(n))
+        if p["units"] == "body":  # every frame's size at once (the running mean takes some of them)
+            sizes = (body_scale(poses, self._positions) if len(self._positions) == poses.shape[1]
+                     else body_scale(poses)).tolist()
+        else:
+            sizes = [None] * n
+        for f, floor in enumerate(floors.tolist()):
             self._frame += 1
             self._history.append(flat[f])
-            floor = 0.0 if noise is None else p["jitter"] * speed_noise(noise[f], self._weights if self._weights
-                                                                         is not None else self._displacement)
-            closed.extend((f, s) for s in self._step(poses[f], flat[f], float(speeds[f]), floor))
+            closed.extend((f, s) for s in self._step(poses[f], flat[f], float(speeds[f]), floor, sizes[f]))
             if self._start is not None:
                 since[f] = self._start
         return closed, since
@@ -330,7 +334,8 @@ class VelocityDirection(Segmenter):
             self._speeds.append(float(speeds[valid][-1]))
         return closed, since
 
-    def _step(self, pose: np.ndarray, points: np.ndarray, speed: float, floor: float = 0.0) -> list[Segment]:
+    def _step(self, pose: np.ndarray, points: np.ndarray, speed: float, floor: float = 0.0,
+              size: float | None = None) -> list[Segment]:
         """One frame after its sensory memory was updated: ``points`` are the chosen parts (3m,), ``speed`` the
         fastest one's over the sensory memory (NaN: none seen, or not enough frames yet), ``floor`` the least rest
         speed the tracker's jitter allows (``jitter``). Segments it closes."""
@@ -342,7 +347,7 @@ class VelocityDirection(Segmenter):
                 self._start, self._buffer = self._frame, []
                 self._began(pose, points)
             self._buffer.append(points)
-        rest = max(self._rest_speed(pose, speed), floor)
+        rest = max(self._rest_speed(pose, speed, size), floor)
         if self._pause:
             if np.isnan(speed) or len(self._speeds) < self._pause:
                 return cut
@@ -416,14 +421,15 @@ class VelocityDirection(Segmenter):
             return self._close_pieces(pieces, began)
         return []
 
-    def _rest_speed(self, pose: np.ndarray, speed: float) -> float:
+    def _rest_speed(self, pose: np.ndarray, speed: float, size: float | None = None) -> float:
         """The speed below which the parts are at rest now: ``rest_speed`` (m/s), or ``size_rest_speed`` body sizes
         per second; at least ``noise`` times the slowest (mean over ``pause``) speed of the last ``floor`` seconds.
-        Records this frame's speed and size first."""
+        Records this frame's speed and size (``size``: the body's in ``pose``, if known) first."""
         p = self.params
         if p["units"] == "body":
             if not self._size_n or self._frame % self._memory == 0:  # the size changes with the pose, slowly
-                size = body_scale(pose, self._positions) if len(self._positions) == len(pose) else body_scale(pose)
+                if size is None:
+                    size = body_scale(pose, self._positions) if len(self._positions) == len(pose) else body_scale(pose)
                 if size > 0:
                     self._size_sum, self._size_n = self._size_sum + size, self._size_n + 1
             rest = p["size_rest_speed"] * (self._size_sum / self._size_n if self._size_n else 0.0)

@@ -57,10 +57,11 @@ def line_speeds(rows: np.ndarray, weights: np.ndarray) -> np.ndarray:
     return np.where(finite.any(axis=1), best, np.nan)
 
 
-def speed_noise(sigma: float, weights: np.ndarray) -> float:
+def speed_noise(sigma, weights: np.ndarray):
     """The root-mean-square speed (m/s; a 3-D norm) a part standing still seems to move at when its positions
-    jitter by ``sigma`` per coordinate and its velocity is the dot product of ``weights`` with them."""
-    return float(sigma * np.sqrt(3.0 * float(weights @ weights)))
+    jitter by ``sigma`` (a number or an array) per coordinate and its velocity is the dot product of ``weights``
+    with them."""
+    return np.asarray(sigma) * np.sqrt(3.0 * float(weights @ weights))
 
 
 class Jitter:
@@ -80,8 +81,9 @@ class Jitter:
 
     def __init__(self, parts: int, floor: int, every: int) -> None:
         self.every = max(1, int(every))
-        self._last: deque[np.ndarray] = deque(maxlen=2)  # the two rows before the next
-        self._steps: deque[np.ndarray] = deque(maxlen=max(3, int(floor)))  # second differences' lengths (m,)
+        self.floor = max(3, int(floor))
+        self._last = np.zeros((0, 3 * parts))  # the (at most two) rows before the next
+        self._steps = np.zeros((0, parts))  # the last `floor` second differences' lengths
         self._parts = parts
         self.sigma = 0.0
         self._frame = -1
@@ -90,26 +92,28 @@ class Jitter:
         """``sigma`` after each of the frames ``rows`` (n, 3m), the frames' own included."""
         rows = np.asarray(rows, dtype=float)
         n = len(rows)
-        out = np.empty(n)
         if not n:
-            return out
-        full = np.concatenate([np.array(self._last).reshape(-1, rows.shape[1]), rows]) if self._last else rows
-        k = len(full) - n  # rows before the block
-        second = (full[2:] - 2.0 * full[1:-1] + full[:-2]).reshape(-1, self._parts, 3) if len(full) > 2 else \
-            np.zeros((0, self._parts, 3))
-        lengths = np.sqrt((second * second).sum(axis=2))  # (len(full) - 2, m): row r is frame r + 2 - k of the block
-        first = 2 - k  # the block frame of lengths' first row
-        for f in range(n):
-            self._frame += 1
-            r = f - first
-            if r >= 0:
-                self._steps.append(lengths[r])
-            if self._frame % self.every == 0 and self._steps:
-                steps = np.array(self._steps)
-                with np.errstate(all="ignore"):
-                    level = np.nanmedian(np.where(np.isfinite(steps), steps, np.nan), axis=0)
-                level = level[np.isfinite(level)]
-                self.sigma = float(level.max()) / (CHI3_MEDIAN * np.sqrt(6.0)) if level.size else 0.0
-            out[f] = self.sigma
-        self._last.extend(rows[-2:])
+            return np.zeros(0)
+        full = np.concatenate([self._last, rows])
+        second = (full[2:] - 2.0 * full[1:-1] + full[:-2]).reshape(-1, self._parts, 3)
+        lengths = np.sqrt((second * second).sum(axis=2))  # one a block frame from its last len(lengths) frames
+        steps = np.concatenate([self._steps, lengths])
+        before = len(self._steps) - (n - len(lengths))  # steps row of block frame 0's second difference, if any
+        frames = self._frame + 1 + np.arange(n)
+        out = np.full(n, self.sigma)
+        for f in np.flatnonzero(frames % self.every == 0).tolist():
+            upto = before + f + 1  # the rows up to frame f
+            if upto <= 0:
+                continue
+            window = steps[max(0, upto - self.floor) : upto]
+            finite = np.isfinite(window)
+            with np.errstate(all="ignore"):
+                level = np.median(window, axis=0) if finite.all() else \
+                    np.nanmedian(np.where(finite, window, np.nan), axis=0)
+            level = level[np.isfinite(level)]
+            out[f:] = float(level.max()) / (CHI3_MEDIAN * np.sqrt(6.0)) if level.size else 0.0
+        self.sigma = float(out[-1])
+        self._frame += n
+        self._steps = steps[-self.floor :]
+        self._last = full[-2:]
         return out
