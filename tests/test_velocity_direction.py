@@ -240,7 +240,9 @@ def _frames_and_blocks(params, parts, poses, visible, cuts):
        params=st.sampled_from([{}, {"level": "movement"}, {"units": "body", "noise": 2.0, "pause": 0.3},
                                {"max_movement": 1.0, "memory": 0.2}, {"parts": ["wrist"], "rest_speed": 0.05},
                                {"level": "movement", "end": "rest", "units": "body", "noise": 2.0},
-                               {"end": "rest", "settle": 0.5, "max_movement": 1.0}]),
+                               {"end": "rest", "settle": 0.5, "max_movement": 1.0},
+                               {"level": "movement", "end": "rest", "units": "body", "noise": 2.0, "window": 0.2,
+                                "jitter": 3.0}, {"window": 0.3, "jitter": 2.0, "memory": 0.2}]),
        hidden=st.booleans())
 @settings(max_examples=40, deadline=None)
 def test_a_block_pushed_at_once_is_its_frames_pushed_one_by_one(seed, cuts, params, hidden):

@@ -84,10 +84,10 @@ from toolkit import ConfigError, Parameter, Segment, Segmenter, hookimpl
 
 __all__ = ["VelocityDirection", "STANCE"]
 
-STANCE = 0.25
+STANCE = 0.2
 """Seconds a rest away from the hubs must last to be a stance that movements leave and come back to (``end =
-"rest"``): longer than a gesture's pauses (a tenth of a second, K&G's sensory memory), shorter than the pauses
-people make between gestures (a third of a second and more)."""
+"rest"``): twice a gesture's pauses (a tenth of a second, K&G's sensory memory), shorter than the pauses people
+make between gestures (a third of a second and more)."""
 
 
 class VelocityDirection(Segmenter):
@@ -176,7 +176,10 @@ class VelocityDirection(Segmenter):
         window = int(round(self.params["window"] * self._fps))
         self._weights = line_weights(window, self._fps) if window >= 2 else None  # the line fit's, or displacement
         self._lag = (window - 1) // 2 if self._weights is not None else 0  # the line fit's delay (frames)
-        self._history: deque[np.ndarray] = deque(maxlen=max(2 * self._memory + 2, window))  # the sensory memory
+        self._still = max(self._memory, window)  # end = rest: poses are compared as the mean of this many frames
+        pause = int(round(self.params["pause"] * self._fps))
+        self._history: deque[np.ndarray] = deque(maxlen=max(2 * self._memory + 2, window) + self._lag + pause // 2
+                                                 + self._still)  # the sensory memory (and what an onset goes back to)
         self._last: tuple[int, int, np.ndarray] | None = None  # the last movement closed: start, end, working memory
         self._done = 0  # the end of the last movement reported: a movement begins no earlier
         self._analysis: StrokeAnalysis | None = None
@@ -363,7 +366,7 @@ class VelocityDirection(Segmenter):
                 # `max_movement` just before a rest too short to report)
                 self._start = max(self._done, self._frame - 2 * self._memory - lag)
                 self._buffer = list(self._history)[-(self._frame - self._start + 1):]
-                self._began(pose, self._buffer[0])
+                self._began(pose, self._held(self._frame - self._start + 1))
             elif self._holding and self._moving >= self._memory:  # moving again after a hold
                 self._rests.left(max(self._start + 1, self._frame - 2 * self._memory - lag))
                 self._holding = False
@@ -374,8 +377,15 @@ class VelocityDirection(Segmenter):
                 began = max(self._start + 1, self._frame - self._resting + 1 - self._memory // 2 - lag)
                 if self.params["end"] == "still":
                     return cut + self._close(began)
-                return cut + self._rested(began, points)
+                return cut + self._rested(began, self._held(1))
         return cut
+
+    def _held(self, back: int) -> np.ndarray:
+        """The mean of the ``_still`` rows of the sensory memory up to the ``back``-th last (1: this frame's): a
+        pose at rest with the tracker's jitter averaged out (3m,)."""
+        rows = list(self._history)
+        end = max(1, len(rows) - back + 1)
+        return np.mean(rows[max(0, end - self._still) : end], axis=0)
 
     def _began(self, pose: np.ndarray, points: np.ndarray) -> None:
         """With ``end = "rest"``: a movement begins where the chosen parts are ``points`` (3m,), a rest of the
