@@ -91,6 +91,7 @@ class Rests:
     keep: int = 8
     hubs: list[np.ndarray] = field(default_factory=list)
     holds: list[Hold] = field(default_factory=list)
+    _stacked: np.ndarray | None = field(default=None, repr=False)  # the hubs as one array (k, m, 3)
 
     def began(self, pose: np.ndarray, radius: float) -> None:
         """A movement begins from ``pose`` (3m,), where the demonstrator was: a hub."""
@@ -102,12 +103,18 @@ class Rests:
         """``pose`` is a rest of this demonstrator's (the latest first; one near it replaced)."""
         pose = np.array(pose, dtype=float)
         self.hubs = [pose] + [h for h in self.hubs if not _apart(h, pose) <= self.radius][: self.keep - 1]
+        self._stacked = None
 
     def at_hub(self, pose: np.ndarray) -> bool:
         """Whether ``pose`` is near one of the hubs (nothing to compare with: the paper's rule, any rest)."""
         if not self.hubs:
             return True
-        d = np.linalg.norm((np.array(self.hubs) - np.asarray(pose)).reshape(len(self.hubs), -1, 3), axis=2)
+        if self._stacked is None or len(self._stacked) != len(self.hubs):
+            self._stacked = np.array(self.hubs).reshape(len(self.hubs), -1, 3)
+        apart = self._stacked - np.asarray(pose).reshape(-1, 3)
+        d = np.sqrt((apart * apart).sum(axis=2))
+        if np.isfinite(d).all():
+            return float(d.mean(axis=1).min()) <= self.radius
         with np.errstate(all="ignore"):
             near = np.nanmean(np.where(np.isfinite(d), d, np.nan), axis=1)  # eq. 1 over the parts seen in both
         near = near[np.isfinite(near)]

@@ -30,29 +30,42 @@ parts hold their last seen position (``docs/conventions.md``), so they do not
 move; a part not seen yet carries no evidence.
 
 Real people (the correspondence problem, K&G §6): the paper's rest is an absolute speed, which a noisy tracker
-never falls below and a large body's sway may exceed. Each of these is a parameter, off by default (the paper):
+never falls below and a large body's sway may exceed, and the paper ends a movement at any rest. Each of these is a
+parameter, off by default (the paper); the observer template (``characters/observers/recordings.toml``,
+``[segmenters.velocity-direction]``) sets ``level = "movement"``, ``units = "body"``, ``window = 0.2``, ``jitter =
+3`` and ``end = "rest"``:
 
 - ``units = "body"``: the rest speed is ``size_rest_speed`` of the demonstrator's own body sizes per second
   (:func:`plugins.lib.body_size.body_scale` of the poses seen, a running mean: about 0.45 m for a standing adult,
   0.20 m for Max). 0.1 body sizes/s (4.5 cm/s on an adult) lies between standing sway (1-2 cm/s) and a gesture
   (tens of cm/s).
+- ``window = w > 0``: each part's velocity is the slope of the least-squares line through its last ``w`` seconds of
+  positions instead of its displacement over the sensory memory (:mod:`.speed`): a tracker's jitter is averaged
+  out (2.5 times less noise at ``w = 0.2`` s and 30 frames/s), at the cost of ``w / 2`` seconds of delay, which the
+  onset and the end are dated back by.
+- ``jitter = k > 0``: the rest speed is at least ``k`` times the root-mean-square speed the tracker's jitter alone
+  gives a part standing still, the jitter measured from the chosen parts' own positions (the median of their second
+  differences over ``floor`` seconds, whether the person moves or not; :class:`.speed.Jitter`). ``k = 3``: a still
+  part seems to move that fast about once in 100,000 frames.
 - ``noise = k > 0``: the rest speed is at least ``k`` times the slowest the demonstrator has been over the last
-  ``floor`` seconds (their own speed distribution: sway plus the tracker's noise, whatever their units). ``k = 2``:
-  the speed of a body at rest fluctuates around its level, so twice the lowest is still rest, and a gesture is
-  many times faster.
+  ``floor`` seconds (their own speed distribution: sway plus the tracker's noise, whatever their units). It reads a
+  walk's slow phase (a stride's turning point) as rest, so the template leaves it off.
 - ``pause = p > 0``: the speed is averaged over the last ``p`` seconds before it is compared with the rest speed,
-  so a movement begins and ends only at a *real rest* of about ``p`` seconds: a velocity minimum between two
-  strokes lasts about a tenth of a second (the sensory memory, §4.1) and no longer ends the movement. ``p = 0.3``
-  s: three sensory memories, shorter than the pauses people make between gestures.
-- ``end = "rest"``: a rest ends the movement under way only where the demonstrator is back near the pose it began
-  from (within ``rest_radius`` body sizes, eq. 1's mean distance of the chosen parts; the pose is the first of the
-  working memory, so a stooped or wide-legged stance is their own rest), or once they have rested ``settle``
-  seconds elsewhere (a new stance; the movement then ends where that rest began). A gesture that holds a pose
-  half-way (a salute, a bow, a pointing hand) is one movement, not two: B&B's hubs are the poses movements leave and
-  come back to, and K&G's forward model follows the whole performance between rests through the motor command
-  graph. ``rest_radius = 0.1``: B&B's hub threshold (0.02 m on Max, 0.20 m body size); ``settle = 2`` s: longer
-  than a gesture holds a pose (about a second), as ``hub-threshold``'s ``settle``. The paper's ``"still"`` (any
-  rest ends it) is the default.
+  so a movement begins and ends only at a *real rest* of about ``p`` seconds.
+- ``end = "rest"``: a rest ends the movement under way only where it is a *hub* of this demonstrator's
+  (:mod:`.rests`; K&G §4.2's hub nodes, "typical start states ... in which a complete movement normally starts and
+  ends"): near the pose it began from or another rest they were seen in (``rest_radius`` body sizes, eq. 1's mean
+  distance over the chosen parts; poses at rest are compared as their mean over the sensory memory or the line
+  fit's window, so the jitter is averaged out). A rest elsewhere is a *hold* (a bow, a pointing hand held half-way:
+  one movement, not two) unless they leave it and come to rest there again (a new stance: the movement is cut where
+  they first rested there) or rest there ``settle`` seconds. A straight *shift* from one stance to another is no
+  movement and is dropped, and a piece that never leaves where it began (some part farther than twice
+  ``rest_radius``) is motion at rest (sway, fidgeting), dropped too. ``rest_radius = 0.1``: B&B's hub threshold
+  (0.02 m on Max, 0.20 m body size); ``settle = 2`` s: longer than a gesture holds a pose (about a second), as
+  ``hub-threshold``'s ``settle``. The paper's ``"still"`` (any rest ends it) is the default.
+
+On locomotion, which never rests, the template's movement level finds no boundary inside a walk: a walk of several
+takes is one movement (closed after ``max_movement`` seconds if it goes on), not one a stride.
 
 Memory: the visual working memory holds the movement under way, so a movement that never ends (a demonstrator who
 never comes to rest) is closed after ``max_movement`` seconds, where it is, and the next one begins at once there:
@@ -187,8 +200,8 @@ class VelocityDirection(Segmenter):
         self._speeds: deque[float] = deque(maxlen=max(1, self._pause))  # for the mean over `pause`
         self._slowest: deque[tuple[int, float]] = deque()  # monotonic queue: the running minimum over `floor`
         self._floor = max(1, int(round(self.params["floor"] * self._fps)))
-        self._jitter = Jitter(len(self._idx), self._floor, max(1, int(round(0.5 * self._fps)))) \
-            if self.params["jitter"] > 0 else None  # measured again every half second
+        self._jitter = Jitter(len(self._idx), self._floor, max(1, int(round(self._fps)))) \
+            if self.params["jitter"] > 0 else None  # measured again every second
         self._positions = ~np.array([p in angles for p in parts]) if parts else np.zeros(0, bool)
         self._size_sum, self._size_n = 0.0, 0
         self._rests = Rests(stance=int(round(STANCE * self._fps))) if self.params["end"] == "rest" else None
@@ -247,12 +260,89 @@ class VelocityDirection(Segmenter):
                      else body_scale(poses)).tolist()
         else:
             sizes = [None] * n
+        if not self._pause and not p["noise"] > 0:  # the rest speed known for the block at once
+            return self._walk(poses, flat, speeds, floors, sizes)
         for f, floor in enumerate(floors.tolist()):
             self._frame += 1
             self._history.append(flat[f])
             closed.extend((f, s) for s in self._step(poses[f], flat[f], float(speeds[f]), floor, sizes[f]))
             if self._start is not None:
                 since[f] = self._start
+        return closed, since
+
+    def _walk(self, poses: np.ndarray, flat: np.ndarray, speeds: np.ndarray, floors: np.ndarray,
+              sizes: list) -> tuple[list[tuple[int, Segment]], np.ndarray]:
+        """:meth:`_step` for every frame of a block without ``pause`` and ``noise`` (the observer template's): the
+        same segments at the same frames, with only the frames where something can happen stepped.
+
+        Without them the rest speed of every frame is known for the block at once (``size_rest_speed`` times the
+        running mean of the body's size, summed in the same order as frame by frame, or ``rest_speed``; at least
+        the jitter's ``floors``), and so are the counts of fast and slow frames that :meth:`_step` keeps. A frame
+        can change something only where a movement begins (no movement under way, moving for the sensory memory),
+        where one under way comes to rest, where a hold is left, or where one has lasted ``max_movement``: the state
+        before such a frame (the counts, the size's sums, the sensory memory, the working memory) is set as the
+        frames before it left it, and :meth:`_step` steps it."""
+        n, p, m = len(flat), self.params, self._memory
+        closed: list[tuple[int, Segment]] = []
+        since = np.full(n, -1, dtype=int)
+        first = self._frame + 1
+        if p["units"] == "body":
+            size = np.array([np.nan if x is None else x for x in sizes])
+            take = ((first + np.arange(n)) % m == 0) & (size > 0)
+            if not self._size_n and (size > 0).any():
+                take[int(np.argmax(size > 0))] = True  # the first size there is, whatever the frame
+            sums = np.cumsum(np.concatenate([[self._size_sum], np.where(take, size, 0.0)]))  # in order, as one by one
+            counts = self._size_n + np.concatenate([[0], np.cumsum(take)])
+            rest = p["size_rest_speed"] * np.where(counts[1:] > 0, sums[1:] / np.maximum(counts[1:], 1), 0.0)
+        else:
+            sums, counts = np.full(n + 1, self._size_sum), np.full(n + 1, self._size_n)
+            rest = np.full(n, float(p["rest_speed"]))
+        rest = np.maximum(rest, floors)
+        valid = ~np.isnan(speeds)
+        fast, frames = valid & (speeds > rest), np.arange(n)
+        slow = valid & ~fast
+        fast_run, slow_run = np.cumsum(fast), np.cumsum(slow)
+        last_slow = np.maximum.accumulate(np.where(slow, frames, -1))
+        last_fast = np.maximum.accumulate(np.where(fast, frames, -1))
+        moving = np.where(last_slow >= 0, fast_run - fast_run[np.maximum(last_slow, 0)], self._moving + fast_run)
+        resting = np.where(last_fast >= 0, slow_run - slow_run[np.maximum(last_fast, 0)], self._resting + slow_run)
+        onsets = np.flatnonzero(fast & (moving >= m))  # a movement begins, or a hold is left
+        rests = np.flatnonzero(slow & (resting >= m))  # a movement under way comes to rest
+        longest = int(round(p["max_movement"] * self._fps))
+        longest = max(longest, 2) if longest else 0
+        pushed = 0  # the block's rows in the sensory memory so far
+
+        def upto(f: int) -> None:  # the state the frames before f left
+            nonlocal pushed
+            self._history.extend(flat[max(pushed, f - (self._history.maxlen or f)) : f])
+            pushed = f
+            self._frame = first + f - 1
+            self._moving = int(moving[f - 1]) if f else self._moving
+            self._resting = int(resting[f - 1]) if f else self._resting
+            self._size_sum, self._size_n = float(sums[f]), int(counts[f])
+
+        f = 0
+        while f < n:
+            if self._start is None:
+                e = int(onsets[np.searchsorted(onsets, f)]) if np.searchsorted(onsets, f) < len(onsets) else n
+            else:
+                e = min(int(rests[np.searchsorted(rests, f)]) if np.searchsorted(rests, f) < len(rests) else n,
+                        int(onsets[np.searchsorted(onsets, f)]) if self._holding and
+                        np.searchsorted(onsets, f) < len(onsets) else n,
+                        max(f, self._start + longest - first) if longest else n)
+                self._buffer.extend(flat[f:e])
+                since[f:e] = self._start
+            if e >= n:
+                break
+            upto(e)
+            self._frame += 1
+            self._history.append(flat[e])
+            pushed = e + 1
+            closed.extend((e, s) for s in self._step(poses[e], flat[e], float(speeds[e]), float(floors[e]), sizes[e]))
+            if self._start is not None:
+                since[e] = self._start
+            f = e + 1
+        upto(n)
         return closed, since
 
     @property
@@ -405,6 +495,10 @@ class VelocityDirection(Segmenter):
         hold; else the rest is a hold and the movement goes on (:mod:`.rests`)."""
         rests = self._rests
         start = self._start
+        if self._holding and self._resting < self._settle and (
+                self._resting != max(self._memory, self._pause) + rests.stance or len(rests.holds) < 2):
+            if not rests.at_hub(points):  # a hold goes on (the working memory is not needed)
+                return []
         window = np.array(self._buffer)
         if rests.at_hub(points):
             return self._close_pieces(rests.pieces(start, began, window), began)
