@@ -66,8 +66,9 @@ def speed_noise(sigma, weights: np.ndarray):
 
 class Jitter:
     """The tracker's jitter ``sigma`` (m a coordinate) of the noisiest chosen part, from the last ``floor`` frames'
-    second differences (see the module); measured again every ``every`` frames and held in between, so frames pushed
-    one by one and in blocks see the same values.
+    second differences (see the module); measured at frames 2, 4, 8, ... (as soon as there is something to measure)
+    and then every ``every`` frames, and held in between, so frames pushed one by one and in blocks see the same
+    values.
 
     Parameters
     ----------
@@ -101,7 +102,9 @@ class Jitter:
         before = len(self._steps) - (n - len(lengths))  # steps row of block frame 0's second difference, if any
         frames = self._frame + 1 + np.arange(n)
         out = np.full(n, self.sigma)
-        for f in np.flatnonzero(frames % self.every == 0).tolist():
+        # every `every` frames, and at frames 2, 4, 8, ... before (a first measure as soon as there is one)
+        early = (frames < self.every) & (frames >= 2) & ((frames & (frames - 1)) == 0)
+        for f in np.flatnonzero((frames % self.every == 0) | early).tolist():
             upto = before + f + 1  # the rows up to frame f
             if upto <= 0:
                 continue
