@@ -83,11 +83,14 @@ class Rests:
 
     ``radius``: how near (in the units of the poses) a pose must be to a hub to be there; the segmenter sets it to
     ``rest_radius`` times the body's size when a movement begins. ``stance``: the frames a hold must last to be a
-    stance that movements leave and come back to (shorter: a pause in a gesture, a hand fidgeting).
+    stance that movements leave and come back to (shorter: a pause in a gesture, a hand fidgeting). ``smooth``: the
+    frames of the moving average the working memory is seen through (the tracker's jitter averaged out) when it is
+    asked whether a piece leaves where it began, is a shift, or comes back to a hold.
     """
 
     radius: float = 0.0
     stance: int = 0
+    smooth: int = 1
     keep: int = 8
     hubs: list[np.ndarray] = field(default_factory=list)
     holds: list[Hold] = field(default_factory=list)
@@ -128,7 +131,7 @@ class Rests:
             h = self.holds[i]
             if h.end is None or h.end - h.start < self.stance or not _apart(h.pose, pose) <= self.radius:
                 continue
-            since = np.asarray(window[h.end - start :], dtype=float).reshape(-1, len(h.pose) // 3, 3)
+            since = self.seen(window[h.end - start :]).reshape(-1, len(h.pose) // 3, 3)
             with np.errstate(all="ignore"):
                 away = np.linalg.norm(since - h.pose.reshape(-1, 3), axis=2)
             if since.size and np.nanmax(np.append(away.ravel(), -np.inf)) > 2.0 * self.radius:
@@ -180,10 +183,19 @@ class Rests:
             return False
         return self.shift(window[before.end - start : now.start - start])
 
+    def seen(self, window: np.ndarray) -> np.ndarray:
+        """Poses ``window`` (N, 3m) through a centred moving average of ``smooth`` frames (the ends held)."""
+        window = np.asarray(window, dtype=float)
+        if self.smooth <= 1 or len(window) < 2:
+            return window
+        from scipy.ndimage import uniform_filter1d
+
+        return uniform_filter1d(window, self.smooth, axis=0, mode="nearest")
+
     def leaves(self, window: np.ndarray) -> bool:
         """Whether poses ``window`` (N, 3m) leave where they began: some part farther than twice the radius from its
         first position (a movement, not motion at rest)."""
-        points = np.asarray(window, dtype=float).reshape(len(window), -1, 3)
+        points = self.seen(window).reshape(len(window), -1, 3)
         with np.errstate(all="ignore"):
             away = np.linalg.norm(points - points[:1], axis=2)
         return bool(np.nanmax(np.append(away.ravel(), -np.inf)) > 2.0 * self.radius)
@@ -191,4 +203,7 @@ class Rests:
     def shift(self, window: np.ndarray) -> bool:
         """Whether poses ``window`` (N, 3m) are a shift of stance: they end away from where they began (eq. 1 farther
         than the radius) and go there :func:`straight`."""
-        return len(window) >= 2 and not _apart(window[0], window[-1]) <= self.radius and straight(window, self.radius)
+        if len(window) < 2:
+            return False
+        window = self.seen(window)
+        return not _apart(window[0], window[-1]) <= self.radius and straight(window, self.radius)

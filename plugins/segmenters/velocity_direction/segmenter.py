@@ -204,7 +204,8 @@ class VelocityDirection(Segmenter):
             if self.params["jitter"] > 0 else None  # measured again every second
         self._positions = ~np.array([p in angles for p in parts]) if parts else np.zeros(0, bool)
         self._size_sum, self._size_n = 0.0, 0
-        self._rests = Rests(stance=int(round(STANCE * self._fps))) if self.params["end"] == "rest" else None
+        self._rests = Rests(stance=int(round(STANCE * self._fps)), smooth=self._still) \
+            if self.params["end"] == "rest" else None
         # end = rest: the hubs and holds
         self._holding = False  # end = rest: the rest under way is a hold (away from the hubs)
         self._settle = max(1, int(round(self.params["settle"] * self._fps)))
