@@ -211,7 +211,10 @@ REST_HOLD = (0.25, 0.75)
 take, and the next take's first pose after it, in the rest-joined streams."""
 TRANSITION = 0.5
 """Seconds of the minimum-jerk transition from one take's last pose to the next take's first (rest-joined
-streams)."""
+streams), at least: longer where a joint has farther to go than :data:`PACE` allows."""
+PACE = 1.0
+"""Body sizes a second (on average; 1.9 at the peak of a minimum-jerk move) the joint that goes farthest covers in
+a transition between two takes: a relaxed arm's pace (0.45 m/s on an adult), not a gesture's."""
 STRIDE = 0.2
 """Seconds of the transition between two locomotion takes (no hold: the walk goes on)."""
 LEAD = 1.0
@@ -230,9 +233,9 @@ def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams:
 
     - ``streams/``, the set to trust: only takes that begin and end at rest (:func:`plugins.bench.joins.at_rest`, a
       rule, not a choice by hand), joined through a rest as a person performs one after another
-      (:func:`plugins.bench.joins.join`): the last pose held :data:`REST_HOLD` seconds, a :data:`TRANSITION`
-      second minimum-jerk transition to the next take's first pose (the take moved to stand where the last one
-      stood, facing its way), that pose held again; :data:`LEAD` seconds of rest before the first and after the last;
+      (:func:`plugins.bench.joins.join`): the last pose held :data:`REST_HOLD` seconds, a minimum-jerk transition
+      of :data:`TRANSITION` seconds or more (at :data:`PACE`) to the next take's first pose (the take moved to
+      stand where the last one stood, facing its way), that pose held again; :data:`LEAD` seconds of rest before the first and after the last;
     - ``cropped/``, the harder set (the streams of the releases before): any gesture demo, the takes joined end to
       end as they were cropped, so most joins are jumps at full speed in another stance, which no segmenter that
       looks for rest can cut.
@@ -264,8 +267,8 @@ def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams:
         raise ConfigError(f"{len(resting)} demos begin and end at rest", file=src,
                           expected=f"at least {per_stream} (--per-stream) for the rest-joined streams",
                           available=[p.name for p in resting])
-    items += [_joined(rng, resting, per_stream, dest / "streams" / f"stream_{k + 1:02d}.bvh", REST_HOLD,
-                      TRANSITION, LEAD) for k in range(streams)]
+    items += [{**_joined(rng, resting, per_stream, dest / "streams" / f"stream_{k + 1:02d}.bvh", REST_HOLD,
+                         TRANSITION, LEAD), "pace": PACE} for k in range(streams)]
     if locomotion is not None:
         walks = _takes(Path(locomotion), "dataset-2_*.bvh", "dataset-2_{content}_{style}_{take}.bvh files")
         _link_repertoire(walks, dest / "locomotion")
@@ -338,7 +341,8 @@ def _bandai_stream(item: dict[str, Any]) -> str:
 
         frames = lambda seconds: int(round(seconds * first.fps))  # noqa: E731
         values, rows = join(parts, labels, [(frames(a), frames(b)) for a, b in item["holds"]],
-                            [frames(item["move"])] * (len(parts) - 1), frames(item["lead"]), frames(item["lead"]))
+                            [frames(item["move"])] * (len(parts) - 1), frames(item["lead"]), frames(item["lead"]),
+                            pace=item.get("pace", 0.0))
     else:
         rows, at = [], 0
         for label, b in zip(labels, parts):

@@ -10,15 +10,19 @@ will do; +y up, as BVH has it):
   centroid, so walking in place is not rest; the body size is :func:`plugins.lib.body_size.body_scale`). 0.3 s is a
   pause people make between gestures (three of Kopp & Graeser's sensory memories, §4.1); 0.05 body sizes (about
   2.5 cm on an adult) is half of Buchsbaum & Blumberg's hub threshold (0.1 body sizes, §5.1), the most that
-  ``hub-threshold`` lets standing sway and noise be (its ``cap``).
+  ``hub-threshold`` lets standing sway and noise be (its ``cap``). And it must move in between: some joint
+  ``MOVES`` (0.2) body sizes or farther from where it began (two of the Bandai-Namco takes at rest at both ends,
+  byebye in the feminine and the not-confident style, move no joint farther than 0.09 body sizes, 4 cm; the others
+  0.4 or more).
 - :func:`placed`: a take moved so that it begins where the take before it ended (the centroid over the floor) and
   turned about the vertical so that its first pose faces the way the last pose did (the yaw that best aligns the two
   poses' joints over the floor, a least-squares fit in closed form).
 - :func:`transition`: the channels from one pose to another in ``frames`` frames with a minimum-jerk profile
   (``10u^3 - 15u^4 + 6u^5``, Flash & Hogan 1985): position channels interpolated, each joint's rotation slerped,
   the body's centroid on the straight line between the two.
-- :func:`join`: takes one after another; before each (after the first) the last pose held, the transition, the next
-  take's first pose held. The true segments are the takes' own frames.
+- :func:`join`: takes one after another; before each (after the first) the last pose held, the transition (at a pace
+  a person keeps when they change stance: no joint faster than a body size a second on average), the next take's
+  first pose held. The true segments are the takes' own frames.
 """
 
 from __future__ import annotations
@@ -35,6 +39,9 @@ REST_WINDOW = 0.3
 """Seconds at a take's beginning and end over which :func:`at_rest` looks."""
 REST_RADIUS = 0.05
 """Body sizes every joint stays within (of its mean over ``REST_WINDOW``) for :func:`at_rest`."""
+MOVES = 0.2
+"""Body sizes (about 10 cm on an adult) some joint must go from where it began for :func:`at_rest` to take a take
+as a movement at all."""
 
 
 def _centred(positions: np.ndarray) -> np.ndarray:
@@ -42,9 +49,11 @@ def _centred(positions: np.ndarray) -> np.ndarray:
     return positions - positions.mean(axis=1, keepdims=True)
 
 
-def at_rest(bvh, window: float = REST_WINDOW, radius: float = REST_RADIUS) -> bool:
+def at_rest(bvh, window: float = REST_WINDOW, radius: float = REST_RADIUS, moves: float = MOVES) -> bool:
     """Whether the take ``bvh`` begins and ends at rest (see the module): over its first and last ``window``
-    seconds no joint moves farther than ``radius`` body sizes from its mean there."""
+    seconds no joint moves farther than ``radius`` body sizes from its mean there; and moves in between (some joint
+    goes farther than ``moves`` body sizes from where it was in the first frame: a take that hardly moves is at rest
+    throughout, not a gesture)."""
     from plugins.lib.body_size import body_scale
 
     frames = max(2, int(round(window * bvh.fps)))
@@ -58,7 +67,8 @@ def at_rest(bvh, window: float = REST_WINDOW, radius: float = REST_RADIUS) -> bo
     for part in (ends[:frames], ends[frames:]):
         if np.linalg.norm(part - part.mean(axis=0), axis=-1).max() > radius * size:
             return False
-    return True
+    centred = _centred(positions)
+    return bool(np.linalg.norm(centred - centred[:1], axis=-1).max() > moves * size)
 
 
 def _roots(bvh) -> list[tuple[int, np.ndarray, np.ndarray, str]]:
@@ -154,23 +164,33 @@ def transition(bvh, start: np.ndarray, end: np.ndarray, frames: int) -> np.ndarr
 
 
 def join(bvh_takes: Sequence, labels: Sequence[str], holds: Sequence[tuple[int, int]], moves: Sequence[int],
-         lead: int = 0, tail: int = 0) -> tuple[np.ndarray, list[tuple[int, int, str]]]:
+         lead: int = 0, tail: int = 0, pace: float = 0.0) -> tuple[np.ndarray, list[tuple[int, int, str]]]:
     """Takes (BVH, one skeleton) one after another: the channel values of the stream (F, C) and its true segments
     (start, end exclusive, label), one a take.
 
     Before take ``k`` (k >= 1) the last pose of take ``k - 1`` is held ``holds[k - 1][0]`` frames, the transition to
-    take ``k``'s first pose (the take :func:`placed` after it) lasts ``moves[k - 1]`` frames, and that pose is held
+    take ``k``'s first pose (the take :func:`placed` after it) lasts ``moves[k - 1]`` frames, or longer with
+    ``pace`` > 0: long enough that the joint that goes farthest covers no more than ``pace`` body sizes a second on
+    average (:func:`plugins.lib.body_size.body_scale` of the pose it leaves), and that pose is held
     ``holds[k - 1][1]`` frames; ``lead`` frames of the first pose begin the stream and ``tail`` frames of the last
     end it."""
+    from plugins.lib.body_size import body_scale
+
     first = bvh_takes[0]
     pieces = [np.repeat(first.values[:1], lead, axis=0), first.values]
     rows, at = [(lead, lead + first.n_frames, labels[0])], lead + first.n_frames
     last = first.values[-1]
     for k in range(1, len(bvh_takes)):
         take = bvh_takes[k]
-        values = placed(first, take.values, _pose(first, last))
+        leaving = _pose(first, last)
+        values = placed(first, take.values, leaving)
         before, after = holds[k - 1]
-        between = [np.repeat(last[None], before, axis=0), transition(first, last, values[0], moves[k - 1]),
+        frames = moves[k - 1]
+        if pace > 0:
+            far = float(np.linalg.norm(_pose(first, values[0]) - leaving, axis=1).max())  # the farthest way
+            seconds = far / (pace * max(float(body_scale(leaving)), 1e-9))
+            frames = max(frames, int(np.ceil(seconds / first.frame_time)))
+        between = [np.repeat(last[None], before, axis=0), transition(first, last, values[0], frames),
                    np.repeat(values[:1], after, axis=0)]
         pieces += [*between, values]
         at += sum(len(p) for p in between)
