@@ -22,7 +22,7 @@ Two things make the speed hold on such a tracker, each a parameter of the segmen
 
 from __future__ import annotations
 
-from collections import deque
+import warnings
 
 import numpy as np
 
@@ -110,9 +110,12 @@ class Jitter:
                 continue
             window = steps[max(0, upto - self.floor) : upto]
             finite = np.isfinite(window)
-            with np.errstate(all="ignore"):
-                level = np.median(window, axis=0) if finite.all() else \
-                    np.nanmedian(np.where(finite, window, np.nan), axis=0)
+            if finite.all():
+                level = np.median(window, axis=0)
+            else:
+                with warnings.catch_warnings():  # a part never seen in the window: no level (NaN), said here
+                    warnings.simplefilter("ignore", RuntimeWarning)
+                    level = np.nanmedian(np.where(finite, window, np.nan), axis=0)
             level = level[np.isfinite(level)]
             out[f:] = float(level.max()) / (CHI3_MEDIAN * np.sqrt(6.0)) if level.size else 0.0
         self.sigma = float(out[-1])
