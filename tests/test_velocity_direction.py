@@ -225,15 +225,22 @@ def _frames_and_blocks(params, parts, poses, visible, cuts):
         onsets.append(-1 if one.active_since is None else one.active_since)
     blocks = VelocityDirection(**params)
     blocks.reset(parts, FPS)
+    got, since = _in_blocks(blocks, poses, visible, cuts)
+    return one, expected, onsets, blocks, got, since
+
+
+def _in_blocks(segmenter, poses, visible, cuts):
+    """``poses`` pushed to ``segmenter`` in blocks of ``cuts`` frames (the rest in one): the segments closed (with the
+    frame that closed them) and the onsets reported at each frame."""
     got, since, at = [], [], 0
     for n in [*cuts, len(poses)]:
-        closed, block_since = blocks.push_block(poses[at : at + n], visible[at : at + n])
+        closed, block_since = segmenter.push_block(poses[at : at + n], visible[at : at + n])
         got.extend((at + i, s) for i, s in closed)
         since.extend(block_since.tolist())
         at += n
         if at >= len(poses):
             break
-    return one, expected, onsets, blocks, got, since
+    return got, since
 
 
 @given(seed=st.integers(0, 10_000), cuts=st.lists(st.integers(1, 40), min_size=1, max_size=12),
@@ -328,18 +335,10 @@ def test_the_compiled_clustering_cuts_where_numpys_steps_cut(monkeypatch):
 
 
 class _Stepped(VelocityDirection):
-    """The reference for ``_walk``: every frame of a block stepped (:meth:`VelocityDirection._step`), as the
-    segmenter does with ``pause`` or ``noise``."""
+    """The reference for ``_walk``: every frame of a block stepped (``_steps``), as the segmenter does with ``pause``
+    or ``noise``."""
 
-    def _walk(self, poses, flat, speeds, floors, sizes):
-        closed, since = [], np.full(len(flat), -1, dtype=int)
-        for f, floor in enumerate(floors.tolist()):
-            self._frame += 1
-            self._history.append(flat[f])
-            closed.extend((f, s) for s in self._step(poses[f], flat[f], float(speeds[f]), floor, sizes[f]))
-            if self._start is not None:
-                since[f] = self._start
-        return closed, since
+    _walk = VelocityDirection._steps
 
 
 @given(seed=st.integers(0, 10_000), cuts=st.lists(st.integers(1, 60), min_size=1, max_size=8),
@@ -363,13 +362,6 @@ def test_a_block_walked_is_its_frames_stepped(seed, cuts, params, hidden):
     for kind in (VelocityDirection, _Stepped):
         seg = kind(**params)
         seg.reset(motion.parts, FPS)
-        got, since, at = [], [], 0
-        for n in [*cuts, len(poses)]:
-            closed, block_since = seg.push_block(poses[at : at + n], visible[at : at + n])
-            got.extend((at + i, s) for i, s in closed)
-            since.extend(block_since.tolist())
-            at += n
-            if at >= len(poses):
-                break
+        got, since = _in_blocks(seg, poses, visible, cuts)
         results.append((got, since, seg.flush(), seg._moving, seg._resting, seg._frame))
     assert results[0] == results[1]

@@ -263,6 +263,14 @@ class VelocityDirection(Segmenter):
             sizes = [None] * n
         if not self._pause and not p["noise"] > 0:  # the rest speed known for the block at once
             return self._walk(poses, flat, speeds, floors, sizes)
+        return self._steps(poses, flat, speeds, floors, sizes)
+
+    def _steps(self, poses: np.ndarray, flat: np.ndarray, speeds: np.ndarray, floors: np.ndarray,
+               sizes: list) -> tuple[list[tuple[int, Segment]], np.ndarray]:
+        """:meth:`_step` for every frame of a block (``flat``: the chosen parts (n, 3m); ``speeds``, ``floors`` and
+        ``sizes``: each frame's speed, jitter floor and body size): the segments closed and the onsets."""
+        closed: list[tuple[int, Segment]] = []
+        since = np.full(len(flat), -1, dtype=int)
         for f, floor in enumerate(floors.tolist()):
             self._frame += 1
             self._history.append(flat[f])
