@@ -235,7 +235,8 @@ def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams:
       rule, not a choice by hand), joined through a rest as a person performs one after another
       (:func:`plugins.bench.joins.join`): the last pose held :data:`REST_HOLD` seconds, a minimum-jerk transition
       of :data:`TRANSITION` seconds or more (at :data:`PACE`) to the next take's first pose (the take moved to
-      stand where the last one stood, facing its way), that pose held again; :data:`LEAD` seconds of rest before the first and after the last;
+      stand where the last one stood, facing its way), that pose held again; :data:`LEAD` seconds of rest before
+      the first and after the last;
     - ``cropped/``, the harder set (the streams of the releases before): any gesture demo, the takes joined end to
       end as they were cropped, so most joins are jumps at full speed in another stance, which no segmenter that
       looks for rest can cut.

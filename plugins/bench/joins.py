@@ -123,7 +123,8 @@ def placed(bvh, values: np.ndarray, after: np.ndarray) -> np.ndarray:
     a, b = after - after.mean(axis=0), first - first.mean(axis=0)
     # the yaw t maximising sum a . Ry(t) b over the floor (x, z): Ry(t) maps (x, z) to (x cos t + z sin t, -x sin t +
     # z cos t), so the sum is cos t * (xa xb + za zb) + sin t * (xa zb - za xb)
-    yaw = float(np.arctan2((a[:, 0] * b[:, 2] - a[:, 2] * b[:, 0]).sum(), (a[:, 0] * b[:, 0] + a[:, 2] * b[:, 2]).sum()))
+    sine, cosine = (a[:, 0] * b[:, 2] - a[:, 2] * b[:, 0]).sum(), (a[:, 0] * b[:, 0] + a[:, 2] * b[:, 2]).sum()
+    yaw = float(np.arctan2(sine, cosine))
     turn = Rotation.from_euler("y", yaw)
     centre = first.mean(axis=0) * [1.0, 0.0, 1.0]
     target = after.mean(axis=0) * [1.0, 0.0, 1.0]

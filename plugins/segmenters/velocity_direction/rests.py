@@ -9,19 +9,21 @@ movement under way only where it is a hub of this demonstrator:
 - near the pose the movement began from, or near any rest they have been seen in (``rest_radius`` body sizes, eq. 1's
   mean distance over the chosen parts): a rest there ends it where the rest began;
 - elsewhere the rest is a *hold* and the movement goes on, unless they leave it (some part farther than twice
-  ``rest_radius``: a movement from it, not a hand fidgeting there) and come to rest near it again later: then it was a new stance (movements leave it and come back to it). The movement is cut where they first rested there,
-  and the one from it back to it follows;
-- or they rest ``settle`` seconds in one place (a new stance they stay in): the movement ends where that rest began.
-
-- or, once they have rested ``STANCE`` seconds at a hold reached by a shift (below) from a hold before it that lasted
-  as long and where the movement had come at least half-way back to its first pose: the movement ended at that hold
-  (a take that ends in another stance than it began, then the shift to the next one's).
+  ``rest_radius``: a movement from it, not a hand fidgeting there) and come to rest near it again later: then it
+  was a new stance (movements leave it and come back to it), if they had held it a stance's time (``stance``; the
+  segmenter's ``STANCE``, 0.2 s). The movement is cut where they first rested there, and the one from it back to it
+  follows;
+- or they rest ``settle`` seconds in one place (a new stance they stay in): the movement ends where that rest began;
+- or they have rested a stance's time at a hold reached by a shift (below) from a hold before it that lasted as
+  long and where the movement had come at least half-way back to its first pose: the movement ended at that hold (a
+  take that ends in another stance than it began, then the shift to the next one's).
 
 A *shift* of stance is not a movement: a piece that goes straight from one rest to another (no part farther from the
 straight line between its first and last positions than ``rest_radius`` body sizes plus a quarter of its way: an arc
-of up to about 100 degrees) is dropped, and one that ends away from where it began with such a shift after a hold ends at the hold. So two takes
-joined through a transition between their stances give the two takes, and a stance change between two gestures
-gives the two gestures.
+of up to about 100 degrees) is dropped, and one that ends away from where it began with such a shift after a hold
+ends at the hold. A piece that never leaves where it began (no part farther than twice ``rest_radius``) is motion at
+rest (sway, fidgeting) and is dropped too. So two takes joined through a transition between their stances give the
+two takes, and a stance change between two gestures gives the two gestures.
 
 Everything here is bookkeeping on frame numbers and the working memory's poses, called by the segmenter only on the
 frames where the demonstrator comes to rest or leaves it.
@@ -124,8 +126,9 @@ class Rests:
         return not near.size or float(near.min()) <= self.radius
 
     def returned(self, pose: np.ndarray, start: int, window: np.ndarray) -> int | None:
-        """The index of the last finished hold near ``pose`` that the demonstrator left (some part farther than twice
-        the radius from it since it ended: a movement from it and back, not a hand fidgeting there) and came back to rest at, or None.
+        """The index of the last finished hold near ``pose`` that the demonstrator held a stance's time, left (some
+        part farther than twice the radius from it since it ended: a movement from it and back, not a hand fidgeting
+        there) and came back to rest at, or None.
         ``window``: the movement's poses from frame ``start`` on."""
         for i in range(len(self.holds) - 1, -1, -1):
             h = self.holds[i]
@@ -150,9 +153,10 @@ class Rests:
     def pieces(self, start: int, end: int, window: np.ndarray, upto: int | None = None,
                shifts: bool = True) -> list[tuple[int, int]]:
         """The movements (start, end) in frames of the stretch from ``start`` to ``end`` (its poses ``window``, one a
-        frame from ``start``) whose holds are ``self.holds[:upto]``: the stretch, dropped if it is a shift of stance
-        (unless not ``shifts``: a reach held for ``settle`` is as much a movement as a shift), or, when it ends away from where
-        it began, ended at its last hold if what follows that hold is a shift (a return is no shift)."""
+        frame from ``start``) whose holds are ``self.holds[:upto]``: none if it never leaves where it began (motion at
+        rest); the stretch if it comes back there; dropped if it is a shift of stance (unless not ``shifts``: a reach
+        held for ``settle`` is as much a movement as a shift); or ended at its last hold if what follows that hold is
+        a shift."""
         holds = [h for h in self.holds[:upto] if h.end is not None and start < h.start and h.end < end]
         if not self.leaves(window[: end - start]):  # motion at rest (sway, a hand fidgeting): no movement
             return []
