@@ -123,27 +123,29 @@ class VelocityDirection(Segmenter):
                   "segmented (0: none).", minimum=0.0),
         Parameter("angle_scale", float, 0.25, "Metres one radian of a finger's joint angles counts as (0.25: a finger "
                   "turning at 0.6 rad/s moves as fast as a wrist at 0.15 m/s).", minimum=0.0, length=True),
-        Parameter("level", str, "stroke", "Report strokes (break points) or whole movements (onset to end).",
-                  choices=("stroke", "movement")),
+        Parameter("level", str, "stroke", "Report strokes (break points) or whole movements (onset to end; a walk, "
+                  "which never rests, is one movement).", choices=("stroke", "movement")),
         Parameter("units", str, "metres", "The rest speed in m/s (`rest_speed`, the paper) or in the demonstrator's "
                   "body sizes per second (`size_rest_speed`).", choices=("metres", "body")),
         Parameter("size_rest_speed", float, 0.1, "With units = body: the rest speed in body sizes per second (the "
                   "root-mean-square distance of the parts from their centroid, running mean over the poses seen).",
                   minimum=0.0),
         Parameter("noise", float, 0.0, "The rest speed is at least this many times the slowest the demonstrator "
-                  "has been over the last `floor` seconds (0: off, the paper).", minimum=0.0),
+                  "has been over the last `floor` seconds (0: off, the paper; in a walk that is a stride's slow "
+                  "phase, so walks are cut into strides).", minimum=0.0),
         Parameter("floor", float, 10.0, "Seconds over which the slowest speed is taken for `noise`.", minimum=0.1),
         Parameter("pause", float, 0.0, "Seconds the speed is averaged over before it is compared with the rest "
                   "speed: a movement begins and ends at a rest of about this long (0: the sensory memory, the "
                   "paper).", minimum=0.0),
-        Parameter("end", str, "still", "Where a movement ends: at any rest (`still`, the paper) or only at a rest "
-                  "near the pose it began from, or after `settle` seconds of rest elsewhere (`rest`).",
-                  choices=("still", "rest")),
+        Parameter("end", str, "still", "Where a movement ends: at any rest (`still`, the paper) or only at one of "
+                  "the demonstrator's own rests (`rest`): near where it began or another rest they were seen in, a "
+                  "stance they left and came back to, or after `settle` seconds; a rest elsewhere is a hold, and a "
+                  "straight shift of stance is no movement.", choices=("still", "rest")),
         Parameter("rest_radius", float, 0.1, "With end = rest: how near (eq. 1's mean distance of the chosen parts, "
-                  "in the demonstrator's body sizes) the pose must be to the one the movement began from for a rest "
-                  "to end it (0.1: B&B's hub threshold, 0.02 m on Max).", minimum=0.0),
-        Parameter("settle", float, 2.0, "With end = rest: seconds of rest away from where the movement began after "
-                  "which it ends anyway (a new stance: longer than a gesture holds a pose).", minimum=0.0),
+                  "in the demonstrator's body sizes) a pose at rest must be to one of their rests to be there; twice "
+                  "it, for one part, is leaving (0.1: B&B's hub threshold, 0.02 m on Max).", minimum=0.0),
+        Parameter("settle", float, 2.0, "With end = rest: seconds of rest away from the demonstrator's rests after "
+                  "which a movement ends anyway (a new stance: longer than a gesture holds a pose).", minimum=0.0),
         Parameter("window", float, 0.0, "Seconds over which each part's velocity is the slope of a least-squares "
                   "line through its positions (a tracker's jitter averaged out; 0: the displacement over the sensory "
                   "memory, the paper).", minimum=0.0),
