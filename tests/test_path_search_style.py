@@ -163,6 +163,7 @@ def test_max_recognises_his_own_movements_performed_stooped_larger_and_slower_on
     each past max_distance (about 0.04 m per sample against 0.03), so every one is "unknown"; compared about their
     own posture and at the repertoire's amplitude, each is the movement performed."""
     matcher = max_character.matcher
+    matcher.params = {**matcher.params, "max_distance": 0.03}  # path search's own (max.toml allows 0.04 for his eye)
     stoop = np.zeros((max_character.body.n_parts, 3))
     stoop[[i for i, p in enumerate(max_character.body.parts) if p != max_character.body.root]] = (0.0, -0.04, 0.03)
 
@@ -203,6 +204,7 @@ def test_max_recognises_his_arm_movements_from_a_wide_stooped_stance_larger_and_
     max_distance; with the still parts' posture removed and the amplitude brought to the repertoire's, each is the
     movement performed (the hands, which move, are still compared where they are)."""
     matcher = max_character.matcher
+    matcher.params = {**matcher.params, "max_distance": 0.03}  # path search's own (max.toml allows 0.04 for his eye)
     parts = max_character.body.parts
     stance = np.zeros((len(parts), 3))
     for part, offset in STANCE.items():

@@ -234,8 +234,10 @@ class Behaviour:
     """What an observer believes the target is doing and why (Buchsbaum & Blumberg §6).
 
     ``known`` is false for an explicit "I don't know" (the shrug). ``learned`` holds what the observer learned
-    from it: the category each object kind affords (``{"ice_cream": "food"}``, §6.3); ``details`` is the action
-    system's own (the paths it tried, the line of sight).
+    from it: the category each object kind affords (``{"ice_cream": "food"}``, §6.3). ``seen_as``: why each object
+    named was taken for what it was (its kind and the look that told it, §4.2); ``in_sight``: the objects in the
+    target's line of sight as the observer read it, with how far each lay off the gaze (degrees, §6.1.2). A report
+    shows these; ``details`` is the action system's own (the paths it tried, the line of sight).
     """
 
     known: bool
@@ -247,6 +249,8 @@ class Behaviour:
     prediction: tuple[str, ...] = ()
     details: Mapping[str, Any] = field(default_factory=dict)
     learned: Mapping[str, str] = field(default_factory=dict)
+    seen_as: Mapping[str, str] = field(default_factory=dict)
+    in_sight: Mapping[str, float] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

@@ -75,6 +75,10 @@ class WorldObject:
         self.position = np.asarray(self.position, dtype=float).reshape(3)
 
 
+def _copy_object(obj: WorldObject) -> WorldObject:
+    return WorldObject(obj.name, obj.kind, obj.position.copy(), obj.radius, obj.colour, obj.held_by, dict(obj.properties))
+
+
 @dataclass(frozen=True)
 class Event:
     """Something that happened in a run: ``kind`` is the hook's name without ``likeme_``."""
@@ -443,13 +447,16 @@ class World:
         self.events: list[Event] = []
         self.pm = pm
         self.history_seconds = 120.0
-        """Seconds of what an actor saw of the objects around its target (:attr:`Actor.sightings`) it keeps."""
+        """Seconds of the objects' past kept (:meth:`objects_at`) and of what an actor saw of the objects around its
+        target (:attr:`Actor.sightings`)."""
         self.memory_seconds: float | None = 120.0
         """Seconds of its working memory an actor keeps beyond the segment under way and what its components still
         need (:class:`toolkit.watching.WatchingLoop`'s ``keep``), read when it begins watching; ``None``: every row
         since it began (``likeme bench watch`` matches every true segment from memory at the end)."""
+        self._removed: dict[str, WorldObject] = {}
         self._policy_key: tuple | None = None
         self._policy_cm: Any = None
+        self._history: dict[int, dict[str, tuple[np.ndarray, str | None]]] = {}
 
     @property
     def time(self) -> float:
@@ -519,14 +526,40 @@ class World:
                 if obj.held_by is not None and obj.held_by in self.actors:
                     holder = self.actors[obj.held_by]
                     obj.position = holder.world_pose()[holder.body.index(obj.properties.get("held_in", holder.body.root))]
+            self._remember()
             for actor in self.actors.values():
                 if actor.target is not None:
                     actor._observe()
             self.announce("likeme_world_stepped", world=self)
 
+    def _remember(self) -> None:
+        self._history[self.frame] = {n: (o.position.copy(), o.held_by) for n, o in self.objects.items()}
+        self._history.pop(self.frame - int(self.history_seconds * self.fps), None)
+
+    def objects_at(self, frame: int) -> dict[str, WorldObject]:
+        """The objects as they were at a past ``frame`` (within ``history_seconds``): copies, for "what was there then".
+
+        Objects that did not exist then are absent; a frame older than the history gives the oldest remembered.
+        """
+        if frame >= self.frame or not self._history:
+            return {n: _copy_object(o) for n, o in self.objects.items()}
+        frame = max(frame, min(self._history))
+        state = self._history.get(frame, {})
+        out = {}
+        for name, (position, held_by) in state.items():
+            source = self.objects.get(name) or self._removed.get(name)
+            if source is None:
+                continue
+            obj = _copy_object(source)
+            obj.position, obj.held_by = position.copy(), held_by
+            out[name] = obj
+        return out
+
     def remove_object(self, name: str) -> WorldObject:
-        """Take an object out of the world (eaten)."""
-        return self.objects.pop(name)
+        """Take an object out of the world (eaten); its past stays in the history."""
+        obj = self.objects.pop(name)
+        self._removed[name] = obj
+        return obj
 
     def run(
         self,

@@ -35,13 +35,14 @@ def _read_recording(path: str) -> tuple[list[str], Any, list[int] | None, float 
     hierarchy (BVH) or None, frame rate (None: the file does not tell) and number of frames."""
     import numpy as np
 
-    from toolkit.recordings import open_recording
+    from toolkit.recordings import SUFFIXES, open_recording
 
+    named = tuple(s for s in SUFFIXES if s != ".npy")  # a .npy array has no joint names to propose parts from
     suffix = Path(path).suffix.lower()
-    if suffix not in (".bvh", ".csv", ".c3d"):  # a .npy array has no joint names to propose parts from
+    if suffix not in named:
         raise ConfigError(f"cannot propose a profile for a {suffix or 'suffix-less'} file", file=path, key=("FILE",),
                           expected="a BVH file, a CSV of joint positions or a C3D file (a .npy array has no joint "
-                                   "names)", available=(".bvh", ".csv", ".c3d"))
+                                   "names)", available=named)
     with open_recording(path, need_fps=False) as recording:  # the proposal needs no frame rate
         kept, count = [], 0
         for block in recording.blocks():

@@ -11,7 +11,7 @@ then root-relative coordinates. All functions are vectorised over leading frame 
 
 The transform and the running median take quick paths in a watching loop (the rotation written out instead of an
 einsum, the middle of each window read off its sorted estimates, no masking where nothing is hidden); each gives the
-same bits as the formula it replaces (``tests/test_root_frame_fast.py`` compares them byte for byte).
+same bits as the formula it replaces (``tests/plugins/lib/test_root_frame_fast.py`` compares them byte for byte).
 """
 
 from __future__ import annotations

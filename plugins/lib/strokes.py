@@ -105,7 +105,7 @@ def direction_clusters(vectors: np.ndarray, angle: float, max_clusters: int = 12
     rounds). The means are one array (k, D); each similarity matrix ``vectors @ means.T`` is computed once for the
     means it belongs to, and a round whose labels are those of the round before ends the re-averaging at once (its
     means would be the same values, which the formula's test then finds close). The same labels as the formula
-    written out cluster by cluster (``tests/test_strokes_clusters.py`` holds it to that formula).
+    written out cluster by cluster (``tests/plugins/lib/test_strokes_clusters.py`` holds it to that formula).
 
     With numba, each re-averaging round is two compiled calls (:func:`_relabel`, :func:`_renormed`) around the two
     products that stay numpy's (the similarity matrix and the means' dot products with themselves, BLAS's bits).
@@ -337,7 +337,8 @@ def _units(vectors: np.ndarray) -> np.ndarray:
 def _dots(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``[u.dot(v) for u, v in zip(a, b)]`` of two (N, D) arrays as one array: a stack of (1, D) @ (D, 1) products,
     which numpy's matmul hands to the same BLAS dot product a vector's ``dot`` calls (``np.linalg.norm`` of a vector
-    too), so the same bits (``tests/test_strokes_clusters.py``); not ``einsum``, which sums in another order."""
+    too), so the same bits (``tests/plugins/lib/test_strokes_clusters.py``); not ``einsum``, which sums in another
+    order."""
     return np.matmul(a[:, None, :], b[:, :, None])[:, 0, 0]
 
 
@@ -354,7 +355,7 @@ def _smoothed(window: np.ndarray, length: int) -> np.ndarray:
     the same steps with what depends on ``length`` and D only computed once (:func:`_savgol_plan`): the filter's
     coefficients convolved over the window, and at each end a quadratic fitted to the ``length`` end rows (the
     scaled Vandermonde matrix, LAPACK's gelsd with the workspace scipy.linalg.lstsq asks for) and evaluated by
-    Horner's rule. ``tests/test_strokes_clusters.py`` holds it to savgol_filter bit for bit."""
+    Horner's rule. ``tests/plugins/lib/test_strokes_clusters.py`` holds it to savgol_filter bit for bit."""
     from scipy.ndimage import convolve1d
 
     coeffs, lhs, scale, gelsd, lwork, iwork, rcond, at = _savgol_plan(length, window.shape[1])

@@ -89,6 +89,22 @@ def test_the_report_says_shrugs_only_when_the_observer_shrugged():
     assert "did: shrug at" in out
 
 
+def test_the_report_says_what_was_in_sight_from_the_behaviours_typed_fields():
+    """What the objects were taken for and what lay in the target's line of sight come from ``Behaviour.seen_as``
+    and ``Behaviour.in_sight``: the ball by the cheese, both in Morris's line of sight (B&B §7.3.1)."""
+    status, out, err = likeme("run", "--json", "objects_close_together")
+    assert status == 0, err
+    (max_,) = [a for a in json.loads(out)["actors"] if a["id"] == "max"]
+    reach, eat = max_["watching"]["behaviours"]
+    assert sorted(reach["in_sight"]) == ["ball", "cheese"] and all(v >= 0 for v in reach["in_sight"].values())
+    assert reach["object"] == "ball" and list(reach["seen_as"]) == ["ball"]
+    assert reach["seen_as"]["ball"].startswith("ball: colour #ff4040 is 0 from ball")
+    assert eat["object"] == "cheese" and list(eat["in_sight"]) == ["ball"]
+    status, out, err = likeme("run", "objects_close_together")
+    assert "the ball was taken for a ball (colour #ff4040 is 0 from ball" in out
+    assert "the cheese and the ball were both in morris's line of sight" in out
+
+
 def test_behaviour_sentence_without_a_response_names_no_response():
     b = {"known": False, "movement": "jump", "response": None}
     assert behaviour_sentence("Max", "morris", b) == "Max does not know why morris did jump"

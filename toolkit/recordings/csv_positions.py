@@ -122,7 +122,7 @@ def _layout(path: Path, names: tuple[str, ...] | None) -> _Layout:
 
 
 def parse_header(line: str, path: Path, names: tuple[str, ...] | None) -> _Layout:
-    """A header line's layout (also the header of CSV lines on standard input, :mod:`toolkit.live`)."""
+    """A header line's layout (also the header of CSV lines on standard input, :mod:`toolkit.recordings.live`)."""
     if not line.strip():
         raise ConfigError("no header line" if not line else "the header line is empty", file=path, line=1,
                           expected="a header naming the columns JOINT_x, JOINT_y, JOINT_z of each joint")
