@@ -81,6 +81,50 @@ def test_every_file_the_docs_name_exists():
             assert (ROOT / path).is_file(), f"{doc.name} names {path}, which does not exist"
 
 
+def _anchors(page):
+    """The anchors of a Markdown page's headings as GitHub makes them: lower case, punctuation dropped, spaces to
+    hyphens, ``-1``, ``-2`` after a repeated one (headings inside fenced code are none); and its ``<a id="...">``."""
+    text = page.read_text()
+    anchors, seen, fenced = set(re.findall(r'<a id="([^"]+)"></a>', text)), {}, False
+    for line in text.splitlines():
+        if line.startswith("```"):
+            fenced = not fenced
+        heading = None if fenced else re.match(r"#{1,6}\s+(.*)", line)
+        if heading:
+            anchor = re.sub(r"[^\w\- ]", "", heading.group(1).strip().lower()).replace(" ", "-")
+            anchors.add(f"{anchor}-{seen[anchor]}" if anchor in seen else anchor)
+            seen[anchor] = seen.get(anchor, 0) + 1
+    return anchors
+
+
+def test_anchors_are_made_as_github_makes_them(tmp_path):
+    page = tmp_path / "page.md"
+    page.write_text("# Max watches Morris (B&B §5)\n## The posegraph's pose index\n```sh\n# a comment\n```\n"
+                    '## Memory\n<a id="memory-issue-12"></a>\n### Memory\n')
+    assert _anchors(page) == {"max-watches-morris-bb-5", "the-posegraphs-pose-index", "memory", "memory-1",
+                              "memory-issue-12"}
+
+
+def test_every_link_to_a_heading_finds_it():
+    """A link ``[...](PAGE.md#anchor)`` or ``[...](#anchor)`` in README.md, docs/ or the code names a heading the
+    page has (a renamed or removed section breaks no link)."""
+    pages = {p.name: p for p in [ROOT / "README.md", *(ROOT / "docs").glob("*.md")]}
+    anchors = {}
+    sources = [*pages.values(), *[p for room in ("toolkit", "plugins", "likeme", "tests", "characters")
+                                  for p in (ROOT / room).rglob("*") if p.suffix in (".py", ".toml", ".md")]]
+    broken = []
+    for source in sources:
+        for target, anchor in re.findall(r"\]\(([\w./-]*\.md)?#([^)\s]+)\)", source.read_text(errors="replace")):
+            name = target.rsplit("/", 1)[-1] if target else source.name
+            if name not in pages:
+                continue
+            if name not in anchors:
+                anchors[name] = _anchors(pages[name])
+            if anchor not in anchors[name]:
+                broken.append(f"{source.relative_to(ROOT)}: {target}#{anchor}")
+    assert not broken, f"links to headings that are not there: {broken}"
+
+
 def _examples_table():
     """The rows of docs/examples.md's table of the papers' worked examples, each a list of its cells."""
     text = (ROOT / "docs" / "examples.md").read_text()
