@@ -1,0 +1,220 @@
+"""What a matcher compares: a demonstration's frames against one's own, frame by frame (the *comparison*).
+
+A matcher is a comparison, a search and a decision (``docs/matchers.md``). The comparison turns a sequence of
+root-relative poses into *frames* (:class:`Frames`) and gives the distance of every frame of one sequence to every
+frame of another (:meth:`Comparison.costs`); the search aligns the two sequences through time, and the decision
+says whether the best alignment is near enough to be a known movement. Two comparisons, chosen once, when a matcher
+is attached (``comparison = "poses"`` or ``"motion"``):
+
+:class:`Poses` (the papers)
+    Buchsbaum & Blumberg 2005, §5.1, eq. 1: the mean over the parts seen of the Euclidean distance between the two
+    root-relative positions of each part (eq. 2), in metres. Where a hand is held is what counts; how it moves is
+    seen only through the sequence of places.
+
+:class:`Motion` (real people, the observer template's)
+    Each part is seen by *where it goes*, *how it moves* and *how the body carries it*, in the demonstrator's own
+    body sizes, so that a tall and a short performer, a stooped and an upright one, compare alike:
+
+    - **shape**: the part's position about its own mean over the sequence (the held posture removed: a stoop, a hand
+      held higher through a wave cancel; the excursion of the movement stays), over the body size;
+    - **motion**: the part's velocity relative to the root in the body's frame, times :data:`HORIZON` seconds, over
+      the body size: the displacement it is making. What tells a wave from a raise of the same hand is this: the
+      reversals of a wave, which positions barely show. The velocity is a Savitzky-Golay derivative
+      (:mod:`plugins.lib.velocity`), so a tracker's frame-to-frame jitter does not pass for motion;
+    - **carry**: where the body goes and where it turns, which root-relative coordinates (§5.1) leave out and which
+      move every part alike: the root's velocity in the body's own frame times :data:`HORIZON` over the body size
+      (a walk forward, backward, sideways; a run), and the turn since the sequence began as the chord
+      ``(cos θ - 1, sin θ)`` a point one body size ahead of the root moves along (a walk that turns left or right).
+
+    The distance of two frames is eq. 1 over these: the mean, over the parts seen in both, of the Euclidean norm of
+    each part's difference in shape, motion and carry together (every part is carried by the body, so the carry
+    enters each part's norm). Unit-free: one body size is 1. Nothing in it depends on the frame rate, which is taken
+    out by the derivative, nor on the tempo, which the search's time warping takes up.
+
+:data:`HORIZON` is 0.25 s: motion and shape count alike for a part swinging at ``1 / (2π · 0.25 s)``, about
+0.64 Hz, the middle of the frequencies of human gestures and steps (half a hertz to a few hertz), so neither
+outweighs the other for any of them. It was not chosen on data (``docs/matchers.md``).
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from plugins.lib.body_size import body_scale
+from plugins.lib.velocity import derivative
+
+__all__ = ["COMPARISONS", "Comparison", "Frames", "HORIZON", "Motion", "Poses", "comparison", "sequence_size"]
+
+HORIZON = 0.25
+"""Seconds over which a velocity counts as a displacement (the motion and the travel of :class:`Motion`)."""
+
+@dataclass(frozen=True)
+class Frames:
+    """A sequence as a comparison sees it.
+
+    Attributes
+    ----------
+    parts : array, shape (n, P, D)
+        Each part's features per frame (:class:`Poses`: its position, D = 3; :class:`Motion`: shape and motion,
+        D = 6).
+    seen : array of bool, shape (n, P)
+        The parts seen in each frame; a frame with none seen carries no evidence.
+    carry : array, shape (n, C)
+        The body's features, shared by every part (:class:`Motion`'s travel and turn, C = 5; C = 0 for
+        :class:`Poses`).
+    carried : array of bool, shape (n,)
+        Whether the carry is known (where the body goes needs its world positions).
+    """
+
+    parts: np.ndarray
+    seen: np.ndarray
+    carry: np.ndarray
+    carried: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.parts)
+
+    def take(self, rows: np.ndarray | slice) -> Frames:
+        """The frames ``rows`` of this sequence."""
+        return Frames(self.parts[rows], self.seen[rows], self.carry[rows], self.carried[rows])
+
+    @staticmethod
+    def join(sequences: list[Frames]) -> Frames:
+        """Sequences one after another (each keeps the features it was given: a take's shape about its own mean)."""
+        return Frames(*(np.concatenate([getattr(s, f) for s in sequences]) for f in
+                        ("parts", "seen", "carry", "carried")))
+
+
+class Comparison(ABC):
+    """How frames are compared: :meth:`frames` of a sequence, :meth:`costs` between two."""
+
+    name: ClassVar[str]
+    unit: ClassVar[str]
+    """What a distance is measured in ("m": metres; "body": the demonstrator's body sizes)."""
+
+    @abstractmethod
+    def frames(self, poses: np.ndarray, visible: np.ndarray, fps: float, *, velocity: np.ndarray | None = None,
+               travel: np.ndarray | None = None, heading: np.ndarray | None = None,
+               size: float | None = None) -> Frames:
+        """The frames of a sequence of root-relative poses.
+
+        Parameters
+        ----------
+        poses : array, shape (n, P, 3)
+            Root-relative poses in the body's frame (hidden parts held where last seen, NaN if never seen).
+        visible : array of bool, shape (n, P)
+        fps : float
+            Frames per second of the sequence.
+        velocity : array, shape (n, P, 3), optional
+            Each part's velocity relative to the root (m/s), where it is known better than from ``poses`` (a
+            posegraph's nodes keep their clip's, measured at the clip's frame rate); ``None``: derived here.
+        travel : array, shape (n, 3), optional
+            The root's velocity in the body's own frame (m/s); ``None`` or NaN rows: not known.
+        heading : array, shape (n,), optional
+            The body's heading (radians, about +y) relative to the sequence's first frame; ``None`` or NaN: not known.
+        size : float, optional
+            The body size the lengths are measured in (:func:`plugins.lib.body_size.body_scale`); ``None``: from
+            the sequence's own median pose.
+        """
+
+    def costs(self, a: Frames, b: Frames) -> np.ndarray:
+        """Every frame of ``a`` against every frame of ``b``: eq. 1 over the parts seen in both, (len(a), len(b)).
+        A pair with no part seen in both costs 0 (no evidence either way)."""
+        diff2 = _pairwise_sq(a.parts, b.parts)  # (n, m, P)
+        if a.carry.shape[1]:
+            both = a.carried[:, None] & b.carried[None, :]
+            carry2 = np.where(both, _pairwise_sq(a.carry[:, None], b.carry[:, None])[..., 0], 0.0)
+            diff2 += carry2[..., None]
+        d = np.sqrt(np.maximum(diff2, 0.0, out=diff2), out=diff2)
+        seen = a.seen[:, None, :] & b.seen[None, :, :]
+        count = seen.sum(axis=-1)
+        total = np.einsum("nmp,nmp->nm", d, seen)
+        return np.where(count > 0, total / np.maximum(count, 1), 0.0)
+
+    def still(self, frames: Frames) -> np.ndarray:
+        """Each frame's distance to standing still (every feature zero): how much there is to explain, (n,).
+
+        For :class:`Motion`, the share of a demonstration that a movement leaves unexplained is its distance over
+        this one (:mod:`plugins.matchers.decision`)."""
+        norm2 = np.einsum("npd,npd->np", frames.parts, frames.parts)
+        if frames.carry.shape[1]:
+            norm2 = norm2 + np.where(frames.carried, np.einsum("nc,nc->n", frames.carry, frames.carry), 0.0)[:, None]
+        d = np.sqrt(norm2)
+        count = frames.seen.sum(axis=1)
+        return np.where(count > 0, (d * frames.seen).sum(axis=1) / np.maximum(count, 1), 0.0)
+
+
+def _pairwise_sq(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Squared Euclidean distances of (n, P, D) against (m, P, D), per part: (n, m, P)."""
+    aa = np.einsum("npd,npd->np", a, a)
+    bb = np.einsum("mpd,mpd->mp", b, b)
+    ab = np.einsum("npd,mpd->nmp", a, b)
+    return aa[:, None, :] + bb[None, :, :] - 2.0 * ab
+
+
+class Poses(Comparison):
+    """Buchsbaum & Blumberg 2005, eq. 1-2: root-relative positions, in metres (the papers)."""
+
+    name = "poses"
+    unit = "m"
+
+    def frames(self, poses, visible, fps, *, velocity=None, travel=None, heading=None, size=None) -> Frames:
+        poses = np.asarray(poses, dtype=float)
+        seen = np.asarray(visible, dtype=bool) & np.isfinite(poses).all(axis=-1)
+        n = len(poses)
+        return Frames(np.where(seen[..., None], poses, 0.0), seen, np.zeros((n, 0)), np.zeros(n, dtype=bool))
+
+
+class Motion(Comparison):
+    """Shape, motion and carry of every part, in body sizes (see the module)."""
+
+    name = "motion"
+    unit = "body"
+
+    def frames(self, poses, visible, fps, *, velocity=None, travel=None, heading=None, size=None) -> Frames:
+        poses = np.asarray(poses, dtype=float)
+        seen = np.asarray(visible, dtype=bool) & np.isfinite(poses).all(axis=-1)
+        n = len(poses)
+        filled = np.where(seen[..., None], poses, 0.0)
+        if size is None:
+            size = sequence_size(filled, seen)
+        scale = 1.0 / size if size > 0 else 0.0
+        counts = seen.sum(axis=0)
+        mean = (filled * seen[..., None]).sum(axis=0) / np.maximum(counts, 1)[:, None]
+        shape = (filled - mean) * scale
+        if velocity is None:
+            velocity = derivative(filled, fps)
+        motion = np.nan_to_num(np.asarray(velocity, dtype=float)) * (HORIZON * scale)
+        carry = np.zeros((n, 5))
+        carried = np.zeros(n, dtype=bool)
+        if travel is not None and heading is not None:
+            travel = np.asarray(travel, dtype=float)
+            heading = np.asarray(heading, dtype=float)
+            carried = np.isfinite(travel).all(axis=1) & np.isfinite(heading)
+            carry[:, :3] = np.where(carried[:, None], travel, 0.0) * (HORIZON * scale)
+            turn = np.where(carried, heading, 0.0)
+            carry[:, 3] = np.cos(turn) - 1.0
+            carry[:, 4] = np.sin(turn)
+        return Frames(np.concatenate([shape, motion], axis=2), seen, carry, carried)
+
+
+def sequence_size(poses: np.ndarray, seen: np.ndarray) -> float:
+    """A sequence's body size: :func:`plugins.lib.body_size.body_scale` of each part's median position over the
+    frames it is seen (0 when fewer than two parts are ever seen)."""
+    med = np.full(poses.shape[1:], np.nan)
+    for p in np.flatnonzero(seen.any(axis=0)):
+        med[p] = np.median(poses[seen[:, p], p], axis=0)
+    return float(body_scale(med))
+
+
+COMPARISONS: dict[str, type[Comparison]] = {"poses": Poses, "motion": Motion}
+"""The comparisons by the name a matcher's ``comparison`` parameter takes."""
+
+
+def comparison(name: str) -> Comparison:
+    """The comparison called ``name`` (:data:`COMPARISONS`)."""
+    return COMPARISONS[name]()
