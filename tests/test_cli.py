@@ -56,6 +56,20 @@ def test_plugins_json_and_params():
     assert plugins["script"]["hooks"] == ["likeme_register_action_systems"]
 
 
+def test_plugins_params_show_a_parameters_own_table_nested():
+    """Options that only mean something together are a table of their own: ``--params`` lists its keys under it,
+    indented, and ``--json`` nests them in its row."""
+    data = json.loads(likeme("plugins", "--json", "--params").stdout)
+    mapping = {c["name"]: c for c in data["components"]["correspondence"]}["body-mapping"]
+    dwell = {p["name"]: p for p in mapping["parameters"]}["dwell"]
+    assert dwell["type"] == "table of speed, window, memory"
+    assert [p["name"] for p in dwell["parameters"]] == ["speed", "window", "memory"]
+    lines = likeme("plugins", "--params").stdout.splitlines()
+    at = lines.index(next(line for line in lines if line.startswith("      dwell: table of speed, window, memory.")))
+    assert [line.split(":")[0] for line in lines[at + 1: at + 4]] == ["          speed", "          window",
+                                                                     "          memory"]
+
+
 def test_validate_builtin_characters_and_scenarios():
     files = sorted(CHARACTERS.glob("*.toml")) + sorted((CHARACTERS / "scenarios").glob("*.toml"))
     result = likeme("validate", *files)

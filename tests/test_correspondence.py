@@ -256,10 +256,11 @@ def test_observe_says_why_a_segment_is_unknown(generated, capsys):
 
     segments = json.loads(capsys.readouterr().out)[0]["segments"]
     assert segments and all(s["movement"] == "unknown" for s in segments)
-    assert all(s["reason"] == "too far from every path" and s["nearest"] and s["mean_distance"] > 0 for s in segments)
+    assert all(s["reason"] == "too far from every path" and s["nearest"] and s["score"] > s["threshold"] == 0
+               and s["measure"] == "mean pose distance along the path (eq. 3)" for s in segments)
     assert main(["observe", str(demo), "--body", str(profile), "--repertoire", str(generated / "repertoire"),
                  "--set", "matcher.max_distance=0"]) == 0
-    assert "rejected: too far from every path (mean_distance" in capsys.readouterr().out
+    assert "rejected: too far from every path (mean pose distance along the path (eq. 3) 0." in capsys.readouterr().out
 
 
 def test_observe_json_ranks_the_forward_models_candidates(generated, capsys):

@@ -311,3 +311,17 @@ def test_errors(data):
 
     with pytest.raises(NotFittedError):
         MovementClassifier(profile).predict(X)
+
+
+def test_a_parameters_own_table_is_set_key_by_key(data):
+    """A parameter's own table (body-mapping's ``dwell``) is reached as ``TABLE__NAME__KEY``: each key alone, the
+    others left at what they were; the table itself is not a parameter of its own."""
+    _, profile = data
+    clf = MovementClassifier(profile, correspondence="body-mapping").set_params(correspondence__dwell__speed=0.2)
+    params = clf.get_params()
+    assert params["correspondence__dwell__speed"] == 0.2 and params["correspondence__dwell__window"] == 0.5
+    assert "correspondence__dwell" not in params
+    assert clf.settings == {"correspondence": {"dwell": {"speed": 0.2}}}
+    assert clone(clf).get_params() == params
+    with pytest.raises(EstimatorInputError, match="correspondence__dwell__sped"):
+        clf.set_params(correspondence__dwell__sped=1.0)

@@ -272,6 +272,10 @@ def test_observe_prints_segments_and_json(data, capsys):
     assert [s["movement"] for s in report[0]["segments"]][: len(truth)].count("unknown") <= 1
     assert {"start_frame", "end_frame", "start_s", "end_s", "confidence", "decision_fraction"} <= set(
         report[0]["segments"][0])
+    # why each segment ends, as the segmenter said (Segment.reason): hub-threshold's hub, or the stream's end
+    ends = [s["ends"] for s in report[0]["segments"]]
+    assert ends and set(ends) <= {"back near a hub pose", "came to rest", "the stream ended"}
+    assert text.count("\n    ends: ") == len(ends)
 
 
 @pytest.mark.parametrize(
@@ -398,14 +402,15 @@ def test_a_plugin_named_instead_takes_its_own_table_of_the_template(data, profil
         plugin = "path-search"
         [matchers.dtw]
         window = 0.25
-        [motors.motor-command-graph]
+        [motors.motor-command-graph.strokes]
         drop = 0.4
         """)
     dtw = compose_observer(pm, profile, data / "repertoire", matcher="dtw", template=mine)
     assert dtw.matcher.params["window"] == 0.25
     assert compose_observer(pm, profile, data / "repertoire", template=mine).matcher.name == "path-search"
     follows = compose_observer(pm, profile, data / "repertoire", matcher="forward-model", template=mine)
-    assert follows.motor.name == "motor-command-graph" and follows.motor.params["drop"] == 0.4  # brought along
+    assert follows.motor.name == "motor-command-graph" and follows.motor.params["strokes"] == {"drop": 0.4,
+                                                                                                "angle": 50.0}
 
 
 def test_naming_the_templates_own_matcher_keeps_its_parameters_and_another_starts_afresh(data, profile, pm):

@@ -72,3 +72,76 @@ def test_a_setting_nested_too_deep_is_refused():
     for depth in (33, 5000):
         with pytest.raises(ConfigError, match="key --set: value of 'keys' nested more than 32 levels deep"):
             parse_settings([f"keys={'[' * depth}{']' * depth}"], tables=False)
+
+
+# -- a parameter's own table: options that only mean something together --------------------------------------------
+
+DWELL = (
+    Parameter("rest", str, "dwell", "how the rest is found", choices=("dwell", "none")),
+    Parameter("dwell", doc="with rest = dwell", parameters=(
+        Parameter("speed", float, 0.05, "slow enough", minimum=0.0, length=True),
+        Parameter("window", float, 0.5, "smoothing", minimum=0.0),
+    )),
+)
+
+
+def test_a_table_comes_back_whole_with_its_defaults():
+    assert DWELL[1].table and DWELL[1].type is dict and DWELL[1].default == {"speed": 0.05, "window": 0.5}
+    assert validate_params("correspondence 'c'", DWELL, {}) == {"rest": "dwell", "dwell": {"speed": 0.05, "window": 0.5}}
+    out = validate_params("correspondence 'c'", DWELL, {"dwell": {"window": 2}})
+    assert out["dwell"] == {"speed": 0.05, "window": 2.0} and isinstance(out["dwell"]["window"], float)
+    assert DWELL[1].describe() == "table of speed, window"
+
+
+@pytest.mark.parametrize("values, message", [
+    ({"dwell": {"sped": 1.0}}, r"key dwell.sped: unknown parameter 'sped' in table 'dwell' of correspondence 'c'; "
+                               r"expected a parameter of table 'dwell' of correspondence 'c'; available: speed, window"),
+    ({"dwell": {"speed": -1.0}}, r"key dwell.speed: value -1.0 out of range; expected a number in \[0, inf\]"),
+    ({"dwell": 0.05}, r"key dwell: wrong type float \(value 0.05\); expected a table of speed, window"),
+])
+def test_a_bad_key_of_a_table_is_named_with_its_path(values, message):
+    with pytest.raises(ConfigError, match=message):
+        validate_params("correspondence 'c'", DWELL, values)
+
+
+def test_lengths_inside_a_table_are_scaled_with_the_body():
+    from toolkit.params import length_names, scaled
+
+    assert length_names(DWELL) == [("dwell", "speed")]
+    values = validate_params("correspondence 'c'", DWELL, {})
+    assert scaled(values, length_names(DWELL), 2.0) == {"rest": "dwell", "dwell": {"speed": 0.1, "window": 0.5}}
+    assert values["dwell"]["speed"] == 0.05  # the values as declared are left alone
+
+
+def test_set_reaches_inside_a_table_and_is_checked_there(pm):
+    from toolkit.params import check_settings, parse_settings
+
+    settings = parse_settings(["correspondence.dwell.speed=0.2", "correspondence.dwell.window=1", "correspondence.rest=none"])
+    assert settings == {"correspondence": {"dwell": {"speed": 0.2, "window": 1}, "rest": "none"}}
+    plugins = {"correspondence": ["body-mapping"]}
+    check_settings(settings, pm, plugins)
+    with pytest.raises(ConfigError, match=r"key --set.correspondence.dwell.sped: unknown parameter 'sped' in table "
+                                          r"'dwell' of correspondence 'body-mapping'.*available: memory, speed, window"):
+        check_settings(parse_settings(["correspondence.dwell.sped=0.2"]), pm, plugins)
+    with pytest.raises(ConfigError, match=r"given both a value and keys"):
+        parse_settings(["correspondence.dwell=1", "correspondence.dwell.speed=0.2"])
+
+
+def test_a_set_inside_a_table_keeps_the_templates_other_keys(pm, write):
+    """``--set TABLE.KEY.INNER`` merges into the template's table key by key (the observer composed keeps the
+    template's other inner keys)."""
+    from toolkit.observe import observer_tables
+
+    template = write("t.toml", """
+        [observer]
+        name = "t"
+        [motor]
+        plugin = "posegraph"
+        [correspondence]
+        plugin = "body-mapping"
+        [correspondence.dwell]
+        window = 2.0
+        memory = 10.0
+        """)
+    tables = observer_tables(pm, settings={"correspondence": {"dwell": {"memory": 5.0}}}, template=template)[1]
+    assert tables["correspondence"]["dwell"] == {"window": 2.0, "memory": 5.0}

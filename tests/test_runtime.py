@@ -94,6 +94,24 @@ def test_streaming_matcher_commits_before_the_segment_ends(pm, watch_scene, reco
     assert imitation[0] < e  # response facilitation: Max starts before Morris ends
 
 
+@pytest.mark.parametrize("typed", [True, False])
+def test_a_deviation_stops_the_imitation_with_the_matchers_reason(pm, watch_scene, recorder, scripted, typed):
+    """K&G Fig. 3's "stop imitation": the runtime reads the typed ``Match.stop`` and ``Match.reason``; a "stop" in
+    the matcher's own ``details`` is not an order."""
+    _, spans = _performed_frames(pm, watch_scene, ["wave"])
+    (s, e), = spans
+    recorder.calls.clear()
+    path = watch_scene(
+        ["wave"],
+        f'[actors.override.segmenter]\nplugin = "scripted-cuts"\ncuts = [[{s - 1}, {e - 1}]]\n'
+        f'[actors.override.matcher]\nplugin = "deviating"\nmovement = "wave"\nafter = 5\ndeviate = 8\n'
+        f'typed = {str(typed).lower()}\n',
+    )
+    load_scenario(path, pm).run()
+    stopped = [c["reason"] for n, c in recorder.calls if n == "imitation_stopped"]
+    assert stopped == (["it sped up"] if typed else ["completed"])
+
+
 def test_watching_needs_a_perception(pm, watch_scene):
     path = watch_scene(["jump"])
     scenario = load_scenario(path, pm)

@@ -428,7 +428,7 @@ def plugins_table(pm: PluginManager, *, params: bool = False) -> dict[str, Any]:
                 "version": info.plugin.version,
             }
             if params:
-                row["parameters"] = [{"name": p.name, "type": p.describe(), "doc": p.doc} for p in info.cls.parameters]
+                row["parameters"] = _parameter_rows(info.cls.parameters)
             rows.append(row)
         components[kind] = rows
     plugins = []
@@ -450,9 +450,29 @@ def plugins_table(pm: PluginManager, *, params: bool = False) -> dict[str, Any]:
     return {"components": components, "plugins": plugins, "skipped": skipped, "failed": failed}
 
 
+def _parameter_rows(parameters: Sequence[Any]) -> list[dict[str, Any]]:
+    """Each parameter's name, type and default, and what it does; a table's parameters nested in its row."""
+    rows = []
+    for p in parameters:
+        row: dict[str, Any] = {"name": p.name, "type": p.describe(), "doc": p.doc}
+        if p.table:
+            row["parameters"] = _parameter_rows(p.parameters)
+        rows.append(row)
+    return rows
+
+
+def _print_parameters(rows: list[dict[str, Any]], indent: str = "      ") -> None:
+    """``likeme plugins --params``: one line per parameter, a table's parameters indented under it."""
+    for p in rows:
+        print(f"{indent}{p['name']}: {p['type']}. {p['doc']}")
+        _print_parameters(p.get("parameters", []), indent + "    ")
+
+
 def components_markdown(pm: PluginManager) -> str:
-    """Every registered component with its summary and parameter table, as Markdown (``docs/components.md``)."""
+    """Every registered component with its summary and parameter table, as Markdown (``docs/components.md``); a
+    table's parameters are rows of their own, keyed ``TABLE.KEY``."""
     from toolkit.components import KINDS
+    from toolkit.params import flat_parameters
 
     lines = [
         "# Component reference",
@@ -469,7 +489,7 @@ def components_markdown(pm: PluginManager) -> str:
                 lines += ["No parameters.", ""]
                 continue
             lines += ["| key | type and default | effect |", "| --- | --- | --- |"]
-            lines += [f"| `{p.name}` | {p.describe()} | {p.doc} |" for p in cls.parameters]
+            lines += [f"| `{'.'.join(key)}` | {p.describe()} | {p.doc} |" for key, p in flat_parameters(cls.parameters)]
             lines.append("")
     return "\n".join(lines)
 
@@ -493,8 +513,7 @@ def cmd_plugins(args: argparse.Namespace, pm: PluginManager) -> int:
         for r in rows:
             dist = f"{r['distribution']} {r['version']}".strip()
             print(f"  {r['name']:<{width}}  {r['summary']}  [{dist}: {r['plugin']}]")
-            for p in r.get("parameters", []):
-                print(f"      {p['name']}: {p['type']}. {p['doc']}")
+            _print_parameters(r.get("parameters", []))
         print()
     print("plugins:")
     for p in table["plugins"]:
@@ -631,12 +650,16 @@ def _recording_views(pm: PluginManager) -> list[str]:
 
 
 def _segment_row(o: Any) -> dict[str, Any]:
-    """One observation as ``likeme observe`` reports it."""
-    return {"start_frame": o.segment.start, "end_frame": o.segment.end, "start_s": round(o.segment.start_time, 3),
-            "end_s": round(o.segment.end_time, 3), "movement": o.movement or "unknown",
-            "confidence": round(o.match.confidence, 3) if o.match else 0.0,
-            "decided_at_frame": o.segment.start + (o.decided_at if o.decided_at is not None else o.segment.n_frames),
-            "decision_fraction": round(o.decision_fraction, 3), **_why_unknown(o), **_candidates(o)}
+    """One observation as ``likeme observe`` reports it: the segment (and why it ends, if the segmenter says), the
+    answer, and why it is unknown, as the matcher says (:class:`toolkit.components.Match`'s typed fields)."""
+    row = {"start_frame": o.segment.start, "end_frame": o.segment.end, "start_s": round(o.segment.start_time, 3),
+           "end_s": round(o.segment.end_time, 3), "movement": o.movement or "unknown",
+           "confidence": round(o.match.confidence, 3) if o.match else 0.0,
+           "decided_at_frame": o.segment.start + (o.decided_at if o.decided_at is not None else o.segment.n_frames),
+           "decision_fraction": round(o.decision_fraction, 3)}
+    if o.segment.reason:
+        row["ends"] = o.segment.reason
+    return {**row, **_why_unknown(o), **_candidates(o)}
 
 
 def _candidates(observation: Any) -> dict[str, Any]:
@@ -649,10 +672,12 @@ def _candidates(observation: Any) -> dict[str, Any]:
 
 
 def _segment_text(seg: dict[str, Any]) -> str:
-    """One segment as ``likeme observe`` prints it (two lines for an unknown one with its reason)."""
+    """One segment as ``likeme observe`` prints it: a line, then why it ends and, for an unknown one, why."""
     line = (f"  frames {seg['start_frame']:5d}-{seg['end_frame']:<5d} ({seg['start_s']:6.2f}-{seg['end_s']:6.2f} s)  "
             f"{seg['movement']:<16} confidence {seg['confidence']:.2f}  decided at frame {seg['decided_at_frame']} "
             f"({seg['decision_fraction']:.0%} of the segment)")
+    if "ends" in seg:
+        line += f"\n    ends: {seg['ends']}"
     if "nearest" in seg or "reason" in seg:
         line += f"\n    {_why_text(seg)}"
     return line
@@ -779,29 +804,33 @@ def _observe_live(args: argparse.Namespace, character: Any, profile: Any, observ
     return 0
 
 
-_WHY_NUMBERS = ("mean_distance", "max_distance", "spread", "predicted_frames", "error_when_dropped", "distance")
-"""The numbers a matcher gives with an unknown answer that say why it rejected the nearest movement."""
-
-
 def _why_unknown(observation: Any) -> dict[str, Any]:
-    """For an unknown segment: the nearest movement and why it was rejected, as the matcher told (else nothing)."""
+    """For an unknown segment: why, as the matcher said (the nearest movement, the reason, the score it was rejected
+    on and the threshold it exceeded, with what they measure), else nothing."""
     match = observation.match
     if match is None or match.movement is not None:
         return {}
-    d = match.details
     out: dict[str, Any] = {}
-    if d.get("nearest"):
-        out["nearest"] = str(d["nearest"])
-    if d.get("reason"):
-        out["reason"] = str(d["reason"])
-    out.update({k: round(float(d[k]), 4) for k in _WHY_NUMBERS if isinstance(d.get(k), (int, float))})
+    if match.nearest:
+        out["nearest"] = str(match.nearest)
+    if match.reason:
+        out["reason"] = str(match.reason)
+    for key in ("score", "threshold"):
+        value = getattr(match, key)
+        if isinstance(value, (int, float)) and math.isfinite(value):
+            out[key] = round(float(value), 4)
+    if match.measure and ("score" in out or "threshold" in out):
+        out["measure"] = str(match.measure)
     return out
 
 
 def _why_text(seg: dict[str, Any]) -> str:
-    """One line: 'nearest bow, rejected: too far from every path (mean_distance 0.081 > max_distance 0.03)'."""
-    numbers = ", ".join(f"{k} {seg[k]:g}" for k in _WHY_NUMBERS if k in seg)
+    """One line: 'nearest bow, rejected: too far from every path (mean pose distance ... 0.081 > 0.03)'."""
     nearest = f"nearest {seg['nearest']}" if "nearest" in seg else "no nearest movement"
+    numbers = ""
+    if "score" in seg:
+        numbers = f"{seg.get('measure', 'score')} {seg['score']:g}" + (f" > {seg['threshold']:g}" if "threshold" in
+                                                                       seg else "")
     return f"{nearest}, rejected: {seg.get('reason', 'no reason given')}" + (f" ({numbers})" if numbers else "")
 
 

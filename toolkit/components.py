@@ -45,7 +45,7 @@ import numpy as np
 
 from toolkit.errors import ConfigError
 from toolkit.motion import Motion, fill_hidden
-from toolkit.params import Parameter, validate_params
+from toolkit.params import Parameter, length_names, scaled, validate_params
 
 if TYPE_CHECKING:  # pragma: no cover - imports for annotations only
     from pathlib import Path
@@ -129,11 +129,18 @@ class Segment:
 
     ``start`` is the first frame, ``end`` is one past the last (exclusive), both
     counted from the first frame the segmenter was given.
+
+    Attributes
+    ----------
+    reason : str
+        Why the segment ends where it does, in the segmenter's words ("back at a hub", "a change of direction",
+        "the end of the stream"); empty when it does not say. ``likeme observe`` prints it.
     """
 
     start: int
     end: int
     fps: float
+    reason: str = ""
 
     def __post_init__(self) -> None:
         if not 0 <= self.start < self.end:
@@ -160,6 +167,9 @@ class Segment:
 class Match:
     """A matcher's answer about one segment.
 
+    The matcher explains its answer in the typed fields below; the watching loop, the runtime and the command line
+    read those and nothing else of it (``details`` is the matcher's own, for views, tests and its own reports).
+
     Attributes
     ----------
     movement : str or None
@@ -172,12 +182,27 @@ class Match:
     path : tuple
         The matched path through the observer's motor graph, if the matcher has one.
     details : mapping
-        Anything else the matcher wants to report (distances).
+        Anything else the matcher wants to keep with the answer (its votes, its prediction errors).
     candidates : tuple of (str, float)
         Ranked candidates, best first (B&B Fig. 13): each movement the matcher found near the segment with its
         distance (lower is closer; the matcher's own measure, so only ratios between candidates of one match mean
         anything). Empty when the matcher ranks nothing; when given with a known answer, the first is
         ``movement``; with an unknown one, the movements it considered and rejected, nearest first.
+    stop : bool
+        After committing (a streaming matcher's early answer), the demonstration deviates from ``movement``: an
+        imitation of it is stopped (K&G 2006, Fig. 3, "stop imitation"); ``reason`` says why.
+    reason : str
+        Why the answer is what it is, in the matcher's words: why a segment is unknown ("too far from every path",
+        "nothing visible") or why an imitation stops ("deviation"). Empty when there is nothing to explain.
+    nearest : str or None
+        With an unknown answer: the movement that came nearest and was rejected (``None``: none came near).
+    score : float or None
+        The number the answer was decided on, in the matcher's own measure (a distance, a prediction error; lower
+        is closer); ``None`` when the matcher decides on none.
+    threshold : float or None
+        The largest ``score`` the matcher accepts for a known answer: an answer whose score is above it is unknown.
+    measure : str
+        What ``score`` and ``threshold`` are, for people ("mean pose distance (eq. 3)").
     """
 
     movement: str | None
@@ -186,22 +211,31 @@ class Match:
     path: tuple = ()
     details: Mapping[str, Any] = field(default_factory=dict)
     candidates: tuple[tuple[str, float], ...] = ()
+    stop: bool = False
+    reason: str = ""
+    nearest: str | None = None
+    score: float | None = None
+    threshold: float | None = None
+    measure: str = ""
 
     @property
     def known(self) -> bool:
         return self.movement is not None
 
     @classmethod
-    def unknown(cls, **details: Any) -> Match:
-        """The explicit "nothing fits" answer."""
-        return cls(None, 0.0, None, (), dict(details))
+    def unknown(cls, reason: str = "", **fields: Any) -> Match:
+        """The explicit "nothing fits" answer, with why (``reason``) and any other typed field (``nearest``,
+        ``score``, ``threshold``, ``measure``, ``path``, ``details``, ``candidates``)."""
+        return cls(None, 0.0, None, reason=reason, **fields)
 
 
 @dataclass(frozen=True)
 class Behaviour:
     """What an observer believes the target is doing and why (Buchsbaum & Blumberg §6).
 
-    ``known`` is false for an explicit "I don't know" (the shrug).
+    ``known`` is false for an explicit "I don't know" (the shrug). ``learned`` holds what the observer learned
+    from it: the category each object kind affords (``{"ice_cream": "food"}``, §6.3); ``details`` is the action
+    system's own (the paths it tried, the line of sight).
     """
 
     known: bool
@@ -212,13 +246,16 @@ class Behaviour:
     object: str | None = None
     prediction: tuple[str, ...] = ()
     details: Mapping[str, Any] = field(default_factory=dict)
+    learned: Mapping[str, str] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
 class MovementRequest:
     """An action system's request to its own motor system.
 
-    ``imitating`` names the actor being imitated, if this is an imitation.
+    ``imitating`` names the actor being imitated, if this is an imitation. ``response``: what the request answers
+    when it is an observer's response to a behaviour it identified (``"imitate"``, ``"shrug"``), for reports;
+    empty for a movement chosen on its own.
     """
 
     movement: str
@@ -226,6 +263,7 @@ class MovementRequest:
     reason: str = ""
     imitating: str | None = None
     object: str | None = None
+    response: str = ""
 
 
 @dataclass(frozen=True)
@@ -302,8 +340,7 @@ class Component(ABC):
         """Multiply every parameter declared a ``length`` by ``factor`` (the character's own height over the height
         its lengths were meant for). Called by the character before :meth:`attach`; ``declared`` keeps the values
         as written, which every call scales from."""
-        lengths = {p.name for p in self.parameters if p.length}
-        self.params = MappingProxyType({k: v * factor if k in lengths else v for k, v in self.declared.items()})
+        self.params = MappingProxyType(scaled(self.declared, length_names(self.parameters), factor))
 
     def inspect(self) -> Mapping[str, Any]:
         """What the component holds now, read-only, for views and tests (its signals: a segmenter's last
@@ -492,6 +529,9 @@ class Matcher(Component):
     """Names of the motor systems this matcher works with (empty: any); the first is used when one is composed."""
     streaming: ClassVar[bool] = False
     """Whether it can commit before a segment ends; if so it implements :meth:`begin` and :meth:`observe`."""
+    report_details: ClassVar[tuple[str, ...]] = ()
+    """Keys of its matches' ``details`` a scenario report shows beside the movement, confidence and decision (the
+    forward model's speed and deviation, what was learned), in this order (:mod:`toolkit.report`)."""
 
     @abstractmethod
     def match(self, motion: Motion) -> Match:
@@ -505,8 +545,8 @@ class Matcher(Component):
         """One more frame of the ongoing segment is in ``memory`` (the newest is ``memory.positions[-1]``);
         return a match to commit now.
 
-        After committing, a match whose ``details["stop"]`` is true tells the runtime that the
-        demonstration deviates from the committed movement: an imitation of it is stopped.
+        After committing, a match whose ``stop`` is true tells the runtime that the demonstration deviates from
+        the committed movement: an imitation of it is stopped (its ``reason`` says why).
         """
         return None
 

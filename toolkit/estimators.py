@@ -23,6 +23,7 @@ part is not seen) at the estimator's ``fps``. :func:`load_recordings` and :func:
 
 from __future__ import annotations
 
+import copy
 import functools
 import re
 from collections.abc import Mapping, Sequence
@@ -36,6 +37,7 @@ from sklearn.utils.validation import check_is_fitted
 from toolkit.errors import ConfigError
 from toolkit.motion import Motion
 from toolkit.observe import OBSERVER_TEMPLATE, Observation, Observer, compose_observer, observer_tables
+from toolkit.params import flat_parameters
 from toolkit.profile import BodyProfile, load_profile
 
 __all__ = ["MovementClassifier", "MovementSegmenter", "EstimatorInputError", "load_recordings", "load_streams",
@@ -86,10 +88,11 @@ class _ObserverEstimator(BaseEstimator):
         return observer_tables(_plugin_manager(), **self._observer_args())[1]
 
     def _plugin_parameters(self) -> dict[str, dict[str, Any]]:
-        """Every parameter (:class:`toolkit.params.Parameter`) of each table's plugin, by table and name."""
+        """Every parameter (:class:`toolkit.params.Parameter`) of each table's plugin, by table and name; the
+        parameters of a parameter's own table by ``NAME__KEY`` (not the table itself)."""
         registry = _plugin_manager().registry
-        return {table: {p.name: p for p in registry.get(table, values["plugin"]).parameters
-                        if (table, p.name) not in HIDDEN}
+        return {table: {"__".join(path): p for path, p in flat_parameters(registry.get(table, values["plugin"]).parameters)
+                        if not p.table and (table, path[0]) not in HIDDEN}
                 for table, values in self._tables().items()}
 
     def _compose(self, repertoire: Any) -> Any:
@@ -118,9 +121,9 @@ class _ObserverEstimator(BaseEstimator):
             available = self._plugin_parameters()
             for table, values in self._tables().items():
                 for name, p in available[table].items():
-                    value = values.get(name, p.default)
-                    if not p.required or name in values:
-                        params[f"{table}__{name}"] = value
+                    given = _get(values, name.split("__"))
+                    if not p.required or given is not _MISSING:
+                        params[f"{table}__{name}"] = p.default if given is _MISSING else given
         return params
 
     def set_params(self, **params: Any) -> _ObserverEstimator:
@@ -139,7 +142,7 @@ class _ObserverEstimator(BaseEstimator):
             setattr(self, key, value)
         if nested:
             available = self._plugin_parameters()
-            settings = {k: dict(v) for k, v in (self.settings or {}).items()}
+            settings = copy.deepcopy({k: dict(v) for k, v in (self.settings or {}).items()})
             for name, value in nested.items():
                 table, key = name.split("__", 1)
                 if key not in available.get(table, {}):
@@ -153,7 +156,11 @@ class _ObserverEstimator(BaseEstimator):
                 except ConfigError as err:
                     raise EstimatorInputError(err.problem, key=(name,), expected=err.expected,
                                               available=err.available) from None
-                settings.setdefault(table, {})[key] = value
+                *inner, last = key.split("__")
+                where = settings.setdefault(table, {})
+                for part in inner:  # a key of a parameter's own table
+                    where = where.setdefault(part, {})
+                where[last] = value
             self.settings = settings
         return self
 
@@ -381,6 +388,18 @@ class MovementSegmenter(_ObserverEstimator):
         precision = tp / found if found else 0.0
         recall = tp / true if true else 0.0
         return 2 * precision * recall / (precision + recall) if precision + recall else 0.0
+
+
+_MISSING = object()
+
+
+def _get(values: Mapping[str, Any], path: Sequence[str]) -> Any:
+    """The value at a key path of nested tables, or ``_MISSING``."""
+    for part in path:
+        if not isinstance(values, Mapping) or part not in values:
+            return _MISSING
+        values = values[part]
+    return values
 
 
 def to_breakpoints(segments: Sequence[tuple[int, int]], n_frames: int) -> list[int]:

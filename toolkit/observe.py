@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from toolkit.character import (COMPONENT_TABLES, Character, _load_chain, character_paths, compose_character,
-                               resolve_file)
+                               merge_tables, resolve_file)
 from toolkit.components import Perception
 from toolkit.errors import ConfigError, PluginError
 from toolkit.motion import Motion
@@ -306,7 +306,7 @@ def observer_tables(pm: Any, *, segmenter: str | None = None, matcher: str | Non
     for key, extra in settings.items():
         if key in tables and extra.get("plugin", tables[key].get("plugin")) != tables[key].get("plugin"):
             tables[key] = {}  # another plugin: none of the template's parameters apply
-        tables[key] = {**tables.get(key, {}), **extra}
+        tables[key] = merge_tables(tables.get(key, {}), extra)  # a parameter's own table merged key by key
     return dict(base["observer"]), tables
 
 

@@ -5,6 +5,11 @@ character loader checks a TOML table against that list before the component is
 built: unknown keys (listing the known ones), types, ranges and choices. The
 same check runs when a component is built from Python, so ``HubThreshold(threshold="x")``
 fails the same way as a bad TOML value.
+
+Options that only mean something together with another option are a *table* of their own: a :class:`Parameter`
+given ``parameters`` holds them, checked key by key like the component's own (``[correspondence.dwell] speed =
+0.05``, ``--set correspondence.dwell.speed=0.05``, ``params["dwell"]["speed"]``); a key it does not have is an error
+listing the keys it has, and the keys not given take their defaults.
 """
 
 from __future__ import annotations
@@ -63,10 +68,14 @@ class Parameter:
         A length on the observer's own body (metres, or metres per second or per radian): a character whose file
         gives ``[character] lengths_for_height`` reads it as meant for a body that tall and scales it to its own
         standing height (docs/correspondence.md, "Decisions relative to the body").
+    parameters : sequence of Parameter, optional
+        A table of options that belong together (see the module): its keys, each checked as a component's own.
+        The parameter's type is then ``dict`` and its value the table with every default filled in; ``default``,
+        if given, is a table of defaults in place of the inner parameters' own.
     """
 
     name: str
-    type: type
+    type: type = dict
     default: Any = REQUIRED
     doc: str = ""
     minimum: float | None = None
@@ -75,13 +84,28 @@ class Parameter:
     items: type | None = None
     check: Callable[[Any], str | None] | None = None
     length: bool = False
+    parameters: Sequence[Parameter] = ()
+
+    def __post_init__(self) -> None:
+        if self.parameters:  # a table: its value is the table with every default filled in
+            object.__setattr__(self, "parameters", tuple(self.parameters))
+            given = {} if self.default is REQUIRED else self.default
+            object.__setattr__(self, "default", validate_params(f"table {self.name!r}", self.parameters, given))
 
     @property
     def required(self) -> bool:
         return self.default is REQUIRED
 
+    @property
+    def table(self) -> bool:
+        """Whether it is a table of parameters of its own (:attr:`parameters`)."""
+        return bool(self.parameters)
+
     def describe(self, *, article: bool = False) -> str:
         """One line: type, bounds and default (``article`` starts it with "a"/"an" and leaves the default out)."""
+        if self.table:
+            return "a table of " + ", ".join(p.name for p in self.parameters) if article else \
+                "table of " + ", ".join(p.name for p in self.parameters)
         text = _TYPE_NAMES[self.type] if article else _TYPE_NAMES[self.type].split(" ", 1)[1]
         if self.items is not None:
             text += f" of {_TYPE_NAMES[self.items].split(' ', 1)[1]}s"
@@ -101,8 +125,15 @@ class Parameter:
         """Return the checked value (ints widened to float) or raise :class:`ConfigError`.
 
         A NaN or infinite number anywhere in the value (in an array or table too) is refused: every number a
-        parameter takes is finite.
+        parameter takes is finite. A table (:attr:`parameters`) is checked key by key and comes back with its
+        defaults filled in; an error's key is then the path inside it (``("dwell", "speed")``).
         """
+        if self.table:
+            value = _check_type(value, dict, self.name, self._expected())
+            try:
+                return validate_params(f"table {self.name!r}", self.parameters, value)
+            except ConfigError as err:
+                raise err.within(prefix=(self.name,)) from None
         value = _check_type(value, self.type, self.name, self._expected())
         where = _non_finite(value)
         if where is not None:
@@ -222,11 +253,57 @@ def validate_params(owner: str, parameters: Sequence[Parameter], values: Mapping
                     err = ConfigError(
                         err.problem, key=(p.name, *err.key[1:]), expected=err.expected, available=err.available
                     )
+                elif p.table:
+                    err = _of(err, owner)
                 raise err from None
         elif p.required:
             raise ConfigError(f"missing required parameter of {owner}", key=(p.name,), expected=p._expected())
         else:
-            out[p.name] = p.default
+            out[p.name] = dict(p.default) if p.table else p.default
+    return out
+
+
+def _of(err: ConfigError, owner: str) -> ConfigError:
+    """An error inside a parameter's table (``... for table 'dwell'``) said to be of ``owner``'s table."""
+    problem, _, table = err.problem.rpartition(" for table ")
+    if not problem:
+        return err
+    expected = err.expected.replace(f"of table {table}", f"of table {table} of {owner}") if err.expected else None
+    return ConfigError(f"{problem} in table {table} of {owner}", key=err.key, expected=expected,
+                       available=err.available)
+
+
+def length_names(parameters: Sequence[Parameter]) -> list[tuple[str, ...]]:
+    """The key paths of every parameter declared a ``length``, inside tables too (``("dwell", "radius")``)."""
+    out: list[tuple[str, ...]] = []
+    for p in parameters:
+        if p.table:
+            out.extend((p.name, *inner) for inner in length_names(p.parameters))
+        elif p.length:
+            out.append((p.name,))
+    return out
+
+
+def scaled(values: Mapping[str, Any], lengths: Sequence[tuple[str, ...]], factor: float) -> dict[str, Any]:
+    """``values`` (checked parameters) with the value at each key path of ``lengths`` multiplied by ``factor``."""
+    out = dict(values)
+    for path in lengths:
+        if len(path) == 1:
+            out[path[0]] = out[path[0]] * factor
+        else:
+            out[path[0]] = scaled(out[path[0]], [path[1:]], factor)
+    return out
+
+
+def flat_parameters(parameters: Sequence[Parameter], prefix: tuple[str, ...] = ()
+                    ) -> list[tuple[tuple[str, ...], Parameter]]:
+    """Every parameter with its key path, the parameters of a table after it (depth first, in declaration order):
+    what ``likeme plugins --params`` and the parameter reference list."""
+    out: list[tuple[tuple[str, ...], Parameter]] = []
+    for p in parameters:
+        out.append(((*prefix, p.name), p))
+        if p.table:
+            out.extend(flat_parameters(p.parameters, (*prefix, p.name)))
     return out
 
 
@@ -245,8 +322,10 @@ def parse_settings(items: list[str], *, tables: bool = True) -> dict[str, Any]:
         table, dot, name = key.strip().partition(".")
         if not tables:
             table, dot, name = "", ".", key.strip()
-        if not sep or not dot or (tables and not table) or not name:
+        path = name.split(".")
+        if not sep or not dot or (tables and not table) or not all(path):
             raise ConfigError(f"invalid setting {item!r}", key=("--set",), expected="TABLE.KEY=VALUE, like segmenter.floor=0"
+                              " (TABLE.KEY.KEY=VALUE inside a parameter's own table)"
                               if tables else "KEY=VALUE, like keys=4")
         try:
             parsed = tomllib.loads(f"v = {value}")["v"]
@@ -257,7 +336,14 @@ def parse_settings(items: list[str], *, tables: bool = True) -> dict[str, Any]:
         if parsed is None or _too_deep({"v": parsed}):
             raise ConfigError(f"value of {key.strip()!r} nested more than {MAX_DEPTH} levels deep", key=("--set",),
                               expected=f"arrays and tables nested at most {MAX_DEPTH} levels deep")
-        (out.setdefault(table, {}) if tables else out)[name] = parsed
+        where = out.setdefault(table, {}) if tables else out
+        for i, part in enumerate(path[:-1]):  # KEY.KEY: inside a parameter's own table
+            inner = where.setdefault(part, {})
+            if not isinstance(inner, dict):
+                raise ConfigError(f"{'.'.join(path[: i + 1])!r} given both a value and keys", key=("--set", table),
+                                  expected="either KEY=VALUE or KEY.INNER=VALUE for one key")
+            where = inner
+        where[path[-1]] = parsed
     return out
 
 
@@ -308,5 +394,9 @@ def check_settings(settings: Mapping[str, Mapping[str, Any]], pm: Any, plugins: 
                     known[key].coerce(value)
                 except ConfigError as err:
                     rest = (key, *err.key[1:]) if err.key[:1] == ("",) else err.key
-                    raise ConfigError(f"{err.problem} for {owner}", key=(option, table, *rest),
-                                      expected=err.expected, available=err.available) from None
+                    if known[key].table and " for table " in err.problem:
+                        err = _of(err, owner)
+                    else:
+                        err = ConfigError(f"{err.problem} for {owner}", expected=err.expected, available=err.available)
+                    raise ConfigError(err.problem, key=(option, table, *rest), expected=err.expected,
+                                      available=err.available) from None

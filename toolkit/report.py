@@ -54,6 +54,7 @@ def _watching(actor: Actor, world: World) -> dict[str, Any]:
     ]
     out["recognised"] = []
     segments = world.events_of("segment_found", actor.id)
+    reported = actor.character.matcher.report_details if actor.character.matcher is not None else ()
     for e in world.events_of("movement_recognised", actor.id):
         m = e.data["match"]
         seg = e.data["segment"]
@@ -70,7 +71,7 @@ def _watching(actor: Actor, world: World) -> dict[str, Any]:
             "early": e.data["segment"] is None,
             "fraction": fraction,
         }
-        for key in ("candidates", "learned", "speed", "deviated"):
+        for key in reported:  # what the matcher itself puts in a report (Matcher.report_details)
             if key in m.details:
                 entry[key] = m.details[key]
         out["recognised"].append(entry)
@@ -79,7 +80,8 @@ def _watching(actor: Actor, world: World) -> dict[str, Any]:
          "returning": e.data.get("returning", 0.0)}
         for e in world.events_of("imitation_stopped", actor.id) if e.data["reason"] != "completed"
     ]
-    out["behaviours"] = [_behaviour(e.data["behaviour"], e.time) for e in world.events_of("behaviour_identified", actor.id)]
+    out["behaviours"] = [_behaviour(e.data["behaviour"], e.time, e.data.get("response"))
+                         for e in world.events_of("behaviour_identified", actor.id)]
     return out
 
 
@@ -130,7 +132,7 @@ def behaviour_sentence(observer: str, target: str, b: dict[str, Any]) -> str:
     return text
 
 
-def _behaviour(b: Any, time: float) -> dict[str, Any]:
+def _behaviour(b: Any, time: float, response: str | None) -> dict[str, Any]:
     return {
         "time": round(time, 3),
         "known": b.known,
@@ -140,8 +142,8 @@ def _behaviour(b: Any, time: float) -> dict[str, Any]:
         "goal": list(b.goal),
         "object": b.object,
         "prediction": list(b.prediction),
-        "learned": dict(b.details.get("learned", {})) if b.details else {},
-        "response": b.details.get("response") if b.details else None,
+        "learned": dict(b.learned),
+        "response": response,
     }
 
 

@@ -375,10 +375,13 @@ class Actor:
         if c.action is None or not match.known:
             return
         behaviour = self._call("action", "interpret", self, target, segment, match, world)
+        event = None
         if behaviour is not None:
-            world.emit("behaviour_identified", self, target, behaviour=behaviour)
+            event = world.emit("behaviour_identified", self, target, behaviour=behaviour)
         request = self._call("action", "respond", self, target, match, behaviour, world)
         if request is not None:
+            if event is not None and request.response:  # what the observer did about it, for reports
+                event.data["response"] = request.response
             self.request(request)
 
     def _finish(self) -> None:
@@ -400,7 +403,7 @@ class _Reports(Listener):
         self.actor._recognised(segment, match)
 
     def deviated(self, match: Match) -> None:  # the committed movement deviates from the demonstration
-        self.actor.stop_imitation(self.actor.target, str(match.details.get("reason", "deviation")))
+        self.actor.stop_imitation(self.actor.target, match.reason or "deviation")
 
 
 MAX_FPS = 1000.0
@@ -479,15 +482,17 @@ class World:
         self.objects[obj.name] = obj
         return obj
 
-    def emit(self, kind: str, actor: Actor, target: Actor | None = None, **data: Any) -> None:
-        """Record an event and call the ``likeme_<kind>`` hook."""
-        self.events.append(Event(self.frame, self.time, kind, actor.id, target.id if target else None, data))
+    def emit(self, kind: str, actor: Actor, target: Actor | None = None, **data: Any) -> Event:
+        """Record an event and call the ``likeme_<kind>`` hook; the event recorded."""
+        event = Event(self.frame, self.time, kind, actor.id, target.id if target else None, data)
+        self.events.append(event)
         if kind == "movement_started":
             self.announce(f"likeme_{kind}", world=self, actor=actor, **data)
         elif kind in ("imitation_started", "imitation_stopped"):
             self.announce(f"likeme_{kind}", world=self, actor=actor, target=target, **data)
         else:
             self.announce(f"likeme_{kind}", world=self, observer=actor, target=target, **data)
+        return event
 
     def announce(self, hook_name: str, **kwargs: Any) -> None:
         """Call a run-event hook through the plugin manager (traced; a failing implementation is named, or dropped

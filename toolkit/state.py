@@ -604,7 +604,7 @@ class Checkpoint:
 
     @hookimpl
     def likeme_behaviour_identified(self, world, observer, target, behaviour):
-        if behaviour.details.get("learned"):
+        if behaviour.learned:
             self.dirty = True
 
     @hookimpl

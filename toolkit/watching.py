@@ -15,7 +15,7 @@ frames in. :class:`WatchingLoop` is that cycle, and the only copy of it:
            a segment closed at this frame    matcher.conclude(its frames) -> the answer     [commit or not]
            a segment under way               a streaming matcher is fed the frame (from the onset when it begins):
                                              matcher.observe(memory) may commit once (response facilitation),
-                                             and after that report a deviation (details["stop"])
+                                             and after that report a deviation (Match.stop)
 
 An :class:`~toolkit.runtime.Actor` in a world feeds it one frame a step from its perception and turns what it
 reports into run events, interpretation and imitation; an :class:`~toolkit.observe.Observer` feeds it packets of
@@ -312,7 +312,7 @@ class Listener:
         """The matcher answered: committed early (``segment`` is ``None``) or at the segment's end."""
 
     def deviated(self, match: Match) -> None:
-        """After committing, the matcher found the demonstration deviating from it (``match.details["stop"]``)."""
+        """After committing, the matcher found the demonstration deviating from it (``match.stop``)."""
 
 
 def call_component(character: Character, key: str, method: str, *args: Any, **kwargs: Any) -> Any:
@@ -497,7 +497,8 @@ class WatchingLoop:
             if onset >= 0:
                 onset = max(onset, self._floor, self.memory.offset)
                 if self._max_frames is not None and row - onset >= self._max_frames:  # never closed: cut it here
-                    out.append(self._close(Segment(onset, row, self.memory.fps), cut=True))
+                    reason = f"still open after {self.max_segment:g} s: cut"
+                    out.append(self._close(Segment(onset, row, self.memory.fps, reason), cut=True))
                     self._floor = onset = row
             self._since = onset
             self._follow(onset, row)
@@ -530,7 +531,7 @@ class WatchingLoop:
         low = max(self._floor, self.memory.offset)
         if not segments or segments[0].start >= low:
             return segments
-        return [s if s.start >= low else Segment(low, s.end, s.fps) for s in segments if s.end > low]
+        return [s if s.start >= low else Segment(low, s.end, s.fps, s.reason) for s in segments if s.end > low]
 
     def _forget(self) -> None:
         """Bounded working memory: rows before the segment under way, before what the segmenter may still report
@@ -590,7 +591,7 @@ class WatchingLoop:
     def _reported(self, match: Any, method: str) -> None:
         """What the matcher returned after a row (by ``method``), checked and told: a deviation, or its commitment."""
         self._check_match(match, method)
-        if match.details.get("stop"):
+        if match.stop:
             self.listener.deviated(match)
         elif self._early is None:
             self._early = match
@@ -814,6 +815,6 @@ def follow(matcher: Any, motion: Motion) -> tuple[Match | None, Match | None]:
     conclusion). For a streaming matcher's batch ``match``."""
     early = None
     for match in feed(matcher, motion):
-        if early is None and match is not None and not match.details.get("stop"):
+        if early is None and match is not None and not match.stop:
             early = match
     return early, matcher.conclude(motion)

@@ -304,6 +304,7 @@ def _behaviour(system: Any, target: Any, movement: str, path: tuple[str, ...], o
     return Behaviour(
         True, movement, path=path, motivation=motivation, goal=goal, object=obj, prediction=prediction,
         details={"line_of_sight": seen, "tried": tried, "drive": h.drive_of(path), **details},
+        learned=details.get("learned", {}),
     )
 
 

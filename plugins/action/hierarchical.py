@@ -362,15 +362,15 @@ class Hierarchical(ActionSystem):
     def respond(self, actor: Any, target: Any, match: Any, behaviour: Behaviour | None, world: Any) -> MovementRequest | None:
         """Imitate the movement (if ``imitate``); otherwise shrug at a behaviour it cannot identify (if ``shrug``).
 
-        The response is noted in the behaviour's details as ``response`` (``"imitate"``, ``"shrug"`` or absent), so
-        that a report says what the observer did, not what it would have done.
+        The request says which (its ``response``: ``"imitate"`` or ``"shrug"``), so that a report says what the
+        observer did, not what it would have done.
         """
         if self.params["imitate"] and match.known and match.movement in actor.character.motor.movements():
-            _note(behaviour, "imitate")
-            return MovementRequest(match.movement, reason=f"imitating {target.id}'s {match.movement}", imitating=target.id)
+            return MovementRequest(match.movement, reason=f"imitating {target.id}'s {match.movement}", imitating=target.id,
+                                   response="imitate")
         if behaviour is not None and not behaviour.known and self.params["shrug"]:
-            _note(behaviour, "shrug")
-            return MovementRequest(self.params["shrug"], reason=f"does not know why {target.id} did {match.movement}")
+            return MovementRequest(self.params["shrug"], reason=f"does not know why {target.id} did {match.movement}",
+                                   response="shrug")
         return None
 
     # -- reports ---------------------------------------------------------------------------
@@ -462,12 +462,6 @@ class Hierarchical(ActionSystem):
             "drives": {n: round(d.level, 3) for n, d in self.drives.items()},
             "beliefs": dict(self.beliefs),
         }
-
-
-def _note(behaviour: Behaviour | None, response: str) -> None:
-    """Write the observer's response into ``behaviour.details`` (a plain dict; other mappings are left alone)."""
-    if behaviour is not None and isinstance(behaviour.details, dict):
-        behaviour.details["response"] = response
 
 
 @hookimpl

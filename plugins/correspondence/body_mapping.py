@@ -46,15 +46,18 @@ class BodyMapping(Correspondence):
         Parameter("size", str, "bones", "How the demonstrator's size is mapped: 'bones' (every bone at the "
                   "observer's length, along the demonstrator's direction) or 'none'.", choices=("bones", "none")),
         Parameter("rest", str, "dwell", "How the demonstrator's rest posture is found: 'dwell' (where they are "
-                  "slow for a while, mapped onto the observer's hub) or 'none' (their rest is taken as one's own).",
-                  choices=("dwell", "none")),
-        Parameter("dwell_speed", float, 0.05, "Speed in body sizes per second (the observer's size, about 0.45 m "
-                  "for an adult) at which a pose counts a quarter as much towards the rest posture as a still one.",
-                  minimum=1e-6),
-        Parameter("window", float, 0.5, "Seconds over which the speed is smoothed: slow for an instant (a turning "
-                  "point) is not dwelling.", minimum=0.0),
-        Parameter("memory", float, 30.0, "Time constant (s) with which the rest estimate forgets: a demonstrator "
-                  "who changes stance is followed after about this long.", minimum=0.1),
+                  "slow for a while, mapped onto the observer's hub; [correspondence.dwell] says how) or 'none' "
+                  "(their rest is taken as one's own).", choices=("dwell", "none")),
+        Parameter("dwell", doc="With rest = 'dwell': what counts as dwelling, and how long it is remembered "
+                  "(plugins.lib.rest_posture.RestPosture).", parameters=(
+                      Parameter("speed", float, 0.05, "Speed in body sizes per second (the observer's size, about "
+                                "0.45 m for an adult) at which a pose counts a quarter as much towards the rest "
+                                "posture as a still one.", minimum=1e-6),
+                      Parameter("window", float, 0.5, "Seconds over which the speed is smoothed: slow for an "
+                                "instant (a turning point) is not dwelling.", minimum=0.0),
+                      Parameter("memory", float, 30.0, "Time constant (s) with which the rest estimate forgets: a "
+                                "demonstrator who changes stance is followed after about this long.", minimum=0.1),
+                  )),
     )
 
     def attach(self, owner: Any) -> None:
@@ -81,8 +84,9 @@ class BodyMapping(Correspondence):
     def reset(self, parts: Sequence[str], fps: float) -> None:
         self._fps = float(fps)
         self._lengths = RunningLengths(len(self.pairs))
-        self._rest = RestPosture(len(self.hub), self._fps, dwell_speed=self.params["dwell_speed"],
-                                 window=self.params["window"], memory=self.params["memory"], prior=self.hub)
+        dwell = self.params["dwell"]
+        self._rest = RestPosture(len(self.hub), self._fps, dwell_speed=dwell["speed"], window=dwell["window"],
+                                 memory=dwell["memory"], prior=self.hub)
 
     def map_block(self, poses: np.ndarray, visible: np.ndarray) -> np.ndarray:
         poses = np.asarray(poses, dtype=float)

@@ -158,6 +158,10 @@ def _kernel():
     return kernel
 
 
+MEASURE = "root-mean-square distance per frame after warping (m)"
+"""What a match's ``score`` and ``threshold`` are."""
+
+
 class DTW(Matcher):
     """Nearest example by multivariate dynamic time warping (dtaidistance); decides at the segment's end."""
 
@@ -225,7 +229,7 @@ class DTW(Matcher):
 
     def match(self, motion: Motion) -> Match:
         if not motion.visible.any() or not self.templates:
-            return Match.unknown(reason="nothing visible")
+            return Match.unknown("nothing visible", details={"reason": "nothing visible"})
         prep = self._prepared()
         # every part seen in every frame: nothing to fill (fill_hidden would copy the same coordinates)
         positions = np.asarray(motion.positions, dtype=float) if motion.visible.all() else motion.filled().positions
@@ -249,8 +253,10 @@ class DTW(Matcher):
         distances = np.sqrt(summed * summed / lengths)  # frame_distance of each template, element by element
         best = int(np.argmin(distances))
         per_frame = float(distances[best])
-        if self.params["max_distance"] and per_frame > self.params["max_distance"]:
-            return Match.unknown(distance=per_frame)
+        limit = self.params["max_distance"] or None
+        if limit is not None and per_frame > limit:
+            return Match.unknown("too far from every example", nearest=prep.labels[best], score=per_frame,
+                                 threshold=limit, measure=MEASURE, details={"distance": per_frame})
         label = prep.labels[best]
         # each movement's nearest example (Fig. 13's ranked candidates), ranked by distance, ties by name
         nearest = np.minimum.reduceat(distances[prep.order], prep.starts)
@@ -260,7 +266,7 @@ class DTW(Matcher):
         confidence = float(1.0 - per_frame / runner_up) if np.isfinite(runner_up) and runner_up > 0 else 1.0
         ranked = sorted(zip(nearest.tolist(), prep.names.tolist()))
         return Match(label, max(0.0, confidence), None, details={"distance": per_frame, "runner_up": runner_up},
-                     candidates=tuple((lab, d) for d, lab in ranked))
+                     candidates=tuple((lab, d) for d, lab in ranked), score=per_frame, threshold=limit, measure=MEASURE)
 
 
 class _Prepared:

@@ -904,6 +904,7 @@ class ForwardModel(Matcher):
     )
 
     streaming = True
+    report_details = ("candidates", "learned", "speed", "deviated")
 
     GRID = 200
     """Points of the fine grid each stroke is tabled on (:meth:`_table`)."""
@@ -2420,7 +2421,7 @@ class ForwardModel(Matcher):
 
     def _conclude(self) -> Match | None:
         if not self.tracks:
-            return Match.unknown(reason="nothing moved")
+            return Match.unknown("nothing moved", details={"reason": "nothing moved"})
         memory = self._local()
         perform, learned, paths, route = [], [], [], []  # route: every edge from the start node (the label's)
         first_from, first_to = None, None
@@ -2464,7 +2465,9 @@ class ForwardModel(Matcher):
             if self.reported:
                 return None  # already reported when it committed
             details = {"reason": "no edge predicts the demonstration", **self._nearest()}
-            return Match(None, 0.0, None, (), details, candidates=self._ranked(self.main))
+            return Match(None, 0.0, None, (), details, candidates=self._ranked(self.main), reason=details["reason"],
+                         nearest=details.get("nearest"), score=details.get("error_when_dropped"),
+                         measure="prediction error of the nearest when it was dropped")
         movement = self.motor.add_together(perform)
         main = self.main
         tracks = list(self.tracks.values())
@@ -2534,9 +2537,8 @@ class ForwardModel(Matcher):
             # stop the imitation; the others' commands were right and are completed by the motor system
             track.stopped, track.home, track.at = True, track.last_correct, len(track.right)
             self.motor.move_to(track.subsystem, track.last_correct)
-            stop = Match(track.committed, 0.0, len(memory), details={"stop": True, "reason": "deviation",
-                                                                      "subsystem": track.subsystem,
-                                                                      "return_to": track.last_correct})
+            stop = Match(track.committed, 0.0, len(memory), stop=True, reason="deviation", details={
+                "stop": True, "reason": "deviation", "subsystem": track.subsystem, "return_to": track.last_correct})
         self._repredict(track, memory)
         return stop
 

@@ -152,11 +152,16 @@ class Travelling(Protocol):
     node_travel: np.ndarray
 
 
+MEASURE = "mean pose distance along the path (eq. 3)"
+"""What a match's ``score`` and ``threshold`` are."""
+
+
 class PathSearch(Matcher):
     """k-best path search through the observer's posegraph from the middle frame outward (§5.2)."""
 
     name = "path-search"
     motor_systems = ("posegraph",)
+    report_details = ("learned",)
     index_min_nodes = INDEX_MIN_NODES
     """Above this many nodes the start poses come from the spatial index (tests set it to force the index on or
     off)."""
@@ -418,7 +423,7 @@ class PathSearch(Matcher):
 
     def match(self, motion: Motion) -> Match:
         if motion.n_frames == 0 or not motion.visible.any():
-            return Match.unknown(reason="nothing visible")
+            return Match.unknown("nothing visible", details={"reason": "nothing visible"})
         self._refresh()
         obs, vis = self.samples(motion)
         if self.params["posture"] == "still":  # the same share of each part's posture removed from the nodes
@@ -431,13 +436,14 @@ class PathSearch(Matcher):
             weights = movement_weights(obs, vis, self.params["attention"], positions)
         path, _, evidence = self.search(obs, vis, weights)  # the beam's eq. 3 cost: recomputed below by the one formula
         if path is None:
-            return Match.unknown(reason="nothing visible")
+            return Match.unknown("nothing visible", details={"reason": "nothing visible"})
         ids = self.label_ids[path]
         voting = ids[ids != self._hub_id]  # the movements' numbers: hubs do not vote
         mean = path_distance(obs, self.nodes_compared[path], vis, weights) / max(evidence, 1)  # eq. 3 per sample
         details: dict[str, Any] = {"mean_distance": mean, "samples": len(path)}
         if voting.size == 0:
-            return Match.unknown(reason="only hub poses", path=tuple(self.node_names[i] for i in path), **details)
+            return Match.unknown("only hub poses", score=mean, measure=MEASURE, details={
+                "reason": "only hub poses", "path": tuple(self.node_names[i] for i in path), **details})
         counts = np.bincount(voting)  # np.unique(voting, return_counts=True): the numbers voted for, ascending
         numbers = counts.nonzero()[0]
         counts = counts[numbers]
@@ -456,10 +462,13 @@ class PathSearch(Matcher):
                 return self._learn(*self.samples(motion, styled=False), details) if self._styled() else \
                     self._learn(obs, vis, details)
             return Match(None, 0.0, None, node_path, {"reason": "too far from every path", "nearest": movement,
-                                                      "max_distance": limit, **details})
+                                                      "max_distance": limit, **details},
+                         reason="too far from every path", nearest=movement, score=mean, threshold=limit,
+                         measure=MEASURE)
         confidence = float(np.exp(-mean / self.params["scale"]) * share)
         return Match(movement, confidence, None, node_path, details,
-                     candidates=self._candidates(obs, vis, weights, movement, mean))
+                     candidates=self._candidates(obs, vis, weights, movement, mean), score=mean, threshold=limit,
+                     measure=MEASURE)
 
     def _candidates(self, obs: np.ndarray, vis: np.ndarray, weights: np.ndarray | None, movement: str,
                     mean: float) -> tuple[tuple[str, float], ...]:

@@ -141,10 +141,13 @@ class MotorCommandGraph(MotorSystem):
         Parameter("arms", list, [["left_shoulder", "left_elbow", "left_wrist"], ["right_shoulder", "right_elbow", "right_wrist"]],
                   "Shoulder, elbow, wrist triples whose elbow follows the wrist by inverse kinematics."),
         *CLIP_PARAMETERS,
-        Parameter("drop", float, 0.5, "With clips: speed-minimum criterion of the stroke segmentation.", minimum=0.0,
-                  maximum=1.0),
-        Parameter("angle", float, 50.0, "With clips: direction criterion (degrees) of the stroke segmentation.",
-                  minimum=1.0, maximum=180.0),
+        Parameter("strokes", doc="With clips: how each clip is cut into guiding strokes, one command each (K&G "
+                  "§4.3; plugins.lib.strokes).", parameters=(
+                      Parameter("drop", float, 0.5, "Speed-minimum criterion of the stroke segmentation.",
+                                minimum=0.0, maximum=1.0),
+                      Parameter("angle", float, 50.0, "Direction criterion (degrees) of the stroke segmentation.",
+                                minimum=1.0, maximum=180.0),
+                  )),
     )
 
     def attach(self, owner: Any) -> None:
@@ -209,7 +212,7 @@ class MotorCommandGraph(MotorSystem):
     def _learn_clips(self, clips: Any) -> None:
         """Every clip through the inverse model into a chain of edges from the hub, named by its movement."""
         (subsystem, idx), = list(self.subsystems.items())[:1]
-        criteria = StrokeCriteria(drop=self.params["drop"], angle=self.params["angle"])
+        criteria = StrokeCriteria(drop=self.params["strokes"]["drop"], angle=self.params["strokes"]["angle"])
         for clip in clips.clips:
             m = clip.motion
             observed = fill_hidden(m.positions[:, idx], m.visible[:, idx], default=self.rest[idx])

@@ -212,10 +212,10 @@ class HubThreshold(Segmenter):
         to it."""
         start = self._start
         if left < 0:
-            return self._close(max(start + 1, began))
-        out = self._close(began) if began > start else []
+            return self._close(max(start + 1, began), "came to rest")
+        out = self._close(began, "came to rest") if began > start else []
         self._start = max(start, left)
-        return out + self._close(max(self._start + 1, back))
+        return out + self._close(max(self._start + 1, back), "came to rest")
 
     def _evidence(self, poses: np.ndarray, visible: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The distance from the reference of each frame of a block (held where nothing is seen), low-pass filtered,
@@ -290,13 +290,13 @@ class HubThreshold(Segmenter):
     def flush(self) -> list[Segment]:
         if self._start is None:
             return []
-        return self._close(self._frame + 1)
+        return self._close(self._frame + 1, "the stream ended")
 
-    def _close(self, end: int) -> list[Segment]:
+    def _close(self, end: int, reason: str = "back near a hub pose") -> list[Segment]:
         start, self._start, self._below = self._start, None, 0
         if (end - start) / self._fps < self.params["min_duration"] or end <= start:
             return []
-        return [Segment(start, end, self._fps)]
+        return [Segment(start, end, self._fps, reason)]
 
     # -- batch ---------------------------------------------------------------------------
 

@@ -177,7 +177,7 @@ class RupturesSegmenter(Segmenter):
         from ``offset``."""
         if seen.sum() < 2:
             return []
-        return [Segment(offset + a, offset + b, self._fps) for a, b in zip(bounds, bounds[1:])
+        return [Segment(offset + a, offset + b, self._fps, "a change point") for a, b in zip(bounds, bounds[1:])
                 if b > a and (b - a) / self._fps >= self.params["min_length"] and seen[a:b].any()]
 
 

@@ -286,7 +286,7 @@ class VelocityDirection(Segmenter):
             elif cut < n:  # never ended: closed, the next one begun
                 self._buffer.extend(flat[f:cut])
                 since[f:cut] = start
-                closed.extend((cut, s) for s in self._close(first + cut))
+                closed.extend((cut, s) for s in self._close(first + cut, "longer than max_movement: cut"))
                 self._start, self._buffer = first + cut, [flat[cut]]
                 if e == cut:  # and this frame ends the one begun
                     closed.extend((cut, s) for s in self._close(max(first + cut + 1, first + cut - int(resting[cut])
@@ -312,7 +312,7 @@ class VelocityDirection(Segmenter):
         if self._start is not None:
             longest = int(round(self.params["max_movement"] * self._fps))
             if longest and self._frame - self._start >= max(longest, 2):  # never ended: closed, the next one begun
-                cut = self._close(self._frame)
+                cut = self._close(self._frame, "longer than max_movement: cut")
                 self._start, self._buffer = self._frame, []
                 self._origin = self._began(pose, points)
             self._buffer.append(points)
@@ -392,9 +392,9 @@ class VelocityDirection(Segmenter):
     def flush(self) -> list[Segment]:
         if self._start is None:
             return []
-        return self._close(self._frame + 1)
+        return self._close(self._frame + 1, "the stream ended")
 
-    def _close(self, end: int) -> list[Segment]:
+    def _close(self, end: int, reason: str = "at rest again") -> list[Segment]:
         start, self._start = self._start, None
         window = np.array(self._buffer[: end - start])
         self._buffer = []
@@ -402,10 +402,11 @@ class VelocityDirection(Segmenter):
             return []
         self._last, self._analysis, self._done = (start, end, window), None, end
         if self.params["level"] == "movement":
-            return [Segment(start, end, self._fps)]
+            return [Segment(start, end, self._fps, reason)]
         cuts = breaks(window, self._fps, self.criteria)  # analyse(window).breaks (inspect() analyses it in full)
         edges = [0, *cuts, end - start]
-        return [Segment(start + a, start + b, self._fps) for a, b in zip(edges, edges[1:]) if b > a]
+        return [Segment(start + a, start + b, self._fps, "a stroke's end: a speed minimum or a turn" if b < end - start
+                        else reason) for a, b in zip(edges, edges[1:]) if b > a]
 
     def analyse(self, window: np.ndarray) -> StrokeAnalysis:
         """One movement's working memory (positions (N, 3k) of the chosen parts) cut into strokes by this

@@ -61,7 +61,7 @@ class NearestMovement(Matcher):
         mid = motion.positions[motion.n_frames // 2]
         vis = motion.visible[motion.n_frames // 2]
         if not vis.any():
-            return Match.unknown(reason="nothing visible")
+            return Match.unknown("nothing visible")
         dist = {n: float(np.linalg.norm(t[vis] - mid[vis], axis=1).mean()) for n, t in self.templates.items()}
         best = min(dist, key=dist.get)
         return Match(best, confidence=float(np.exp(-dist[best] / 0.05)), details={"distances": dist})
@@ -90,6 +90,22 @@ class EarlyCommit(Matcher):
         return Match(self.params["movement"], 0.5)
 
 
+class Deviating(EarlyCommit):
+    """Commits to `movement` after `after` frames, then reports a deviation after `deviate` frames: with ``stop =
+    true`` (the typed field the runtime reads) or only a ``"stop"`` in its details (which it does not read)."""
+
+    name = "deviating"
+    parameters = (*EarlyCommit.parameters, Parameter("deviate", int, 10), Parameter("typed", bool, True))
+
+    def observe(self, memory):
+        self.seen = memory.n
+        if self.seen == self.params["deviate"]:
+            if self.params["typed"]:
+                return Match(self.params["movement"], 0.0, self.seen, stop=True, reason="it sped up")
+            return Match(self.params["movement"], 0.0, self.seen, details={"stop": True, "reason": "it sped up"})
+        return super().observe(memory)
+
+
 @hookimpl
 def likeme_register_segmenters():
     return [ScriptedCuts]
@@ -97,4 +113,4 @@ def likeme_register_segmenters():
 
 @hookimpl
 def likeme_register_matchers():
-    return [NearestMovement, EarlyCommit]
+    return [NearestMovement, EarlyCommit, Deviating]
