@@ -136,7 +136,8 @@ class Comparison(ABC):
         return np.where(count > 0, total / np.maximum(count, 1), 0.0)
 
     def still(self, frames: Frames) -> np.ndarray:
-        """Each frame's distance to standing still (every feature zero): how much there is to explain, (n,).
+        """Each frame's distance to standing still: how much there is to explain, (n,). Here: to every feature zero
+        (no excursion from the mean posture, no motion, no carry).
 
         For :class:`Motion`, the share of a demonstration that a movement leaves unexplained is its distance over
         this one (:mod:`plugins.matchers.decision`)."""
@@ -167,6 +168,14 @@ class Poses(Comparison):
         seen = np.asarray(visible, dtype=bool) & np.isfinite(poses).all(axis=-1)
         n = len(poses)
         return Frames(np.where(seen[..., None], poses, 0.0), seen, np.zeros((n, 0)), np.zeros(n, dtype=bool))
+
+    def still(self, frames: Frames) -> np.ndarray:
+        """Each frame's eq. 1 distance to the sequence's mean pose (its own posture held still), (n,)."""
+        counts = frames.seen.sum(axis=0)
+        mean = (frames.parts * frames.seen[..., None]).sum(axis=0) / np.maximum(counts, 1)[:, None]
+        d = np.sqrt(((frames.parts - mean) ** 2).sum(axis=-1))
+        count = frames.seen.sum(axis=1)
+        return np.where(count > 0, (d * frames.seen).sum(axis=1) / np.maximum(count, 1), 0.0)
 
 
 class Motion(Comparison):
