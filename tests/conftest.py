@@ -30,7 +30,7 @@ CALLED_HOOKS: set[str] = set()
 @pytest.fixture(autouse=True, scope="session")
 def _record_hook_calls():
     """Monitor every plugin manager the tests make (the way tracing does) and note the hooks that ran an implementation:
-    ``tests/test_docs.py`` checks that every hook was really called by some test."""
+    ``tests/docs/test_docs.py`` checks that every hook was really called by some test."""
     original = PluginManager.__init__
 
     def init(self, *args, **kwargs):
@@ -44,7 +44,7 @@ def _record_hook_calls():
 
 
 HOOK_CHECK = "test_every_hook_is_called_by_a_test"
-"""tests/test_docs.py's check that every hook was called by some test: it needs every other test to have run."""
+"""tests/docs/test_docs.py's check that every hook was called by some test: it needs every other test to have run."""
 
 
 def pytest_collection_modifyitems(session, config, items):
@@ -78,7 +78,7 @@ def pytest_testnodedown(node, error):
 @pytest.hookimpl(tryfirst=True)
 def pytest_sessionfinish(session, exitstatus):
     """A worker sends the hooks it saw called; the controller checks that every hook was called by some test (on
-    any worker), reported as the same tests ``tests/test_docs.py`` defines, when every worker collected every test
+    any worker), reported as the same tests ``tests/docs/test_docs.py`` defines, when every worker collected every test
     module."""
     config = session.config
     if hasattr(config, "workeroutput"):  # an xdist worker
@@ -87,7 +87,7 @@ def pytest_sessionfinish(session, exitstatus):
         return
     if not _WORKERS or not all(whole for whole, _ in _WORKERS):
         return
-    from tests.test_docs import HOOKS
+    from tests.docs.test_docs import HOOKS
 
     called = set().union(*(hooks for _, hooks in _WORKERS))
     failed = 0
@@ -95,7 +95,7 @@ def pytest_sessionfinish(session, exitstatus):
         test = f"{HOOK_CHECK}[{name}]"
         ok = name in called
         failed += not ok
-        report = pytest.TestReport(f"tests/test_docs.py::{test}", ("tests/test_docs.py", 0, test), {},
+        report = pytest.TestReport(f"tests/docs/test_docs.py::{test}", ("tests/docs/test_docs.py", 0, test), {},
                             "passed" if ok else "failed",
                             None if ok else f"no test made the toolkit call {name} with an implementation registered "
                                             "(on any xdist worker)", "call")
@@ -210,7 +210,7 @@ def write(tmp_path):
 @pytest.fixture
 def recorder(pm):
     """The event-recording fixture plugin, registered into ``pm``; returns the plugin (its ``calls`` list)."""
-    from tests.plugins.recorder import Recorder
+    from tests.fixtures.recorder import Recorder
 
     plugin = Recorder()
     pm.register(plugin, name="recorder")
@@ -220,7 +220,7 @@ def recorder(pm):
 @pytest.fixture
 def scripted(pm):
     """Register the scripted segmenter and matcher fixture plugin into ``pm``."""
-    from tests.plugins import scripted as module
+    from tests.fixtures import scripted as module
 
     pm.register_plugin(module, _info("scripted"))
     return module
@@ -280,4 +280,4 @@ def watch_scene(write):
 def _info(name):
     from toolkit.manager import PluginInfo
 
-    return PluginInfo(name, f"tests.plugins.{name}", "(tests)", "")
+    return PluginInfo(name, f"tests.fixtures.{name}", "(tests)", "")

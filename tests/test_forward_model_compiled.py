@@ -15,7 +15,7 @@ import pytest
 from plugins.bench.mocap import _streams
 from plugins.matchers.forward_model import ForwardModel
 from tests.test_forward_model_fast import kernels
-from tests.test_watching_settled import data, pm_, profile, watched  # noqa: F401 (fixtures)
+from tests.toolkit.test_watching_settled import data, pm_, profile, watched  # noqa: F401 (fixtures)
 from toolkit.observe import compose_observer
 
 

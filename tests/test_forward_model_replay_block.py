@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 from plugins.bench.data import make_data
 from plugins.bench.mocap import _streams
 from plugins.matchers.forward_model import ForwardModel
-from tests.test_watching_settled import frozen, watched
+from tests.toolkit.test_watching_settled import frozen, watched
 from toolkit import Match, Matcher, create_plugin_manager
 from toolkit.errors import PluginError
 from toolkit.observe import Observer, compose_observer

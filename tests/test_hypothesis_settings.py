@@ -9,7 +9,8 @@ from pathlib import Path
 import pytest
 
 HERE = Path(__file__).resolve().parent
-MODULES = sorted(p.stem for p in HERE.glob("test_*.py") if "hypothesis" in p.read_text(encoding="utf-8"))
+MODULES = sorted(".".join(p.relative_to(HERE).with_suffix("").parts) for p in HERE.rglob("test_*.py")
+                 if "fixtures" not in p.parts and "hypothesis" in p.read_text(encoding="utf-8"))
 
 
 def property_tests(module):
@@ -29,7 +30,7 @@ def test_no_property_test_has_a_deadline(name):
 
 
 def test_the_property_tests_are_found():
-    from tests import test_metrics
+    from tests.plugins.bench import test_metrics
 
     assert {"test_edit_distance_is_a_metric", "test_macro_f1_and_confusion_equal_the_hand_written_ones"} <= {
         name for name, _ in property_tests(test_metrics)}

@@ -13,7 +13,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from tests.test_relative_lengths import generated  # noqa: F401  (the generated recordings, a module fixture)
+from tests.toolkit.test_relative_lengths import generated  # noqa: F401  (the generated recordings, a module fixture)
 from toolkit import create_plugin_manager
 from toolkit.observe import Observer
 from toolkit.observe import compose_observer

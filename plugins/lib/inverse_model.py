@@ -70,7 +70,7 @@ def _timings(parts: list[np.ndarray], fps: float) -> list[tuple[float, float]]:
 
     The Savitzky-Golay filter works along the time axis, column by column (a convolution, and a least-squares
     polynomial at each end), so filtering the parts' speeds side by side gives each part's own filtered speed;
-    ``tests/test_inverse_model_once.py`` checks it bit for bit.
+    ``tests/plugins/lib/test_inverse_model_once.py`` checks it bit for bit.
     """
     speeds = np.stack([np.linalg.norm(np.diff(p, axis=0), axis=1) * fps for p in parts], axis=1)
     if len(speeds) >= 7:

@@ -41,7 +41,7 @@ UPRIGHT_RATIO = 0.5
 """A body stands upright when its vertical extent is at least this fraction of its span (the median frame)."""
 FLIP_RATE = 1e-3
 """The facing may flip (turn by more than :data:`FLIP_ANGLE` from one frame to the next) in at most this fraction of
-the frames (``tests/test_profile.py`` holds the Bandai-Namco profile to it)."""
+the frames (``tests/toolkit/test_profile.py`` holds the Bandai-Namco profile to it)."""
 FLIP_ANGLE = 2.0
 """A turn (radians) between two consecutive frames that no body makes: a flip of the estimate."""
 UP_COSINE = 0.7

@@ -1,0 +1,1 @@
+"""The documentation stays true: its hooks, its Python blocks and the command output it shows."""

@@ -1,0 +1,1 @@
+"""Tests of the top floor: the likeme command, the estimators, the profile proposer and checks."""

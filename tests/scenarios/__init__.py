@@ -1,0 +1,1 @@
+"""Scenario tests that replay the papers' examples (characters/scenarios/), whole runs end to end."""

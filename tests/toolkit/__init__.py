@@ -1,0 +1,1 @@
+"""Tests of the core, toolkit/: one file per module."""
