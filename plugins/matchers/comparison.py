@@ -26,10 +26,13 @@ is attached (``comparison = "poses"`` or ``"motion"``):
       (a walk forward, backward, sideways; a run), and the turn since the sequence began as the chord
       ``(cos θ - 1, sin θ)`` a point one body size ahead of the root moves along (a walk that turns left or right).
 
-    The distance of two frames is eq. 1 over these: the mean, over the parts seen in both, of the Euclidean norm of
-    each part's difference in shape, motion and carry together (every part is carried by the body, so the carry
-    enters each part's norm). Unit-free: one body size is 1. Nothing in it depends on the frame rate, which is taken
-    out by the derivative, nor on the tempo, which the search's time warping takes up.
+    The distance of two frames is eq. 1 over these with the root of the mean square in place of the mean: the root
+    of the mean, over the parts seen in both, of the squared Euclidean norm of each part's difference in shape,
+    motion and carry together (every part is carried by the body, so the carry enters each part's norm). The root
+    mean square lets the parts that differ most, the ones that move, count most, where eq. 1's plain mean lets the
+    many still parts of a whole body outweigh a waving hand; and it is a few matrix products for all frame pairs at
+    once. Unit-free: one body size is 1. Nothing in it depends on the frame rate, which is taken out by the
+    derivative, nor on the tempo, which the search's time warping takes up.
 
 :data:`HORIZON` is 0.25 s: motion and shape count alike for a part swinging at ``1 / (2π · 0.25 s)``, about
 0.64 Hz, the middle of the frequencies of human gestures and steps (half a hertz to a few hertz), so neither
@@ -38,13 +41,17 @@ outweighs the other for any of them. It was not chosen on data (``docs/matchers.
 
 from __future__ import annotations
 
+import warnings
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
+from functools import cached_property
 from typing import ClassVar
 
 import numpy as np
 
 from plugins.lib.body_size import body_scale
+from plugins.lib.root_frame import root_relative, smooth_heading
+from plugins.lib.travel import body_velocity, turned
 from plugins.lib.velocity import derivative
 
 __all__ = ["COMPARISONS", "Comparison", "Frames", "HORIZON", "Motion", "Poses", "comparison", "sequence_size"]
@@ -77,6 +84,17 @@ class Frames:
 
     def __len__(self) -> int:
         return len(self.parts)
+
+    @cached_property
+    def products(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """What :meth:`Motion.costs` multiplies, kept with the frames (a repertoire's are computed once): the parts
+        with the unseen ones zeroed, flat (n, P * D); their squared norms (n, P); the mask as numbers (n, P); the
+        carry with the unknown ones zeroed (n, C) and its squared norms (n,)."""
+        seen = self.seen.astype(float)
+        masked = self.parts * seen[..., None]
+        carry = np.where(self.carried[:, None], self.carry, 0.0)
+        return (masked.reshape(len(self), -1), np.einsum("npd,npd->np", masked, masked), seen, carry,
+                np.einsum("nc,nc->n", carry, carry))
 
     def take(self, rows: np.ndarray | slice) -> Frames:
         """The frames ``rows`` of this sequence."""
@@ -123,38 +141,60 @@ class Comparison(ABC):
 
     def costs(self, a: Frames, b: Frames) -> np.ndarray:
         """Every frame of ``a`` against every frame of ``b``: eq. 1 over the parts seen in both, (len(a), len(b)).
-        A pair with no part seen in both costs 0 (no evidence either way)."""
-        diff2 = _pairwise_sq(a.parts, b.parts)  # (n, m, P)
-        if a.carry.shape[1]:
-            both = a.carried[:, None] & b.carried[None, :]
-            carry2 = np.where(both, _pairwise_sq(a.carry[:, None], b.carry[:, None])[..., 0], 0.0)
-            diff2 += carry2[..., None]
-        d = np.sqrt(np.maximum(diff2, 0.0, out=diff2), out=diff2)
-        seen = a.seen[:, None, :] & b.seen[None, :, :]
-        count = seen.sum(axis=-1)
-        total = np.einsum("nmp,nmp->nm", d, seen)
-        return np.where(count > 0, total / np.maximum(count, 1), 0.0)
+        A pair with no part seen in both costs 0 (no evidence either way). Compiled (:func:`_eq1`)."""
+        out = np.empty((len(a), len(b)))
+        if out.size:
+            _kernel()(np.ascontiguousarray(a.parts, dtype=np.float64), a.seen, np.ascontiguousarray(a.carry,
+                      dtype=np.float64), a.carried, np.ascontiguousarray(b.parts, dtype=np.float64), b.seen,
+                      np.ascontiguousarray(b.carry, dtype=np.float64), b.carried, out)
+        return out
 
+    @abstractmethod
     def still(self, frames: Frames) -> np.ndarray:
-        """Each frame's distance to standing still: how much there is to explain, (n,). Here: to every feature zero
-        (no excursion from the mean posture, no motion, no carry).
-
-        For :class:`Motion`, the share of a demonstration that a movement leaves unexplained is its distance over
-        this one (:mod:`plugins.matchers.decision`)."""
-        norm2 = np.einsum("npd,npd->np", frames.parts, frames.parts)
-        if frames.carry.shape[1]:
-            norm2 = norm2 + np.where(frames.carried, np.einsum("nc,nc->n", frames.carry, frames.carry), 0.0)[:, None]
-        d = np.sqrt(norm2)
-        count = frames.seen.sum(axis=1)
-        return np.where(count > 0, (d * frames.seen).sum(axis=1) / np.maximum(count, 1), 0.0)
+        """Each frame's distance to standing still: how much there is to explain, (n,). The share of a
+        demonstration that a movement leaves unexplained is its distance over this one
+        (:mod:`plugins.matchers.decision`)."""
 
 
-def _pairwise_sq(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Squared Euclidean distances of (n, P, D) against (m, P, D), per part: (n, m, P)."""
-    aa = np.einsum("npd,npd->np", a, a)
-    bb = np.einsum("mpd,mpd->mp", b, b)
-    ab = np.einsum("npd,mpd->nmp", a, b)
-    return aa[:, None, :] + bb[None, :, :] - 2.0 * ab
+def _eq1(a, a_seen, a_carry, a_carried, b, b_seen, b_carry, b_carried, out):
+    """eq. 1 of every frame pair: ``out[i, j]`` the mean over the parts seen in both of the Euclidean norm of the
+    part's difference, the carries' difference (where both are known) added to each part's squared norm; 0 where
+    no part is seen in both. Plain Python as written (the reference), compiled by :func:`_kernel`."""
+    n, parts, dims = a.shape
+    m = b.shape[0]
+    width = a_carry.shape[1]
+    for i in range(n):
+        for j in range(m):
+            carry = 0.0
+            if width and a_carried[i] and b_carried[j]:
+                for c in range(width):
+                    d = a_carry[i, c] - b_carry[j, c]
+                    carry += d * d
+            total = 0.0
+            count = 0
+            for p in range(parts):
+                if a_seen[i, p] and b_seen[j, p]:
+                    sq = carry
+                    for k in range(dims):
+                        d = a[i, p, k] - b[j, p, k]
+                        sq += d * d
+                    total += np.sqrt(sq)
+                    count += 1
+            out[i, j] = total / count if count else 0.0
+
+
+_compiled = None
+
+
+def _kernel():
+    """:func:`_eq1` compiled by numba (:func:`plugins.lib.compiled.compiled`), or the reference without it."""
+    global _compiled
+    if _compiled is None:
+        from plugins.lib.compiled import compiled
+
+        found = compiled(_eq1)
+        _compiled = found[0] if found is not None else _eq1
+    return _compiled
 
 
 class Poses(Comparison):
@@ -211,13 +251,84 @@ class Motion(Comparison):
         return Frames(np.concatenate([shape, motion], axis=2), seen, carry, carried)
 
 
+    def costs(self, a: Frames, b: Frames) -> np.ndarray:
+        """Every frame of ``a`` against every frame of ``b``: the root mean square over the parts seen in both of
+        each part's difference with the carries' (where both are known) added, (len(a), len(b)); 0 where no part
+        is seen in both. As matrix products: the sum over the parts seen in both of ``|x|^2 + |y|^2 - 2 x.y``
+        (:attr:`Frames.products`); best on one BLAS thread (:func:`plugins.lib.compiled.one_thread`)."""
+        xa, na, sa, ca, qa = a.products
+        xb, nb, sb, cb, qb = b.products
+        count = sa @ sb.T
+        square = na @ sb.T + sa @ nb.T - 2.0 * (xa @ xb.T)
+        if ca.shape[1]:
+            carry = qa[:, None] + qb[None, :] - 2.0 * (ca @ cb.T)
+            square += np.where(np.outer(a.carried, b.carried), carry, 0.0) * count
+        with np.errstate(invalid="ignore", divide="ignore"):
+            mean = np.where(count > 0, square / np.maximum(count, 1.0), 0.0)
+        return np.sqrt(np.maximum(mean, 0.0))
+
+    def still(self, frames: Frames) -> np.ndarray:
+        """Each frame's distance to standing still, every feature zero (no excursion from the mean posture, no
+        motion, no carry): the root mean square of its parts' norms with the carry's, (n,)."""
+        norm2 = np.einsum("npd,npd->np", frames.parts, frames.parts)
+        if frames.carry.shape[1]:
+            norm2 = norm2 + np.where(frames.carried, np.einsum("nc,nc->n", frames.carry, frames.carry), 0.0)[:, None]
+        count = frames.seen.sum(axis=1)
+        return np.sqrt(np.where(count > 0, (norm2 * frames.seen).sum(axis=1) / np.maximum(count, 1), 0.0))
+
+    def of_motion(self, motion, body, rows: np.ndarray, fps: float) -> Frames:
+        """The frames of a whole observed motion (a segment in working memory, with its world positions) at its
+        frames ``rows``, given as a sequence of ``fps`` frames a second.
+
+        Where the world positions are known, the body's frame is found again from them over the whole segment, as
+        it is for the clips a repertoire is built from (:func:`plugins.lib.clip_repertoire.root_relative_motion`:
+        the facing a centred running median over :data:`FACING_WINDOW`): a perception that watches live can only
+        look back, so its facing lags behind a turn, and the parts would be seen swinging sideways as the body
+        turns. Each part's motion is derived at the motion's own frame rate before the rows are taken, and the
+        body size is the segment's."""
+        positions, visible = motion.positions, motion.visible
+        travel = heading = None
+        if motion.world is not None and np.isfinite(motion.world).any():
+            window = max(1, int(round(FACING_WINDOW * motion.fps)))
+            local, seen, _, _ = root_relative(motion.world, motion.visible, body,
+                                              lambda h: smooth_heading(h, window))
+            if seen.any():
+                positions, visible = local, seen
+                travel = body_velocity(motion.world, local, seen, body.root_index, motion.fps, frames=rows)
+                heading = turned(motion.world, local, seen, body.root_index)[rows]
+        seen = visible & np.isfinite(positions).all(axis=-1)
+        relative = np.where(seen[..., None], positions, 0.0)
+        root = body.root_index
+        held = _held(relative, seen)
+        velocity = derivative(held - held[:, root : root + 1], motion.fps)[rows]
+        return self.frames(held[rows], seen[rows], fps, velocity=velocity, travel=travel, heading=heading,
+                           size=sequence_size(relative, seen))
+
+
+FACING_WINDOW = 1.0
+"""Seconds of the centred running median of the facing when a whole segment's frame is found again."""
+
+
+def _held(positions: np.ndarray, seen: np.ndarray) -> np.ndarray:
+    """Each part held where it was last seen (first seen, before that), docs/conventions.md; 0 if never seen."""
+    out = positions.copy()
+    for p in np.flatnonzero(~seen.all(axis=0)):
+        rows = np.flatnonzero(seen[:, p])
+        if not len(rows):
+            out[:, p] = 0.0
+            continue
+        last = np.maximum.accumulate(np.where(seen[:, p], np.arange(len(seen)), -1))
+        out[:, p] = positions[np.where(last >= 0, last, rows[0]), p]
+    return out
+
+
 def sequence_size(poses: np.ndarray, seen: np.ndarray) -> float:
     """A sequence's body size: :func:`plugins.lib.body_size.body_scale` of each part's median position over the
     frames it is seen (0 when fewer than two parts are ever seen)."""
-    med = np.full(poses.shape[1:], np.nan)
-    for p in np.flatnonzero(seen.any(axis=0)):
-        med[p] = np.median(poses[seen[:, p], p], axis=0)
-    return float(body_scale(med))
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # a part never seen: its median is NaN, and left out
+        median = np.nanmedian(np.where(seen[..., None], poses, np.nan), axis=0)
+    return float(body_scale(median))
 
 
 COMPARISONS: dict[str, type[Comparison]] = {"poses": Poses, "motion": Motion}

@@ -19,10 +19,10 @@ from typing import Any, Protocol
 import networkx as nx
 import numpy as np
 
+from plugins.lib.compiled import one_thread
 from plugins.lib.pose_distance import path_distance
-from plugins.lib.travel import body_velocity, turned
-from plugins.lib.velocity import derivative
-from plugins.matchers.comparison import Comparison, Frames, Poses, comparison, sequence_size
+from plugins.matchers.comparison import Comparison, Frames, comparison
+from plugins.matchers.comparison import Motion as MotionComparison
 from plugins.matchers.decision import Calibrated, Calibration, Decision, Distance
 from plugins.matchers.path_search.kbest import INDEX_MIN_NODES, KBest
 from plugins.matchers.path_search.per_movement import Chains, chain_distances, chain_path
@@ -187,7 +187,7 @@ class EachMovement(Search):
         if self.nodes is None or not samples.seen.any():
             return None
         m = self.matcher
-        per_chain = chain_distances(m.comparison, samples, self.nodes, self.chains)
+        per_chain, cost = chain_distances(m.comparison, samples, self.nodes, self.chains)
         distances: dict[str, float] = {}
         for movement, d in zip(self.chains.movements, per_chain):
             distances[movement] = min(distances.get(movement, np.inf), float(d))
@@ -195,7 +195,7 @@ class EachMovement(Search):
         if not ranked:
             return None
         best = int(np.argmin(per_chain))
-        path = chain_path(m.comparison, samples, self.nodes, self.chains, best)
+        path = chain_path(cost, self.chains, best)
         return Found(ranked[0][0], path, 1.0, ranked, {"mean_distance": ranked[0][1], "samples": len(samples)})
 
     def calibration(self):
@@ -205,7 +205,7 @@ class EachMovement(Search):
         for c, take in enumerate(self.takes):
             skip = np.zeros(len(self.chains), dtype=bool)
             skip[c] = True
-            distances = chain_distances(m.comparison, take, self.nodes, self.chains, skip)
+            distances, _ = chain_distances(m.comparison, take, self.nodes, self.chains, skip)
             still = float(np.mean(m.comparison.still(take)))
             mine = movements == movements[c]
             for out, chosen in ((own, mine & ~skip), (other, ~mine)):
@@ -298,9 +298,10 @@ class PathSearch(Matcher):
         self.take_nodes = {m: [np.array([index[nd] for nd in take], dtype=np.intp) for take in takes if take]
                            for m, takes in motor.takes().items()}
         self._version = n
-        self.searcher.rebuild()
-        if isinstance(self.decision, Calibrated):
-            self.decision.calibrate(self.searcher.calibration())
+        with one_thread():
+            self.searcher.rebuild()
+            if isinstance(self.decision, Calibrated):
+                self.decision.calibrate(self.searcher.calibration())
 
     def take_frames(self, nodes: np.ndarray) -> Frames:
         """The frames of one take's nodes (in their order): as the comparison sees a demonstration, about the take's
@@ -321,22 +322,15 @@ class PathSearch(Matcher):
                              f"not {list(motion.parts)} (Motion.onto maps them by name)")
         idx = _sample_frames(motion, self.motor.node_rate)
         poses, visible = motion.positions[idx], motion.visible[idx]
-        if isinstance(self.comparison, Poses):
-            return self.comparison.frames(poses, visible, self.motor.node_rate), (poses, visible)
-        root = self.owner.body.root_index
-        seen = motion.visible & np.isfinite(motion.positions).all(axis=-1)
-        relative = np.where(seen[..., None], motion.positions, 0.0)
-        velocity = derivative(relative - relative[:, root : root + 1], motion.fps)[idx]
-        travel = heading = None
-        if motion.world is not None:
-            travel = body_velocity(motion.world, motion.positions, motion.visible, root, motion.fps, frames=idx)
-            heading = turned(motion.world, motion.positions, motion.visible, root)[idx]
-        size = sequence_size(relative, seen)
-        frames = self.comparison.frames(poses, visible, self.motor.node_rate, velocity=velocity, travel=travel,
-                                        heading=heading, size=size)
-        return frames, (poses, visible)
+        if isinstance(self.comparison, MotionComparison):
+            return self.comparison.of_motion(motion, self.owner.body, idx, self.motor.node_rate), (poses, visible)
+        return self.comparison.frames(poses, visible, self.motor.node_rate), (poses, visible)
 
     def match(self, motion: Motion) -> Match:
+        with one_thread():
+            return self._match(motion)
+
+    def _match(self, motion: Motion) -> Match:
         if motion.n_frames == 0 or not motion.visible.any():
             return Match.unknown("nothing visible", details={"reason": "nothing visible"})
         self._refresh()

@@ -147,15 +147,16 @@ def _kernel():
 
 
 def chain_distances(comparison: Comparison, samples: Frames, nodes: Frames, chains: Chains,
-                    skip: np.ndarray | None = None) -> np.ndarray:
-    """Each chain's distance to the samples (C,): its best path's summed frame distance over the path's length.
+                    skip: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray | None]:
+    """Each chain's distance to the samples (C,): its best path's summed frame distance over the path's length;
+    and the frame distances it was found from (samples by the nodes kept, ``None`` when nothing was compared).
 
     ``nodes``: the frames of every node of the chains, in chain order (``Frames.join`` of the takes'); ``skip``
     (C,) bool: chains left out (infinite)."""
     keep = np.ones(len(chains), dtype=bool) if skip is None else ~np.asarray(skip, dtype=bool)
     best = np.full(len(chains), np.inf)
     if len(samples) == 0 or not keep.any():
-        return best
+        return best, None
     if keep.all():
         cost, starts, cyclic = comparison.costs(samples, nodes), chains.starts, chains.cyclic
     else:
@@ -164,49 +165,62 @@ def chain_distances(comparison: Comparison, samples: Frames, nodes: Frames, chai
         cost = comparison.costs(samples, nodes.take(columns))
         starts = np.concatenate([[0], np.cumsum(np.diff(chains.starts)[kept])]).astype(np.intp)
         cyclic = chains.cyclic[kept]
+    cost = np.ascontiguousarray(cost, dtype=np.float64)
     found = np.empty(len(starts) - 1)
     end = np.empty(len(starts) - 1, dtype=np.intp)
-    _kernel()(np.ascontiguousarray(cost, dtype=np.float64), starts, cyclic, found, end)
+    _kernel()(cost, starts, cyclic, found, end)
     best[keep] = found
-    return best
+    return best, cost
 
 
-def chain_path(comparison: Comparison, samples: Frames, nodes: Frames, chains: Chains, c: int) -> np.ndarray:
-    """The node indices of chain ``c``'s best path, one per sample (the node each sample was last aligned with),
-    found by the same warping as :func:`chain_distances` with its steps kept and followed back."""
-    columns = np.arange(chains.starts[c], chains.starts[c + 1])
-    cost = comparison.costs(samples, nodes.take(columns))
+def _warp_path(cost, cyclic, out):
+    """The warping of :func:`_warp` on one chain (``cost`` (n, m)), its steps kept and followed back from the best
+    end: ``out[i]`` the column the sample ``i`` was last aligned with. Plain Python as written, compiled by
+    :func:`_path_kernel`."""
     n, m = cost.shape
-    total = np.full((n, m), np.inf)
-    length = np.zeros((n, m))
+    total = np.empty((n, m))
+    length = np.empty((n, m))
     step = np.zeros((n, m), dtype=np.int8)  # 0 start, 1 diagonal, 2 vertical, 3 horizontal
-    total[0] = cost[0]
-    length[0] = 1.0
-    cyclic = bool(chains.cyclic[c]) and m > 1
+    for j in range(m):
+        total[0, j] = cost[0, j]
+        length[0, j] = 1.0
     for i in range(1, n):
         for j in range(m):
-            options = []
             if j > 0:
-                options.append((total[i - 1, j - 1], length[i - 1, j - 1], 1, j - 1))
-            elif cyclic:
-                options.append((total[i - 1, m - 1], length[i - 1, m - 1], 1, m - 1))
-            options.append((total[i - 1, j], length[i - 1, j], 2, j))
-            if j > 0:
-                options.append((total[i, j - 1], length[i, j - 1], 3, j - 1))
-            d, dl, s, _ = min(options, key=lambda o: o[0])
-            total[i, j], length[i, j], step[i, j] = d + cost[i, j], dl + 1.0, s
-        if cyclic:
+                d, dl, s = total[i - 1, j - 1], length[i - 1, j - 1], 1
+            elif cyclic and m > 1:
+                d, dl, s = total[i - 1, m - 1], length[i - 1, m - 1], 1
+            else:
+                d, dl, s = np.inf, 0.0, 1
+            if total[i - 1, j] < d:
+                d, dl, s = total[i - 1, j], length[i - 1, j], 2
+            if j > 0 and total[i, j - 1] < d:
+                d, dl, s = total[i, j - 1], length[i, j - 1], 3
+            total[i, j] = d + cost[i, j]
+            length[i, j] = dl + 1.0
+            step[i, j] = s
+        if cyclic and m > 1:
             j = 0
             while j < m:
                 left = m - 1 if j == 0 else j - 1
                 value = total[i, left] + cost[i, j]
                 if value < total[i, j]:
-                    total[i, j], length[i, j], step[i, j] = value, length[i, left] + 1.0, 3
+                    total[i, j] = value
+                    length[i, j] = length[i, left] + 1.0
+                    step[i, j] = 3
                     j += 1
                 else:
                     break
-    i, j = n - 1, int(np.argmin(total[-1] / length[-1]))
-    out = np.full(n, -1, dtype=np.intp)
+    j = 0
+    best = np.inf
+    for c in range(m):
+        mean = total[n - 1, c] / length[n - 1, c]
+        if mean < best:
+            best = mean
+            j = c
+    i = n - 1
+    for r in range(n):
+        out[r] = -1
     while True:
         if out[i] < 0:  # the last node aligned with sample i (a horizontal step aligns it with several)
             out[i] = j
@@ -214,9 +228,30 @@ def chain_path(comparison: Comparison, samples: Frames, nodes: Frames, chains: C
         if s == 0:
             break
         if s == 1:
-            i, j = i - 1, (j - 1) % m
+            i -= 1
+            j = j - 1 if j > 0 else m - 1
         elif s == 2:
             i -= 1
         else:
-            j = (j - 1) % m
+            j = j - 1 if j > 0 else m - 1
+
+
+_compiled_path = None
+
+
+def _path_kernel():
+    global _compiled_path
+    if _compiled_path is None:
+        found = compiled(_warp_path)
+        _compiled_path = found[0] if found is not None else _warp_path
+    return _compiled_path
+
+
+def chain_path(cost: np.ndarray, chains: Chains, c: int) -> np.ndarray:
+    """The node indices of chain ``c``'s best path, one per sample (the node each sample was last aligned with),
+    found by the same warping as :func:`chain_distances` with its steps kept and followed back; ``cost``: the frame
+    distances :func:`chain_distances` returned (every chain kept)."""
+    block = np.ascontiguousarray(cost[:, chains.starts[c] : chains.starts[c + 1]])
+    out = np.empty(len(block), dtype=np.intp)
+    _path_kernel()(block, bool(chains.cyclic[c]), out)
     return chains.chain(c)[out]
