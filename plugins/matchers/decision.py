@@ -28,9 +28,11 @@ chosen once when a matcher is attached (``decision = "distance"`` or ``"calibrat
     the ``1 - known_rejected`` quantile of the *own* scores (so that at most ``known_rejected`` of the performances
     of a known movement are called unknown, as far as the repertoire's own takes show how performances vary) and
     the median of the *other* scores (a demonstration nearer to a known movement than the repertoire's movements
-    typically lie to each other is taken for it). Takes recorded one after another differ by almost nothing, so
-    the first alone would reject every other performer; the second alone ignores how widely a movement is
-    performed. With one take of each movement only the second is known.
+    typically lie to each other is taken for it), and never above 1: a movement that explains a demonstration no
+    better than standing still does not stand for it, however far apart the repertoire's movements lie. Takes
+    recorded one after another differ by almost nothing, so the first alone would reject every other performer;
+    the second alone ignores how widely a movement is performed. With one take of each movement only the second
+    is known.
 
 The decision's answer, with the score and the threshold it was decided on, goes into the typed fields of
 :class:`toolkit.Match` (``score``, ``threshold``, ``nearest``, ``measure``), which ``likeme observe`` prints for
@@ -153,15 +155,20 @@ class Calibrated(Decision):
         self.calibration = calibration
 
     def threshold(self) -> float:
-        """The larger of the ``1 - known_rejected`` quantile of the own scores and the median of the other scores;
-        infinite (everything known) while the repertoire has no two movements and no two takes of one."""
+        """The larger of the ``1 - known_rejected`` quantile of the own scores and the median of the other scores,
+        at most :data:`STILL` (1: no better than standing still); :data:`STILL` while the repertoire has neither
+        two movements nor two takes of one."""
         limits = []
         if self.calibration.own:
             limits.append(float(np.quantile(self.calibration.own, 1.0 - self.known_rejected)))
         if self.calibration.other:
             limits.append(float(np.median(self.calibration.other)))
-        return max(limits) if limits else float("inf")
+        return min(max(limits), STILL) if limits else STILL
 
+
+STILL = 1.0
+"""The largest calibrated threshold: a score of 1 is a demonstration its nearest movement explains no better than
+standing still would."""
 
 DECISIONS = {"distance": Distance, "calibrated": Calibrated}
 """The decisions by the name a matcher's ``decision`` parameter takes."""

@@ -1,8 +1,8 @@
-"""Path search's fast paths (issue 22) give the numbers and answers of the paths they replaced.
+"""The k-best beam's fast paths (issue 22) give the numbers and answers of the paths they replaced.
 
 Each fast path is pinned to the arithmetic it stands for: :class:`plugins.lib.pose_distance.PoseScan` to the einsum
 of eq. 1 over every part, its single-precision screen to a bound of its error, the screened start nodes to
-:meth:`PathSearch._starts` over the whole scan, the padded reach table to :func:`_gather`, :func:`_firsts` to
+:meth:`KBest._starts` over the whole scan, the padded reach table to :func:`_gather`, :func:`_firsts` to
 ``np.unique``, ``body_velocity(frames=...)`` to the whole computation (written out here as it was); and whole
 searches on the project's generated streams give the same matches with every fast path on and off.
 """
@@ -16,7 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-import plugins.matchers.path_search as ps
+import plugins.matchers.path_search.kbest as ps
 from plugins.lib.pose_distance import PoseScan
 from plugins.lib.travel import body_velocity, frame_rotation
 
@@ -141,6 +141,17 @@ def test_body_velocity_at_some_frames_is_the_whole_computations_rows(n, parts, s
     assert np.array_equal(body_velocity(world, local, visible, 0, fps, frames=frames), want[frames], equal_nan=True)
 
 
+@settings(max_examples=300, deadline=None)
+@given(st.integers(1, 60), st.integers(1, 12), st.integers(0, 2**32 - 1))
+def test_the_start_nodes_are_the_stable_sorts(n, k, seed):
+    rng = np.random.default_rng(seed)
+    first = rng.choice([0.0, 0.5, 1.0, np.inf, np.nan], n) if seed % 3 == 0 else rng.integers(0, 4, n) / 4.0
+    if seed % 5 == 0:
+        first = np.where(rng.random(n) < 0.3, np.inf, first)  # excluded nodes
+    beam = ps.KBest.__new__(ps.KBest)  # no graph is needed for the starts
+    assert np.array_equal(beam._starts(first, k), np.argsort(first, kind="stable")[:k])
+
+
 @pytest.fixture(scope="module")
 def generated(tmp_path_factory):
     """The project's generated benchmark data (two streams), its profile and its streams read."""
@@ -156,15 +167,15 @@ def generated(tmp_path_factory):
     return pm, profile, folder, streams
 
 
-SETTINGS = [[], ["matcher.per_movement=false"], ["matcher.travel=0", "matcher.k=3"],
-            ["matcher.per_movement=false", "matcher.max_stay=0", "matcher.max_skip=3"]]
+PAPER = ["matcher.comparison=poses", "matcher.search=k-best", "matcher.decision=distance"]
+SETTINGS = [PAPER, [*PAPER, "matcher.k-best.k=3"], [*PAPER, "matcher.k-best.max_skip=3"]]
 
 
 @pytest.mark.parametrize("settings", SETTINGS)
 @pytest.mark.parametrize("segmenter", ["hub-threshold", "velocity-direction"])
 def test_the_same_matches_with_the_fast_paths_off(generated, settings, segmenter, monkeypatch):
-    """Every segment of the generated streams (the template's search: per_movement, travel, max_stay, spread; and
-    the paper's): the same Match, field for field, with the screen, the padded tables and PoseScan's planes off."""
+    """Every segment of the generated streams (the paper's search, several beams): the same Match, field for field,
+    with the screen, the padded tables and PoseScan's planes off."""
     from toolkit.observe import Observer, compose_observer
     from toolkit.params import parse_settings
 
@@ -174,11 +185,12 @@ def test_the_same_matches_with_the_fast_paths_off(generated, settings, segmenter
         character = compose_observer(pm, profile, folder / "repertoire", segmenter=segmenter, matcher="path-search",
                                      settings=parse_settings(settings))
         matcher = character.matcher
+        beam = matcher.searcher.kbest
         if not fast:
-            monkeypatch.setattr(matcher, "_screened", lambda query, k: None)
-            matcher.succ = matcher.succ._replace(padded=None)
-            matcher.pred = matcher.pred._replace(padded=None)
-            matcher._scan.planes = False
+            monkeypatch.setattr(beam, "_screened", lambda query, k: None)
+            beam.succ = beam.succ._replace(padded=None)
+            beam.pred = beam.pred._replace(padded=None)
+            beam._scan.planes = False
         found = []
         original = matcher.match
 
@@ -191,8 +203,8 @@ def test_the_same_matches_with_the_fast_paths_off(generated, settings, segmenter
         for motion in streams:
             Observer(character, profile.body, motion.fps).watch(motion)
         if fast:  # the fast paths were taken (the padded table with max_skip = 2; 3 reaches past LONG_ROW nodes)
-            assert matcher._scan.planes
-            assert (matcher.succ.padded is not None) == (matcher.params["max_skip"] == 2)
+            assert beam._scan.planes
+            assert (beam.succ.padded is not None) == (matcher.params["k-best"]["max_skip"] == 2)
         return found
 
     fast, slow = run(True), run(False)
@@ -202,22 +214,22 @@ def test_the_same_matches_with_the_fast_paths_off(generated, settings, segmenter
 
 def test_the_screened_starts_are_the_scans(generated):
     """Queries at and between the graph's own poses (ties, exact hits): the screened start nodes and costs equal
-    _starts over the whole scan, with and without per_movement, for several k."""
+    _starts over the whole scan, for several k."""
     from toolkit.observe import compose_observer
+    from toolkit.params import parse_settings
 
     pm, profile, folder, _ = generated
-    matcher = compose_observer(pm, profile, folder / "repertoire", matcher="path-search").matcher
+    matcher = compose_observer(pm, profile, folder / "repertoire", matcher="path-search",
+                               settings=parse_settings(PAPER)).matcher.searcher.kbest
     nodes = matcher.nodes_compared
     rng = np.random.default_rng(7)
     queries = [nodes[i] for i in rng.integers(0, len(nodes), 20)]
     queries += [0.5 * (nodes[i] + nodes[j]) for i, j in rng.integers(0, len(nodes), (20, 2))]
     queries += [nodes[i] + rng.normal(scale=0.05, size=nodes.shape[1:]) for i in rng.integers(0, len(nodes), 20)]
-    for per_movement in (True, False):
-        matcher.params = {**matcher.params, "per_movement": per_movement}
-        for k in (1, 3, 8, 40):
-            for query in queries:
-                first = einsum_scan(nodes, query)
-                want = matcher._starts(first, k)
-                start, costs = matcher._screened(query, k)
-                assert start.tolist() == want.tolist()
-                assert np.array_equal(costs, first[want])
+    for k in (1, 3, 8, 40):
+        for query in queries:
+            first = einsum_scan(nodes, query)
+            want = matcher._starts(first, k)
+            start, costs = matcher._screened(query, k)
+            assert start.tolist() == want.tolist()
+            assert np.array_equal(costs, first[want])

@@ -1,8 +1,5 @@
-"""Path search (Buchsbaum & Blumberg 2005, §5.2) on a posegraph small enough to work out by hand.
-
-A stick figure of five parts whose hand either rises (``raise``) or goes forward (``reach``) and back, 0.5 s out and
-0.5 s back, sampled at 10 pose nodes a second: each movement is a path of nine nodes out of the hub and back.
-"""
+"""Path search's k-best beam (Buchsbaum & Blumberg 2005, §5.2) on a posegraph small enough to work out by hand
+(the stick figure of :mod:`tests.plugins.matchers.path_search.stick`)."""
 
 from __future__ import annotations
 
@@ -12,48 +9,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from plugins.matchers.path_search import _reach
+from plugins.matchers.path_search import kbest
+from plugins.matchers.path_search.kbest import _reach
+from tests.plugins.matchers.path_search.stick import FPS, STICK, observed
 from toolkit import Motion, load_character
-
-STICK = """
-[character]
-name = "Stick"
-
-[body]
-parts = ["root", "head", "lk", "rk", "hand"]
-root = "root"
-facing = { left = "lk", right = "rk", forward = "head" }
-
-[motor]
-plugin = "posegraph"
-node_rate = 10.0
-
-[motor.poses.stand]
-root = [0.0, 1.0, 0.0]
-head = [0.0, 1.6, 0.1]
-lk = [0.1, 0.5, 0.0]
-rk = [-0.1, 0.5, 0.0]
-hand = [0.3, 1.0, 0.0]
-
-[motor.poses.up]
-base = "stand"
-hand = [0.3, 1.6, 0.0]
-
-[motor.poses.front]
-base = "stand"
-hand = [0.3, 1.0, 0.6]
-
-[motor.movements.raise]
-keys = [{ pose = "stand", at = 0.0 }, { pose = "up", at = 0.5 }, { pose = "stand", at = 1.0 }]
-
-[motor.movements.reach]
-keys = [{ pose = "stand", at = 0.0 }, { pose = "front", at = 0.5 }, { pose = "stand", at = 1.0 }]
-
-[matcher]
-plugin = "path-search"
-"""
-
-FPS = 30.0
 
 
 @pytest.fixture
@@ -93,7 +52,7 @@ def test_the_mean_distance_is_eq_1_per_sample_averaged_over_the_visible_parts(st
     assert match.movement == "reach" and match.details["mean_distance"] == pytest.approx(0.01 / 5)
     match = stick.matcher.match(observed(stick, "reach", offset=(0.01, 0.0, 0.0), hidden="head"))
     assert match.movement == "reach" and match.details["mean_distance"] == pytest.approx(0.01 / 4)
-    assert match.confidence == pytest.approx(np.exp(-(0.01 / 4) / stick.matcher.params["scale"]))
+    assert match.confidence == pytest.approx(np.exp(-(0.01 / 4) / stick.matcher.params["distance"]["scale"]))
 
 
 def test_farther_than_max_distance_is_unknown_not_the_nearest(stick):
@@ -109,8 +68,8 @@ def test_a_path_may_skip_nodes_so_a_faster_movement_still_aligns(stick):
     fast = observed(stick, "raise", speed=2.0)
     match = stick.matcher.match(fast)
     assert match.movement == "raise" and match.details["mean_distance"] == pytest.approx(0.0, abs=1e-9)
-    stick.matcher.params = {**stick.matcher.params, "max_skip": 1}
-    stick.matcher._cache_version = -1  # the reach tables are rebuilt for the new max_skip
+    stick.matcher.params = {**stick.matcher.params, "k-best": {"k": 8, "max_skip": 1}}
+    stick.matcher._version = -1  # the reach tables are rebuilt for the new max_skip
     slow = stick.matcher.match(fast)
     assert slow.details["mean_distance"] > 0.01
 
@@ -121,36 +80,21 @@ def test_hub_poses_do_not_vote(stick):
     assert match.movement is None and match.details["reason"] == "only hub poses"
 
 
-def test_max_stay_limits_how_long_a_path_stands_on_one_node(stick):
-    """Four times slower than the stick's own raise: a path that may stay on a node as long as it likes keeps up
-    with the hand to within the nodes' spacing; with max_stay = 1 it must move on every second sample, runs ahead
-    of the observed hand, and pays for it."""
-    slow = observed(stick, "raise", speed=0.25)
-    free = stick.matcher.match(slow)
-    assert free.movement == "raise" and free.details["mean_distance"] < 0.01
-    stick.matcher.params = {**stick.matcher.params, "max_stay": 1}
-    limited = stick.matcher.match(slow)
-    assert limited.details["mean_distance"] > 2 * free.details["mean_distance"]
-    runs = [len(list(g)) for _, g in __import__("itertools").groupby(limited.path)]
-    assert max(runs) <= 2  # a node and one stay at most
-
-
-def test_per_movement_keeps_a_hypothesis_for_a_movement_the_k_nearest_start_poses_miss(stick):
+def test_k_best_from_the_middle_frame_loses_a_movement_whose_middle_is_elsewhere(stick):
     """A raise whose middle frame is glitched to the reach's forward pose: with k = 1 the only start is on the reach,
-    and the beam spends half the movement there before it can get back into the raise; keeping each movement's
-    best path finds the raise along its whole length."""
+    and the beam spends half the movement there before it can get back into the raise (the per-movement search
+    finds the raise: tests/plugins/matchers/path_search/test_per_movement.py)."""
     motion = observed(stick, "raise")
     positions = motion.positions.copy()
     mid = motion.n_frames // 2
     hand = stick.body.index("hand")
     positions[mid - 1 : mid + 2, hand] = stick.motor.key_poses["front"][hand] - stick.motor.key_poses["front"][0]
     glitched = Motion(positions, FPS, motion.parts, motion.visible)
-    stick.matcher.params = {**stick.matcher.params, "k": 1, "max_distance": 10.0}
+    stick.matcher.params = {**stick.matcher.params, "k-best": {"k": 1, "max_skip": 2},
+                            "distance": {"max_distance": 10.0, "scale": 0.02}}
+    stick.matcher._version = -1  # the beam is rebuilt for the new k
     narrow = stick.matcher.match(glitched)
     assert narrow.details["votes"]["reach"] >= narrow.details["votes"].get("raise", 0)  # half the path on the reach
-    stick.matcher.params = {**stick.matcher.params, "per_movement": True}
-    match = stick.matcher.match(glitched)
-    assert match.movement == "raise" and set(match.details["votes"]) == {"raise"}
 
 
 def reference_reach(graph, nodes, index, max_skip, *, forward):
@@ -192,8 +136,7 @@ def test_reach_tables_equal_the_hand_written_ones(case):
 def test_the_reach_factored_through_wide_nodes_is_the_same_reach(case):
     """Every long node's local nodes and the rings of the wide nodes it reaches first make up exactly its reach;
     the other nodes keep their whole reach."""
-    import plugins.matchers.path_search as ps
-
+    ps = kbest
     n, edges, order, max_skip, forward, wide, long_row = case
     graph = nx.DiGraph()
     graph.add_nodes_from(f"n{i}" for i in range(n))
@@ -222,13 +165,11 @@ def test_the_reach_factored_through_wide_nodes_is_the_same_reach(case):
         assert got == set(want[indptr[i]:indptr[i + 1]].tolist())
 
 
-@pytest.mark.parametrize("settings", [["matcher.per_movement=true"],
-                                      ["matcher.per_movement=true", "matcher.max_stay=1", "matcher.k=3"],
-                                      ["matcher.per_movement=false", "matcher.max_skip=3"]])
+@pytest.mark.parametrize("settings", [["matcher.k-best.k=3"], ["matcher.k-best.max_skip=3"]])
 def test_a_beam_step_through_hubs_keeps_the_same_paths_as_listing_every_pair(tmp_path, settings):
     """Generated repertoires of many movements sharing a hub (likeme bench scaling's): every demo gets the same path,
     movement and confidence whether the reach is factored through the hub or listed pair by pair."""
-    import plugins.matchers.path_search as ps
+    ps = kbest
     from plugins.bench.memory import _data
     from plugins.bench.scaling import _demos, generated_clips
     from plugins.lib.clip_repertoire import clip_repertoire
@@ -245,10 +186,11 @@ def test_a_beam_step_through_hubs_keeps_the_same_paths_as_listing_every_pair(tmp
     for long_row in (0, 10**9):  # 0: every row through the hub factored; 10**9: every pair listed, as before
         saved, ps.LONG_ROW = ps.LONG_ROW, long_row
         try:
-            character = compose_observer(pm, profile, repertoire, matcher="", settings=parse_settings(settings))
+            character = compose_observer(pm, profile, repertoire, matcher="", settings=parse_settings(
+                ["matcher.comparison=poses", "matcher.search=k-best", "matcher.decision=distance", *settings]))
             observer = Observer(character, profile.body, 30.0)
             answers[long_row] = [observer.classify(motion).match for _, motion in _demos(pm, 30.0)]
-            table = character.matcher.succ
+            table = character.matcher.searcher.kbest.succ
         finally:
             ps.LONG_ROW = saved
         assert (len(table.wide[1]) > 0) == (long_row == 0)  # the hub (40 movements) is wide

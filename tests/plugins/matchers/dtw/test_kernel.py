@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 
 from plugins.matchers import dtw as dtw_module
 from plugins.matchers.dtw import frame_distance, warp_all
-from tests.test_matcher_speed import _dtw_matcher as _matcher
+from tests.plugins.matchers.dtw.test_abandoning import _dtw_matcher as _matcher
 from toolkit import Motion
 
 kernel = dtw_module._kernel()
