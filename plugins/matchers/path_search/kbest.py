@@ -33,15 +33,17 @@ onward nodes only for the paths that can be the best way to them (the least cost
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import networkx as nx
 import numpy as np
 
-from plugins.lib.pose_distance import PoseScan, pose_distance
+from plugins.lib.pose_distance import PoseScan, path_distance, pose_distance
 from plugins.lib.pose_index import PoseIndex
+from plugins.matchers.decision import Calibration
+from plugins.matchers.path_search.search import Found, Search
 
-__all__ = ["INDEX_MIN_NODES", "KBest"]
+__all__ = ["INDEX_MIN_NODES", "Beam", "KBest"]
 
 INDEX_MIN_NODES = 5000
 """Posegraphs of more nodes than this find the k start poses with :class:`plugins.lib.pose_index.PoseIndex`
@@ -201,6 +203,74 @@ class KBest:
         kth = np.partition(first, k - 1)[k - 1]
         chosen = np.flatnonzero(first <= kth)  # the k best and the nodes tied with the k-th: the first k by node
         return chosen[np.lexsort((chosen, first[chosen]))][:k]
+
+
+class Beam(Search):
+    """The paper's k-best beam from the middle frame (:mod:`plugins.matchers.path_search.kbest`): the majority
+    movement of the best path; runners-up (``candidates``) each from one more search without the movements found."""
+
+    def rebuild(self) -> None:
+        m = self.matcher
+        options = m.params["k-best"]
+        self.kbest = KBest(m.motor.graph, m.node_names, m.motor.node_root_relative, options["k"],
+                           options["max_skip"], m.index_min_nodes)
+
+    def find(self, samples):
+        m = self.matcher
+        obs, vis = samples.parts, samples.seen
+        path, _, evidence = self.kbest.search(obs, vis)
+        if path is None:
+            return None
+        ids = m.label_ids[path]
+        voting = ids[ids != m.hub_id]  # the movements' numbers: hubs do not vote
+        mean = path_distance(obs, m.motor.node_root_relative[path], vis) / max(evidence, 1)  # eq. 3 per sample
+        details: dict[str, Any] = {"mean_distance": mean, "samples": len(path)}
+        if voting.size == 0:
+            return Found(None, path, 0.0, (), details)
+        counts = np.bincount(voting)  # np.unique(voting, return_counts=True): the numbers voted for, ascending
+        numbers = counts.nonzero()[0]
+        counts = counts[numbers]
+        names = m.label_names[numbers]  # the names in their order, as np.unique over the names gives them
+        best = int(np.argmax(counts))
+        movement = str(names[best])
+        details["votes"] = {str(n): int(c) for n, c in zip(names, counts)}
+        found = [(movement, mean)]
+        exclude = m.labels == movement
+        for _ in range(m.params["candidates"]):  # Fig. 13: the best path through the other movements' nodes
+            other_path, cost, other_evidence = self.kbest.search(obs, vis, exclude)
+            if other_path is None or not np.isfinite(cost):  # no path through the movements left
+                break
+            voting = m.labels[other_path][m.labels[other_path] != ""]
+            if voting.size == 0:
+                break
+            values, tally = np.unique(voting, return_counts=True)
+            other = str(values[int(np.argmax(tally))])
+            found.append((other, float(path_distance(obs, m.motor.node_root_relative[other_path], vis)
+                                        / max(other_evidence, 1))))
+            exclude = exclude | (m.labels == other)
+        ranked = (found[0], *sorted(found[1:], key=lambda c: c[1]))
+        return Found(movement, path, counts[best] / voting.size, ranked, details)
+
+    def calibration(self):
+        m = self.matcher
+        own, other = [], []
+        for movement, takes in m.take_nodes.items():
+            for take in takes:
+                obs = m.motor.node_root_relative[take]
+                vis = np.ones(obs.shape[:2], dtype=bool)
+                still = float(np.mean(m.comparison.still(m.comparison.frames(obs, vis, m.motor.node_rate))))
+                mine = m.labels == movement
+                searches = ((other, mine),)
+                if len(takes) > 1:
+                    alone = ~mine
+                    alone[take] = True
+                    searches += ((own, alone),)
+                for out, exclude in searches:
+                    path, _, evidence = self.kbest.search(obs, vis, exclude)
+                    if path is not None:
+                        d = path_distance(obs, m.motor.node_root_relative[path], vis) / max(evidence, 1)
+                        out.append(d / still if still > 0 else np.inf)
+        return Calibration.of(own, other)
 
 
 def _reach(graph, nodes, index, max_skip: int, *, forward: bool) -> tuple[np.ndarray, np.ndarray]:

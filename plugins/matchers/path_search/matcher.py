@@ -12,20 +12,18 @@ chooses those for real people (``characters/observers/recordings.toml``, ``docs/
 
 from __future__ import annotations
 
-from abc import ABC, abstractmethod
-from dataclasses import dataclass, field
 from typing import Any, Protocol
 
 import networkx as nx
 import numpy as np
 
 from plugins.lib.compiled import one_thread
-from plugins.lib.pose_distance import path_distance
 from plugins.matchers.comparison import Comparison, Frames, comparison
 from plugins.matchers.comparison import Motion as MotionComparison
-from plugins.matchers.decision import Calibrated, Calibration, Decision, Distance
-from plugins.matchers.path_search.kbest import INDEX_MIN_NODES, KBest
-from plugins.matchers.path_search.per_movement import Chains, chain_distances, chain_path
+from plugins.matchers.decision import Calibrated, Decision, Distance
+from plugins.matchers.path_search.kbest import INDEX_MIN_NODES, Beam
+from plugins.matchers.path_search.per_movement import EachMovement
+from plugins.matchers.path_search.search import Search
 from toolkit import ConfigError, Match, Matcher, Motion, Parameter
 from toolkit.components import provides
 
@@ -69,153 +67,8 @@ class PoseGraph(Protocol):
         """Add an observed path of root-relative poses as a new movement; its nodes."""
 
 
-@dataclass
-class Found:
-    """What a search found for a demonstration: its answer (``None``: the best path holds only hubs), the node path
-    of the answer, the share of that path's nodes that belong to it (hubs do not vote), and the ranked movements
-    with their distances, the answer first."""
-
-    movement: str | None
-    path: np.ndarray
-    share: float = 1.0
-    ranked: tuple[tuple[str, float], ...] = ()
-    details: dict[str, Any] = field(default_factory=dict)
-
-    @property
-    def distance(self) -> float:
-        return self.ranked[0][1] if self.ranked else float("inf")
-
-
-class Search(ABC):
-    """How path search looks for the nearest path (the strategy chosen by ``search``)."""
-
-    def __init__(self, matcher: PathSearch) -> None:
-        self.matcher = matcher
-
-    @abstractmethod
-    def rebuild(self) -> None:
-        """Build what the search needs of the posegraph as it is now (at attach and after learning)."""
-
-    @abstractmethod
-    def find(self, samples: Frames, raw: tuple[np.ndarray, np.ndarray]) -> Found | None:
-        """The nearest path to the demonstration's ``samples``; ``raw``: the sampled poses and masks as observed.
-        ``None`` when nothing was seen."""
-
-    @abstractmethod
-    def calibration(self) -> Calibration:
-        """Leave one take out and leave one movement out on the repertoire (:class:`Calibration`)."""
-
-
-class Beam(Search):
-    """The paper's k-best beam from the middle frame (:mod:`plugins.matchers.path_search.kbest`): the majority
-    movement of the best path; runners-up (``candidates``) each from one more search without the movements found."""
-
-    def rebuild(self) -> None:
-        m = self.matcher
-        options = m.params["k-best"]
-        self.kbest = KBest(m.motor.graph, m.node_names, m.motor.node_root_relative, options["k"],
-                           options["max_skip"], m.index_min_nodes)
-
-    def find(self, samples, raw):
-        m = self.matcher
-        obs, vis = samples.parts, samples.seen
-        path, _, evidence = self.kbest.search(obs, vis)
-        if path is None:
-            return None
-        ids = m.label_ids[path]
-        voting = ids[ids != m.hub_id]  # the movements' numbers: hubs do not vote
-        mean = path_distance(obs, m.motor.node_root_relative[path], vis) / max(evidence, 1)  # eq. 3 per sample
-        details: dict[str, Any] = {"mean_distance": mean, "samples": len(path)}
-        if voting.size == 0:
-            return Found(None, path, 0.0, (), details)
-        counts = np.bincount(voting)  # np.unique(voting, return_counts=True): the numbers voted for, ascending
-        numbers = counts.nonzero()[0]
-        counts = counts[numbers]
-        names = m.label_names[numbers]  # the names in their order, as np.unique over the names gives them
-        best = int(np.argmax(counts))
-        movement = str(names[best])
-        details["votes"] = {str(n): int(c) for n, c in zip(names, counts)}
-        found = [(movement, mean)]
-        exclude = m.labels == movement
-        for _ in range(m.params["candidates"]):  # Fig. 13: the best path through the other movements' nodes
-            other_path, cost, other_evidence = self.kbest.search(obs, vis, exclude)
-            if other_path is None or not np.isfinite(cost):  # no path through the movements left
-                break
-            voting = m.labels[other_path][m.labels[other_path] != ""]
-            if voting.size == 0:
-                break
-            values, tally = np.unique(voting, return_counts=True)
-            other = str(values[int(np.argmax(tally))])
-            found.append((other, float(path_distance(obs, m.motor.node_root_relative[other_path], vis)
-                                        / max(other_evidence, 1))))
-            exclude = exclude | (m.labels == other)
-        ranked = (found[0], *sorted(found[1:], key=lambda c: c[1]))
-        return Found(movement, path, counts[best] / voting.size, ranked, details)
-
-    def calibration(self):
-        m = self.matcher
-        own, other = [], []
-        for movement, takes in m.take_nodes.items():
-            for take in takes:
-                obs = m.motor.node_root_relative[take]
-                vis = np.ones(obs.shape[:2], dtype=bool)
-                still = float(np.mean(m.comparison.still(m.comparison.frames(obs, vis, m.motor.node_rate))))
-                mine = m.labels == movement
-                searches = ((other, mine),)
-                if len(takes) > 1:
-                    alone = ~mine
-                    alone[take] = True
-                    searches += ((own, alone),)
-                for out, exclude in searches:
-                    path, _, evidence = self.kbest.search(obs, vis, exclude)
-                    if path is not None:
-                        d = path_distance(obs, m.motor.node_root_relative[path], vis) / max(evidence, 1)
-                        out.append(d / still if still > 0 else np.inf)
-        return Calibration.of(own, other)
-
-
-class EachMovement(Search):
-    """Every movement's own best path, exactly (:mod:`plugins.matchers.path_search.per_movement`)."""
-
-    def rebuild(self) -> None:
-        m = self.matcher
-        self.chains = Chains.of(m.motor)
-        self.takes = [m.take_frames(self.chains.chain(c)) for c in range(len(self.chains))]
-        self.nodes = Frames.join(self.takes) if self.takes else None
-
-    def find(self, samples, raw):
-        if self.nodes is None or not samples.seen.any():
-            return None
-        m = self.matcher
-        per_chain, cost = chain_distances(m.comparison, samples, self.nodes, self.chains)
-        distances: dict[str, float] = {}
-        for movement, d in zip(self.chains.movements, per_chain):
-            distances[movement] = min(distances.get(movement, np.inf), float(d))
-        ranked = tuple(sorted(((mv, d) for mv, d in distances.items() if np.isfinite(d)), key=lambda c: (c[1], c[0])))
-        if not ranked:
-            return None
-        best = int(np.argmin(per_chain))
-        path = chain_path(cost, self.chains, best)
-        return Found(ranked[0][0], path, 1.0, ranked, {"mean_distance": ranked[0][1], "samples": len(samples)})
-
-    def calibration(self):
-        m = self.matcher
-        own, other = [], []
-        movements = np.asarray(self.chains.movements, dtype=object)
-        for c, take in enumerate(self.takes):
-            skip = np.zeros(len(self.chains), dtype=bool)
-            skip[c] = True
-            distances, _ = chain_distances(m.comparison, take, self.nodes, self.chains, skip)
-            still = float(np.mean(m.comparison.still(take)))
-            mine = movements == movements[c]
-            for out, chosen in ((own, mine & ~skip), (other, ~mine)):
-                if chosen.any():
-                    d = float(distances[chosen].min())
-                    out.append(d / still if still > 0 else np.inf)
-        return Calibration.of(own, other)
-
-
-SEARCHES = {"k-best": Beam, "per-movement": EachMovement}
+SEARCHES: dict[str, type[Search]] = {"k-best": Beam, "per-movement": EachMovement}
+"""The search strategies by the name the ``search`` parameter takes."""
 
 
 class PathSearch(Matcher):
@@ -335,7 +188,7 @@ class PathSearch(Matcher):
             return Match.unknown("nothing visible", details={"reason": "nothing visible"})
         self._refresh()
         samples, raw = self.samples(motion)
-        found = self.searcher.find(samples, raw)
+        found = self.searcher.find(samples)
         if found is None:
             return Match.unknown("nothing visible", details={"reason": "nothing visible"})
         node_path = tuple(self.node_names[i] for i in found.path)

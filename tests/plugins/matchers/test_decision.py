@@ -8,10 +8,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from plugins.matchers.decision import Calibrated, Calibration, Distance
-from plugins.matchers.path_search.per_movement import chain_distances
+from plugins.matchers.warping import chain_distances
 from toolkit import load_character
 from toolkit.observe import Observer, compose_observer
-from toolkit.params import parse_settings
 from toolkit.profile import load_profile
 from tests.plugins.matchers.path_search.stick import STICK, observed
 

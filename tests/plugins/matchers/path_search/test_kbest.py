@@ -20,17 +20,6 @@ def stick(write, pm):
     return load_character(write("stick.toml", STICK), pm)
 
 
-def observed(stick, movement: str, *, speed: float = 1.0, offset=(0.0, 0.0, 0.0), hidden: str | None = None) -> Motion:
-    """The stick's own movement, root-relative as an observer perceives it, the hand moved by ``offset``."""
-    motion = stick.motor.perform(movement, fps=FPS, speed=speed).root_relative(stick.body.root)
-    positions = motion.positions.copy()
-    positions[:, stick.body.index("hand")] += offset
-    visible = np.ones(positions.shape[:2], dtype=bool)
-    if hidden is not None:
-        visible[:, stick.body.index(hidden)] = False
-    return Motion(positions, FPS, motion.parts, visible)
-
-
 def test_the_graph_is_two_paths_of_nine_nodes_through_one_hub(stick):
     motor = stick.motor
     assert motor.graph.number_of_nodes() == 1 + 2 * 9

@@ -13,7 +13,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from plugins.matchers.path_search.per_movement import Chains, _warp, _warp_path, _kernel, _path_kernel
+from plugins.matchers.path_search.per_movement import posegraph_chains
+from plugins.matchers.warping import _kernel, _path_kernel, _warp, _warp_path
 from tests.plugins.matchers.path_search.stick import FPS, STICK, observed
 from toolkit import Motion, load_character
 
@@ -119,7 +120,7 @@ def stick(write, pm):
 
 
 def test_the_chains_are_the_takes_without_hubs(stick):
-    chains = Chains.of(stick.motor)
+    chains = posegraph_chains(stick.motor)
     assert chains.movements == ("raise", "reach")
     assert [len(chains.chain(c)) for c in range(2)] == [9, 9]
     assert not chains.cyclic.any()
