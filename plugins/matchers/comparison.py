@@ -219,12 +219,23 @@ class Poses(Comparison):
 
 
 class Motion(Comparison):
-    """Shape, motion and carry of every part, in body sizes (see the module)."""
+    """Shape, motion and carry of every part, in body sizes (see the module).
+
+    ``shape = False``: motion and carry only, what can be compared before a movement is over (the shape needs the
+    whole movement's mean posture): the forward model's, which predicts while the demonstration comes in."""
 
     name = "motion"
     unit = "body"
 
-    def frames(self, poses, visible, fps, *, velocity=None, travel=None, heading=None, size=None) -> Frames:
+    def __init__(self, shape: str = "mean") -> None:
+        if shape not in ("mean", "onset", "none"):
+            raise ValueError(f"shape must be 'mean', 'onset' or 'none', not {shape!r}")
+        self.shape = shape
+
+    def frames(self, poses, visible, fps, *, velocity=None, travel=None, heading=None, size=None,
+               origin=None) -> Frames:
+        """:meth:`Comparison.frames`; ``origin`` (P, 3): with ``shape = "onset"``, the pose the shape is measured
+        from (default: the first frame's)."""
         poses = np.asarray(poses, dtype=float)
         seen = np.asarray(visible, dtype=bool) & np.isfinite(poses).all(axis=-1)
         n = len(poses)
@@ -232,9 +243,12 @@ class Motion(Comparison):
         if size is None:
             size = sequence_size(filled, seen)
         scale = 1.0 / size if size > 0 else 0.0
-        counts = seen.sum(axis=0)
-        mean = (filled * seen[..., None]).sum(axis=0) / np.maximum(counts, 1)[:, None]
-        shape = (filled - mean) * scale
+        if self.shape == "onset":
+            shape = (filled - (filled[:1] if origin is None else np.asarray(origin, dtype=float))) * scale
+        else:
+            counts = seen.sum(axis=0)
+            mean = (filled * seen[..., None]).sum(axis=0) / np.maximum(counts, 1)[:, None]
+            shape = (filled - mean) * scale
         if velocity is None:
             velocity = derivative(filled, fps)
         motion = np.nan_to_num(np.asarray(velocity, dtype=float)) * (HORIZON * scale)
@@ -248,7 +262,8 @@ class Motion(Comparison):
             turn = np.where(carried, heading, 0.0)
             carry[:, 3] = np.cos(turn) - 1.0
             carry[:, 4] = np.sin(turn)
-        return Frames(np.concatenate([shape, motion], axis=2), seen, carry, carried)
+        return Frames(motion if self.shape == "none" else np.concatenate([shape, motion], axis=2), seen, carry,
+                      carried)
 
 
     def costs(self, a: Frames, b: Frames) -> np.ndarray:

@@ -24,15 +24,18 @@ chosen once when a matcher is attached (``decision = "distance"`` or ``"calibrat
     - *other*: each take against the repertoire without its movement (leave one movement out): how near a
       movement the repertoire does not hold comes to the nearest it does hold.
 
-    A demonstration is unknown when its score is above the threshold (:meth:`Calibrated.threshold`): the larger of
-    the ``1 - known_rejected`` quantile of the *own* scores (so that at most ``known_rejected`` of the performances
-    of a known movement are called unknown, as far as the repertoire's own takes show how performances vary) and
-    the median of the *other* scores (a demonstration nearer to a known movement than the repertoire's movements
-    typically lie to each other is taken for it), and never above 1: a movement that explains a demonstration no
-    better than standing still does not stand for it, however far apart the repertoire's movements lie. Takes
-    recorded one after another differ by almost nothing, so the first alone would reject every other performer;
-    the second alone ignores how widely a movement is performed. With one take of each movement only the second
-    is known.
+    A demonstration is unknown when its score is above the threshold (:meth:`Calibrated.threshold`): the
+    ``1 - known_rejected`` quantile of the *own* scores and of the *other* scores, the larger of the two, and never
+    above 1 (a movement that explains a demonstration no better than standing still does not stand for it). The
+    meaning a user sets is ``known_rejected``: at most that share of the performances of a known movement are
+    called unknown, as far as the repertoire shows how far a performance may lie from its movement. Where a
+    movement has several takes, their spread shows it; takes recorded one after another differ by almost nothing,
+    and one take shows nothing, so the repertoire's movements stand for it too: a performance of a movement is
+    taken to lie no farther from it than the repertoire's movements lie from their nearest neighbours, all but
+    ``known_rejected`` of them. The same setting then holds with one take of each movement, two, or fourteen. A
+    movement the repertoire does not hold is unknown where it lies farther from every known movement than that;
+    one as near to a known movement as the repertoire's own movements are to each other cannot be told from a
+    performance of it (``docs/matchers.md`` has the figures).
 
 The decision's answer, with the score and the threshold it was decided on, goes into the typed fields of
 :class:`toolkit.Match` (``score``, ``threshold``, ``nearest``, ``measure``), which ``likeme observe`` prints for
@@ -122,13 +125,13 @@ class Distance(Decision):
     name = "distance"
     relative = False
 
-    def __init__(self, max_distance: float, unit: str = "m") -> None:
+    def __init__(self, max_distance: float, measure: str = "mean distance (m)") -> None:
         self.max_distance = float(max_distance)
-        self.unit = unit
+        self._measure = measure
 
     @property
     def measure(self) -> str:
-        return f"mean distance ({self.unit})"
+        return self._measure
 
     def threshold(self) -> float:
         return self.max_distance if self.max_distance > 0 else float("inf")
@@ -144,7 +147,7 @@ class Calibrated(Decision):
         if not 0.0 <= known_rejected <= 1.0:
             raise ValueError(f"known_rejected must be in [0, 1], not {known_rejected!r}")
         self.known_rejected = float(known_rejected)
-        self.calibration = Calibration()
+        self.calibrate(Calibration())
 
     @property
     def measure(self) -> str:
@@ -153,16 +156,17 @@ class Calibrated(Decision):
     def calibrate(self, calibration: Calibration) -> None:
         """Take the scores measured on the repertoire (:class:`Calibration`)."""
         self.calibration = calibration
+        self._threshold = self._limit()
 
     def threshold(self) -> float:
-        """The larger of the ``1 - known_rejected`` quantile of the own scores and the median of the other scores,
-        at most :data:`STILL` (1: no better than standing still); :data:`STILL` while the repertoire has neither
-        two movements nor two takes of one."""
-        limits = []
-        if self.calibration.own:
-            limits.append(float(np.quantile(self.calibration.own, 1.0 - self.known_rejected)))
-        if self.calibration.other:
-            limits.append(float(np.median(self.calibration.other)))
+        return self._threshold
+
+    def _limit(self) -> float:
+        """The larger of the ``1 - known_rejected`` quantiles of the own and of the other scores, at most
+        :data:`STILL` (1: no better than standing still); :data:`STILL` while the repertoire has neither two
+        movements nor two takes of one."""
+        scores = [np.asarray(s) for s in (self.calibration.own, self.calibration.other) if len(s)]
+        limits = [float(np.quantile(s, 1.0 - self.known_rejected)) for s in scores]
         return min(max(limits), STILL) if limits else STILL
 
 

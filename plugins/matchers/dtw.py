@@ -213,7 +213,7 @@ class DTW(Matcher):
             self.decision: Decision = Calibrated(self.params["calibrated"]["known_rejected"])
             self.decision.calibrate(self._calibration())
         else:
-            self.decision = Distance(self.params["distance"]["max_distance"], "m")
+            self.decision = Distance(self.params["distance"]["max_distance"], MEASURE)
 
     def _calibration(self) -> Calibration:
         """Each template as a segment: against its movement's other templates (leave one take out) and against the
@@ -298,7 +298,7 @@ class DTW(Matcher):
         per_frame = float(distances[best])
         label = prep.labels[best]
         verdict = self.decision.decide(label, per_frame, _still(series) if self.decision.relative else 1.0)
-        measure = self.decision.measure if self.decision.relative else MEASURE
+        measure = self.decision.measure
         if verdict.movement is None:
             return Match.unknown("too far from every example", nearest=label, score=verdict.score,
                                  threshold=verdict.threshold, measure=measure, details={"distance": per_frame})

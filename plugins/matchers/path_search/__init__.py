@@ -11,10 +11,10 @@ decision (:mod:`plugins.matchers.decision`), each chosen once when the matcher i
 ``docs/matchers.md`` says how they work together and which the observer template chooses for real people.
 """
 
-from plugins.matchers.path_search.matcher import PathSearch, PoseGraph
+from plugins.matchers.path_search.matcher import PathSearch, PoseGraph, Takes
 from toolkit import hookimpl
 
-__all__ = ["PathSearch", "PoseGraph"]
+__all__ = ["PathSearch", "PoseGraph", "Takes"]
 
 
 @hookimpl

@@ -211,7 +211,7 @@ class Beam(Search):
 
     def rebuild(self) -> None:
         m = self.matcher
-        options = m.params["k-best"]
+        options = m.params["beam"]
         self.kbest = KBest(m.motor.graph, m.node_names, m.motor.node_root_relative, options["k"],
                            options["max_skip"], m.index_min_nodes)
 
@@ -240,10 +240,10 @@ class Beam(Search):
             other_path, cost, other_evidence = self.kbest.search(obs, vis, exclude)
             if other_path is None or not np.isfinite(cost):  # no path through the movements left
                 break
-            voting = m.labels[other_path][m.labels[other_path] != ""]
-            if voting.size == 0:
+            others = m.labels[other_path][m.labels[other_path] != ""]
+            if others.size == 0:
                 break
-            values, tally = np.unique(voting, return_counts=True)
+            values, tally = np.unique(others, return_counts=True)
             other = str(values[int(np.argmax(tally))])
             found.append((other, float(path_distance(obs, m.motor.node_root_relative[other_path], vis)
                                         / max(other_evidence, 1))))

@@ -27,25 +27,20 @@ from plugins.matchers.path_search.search import Search
 from toolkit import ConfigError, Match, Matcher, Motion, Parameter
 from toolkit.components import provides
 
-__all__ = ["PathSearch", "PoseGraph"]
+__all__ = ["PathSearch", "PoseGraph", "Takes"]
 
 
 class PoseGraph(Protocol):
     """A posegraph: whole-body poses as nodes, movements as paths between hubs (Buchsbaum & Blumberg 2005, §4.1).
 
-    What path search needs of a motor system: ``plugins.motor.posegraph`` provides it.
+    What the paper's path search needs of a motor system: ``plugins.motor.posegraph`` provides it (and
+    :class:`Takes`).
     """
 
     graph: nx.DiGraph
     """Nodes by name; an edge from each pose to the next of its movement (hubs are shared)."""
     node_root_relative: np.ndarray
     """Every node's pose, root-relative, (N, P, 3), in the order of :attr:`nodes`."""
-    node_motion: np.ndarray
-    """How each part was moving at each node (velocity relative to the root, m/s), (N, P, 3)."""
-    node_travel: np.ndarray
-    """The root's velocity in the body's frame at each node (m/s), (N, 3)."""
-    node_heading: np.ndarray
-    """How far the body had turned at each node since its take began (radians; NaN: not known), (N,)."""
     node_rate: float
     """Pose nodes per second of movement."""
 
@@ -59,12 +54,24 @@ class PoseGraph(Protocol):
     def movements(self) -> list[str]:
         """The movements of the repertoire."""
 
-    def takes(self) -> dict[str, list[list[str]]]:
-        """Movement -> the node names of each of its takes (hubs left out)."""
-
     def learn(self, name: str, poses: np.ndarray, visible: np.ndarray | None = None, *, source: str = "",
               announce: bool = True) -> list[str]:
         """Add an observed path of root-relative poses as a new movement; its nodes."""
+
+
+class Takes(Protocol):
+    """A posegraph that knows its takes and how its nodes move: what the per-movement search, the motion comparison
+    and the calibrated decision need besides :class:`PoseGraph`."""
+
+    node_motion: np.ndarray
+    """How each part was moving at each node (velocity relative to the root, m/s), (N, P, 3)."""
+    node_travel: np.ndarray
+    """The root's velocity in the body's frame at each node (m/s), (N, 3)."""
+    node_heading: np.ndarray
+    """How far the body had turned at each node since its take began (radians; NaN: not known), (N,)."""
+
+    def takes(self) -> dict[str, list[list[str]]]:
+        """Movement -> the node names of each of its takes (hubs left out)."""
 
 
 SEARCHES: dict[str, type[Search]] = {"k-best": Beam, "per-movement": EachMovement}
@@ -93,7 +100,7 @@ class PathSearch(Matcher):
                   "'distance', beyond [matcher.distance] max_distance (the paper); 'calibrated', beyond a threshold "
                   "calibrated on the repertoire's own takes ([matcher.calibrated]).",
                   choices=("distance", "calibrated")),
-        Parameter("k-best", doc="The beam of search = 'k-best'.", parameters=(
+        Parameter("beam", doc="The beam of search = 'k-best'.", parameters=(
             Parameter("k", int, 8, "Number of start poses and of paths kept at every step (the beam width). "
                       "Larger is more robust to noise and occlusion, and slower.", minimum=1),
             Parameter("max_skip", int, 2, "Most nodes a path may advance per observed sample (0 = stay is always "
@@ -124,15 +131,24 @@ class PathSearch(Matcher):
         provides(owner.motor, PoseGraph, needed_by="path-search", what="a posegraph motor system",
                  expected=" or ".join(f'[motor] plugin = "{name}"' for name in self.motor_systems))
         self.motor = owner.motor
+        for key, value in (("search", "per-movement"), ("comparison", "motion"), ("decision", "calibrated")):
+            if self.params[key] == value:
+                provides(owner.motor, Takes, needed_by=f"path-search's {key} = '{value}'",
+                         what="a posegraph that knows its takes and how its nodes move", key=(key,),
+                         expected="a motor system with takes(), node_motion, node_travel and node_heading (posegraph)")
         if self.params["comparison"] != "poses" and self.params["search"] == "k-best":
             raise ConfigError("search = 'k-best' compares poses (eq. 1)", key=("search",),
                               expected="search = 'per-movement' with comparison = 'motion', or comparison = 'poses'")
+        if self.params["comparison"] != "poses" and self.params["decision"] == "distance":
+            raise ConfigError("decision = 'distance' holds eq. 1 to max_distance in metres, and comparison = "
+                              f"'{self.params['comparison']}' measures in body sizes", key=("decision",),
+                              expected="decision = 'calibrated' with comparison = 'motion', or comparison = 'poses'")
         self.comparison: Comparison = comparison(self.params["comparison"])
         self.searcher: Search = SEARCHES[self.params["search"]](self)
         if self.params["decision"] == "calibrated":
             self.decision: Decision = Calibrated(self.params["calibrated"]["known_rejected"])
         else:
-            self.decision = Distance(self.params["distance"]["max_distance"], self.comparison.unit)
+            self.decision = Distance(self.params["distance"]["max_distance"], "mean pose distance along the path (eq. 3)")
         self._version = -1
         self._refresh()  # the tables of the graph as composed, now rather than at the first match
 
@@ -149,7 +165,7 @@ class PathSearch(Matcher):
         # movement, in the order of the names (np.unique over numbers ranks as over names); hubs' "" comes first
         self.hub_id = 0 if len(self.label_names) and self.label_names[0] == "" else -1
         self.take_nodes = {m: [np.array([index[nd] for nd in take], dtype=np.intp) for take in takes if take]
-                           for m, takes in motor.takes().items()}
+                           for m, takes in motor.takes().items()} if callable(getattr(motor, "takes", None)) else {}
         self._version = n
         with one_thread():
             self.searcher.rebuild()

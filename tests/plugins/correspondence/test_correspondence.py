@@ -235,7 +235,7 @@ def test_open_protocol_counts_unknown_as_right_for_a_movement_left_out(generated
 
     profile = load_profile(generated / "profile.toml")
     result = recognition(pm, profile, generated / "repertoire", generated / "demos", ["path-search"],
-                         protocol="open")
+                         protocol="open", observer={"template": "papers"})
     row = result["plugins"][0]
     assert {item["truth"] for item in result["items"]} == {"unknown"}
     right = [item["recognised"] == "unknown" for item in result["items"]]
@@ -251,15 +251,15 @@ def test_observe_says_why_a_segment_is_unknown(generated, capsys):
     profile = generated / "profile.toml"
     demo = sorted((generated / "demos").glob("*/*.bvh"))[0]
     assert main(["observe", str(demo), "--body", str(profile), "--repertoire", str(generated / "repertoire"),
-                 "--set", "matcher.max_distance=0", "--json"]) == 0
+                 "--observer", "papers", "--set", "matcher.distance.max_distance=1e-9", "--json"]) == 0
     import json
 
     segments = json.loads(capsys.readouterr().out)[0]["segments"]
     assert segments and all(s["movement"] == "unknown" for s in segments)
-    assert all(s["reason"] == "too far from every path" and s["nearest"] and s["score"] > s["threshold"] == 0
+    assert all(s["reason"] == "too far from every path" and s["nearest"] and s["score"] > s["threshold"] == 1e-9
                and s["measure"] == "mean pose distance along the path (eq. 3)" for s in segments)
     assert main(["observe", str(demo), "--body", str(profile), "--repertoire", str(generated / "repertoire"),
-                 "--set", "matcher.max_distance=0"]) == 0
+                 "--observer", "papers", "--set", "matcher.distance.max_distance=1e-9"]) == 0
     assert "rejected: too far from every path (mean pose distance along the path (eq. 3) 0." in capsys.readouterr().out
 
 

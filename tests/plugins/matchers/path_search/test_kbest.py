@@ -57,7 +57,7 @@ def test_a_path_may_skip_nodes_so_a_faster_movement_still_aligns(stick):
     fast = observed(stick, "raise", speed=2.0)
     match = stick.matcher.match(fast)
     assert match.movement == "raise" and match.details["mean_distance"] == pytest.approx(0.0, abs=1e-9)
-    stick.matcher.params = {**stick.matcher.params, "k-best": {"k": 8, "max_skip": 1}}
+    stick.matcher.params = {**stick.matcher.params, "beam": {"k": 8, "max_skip": 1}}
     stick.matcher._version = -1  # the reach tables are rebuilt for the new max_skip
     slow = stick.matcher.match(fast)
     assert slow.details["mean_distance"] > 0.01
@@ -79,7 +79,7 @@ def test_k_best_from_the_middle_frame_loses_a_movement_whose_middle_is_elsewhere
     hand = stick.body.index("hand")
     positions[mid - 1 : mid + 2, hand] = stick.motor.key_poses["front"][hand] - stick.motor.key_poses["front"][0]
     glitched = Motion(positions, FPS, motion.parts, motion.visible)
-    stick.matcher.params = {**stick.matcher.params, "k-best": {"k": 1, "max_skip": 2},
+    stick.matcher.params = {**stick.matcher.params, "beam": {"k": 1, "max_skip": 2},
                             "distance": {"max_distance": 10.0, "scale": 0.02}}
     stick.matcher._version = -1  # the beam is rebuilt for the new k
     narrow = stick.matcher.match(glitched)
@@ -154,7 +154,7 @@ def test_the_reach_factored_through_wide_nodes_is_the_same_reach(case):
         assert got == set(want[indptr[i]:indptr[i + 1]].tolist())
 
 
-@pytest.mark.parametrize("settings", [["matcher.k-best.k=3"], ["matcher.k-best.max_skip=3"]])
+@pytest.mark.parametrize("settings", [["matcher.beam.k=3"], ["matcher.beam.max_skip=3"]])
 def test_a_beam_step_through_hubs_keeps_the_same_paths_as_listing_every_pair(tmp_path, settings):
     """Generated repertoires of many movements sharing a hub (likeme bench scaling's): every demo gets the same path,
     movement and confidence whether the reach is factored through the hub or listed pair by pair."""

@@ -168,7 +168,7 @@ def generated(tmp_path_factory):
 
 
 PAPER = ["matcher.comparison=poses", "matcher.search=k-best", "matcher.decision=distance"]
-SETTINGS = [PAPER, [*PAPER, "matcher.k-best.k=3"], [*PAPER, "matcher.k-best.max_skip=3"]]
+SETTINGS = [PAPER, [*PAPER, "matcher.beam.k=3"], [*PAPER, "matcher.beam.max_skip=3"]]
 
 
 @pytest.mark.parametrize("settings", SETTINGS)
@@ -204,7 +204,7 @@ def test_the_same_matches_with_the_fast_paths_off(generated, settings, segmenter
             Observer(character, profile.body, motion.fps).watch(motion)
         if fast:  # the fast paths were taken (the padded table with max_skip = 2; 3 reaches past LONG_ROW nodes)
             assert beam._scan.planes
-            assert (beam.succ.padded is not None) == (matcher.params["k-best"]["max_skip"] == 2)
+            assert (beam.succ.padded is not None) == (matcher.params["beam"]["max_skip"] == 2)
         return found
 
     fast, slow = run(True), run(False)
