@@ -170,13 +170,18 @@ def _motion_capture_commands(sub: Any) -> None:
                    help="the recordings' format: BVH, CSV joint positions, .npy arrays or C3D markers (default: bvh)")
     p.set_defaults(handler=_handler("data", "cmd_make_data"))
 
-    p = sub.add_parser("bandai", help="build benchmark folders from the Bandai-Namco clips (links; nothing copied)")
+    p = sub.add_parser("bandai", help="build benchmark folders from the Bandai-Namco clips (links; nothing copied): "
+                       "streams/ (takes at rest joined through a rest), cropped/ (takes joined end to end), and with "
+                       "--locomotion locomotion/")
     p.add_argument("src", metavar="BANDAI_DIR")
     _jobs_options(p, "the streams, each read from its clips and written; the same files whatever N")
     p.add_argument("dest", metavar="DIR")
     p.add_argument("--seed", type=seed_type, default=0)
     p.add_argument("--profile", default=None, help="the body profile to put beside the data (default: the built-in "
                    "profiles/bandai-namco.toml, from the source tree or the installed copy)")
+    p.add_argument("--locomotion", metavar="DIR", default=None, help="also write DIR/locomotion/ from the folder of "
+                   "Bandai-Namco dataset-2's locomotion clips (a repertoire of its normal style and streams of the "
+                   "others, walks joined without a rest)")
     p.set_defaults(handler=_handler("data", "cmd_bandai"))
 
 

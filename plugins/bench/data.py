@@ -2,7 +2,9 @@
 
 - ``make_data``: ``repertoire/NAME/max.bvh`` (Max's own movements), ``demos/NAME/morris_S.bvh`` (Morris's versions
   at three speeds, with noise), ``streams/stream_K.bvh`` with ``stream_K.segments.csv``, and ``profile.toml``;
-- ``bandai``: the same layout from the Bandai-Namco clips (links and generated streams; nothing is copied);
+- ``bandai``: the same layout from the Bandai-Namco clips (links and generated streams; nothing is copied): streams
+  of takes that begin and end at rest joined through a rest, the cropped takes joined end to end (a harder set), and
+  locomotion streams (:mod:`plugins.bench.joins`);
 - ``read_segments``: a stream's true segments (header ``start_frame,end_frame,movement``, end exclusive).
 """
 
@@ -201,15 +203,48 @@ def _write_segments(path: Path, rows: list[tuple[int, int, str]]) -> None:
                     encoding="utf-8")
 
 
+LOCOMOTION = ("walk", "run", "dash", "walk-back", "walk-left", "walk-right", "dance-short", "dance-long")
+"""Dataset-1's contents that never come back to a standing pose (left out of the gesture streams)."""
+
+REST_HOLD = (0.25, 0.75)
+"""Seconds (the least and the most, drawn uniformly) a take's last pose is held before the transition to the next
+take, and the next take's first pose after it, in the rest-joined streams."""
+TRANSITION = 0.5
+"""Seconds of the minimum-jerk transition from one take's last pose to the next take's first (rest-joined
+streams), at least: longer where a joint has farther to go than :data:`PACE` allows."""
+PACE = 1.0
+"""Body sizes a second (on average; 1.9 at the peak of a minimum-jerk move) the joint that goes farthest covers in
+a transition between two takes: a relaxed arm's pace (0.45 m/s on an adult), not a gesture's."""
+STRIDE = 0.2
+"""Seconds of the transition between two locomotion takes (no hold: the walk goes on)."""
+LEAD = 1.0
+"""Seconds of the first pose before a rest-joined stream's first take and of the last after its last."""
+
+
 def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams: int = 12, per_stream: int = 5,
-           gestures_only: bool = True, jobs: int = 1, scheduler: str | None = None) -> Path:
+           gestures_only: bool = True, locomotion: Path | None = None, jobs: int = 1,
+           scheduler: str | None = None) -> Path:
     """Benchmark folders from the Bandai-Namco clips (links and generated streams; nothing is copied).
 
     ``repertoire/``: the normal-style clips; ``demos/``: every other style of the movements the repertoire has;
     ``all/``: every style of those movements, for leave one style out (``likeme bench recognition --repertoire
-    DIR/all --protocol groups --group STYLE_PATTERN``, :data:`STYLE_PATTERN`); ``streams/``: ``per_stream`` random
-    gesture demos (other styles) one after another, with their segments. Locomotion never returns to a standing
-    pose, so streams hold gestures only unless told otherwise.
+    DIR/all --protocol groups --group STYLE_PATTERN``, :data:`STYLE_PATTERN`). Two sets of segmentation streams,
+    ``per_stream`` demos (other styles than the repertoire's) in each, with their segments:
+
+    - ``streams/``, the set to trust: only takes that begin and end at rest (:func:`plugins.bench.joins.at_rest`, a
+      rule, not a choice by hand), joined through a rest as a person performs one after another
+      (:func:`plugins.bench.joins.join`): the last pose held :data:`REST_HOLD` seconds, a minimum-jerk transition
+      of :data:`TRANSITION` seconds or more (at :data:`PACE`) to the next take's first pose (the take moved to
+      stand where the last one stood, facing its way), that pose held again; :data:`LEAD` seconds of rest before
+      the first and after the last;
+    - ``cropped/``, the harder set (the streams of the releases before): any gesture demo, the takes joined end to
+      end as they were cropped, so most joins are jumps at full speed in another stance, which no segmenter that
+      looks for rest can cut.
+
+    ``locomotion``: the folder of Bandai-Namco dataset-2's locomotion clips; if given, ``locomotion/repertoire/``
+    (its normal style) and ``locomotion/streams/`` (other styles, 4 takes a stream joined by :data:`STRIDE` s
+    transitions without a hold: the walk never rests) are written too. Locomotion (:data:`LOCOMOTION`) never
+    returns to a standing pose, so the gesture streams hold gestures only unless ``gestures_only`` is false.
 
     Each stream's clips are drawn here, one stream after another; the streams are then read and written as items
     of :func:`plugins.bench.jobs.run_items` (``jobs`` local processes or the Dask ``scheduler``), the same files
@@ -218,49 +253,105 @@ def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams:
     from plugins.bench.jobs import run_items
 
     src, dest = Path(src), Path(dest)
-    files = sorted(src.glob("dataset-1_*.bvh"))
+    clips = _takes(src, "dataset-1_*.bvh", "dataset-1_{content}_{style}_{take}.bvh files")
+    known = _link_repertoire(clips, dest, with_all=True)
+    pool = [p for (c, s), ps in clips.items() if s != "normal" and c in known and
+            (c not in LOCOMOTION or not gestures_only) for p in ps]
+    rng = np.random.default_rng(seed)
+    items = [{"clips": [str(pool[i]) for i in rng.choice(len(pool), per_stream, replace=False)],
+              "path": str(dest / "cropped" / f"stream_{k + 1:02d}.bvh")} for k in range(streams)]
+    from plugins.bench.joins import at_rest
+    from toolkit.bvh import read_bvh
+
+    resting = [p for p in pool if at_rest(read_bvh(p))]
+    if len(resting) < per_stream:
+        raise ConfigError(f"{len(resting)} demos begin and end at rest", file=src,
+                          expected=f"at least {per_stream} (--per-stream) for the rest-joined streams",
+                          available=[p.name for p in resting])
+    items += [{**_joined(rng, resting, per_stream, dest / "streams" / f"stream_{k + 1:02d}.bvh", REST_HOLD,
+                         TRANSITION, LEAD), "pace": PACE} for k in range(streams)]
+    if locomotion is not None:
+        walks = _takes(Path(locomotion), "dataset-2_*.bvh", "dataset-2_{content}_{style}_{take}.bvh files")
+        _link_repertoire(walks, dest / "locomotion")
+        pool = [p for (c, s), ps in walks.items() if s != "normal" for p in ps]
+        items += [_joined(rng, pool, min(4, len(pool)), dest / "locomotion" / "streams" / f"stream_{k + 1:02d}.bvh",
+                          (0.0, 0.0), STRIDE, 0.0) for k in range(max(1, streams // 2))]
+    for item in items:
+        Path(item["path"]).parent.mkdir(parents=True, exist_ok=True)
+    run_items(_bandai_stream, items, jobs=jobs, scheduler=scheduler)
+    text = Path(profile_path).read_text(encoding="utf-8")
+    for folder in [dest] + ([dest / "locomotion"] if locomotion is not None else []):
+        (folder / "profile.toml").write_text(text, encoding="utf-8")
+    return dest
+
+
+def _takes(src: Path, pattern: str, expected: str) -> dict[tuple[str, str], list[Path]]:
+    """The clips of a Bandai-Namco folder by (content, style), from their names."""
+    files = sorted(src.glob(pattern))
     if not files:
-        raise ConfigError("no Bandai-Namco clips", file=src, expected="dataset-1_{content}_{style}_{take}.bvh files")
+        raise ConfigError("no Bandai-Namco clips", file=src, expected=expected)
     clips: dict[tuple[str, str], list[Path]] = {}
     for f in files:
         _, content, style, _ = f.stem.split("_")
         clips.setdefault((content, style), []).append(f)
+    return clips
+
+
+def _link_repertoire(clips: dict[tuple[str, str], list[Path]], dest: Path, with_all: bool = False) -> set[str]:
+    """Links: ``repertoire/CONTENT/`` the normal style, ``demos/CONTENT/`` the others of the contents the repertoire
+    has (and ``all/CONTENT/`` every style of them); the contents."""
     known = {c for c, s in clips if s == "normal"}
     for (content, style), paths in clips.items():
         if content not in known:
             continue
         for p in paths:
-            for target in (dest / ("repertoire" if style == "normal" else "demos") / content / p.name,
-                           dest / "all" / content / p.name):
+            folders = [dest / ("repertoire" if style == "normal" else "demos")] + ([dest / "all"] if with_all else [])
+            for target in (folder / content / p.name for folder in folders):
                 target.parent.mkdir(parents=True, exist_ok=True)
                 if not target.exists():
                     target.symlink_to(p.resolve())
-    locomotion = {"walk", "run", "dash", "walk-back", "walk-left", "walk-right", "dance-short"}
-    pool = [p for (c, s), ps in clips.items() if s != "normal" and c in known and
-            (c not in locomotion or not gestures_only) for p in ps]
-    rng = np.random.default_rng(seed)
-    (dest / "streams").mkdir(parents=True, exist_ok=True)
-    items = [{"clips": [str(pool[i]) for i in rng.choice(len(pool), per_stream, replace=False)],
-              "path": str(dest / "streams" / f"stream_{k + 1:02d}.bvh")} for k in range(streams)]
-    run_items(_bandai_stream, items, jobs=jobs, scheduler=scheduler)
-    (dest / "profile.toml").write_text(Path(profile_path).read_text(encoding="utf-8"), encoding="utf-8")
-    return dest
+    return known
+
+
+def _joined(rng: np.random.Generator, pool: list[Path], count: int, path: Path, hold: tuple[float, float],
+            move: float, lead: float) -> dict[str, Any]:
+    """One rest-joined (or locomotion) stream's item: ``count`` takes of ``pool`` drawn without replacement, the
+    holds between them drawn in seconds from ``hold``, ``move`` seconds of transition, ``lead`` seconds of rest at
+    each end."""
+    chosen = [str(pool[i]) for i in rng.choice(len(pool), count, replace=False)]
+    holds = rng.uniform(hold[0], hold[1], size=(count - 1, 2)).round(3).tolist()
+    return {"clips": chosen, "path": str(path), "holds": holds, "move": move, "lead": lead}
 
 
 def _bandai_stream(item: dict[str, Any]) -> str:
     """One stream of :func:`bandai`: the clips ``item["clips"]`` one after another, written to ``item["path"]``
-    with its ``.segments.csv`` beside it."""
+    with its ``.segments.csv`` beside it; joined end to end, or through :func:`plugins.bench.joins.join` when the
+    item has ``holds`` (seconds before and after each transition), ``move`` (seconds of transition) and ``lead``."""
     from toolkit.bvh import BVH, read_bvh, write_bvh
 
     chosen = [Path(p) for p in item["clips"]]
     parts = [read_bvh(p) for p in chosen]
-    rows, at = [], 0
-    for p, b in zip(chosen, parts):
-        rows.append((at, at + b.n_frames, p.stem.split("_")[1]))
-        at += b.n_frames
     first = parts[0]
+    for p, b in zip(chosen, parts):
+        if [(j.name, j.channels) for j in b.joints] != [(j.name, j.channels) for j in first.joints]:
+            raise ConfigError("another skeleton than the stream's first take", file=p,
+                              expected=f"the joints and channels of {chosen[0].name}")
+    labels = [p.stem.split("_")[1] for p in chosen]
+    if "holds" in item:
+        from plugins.bench.joins import join
+
+        frames = lambda seconds: int(round(seconds * first.fps))  # noqa: E731
+        values, rows = join(parts, labels, [(frames(a), frames(b)) for a, b in item["holds"]],
+                            [frames(item["move"])] * (len(parts) - 1), frames(item["lead"]), frames(item["lead"]),
+                            pace=item.get("pace", 0.0))
+    else:
+        rows, at = [], 0
+        for label, b in zip(labels, parts):
+            rows.append((at, at + b.n_frames, label))
+            at += b.n_frames
+        values = np.concatenate([b.values for b in parts])
     path = Path(item["path"])
-    write_bvh(BVH(first.joints, first.frame_time, np.concatenate([b.values for b in parts]), "stream"), path)
+    write_bvh(BVH(first.joints, first.frame_time, values, "stream"), path)
     _write_segments(path.with_name(path.name[: -len(".bvh")] + ".segments.csv"), rows)
     return item["path"]
 
@@ -282,5 +373,6 @@ def cmd_bandai(args, pm) -> int:
 
     profile = Path(args.profile) if args.profile else resolve_file("profiles/bandai-namco.toml", None, pm,
                                                                    key=("--profile",))
-    print(bandai(Path(args.src), Path(args.dest), profile, seed=args.seed, jobs=args.jobs, scheduler=args.scheduler))
+    print(bandai(Path(args.src), Path(args.dest), profile, seed=args.seed, jobs=args.jobs, scheduler=args.scheduler,
+                 locomotion=Path(args.locomotion) if args.locomotion else None))
     return 0

@@ -4,6 +4,10 @@
   true movement and it overlaps that movement by at least half of its own
   length; counting is one to one (each true movement is claimed at most once,
   by the found segment that overlaps it most).
+- Boundaries: each pair's start and end, compared with the true movement's, give the *boundary error* (mean
+  absolute difference in frames over the pairs' boundaries) and the share of the true boundaries (two a true
+  movement) that a found segment puts within a tolerance (``likeme bench segmentation``: 0.25 s) of where they
+  are; a true movement no segment counts for has both its boundaries missed, so the share falls with recall too.
 - The movement error rate is the edit distance (insertions, deletions,
   substitutions) between the recognised and the true label sequences, divided by
   the number of true movements (``rapidfuzz``'s Levenshtein distance).
@@ -45,8 +49,14 @@ def match_segments(found: Sequence[Span], truth: Sequence[Span]) -> list[tuple[i
     return sorted(pairs)
 
 
-def segmentation_scores(found: Sequence[Span], truth: Sequence[Span]) -> dict[str, float]:
-    """Precision, recall, F1 and mean absolute boundary error (frames) of found against true segments."""
+def segmentation_scores(found: Sequence[Span], truth: Sequence[Span], tolerance: float = 0.0) -> dict[str, float]:
+    """Precision, recall, F1 and the boundary scores of found against true segments.
+
+    ``boundary_error``: mean absolute difference (frames) between the paired segments' starts and ends (NaN without
+    a pair); ``boundary_errors``: each of those differences (two a pair); ``within``: the share of the true
+    boundaries (two a true movement) a paired segment puts no farther than ``tolerance`` frames away (1.0 without
+    true movements).
+    """
     pairs = match_segments(found, truth)
     tp = len(pairs)
     precision = tp / len(found) if found else (1.0 if not truth else 0.0)
@@ -61,6 +71,8 @@ def segmentation_scores(found: Sequence[Span], truth: Sequence[Span]) -> dict[st
         "found": len(found),
         "true": len(truth),
         "boundary_error": float(np.mean(errors)) if errors else float("nan"),
+        "boundary_errors": [float(e) for e in errors],
+        "within": sum(e <= tolerance for e in errors) / (2 * len(truth)) if truth else 1.0,
     }
 
 

@@ -13,7 +13,8 @@ through a body profile (:mod:`toolkit.profile`) and watches them with
   demos of a repertoire made of all the other clips).
 - ``segmentation``: each stream ``NAME.bvh`` (or ``.csv``, ``.npy``) has ``NAME.segments.csv``
   (:func:`plugins.bench.data.read_segments`).
-  Precision, recall, F1 and boundary error (:mod:`plugins.bench.metrics`) per segmenter.
+  Precision, recall, F1, the mean boundary error in frames and the share of true boundaries found within 0.25 s
+  (:mod:`plugins.bench.metrics`) per segmenter.
 - ``stream``: segment and recognise end to end for every pairing; the movement error rate (edit distance over the
   true count).
 
@@ -286,10 +287,18 @@ def _repertoire_without(folder: Path, movement: str | None, files: frozenset[Pat
         yield Path(tmp)
 
 
+BOUNDARY_TOLERANCE = 0.25
+"""Seconds within which ``segmentation``'s ``within`` counts a boundary as found where it is."""
+
+
 def segmentation(pm, profile, streams: Path, segmenters: Sequence[str], *, repertoire: Path | None = None,
                  settings=None, quiet: bool = True, observer: dict[str, Any] | None = None,
                  fps: float | None = None) -> dict[str, Any]:
-    """Segment every stream with every segmenter; precision, recall, F1, boundary error and speed."""
+    """Segment every stream with every segmenter; precision, recall, F1, boundary error and speed.
+
+    ``boundary_error``: the mean absolute difference (frames) of every paired boundary over all the streams;
+    ``within``: the share of all the true boundaries found within :data:`BOUNDARY_TOLERANCE` seconds
+    (:func:`plugins.bench.metrics.segmentation_scores`)."""
     settings = _with_clip_rate(settings, fps)
     data = [(path, truth, profile.read(path, fps)) for path, truth in _streams(streams)]
     plugins, rows, timelines = [], [], _timelines(data)
@@ -297,22 +306,26 @@ def segmentation(pm, profile, streams: Path, segmenters: Sequence[str], *, reper
         clock = _Clock(compose_observer(pm, profile, repertoire or streams, segmenter=name, matcher=None,
                                         settings=settings, **(observer or {})), profile)
         found_all = true_all = tp = 0
-        errors = []
+        errors: list[float] = []
+        within = 0.0
         for path, truth, motion in _progress(data, f"segmentation {name}", quiet):
             found = [o.segment for o in clock.run("watch", motion)]
             timelines[path.name]["found"][name] = [[f.start, f.end] for f in found]
-            s = segmentation_scores([(f.start, f.end) for f in found], [(a, b) for a, b, _ in truth])
+            s = segmentation_scores([(f.start, f.end) for f in found], [(a, b) for a, b, _ in truth],
+                                    tolerance=BOUNDARY_TOLERANCE * motion.fps)
             found_all, true_all, tp = found_all + s["found"], true_all + s["true"], tp + s["true_positives"]
-            if s["true_positives"]:
-                errors.append((s["boundary_error"], s["true_positives"]))
+            errors.extend(s["boundary_errors"])
+            within += s["within"] * 2 * s["true"]
             rows.append({"plugin": name, "item": path.name, "found": s["found"], "true": s["true"],
-                         "f1": round(s["f1"], 4), "boundary_error": round(s["boundary_error"], 2)})
+                         "f1": round(s["f1"], 4), "boundary_error": round(s["boundary_error"], 2),
+                         "within": round(s["within"], 4)})
         precision = tp / found_all if found_all else 0.0
         recall = tp / true_all if true_all else 0.0
         f1 = 2 * precision * recall / (precision + recall) if precision + recall else 0.0
-        boundary = sum(e * n for e, n in errors) / max(1, sum(n for _, n in errors))
         plugins.append({"plugin": name, "precision": precision, "recall": recall, "f1": f1,
-                        "boundary_error": boundary, "fps": clock.fps, "items": len(data)})
+                        "boundary_error": float(np.mean(errors)) if errors else float("nan"),
+                        "within": within / (2 * true_all) if true_all else 1.0, "fps": clock.fps,
+                        "items": len(data)})
     return {"benchmark": "segmentation", "plugins": plugins, "items": rows, "timelines": list(timelines.values())}
 
 
@@ -357,7 +370,7 @@ COLUMNS = {
                     ("macro_f1", "{:.3f}"), ("decision_median", "{:.2f}"),
                     ("decision_p90", "{:.2f}"), ("fps", "{:.0f}"), ("items", "{}")],
     "segmentation": [("precision", "{:.3f}"), ("recall", "{:.3f}"), ("f1", "{:.3f}"), ("boundary_error", "{:.1f}"),
-                     ("fps", "{:.0f}"), ("items", "{}")],
+                     ("within", "{:.3f}"), ("fps", "{:.0f}"), ("items", "{}")],
     "stream": [("error_rate", "{:.3f}"), ("fps", "{:.0f}"), ("items", "{}")],
 }
 

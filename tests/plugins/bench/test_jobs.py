@@ -11,6 +11,7 @@ import json
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from plugins.bench.command import TIMING_NOTE
@@ -222,24 +223,28 @@ def test_make_data_writes_the_same_files_whatever_wrote_them(tmp_path):
 def test_bandai_streams_the_same_whatever_wrote_them(tmp_path):
     from plugins.bench.data import bandai
     from plugins.bench.fuzz import _hand_bvh
+    from toolkit.bvh import format_bvh, parse_bvh
 
     src = tmp_path / "src"
     src.mkdir()
-    text = _hand_bvh()
     for i, content in enumerate(("bow", "bye", "guide")):
         for style in ("normal", "happy", "sad"):  # other styles: the streams' clips
-            lines = text.splitlines()
-            lines[-1] = " ".join(str(float(v) + i) for v in lines[-1].split())  # each clip its own last frame
-            (src / f"dataset-1_{content}_{style}_001.bvh").write_text("\n".join(lines) + "\n")
+            take = parse_bvh(_hand_bvh())
+            take.values[-1] += i  # each clip its own last frame
+            # held a third of a second at each end: at rest (plugins.bench.joins.at_rest)
+            take.values = np.concatenate([np.repeat(take.values[:1], 10, axis=0), take.values,
+                                          np.repeat(take.values[-1:], 10, axis=0)])
+            (src / f"dataset-1_{content}_{style}_001.bvh").write_text(format_bvh(take))
     profile = tmp_path / "p.toml"
     profile.write_text("[profile]\n")
     bandai(src, tmp_path / "one", profile, streams=3, per_stream=2)
     bandai(src, tmp_path / "two", profile, streams=3, per_stream=2, jobs=2)
-    one = {k: v for k, v in _files(tmp_path / "one").items() if k.startswith("streams/")}
-    assert one == {k: v for k, v in _files(tmp_path / "two").items() if k.startswith("streams/")}
-    assert len(one) == 6
-    rows = (tmp_path / "one" / "streams" / "stream_01.segments.csv").read_text().splitlines()
-    assert len(rows) == 3 and rows[1].split(",")[2] in {"bow", "bye", "guide"}
+    for folder in ("streams/", "cropped/"):
+        one = {k: v for k, v in _files(tmp_path / "one").items() if k.startswith(folder)}
+        assert one == {k: v for k, v in _files(tmp_path / "two").items() if k.startswith(folder)}
+        assert len(one) == 6
+        rows = (tmp_path / "one" / folder / "stream_01.segments.csv").read_text().splitlines()
+        assert len(rows) == 3 and rows[1].split(",")[2] in {"bow", "bye", "guide"}
 
 
 @pytest.mark.parametrize("argv, fragment", [

@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -146,3 +147,24 @@ def test_bench_facilitation_runs(tmp_path):
     assert data["recognition_accuracy"] >= 0.5 and data["imitation_error_mean"] < 0.05
     assert hand["recognition_accuracy"] >= 0.5 and hand["imitation_error_mean"] < 0.1  # radians
     assert "hands" in result.stdout  # the table has a column for them
+
+
+def test_boundary_scores_count_true_boundaries_within_the_tolerance():
+    truth = [(10, 30), (40, 60), (70, 90)]
+    found = [(12, 30), (40, 52)]  # errors 2, 0 and 0, 8; the third movement is missed
+    s = segmentation_scores(found, truth, tolerance=3)
+    assert sorted(s["boundary_errors"]) == [0.0, 0.0, 2.0, 8.0]
+    assert s["boundary_error"] == pytest.approx(2.5)
+    assert s["within"] == pytest.approx(3 / 6)  # of the six true boundaries, three found within 3 frames
+    assert segmentation_scores(found, truth, tolerance=8)["within"] == pytest.approx(4 / 6)
+    assert segmentation_scores([], [])["within"] == 1.0
+
+
+@given(st.lists(st.tuples(st.integers(0, 500), st.integers(1, 60)), max_size=6),
+       st.lists(st.tuples(st.integers(0, 500), st.integers(1, 60)), max_size=6), st.floats(0, 100))
+def test_boundary_share_is_a_share_that_grows_with_the_tolerance(a, b, tolerance):
+    found, truth = [(s, s + n) for s, n in a], [(s, s + n) for s, n in b]
+    low, high = (segmentation_scores(found, truth, tolerance=t)["within"] for t in (tolerance, tolerance + 10))
+    assert 0.0 <= low <= high <= 1.0
+    disjoint = [(100 * k + s % 40, 100 * k + s % 40 + n) for k, (s, n) in enumerate(b)]
+    assert segmentation_scores(disjoint, disjoint)["within"] == 1.0

@@ -225,22 +225,31 @@ def _frames_and_blocks(params, parts, poses, visible, cuts):
         onsets.append(-1 if one.active_since is None else one.active_since)
     blocks = VelocityDirection(**params)
     blocks.reset(parts, FPS)
+    got, since = _in_blocks(blocks, poses, visible, cuts)
+    return one, expected, onsets, blocks, got, since
+
+
+def _in_blocks(segmenter, poses, visible, cuts):
+    """``poses`` pushed to ``segmenter`` in blocks of ``cuts`` frames (the rest in one): the segments closed (with the
+    frame that closed them) and the onsets reported at each frame."""
     got, since, at = [], [], 0
     for n in [*cuts, len(poses)]:
-        closed, block_since = blocks.push_block(poses[at : at + n], visible[at : at + n])
+        closed, block_since = segmenter.push_block(poses[at : at + n], visible[at : at + n])
         got.extend((at + i, s) for i, s in closed)
         since.extend(block_since.tolist())
         at += n
         if at >= len(poses):
             break
-    return one, expected, onsets, blocks, got, since
+    return got, since
 
 
 @given(seed=st.integers(0, 10_000), cuts=st.lists(st.integers(1, 40), min_size=1, max_size=12),
        params=st.sampled_from([{}, {"level": "movement"}, {"units": "body", "noise": 2.0, "pause": 0.3},
                                {"max_movement": 1.0, "memory": 0.2}, {"parts": ["wrist"], "rest_speed": 0.05},
                                {"level": "movement", "end": "rest", "units": "body", "noise": 2.0},
-                               {"end": "rest", "settle": 0.5, "max_movement": 1.0}]),
+                               {"end": "rest", "settle": 0.5, "max_movement": 1.0},
+                               {"level": "movement", "end": "rest", "units": "body", "noise": 2.0, "window": 0.2,
+                                "jitter": 3.0}, {"window": 0.3, "jitter": 2.0, "memory": 0.2}]),
        hidden=st.booleans())
 @settings(max_examples=40, deadline=None)
 def test_a_block_pushed_at_once_is_its_frames_pushed_one_by_one(seed, cuts, params, hidden):
@@ -323,3 +332,36 @@ def test_the_compiled_clustering_cuts_where_numpys_steps_cut(monkeypatch):
     monkeypatch.setattr(strokes, "_round_kernels", lambda: None)
     assert [VelocityDirection(**s).segment(m) for s in settings_ for m in motions] == compiled
     assert sum(len(c) for c in compiled) > len(compiled)  # movements were cut into strokes
+
+
+class _Stepped(VelocityDirection):
+    """The reference for ``_walk``: every frame of a block stepped (``_steps``), as the segmenter does with ``pause``
+    or ``noise``."""
+
+    _walk = VelocityDirection._steps
+
+
+@given(seed=st.integers(0, 10_000), cuts=st.lists(st.integers(1, 60), min_size=1, max_size=8),
+       params=st.sampled_from([{"level": "movement", "end": "rest", "units": "body", "window": 0.2, "jitter": 3.0},
+                               {"end": "rest", "settle": 0.5, "max_movement": 1.0, "jitter": 2.0},
+                               {"units": "body", "window": 0.3}, {"level": "movement", "max_movement": 1.5},
+                               {"end": "rest", "units": "body", "memory": 0.2, "rest_radius": 0.3}]),
+       hidden=st.booleans())
+@settings(max_examples=30, deadline=None)
+def test_a_block_walked_is_its_frames_stepped(seed, cuts, params, hidden):
+    """Without ``pause`` and ``noise`` a block is walked (only the frames where something can happen stepped): the
+    same segments at the same frames and the same onsets as every frame stepped, whatever the packet sizes."""
+    rng = np.random.default_rng(seed)
+    motion, _ = stroke_sequence(rng, int(rng.integers(1, 4)), noise=0.003)
+    poses = motion.positions.copy()
+    visible = np.ones(poses.shape[:2], dtype=bool)
+    if hidden:
+        visible[30:40, 1] = False
+        poses[30:40, 1] = poses[29, 1]
+    results = []
+    for kind in (VelocityDirection, _Stepped):
+        seg = kind(**params)
+        seg.reset(motion.parts, FPS)
+        got, since = _in_blocks(seg, poses, visible, cuts)
+        results.append((got, since, seg.flush(), seg._moving, seg._resting, seg._frame))
+    assert results[0] == results[1]

@@ -1,0 +1,213 @@
+"""Where a movement ends when the demonstrator rests their own way (``end = "rest"``).
+
+Kopp & Graeser 2006, §4.1 and §4.2: a movement runs from an onset out of rest to the next rest, and the motor
+command graph's *hub nodes* are "typical start states, positions and configurations in which a complete movement
+normally starts and ends" (after Buchsbaum & Blumberg 2005's hubs, §4.1). A real person rests in their own stance,
+changes it between gestures, and holds poses half-way through a gesture (a bow, a pointing hand). So a rest ends the
+movement under way only where it is a hub of this demonstrator:
+
+- near the pose the movement began from, or near any rest they have been seen in (``rest_radius`` body sizes, eq. 1's
+  mean distance over the chosen parts): a rest there ends it where the rest began;
+- elsewhere the rest is a *hold* and the movement goes on, unless they leave it (some part farther than twice
+  ``rest_radius``: a movement from it, not a hand fidgeting there) and come to rest near it again later: then it
+  was a new stance (movements leave it and come back to it), if they had held it a stance's time (``stance``; the
+  segmenter's ``STANCE``, 0.2 s). The movement is cut where they first rested there, and the one from it back to it
+  follows;
+- or they rest ``settle`` seconds in one place (a new stance they stay in): the movement ends where that rest began;
+- or they have rested a stance's time at a hold reached by a shift (below) from a hold before it that lasted as
+  long and where the movement had come at least half-way back to its first pose: the movement ended at that hold (a
+  take that ends in another stance than it began, then the shift to the next one's).
+
+A *shift* of stance is not a movement: a piece that goes straight from one rest to another (no part farther from the
+straight line between its first and last positions than ``rest_radius`` body sizes plus a quarter of its way: an arc
+of up to about 100 degrees) is dropped, and one that ends away from where it began with such a shift after a hold
+ends at the hold. A piece that never leaves where it began (no part farther than twice ``rest_radius``) is motion at
+rest (sway, fidgeting) and is dropped too. So two takes joined through a transition between their stances give the
+two takes, and a stance change between two gestures gives the two gestures.
+
+Everything here is bookkeeping on frame numbers and the working memory's poses, called by the segmenter only on the
+frames where the demonstrator comes to rest or leaves it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["Hold", "Rests", "straight"]
+
+SHIFT_BOW = 0.25
+"""How far (a share of its length) a shift of stance may bow out of a straight line."""
+
+
+def _apart(a: np.ndarray, b: np.ndarray) -> float:
+    """Eq. 1's mean distance between two poses of the chosen parts (3m,), over the parts seen in both (NaN: none)."""
+    d = np.linalg.norm((np.asarray(a) - np.asarray(b)).reshape(-1, 3), axis=1)
+    d = d[np.isfinite(d)]
+    return float(d.mean()) if d.size else float("nan")
+
+
+def straight(window: np.ndarray, radius: float) -> bool:
+    """Whether poses ``window`` (N, 3m) go straight from the first to the last: no part strays from the straight
+    line between its own first and last positions farther than ``radius`` plus :data:`SHIFT_BOW` of its own way's
+    length (a part not seen throughout is not counted)."""
+    window = np.asarray(window, dtype=float)
+    if len(window) < 2:
+        return True
+    points = window.reshape(len(window), -1, 3)
+    a, b = points[0], points[-1]
+    way = b - a  # (m, 3)
+    length = np.sqrt((way * way).sum(axis=1))
+    with np.errstate(all="ignore"):
+        t = np.clip(((points - a) * way).sum(axis=2) / np.where(length > 0, length * length, 1.0), 0.0, 1.0)
+        off = np.linalg.norm(points - (a + t[..., None] * way), axis=2)  # (N, m)
+        seen = np.isfinite(off).all(axis=0) & np.isfinite(length)
+    if not seen.any():
+        return True
+    return bool((off[:, seen].max(axis=0) <= radius + SHIFT_BOW * length[seen]).all())
+
+
+@dataclass
+class Hold:
+    """A rest during a movement away from its hubs: where it began and ended (frames; ``end`` None while it lasts)
+    and the pose (3m,)."""
+
+    start: int
+    pose: np.ndarray
+    end: int | None = None
+
+
+@dataclass
+class Rests:
+    """One demonstrator's rests, as far as seen: the hubs (poses they rested in that movements began from or came
+    back to, the latest ``keep``) and the holds of the movement under way.
+
+    ``radius``: how near (in the units of the poses) a pose must be to a hub to be there; the segmenter sets it to
+    ``rest_radius`` times the body's size when a movement begins. ``stance``: the frames a hold must last to be a
+    stance that movements leave and come back to (shorter: a pause in a gesture, a hand fidgeting). ``smooth``: the
+    frames of the moving average the working memory is seen through (the tracker's jitter averaged out) when it is
+    asked whether a piece leaves where it began, is a shift, or comes back to a hold.
+    """
+
+    radius: float = 0.0
+    stance: int = 0
+    smooth: int = 1
+    keep: int = 8
+    hubs: list[np.ndarray] = field(default_factory=list)
+    holds: list[Hold] = field(default_factory=list)
+    _stacked: np.ndarray | None = field(default=None, repr=False)  # the hubs as one array (k, m, 3)
+
+    def began(self, pose: np.ndarray, radius: float) -> None:
+        """A movement begins from ``pose`` (3m,), where the demonstrator was: a hub."""
+        self.radius = radius
+        self.holds = []
+        self.hub(pose)
+
+    def hub(self, pose: np.ndarray) -> None:
+        """``pose`` is a rest of this demonstrator's (the latest first; one near it replaced)."""
+        pose = np.array(pose, dtype=float)
+        self.hubs = [pose] + [h for h in self.hubs if not _apart(h, pose) <= self.radius][: self.keep - 1]
+        self._stacked = None
+
+    def at_hub(self, pose: np.ndarray) -> bool:
+        """Whether ``pose`` is near one of the hubs (nothing to compare with: the paper's rule, any rest)."""
+        if not self.hubs:
+            return True
+        if self._stacked is None or len(self._stacked) != len(self.hubs):
+            self._stacked = np.array(self.hubs).reshape(len(self.hubs), -1, 3)
+        apart = self._stacked - np.asarray(pose).reshape(-1, 3)
+        d = np.sqrt((apart * apart).sum(axis=2))
+        if np.isfinite(d).all():
+            return float(d.mean(axis=1).min()) <= self.radius
+        with np.errstate(all="ignore"):
+            near = np.nanmean(np.where(np.isfinite(d), d, np.nan), axis=1)  # eq. 1 over the parts seen in both
+        near = near[np.isfinite(near)]
+        return not near.size or float(near.min()) <= self.radius
+
+    def returned(self, pose: np.ndarray, start: int, window: np.ndarray) -> int | None:
+        """The index of the last finished hold near ``pose`` that the demonstrator held a stance's time, left (some
+        part farther than twice the radius from it since it ended: a movement from it and back, not a hand fidgeting
+        there) and came back to rest at, or None.
+        ``window``: the movement's poses from frame ``start`` on."""
+        for i in range(len(self.holds) - 1, -1, -1):
+            h = self.holds[i]
+            if h.end is None or h.end - h.start < self.stance or not _apart(h.pose, pose) <= self.radius:
+                continue
+            since = self.seen(window[h.end - start :]).reshape(-1, len(h.pose) // 3, 3)
+            with np.errstate(all="ignore"):
+                away = np.linalg.norm(since - h.pose.reshape(-1, 3), axis=2)
+            if since.size and np.nanmax(np.append(away.ravel(), -np.inf)) > 2.0 * self.radius:
+                return i
+        return None
+
+    def hold(self, frame: int, pose: np.ndarray) -> None:
+        """A rest away from the hubs began at ``frame`` in ``pose``."""
+        self.holds.append(Hold(frame, np.array(pose, dtype=float)))
+
+    def left(self, frame: int) -> None:
+        """The demonstrator moves again at ``frame``: the hold under way (if any) ends there."""
+        if self.holds and self.holds[-1].end is None:
+            self.holds[-1].end = frame
+
+    def pieces(self, start: int, end: int, window: np.ndarray, upto: int | None = None,
+               shifts: bool = True) -> list[tuple[int, int]]:
+        """The movements (start, end) in frames of the stretch from ``start`` to ``end`` (its poses ``window``, one a
+        frame from ``start``) whose holds are ``self.holds[:upto]``: none if it never leaves where it began (motion at
+        rest); the stretch if it comes back there; dropped if it is a shift of stance (unless not ``shifts``: a reach
+        held for ``settle`` is as much a movement as a shift); or ended at its last hold if what follows that hold is
+        a shift."""
+        holds = [h for h in self.holds[:upto] if h.end is not None and start < h.start and h.end < end]
+        if not self.leaves(window[: end - start]):  # motion at rest (sway, a hand fidgeting): no movement
+            return []
+        if _apart(window[0], window[end - start - 1]) <= self.radius:  # back where it began: no shift
+            return [(start, end)]
+        if shifts and self.shift(window[: end - start]):
+            return []
+        if holds:
+            last = holds[-1]
+            if self.shift(window[last.end - start : end - start]):
+                return [(start, last.start)]
+        return [(start, end)]
+
+    def ended_before(self, start: int, window: np.ndarray) -> bool:
+        """Whether the movement (from frame ``start``, poses ``window``) ended at its hold before the last one: that
+        hold lasted a stance's time, the movement had come at least half-way back there (eq. 1 from its first pose
+        at most half the farthest it had been), and it went from there to the last hold by a shift."""
+        if len(self.holds) < 2:
+            return False
+        before, now = self.holds[-2], self.holds[-1]
+        if before.end is None or before.end - before.start < self.stance:
+            return False
+        points = np.asarray(window[: before.start - start], dtype=float).reshape(before.start - start, -1, 3)
+        with np.errstate(all="ignore"):
+            way = np.nanmean(np.linalg.norm(points - points[:1], axis=2), axis=1)  # eq. 1 from the first pose
+        way = way[np.isfinite(way)]
+        if not way.size or not _apart(window[0], before.pose) <= 0.5 * float(way.max()):
+            return False
+        return self.shift(window[before.end - start : now.start - start])
+
+    def seen(self, window: np.ndarray) -> np.ndarray:
+        """Poses ``window`` (N, 3m) through a centred moving average of ``smooth`` frames (the ends held)."""
+        window = np.asarray(window, dtype=float)
+        if self.smooth <= 1 or len(window) < 2:
+            return window
+        from scipy.ndimage import uniform_filter1d
+
+        return uniform_filter1d(window, self.smooth, axis=0, mode="nearest")
+
+    def leaves(self, window: np.ndarray) -> bool:
+        """Whether poses ``window`` (N, 3m) leave where they began: some part farther than twice the radius from its
+        first position (a movement, not motion at rest)."""
+        points = self.seen(window).reshape(len(window), -1, 3)
+        with np.errstate(all="ignore"):
+            away = np.linalg.norm(points - points[:1], axis=2)
+        return bool(np.nanmax(np.append(away.ravel(), -np.inf)) > 2.0 * self.radius)
+
+    def shift(self, window: np.ndarray) -> bool:
+        """Whether poses ``window`` (N, 3m) are a shift of stance: they end away from where they began (eq. 1 farther
+        than the radius) and go there :func:`straight`."""
+        if len(window) < 2:
+            return False
+        window = self.seen(window)
+        return not _apart(window[0], window[-1]) <= self.radius and straight(window, self.radius)

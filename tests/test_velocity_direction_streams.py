@@ -1,0 +1,182 @@
+"""velocity-direction at movement level on hand-built streams of a person gesturing (issue 36), with the observer
+template's settings (``characters/observers/recordings.toml``, ``[segmenters.velocity-direction]``): a stance change
+between two gestures, a tracker's jitter of 1 cm at 30 frames/s, a gesture that holds a pose half-way, two gestures
+with 0.3 s of rest between them; and the pieces it is made of (:mod:`plugins.segmenters.velocity_direction.speed`,
+:mod:`plugins.segmenters.velocity_direction.rests`)."""
+
+from __future__ import annotations
+
+import tomllib
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from plugins.bench.metrics import segmentation_scores
+from plugins.segmenters.velocity_direction import VelocityDirection
+from plugins.segmenters.velocity_direction.rests import Rests, straight
+from plugins.segmenters.velocity_direction.speed import Jitter, line_speeds, line_weights, speed_noise
+from tests.conftest import CHARACTERS
+from tests.gesture_streams import FPS, bowing, hold, move, point, stance, stream, wave
+
+TEMPLATE = tomllib.loads((CHARACTERS / "observers" / "recordings.toml").read_text())["segmenters"][
+    "velocity-direction"]
+"""What ``--segmenter velocity-direction`` gets from the observer template."""
+A, B = stance("down"), stance("clasped", wide=0.15)  # two stances: arms hanging; hands clasped, feet wider
+
+
+def scores(pieces, tracker=0.0, seed=0, size=1.0, **params):
+    """Segmentation scores of the template (``params`` replacing some of its settings) on ``pieces`` with
+    ``tracker`` metres of jitter."""
+    motion, truth = stream(pieces, jitter=tracker, seed=seed, size=size)
+    found = VelocityDirection(**{**TEMPLATE, **params}).segment(motion)
+    return segmentation_scores([(s.start, s.end) for s in found], truth, tolerance=0.25 * FPS)
+
+
+@given(seed=st.integers(0, 1000), rest=st.floats(0.3, 0.8), size=st.sampled_from([0.2, 1.0, 1.3]),
+       jitter=st.sampled_from([0.0, 0.01]))
+@settings(max_examples=12, deadline=None)
+def test_a_stance_change_between_two_gestures(seed, rest, size, jitter):
+    """A wave from one stance, a shift to another (hands clasped, feet wider) held ``rest`` seconds, a point from
+    there: two movements, each within 0.25 s of where it begins and ends; the shift is no movement and the new stance
+    swallows nothing after it. On a mouse-sized body (0.2) and a large one alike (body units)."""
+    pieces = [("rest", [hold(A, 1.0)]), ("movement", wave(A)), ("rest", [hold(A, rest)]),
+              ("shift", [move(A, B, 0.6)]), ("rest", [hold(B, rest)]), ("movement", point(B)),
+              ("rest", [hold(B, rest)]), ("movement", wave(B)), ("rest", [hold(B, 1.0)])]
+    s = scores(pieces, tracker=jitter * size, seed=seed, size=size)
+    assert s["f1"] == 1.0 and s["within"] == 1.0, s
+
+
+def test_the_papers_end_reports_the_shift_and_a_hold_away_from_rest_keeps_going_without_the_stance_rules():
+    """The same stream with the paper's end (any rest ends a movement) reports the shift of stance as a movement."""
+    pieces = [("rest", [hold(A, 1.0)]), ("movement", wave(A)), ("rest", [hold(A, 0.5)]),
+              ("shift", [move(A, B, 0.6)]), ("rest", [hold(B, 0.5)]), ("movement", point(B)), ("rest", [hold(B, 1.0)])]
+    assert scores(pieces, end="still")["precision"] == pytest.approx(2 / 3)
+    assert scores(pieces)["f1"] == 1.0
+
+
+@given(seed=st.integers(0, 1000))
+@settings(max_examples=8, deadline=None)
+def test_jitter_of_a_centimetre_at_30_frames_a_second(seed):
+    """Four gestures between rests of 0.8 s, every part jittering by 1 cm (a Kinect's tracker): every movement
+    found, within 0.25 s."""
+    pieces = [("rest", [hold(A, 1.0)]), ("movement", wave(A)), ("rest", [hold(A, 0.8)]), ("movement", point(A)),
+              ("rest", [hold(A, 0.8)]), ("movement", bowing(A)), ("rest", [hold(A, 0.8)]),
+              ("movement", point(A, hold_s=0.5)), ("rest", [hold(A, 1.0)])]
+    assert scores(pieces, tracker=0.01, seed=seed)["f1"] == 1.0
+    assert scores(pieces, tracker=0.02, seed=seed)["f1"] >= 0.85  # twice that: still most of them
+
+
+def test_the_line_fit_and_the_measured_jitter_are_what_hold_under_jitter():
+    """The rest speed in body units alone (no ``noise``, ``window`` or ``jitter``) finds nothing at 1 cm of jitter
+    (the jitter at rest is faster than it); the measured jitter alone (no ``noise``) finds every movement; at 5 cm the
+    template without the line fit and the measured jitter falls apart, with them most movements are found."""
+    pieces = [("rest", [hold(A, 1.0)])] + [p for _ in range(4) for p in (("movement", point(A)),
+                                                                            ("rest", [hold(A, 0.8)]))]
+
+    def f1(tracker, **params):
+        return np.mean([scores(pieces, tracker=tracker, seed=seed, **params)["f1"] for seed in range(3)])
+
+    assert f1(0.01, noise=0.0, window=0.0, jitter=0.0) < 0.5
+    assert f1(0.01, noise=0.0) == 1.0
+    assert f1(0.05, window=0.0, jitter=0.0) < 0.5
+    assert f1(0.05) >= 0.8
+
+
+@given(hold_s=st.floats(0.3, 1.5), seed=st.integers(0, 1000), jitter=st.sampled_from([0.0, 0.01]))
+@settings(max_examples=12, deadline=None)
+def test_a_gesture_that_holds_a_pose_half_way_is_one_movement(hold_s, seed, jitter):
+    """A point held ``hold_s`` seconds and a bow held as long, each coming back to the rest: one movement each (the
+    paper's end cuts each in two at its hold)."""
+    pieces = [("rest", [hold(A, 1.0)]), ("movement", point(A, hold_s=hold_s)), ("rest", [hold(A, 0.8)]),
+              ("movement", bowing(A, hold_s=hold_s)), ("rest", [hold(A, 1.0)])]
+    s = scores(pieces, tracker=jitter, seed=seed)
+    assert s["f1"] == 1.0 and s["within"] == 1.0, s
+    assert scores(pieces, tracker=jitter, seed=seed, end="still")["precision"] <= 0.5
+
+
+@given(gap=st.floats(0.3, 0.5), seed=st.integers(0, 1000), jitter=st.sampled_from([0.0, 0.01]))
+@settings(max_examples=12, deadline=None)
+def test_two_gestures_with_a_third_of_a_second_of_rest_between_them(gap, seed, jitter):
+    """A wave, ``gap`` seconds (from 0.3) of rest, a point: two movements, not one."""
+    pieces = [("rest", [hold(A, 1.0)]), ("movement", wave(A)), ("rest", [hold(A, gap)]), ("movement", point(A)),
+              ("rest", [hold(A, 1.0)])]
+    s = scores(pieces, tracker=jitter, seed=seed)
+    assert s["f1"] == 1.0 and s["within"] == 1.0, s
+
+
+# -- the pieces -------------------------------------------------------------------------------------------------
+
+
+@given(st.integers(2, 40), st.floats(-5, 5), st.floats(-5, 5), st.floats(1, 240))
+def test_the_line_weights_give_a_lines_slope(frames, slope, offset, fps):
+    t = np.arange(frames) / fps
+    assert float(line_weights(frames, fps) @ (offset + slope * t)) == pytest.approx(slope, abs=1e-9)
+
+
+def test_line_speeds_take_the_fastest_part_and_skip_parts_not_seen():
+    rows = np.zeros((6, 6))
+    rows[:, 0] = np.arange(6) * 0.1  # part 1 along x at 0.1 a frame
+    rows[:, 4] = np.arange(6) * 0.2  # part 2 along y at 0.2 a frame
+    w = line_weights(3, 30.0)
+    assert np.allclose(line_speeds(rows, w), 6.0)
+    rows[2, 3:] = np.nan  # part 2 not seen once: the windows over frame 2 count part 1 alone
+    assert np.allclose(line_speeds(rows, w), [3.0, 3.0, 3.0, 6.0])
+    rows[:, :3] = np.nan
+    assert np.isnan(line_speeds(rows, w)[:3]).all()
+
+
+@pytest.mark.parametrize("sigma", [0.002, 0.01, 0.03])
+def test_the_jitter_is_measured_whether_the_person_moves_or_not(sigma):
+    """White noise of ``sigma`` on a part standing still and on one moving smoothly: measured within 15 %; and the
+    speed it alone gives a part standing still is what :func:`speed_noise` says."""
+    rng = np.random.default_rng(1)
+    t = np.arange(600) / FPS
+    still = np.zeros((600, 3))
+    moving = np.stack([0.3 * np.sin(2 * t), 0.2 * np.cos(3 * t), 0.1 * t], axis=1)
+    rows = np.concatenate([still, moving], axis=1) + rng.normal(0, sigma, (600, 6))
+    jitter = Jitter(2, floor=300, every=15)
+    assert jitter.update(rows)[-1] == pytest.approx(sigma, rel=0.15)
+    w = line_weights(6, FPS)
+    rms = np.sqrt(np.mean(line_speeds(rng.normal(0, sigma, (5000, 3)), w) ** 2))
+    assert rms == pytest.approx(float(speed_noise(sigma, w)), rel=0.05)
+
+
+def test_the_jitter_of_a_block_is_its_frames_one_by_one():
+    rows = np.random.default_rng(2).normal(0, 0.01, (100, 6))
+    one, blocks = Jitter(2, 40, 7), Jitter(2, 40, 7)
+    expected = np.concatenate([one.update(rows[i : i + 1]) for i in range(100)])
+    assert np.array_equal(np.concatenate([blocks.update(rows[a:b]) for a, b in ((0, 1), (1, 33), (33, 100))]),
+                          expected)
+
+
+def test_a_straight_shift_an_arc_and_a_gesture_out_and_back():
+    t = np.linspace(0, 1, 30)[:, None]
+    line = np.concatenate([t * [0.5, 0, 0], t * [0, 0.3, 0]], axis=1)  # two parts each on a straight line
+    assert straight(line, 0.02)
+    arc = np.concatenate([0.5 * np.hstack([np.sin(t * np.pi / 2), 1 - np.cos(t * np.pi / 2), 0 * t])] * 2, axis=1)
+    assert straight(arc, 0.02)  # a quarter circle bows out by a fifth of its chord
+    out_and_back = np.concatenate([np.sin(t * np.pi) * [0.5, 0, 0], 0 * line[:, 3:]], axis=1)
+    assert not straight(out_and_back, 0.02)
+    rests = Rests(radius=0.02)
+    assert rests.shift(line) and not rests.shift(out_and_back) and not rests.shift(line[:1].repeat(5, axis=0))
+    assert rests.leaves(out_and_back) and not rests.leaves(line[:3] * 0.1)
+
+
+def test_hubs_holds_and_returns():
+    rests = Rests(radius=0.05, stance=5)
+    a, b = np.zeros(6), np.full(6, 0.5)
+    rests.began(a, 0.05)
+    assert rests.at_hub(a + 0.01) and not rests.at_hub(b)
+    rests.hold(10, b)
+    rests.left(20)
+    window = np.concatenate([np.zeros((10, 6)), np.repeat(b[None], 10, 0), np.linspace(b, b + 0.4, 10),
+                             np.linspace(b + 0.4, b, 10)])
+    assert rests.returned(b + 0.01, 0, window) == 0
+    assert rests.returned(b + 0.01, 0, window[:22]) is None  # not left yet: a hand fidgeting at the hold
+    short = Rests(radius=0.05, stance=15)
+    short.began(a, 0.05)
+    short.hold(10, b)
+    short.left(20)
+    assert short.returned(b, 0, window) is None  # a pause shorter than a stance
