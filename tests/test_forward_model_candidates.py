@@ -13,7 +13,7 @@ import pytest
 from plugins.matchers.forward_model import Track
 from toolkit import Motion
 from toolkit.observe import Observer
-from tests.test_forward_model_travel import PARTS, SIDE, _observer, _raise, _side_steps, clips  # noqa: F401
+from tests.plugins.motor.test_edge_travel import PARTS, SIDE, _observer, _side_steps, clips  # noqa: F401
 
 
 def test_a_movement_that_dropped_out_is_held_at_the_error_it_dropped_out_with(clips):
@@ -29,18 +29,6 @@ def test_a_movement_that_dropped_out_is_held_at_the_error_it_dropped_out_with(cl
     assert [m for m, _ in matcher._ranked(track)] == ["c", "a", "b"]
     answer = matcher._ranked(track, "movement a", ("a",))
     assert answer[0] == ("movement a", pytest.approx(1.5)) and [m for m, _ in answer[1:]] == ["c", "b"]
-
-
-@pytest.mark.parametrize("movement,vx", [("left", SIDE), ("right", -SIDE)])
-def test_the_answer_comes_first_and_every_movement_considered_follows_by_error(clips, movement, vx):
-    profile, observer = _observer(clips, dropout="relative", travel=0.5)
-    match = Observer(observer, profile.body, 30.0).classify(Motion(_side_steps(44, vx), 30.0, PARTS)).match
-    assert match.movement == movement
-    names = [m for m, _ in match.candidates]
-    errors = [e for _, e in match.candidates]
-    assert names[0] == movement and set(names) == {"left", "right", "raise"}
-    assert errors == sorted(errors)  # here the answer predicted best, too
-    assert errors[0] < errors[1]
 
 
 def test_an_unknown_answer_ranks_what_it_considered_and_still_names_the_nearest(clips):

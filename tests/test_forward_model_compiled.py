@@ -19,8 +19,7 @@ from tests.toolkit.test_watching_settled import data, pm_, profile, watched  # n
 from toolkit.observe import compose_observer
 
 
-@pytest.mark.parametrize("settings", [{}, {"threshold": 0.02}, {"together": False, "threshold": 0.03},
-                                      {"relative": True, "dropout": "relative"}])
+@pytest.mark.parametrize("settings", [{}, {"threshold": 0.02}, {"together": False, "threshold": 0.03}])
 def test_compiled_loops_watch_as_numpys_steps(pm_, data, profile, monkeypatch, settings):  # noqa: F811
     streams = [profile.read(path, None) for path, _ in _streams(data / "streams")]
     runs = []

@@ -47,11 +47,10 @@ def test_a_running_path_length_refuses_a_memory_that_shrank():
         walk.lengths(np.zeros((4, 1, 3)))
 
 
-def _arms(write, pm, *, relative: bool = False, error: str = "max", strokes: int = 4, seed: int = 0,
-          threshold: float = 10.0):
+def _arms(write, pm, *, strokes: int = 4, seed: int = 0, threshold: float = 10.0):
     """The two-wrist body with ``strokes`` random one-second commands from the hub (the right wrist held still in
     every other one)."""
-    text = ARMS + f'threshold = {threshold}\nrelative = {str(relative).lower()}\nerror = "{error}"\n'
+    text = ARMS + f'threshold = {threshold}\n'
     character = load_character(write("arms.toml", text), pm)
     motor, rng = character.motor, np.random.default_rng(seed)
     left, right = motor.rest[2], motor.rest[3]
@@ -63,16 +62,14 @@ def _arms(write, pm, *, relative: bool = False, error: str = "max", strokes: int
     return character, names
 
 
-@pytest.mark.parametrize("relative,error", [(False, "max"), (False, "mean"), (True, "max"), (True, "mean")])
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(lengths=arrays(np.float64, 2, elements=st.floats(0.0, 1.0)),
        last=arrays(np.float64, (2, 3), elements=coordinates),
        first=arrays(np.float64, (2, 3), elements=coordinates), order=st.randoms(use_true_random=False))
-def test_candidates_predicted_at_once_are_predicted_one_by_one(write, pm, relative, error, lengths, last, first,
-                                                               order):
+def test_candidates_predicted_at_once_are_predicted_one_by_one(write, pm, lengths, last, first, order):
     """:meth:`ForwardModel._errors` (the one-command candidates stacked) gives each candidate exactly the error
-    :meth:`ForwardModel._error` gives it alone, in the candidates' order, with anchors and ``relative``."""
-    character, names = _arms(write, pm, relative=relative, error=error)
+    :meth:`ForwardModel._error` gives it alone, in the candidates' order, with anchors."""
+    character, names = _arms(write, pm)
     matcher = character.matcher
     paths = [(name,) for name in names] + [(names[0], names[1])]
     order.shuffle(paths)

@@ -29,7 +29,7 @@ from toolkit.profile import load_profile
 from toolkit.watching import WatchingLoop
 
 SETTINGS = ({}, {"threshold": 0.02}, {"threshold": 0.01, "learn": False}, {"together": False},
-            {"relative": True, "dropout": "relative", "min_move": 0.05})
+            {"min_move": 0.05})
 
 
 @pytest.fixture(scope="module")

@@ -44,106 +44,8 @@ stroke becomes a guiding stroke by the inverse model, and the strokes become new
 edges and nodes leading from the active node (ending in the hub when the
 demonstration returns there).
 
-Drop-out relative to the other candidates (issue 18; not in the paper, which leaves the correspondence problem
-open, §6): the paper's drop-out (``dropout = "absolute"``, the default) compares each candidate's prediction
-error with one fixed ``threshold``, set for the wrist of a body like one's own. Another person's stance and style
-put every prediction off by about as much from the first frame (a styled bow is 10-15 cm from every candidate at its
-onset on a 1.5 m body), so on real clips every candidate drops out and nothing is committed. With
-``dropout = "relative"`` the candidates race: a candidate drops out when its error exceeds ``ratio`` times the best
-living candidate's. What all candidates share (the stance, the body) cancels in the ratio; what tells them apart (the
-movement) does not. The ratio has no unit, so it holds for any body and skeleton; 1.5 means "half again as far off
-as the best", a clear lead and not a matter of noise. Two refinements follow from what the quantities mean:
-
-- errors under ``min_move`` count as ``min_move``: predictions that differ by less than the smallest displacement
-  that counts as a movement cannot be told apart, so a near-perfect best does not drop every other candidate;
-- ``ceiling``: a candidate whose error exceeds it drops out whatever the others do, so a demonstration that no edge
-  fits is still "unknown", not the least bad edge (0.15 m at Max's scale, three times the paper's 0.05 m: a part
-  predicted three wrists' thresholds away is somewhere else).
-
-With ``stillness`` a candidate also drops out when it predicts worse, by more than ``min_move``, than predicting
-no movement at all (every part staying where it was seen at the onset): it explains nothing of what is seen. This
-needs no length of its own and holds for any body; it is meant with ``relative = true``, where candidates and
-stillness alike compare displacements since the onset (with positions, a stance unlike one's own puts every
-candidate behind stillness from the first frame).
-
 Commitment is as in the paper (Fig. 3): when every living candidate stands for one movement (and ``min_progress``
-of it has been seen). With ``race`` the ratio compares each candidate's mean error since the onset rather than this
-frame's, so one frame does not decide. A demonstration that ends with several candidates still alive is answered
-with the best of them (the race's finish, :meth:`ForwardModel._leader`); every one of them is within the ceiling.
-
-Spread between takes (issue 18): a movement learned from several clips (``MotorCommandGraph.takes``) says how much
-its performances differ. With ``spread`` > 0 each such movement's candidates drop out beyond ``spread`` times its
-spread between takes (:meth:`ForwardModel.spreads`: the median over its takes of the take's mean prediction error
-under the nearest other take's commands), in place of ``threshold`` or ``ceiling``, as ``path-search``'s ``spread``
-does for its ``max_distance``. A movement people perform alike is held tight, one they perform in many ways loosely.
-
-Across styles (issue 18; K&G §4.1, §4.4, §6), three more settings, each off by default (the paper):
-
-- ``error = "moving"``: K&G follow the subsystems that move (§4.1). A whole-body subsystem (a repertoire of
-  clips) has many parts that take no part in a movement, and their errors (a head held otherwise, another stance)
-  outweigh those of the few that do. Each part's error is weighted by the path it has been seen to cover since the
-  onset, over the parts' sum (:func:`moving_weights`): the weights have no unit and sum to 1, a still part weighs
-  nothing, and the error stays in metres.
-- ``clock = "lead"``: one motor command has one time (§4.4 re-parameterises it by the path its movement covers,
-  and a hand's fingers share one clock, §4.2). Every part is predicted at the time at which the command's lead part
-  has covered the lead's observed path (:func:`lead_clock`), rather than each part at its own observed path length,
-  so a command that moves parts the demonstrator keeps still (or keeps still parts that move) predicts them where
-  they are not. With ``relative``, displacements are then taken from where the lead joined the command.
-- ``unexplained`` (a share, unit-free; with ``dropout = "relative"``): "unknown" without metres. A candidate is
-  committed to, or wins the race at the end, only while its mean prediction error since the onset is at most
-  ``unexplained`` times the demonstration's own mean extent, the error of predicting that nothing moves
-  (:func:`explained`); the ceiling in metres is then not used. 1 means "predicts better than standing still":
-  the ratio is unchanged when the demonstration and the prediction are scaled or moved together, so it holds for
-  any body and skeleton.
-
-Travel (issue 18; B&B §7.1, K&G §6): the commands move parts relative to the root (B&B §5.1's root-relative
-coordinates), so a walk to the left, to the right, backwards and forwards, whose leg swings are alike, are alike to
-them. With ``travel`` = τ > 0 where the body goes is one more part, as ``path-search``'s ``travel``: the root's
-displacement over τ seconds in the body's own frame (:mod:`plugins.lib.travel`). It is *observed* from the working
-memory's world positions, at each frame from the frames up to it (the mean velocity over the last quarter second,
-not known before the segment has lasted that long); *predicted* from where the body went while the
-command was shown (``Edge.travel``, kept by the motor command graph for clips and for what it learns by watching),
-read at the point of the command where its lead part is predicted (K&G §4.1: the forward model predicts from the
-command); and *compared* as one more part of ``error``: the largest, one more in the mean, or weighted by how far
-it has been seen to go (the root's path in the world since the onset) with ``moving``. It is compared as it is,
-also with ``relative``: travel is a velocity, which another person's stance does not offset. Where the world
-positions are not known the travel part is left out; a command without travel is performed on the spot. The
-drop-out, ``stillness`` (the body on the spot) and ``unexplained`` (the extent includes the travel) see it; the
-end check (:meth:`ForwardModel._ended`), the start node and the spreads between takes compare the parts alone.
-
-The styled comparison (issue 18; K&G §4.4, §6; B&B §7.1), path search's ``posture`` and the posegraph's
-``tempo`` estimated online (:mod:`plugins.lib.online_style`): the forward model commits early, so it
-cannot measure a style over the whole segment; each candidate is fitted to the frames seen so far, from running sums
-(the same work a frame at any length of segment), each setting off by default (the paper):
-
-- ``posture = "removed"``: each candidate's prediction and the observation are compared each about its own mean
-  over the frames seen so far, so a part held otherwise through the movement (a stance, a hand held higher) cancels
-  on both sides alike, rather than only the onset's posture as ``relative`` removes it; ``unexplained`` and
-  ``stillness`` then compare with predicting that nothing moves in the same way (each part about its own mean);
-- ``tempo`` = a factor (2, the posegraph's): the command is predicted at the time it reaches at a pace (command
-  seconds per second seen) among paces at most 12% apart within the factor either way, the pace whose prediction
-  leaves the least squared residual over the frames seen (with the posture above); K&G §4.4 re-parameterise each
-  part by the path length it has covered, which lets a command that moves a part the demonstrator keeps still
-  predict it where it is seen, and a movement made larger run ahead along its command. A candidate path goes on
-  along the next edges once its pace's time passes the path's end; the end check compares the fitted prediction.
-
-Amplitude (the observation scaled by its extent over the command's over the same progress, within a factor 2) was
-built and measured too, and lowered the accuracy on the Bandai-Namco clips in every combination: not kept
-(docs/benchmarks.md, "The forward model's styled comparison (issue 18, fmstyled)").
-
-The spreads between takes (``spread``; :meth:`ForwardModel.take_errors`) use the styled comparison too when it is on
-(issue 18, fmstyled2): each take is followed by another take's commands as a demonstration is, about each side's own
-mean and at the pace fitted to the frames seen so far (the running sums as cumulative sums over the take,
-:func:`plugins.lib.online_style.distances_all`), so the limit ``spread`` times the spread and the candidates' errors it
-bounds compare like with like: two takes that differ only by a held stance, or by their pace, have no spread.
-
-Cost (K&G §4.4 predict every candidate in parallel): with ``tempo`` every candidate's prediction at every pace is one
-gather over the commands stacked once per subsystem (:meth:`ForwardModel._at_times_all`), the running sums and best
-paces of all candidates at once (:func:`plugins.lib.online_style.residuals_all`), and their travel parts at once; the
-same values as candidate by candidate (``tests/test_forward_model_styled_batch.py``). Without ``tempo`` (``posture``
-alone) the same batch runs with one pace, every one-command candidate placed along its strokes at once on the
-path-length clock (:meth:`ForwardModel._styled_clock_all`); :meth:`ForwardModel._styled_predict`, path by path, is the
-tests' reference (and what runs when the commands cannot be stacked).
+of it has been seen).
 
 Ranked candidates (B&B Fig. 13; K&G §4.4, Fig. 3's candidates): every answer of one followed subsystem carries
 ``Match.candidates``, the movements the forward models considered in the segment with their prediction errors,
@@ -191,14 +93,13 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from plugins.lib import online_style
 from plugins.lib.compiled import compiled
 from plugins.lib.strokes import StrokeCriteria
 from toolkit import Match, Matcher, Motion, Parameter, hookimpl
 from toolkit.components import provides
 from toolkit.watching import WorkingMemory, follow
 
-__all__ = ["ForwardModel", "Track", "CommandGraphs", "moving_weights", "explained", "lead_clock"]
+__all__ = ["ForwardModel", "Track", "CommandGraphs"]
 
 
 def _distances(x: np.ndarray, y: np.ndarray, z: np.ndarray, first: np.ndarray) -> np.ndarray:
@@ -255,52 +156,11 @@ class CommandGraphs(Protocol):
         """The labelled movement a path of edges stands for, if one."""
 
     def learn_observed(self, subsystem: str, start: str, observed: np.ndarray, fps: float, *,
-                       criteria: StrokeCriteria = StrokeCriteria(), travel: np.ndarray | None = None) -> list[str]:
-        """Learn an observed movement as new edges from ``start`` (true imitation); their names. ``travel`` (n, 3):
-        where the body went at each frame (the root's velocity in the body's frame), kept with the edges."""
+                       criteria: StrokeCriteria = StrokeCriteria()) -> list[str]:
+        """Learn an observed movement as new edges from ``start`` (true imitation); their names."""
 
     def rest_pose(self) -> np.ndarray:
         """The body's rest pose, local frame (P, 3)."""
-
-
-def moving_weights(lengths: np.ndarray) -> np.ndarray:
-    """Each part's share of the path the parts have been seen to cover (k,): ``lengths / lengths.sum()``, the
-    parts alike (``1 / k``) when none has moved (or a length is not finite). The weights sum to 1 and have no unit,
-    so a weighted error is in the units of the distances, and a still part weighs nothing."""
-    lengths = np.asarray(lengths, dtype=float)
-    total = float(lengths.sum())
-    if not np.isfinite(total) or total <= 0.0:
-        return np.full(len(lengths), 1.0 / max(len(lengths), 1))
-    return lengths / total
-
-
-def explained(error: float, extent: float, unexplained: float, floor: float = 0.0) -> bool:
-    """Whether a prediction whose mean error is ``error`` explains the demonstration: ``error <= unexplained *
-    max(extent, floor)``, where ``extent`` is the mean error of predicting that nothing moves (the demonstration's
-    own extent of movement, in the same units) and ``floor`` the smallest extent that counts as a movement. The
-    ratio ``error / extent`` has no unit: it is unchanged when the demonstration and the prediction are scaled
-    together (another body size) or moved together (another place), so the same ``unexplained`` holds for a mouse
-    and a person."""
-    return bool(error <= unexplained * max(extent, floor))
-
-
-def lead_clock(arcs: np.ndarray, lead: int, length: float) -> np.ndarray:
-    """Every part's path length (k,) at the time at which part ``lead`` has covered ``length`` of its stroke.
-
-    ``arcs`` (k, G) are the cumulative path lengths of one command's strokes on a grid uniform in time (the parts of
-    one command share its duration), so the time is a fractional grid index: where ``arcs[lead]`` reaches
-    ``length`` (its first point there when the lead pauses), clipped to the stroke; each part is read there. A
-    lead that does not move (every length 0) holds every part at its start."""
-    arcs = np.asarray(arcs, dtype=float)
-    g = arcs.shape[1]
-    row = arcs[lead]
-    if not np.isfinite(length) or row[-1] <= 0.0:
-        return arcs[:, 0].copy()
-    length = min(max(length, 0.0), float(row[-1]))
-    j = int(np.clip(np.searchsorted(row, length, side="left") - 1, 0, g - 2))
-    step = row[j + 1] - row[j]
-    w = 0.0 if step <= 0 else min(max((length - row[j]) / step, 0.0), 1.0)
-    return arcs[:, j] + w * (arcs[:, j + 1] - arcs[:, j])
 
 
 def _arc(points: np.ndarray) -> np.ndarray:
@@ -346,14 +206,6 @@ class Track:
     anchors: dict[str, np.ndarray] = field(default_factory=dict)
     first: np.ndarray | None = None
     """The subsystem's parts as seen at the onset (k, 3); ``None``: read from working memory."""
-    sums: dict[tuple[str, ...], tuple[float, int]] = field(default_factory=dict)
-    """Per candidate path, its summed prediction errors and the frames summed (a path extended from another
-    inherits its sums): the race of ``race``."""
-    weights: np.ndarray | None = None
-    """With ``error = "moving"``: the parts' weights (k,) at the frame followed last (:func:`moving_weights`)."""
-    extent: tuple[float, int] = (0.0, 0)
-    """With ``unexplained``: the summed error of predicting no movement (the demonstration's extent) and the frames
-    summed."""
     stopped: bool = False
     """The imitation of a commitment was stopped at a deviation (once a segment; the body went back to ``home``)."""
     home: str | None = None
@@ -369,20 +221,6 @@ class Track:
     begun: Track | None = None
     """After a deviation, predicted again: the segment's first track of the subsystem (what :meth:`ForwardModel.inspect`
     shows of the segment's start)."""
-    travel_seen: np.ndarray | None = None
-    """With ``travel``: the travel part seen at the frame followed last (3,), the root's displacement over ``travel``
-    seconds in the body's frame; ``None`` when not known (no world positions, fewer than two frames)."""
-    travel_weights: np.ndarray | None = None
-    """With ``travel`` and ``error = "moving"``: the weights (k + 1,) of the parts and of the travel part at the frame
-    followed last (:func:`moving_weights` of the parts' path lengths and the root's path in the world)."""
-    styled: dict[tuple[str, ...], Any] = field(default_factory=dict)
-    """With the styled comparison (``posture``, ``tempo``): per candidate path, its running fit
-    (:class:`plugins.lib.online_style.Fit`; its ``extra`` holds the last frame's ``along``, ``pace``,
-    whether the best pace has passed the path's end (``past``), and the ``error``)."""
-    seen: Any = None
-    """With the styled comparison: the running sums of the observation (:class:`plugins.lib.online_style.Observed`)."""
-    fitted: int = 0
-    """With the styled comparison: the rows since the onset added to the fits."""
     placed: tuple[dict[str, int], np.ndarray] | None = None
     """The anchors placed at once when the track began (:meth:`ForwardModel._anchor`): each command's row in them and
     the array (C, k) whose rows are those of ``anchors``."""
@@ -397,8 +235,6 @@ class _EdgeTable:
     positions: np.ndarray
     arcs: np.ndarray
     lead: int
-    travel: np.ndarray | None = None
-    """With ``travel``: where the body went (m/s, body frame) at each point of the lead part's grid (G, 3)."""
 
 
 def _row_keys(arcs: np.ndarray, first: int = 0) -> np.ndarray | None:
@@ -481,47 +317,6 @@ class _StrokeRows:
         w = np.divide(x - a0, step, out=np.zeros_like(x), where=step > 0)
         p0 = self.positions[rows, j]
         return p0 + np.clip(w, 0.0, 1.0)[:, None] * (self.positions[rows, j + 1] - p0)
-
-
-class _TimedTables:
-    """Every command of one subsystem the styled comparison has predicted, stacked for
-    :meth:`ForwardModel._at_times_all`: each command's strokes on the fine grid, positions (T, k, G, 3) and
-    cumulative path lengths (T, k, G), with each part's stroke duration (T, k), the command's duration (T,) and, with
-    ``travel``, its travel grid (T, G, 3). A command met for the first time, or whose table changed, is added (the
-    stack is rebuilt then, once per new command; every command is uniform in its own time)."""
-
-    __slots__ = ("index", "tables", "positions", "arcs", "durations", "edge_durations", "totals", "travel")
-
-    def __init__(self) -> None:
-        self.index: dict[str, tuple[Any, int]] = {}
-        self.tables: list[tuple[np.ndarray, np.ndarray, np.ndarray, float, np.ndarray | None]] = []
-        self.positions = self.arcs = self.durations = self.edge_durations = self.totals = self.travel = None
-
-    def rows(self, names: list[str], model: ForwardModel) -> np.ndarray | None:
-        """The row of each command in the stack (added when new or changed); ``None`` when they cannot be stacked
-        (grids of other sizes)."""
-        out, grew = [], False
-        for name in names:
-            table = model._edge(name)
-            kept = self.index.get(name)
-            if kept is None or kept[0] is not table:
-                edge = model.motor.edge(name)
-                duration = np.array([c.duration for c in edge.commands])
-                if self.tables and table.positions.shape != self.tables[0][0].shape:
-                    return None
-                self.index[name] = kept = (table, len(self.tables))
-                self.tables.append((table.positions, table.arcs, duration, edge.duration, table.travel))
-                grew = True
-            out.append(kept[1])
-        if grew or self.positions is None:
-            self.positions = np.stack([t[0] for t in self.tables])
-            self.arcs = np.stack([t[1] for t in self.tables])
-            self.durations = np.stack([t[2] for t in self.tables])
-            self.edge_durations = np.array([t[3] for t in self.tables], dtype=float)
-            self.totals = self.arcs[:, :, -1]
-            travel = [t[4] for t in self.tables]
-            self.travel = np.stack(travel) if all(t is not None for t in travel) else None  # (T, G, 3)
-        return np.array(out, dtype=np.intp)
 
 
 def _along_rows(arcs: np.ndarray, positions: np.ndarray, x: np.ndarray, keys: np.ndarray | None = None) -> np.ndarray:
@@ -839,58 +634,7 @@ class ForwardModel(Matcher):
         Parameter("angle_scale", float, 0.25, "Metres one radian of finger joint angle counts as when a hand "
                   "subsystem's errors and movement are compared with threshold, deviation and min_move "
                   "(0.25: the 0.05 m threshold is 0.2 rad, 11 degrees).", minimum=1e-6, length=True),
-        Parameter("dropout", str, "absolute", "How a candidate drops out (K&G §4.4): 'absolute', the paper's, when "
-                  "its prediction error exceeds threshold; 'relative', when it exceeds ratio times the best living "
-                  "candidate's, or the absolute ceiling (see the module).", choices=("absolute", "relative")),
-        Parameter("ratio", float, 1.5, "With dropout = relative: a candidate drops out when its prediction error "
-                  "exceeds this many times the best living candidate's (errors under min_move count as min_move).",
-                  minimum=1.0),
-        Parameter("race", bool, False, "With dropout = relative: compare each candidate's mean prediction error "
-                  "since the onset, not this frame's, with the best's (evidence accumulates; one frame does not "
-                  "decide); the ceiling still applies to this frame's."),
-        Parameter("ceiling", float, 0.15, "With dropout = relative: prediction error (m) above which a candidate "
-                  "drops out whatever the others do, so a demonstration no edge fits is unknown.", minimum=0.0,
-                  length=True),
-        Parameter("stillness", bool, False, "Also drop a candidate whose prediction error exceeds, by more than "
-                  "min_move, that of predicting no movement at all (every part staying where it was at the onset): "
-                  "it explains nothing of what is seen. Meant with relative = true (both then compare displacements)."),
-        Parameter("unexplained", float, 0.0, "With dropout = relative: a unit-free limit in place of the ceiling. "
-                  "A candidate is committed to, or wins the race at the end, only while its mean prediction error "
-                  "since the onset is at most this many times the demonstration's own mean extent (the error of "
-                  "predicting that nothing moves, combined over the parts as error says); else the answer is "
-                  "unknown. 0: not used (the ceiling in metres decides).", minimum=0.0),
-        Parameter("spread", float, 0.0, "A movement with several takes: its candidates drop out beyond this many "
-                  "times its spread between takes (each take's mean prediction error under the nearest other take's "
-                  "commands) instead of threshold (absolute) or ceiling (relative); 0: not used (the paper).",
-                  minimum=0.0),
         Parameter("max_candidates", int, 24, "Most candidate command paths followed at once (the best predictions).", minimum=1),
-        Parameter("error", str, "max", "How the prediction errors of a subsystem's parts combine: the largest "
-                  "(a wrist subsystem, §4.4), the mean (eq. 1 of B&B 2005, for whole-body subsystems), or 'moving': "
-                  "the mean weighted by the path length each part has been seen to cover since the onset, so the "
-                  "parts that move carry the error and a still body does not (K&G §4.1 follow the moving "
-                  "subsystems; see the module).", choices=("max", "mean", "moving")),
-        Parameter("relative", bool, False, "Compare displacements since the onset instead of positions, so that a "
-                  "demonstrator whose posture differs from the observer's own (another style's stance) still fits."),
-        Parameter("clock", str, "parts", "Where along a command each part is predicted: 'parts', each at the path "
-                  "length it has been seen to cover (the default); 'lead', every part at the time at which the "
-                  "command's lead part has covered the lead's observed path (one motor command, one time, as a "
-                  "hand's fingers share one; §4.4's re-parameterisation), so a command that moves parts the "
-                  "demonstrator keeps still, or keeps still parts that move, predicts them where they are not. "
-                  "With relative, displacements are then taken from where the lead joined the command.",
-                  choices=("parts", "lead")),
-        Parameter("travel", float, 0.0, "Seconds over which where the body goes counts as one more part: the root's "
-                  "displacement over this time in the body's own frame (plugins.lib.travel), observed from the world "
-                  "positions and predicted from the travel each command was shown with (Edge.travel), at the point of "
-                  "the command the parts are predicted at. 0: root-relative parts only (the paper).", minimum=0.0),
-        Parameter("posture", str, "kept", "Styled comparison (issue 18; K&G §6, B&B §7.1): 'removed' compares each "
-                  "candidate's prediction and the observation each about its own mean over the frames seen so far "
-                  "(plugins.lib.online_style), so a stance or a hand held otherwise through the movement cancels; "
-                  "'kept': as relative says (the paper).", choices=("kept", "removed")),
-        Parameter("tempo", float, 0.0, "Styled comparison: each candidate is predicted at the time its command "
-                  "reaches at a pace (command seconds per second seen) fitted to the frames seen so far, among "
-                  "paces at most 12% apart within this factor either way (posegraph's tempo), so predictions follow "
-                  "the demonstrator's own pace. 0: the path-length clock of reparameterise (the paper, §4.4).",
-                  minimum=0.0, check=lambda v: None if v == 0 or v >= 1 else "0 (off) or a factor of at least 1"),
         Parameter("together", bool, True, "Follow every subsystem that moves during a demonstration, each with its "
                   "own candidates, and imitate them at once (a hand-arm movement, §4.2); off: only the first to move."),
         Parameter("learn", bool, True, "Learn new edges by the inverse model when no edge predicts the demonstration."),
@@ -918,19 +662,14 @@ class ForwardModel(Matcher):
         # observed root-relative positions are placed at the observer's own root height; finger angles stay as they are
         self._root_height = np.where(owner.body.angle_mask[:, None], 0.0, motor.rest_pose()[owner.body.root_index])
         self._criteria = StrokeCriteria(drop=self.params["drop"], angle=self.params["angle"])
-        self._root = owner.body.root_index
         self._keys: dict[tuple[str, ...], str] = {}  # path -> movement (:meth:`_movement_key`)
         self._key_version: tuple | None = None
-        self._travel_stacks: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
-        if self.params["travel"] > 0:
-            import scipy.ndimage  # noqa: F401  (travel's filter: imported at set-up, not in the first match)
         _kernels()  # compiled (or loaded from numba's cache) now, not in the first demonstration
         self._tables: dict[int, tuple] = {}
         self._edges: dict[str, _EdgeTable] = {}
         self._half_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
         self._stroke_tables: OrderedDict[tuple[str, ...], tuple[list, tuple]] = OrderedDict()
         self._stroke_rows = _StrokeRows(self.GRID)
-        self._time_tables: dict[str, _TimedTables] = {}  # subsystem -> the commands the styled comparison predicted
         self._scales: dict[str, tuple[Any, float]] = {}
         self._placed: OrderedDict[tuple[tuple[str, ...], bytes], tuple[tuple, np.ndarray]] = OrderedDict()
         self._memory: WorkingMemory | None = None
@@ -938,7 +677,6 @@ class ForwardModel(Matcher):
         self._last_local: np.ndarray | None = None
         self._tracked: dict[str, _Tracked] = {}
         self._revision = 0
-        self._spreads: dict[str, float] | None = None
         self.tracks: dict[str, Track] = {}
         self.reported = False
         every = getattr(motor, "edges", None)  # optional (not in CommandGraphs): every edge of a subsystem
@@ -1224,10 +962,7 @@ class ForwardModel(Matcher):
 
         The active node is where the last movement the matcher followed ended; a demonstrator who went back to
         the hub without being followed (a movement that was not recognised, a posture that differed from the
-        observer's own at its end) begins his next movement there. With ``relative`` too (issue 18): another
-        stance is off one's own states by centimetres, while a movement's end is off the hub by the movement; keeping
-        the active node whatever is seen (as this did before) let one unrecognised movement's end node start every
-        later segment of a stream from the wrong node (the generated streams' error 0.778 against 0.333).
+        observer's own at its end) begins his next movement there.
         """
         active = self.motor.active_node(name)
         if active == "hub" or not np.isfinite(seen).any():
@@ -1236,10 +971,9 @@ class ForwardModel(Matcher):
         return active if far[0] <= far[1] else "hub"
 
     def _distance_to(self, name: str, state: np.ndarray, seen: np.ndarray) -> float:
-        """How far the parts seen (k, 3) are from a state of subsystem ``name``, combined as ``error`` says."""
-        d = np.linalg.norm(state - seen, axis=-1) * self._scale_of(name)
-        # "moving" is the plain mean here: a state is compared at the onset, before any part has moved
-        return float(np.nanmax(d) if self.params["error"] == "max" else np.nanmean(d))
+        """How far the parts seen (k, 3) are from a state of subsystem ``name``: the largest part's distance (parts
+        never seen left out)."""
+        return float(np.nanmax(np.linalg.norm(state - seen, axis=-1) * self._scale_of(name)))
 
     def _observed(self, track: Track, memory: np.ndarray) -> np.ndarray:
         """The working memory of a subsystem's parts since it is followed, (n, k, 3).
@@ -1286,13 +1020,9 @@ class ForwardModel(Matcher):
         lengths = self._walked(track, observed)  # once per frame (incremental)
         last = observed[-1]
         frame = self._memory.n - 1
-        if self.params["travel"] > 0 and not track.hand:
-            self._travel_seen(track, len(memory), lengths)
-        styled = self._styled(track)
         if track.committed is not None:
-            error = self._styled_errors(track, [track.committed_path], observed, lengths)[track.committed_path] \
-                if styled else self._error(track, track.committed_path,
-                                           self._clock(track, track.committed_path, lengths, len(observed)), last)
+            error = self._error(track, track.committed_path,
+                                self._clock(track, track.committed_path, lengths, len(observed)), last)
             track.trace.append((frame, {track.committed_path: error}))
             if error <= self.params["deviation"]:
                 return None
@@ -1300,37 +1030,21 @@ class ForwardModel(Matcher):
         if not track.candidates:
             return None
         n = len(observed)
-        paths = self._styled_extended(track) if styled else self._extended(track, lengths, n)
-        if styled:
-            errors = self._styled_errors(track, paths, observed, lengths)
-        elif self.params["reparameterise"]:  # the clock is the path length observed: every candidate at once
+        paths = self._extended(track, lengths, n)
+        if self.params["reparameterise"]:  # the clock is the path length observed: every candidate at once
             errors = self._errors(track, paths, lengths, last)
         else:
             errors = {path: self._error(track, path, self._clock(track, path, lengths, n), last) for path in paths}
         track.trace.append((frame, errors))
-        unexplained = self.params["unexplained"] > 0 and self.params["dropout"] == "relative"
-        still = None
-        if (self.params["stillness"] or unexplained) and styled and self.params["posture"] == "removed":
-            still = self._styled_still(track, observed, lengths)
-        elif self.params["stillness"] or unexplained:  # predicting no movement: every part still, the body on the spot
-            still = self._distance(track, observed[0], last) if not self._traveling(track) else float(
-                self._with_travel(track, (_norms(observed[0] - last) * track.scale)[None],
-                                  np.array([_norms(track.travel_seen)]))[0])
-        evidence = self._evidence(track, errors)
-        if unexplained:
-            total, frames = track.extent
-            track.extent = (total + still, frames + 1)
-        alive = self._survivors(errors, evidence, still if self.params["stillness"] else None)
+        alive = self._survivors(errors)
         if len(alive) > self.params["max_candidates"]:  # keep the best predictions
             alive = dict(sorted(alive.items(), key=lambda kv: kv[1])[: self.params["max_candidates"]])
         track.candidates = alive
         if alive and len({self._movement_key(p) for p in alive}) == 1:  # one first command (or movement) prevails
             path = min(alive, key=alive.get)
-            along = track.styled[path].extra["along"] if styled else \
-                self._along(track, path[0], self._clock(track, path, lengths, n))
+            along = self._along(track, path[0], self._clock(track, path, lengths, n))
             progress = self._progress(path[0], along)
-            if (progress >= self.params["min_progress"] or len(path) > 1) and self._timed(track, observed) and \
-                    self._explained(track, path):
+            if (progress >= self.params["min_progress"] or len(path) > 1) and self._timed(track, observed):
                 self._commit(track, path, along, progress, len(observed), alive[path])
         return None
 
@@ -1338,477 +1052,19 @@ class ForwardModel(Matcher):
                 error: float) -> None:
         """Commit a subsystem to candidate ``path`` (the whole learned sequence it begins), at the speed seen."""
         track.committed_path = self._known_continuation(path)
-        if path in track.styled:  # the whole sequence predicts the frames seen as its beginning did
-            track.styled[track.committed_path] = track.styled[path]
         track.committed = self.motor.add_sequence(list(track.committed_path))
         track.committed_at = self._memory.n
         track.speed = self._speed(track, path, n_observed)
         track.progress = progress
-        track.confidence = float(np.exp(-error / self._limit(path)))
-
-    def _leader(self, track: Track, memory: np.ndarray) -> bool:
-        """With ``dropout = relative``, at the end of a demonstration no candidate prevailed in alone: commit the
-        subsystem to the best of those still alive (the lowest error, or with ``race`` the lowest mean error), as
-        the race's finish. Every one of them is within its ceiling: what is unknown is decided by the ceiling, not
-        here. Returns whether it committed."""
-        if self.params["dropout"] != "relative" or track.committed is not None or not track.candidates:
-            return False
-        score = ({p: t / n for p, (t, n) in track.sums.items() if p in track.candidates} if self.params["race"]
-                 else {}) or track.candidates
-        path = min(score, key=score.get)
-        if not self._explained(track, path):  # even the best explains too little of the movement: unknown
-            return False
-        observed = self._observed(track, memory)
-        along = self._along(track, path[0], _lengths(observed))
-        self._commit(track, path, along, self._progress(path[0], along), len(observed), track.candidates[path])
-        return True
-
-    # -- the styled comparison (issue 18; K&G §6, B&B §7.1) ------------------------------------------
-
-    def _styled(self, track: Track) -> bool:
-        """Whether ``track`` is compared in the demonstrator's own style (``posture``, ``tempo``;
-        :mod:`plugins.lib.online_style`): any of them on, for a positional subsystem (a hand's fingers share one
-        clock and keep the paper's comparison)."""
-        p = self.params
-        return not track.hand and (p["posture"] == "removed" or p["tempo"] > 0)
-
-    def _styled_extended(self, track: Track) -> list[tuple[str, ...]]:
-        """:meth:`_extended` for the styled comparison: a candidate path continues along the edges of its end node
-        once, at the last frame, its fitted prediction passed the path's end (the best pace's time past the path's
-        duration; with the path-length clock, the lead part's length past its stroke)."""
-        out = []
-        for path in track.candidates:
-            fit = track.styled.get(path)
-            out.extend(self._next(track, path) if fit is not None and fit.extra.get("past") else [path])
-        return out
-
-    def _styled_errors(self, track: Track, paths: list[tuple[str, ...]], observed: np.ndarray,
-                       lengths: np.ndarray) -> dict[tuple[str, ...], float]:
-        """This frame's prediction error of each candidate path in the demonstrator's own style
-        (:mod:`plugins.lib.online_style`): the rows seen since the last call added to the observation's running
-        sums and to each path's (a path extended this frame goes on from its parent's sums: its predictions of
-        the frames before are the same), each path's prediction at the pace that fits the frames seen best,
-        compared about each side's own mean (``posture``), the parts (and the travel part) combined as ``error``
-        says. With ``relative`` both sides
-        are displacements since the onset."""
-        n, start = len(observed), track.fitted
-        k = observed.shape[1]
-        rel = self.params["relative"]
-        o = observed[start:n] - observed[0] if rel else observed[start:n]
-        if track.seen is None:
-            track.seen = online_style.Observed.empty(k)
-        if n > start:
-            track.seen.add(o)
-        paces = online_style.paces(self.params["tempo"])
-        centred = self.params["posture"] == "removed"
-        fits = {}
-        errors = {}
-        batch = self._styled_predict_all(track, paths, observed, start, n, paces) if n > start else None
-        for path in paths:
-            fit = track.styled.get(path)
-            if fit is None:
-                parent = track.styled.get(path[:-1])
-                fit = parent.copy() if parent is not None else online_style.Fit.empty(len(paces), k)
-            fits[path] = fit
-        travel = None
-        together = batch is not None and len(fits) == len(paths)  # every candidate's sums at once
-        if together:
-            ds, bests = online_style.residuals_all(track.seen, list(fits.values()), o, batch[0], centred)
-            if self._traveling(track) and self.params["tempo"] > 0:  # from the commands stacked for the paces
-                travel = self._travel_all(track.subsystem, paths, batch[1][np.arange(len(paths)), bests])
-        for c, path in enumerate(paths):
-            fit = fits[path]
-            if n > start:
-                if together:
-                    p, along, past = batch[0][c], batch[1][c], batch[2][c]
-                    d, best = ds[c], int(bests[c])
-                else:
-                    p, along, past = (batch[0][c], batch[1][c], batch[2][c]) if batch is not None else \
-                        self._styled_predict(track, path, observed, start, n, paces)
-                    fit.add(o, p)
-                    d, best = online_style.residuals(track.seen, fit, o[-1], p[:, -1], centred)
-                d = d * track.scale
-                if self._traveling(track):
-                    dt = _norms((self._travel_predicted(path, along[best]) if travel is None else travel[c])
-                                - track.travel_seen)
-                    error = float(self._with_travel(track, d[None], np.array([dt]))[0])
-                else:
-                    error = float(self._combine(track, d[None], lengths)[0])
-                fit.extra.update(along=along[best], pace=float(paces[best]), past=bool(past[best]), error=error)
-            errors[path] = fit.extra.get("error", np.inf)
-        if track.committed is None:
-            track.styled = fits
-        else:
-            track.styled.update(fits)
-        track.fitted = n
-        return errors
-
-    def _styled_still(self, track: Track, observed: np.ndarray, lengths: np.ndarray) -> float:
-        """With ``posture = "removed"``: the error of predicting that nothing moves, compared as the candidates are
-        (``stillness``, ``unexplained``): a prediction that holds every part still is its own mean, so each part's
-        distance is the observation's from its mean over the frames seen (:meth:`_styled_errors` has added this
-        frame); the body on the spot for the travel part."""
-        seen = track.seen
-        o = observed[-1] - observed[0] if self.params["relative"] else observed[-1]
-        d = _norms(o - seen.so / max(seen.n, 1)) * track.scale
-        if self._traveling(track):
-            return float(self._with_travel(track, d[None], np.array([_norms(track.travel_seen)]))[0])
-        return float(self._combine(track, d[None], lengths)[0])
-
-    def _onset_time(self, track: Track, path: tuple[str, ...]) -> float:
-        """With ``tempo``: the command time of path ``path`` at the onset, where its lead part joined its first
-        command (:meth:`_anchor`; 0 with ``relative``)."""
-        lead = self._lead(path[0])
-        return self._mapped_time(self._strokes_of(path[0])[lead], float(self._anchor(track, path[0])[lead]))
-
-    def _styled_predict(self, track: Track, path: tuple[str, ...], observed: np.ndarray, start: int, n: int,
-                        paces: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Path ``path``'s predictions of rows ``start .. n - 1`` since the onset, (S, m, k, 3) at each of the S
-        ``paces`` (displacements from the path's point at the onset with ``relative``), with each pace's place
-        along the path at the last row (S, k) and whether it has passed the path's end (S,).
-
-        With ``tempo``: at command time ``t0 + pace * i / fps`` for row ``i``, ``t0`` where the lead part joined the
-        command (:meth:`_anchor`; 0 with ``relative``). Without: the path-length clock (:meth:`_clock`), one pace."""
-        anchor = self._anchor(track, path[0])
-        rows = np.arange(start, n)
-        if self.params["tempo"] > 0:
-            times = self._onset_time(track, path) + paces[:, None] * (np.append(rows, 0) / self.fps)[None]  # (S, m + 1): the onset's last
-            points, along, past = self._at_times(path, times.ravel())
-            points = points.reshape(len(paces), len(rows) + 1, *points.shape[1:])
-            along = along.reshape(len(paces), len(rows) + 1, -1)[:, -2]
-            past = past.reshape(len(paces), len(rows) + 1)[:, -2]
-            p = points[:, :-1] - points[:, -1:] if self.params["relative"] else points[:, :-1]
-            return p, along, past
-        ls = [lengths_ for lengths_ in (_lengths(observed[: i + 1]) for i in rows)]
-        alongs = []
-        for lengths_ in ls:
-            along = anchor + lengths_
-            if self.params["clock"] == "lead":
-                along = self._lead_clock(path, along)
-            alongs.append(along)
-        p = np.stack([self._predict(track, path, a) for a in alongs])[None]
-        if self.params["relative"]:
-            p = p - self._predict(track, path, anchor)
-        lead = self._lead(path[0])
-        total = sum(self._edge(e).arcs[lead, -1] for e in path)
-        return p, alongs[-1][None], np.array([alongs[-1][lead] > total + 0.01 / track.scale])
-
-    def _styled_predict_all(self, track: Track, paths: list[tuple[str, ...]], observed: np.ndarray, start: int,
-                            n: int, paces: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-        """:meth:`_styled_predict` for every candidate path at once (the same values): predictions (C, S, m, k, 3),
-        places along the paths at the last row (C, S, k) and whether past their ends (C, S); ``None`` when the
-        paths' commands cannot be stacked (:class:`_TimedTables`). Without ``tempo``, one pace on the path-length
-        clock (:meth:`_styled_clock_all`)."""
-        if not paths:
-            return None
-        if not self.params["tempo"] > 0:
-            return self._styled_clock_all(track, paths, observed, start, n)
-        rows = np.arange(start, n)
-        clock = np.append(rows, 0) / self.fps  # (m + 1,): the onset's last
-        t0 = np.array([self._onset_time(track, path) for path in paths])
-        times = t0[:, None, None] + paces[None, :, None] * clock[None, None]  # (C, S, m + 1)
-        out = self._at_times_all(track.subsystem, paths, times.reshape(len(paths), -1))
-        if out is None:
-            return None
-        points, along, past = out
-        points = points.reshape(len(paths), len(paces), len(rows) + 1, *points.shape[2:])
-        along = along.reshape(len(paths), len(paces), len(rows) + 1, -1)[:, :, -2]
-        past = past.reshape(len(paths), len(paces), len(rows) + 1)[:, :, -2]
-        p = points[:, :, :-1] - points[:, :, -1:] if self.params["relative"] else points[:, :, :-1]
-        return p, along, past
-
-    def _styled_clock_all(self, track: Track, paths: list[tuple[str, ...]], observed: np.ndarray, start: int,
-                          n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """:meth:`_styled_predict` without ``tempo`` (one pace, the path-length clock) for every candidate path at
-        once, the same values: rows ``start .. n - 1``'s path lengths (:func:`_lengths` of the rows up to each) are
-        computed once for all paths; the one-command paths (the common case) are placed along their strokes at once
-        (:meth:`_StrokeRows.along`, as :meth:`_errors` places them: the same points as :meth:`_predict`), the others
-        and ``clock = "lead"`` path by path. Predictions (C, 1, m, k, 3), places along at the last row (C, 1, k),
-        past the end (C, 1)."""
-        rows = range(start, n)
-        walked = np.stack([_lengths(observed[: i + 1]) for i in rows])  # (m, k)
-        c_n, m, k = len(paths), len(rows), observed.shape[1]
-        p = np.empty((c_n, m, k, 3))
-        along = np.empty((c_n, k))
-        past = np.empty(c_n, dtype=bool)
-        one = [c for c, path in enumerate(paths) if len(path) == 1] if self.params["clock"] != "lead" else []
-        if one:
-            strokes, totals, leads, anchors, _ = self._stacked(track, tuple(paths[c][0] for c in one))
-            x = anchors[None] + walked[:, None]  # (m, C1, k): _along's anchor + lengths
-            at = self._stroke_rows.along(np.tile(strokes, m), np.minimum(x, totals[None]).reshape(-1))
-            p[one] = at.reshape(m, len(one), k, 3).transpose(1, 0, 2, 3)
-            if self.params["relative"]:
-                p[one] -= self._stroke_rows.along(strokes, np.minimum(anchors, totals).reshape(-1)).reshape(
-                    len(one), 1, k, 3)
-            along[one] = x[-1]
-            past[one] = x[-1, np.arange(len(one)), leads] > totals[np.arange(len(one)), leads] + 0.01 / track.scale
-        chosen = set(one)
-        for c, path in enumerate(paths):
-            if c not in chosen:
-                pc, ac, ec = self._styled_predict(track, path, observed, start, n, np.array([1.0]))
-                p[c], along[c], past[c] = pc[0], ac[0], ec[0]
-        return p[:, None], along[:, None], past[:, None]
-
-    def _at_times_all(self, subsystem: str, paths: list[tuple[str, ...]],
-                      times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-        """:meth:`_at_times` of C paths at once, path ``c`` at command times ``times[c]`` ((C, N); the same values):
-        positions (C, N, k, 3), places along (C, N, k) and past the end (C, N). Each time is on the last edge of its
-        path that has begun by then (the first edge before it begins), as :meth:`_at_times` overwrites edge after
-        edge; the edges' starts and the places before them are the same running sums."""
-        timed = self._time_tables.get(subsystem)
-        if timed is None:
-            timed = self._time_tables[subsystem] = _TimedTables()
-        longest = max(len(path) for path in paths)
-        ids = timed.rows([name for path in paths for name in path], self)
-        if ids is None:
-            return None
-        c_n = len(paths)
-        slots = np.zeros((c_n, longest), dtype=np.intp)
-        used = np.zeros((c_n, longest), dtype=bool)
-        at = 0
-        for c, path in enumerate(paths):
-            slots[c, : len(path)] = ids[at : at + len(path)]
-            used[c, : len(path)] = True
-            at += len(path)
-        # per path, each edge's start (s) and the path length before it, part by part: running sums in path order
-        durations = np.where(used, timed.edge_durations[slots], 0.0)
-        starts = np.zeros((c_n, longest + 1))
-        np.cumsum(durations, axis=1, out=starts[:, 1:])
-        before = np.zeros((c_n, longest + 1, timed.totals.shape[1]))
-        np.cumsum(np.where(used[..., None], timed.totals[slots], 0.0), axis=1, out=before[:, 1:])
-        ends = starts[np.arange(c_n), np.array([len(path) for path in paths])]  # (C,): each path's duration
-        begun = (times[:, :, None] - starts[:, None, :longest] >= 0) & used[:, None, :]  # (C, N, L)
-        slot = np.maximum(longest - 1 - np.argmax(begun[:, :, ::-1], axis=2), 0)
-        slot = np.where(begun.any(axis=2), slot, 0)  # (C, N): the edge of the path each time is on
-        cc = np.arange(c_n)[:, None]
-        table = slots[cc, slot]  # (C, N)
-        local = times - starts[cc, slot]
-        g = timed.positions.shape[2]
-        u = np.clip(local[..., None] / timed.durations[table], 0.0, 1.0) * (g - 1)  # (C, N, k)
-        j = np.clip(np.floor(u).astype(np.intp), 0, g - 2)
-        w = u - j
-        k = timed.positions.shape[1]
-        at = (table[..., None] * k + np.arange(k)) * g + j  # flat index of [table, part, j] (a gather: the same values)
-        flat_p, flat_a = timed.positions.reshape(-1, 3), timed.arcs.reshape(-1)
-        points = flat_p[at] * (1 - w[..., None]) + flat_p[at + 1] * w[..., None]
-        arcs = flat_a[at] * (1 - w) + flat_a[at + 1] * w
-        first = slot == 0
-        along = np.where(first[..., None], arcs, arcs + before[cc, slot])
-        return points, along, times > ends[:, None]
-
-    def _at_times(self, path: tuple[str, ...], times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Every part of path ``path`` at command times ``times`` (N,): positions (N, k, 3), places along the path
-        (N, k: path length from its start, edge after edge, as :meth:`_along` counts) and whether the time is past
-        the path's end (N,). Each part's stroke is tabled uniformly in its own time (:meth:`_table`) and holds its
-        end once it has ended; the edges follow one another after each edge's duration."""
-        start, before = 0.0, None
-        out_p = out_a = None
-        for name in path:
-            edge, table = self.motor.edge(name), self._edge(name)
-            k, g, _ = table.positions.shape
-            duration = np.array([c.duration for c in edge.commands])
-            local = times - start
-            u = np.clip(local[:, None] / duration[None], 0.0, 1.0) * (g - 1)
-            j = np.clip(np.floor(u).astype(np.intp), 0, g - 2)
-            w = u - j
-            cols = np.arange(k)[None]
-            points = table.positions[cols, j] * (1 - w[..., None]) + table.positions[cols, j + 1] * w[..., None]
-            arcs = table.arcs[cols, j] * (1 - w) + table.arcs[cols, j + 1] * w
-            if before is None:
-                out_p, out_a, before = points, arcs, np.zeros(k)
-            else:
-                here = local >= 0
-                out_p[here] = points[here]
-                out_a[here] = arcs[here] + before
-            before = before + table.arcs[:, -1]
-            start += edge.duration
-        return out_p, out_a, times > start
+        track.confidence = float(np.exp(-error / self.params["threshold"]))
 
     # -- drop-out (K&G §4.4, Fig. 3) ----------------------------------------------------------------
 
-    def _survivors(self, errors: Mapping[tuple[str, ...], float],
-                   evidence: Mapping[tuple[str, ...], float] | None = None,
-                   still: float | None = None) -> dict[tuple[str, ...], float]:
-        """The candidates (paths and their prediction errors this frame) that do not drop out.
-
-        ``absolute`` (the paper): those within their limit (:meth:`_limit`: ``threshold``, or ``spread`` times
-        their movement's spread between takes). ``relative``: those within their limit (``ceiling``, or the
-        spread's) whose ``evidence`` (this frame's errors, or with ``race`` their means since the onset) is within
-        ``ratio`` times the best of them, errors under ``min_move`` counted as ``min_move`` (two predictions closer
-        than the smallest displacement that counts as a movement are not told apart).
-
-        ``still`` (with ``stillness``): the error of predicting no movement at all (every part where it was at the
-        onset); a candidate more than ``min_move`` worse than that explains nothing of what is seen and drops out.
-        """
-        alive = {path: error for path, error in errors.items() if error <= self._limit(path)}
-        if still is not None:
-            alive = {path: error for path, error in alive.items() if error <= still + self.params["min_move"]}
-        if self.params["dropout"] == "relative" and alive:
-            score = errors if evidence is None else evidence
-            bar = self.params["ratio"] * max(min(score[p] for p in alive), self.params["min_move"])
-            alive = {path: error for path, error in alive.items() if score[path] <= bar}
-        return alive
-
-    def _evidence(self, track: Track, errors: Mapping[tuple[str, ...], float]) -> Mapping[tuple[str, ...], float]:
-        """What the relative drop-out compares: this frame's errors, or with ``race`` each candidate's mean error
-        since the onset (its sums updated here; a path extended this frame inherits its parent's)."""
-        if not self.params["race"] and not (self.params["unexplained"] > 0 and self.params["dropout"] == "relative"):
-            return errors
-        sums = {}
-        for path, error in errors.items():
-            total, n = track.sums.get(path) or track.sums.get(path[:-1]) or (0.0, 0)
-            sums[path] = (total + error, n + 1)
-        track.sums = sums
-        if not self.params["race"]:
-            return errors
-        return {path: total / n for path, (total, n) in sums.items()}
-
-    def _explained(self, track: Track, path: tuple[str, ...]) -> bool:
-        """With ``unexplained`` (and ``dropout = relative``): whether candidate ``path``'s mean prediction error since
-        the onset is at most ``unexplained`` times the demonstration's mean extent (:func:`explained`); always true
-        without it."""
-        if not (self.params["unexplained"] > 0 and self.params["dropout"] == "relative"):
-            return True
-        total, n = track.sums.get(path, (0.0, 0))
-        extent, frames = track.extent
-        return explained(total / max(n, 1), extent / max(frames, 1), self.params["unexplained"],
-                         self.params["min_move"])
-
-    def _limit(self, path: tuple[str, ...]) -> float:
-        """The prediction error above which candidate ``path`` drops out whatever the others do: ``spread`` times
-        its movement's spread between takes (``spread`` > 0 and a movement of several takes), else ``threshold``
-        (``absolute``) or ``ceiling`` (``relative``)."""
-        if self.params["spread"] > 0:
-            spread = self.spreads().get(self._movement_key(path))
-            if spread is not None:
-                return self.params["spread"] * spread
-        if self.params["dropout"] == "relative" and self.params["unexplained"] > 0:
-            return float("inf")  # unknown is decided against the demonstration's own extent (:meth:`_explained`)
-        return self.params["threshold" if self.params["dropout"] == "absolute" else "ceiling"]
-
-    def spreads(self) -> dict[str, float]:
-        """Each movement's spread between takes (issue 18; not in the paper), for movements of several takes
-        (``MotorCommandGraph.takes``): the median over its takes of the take's mean prediction error (over its
-        frames, as ``error`` combines the parts) under the nearest other take's commands, as the forward model
-        would predict the take from them (:meth:`take_errors`). Computed once, when first needed."""
-        if self._spreads is None:
-            takes = self.motor.takes() if hasattr(self.motor, "takes") else {}
-            self._spreads = {}
-            if self.params["tempo"] > 0:  # every take's commands stacked once (_at_times_all), not once per new take
-                names: dict[str, list[str]] = {}
-                for examples in takes.values():
-                    for edges, subsystem, *_ in examples:
-                        names.setdefault(subsystem, []).extend(edges)
-                for subsystem, every in names.items():
-                    timed = self._time_tables.get(subsystem)
-                    if timed is None:
-                        timed = self._time_tables[subsystem] = _TimedTables()
-                    timed.rows(list(dict.fromkeys(every)), self)
-            for movement, examples in takes.items():
-                if len(examples) < 2:
-                    continue
-                distances = []
-                kept: dict[Any, Any] = {"longest": max(len(observed) for _, _, observed, _ in examples)}
-                for i, (_, subsystem, observed, fps) in enumerate(examples):
-                    others = [tuple(edges) for j, (edges, *_) in enumerate(examples) if j != i]
-                    errors = [self.take_errors(subsystem, observed, path, fps, kept=kept) for path in others]
-                    distances.append(min((float(np.mean(e)) for e in errors if len(e)), default=float("nan")))
-                finite = [d for d in distances if np.isfinite(d)]
-                if len(finite) >= 2:
-                    self._spreads[movement] = float(np.median(finite))
-        return self._spreads
-
-    def take_errors(self, subsystem: str, observed: np.ndarray, path: tuple[str, ...],
-                    fps: float | None = None, kept: dict | None = None) -> np.ndarray:
-        """The prediction error, frame by frame, of command path ``path`` on a subsystem's observed movement
-        ``observed`` (n, k, 3) followed from its first frame: the forward model's own prediction (:meth:`_error`,
-        anchors and ``relative`` included) with the observed path lengths up to each frame (the positions
-        averaged over three frames, as :func:`_lengths` does, over the whole take at once).
-
-        With the styled comparison (``posture``, ``tempo``; :meth:`_styled`) the take is compared as a
-        demonstration is (:meth:`_take_errors_styled`), so that a spread between takes and the errors of the
-        candidates it bounds compare like with like. ``fps``: the take's frame rate (the pace's clock; by default
-        the segment's, else 30). ``kept``: what :meth:`spreads` keeps between the calls of one movement's takes (each
-        take's path lengths and weights, each path's predictions at the paces over the longest take, ``"longest"``
-        rows), the same values computed once."""
-        from scipy.ndimage import uniform_filter1d
-
-        track = Track(subsystem, self._scale_of(subsystem), self.motor.is_hand(subsystem), "hub", 0, {}, [],
-                      first=observed[0])
-        walked = kept.get(("walked", id(observed))) if kept is not None else None
-        if walked is None:
-            smooth = uniform_filter1d(observed, size=3, axis=0, mode="nearest") if len(observed) >= 3 else observed
-            walked = np.concatenate([np.zeros((1, observed.shape[1])),
-                                     np.cumsum(np.linalg.norm(np.diff(smooth, axis=0), axis=-1), axis=0)])
-            if kept is not None:  # the take's array is alive while spreads() runs: its id is its own
-                kept[("walked", id(observed))] = walked
-        if self._styled(track) and len(path):
-            return self._take_errors_styled(track, observed, path, walked,
-                                            fps if fps else getattr(self, "fps", None) or 30.0, kept)
-        if track.hand or not len(path) or self.params["clock"] == "lead":  # one clock: frame by frame, as followed
-            return np.array([self._error(track, path, walked[t], observed[t]) for t in range(1, len(observed))])
-        # every frame at once: each part along its strokes of the whole path, laid end to end (what _predict does
-        # edge by edge: a part past the end of one edge's stroke goes on along the next, and stops at the last end)
-        edges = [self._edge(name) for name in path]
-        positions = np.concatenate([e.positions for e in edges], axis=1)  # (k, G, 3)
-        totals = np.stack([e.arcs[:, -1] for e in edges])  # (E, k)
-        starts = np.concatenate([np.zeros((1, totals.shape[1])), np.cumsum(totals, axis=0)[:-1]])
-        arcs = np.concatenate([e.arcs + starts[i][:, None] for i, e in enumerate(edges)], axis=1)  # (k, G)
-        along = walked[1:] + self._anchor(track, path[0])  # (T, k)
-        predicted = np.stack([np.stack([np.interp(along[:, p], arcs[p], positions[p, :, c]) for c in range(3)],
-                                       axis=-1) for p in range(len(arcs))], axis=1)  # (T, k, 3)
-        d = np.linalg.norm(predicted + self._onset_offset(track, path[0]) - observed[1:], axis=-1) * track.scale
-        return self._take_combined(d, walked, kept)
-
-    def _take_combined(self, d: np.ndarray, walked: np.ndarray, kept: dict | None = None) -> np.ndarray:
-        """A take's per-part errors at frames 1 .. n - 1 (n - 1, k) combined as ``error`` says, ``moving`` with the
-        path lengths ``walked`` (n, k) up to each frame (:func:`moving_weights`; kept in ``kept`` per take)."""
-        if self.params["error"] == "moving":
-            weights = kept.get(("weights", id(walked))) if kept is not None else None
-            if weights is None:
-                weights = np.apply_along_axis(moving_weights, 1, walked[1:])
-                if kept is not None:
-                    kept[("weights", id(walked))] = weights
-            return (d * weights).sum(axis=1)
-        return d.max(axis=1) if self.params["error"] == "max" else d.mean(axis=1)
-
-    def _take_errors_styled(self, track: Track, observed: np.ndarray, path: tuple[str, ...], walked: np.ndarray,
-                            fps: float, kept: dict | None = None) -> np.ndarray:
-        """:meth:`take_errors` in the demonstrator's own style: at each frame ``t`` of the take (1 .. n - 1) the
-        error :meth:`_styled_errors` gives when following it, every frame at once. The running sums of
-        :mod:`plugins.lib.online_style` over rows 0 .. t are cumulative sums over the take: per pace the residual
-        over the frames up to ``t`` (:func:`online_style.distances_all`), the best pace at each frame, and that pace's
-        per-part distance at ``t``, each side about its own mean up to ``t`` with ``posture = "removed"``. The parts
-        are compared alone (the spreads leave travel out), combined as ``error`` says with the path lengths walked
-        up to ``t`` (:func:`moving_weights`)."""
-        if self.params["tempo"] > 0:
-            # each value is computed by itself (element by element): the predictions of a path over the longest take
-            # of a movement, kept, hold those over a shorter one as their first rows (the same bits)
-            t0 = self._onset_time(track, path)
-            key = ("points", path, fps, t0)
-            sums = kept.get(key) if kept is not None else None
-            if sums is None or sums[0].shape[1] < len(observed):
-                rows = np.arange(max(len(observed), kept["longest"]) if kept is not None else len(observed))
-                paces = online_style.paces(self.params["tempo"])
-                times = t0 + paces[:, None] * (rows / fps)[None]  # (S, n): row 0 is the onset
-                at_once = self._at_times_all(track.subsystem, [path], times.reshape(1, -1))  # each time on its edge
-                points = (at_once[0][0] if at_once is not None else self._at_times(path, times.ravel())[0]).reshape(
-                    len(paces), len(rows), -1, 3)
-                # with their own running sums (online_style.prediction_sums: a shorter take's are their first rows)
-                sums = online_style.prediction_sums(points - points[:, :1] if self.params["relative"] else points)
-                if kept is not None:
-                    kept[key] = sums
-            p = None
-        else:  # the path-length clock, one pace: each part along its strokes after the path walked (as _predict)
-            anchor = self._anchor(track, path[0])
-            clock = self._lead_clock if self.params["clock"] == "lead" else (lambda _, along: along)
-            p = np.stack([self._predict(track, path, clock(path, anchor + w)) for w in walked])[None]
-            if self.params["relative"]:
-                p = p - self._predict(track, path, anchor)
-            sums = None
-        o = observed - observed[0] if self.params["relative"] else observed
-        d, _ = online_style.distances_all(o, p, self.params["posture"] == "removed", sums)
-        return self._take_combined(d[1:] * track.scale, walked, kept)
+    def _survivors(self, errors: Mapping[tuple[str, ...], float]) -> dict[tuple[str, ...], float]:
+        """The candidates (paths and their prediction errors this frame) that do not drop out: those whose
+        prediction error is within ``threshold``."""
+        threshold = self.params["threshold"]
+        return {path: error for path, error in errors.items() if error <= threshold}
 
     def _last_correct(self, track: Track, lengths: np.ndarray, memory: np.ndarray) -> None:
         """The node at which the demonstration last agreed with the committed path: the start of the edge it was on.
@@ -1870,127 +1126,9 @@ class ForwardModel(Matcher):
             tables = [self._table(stroke) for stroke in commands]
             arcs = np.stack([arc for _, _, arc in tables])
             lead = int(np.argmax(arcs[:, -1]))
-            travel = self._travel_grid(name, tables[lead][0]) if self.params["travel"] > 0 else None
-            table = _EdgeTable(commands, np.stack([positions for _, positions, _ in tables]), arcs, lead, travel)
+            table = _EdgeTable(commands, np.stack([positions for _, positions, _ in tables]), arcs, lead)
             self._edges[name] = table
         return table
-
-    def _travel_grid(self, name: str, times: np.ndarray) -> np.ndarray:
-        """Where the body went (m/s, body frame) while command ``name`` was shown, at the times ``times`` of its lead
-        part's grid (G, 3): the edge's travel (``Edge.travel``, one row per frame shown) read at the same share of
-        the command's time (the command was fitted to those frames, so its start is the first and its end the last);
-        none known: on the spot (0)."""
-        travel = getattr(self.motor.edge(name), "travel", None)
-        if travel is None or not len(travel):
-            return np.zeros((len(times), 3))
-        travel = np.asarray(travel, dtype=float)
-        if len(travel) == 1:
-            return np.repeat(travel, len(times), axis=0)
-        at = times / max(float(times[-1]), 1e-12) * (len(travel) - 1)
-        steps = np.arange(len(travel))
-        return np.stack([np.interp(at, steps, travel[:, c]) for c in range(3)], axis=1)
-
-    TRAVEL_WINDOW = 0.25
-    """Seconds over which the travel seen is averaged (:mod:`plugins.lib.travel`'s window: a step's sway left and
-    right cancels)."""
-
-    def _travel_seen(self, track: Track, n: int, lengths: np.ndarray) -> None:
-        """With ``travel``: the travel part seen at row ``n - 1`` of the segment (:attr:`Track.travel_seen`) as an
-        observer knows it then: the root's mean velocity over the last :attr:`TRAVEL_WINDOW` seconds (its world
-        displacement over them, divided by their time; the same average as :func:`plugins.lib.travel.body_velocity`
-        takes, from the frames seen so far), turned into the body's frame by the facing at that row
-        (:func:`plugins.lib.travel.frame_rotation`), times ``travel`` seconds. Not known (``None``, the travel part
-        left out) before the segment has lasted the window: a velocity from one or two frames is mostly
-        observation noise. With ``error = "moving"``, the weights of the parts and the travel part
-        (:attr:`Track.travel_weights`): the travel's path is the root's path in the world since the onset, the
-        parts' their paths relative to the root, each as far as it has been seen to go."""
-        from plugins.lib.travel import frame_rotation
-
-        memory, root = self._memory, self._root
-        taps = max(1, int(round(self.TRAVEL_WINDOW * memory.fps)))
-        track.travel_seen = None
-        world = memory.world
-        if n - 1 - taps >= 0:
-            moved = world[n - 1, root] - world[n - 1 - taps, root]
-            angle = frame_rotation(world[n - 1: n], memory.positions[n - 1: n], memory.visible[n - 1: n], root)[0]
-            if np.isfinite(moved).all() and np.isfinite(angle):
-                v = moved * (memory.fps / taps)
-                turned = (v[0] + 1j * v[2]) * np.exp(1j * angle)
-                track.travel_seen = np.array([turned.real, v[1], turned.imag]) * self.params["travel"]
-        if self.params["error"] == "moving":
-            walked = _lengths(world[track.onset:n, root][:, None])[0] if n - track.onset > 1 else 0.0
-            track.travel_weights = moving_weights(np.append(lengths, walked if np.isfinite(walked) else 0.0))
-
-    def _travel_predicted(self, path: tuple[str, ...], along: np.ndarray) -> np.ndarray:
-        """With ``travel``: the travel part path ``path`` predicts (3,) when its parts are ``along`` it: the travel
-        the command was shown with where its first command's lead part is (edge by edge: a lead past the end of
-        one edge goes on along the next), times ``travel`` seconds."""
-        lead = self._lead(path[0])
-        left = float(along[lead])
-        for i, name in enumerate(path):
-            edge = self._edge(name)
-            total = float(edge.arcs[lead, -1])
-            if left <= total or i == len(path) - 1:
-                point = _along_rows(edge.arcs[lead][None], edge.travel[None], np.array([min(left, total)]))[0]
-                return point * self.params["travel"]
-            left -= total
-        return np.zeros(3)  # no command (not reached)
-
-    def _travel_all(self, subsystem: str, paths: list[tuple[str, ...]], along: np.ndarray) -> np.ndarray | None:
-        """:meth:`_travel_predicted` of C paths at once (C, 3; the same values), ``along`` (C, k) their parts' places
-        along them, from the commands :meth:`_at_times_all` stacked this frame; ``None`` without their travel."""
-        timed = self._time_tables.get(subsystem)
-        if timed is None or timed.travel is None:
-            return None
-        ids, leads, xs = [], [], []
-        for c, path in enumerate(paths):  # the edge each lead is on, as _travel_predicted walks them
-            lead = self._lead(path[0])
-            left = float(along[c, lead])
-            for i, name in enumerate(path):
-                total = float(timed.totals[timed.index[name][1], lead])
-                if left <= total or i == len(path) - 1:
-                    ids.append(timed.index[name][1])
-                    xs.append(min(left, total))
-                    break
-                left -= total
-            leads.append(lead)
-        ids = np.array(ids, dtype=np.intp)
-        return _along_rows(timed.arcs[ids, np.array(leads, dtype=np.intp)], timed.travel[ids],
-                           np.array(xs)) * self.params["travel"]
-
-    def _travel_batch(self, names: tuple[str, ...], along: np.ndarray, leads: np.ndarray) -> np.ndarray:
-        """:meth:`_travel_predicted` of one-command paths ``names`` at once (C, 3), ``along`` (C, k) their parts'
-        places along them (already within their strokes) and ``leads`` (C,) their lead parts."""
-        edges = [self._edge(name) for name in names]
-        kept = self._travel_stacks.get(names)
-        if kept is None or not all(a is b for a, b in zip(kept[0], edges)):
-            kept = (edges, (np.stack([e.arcs[e.lead] for e in edges]), np.stack([e.travel for e in edges])))
-            self._travel_stacks[names] = kept
-            if len(self._travel_stacks) > 64:
-                self._travel_stacks.popitem(last=False)
-        else:
-            self._travel_stacks.move_to_end(names)
-        arcs, travel = kept[1]
-        x = along[np.arange(len(names)), leads]
-        return _along_rows(arcs, travel, np.minimum(x, arcs[:, -1])) * self.params["travel"]
-
-    def _with_travel(self, track: Track, d: np.ndarray, dt: np.ndarray) -> np.ndarray:
-        """Per-part distances (C, k) and the travel part's (C,) combined as ``error`` says, the travel one more
-        part (C,): the largest, the mean over k + 1 parts, or weighted by how far each has been seen to go
-        (:attr:`Track.travel_weights`)."""
-        error = self.params["error"]
-        if error == "moving":
-            w = track.travel_weights
-            if w is None:
-                w = moving_weights(np.zeros(d.shape[1] + 1))
-            return d @ w[:-1] + dt * w[-1]
-        if error == "max":
-            return np.maximum(d.max(axis=1), dt)
-        return (d.sum(axis=1) + dt) / (d.shape[1] + 1)
-
-    def _traveling(self, track: Track) -> bool:
-        """Whether the travel part is compared this frame: ``travel`` on, a positional subsystem, travel seen."""
-        return self.params["travel"] > 0 and not track.hand and track.travel_seen is not None
 
     def _table(self, stroke: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(times, positions, cumulative path length) of a stroke on a fine grid, computed once per stroke."""
@@ -2027,7 +1165,7 @@ class ForwardModel(Matcher):
         strokes stacked for :meth:`_errors`: each path's lead part's observed length plus its anchor, against the lead's
         stroke length (the same values, element by element, as path by path)."""
         names = tuple(path[0] for path in paths)
-        _, totals, leads, anchors, _ = self._stacked(track, names)
+        _, totals, leads, anchors = self._stacked(track, names)
         rows = np.arange(len(names))
         passed = lengths[leads] + anchors[rows, leads] > totals[rows, leads] + 0.01 / track.scale
         if not passed.any():
@@ -2116,22 +1254,9 @@ class ForwardModel(Matcher):
         return out
 
     def _error(self, track: Track, path: tuple[str, ...], lengths: np.ndarray, last: np.ndarray) -> float:
-        """Distance between the path's prediction and the parts' last observed positions ``last`` (k, 3).
-
-        The largest over the parts, or their mean (``error``); with ``relative`` the prediction is moved by
-        the offset between the observed onset posture and the path's start.
-        """
-        along = self._along(track, path[0], lengths)
-        if self.params["clock"] == "lead" and not track.hand:
-            along = self._lead_clock(path, along)
-        predicted = self._predict(track, path, along)
-        if self.params["error"] == "moving":
-            self._weights(track, lengths)
-        if self._traveling(track):
-            d = _norms(predicted + self._onset_offset(track, path[0]) - last) * track.scale
-            dt = _norms(self._travel_predicted(path, along) - track.travel_seen)
-            return float(self._with_travel(track, d[None], np.array([dt]))[0])
-        return self._distance(track, predicted + self._onset_offset(track, path[0]), last)
+        """Distance between the path's prediction and the parts' last observed positions ``last`` (k, 3): the
+        largest over the parts (:meth:`_distance`)."""
+        return self._distance(track, self._predict(track, path, self._along(track, path[0], lengths)), last)
 
     def _errors(self, track: Track, paths: list[tuple[str, ...]], lengths: np.ndarray,
                 last: np.ndarray) -> dict[tuple[str, ...], float]:
@@ -2141,33 +1266,19 @@ class ForwardModel(Matcher):
         batch = [] if track.hand else [path for path in paths if len(path) == 1]
         errors: dict[tuple[str, ...], float] = {}
         if len(batch) > 1:
-            rows, totals, leads, anchors, offsets = self._stacked(track, tuple(path[0] for path in batch))
+            rows, totals, _, anchors = self._stacked(track, tuple(path[0] for path in batch))
             k = len(lengths)
             along = np.minimum(lengths + anchors, totals)  # (C, k): _along, then _predict's minimum
-            if self.params["clock"] == "lead":
-                along = np.stack([self._lead_clock((path[0],), a) for path, a in zip(batch, along)])
-            predicted = self._stroke_rows.along(rows, along.reshape(-1)).reshape(len(batch), k, 3) + offsets
+            predicted = self._stroke_rows.along(rows, along.reshape(-1)).reshape(len(batch), k, 3)
             d = _norms(predicted - last) * track.scale
-            if self._traveling(track):
-                travel = self._travel_batch(tuple(path[0] for path in batch), along, leads)
-                combined = self._with_travel(track, d, _norms(travel - track.travel_seen))
-            else:
-                combined = self._combine(track, d, lengths)
-            errors = dict(zip(batch, combined.tolist()))
+            errors = dict(zip(batch, d.max(axis=1).tolist()))  # the largest part error of each
         return {path: errors[path] if path in errors else self._error(track, path, lengths, last) for path in paths}
-
-    def _combine(self, track: Track, d: np.ndarray, lengths: np.ndarray) -> np.ndarray:
-        """Per-part distances (C, k) of C predictions combined as ``error`` says (C,)."""
-        error = self.params["error"]
-        if error == "moving":
-            return d @ self._weights(track, lengths)
-        return d.max(axis=1) if error == "max" else d.mean(axis=1)
 
     def _stacked(self, track: Track, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
         """For commands ``names`` followed by ``track``: their strokes' rows in the table of every stroke
-        (:class:`_StrokeRows`, C * k), stroke lengths (C, k), lead parts (C,), anchors (C, k) and onset offsets
-        (C, k, 3; 0.0 without ``relative``), stacked once per set of candidates (kept until the set changes; the
-        rows, lengths and leads for the last sets of candidates of any track)."""
+        (:class:`_StrokeRows`, C * k), stroke lengths (C, k), lead parts (C,) and anchors (C, k), stacked once per
+        set of candidates (kept until the set changes; the rows, lengths and leads for the last sets of candidates
+        of any track)."""
         kept = self._tracked.get(track.subsystem)
         cache = getattr(kept, "stacked", None) if kept is not None and kept.track is track else None
         if cache is not None and cache[0] == names:
@@ -2183,10 +1294,7 @@ class ForwardModel(Matcher):
                 self._stroke_tables.popitem(last=False)
         else:
             self._stroke_tables.move_to_end(names)
-        # without ``relative`` every offset is 0.0: added as a scalar (the same additions as of zeros stacked)
-        offsets = np.stack([np.broadcast_to(self._onset_offset(track, n), e.positions[:, 0].shape)
-                            for n, e in zip(names, edges)]) if self.params["relative"] else 0.0
-        stacked = (*strokes[1], self._anchors(track, names), offsets)
+        stacked = (*strokes[1], self._anchors(track, names))
         if kept is not None and kept.track is track:
             kept.stacked = (names, stacked)
         return stacked
@@ -2213,12 +1321,11 @@ class ForwardModel(Matcher):
         A segment often begins a little after the movement did (a hub threshold is crossed once the body has
         left the hub; a stream starts in motion): each part is placed at the point of the first half of its
         stroke nearest to where it was seen at the track's onset, and predicted from there (0 when it was seen
-        at the stroke's start). With ``relative`` the observed posture is not comparable with the command's
-        positions, and a hand's fingers share one clock: both are followed from the start (0).
+        at the stroke's start). A hand's fingers share one clock: they are followed from the start (0).
         """
         anchor = track.anchors.get(name)
         if anchor is None:
-            if self.params["relative"] or track.hand:
+            if track.hand:
                 anchor = track.anchors[name] = np.zeros(len(self._edge(name).arcs))
                 return anchor
             # this command's and those of the track's other candidates still without one, at once (all are placed
@@ -2257,30 +1364,6 @@ class ForwardModel(Matcher):
             self._half_tables.popitem(last=False)
         return halves
 
-    def _onset_offset(self, track: Track, name: str) -> np.ndarray | float:
-        """With ``relative``: the observed onset posture minus where command ``name`` starts (k, 3); else 0."""
-        if not self.params["relative"]:
-            return 0.0
-        edge = self._edge(name)
-        if self.params["clock"] == "lead" and not track.hand:  # from where the lead joined the command
-            joined = self._lead_clock((name,), self._anchor(track, name))
-            return self._first(track) - _along_rows(edge.arcs, edge.positions, np.minimum(joined, edge.arcs[:, -1]))
-        return self._first(track) - edge.positions[:, 0]
-
-    def _lead_clock(self, path: tuple[str, ...], along: np.ndarray) -> np.ndarray:
-        """With ``clock = "lead"``: how far along ``path`` each part is (k,) at the time at which the lead part of
-        its first command is ``along[lead]`` along it (:func:`lead_clock`, edge by edge: a lead past the end of one
-        edge goes on along the next, every part with it)."""
-        lead = self._lead(path[0])
-        left, before = float(along[lead]), np.zeros(len(along))
-        for i, name in enumerate(path):
-            edge = self._edge(name)
-            if left <= edge.arcs[lead, -1] or i == len(path) - 1:
-                return before + lead_clock(edge.arcs, lead, left)
-            left -= float(edge.arcs[lead, -1])
-            before = before + edge.arcs[:, -1]
-        return before
-
     def _first(self, track: Track) -> np.ndarray:
         """The subsystem's parts where they were seen at the track's onset (k, 3)."""
         if track.first is not None:
@@ -2288,21 +1371,9 @@ class ForwardModel(Matcher):
         return self._at(track.onset)[self.motor.subsystems[track.subsystem]]
 
     def _distance(self, track: Track, predicted: np.ndarray, observed: np.ndarray) -> float:
-        """Per-part distances (k, 3 each) combined as ``error`` says: the largest or the mean (radians of a hand scaled)."""
-        d = _norms(predicted - observed) * track.scale
-        if self.params["error"] == "moving":
-            return float(d @ self._weights(track))
-        return float(d.max() if self.params["error"] == "max" else d.mean())
-
-    def _weights(self, track: Track, lengths: np.ndarray | None = None) -> np.ndarray:
-        """With ``error = "moving"``: each part's weight (k,), its observed path length since the onset over the
-        parts' sum (:func:`moving_weights`); ``lengths`` given, they are kept on the track for the frame's other
-        comparisons."""
-        if lengths is not None:
-            track.weights = moving_weights(lengths)
-        elif track.weights is None:
-            track.weights = moving_weights(np.zeros(len(self.motor.subsystems[track.subsystem])))
-        return track.weights
+        """The prediction error: the largest of the per-part distances (k, 3 each; radians of a hand scaled), as K&G
+        compare the wrist (§4.4)."""
+        return float((_norms(predicted - observed) * track.scale).max())
 
     def _progress(self, name: str, along: np.ndarray) -> float:
         """The share of command ``name``'s time its lead part has covered, ``along`` its path."""
@@ -2502,15 +1573,6 @@ class ForwardModel(Matcher):
             observed = observed[: (int(moving[-1]) + 2 if len(moving) else len(observed))]
         if len(observed) < 3:
             return []
-        if self.params["travel"] > 0 and not track.hand:  # where the body went, kept with the new edges
-            from plugins.lib.travel import body_velocity
-
-            seen = self._memory
-            if np.isfinite(seen.world[:, self._root]).any():
-                travel = np.nan_to_num(body_velocity(seen.world, seen.positions, seen.visible, self._root,
-                                                     seen.fps))[track.learn_from: track.learn_from + len(observed)]
-                return self.motor.learn_observed(track.subsystem, track.last_correct, observed, self.fps,
-                                                 criteria=self._criteria, travel=travel)
         return self.motor.learn_observed(track.subsystem, track.last_correct, observed, self.fps, criteria=self._criteria)
 
     def match(self, motion: Motion) -> Match:
@@ -2577,24 +1639,16 @@ class ForwardModel(Matcher):
     def _settle(self, track: Track, memory: np.ndarray) -> Track:
         """At the end of the demonstration: a subsystem's commitment must end where the demonstration did; while
         it does not, it deviated (:meth:`_deviate`: the last correct node, the edge excluded, the rest predicted
-        again). With ``dropout = relative`` a subsystem without a commitment is first committed to the race's
-        leader (not checked against the end: the race's finish). Returns the subsystem's track as it is then."""
-        if self._leader(track, memory):
-            return track
+        again). Returns the subsystem's track as it is then."""
         while track.committed is not None and not self._ended(track, memory):
             self._deviate(track, _lengths(self._observed(track, memory)), memory)
             track = self.tracks[track.subsystem]
-            if self._leader(track, memory):
-                break
         return track
 
     def _ended(self, track: Track, memory: np.ndarray) -> bool:
         """Whether the demonstration ended (the last row of ``memory``) where the committed path does."""
-        fit = track.styled.get(track.committed_path)
-        if self._styled(track) and fit is not None and "error" in fit.extra:  # where the fitted prediction is now
-            return fit.extra["error"] <= self.params["deviation"]
         end = self.motor.edge(track.committed_path[-1]).target
-        expected = self.motor.state(track.subsystem, end) + self._onset_offset(track, track.committed_path[0])
+        expected = self.motor.state(track.subsystem, end)
         seen = memory[-1, self.motor.subsystems[track.subsystem]]
         return self._distance(track, expected, seen) <= self.params["deviation"]
 
