@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from plugins.lib.compiled import compiled
+from plugins.lib.compiled import compiled_now
 from plugins.matchers.forward_model.tables import Tables
 
 if TYPE_CHECKING:
@@ -72,13 +72,8 @@ def _kernel() -> Any:
     """:func:`place_rows` compiled by numba (cached on disk; no ``fastmath``: no reordered sums, no fused
     multiply-adds), or ``None`` without numba (numpy's steps run then, with the same values). Compiled (or loaded)
     when a forward model is attached, not in its first demonstration."""
-    kernels = compiled(place_rows)
-    if kernels is None:
-        return None
-    (place,) = kernels
-    one, row = np.zeros((1, 2)), np.zeros(1, dtype=np.int64)
-    place(one, one, one, one, row, np.zeros((1, 3)), row, np.zeros(1))  # compiled for the types it is called with
-    return place
+    one, row = np.zeros((1, 2)), np.zeros(1, dtype=np.int64)  # the types it is called with
+    return compiled_now(place_rows, one, one, one, one, row, np.zeros((1, 3)), row, np.zeros(1))
 
 
 class Halves:

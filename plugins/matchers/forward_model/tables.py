@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from plugins.lib.compiled import compiled
+from plugins.lib.compiled import compiled_now
 from plugins.matchers.forward_model.path_length import arc
 
 __all__ = ["EdgeTable", "StrokeRows", "Tables", "along_rows", "along_table", "row_keys"]
@@ -113,13 +113,8 @@ def _kernel() -> Any:
     """:func:`along_table` compiled by numba (cached on disk; no ``fastmath``: no reordered sums, no fused
     multiply-adds), or ``None`` without numba (numpy's steps run then, with the same values). Compiled (or loaded)
     when a forward model is attached, not in its first demonstration."""
-    kernels = compiled(along_table)
-    if kernels is None:
-        return None
-    (along,) = kernels
-    one, row = np.zeros((1, 2)), np.zeros(1, dtype=np.int64)
-    along(one, np.zeros((1, 2, 3)), row, np.zeros(1), True, np.empty((1, 3)))  # compiled for the types it is called with
-    return along
+    one, row = np.zeros((1, 2)), np.zeros(1, dtype=np.int64)  # the types it is called with
+    return compiled_now(along_table, one, np.zeros((1, 2, 3)), row, np.zeros(1), True, np.empty((1, 3)))
 
 
 class StrokeRows:
