@@ -23,7 +23,7 @@ import numpy as np
 
 from plugins.matchers.forward_model.anchors import Anchors
 from plugins.matchers.forward_model.path_length import norms
-from plugins.matchers.forward_model.tables import Tables, along_rows
+from plugins.matchers.forward_model.tables import Tables
 
 if TYPE_CHECKING:
     from plugins.matchers.forward_model.observation import Observation
@@ -44,7 +44,8 @@ class Predictions:
         self.observation = observation
 
     def predict(self, track: Track, path: Path, lengths: np.ndarray) -> np.ndarray:
-        """Where each part of the subsystem should be (k, 3) when it is ``lengths`` along ``path``.
+        """Where each part of the subsystem should be (k, 3) when it is ``lengths`` along ``path``: each part along
+        its own strokes, edge after edge (:meth:`placed`).
 
         The fingers of a hand share their timing (one transition function, §4.2): they are all predicted at the
         time at which the lead finger has covered its observed path, so fingers that move in another order than
@@ -61,27 +62,7 @@ class Predictions:
                     t = tables.mapped_time(commands[lead], left)
                     return np.array([c.position(t) for c in commands])
                 left -= a[-1]
-        if len(path) == 1:  # one command: every part along its stroke (what the loop below does for one edge)
-            edge = tables.edge(path[0])
-            return along_rows(edge.arcs, edge.positions, np.minimum(lengths, edge.arcs[:, -1]))
-        # each part along its own strokes: on the first edge whose stroke is longer than what is left to place
-        out = np.empty((len(lengths), 3))
-        left = np.array(lengths, dtype=float)
-        open_ = np.ones(len(left), dtype=bool)
-        for i, name in enumerate(path):
-            edge = tables.edge(name)
-            total = edge.arcs[:, -1]
-            here = open_ & ((left <= total) | (i == len(path) - 1))
-            if here.all():  # every part on this edge: its strokes as they are (no copy)
-                out[:] = along_rows(edge.arcs, edge.positions, np.minimum(left, total))
-                open_[:] = False
-            elif here.any():
-                out[here] = along_rows(edge.arcs[here], edge.positions[here], np.minimum(left[here], total[here]))
-                open_ &= ~here
-            if not open_.any():
-                break
-            left = np.where(open_, left - total, left)
-        return out
+        return tables.rows.along(*self.placed(path, lengths))
 
     @staticmethod
     def distance(track: Track, predicted: np.ndarray, observed: np.ndarray) -> float:
@@ -95,19 +76,50 @@ class Predictions:
         return self.distance(track, self.predict(track, path, self.anchors.along(track, path[0], lengths)), last)
 
     def errors(self, track: Track, paths: list[Path], lengths: np.ndarray, last: np.ndarray) -> dict[Path, float]:
-        """:meth:`error` of every candidate path, in their order: the one-command paths of a positional subsystem
-        predicted at once (their strokes stacked part by part, :meth:`stacked`; the same arithmetic row by row, so
-        the same values), the others one by one."""
-        batch = [] if track.hand else [path for path in paths if len(path) == 1]
+        """:meth:`error` of every candidate path, in their order. The paths of a positional subsystem are predicted
+        at once, their parts' points gathered from the table of every stroke: the one-command paths from their
+        strokes stacked part by part (:meth:`stacked`), the longer ones each part on its edge (:meth:`placed`); the
+        same arithmetic row by row, so the same values. A hand's paths one by one."""
         errors: dict[Path, float] = {}
-        if len(batch) > 1:
-            rows, totals, _, anchors = self.stacked(track, tuple(path[0] for path in batch))
+        if not track.hand:
             k = len(lengths)
-            along = np.minimum(lengths + anchors, totals)  # (C, k): Anchors.along, then predict's minimum
-            predicted = self.tables.rows.along(rows, along.reshape(-1)).reshape(len(batch), k, 3)
-            d = norms(predicted - last) * track.scale
-            errors = dict(zip(batch, d.max(axis=1).tolist()))  # the largest part error of each
+            one = [path for path in paths if len(path) == 1]
+            if len(one) > 1:
+                rows, totals, _, anchors = self.stacked(track, tuple(path[0] for path in one))
+                along = np.minimum(lengths + anchors, totals)  # (C, k): Anchors.along, then predict's minimum
+                predicted = self.tables.rows.along(rows, along.reshape(-1)).reshape(len(one), k, 3)
+                d = norms(predicted - last) * track.scale
+                errors = dict(zip(one, d.max(axis=1).tolist()))  # the largest part error of each
+            longer = [path for path in paths if len(path) > 1]
+            if longer:
+                placed = [self.placed(path, self.anchors.along(track, path[0], lengths)) for path in longer]
+                rows = np.concatenate([r for r, _ in placed])
+                predicted = self.tables.rows.along(rows, np.concatenate([x for _, x in placed]))
+                d = norms(predicted.reshape(len(longer), k, 3) - last) * track.scale
+                errors.update(zip(longer, d.max(axis=1).tolist()))
         return {path: errors[path] if path in errors else self.error(track, path, lengths, last) for path in paths}
+
+    def placed(self, path: Path, lengths: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Where each part of a positional subsystem ``lengths`` along ``path`` is predicted: its stroke's row in the
+        table of every stroke (k,), on the first edge whose stroke is longer than what is left to place (the last
+        edge for what is left past it), and how far along that stroke (k,), clipped to it."""
+        tables = self.tables
+        k = len(lengths)
+        rows, x = np.empty(k, dtype=np.int64), np.empty(k)
+        left = np.array(lengths, dtype=float)
+        open_ = np.ones(k, dtype=bool)
+        for i, name in enumerate(path):
+            edge = tables.edge(name)
+            total = edge.arcs[:, -1]
+            here = open_ & ((left <= total) | (i == len(path) - 1))
+            if here.any():
+                rows[here] = tables.rows.rows(name, edge) + np.flatnonzero(here)
+                x[here] = np.minimum(left[here], total[here])
+                open_ &= ~here
+            if not open_.any():
+                break
+            left = np.where(open_, left - total, left)
+        return rows, x
 
     def stacked(self, track: Track, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
         """For commands ``names`` followed by ``track``: their strokes' rows in the table of every stroke (C * k),

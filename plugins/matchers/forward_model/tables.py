@@ -21,7 +21,7 @@ import numpy as np
 from plugins.lib.compiled import compiled_now
 from plugins.matchers.forward_model.path_length import arc
 
-__all__ = ["EdgeTable", "StrokeRows", "Tables", "along_rows", "along_table", "row_keys"]
+__all__ = ["EdgeTable", "StrokeRows", "Tables", "along_table", "row_keys"]
 
 
 @dataclass(frozen=True)
@@ -36,38 +36,17 @@ class EdgeTable:
 
 
 def row_keys(arcs: np.ndarray, first: int = 0) -> np.ndarray | None:
-    """``arcs`` (R, G) as one sorted complex array for :func:`along_rows`: row r's values are ``first + r + 1j *
+    """``arcs`` (R, G) as one sorted complex array for :meth:`StrokeRows.along`: row r's values are ``first + r + 1j *
     arcs[r]``, and numpy orders complex numbers lexicographically (real part, then imaginary), so one
-    ``searchsorted`` counts, for every row at once, the points of its own row at most a given length. ``None`` when
-    a row does not grow (NaN, or a decrease): then the count is taken by comparing every point."""
+    ``searchsorted`` counts, for every row at once, the points of its own row at most a given length (the same
+    count as comparing every point: exact comparisons of the same numbers). ``None`` when a row does not grow (NaN,
+    or a decrease): then the count is taken by comparing every point."""
     if not arcs.size or not bool((arcs[:, 1:] >= arcs[:, :-1]).all()):
         return None
     keys = np.empty(arcs.shape, dtype=complex)
     keys.real = np.arange(first, first + len(arcs))[:, None]
     keys.imag = arcs
     return keys.ravel()
-
-
-def along_rows(arcs: np.ndarray, positions: np.ndarray, x: np.ndarray, keys: np.ndarray | None = None) -> np.ndarray:
-    """Per row r, the point of ``positions[r]`` (G, 3) at path length ``x[r]`` along ``arcs[r]`` (G,), linearly
-    interpolated (``np.interp`` row by row); 0 <= x[r] <= arcs[r, -1].
-
-    ``keys`` (:func:`row_keys` of ``arcs``): the points at most ``x[r]`` along each row counted by one binary search
-    instead of a comparison of every point (the same count: exact comparisons of the same numbers)."""
-    if keys is None:
-        count = (arcs <= x[:, None]).sum(axis=1)
-    else:
-        rows = np.arange(len(x))
-        query = np.empty(len(x), dtype=complex)
-        query.real, query.imag = rows, x
-        count = np.searchsorted(keys, query, side="right") - rows * arcs.shape[1]
-        count[np.isnan(x)] = 0  # a NaN length is at most no point
-    j = np.clip(count - 1, 0, arcs.shape[1] - 2)
-    rows = np.arange(len(x))
-    a0, a1 = arcs[rows, j], arcs[rows, j + 1]
-    step = a1 - a0
-    w = np.divide(x - a0, step, out=np.zeros_like(x), where=step > 0)
-    return positions[rows, j] + np.clip(w, 0.0, 1.0)[:, None] * (positions[rows, j + 1] - positions[rows, j])
 
 
 def along_table(arcs: np.ndarray, positions: np.ndarray, rows: np.ndarray, x: np.ndarray, ordered: bool,
@@ -163,8 +142,9 @@ class StrokeRows:
         return first
 
     def along(self, rows: np.ndarray, x: np.ndarray) -> np.ndarray:
-        """:func:`along_rows` of the strokes in ``rows`` at path lengths ``x``: the same points, the same values (in a
-        compiled loop, :func:`along_table`, with numba; else numpy's steps)."""
+        """The points (N, 3) of the strokes in ``rows`` (N,) at path lengths ``x`` (N,), linearly interpolated
+        (``np.interp`` row by row), each length clipped to its stroke: the two points about each length gathered
+        (in a compiled loop, :func:`along_table`, with numba; else numpy's steps, the same values)."""
         g = self.arcs.shape[1]
         kernel = _kernel()
         if kernel is not None and x.dtype == np.float64 and rows.dtype == np.int64:

@@ -1,5 +1,6 @@
 """The commands' strokes on a fine grid (:mod:`plugins.matchers.forward_model.tables`): the points along the table
-of every stroke, and their counts by one binary search, are those of the plain computation, to the bit."""
+of every stroke, and their counts by one binary search, are those of the plain computation (:func:`_along_rows`,
+``np.interp`` row by row), to the bit."""
 
 from __future__ import annotations
 
@@ -8,16 +9,29 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from plugins.matchers.forward_model.tables import EdgeTable, StrokeRows, along_rows, row_keys
+from plugins.matchers.forward_model.tables import EdgeTable, StrokeRows, row_keys
 from tests.plugins.matchers.forward_model.helpers import KERNELS, kernels
+
+
+def _along_rows(arcs: np.ndarray, positions: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """The plain computation: per row r, the point of ``positions[r]`` (G, 3) at path length ``x[r]`` along
+    ``arcs[r]`` (G,), linearly interpolated, the points at most ``x[r]`` counted by comparing every point."""
+    count = (arcs <= x[:, None]).sum(axis=1)
+    j = np.clip(count - 1, 0, arcs.shape[1] - 2)
+    rows = np.arange(len(x))
+    a0, a1 = arcs[rows, j], arcs[rows, j + 1]
+    step = a1 - a0
+    w = np.divide(x - a0, step, out=np.zeros_like(x), where=step > 0)
+    return positions[rows, j] + np.clip(w, 0.0, 1.0)[:, None] * (positions[rows, j + 1] - positions[rows, j])
 
 
 @given(seed=st.integers(0, 10_000), rows=st.integers(1, 30), points=st.integers(2, 40), ties=st.booleans(),
        nan=st.booleans())
 @settings(max_examples=200, deadline=None)
 def test_point_counts_by_binary_search_are_the_compared_ones(seed, rows, points, ties, nan):
-    """:func:`along_rows` with the keys of :func:`row_keys` gives the same points as comparing every point:
-    lengths at a stroke's start, its end, exactly on a point, between points, on steps of no length (ties), NaN."""
+    """:class:`StrokeRows` counting the points by one binary search over the keys of :func:`row_keys` (numpy's
+    steps) gives the points of comparing every point: lengths at a stroke's start, its end, exactly on a point,
+    between points, on steps of no length (ties), NaN."""
     rng = np.random.default_rng(seed)
     steps = rng.random((rows, points - 1))
     if ties:  # steps of no length, and lengths that repeat
@@ -30,9 +44,13 @@ def test_point_counts_by_binary_search_are_the_compared_ones(seed, rows, points,
                                                    np.where(pick == 3, 0.0, x)))
     if nan:
         x[rng.integers(rows)] = np.nan
-    keys = row_keys(arcs)
-    assert keys is not None
-    np.testing.assert_array_equal(along_rows(arcs, positions, x, keys), along_rows(arcs, positions, x))
+    assert row_keys(arcs) is not None
+    table = StrokeRows(points)
+    table.rows("e", EdgeTable([], positions, arcs, 0))
+    assert table.sorted
+    with kernels("numpy"):
+        got = table.along(np.arange(rows), x)
+    np.testing.assert_array_equal(got, _along_rows(arcs, positions, x))
 
 
 def test_rows_that_do_not_grow_have_no_keys():
@@ -47,7 +65,7 @@ def test_rows_that_do_not_grow_have_no_keys():
 @pytest.mark.parametrize("mode", KERNELS)
 def test_the_table_of_every_stroke_predicts_as_the_stacked_strokes(mode, seed, commands, changed, unsorted):
     """:class:`StrokeRows` (every command's strokes as rows of one growing table, a set of candidates as row
-    numbers) gives the points :func:`along_rows` gives of the same strokes stacked: commands added one by one (the
+    numbers) gives the points :func:`_along_rows` gives of the same strokes stacked: commands added one by one (the
     table grows past its first size), a command whose table changed (new rows), a stroke whose lengths do not grow
     (then every point is compared); compiled, as the compiled loop's plain-Python reference, and by numpy's steps.
     Lengths at a stroke's end, past it, before its start, -0 and NaN included; the values to the bit."""
@@ -81,7 +99,7 @@ def test_the_table_of_every_stroke_predicts_as_the_stacked_strokes(mode, seed, c
     assert table.sorted == (not unsorted)
     with kernels(mode):
         got = table.along(rows, x)
-    want = along_rows(arcs, positions, x)
+    want = _along_rows(arcs, positions, x)
     assert np.array_equal(np.isnan(got), np.isnan(want))
     assert np.array_equal(np.where(np.isnan(got), 0.0, got).view(np.uint64),
                           np.where(np.isnan(want), 0.0, want).view(np.uint64))
