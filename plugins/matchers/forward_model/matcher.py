@@ -42,15 +42,20 @@ class ForwardModel(Matcher):
     name = "forward-model"
     motor_systems = ("motor-command-graph",)
     parameters = (
-        Parameter("threshold", float, 0.05, "Prediction error (m) above which a candidate edge drops out.", minimum=0.0, length=True),
+        Parameter("threshold", float, 0.05, "Prediction error (m) above which a candidate edge drops out.",
+                  minimum=0.0, length=True),
         Parameter("deviation", float, 0.05, "Error (m) between the imitated edge and the demonstration that stops the "
-                  "imitation (also checked at the end: the demonstration must end where the edge does).", minimum=0.0, length=True),
-        Parameter("min_progress", float, 0.2, "Share of the edge's path that must be seen before committing.", minimum=0.0, maximum=1.0),
-        Parameter("min_move", float, 0.02, "Displacement (m) of a subsystem that makes it one under consideration.", minimum=0.0, length=True),
+                  "imitation (also checked at the end: the demonstration must end where the edge does).",
+                  minimum=0.0, length=True),
+        Parameter("min_progress", float, 0.2, "Share of the edge's path that must be seen before committing.",
+                  minimum=0.0, maximum=1.0),
+        Parameter("min_move", float, 0.02, "Displacement (m) of a subsystem that makes it one under consideration.",
+                  minimum=0.0, length=True),
         Parameter("angle_scale", float, 0.25, "Metres one radian of finger joint angle counts as when a hand "
                   "subsystem's errors and movement are compared with threshold, deviation and min_move "
                   "(0.25: the 0.05 m threshold is 0.2 rad, 11 degrees).", minimum=1e-6, length=True),
-        Parameter("max_candidates", int, 24, "Most candidate command paths followed at once (the best predictions).", minimum=1),
+        Parameter("max_candidates", int, 24, "Most candidate command paths followed at once (the best predictions).",
+                  minimum=1),
         Parameter("together", bool, True, "Follow every subsystem that moves during a demonstration, each with its "
                   "own candidates, and imitate them at once (a hand-arm movement, §4.2); off: only the first to move."),
         Parameter("learn", bool, True, "Learn new edges by the inverse model when no edge predicts the demonstration."),
@@ -102,8 +107,8 @@ class ForwardModel(Matcher):
         params = self.params
         self.clock = PathLength(self) if params["reparameterise"] else Elapsed(self)
         self.tracking.following = EveryMoving() if params["together"] else FirstToMove()
-        self.learning = InverseModel(self, StrokeCriteria(drop=params["strokes"]["drop"],
-                                                          angle=params["strokes"]["angle"])) if params["learn"] else None
+        strokes = StrokeCriteria(drop=params["strokes"]["drop"], angle=params["strokes"]["angle"])
+        self.learning = InverseModel(self, strokes) if params["learn"] else None
         self._chosen = params
 
     # -- streaming ------------------------------------------------------------------------------
@@ -269,7 +274,7 @@ class ForwardModel(Matcher):
         learned by the inverse model (true imitation, §4.3), as is the movement of a subsystem no edge predicted.
         Whatever was not yet imitated is returned as one movement (several subsystems: performed together).
         """
-        if self.observation.memory is None:  # concluded without having followed the segment: follow it, frame by frame
+        if self.observation.memory is None:  # concluded without having followed the segment: follow it now
             return follow(self, motion)[1]
         try:
             return self._conclude()
