@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-__all__ = ["compiled", "one_thread"]
+__all__ = ["compiled", "compiled_now", "one_thread"]
 
 
 def compiled(*functions: Callable[..., Any]) -> tuple[Callable[..., Any], ...] | None:
@@ -27,6 +27,18 @@ def compiled(*functions: Callable[..., Any]) -> tuple[Callable[..., Any], ...] |
         return tuple(numba.njit(cache=True, nogil=True, boundscheck=False)(f) for f in functions)
     except RuntimeError:  # no writable place for numba's cache
         return tuple(numba.njit(nogil=True, boundscheck=False)(f) for f in functions)
+
+
+def compiled_now(function: Callable[..., Any], *example: Any) -> Callable[..., Any] | None:
+    """``function`` compiled by numba (:func:`compiled`) and called once with ``example`` arguments, so that it is
+    compiled (or loaded from numba's cache) for their types now rather than at its first real call; ``None`` without
+    numba."""
+    kernels = compiled(function)
+    if kernels is None:
+        return None
+    (kernel,) = kernels
+    kernel(*example)
+    return kernel
 
 
 _CONTROLLER = None

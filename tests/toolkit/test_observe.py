@@ -157,8 +157,7 @@ def test_nan_frames_and_hidden_parts_are_not_seen_rather_than_a_crash(data, prof
 
 
 def test_the_forward_model_commits_before_a_familiar_demo_ends(data, profile, pm):
-    character = compose_observer(pm, profile, data / "repertoire", matcher="forward-model",
-                                 settings={"matcher": {"error": "mean"}})
+    character = compose_observer(pm, profile, data / "repertoire", matcher="forward-model")
     motion = profile.read(data / "repertoire" / "jump" / "max.bvh")  # his own jump, watched
     obs = Observer(character, profile.body, motion.fps).classify(motion)
     assert obs.movement == "jump"

@@ -15,7 +15,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from plugins.correspondence.body_mapping import BodyMapping
-from plugins.lib.attention import movement_weights
 from plugins.lib.body_size import RunningLengths, bone_lengths, bone_tree, retarget, rigid_pairs
 from plugins.lib.pose_distance import pose_distance
 from plugins.lib.rest_posture import RestPosture
@@ -124,16 +123,6 @@ def test_rest_posture_is_where_the_body_dwells():
     early = RestPosture(len(PARTS), FPS, dwell_speed=0.05, window=0.5, memory=30.0, prior=REST).update(
         moving, np.ones(moving.shape[:2], bool), size=0.45)
     assert pose_distance(early[30], REST) < 0.05  # never still: one's own rest is assumed
-
-
-def test_attention_weights_what_moves():
-    poses = wave()
-    weights = movement_weights(poses, np.ones(poses.shape[:2], bool), 1.0)
-    assert np.argmax(weights) == PARTS.index("left_hand") and np.isclose(weights.sum(), 1.0)
-    plain = movement_weights(poses, np.ones(poses.shape[:2], bool), 0.0)
-    np.testing.assert_allclose(plain, 1 / len(PARTS))
-    a, b = poses[30], REST
-    assert np.isclose(pose_distance(a, b, None, plain), pose_distance(a, b))  # attention 0 is eq. 1
 
 
 # -- the plugin --------------------------------------------------------------------------------------------

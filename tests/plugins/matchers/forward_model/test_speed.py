@@ -8,7 +8,8 @@ which the corresponding motor command (with the speed demonstrated at first) wou
 same length. From this, the speed difference can be calculated and used to re-parameterize the motor command."
 
 Max learns one of Moritz's movements (out, hold, back) at its own speed, then Moritz performs it again at known speed
-factors (his key frames played that much faster): the factor Max measures must be within 10% of the true one.
+factors (his key frames played that much faster): the factor Max measures must be within 10% of the true one
+(:mod:`plugins.matchers.forward_model.speed`).
 """
 
 from __future__ import annotations
@@ -18,8 +19,8 @@ import pytest
 
 from plugins.lib.guiding_stroke import GuidingStroke
 from tests.conftest import CHARACTERS
-from tests.test_forward_model import ARMS  # the two-wrist character of the forward model's tests
-from toolkit import create_plugin_manager, load_character, load_scenario
+from tests.plugins.matchers.forward_model.helpers import ARMS, demonstration, stroke_path
+from toolkit import Motion, create_plugin_manager, load_character, load_scenario
 from toolkit.watching import feed
 
 SPEEDS = (0.6, 1.0, 1.5, 2.0)
@@ -137,8 +138,12 @@ def test_a_command_written_by_hand_is_timed_by_its_own_commands(write, pm, speed
     path = stroke.retimed(1.0 / speed).trajectory(30.0)
     frames = np.repeat(motor.rest[None], len(path), axis=0)
     frames[:, 2] = path
-    from toolkit import Motion
-
     commit = next(a for a in feed(character.matcher, Motion(frames - motor.rest[0], 30.0, character.body.parts))
                   if a is not None)
     assert commit.path == (out,) and commit.details["speed"] == pytest.approx(speed, rel=0.10)
+
+
+def test_a_faster_demonstration_is_recognised_at_its_speed(arms):
+    demo = demonstration(arms, stroke_path(arms.motor.rest[2], [0.3, 0.0, 0.0], duration=0.5))
+    commit = next(a for a in feed(arms.matcher, demo) if a is not None)
+    assert commit.path == (arms.out,) and commit.details["speed"] == pytest.approx(2.0, rel=0.10)

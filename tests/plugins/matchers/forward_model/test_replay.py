@@ -1,5 +1,6 @@
-"""Rows given at once (``Matcher.replay``, issue 22): the forward model's answers and state are those of the rows
-fed one at a time.
+"""Rows given at once (``Matcher.replay``, issue 22; :meth:`ForwardModel.replay
+<plugins.matchers.forward_model.matcher.ForwardModel.replay>`): the forward model's answers and state are those of the
+rows fed one at a time.
 
 When the watching loop gives a streaming matcher rows that are all in working memory already (a stroke matched on
 its own frames after the segmenter split a movement, a segment whose onset was reported late), it calls
@@ -29,7 +30,7 @@ from toolkit.profile import load_profile
 from toolkit.watching import WatchingLoop
 
 SETTINGS = ({}, {"threshold": 0.02}, {"threshold": 0.01, "learn": False}, {"together": False},
-            {"relative": True, "dropout": "relative", "min_move": 0.05})
+            {"min_move": 0.05})
 
 
 @pytest.fixture(scope="module")
