@@ -333,14 +333,19 @@ class Warping:
         self.length = np.zeros(len(frames))
         self.samples = 0
 
-    def advance(self, samples: Frames) -> tuple[np.ndarray, np.ndarray]:
-        """Take the next samples; each chain's distance so far after each of them (len(samples), C), and the frame
-        (the index within its chain) each chain's best path ends on."""
+    def advance(self, samples: Frames) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Take the next samples; after each of them (arrays (len(samples), C)): each chain's distance so far, the
+        frame (the index within its chain) its best path ends on, and the sample's own distance to that frame."""
         means = np.full((len(samples), len(self.chains)), np.inf)
         ends = np.full((len(samples), len(self.chains)), -1, dtype=np.intp)
-        if len(samples) and len(self.frames):
-            cost = np.ascontiguousarray(self.comparison.costs(samples, self.frames), dtype=np.float64)
+        local = np.full((len(samples), len(self.chains)), np.inf)
+        for i in range(len(samples) if len(self.frames) else 0):  # one sample at a time: the same numbers
+            # whatever the samples come in (a matrix product's rounding depends on how many rows it multiplies)
+            cost = np.ascontiguousarray(self.comparison.costs(samples.take(slice(i, i + 1)), self.frames),
+                                        dtype=np.float64)
             _advance_kernel()(cost, self.chains.starts, self.chains.cyclic, self.total, self.length,
-                              self.samples == 0, means, ends)
-        self.samples += len(samples)
-        return means, ends
+                              self.samples == 0, means[i : i + 1], ends[i : i + 1])
+            found = ends[i] >= 0
+            local[i, found] = cost[0, self.chains.starts[:-1][found] + ends[i, found]]
+            self.samples += 1
+        return means, ends, local

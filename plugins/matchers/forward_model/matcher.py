@@ -20,7 +20,9 @@ import numpy as np
 from plugins.lib.strokes import StrokeCriteria
 from plugins.matchers.forward_model.anchors import Anchors
 from plugins.matchers.forward_model.command_graphs import CommandGraphs
+from plugins.matchers.decision import Calibrated
 from plugins.matchers.forward_model.commitment import Commitment
+from plugins.matchers.forward_model.following import Following, Streaming, Takes
 from plugins.matchers.forward_model.learning import InverseModel
 from plugins.matchers.forward_model.observation import Observation
 from plugins.matchers.forward_model.path_length import norms
@@ -42,6 +44,17 @@ class ForwardModel(Matcher):
     name = "forward-model"
     motor_systems = ("motor-command-graph",)
     parameters = (
+        Parameter("comparison", str, "strokes", "What the forward models compare: 'strokes', each subsystem's "
+                  "guiding strokes at the path length seen, the largest part's error in metres, dropped beyond "
+                  "threshold (the paper); 'motion', every take learned from clips played by its commands and "
+                  "followed by time warping with the comparison and the calibrated decision the matchers share "
+                  "(plugins.matchers.forward_model.following; real people).", choices=("strokes", "motion")),
+        Parameter("calibrated", doc="The calibration of comparison = 'motion' (plugins.matchers.decision).",
+                  parameters=(
+                      Parameter("known_rejected", float, 0.05, "The share of a known movement's performances that "
+                                "may be called unknown, as far as the repertoire shows how they vary.",
+                                minimum=0.0, maximum=1.0),
+                  )),
         Parameter("threshold", float, 0.05, "Prediction error (m) above which a candidate edge drops out.",
                   minimum=0.0, length=True),
         Parameter("deviation", float, 0.05, "Error (m) between the imitated edge and the demonstration that stops the "
@@ -82,6 +95,18 @@ class ForwardModel(Matcher):
         provides(motor, CommandGraphs, needed_by="forward-model", what="a motor command graph",
                  expected=" or ".join(f'[motor] plugin = "{name}"' for name in self.motor_systems))
         self.motor = motor
+        if self.params["comparison"] == "motion":  # the real people's forward model, chosen once: it answers the
+            # watching loop's calls in place of the paper's mechanism below (K&G §4.4 with the shared comparison)
+            provides(motor, Takes, needed_by="forward-model's comparison = 'motion'", what="a motor command graph "
+                     "that knows the takes it learned from clips", key=("comparison",),
+                     expected="a motor system with takes(), subsystems and body (motor-command-graph with clips)")
+            following = Following(motor, owner.body, Calibrated(self.params["calibrated"]["known_rejected"]),
+                                  self.params["min_progress"])
+            stream = Streaming(following)
+            for name in ("begin", "observe", "replay", "settled", "conclude", "inspect"):
+                setattr(self, name, getattr(stream, name))
+            self.match = following.match
+            return
         # observed root-relative positions are placed at the observer's own root height; finger angles stay as they are
         self.observation = Observation(motor, np.where(owner.body.angle_mask[:, None], 0.0,
                                                        motor.rest_pose()[owner.body.root_index]))

@@ -63,7 +63,7 @@ def _observer(clips, **matcher):
     pm = create_plugin_manager(autoload=False, trace=False)
     profile = load_profile(clips / "profile.toml")
     return profile, compose_observer(pm, profile, clips / "repertoire", matcher="forward-model",
-                                     lengths_for_height=0, settings={"matcher": {"learn": False, **matcher}})
+                                     lengths_for_height=0, settings={"matcher": {"comparison": "strokes", "learn": False, **matcher}})
 
 
 def test_a_clips_edges_carry_where_the_body_went(clips):

@@ -69,7 +69,7 @@ def pairs(pm, generated):
     def pair(i: int) -> tuple[ForwardModel, ForwardModel]:
         if i not in cache:
             cache[i] = tuple(compose_observer(pm, profile, data / "repertoire", segmenter="velocity-direction",
-                                              matcher="forward-model", settings={"matcher": dict(SETTINGS[i])}).matcher
+                                              matcher="forward-model", settings={"matcher": {"comparison": "strokes", **SETTINGS[i]}}).matcher
                              for _ in range(2))
         return cache[i]
 
@@ -129,7 +129,7 @@ def test_the_watching_loop_gives_the_same_observations(pm, generated, monkeypatc
     runs, observed = [], []
     for at_once in (False, True):
         character = compose_observer(pm, profile, data / "repertoire", segmenter="velocity-direction",
-                                     matcher="forward-model", settings={"matcher": dict(options)})
+                                     matcher="forward-model", settings={"matcher": {"comparison": "strokes", **options}})
         calls = [0]
         observe = ForwardModel.observe
 
