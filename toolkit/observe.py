@@ -47,7 +47,7 @@ OBSERVER_TEMPLATE = "observers/recordings.toml"
 
 OBSERVER_FOLDER = "observers"
 """The folder of observer templates in each folder of the character path (:func:`toolkit.character.character_paths`):
-a template named without a path (``--observer several-takes``) is looked up there."""
+a template named without a path (``--observer papers``) is looked up there."""
 
 
 def observer_templates(pm: Any = None) -> list[str]:
@@ -57,7 +57,7 @@ def observer_templates(pm: Any = None) -> list[str]:
 
 def observer_template_path(template: str | Path | None, pm: Any = None, *, key: tuple = ("--observer",)) -> Path:
     """The file of an observer template: a path, a name on the character path (``observers/recordings``), or the
-    name of a template in an ``observers`` folder of the character path (``recordings``, ``several-takes``);
+    name of a template in an ``observers`` folder of the character path (``recordings``, ``papers``);
     ``None`` or ``""``: :data:`OBSERVER_TEMPLATE`. A :class:`ConfigError` naming ``key`` and listing the templates
     found otherwise."""
     ref = str(template or OBSERVER_TEMPLATE)

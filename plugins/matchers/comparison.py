@@ -96,6 +96,16 @@ class Frames:
         return (masked.reshape(len(self), -1), np.einsum("npd,npd->np", masked, masked), seen, carry,
                 np.einsum("nc,nc->n", carry, carry))
 
+    @cached_property
+    def flat(self) -> tuple[np.ndarray, np.ndarray]:
+        """The parts' features a frame after another, contiguous (n, P * D), and the carry with the unknown ones
+        zeroed and a last column of 1 where it is known (n, C + 1), in single precision (a distance in body sizes
+        needs no more than seven digits, and half the numbers to read): what :func:`_rms_full` reads."""
+        carry = np.zeros((len(self), self.carry.shape[1] + 1), dtype=np.float32)
+        carry[:, :-1] = np.where(self.carried[:, None], self.carry, 0.0)
+        carry[:, -1] = self.carried
+        return np.ascontiguousarray(self.parts.reshape(len(self), -1), dtype=np.float32), carry
+
     def take(self, rows: np.ndarray | slice) -> Frames:
         """The frames ``rows`` of this sequence."""
         return Frames(self.parts[rows], self.seen[rows], self.carry[rows], self.carried[rows])
@@ -282,6 +292,22 @@ class Motion(Comparison):
             mean = np.where(count > 0, square / np.maximum(count, 1.0), 0.0)
         return np.sqrt(np.maximum(mean, 0.0))
 
+    def row_costs(self, a: Frames, b: Frames) -> np.ndarray:
+        """:meth:`costs` computed pair by pair in a compiled loop (:func:`_rms`): each row's numbers the same whatever
+        rows come with it (a matrix product's rounding depends on how many rows it multiplies), for a forward model
+        fed rows one by one or at once; slower than :meth:`costs` for many rows."""
+        out = np.empty((len(a), len(b)))
+        if out.size and a.seen.all() and b.seen.all():  # every part seen: one contiguous run of numbers a frame
+            flat_a, carry_a = a.flat
+            flat_b, carry_b = b.flat
+            _full_kernel()(flat_a, carry_a, flat_b, carry_b, a.parts.shape[1], out)
+        elif out.size:
+            _rms_kernel()(np.ascontiguousarray(a.parts, dtype=np.float64), a.seen,
+                          np.ascontiguousarray(np.where(a.carried[:, None], a.carry, 0.0)), a.carried,
+                          np.ascontiguousarray(b.parts, dtype=np.float64), b.seen,
+                          np.ascontiguousarray(np.where(b.carried[:, None], b.carry, 0.0)), b.carried, out)
+        return out
+
     def still(self, frames: Frames) -> np.ndarray:
         """Each frame's distance to standing still, every feature zero (no excursion from the mean posture, no
         motion, no carry): the root mean square of its parts' norms with the carry's, (n,)."""
@@ -335,6 +361,83 @@ def _held(positions: np.ndarray, seen: np.ndarray) -> np.ndarray:
         last = np.maximum.accumulate(np.where(seen[:, p], np.arange(len(seen)), -1))
         out[:, p] = positions[np.where(last >= 0, last, rows[0]), p]
     return out
+
+
+def _rms(a, a_seen, a_carry, a_carried, b, b_seen, b_carry, b_carried, out):
+    """:meth:`Motion.costs` of every frame pair, pair by pair: ``out[i, j]`` the root of the mean over the parts seen
+    in both of each part's squared difference plus the carries' (where both are known); 0 where no part is seen in
+    both. Plain Python as written (the reference), compiled by :func:`_rms_kernel`."""
+    n, parts, dims = a.shape
+    m = b.shape[0]
+    width = a_carry.shape[1]
+    for i in range(n):
+        for j in range(m):
+            carry = 0.0
+            if a_carried[i] and b_carried[j]:
+                for c in range(width):
+                    d = a_carry[i, c] - b_carry[j, c]
+                    carry += d * d
+            total = 0.0
+            count = 0
+            for p in range(parts):
+                if a_seen[i, p] and b_seen[j, p]:
+                    sq = carry
+                    for k in range(dims):
+                        d = a[i, p, k] - b[j, p, k]
+                        sq += d * d
+                    total += sq
+                    count += 1
+            out[i, j] = np.sqrt(total / count) if count else 0.0
+
+
+def _rms_full(a, a_carry, b, b_carry, parts, out):
+    """:func:`_rms` where every part is seen in both: ``a`` (n, P * D) and ``b`` (m, P * D) a frame's features in
+    one run, the carries with a last column of 1 where known (:attr:`Frames.flat`). The same numbers as
+    :func:`_rms` up to the order of the sums, which the compiled loop takes side by side (the same order at every
+    call: a row's numbers do not depend on the rows beside it). Plain Python, compiled by :func:`_full_kernel`."""
+    n, width = a.shape
+    m = b.shape[0]
+    c = a_carry.shape[1] - 1
+    for i in range(n):
+        for j in range(m):
+            sq = np.float32(0.0)
+            for k in range(width):
+                d = a[i, k] - b[j, k]
+                sq += d * d
+            carry = np.float32(0.0)
+            if a_carry[i, c] > 0 and b_carry[j, c] > 0:
+                for k in range(c):
+                    d = a_carry[i, k] - b_carry[j, k]
+                    carry += d * d
+            out[i, j] = np.sqrt(np.float64(sq) / parts + np.float64(carry))
+
+
+_full_compiled = None
+
+
+def _full_kernel():
+    """:func:`_rms_full` compiled by numba, or the reference without it."""
+    global _full_compiled
+    if _full_compiled is None:
+        from plugins.lib.compiled import compiled
+
+        found = compiled(_rms_full, reordered=True)
+        _full_compiled = found[0] if found is not None else _rms_full
+    return _full_compiled
+
+
+_rms_compiled = None
+
+
+def _rms_kernel():
+    """:func:`_rms` compiled by numba (:func:`plugins.lib.compiled.compiled`), or the reference without it."""
+    global _rms_compiled
+    if _rms_compiled is None:
+        from plugins.lib.compiled import compiled
+
+        found = compiled(_rms)
+        _rms_compiled = found[0] if found is not None else _rms
+    return _rms_compiled
 
 
 def sequence_size(poses: np.ndarray, seen: np.ndarray) -> float:

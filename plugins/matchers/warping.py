@@ -339,13 +339,12 @@ class Warping:
         means = np.full((len(samples), len(self.chains)), np.inf)
         ends = np.full((len(samples), len(self.chains)), -1, dtype=np.intp)
         local = np.full((len(samples), len(self.chains)), np.inf)
-        for i in range(len(samples) if len(self.frames) else 0):  # one sample at a time: the same numbers
-            # whatever the samples come in (a matrix product's rounding depends on how many rows it multiplies)
-            cost = np.ascontiguousarray(self.comparison.costs(samples.take(slice(i, i + 1)), self.frames),
-                                        dtype=np.float64)
+        if len(samples) and len(self.frames):
+            # pair by pair: the same numbers whatever the samples come in (row_costs)
+            cost = self.comparison.row_costs(samples, self.frames)
             _advance_kernel()(cost, self.chains.starts, self.chains.cyclic, self.total, self.length,
-                              self.samples == 0, means[i : i + 1], ends[i : i + 1])
-            found = ends[i] >= 0
-            local[i, found] = cost[0, self.chains.starts[:-1][found] + ends[i, found]]
-            self.samples += 1
+                              self.samples == 0, means, ends)
+            rows, chains = np.nonzero(ends >= 0)
+            local[rows, chains] = cost[rows, self.chains.starts[:-1][chains] + ends[rows, chains]]
+            self.samples += len(samples)
         return means, ends, local

@@ -357,22 +357,25 @@ class Following:
                 events.append((row, match))
         return events
 
-    def _scores(self, upto: int) -> tuple[np.ndarray, np.ndarray]:
-        """Each movement's score so far (its best take's distance over the demonstration's distance to standing
-        still; in :attr:`movements` order) and the chain of that take."""
+    def _scores(self, upto: int) -> np.ndarray:
+        """Each movement's score so far (in :attr:`movements` order): its best take's distance over the
+        demonstration's distance to standing still."""
+        best = np.minimum.reduceat(self.means[self._order], self._heads)
+        if not self.decision.relative:
+            return best
         still = self._still[upto] if len(self._still) else 0.0
-        chains = self.prediction.chains
-        grouped = self.means[self._order]
-        best = np.minimum.reduceat(grouped, self._heads)
-        at = self._order[self._heads + np.array([np.argmin(grouped[a:b]) for a, b in
-                                                 zip(self._heads, np.append(self._heads[1:], len(grouped)))])] \
-            if len(grouped) else np.zeros(0, dtype=np.intp)
-        scores = np.array([self.decision.score(float(d), still) for d in best]) if self.decision.relative else best
-        return scores, at
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(still > 0, best / still, np.where(best <= 0, 0.0, np.inf))
+
+    def _take(self, movement: int) -> int:
+        """The chain of a movement's best take so far."""
+        a = self._heads[movement]
+        b = self._heads[movement + 1] if movement + 1 < len(self._heads) else len(self._order)
+        return int(self._order[a + int(np.argmin(self.means[self._order[a:b]]))])
 
     def _decide(self, frame: int, sample: int) -> Match | None:
         limit = self.decision.threshold()
-        scores, best = self._scores(sample)
+        scores = self._scores(sample)
         order = np.argsort(scores, kind="stable")
         if self.committed is not None:
             if self.deviated:
@@ -391,7 +394,7 @@ class Following:
         runner = float(scores[order[1]]) if len(order) > 1 else np.inf
         if not (score <= limit and runner >= LEAD * score):
             return None
-        c = int(best[first])
+        c = self._take(first)
         length = self.prediction.chains.starts[c + 1] - self.prediction.chains.starts[c]
         progress = (self.ends[c] + 1) / length
         if progress < self.min_progress:
@@ -411,8 +414,11 @@ class Following:
         a = max(0, sample + 1 - max(1, int(round(RECENT * RATE))))
         moving = float(self._stills[a : sample + 1].sum())
         error = self._local[a : sample + 1].sum(axis=0)
-        per_take = np.array([self.decision.score(float(e), moving) for e in error]) if self.decision.relative \
-            else error / (sample + 1 - a)
+        if self.decision.relative:
+            with np.errstate(divide="ignore", invalid="ignore"):
+                per_take = error / moving if moving > 0 else np.where(error <= 0, 0.0, np.inf)
+        else:
+            per_take = error / (sample + 1 - a)
         return np.minimum.reduceat(per_take[self._order], self._heads)
 
     def conclude(self, frames: int) -> Match | None:
@@ -423,7 +429,7 @@ class Following:
             return None
         if not len(self._still):
             return Match.unknown("nothing seen", details={"reason": "nothing seen"})
-        scores, _ = self._scores(len(self._still) - 1)
+        scores = self._scores(len(self._still) - 1)
         ranked = tuple(sorted(zip(self.movements, scores.tolist()), key=lambda kv: (kv[1], kv[0])))
         limit = self.decision.threshold()
         nearest, score = ranked[0] if ranked else (None, np.inf)
@@ -498,7 +504,7 @@ class Streaming:
 
     def inspect(self) -> dict[str, Any]:
         f = self.following
-        scores = dict(zip(f.movements, (f._scores(len(f._still) - 1)[0] if len(getattr(f, "_still", ())) else
+        scores = dict(zip(f.movements, (f._scores(len(f._still) - 1) if len(getattr(f, "_still", ())) else
                                        np.full(len(f.movements), np.inf)).tolist()))
         return {"committed": f.committed, "deviated": f.deviated, "scores": scores,
                 "threshold": f.decision.threshold()}
