@@ -308,7 +308,7 @@ def test_the_pictures_larger_stooped_demonstrator_is_mapped_onto_maxs_size_and_r
     text = (Path(__file__).resolve().parents[3] / "docs" / "correspondence.md").read_text(encoding="utf-8")
     block = re.search(r"On the project's own data.*?```python\n(.*?)```", text, re.S).group(1)
     monkeypatch.chdir(tmp_path)
-    exec(block.replace("/tmp/gen", str(generated)), {})  # writes wave_stooped.csv here
+    exec(block.replace('"gen/', f'"{generated}/'), {})  # writes wave_stooped.csv here
     profile = load_profile(generated / "profile.toml")
     seen = profile.read(tmp_path / "wave_stooped.csv")
     mapped = {}
