@@ -127,6 +127,12 @@ def behaviour_sentence(observer: str, target: str, b: dict[str, Any]) -> str:
         text += f"; {target} wants to be {' and '.join(b['goal'])}"
     if b["prediction"]:
         text += f"; next {target} will {b['prediction'][0]}"
+    seen_as = b.get("seen_as", {}).get(b["object"]) if b["object"] else None
+    if seen_as:  # what the object looked like to the observer, and why (an action system's details["seen_as"])
+        text += f"; the {b['object']} was taken for a {seen_as.replace(': ', ' (', 1)})"
+    in_sight = list(b.get("in_sight", {}))
+    if len(in_sight) > 1:
+        text += f"; the {' and the '.join(in_sight)} were {'both' if len(in_sight) == 2 else 'all'} in {target}'s line of sight"
     for kind, category in b.get("learned", {}).items():
         text += f"; {observer} learns that {kind} is {category}"
     return text
@@ -144,6 +150,8 @@ def _behaviour(b: Any, time: float, response: str | None) -> dict[str, Any]:
         "prediction": list(b.prediction),
         "learned": dict(b.learned),
         "response": response,
+        "seen_as": {str(k): str(v) for k, v in b.details.get("seen_as", {}).items()} if b.details else {},
+        "in_sight": {str(k): float(v) for k, v in b.details.get("in_sight", {}).items()} if b.details else {},
     }
 
 

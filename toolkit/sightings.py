@@ -11,7 +11,9 @@ What the record says of an object at a row is what the observer last knew of it 
 - an object never seen before that row does not exist for the observer;
 - an object seen before but not at that row (hidden, or out of view) is where it was last seen;
 - an object that was not seen where the observer's eye should have seen it (:meth:`Perception.in_view
-  <toolkit.components.Perception.in_view>`) is gone from then on, until it is seen again (eaten, taken away).
+  <toolkit.components.Perception.in_view>`) more than :data:`CARRIED` seconds after it was last seen is gone from
+  then on, until it is seen again (eaten, taken away); missed sooner, it may have been carried out of sight a moment
+  (a cheese in a hand that went behind the head).
 
 Bounded like working memory: rows older than ``keep`` seconds, or than the first row working memory still holds
 (:meth:`forget`), are dropped, except each object's last sighting before them, so an object seen long ago is still
@@ -26,7 +28,11 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["Sighting", "Sightings"]
+__all__ = ["CARRIED", "Sighting", "Sightings"]
+
+CARRIED = 0.5
+"""Seconds after its last sighting during which an object missed where it was is not yet gone: it may have been
+carried out of sight (a cheese in a hand that went behind the head); missed after that, it is gone."""
 
 
 @dataclass(frozen=True)
@@ -123,11 +129,17 @@ class Sightings:
             if name in sizes:
                 track.radius = float(sizes[name])
         for name in missed:
-            if name in self._objects:
-                self._objects[name].gone.append(row)
+            track = self._objects.get(name)
+            if track is not None and not self._carried(track, row):
+                track.gone.append(row)
         self.n += 1
         if self.n - self.offset > 2 * self.keep:
             self.forget(self.n - self.keep)
+
+    def _carried(self, track: _Track, row: int) -> bool:
+        """Whether an object missed at ``row`` may still be about, out of sight a moment: it was last seen at most
+        :data:`CARRIED` seconds before (carried behind the head, say), so missing it proves nothing yet."""
+        return track.n > 0 and row - int(track.rows[track.n - 1]) <= CARRIED * self.fps
 
     def remembered(self, row: int | None = None) -> dict[str, np.ndarray]:
         """Where each object the observer still believes in was last seen, at ``row`` (default: the newest)."""

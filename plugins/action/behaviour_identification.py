@@ -12,11 +12,12 @@ food or toy objects available at the time he saw Morris reaching"):
   with an actor's interface (``id``, ``body``, ``world_pose()``, ``heading``)
   for the triggers to evaluate;
 - the objects as perceived by then (:func:`perceived_objects`, from the
-  observer's :class:`~toolkit.sightings.Sightings`): each where it was last
+  observer's :class:`~toolkit.sightings.Sightings`): each under the observer's own name for it, where it was last
   seen (an occluded one where it was before it was hidden; one never seen does
   not exist; one missed where it should have been seen is gone), of the kind
-  it looked like, and held by the target when it was seen moving with the
-  target's hand (:func:`seen_held`).
+  it looked like (its colour and size, :mod:`plugins.perception.object_looks`: a ball painted cheese-yellow is a
+  cheese to the observer, and ``details["seen_as"]`` says why), and held by the target when it was seen moving
+  with the target's hand (:func:`seen_held`).
 
 So the observer can be wrong where its perception was: an object it never saw
 makes no behaviour possible (§7.3.1's perceptual failure).
@@ -28,16 +29,18 @@ makes no behaviour possible (§7.3.1's perceptual failure).
    movement-action correspondence map (most used first), else from its
    declaration (§6.1.1, Fig. 11);
 3. every path from the top of the hierarchy down to those leaves (Fig. 12);
-4. the order in which to try them: if the target's line of sight (its head and
-   nose, both visible) falls on an object, the paths whose motivational
-   subsystem selects that kind of object first; otherwise the observer's own
-   most frequent motivation for the movement first (§6.1.2);
+4. the order in which to try them: the objects in the target's line of sight, read from its head and nose as
+   perceived, in 3D and with the uncertainty of the observer's own perception
+   (:mod:`plugins.action.line_of_sight`); the paths whose motivational subsystem selects the kind of an object in
+   sight come first; among them, and for the rest, the observer's own most frequent motivation for the movement
+   first (§6.1.2). Objects close together are in sight together, and then the habits choose (§7.3.1's natural
+   mistake); with no line of sight, the habits alone;
 5. along each path, the can-I triggers are evaluated *for the target as
    perceived* and *against the objects as perceived when the movement began*
    (not now); an object selection trigger picks the object in the line of
-   sight, else the one the observer would attend to (the closest of that
-   kind). The first path whose triggers all hold is the identified behaviour;
-   the rest are the fall back. When the motion alone is ambiguous, the can-I
+   sight (of several of its kind in sight, the one the observer would attend to, the closest), else the one the
+   observer would attend to (the closest of that kind). The first path whose triggers all hold is the identified
+   behaviour; the rest are the fall back. When the motion alone is ambiguous, the can-I
    triggers decide between the candidates (reach or jump: the object within
    reach or high in the air, Fig. 13);
 6. the should-I triggers of the path are the likely motivation, its do-until
@@ -62,10 +65,11 @@ from typing import Any
 import numpy as np
 
 from plugins.action.action_tuple import evaluate_path
+from plugins.action.line_of_sight import in_sight, perceived_gaze
 from plugins.action.prediction import predict
 from toolkit import Behaviour
 
-__all__ = ["MARGIN", "GRIP", "PerceivedActor", "PerceivedObject", "close_candidates", "identify", "line_of_sight",
+__all__ = ["MARGIN", "GRIP", "PerceivedActor", "PerceivedObject", "close_candidates", "identify", "sight",
            "evaluate_path", "perceived_objects", "perceived_target", "predict", "seen_held"]
 
 MARGIN = 0.25
@@ -73,8 +77,10 @@ MARGIN = 0.25
 candidate whose distance is within ``(1 + MARGIN)`` times the best's is close enough that the motion alone does not
 tell them apart, and the can-I triggers decide."""
 
-GRIP = 0.06
-"""Metres beyond an object's radius within which it is at the target's hand (seen held, with :func:`seen_held`)."""
+GRIP = 0.10
+"""Metres beyond an object's radius within which it is at the target's hand (seen held, with :func:`seen_held`): a
+hand's own size (the object sits in its grip, not at its centre) and what an eye may be off by, a hand seen half
+hidden behind what it holds."""
 
 MOVED = 0.02
 """Metres an object must have moved from where it was first seen to have been taken (not lying where it lay)."""
@@ -190,37 +196,14 @@ def perceived_objects(observer: Any, target: Any, row: int, until: int | None = 
     return out
 
 
-def line_of_sight(system: Any, observer: Any, target: Any, row: int, objects: dict[str, Any]) -> str | None:
-    """The object the target was looking at around memory row ``row``, from its seen head and nose; else ``None``."""
-    memory = observer.memory
-    if memory is None or memory.n == 0:
-        return None
-    parts = memory.parts  # the observer's own parts, onto which it perceives the target's
-    a, b = (parts.index(p) if p in parts else None for p in system.params["gaze"])
-    if a is None or b is None:
-        return None
-    both = memory.visible[:, a] & memory.visible[:, b]
-    if not both.any():
-        return None
-    rows = np.flatnonzero(both) + memory.offset  # row numbers since watching began
-    r = int(rows[np.argmin(np.abs(rows - row))])
-    if abs(r - row) > memory.fps:  # nothing seen within a second of the movement
-        return None
-    head, nose = memory.world[r - memory.offset, a], memory.world[r - memory.offset, b]
-    gaze = (nose - head)[[0, 2]]
-    if np.linalg.norm(gaze) < 1e-9:
-        return None
-    best, best_angle = None, np.radians(system.params["sight_angle"])
-    for name, obj in objects.items():
-        if obj.held_by is not None and obj.held_by != target.id:
-            continue
-        to = (obj.position - head)[[0, 2]]
-        if np.linalg.norm(to) < 1e-9:
-            continue
-        angle = np.arccos(np.clip(np.dot(gaze, to) / (np.linalg.norm(gaze) * np.linalg.norm(to)), -1, 1))
-        if angle <= best_angle:
-            best, best_angle = name, angle
-    return best
+def sight(system: Any, observer: Any, target: Any, row: int, objects: dict[str, Any]) -> list[tuple[str, float]]:
+    """The objects in the target's line of sight around memory row ``row``, read from its head and nose as the
+    observer perceived them, with the uncertainty of its perception (:func:`plugins.action.line_of_sight.in_sight`):
+    (name, degrees off the gaze), nearest first; empty when the head and nose were not seen or no object is in sight."""
+    gaze = perceived_gaze(observer, row, tuple(system.params["gaze"]))
+    if gaze is None:
+        return []
+    return in_sight(gaze, objects, system.params["sight_angle"], holder=target.id)
 
 
 def _words(text: str, obj: str | None) -> str:
@@ -232,7 +215,9 @@ def _category(system: Any, top: str) -> str | None:
     return select.params.get("kind") if select is not None else None
 
 
-def _ordered_paths(system: Any, movement: str, seen: str | None, objects: dict[str, Any]) -> list[tuple[str, ...]]:
+def _ordered_paths(system: Any, movement: str, seen: list[str], objects: dict[str, Any]) -> list[tuple[str, ...]]:
+    """The paths to try for ``movement``: those whose motivational subsystem selects the kind of an object in sight
+    (``seen``) first, then the rest; each group in the order of the observer's own habits (§6.1.2)."""
     h = system.hierarchy
     counts: Counter = system.correspondence.get(movement, Counter())
     leaves = [p[-1] for p, _ in counts.most_common()] + h.leaves_for(movement)
@@ -241,12 +226,24 @@ def _ordered_paths(system: Any, movement: str, seen: str | None, objects: dict[s
     habit = Counter()
     for p, n in counts.items():
         habit[p[0]] += n
-    first = []
-    if seen is not None:
-        kind = system.beliefs.get(objects[seen].kind)
-        first = [p for p in paths if kind is not None and _category(system, p[0]) == kind]
+    kinds = {system.beliefs.get(objects[n].kind) for n in seen} - {None}
+    first = sorted((p for p in paths if _category(system, p[0]) in kinds), key=lambda p: -habit[p[0]])
     rest = sorted((p for p in paths if p not in first), key=lambda p: -habit[p[0]])
     return first + rest
+
+
+def _attending(system: Any, path: tuple[str, ...], seen: list[str], then: Any) -> tuple[str | None, Any]:
+    """The object of attention to evaluate ``path`` with, and the objects to evaluate it against: the one object of
+    its kind in sight; of several in sight, the observer's own choice among them (its object selection picks from
+    those, the others of the kind left out); none in sight: its own choice among all."""
+    category = _category(system, path[0])
+    mine = [n for n in seen if category is not None and system.beliefs.get(then.objects[n].kind) == category]
+    if len(mine) == 1:
+        return mine[0], then
+    if not mine:
+        return None, then
+    kept = {n: o for n, o in then.objects.items() if n in mine or system.beliefs.get(o.kind) != category}
+    return None, SimpleNamespace(**{**vars(then), "objects": kept})
 
 
 def identify(system: Any, observer: Any, target: Any, movements: str | list[str], row: int,
@@ -268,7 +265,9 @@ def identify(system: Any, observer: Any, target: Any, movements: str | list[str]
     objects = perceived_objects(observer, target, row, until)
     then = SimpleNamespace(objects=objects, row=perceived.row, frame=getattr(observer, "watch_start", 0) + perceived.row,
                            time=perceived.row / memory.fps)
-    seen = line_of_sight(system, observer, perceived, row if middle is None else middle, objects)
+    sighted = sight(system, observer, perceived, row if middle is None else middle, objects)
+    seen = [n for n, _ in sighted]
+    looked = {"line_of_sight": seen[0] if len(seen) == 1 else None, "in_sight": {n: round(a, 1) for n, a in sighted}}
     candidates = {"candidates": movements} if len(movements) > 1 else {}
     tried: list[str] = []
     first_paths: list[tuple[str, ...]] = []
@@ -279,37 +278,49 @@ def identify(system: Any, observer: Any, target: Any, movements: str | list[str]
         if not first_paths:
             first, first_paths = movement, paths
         for path in paths:
-            kind = system.beliefs.get(objects[seen].kind) if seen is not None else None
-            attention = seen if kind is not None and _category(system, path[0]) == kind else None
-            ok, obj = evaluate_path(system, perceived, then, path, attention, system.beliefs)
+            attention, against = _attending(system, path, seen, then)
+            ok, obj = evaluate_path(system, perceived, against, path, attention, system.beliefs)
             tried.append(" > ".join(path))
             if ok:
-                return _behaviour(system, perceived, movement, path, obj, then, seen, tried, **candidates)
+                return _behaviour(system, perceived, movement, path, obj, then, looked, tried, **candidates)
     if not first_paths:
         return None  # a movement no behaviour of the observer uses: there is nothing to identify
     if system.params["learn_affordances"]:
-        learned = _learn_affordance(system, perceived, first, first_paths, then, seen)
+        learned = _learn_affordance(system, perceived, first, first_paths, then, seen, looked)
         if learned is not None:
             return learned
     return Behaviour(False, first, details={"reason": "no behaviour of mine with this movement was possible", "tried": tried,
-                                               "line_of_sight": seen, "objects_seen": sorted(objects), **candidates})
+                                               **looked, "objects_seen": sorted(objects),
+                                               "seen_as": _seen_as(objects, objects), **candidates})
+
+
+def _seen_as(objects: dict[str, Any], names: Any) -> dict[str, str]:
+    """Why each of ``names`` was taken for what it was: its kind and the look that told it (colour, size)."""
+    out = {}
+    for name in names:
+        obj = objects.get(name)
+        if obj is not None and obj.kind is not None:
+            reason = getattr(obj.kind, "reason", "")
+            out[name] = f"{obj.kind}: {reason}" if reason else str(obj.kind)
+    return out
 
 
 def _behaviour(system: Any, target: Any, movement: str, path: tuple[str, ...], obj: str | None, then: Any,
-               seen: str | None, tried: list[str], **details: Any) -> Behaviour:
+               looked: dict[str, Any], tried: list[str], **details: Any) -> Behaviour:
     h = system.hierarchy
     motivation = tuple(dict.fromkeys(t.describe() for name in path for t in h.tuples[name].should))
     goal = tuple(dict.fromkeys(_words(t.describe(), obj) for name in path for t in h.tuples[name].until))
     prediction = predict(system, target, path, obj, then)
     return Behaviour(
         True, movement, path=path, motivation=motivation, goal=goal, object=obj, prediction=prediction,
-        details={"line_of_sight": seen, "tried": tried, "drive": h.drive_of(path), **details},
+        details={**looked, "tried": tried, "drive": h.drive_of(path),
+                 **({"seen_as": _seen_as(then.objects, [obj])} if obj is not None else {}), **details},
         learned=details.get("learned", {}),
     )
 
 
 def _learn_affordance(system: Any, target: Any, movement: str, paths: list[tuple[str, ...]], then: Any,
-                      seen: str | None) -> Behaviour | None:
+                      seen: list[str], looked: dict[str, Any]) -> Behaviour | None:
     drives = {system.hierarchy.drive_of(p) for p in paths}
     if len(drives) != 1:
         return None  # the movement serves several purposes: nothing to conclude
@@ -320,20 +331,20 @@ def _learn_affordance(system: Any, target: Any, movement: str, paths: list[tuple
     unknown = {n: o for n, o in then.objects.items() if o.kind is not None and o.kind not in system.beliefs}
     if not unknown:
         return None
-    if seen in unknown:
-        candidates = [seen]
+    looked_at = [n for n in seen if n in unknown]
+    if looked_at:
+        candidates = looked_at
     else:  # the closest to the target as perceived (an object at an unknown distance last)
         root = target.world_pose()[target.body.root_index]
         candidates = sorted(unknown, key=lambda n: np.nan_to_num(float(np.linalg.norm(unknown[n].position - root)),
                                                                  nan=np.inf))
     for name in candidates:
         assumed = dict(system.beliefs)
-        assumed[unknown[name].kind] = category
+        assumed[str(unknown[name].kind)] = category
         for path in paths:
             ok, obj = evaluate_path(system, target, then, path, name, assumed)
             if ok and obj == name:
-                system.beliefs[unknown[name].kind] = category
-                return _behaviour(system, target, movement, path, obj, then, seen, [" > ".join(p) for p in paths],
-                                  learned={unknown[name].kind: category})
+                system.beliefs[str(unknown[name].kind)] = category
+                return _behaviour(system, target, movement, path, obj, then, looked, [" > ".join(p) for p in paths],
+                                  learned={str(unknown[name].kind): category})
     return None
-

@@ -83,8 +83,9 @@ class Hierarchical(ActionSystem):
         Parameter("learn_affordances", bool, True, "Learn what unknown objects afford by watching (§6.3)."),
         Parameter("candidate_margin", float, 0.25, "Fig. 13: a matcher's ranked candidate within (1 + this) times the "
                   "best's distance is close enough for the can-I triggers to choose it instead.", minimum=0.0),
-        Parameter("sight_angle", float, 20.0, "Degrees (horizontal) around the target's head-to-nose line within which "
-                  "an object counts as in its line of sight (§6.1.2).", minimum=0.0, maximum=180.0),
+        Parameter("sight_angle", float, 20.0, "Degrees around the target's head-to-nose line (in 3D) beyond which no "
+                  "object counts as in its line of sight (§6.1.2); within it, every object within the gaze's "
+                  "uncertainty is (plugins/action/line_of_sight.py).", minimum=0.0, maximum=180.0),
         Parameter("gaze", list, ["head", "nose"], "The target's parts whose line gives its line of sight.", items=str),
         Parameter("imitate", bool, False, "Imitate every recognised movement (§5.3); takes precedence over shrugging."),
         Parameter("shrug", str, "", "Movement performed when a behaviour cannot be identified (\"I don't know\"); empty: none."),

@@ -25,7 +25,7 @@ from plugins.bench import progress as progress_bar
 from toolkit import World, load_character
 from toolkit.state import write_atomic
 
-__all__ = ["BEHAVIOUR_CONDITIONS", "behaviour_benchmark", "render_behaviour", "cmd_behaviour"]
+__all__ = ["BEHAVIOUR_CONDITIONS", "behaviour_benchmark", "render_behaviour", "cmd_behaviour", "world_name"]
 
 
 BEHAVIOUR_CONDITIONS = ("line-of-sight", "no-line-of-sight", "close-together", "random-placement")
@@ -39,6 +39,8 @@ REACH = (0.25, 0.42)
 SIDE = 90.0
 """``random-placement``: objects lie anywhere within reach on the side of Morris where his hands go, at azimuths
 (degrees from straight ahead) drawn uniformly in [-SIDE, SIDE]."""
+COLOURS = {"cheese": "#ffd700", "ball": "#ff4040", "baton": "#8040ff", "screen": "#808080"}
+"""What each object of an episode looks like (Max knows them by these looks, characters/max.toml)."""
 
 
 def _draw(rng: np.random.Generator, condition: str) -> dict[str, Any]:
@@ -73,6 +75,22 @@ def _draw(rng: np.random.Generator, condition: str) -> dict[str, Any]:
             "positions": {wanted: pos_wanted, other: pos_other}}
 
 
+def world_name(world: Any, observer: str, name: str | None) -> str | None:
+    """The world's name of the object ``observer`` calls ``name``: the world object nearest to where the observer
+    first saw it, as the world was then (ground truth, for judging an observer; the observer never reads it)."""
+    actor = world.actors[observer]
+    sightings = actor.sightings
+    if name is None or sightings is None:
+        return None
+    rows, positions = sightings.track(name, sightings.n - 1)
+    if not len(rows):
+        return None
+    then = world.objects_at(actor.watch_start + int(rows[0]))
+    if not then:
+        return None
+    return min(then, key=lambda n: float(np.linalg.norm(then[n].position - positions[0])))
+
+
 _WORKER_PM: Any = None
 
 
@@ -95,14 +113,19 @@ def _run_episode(item: dict[str, Any], pm: Any = None) -> dict[str, Any]:
         "hunger": {"level": 0.8 if drive == "hunger" else 0.0, "rate": 0.0},
         "play": {"level": 0.8 if drive == "play" else 0.0, "rate": 0.0}}, "seed": item["seed"]}})
     max_ = load_character("max", pm, override={"action": {"imitate": False}})
+    if item.get("perception", "own") == "synthetic-vision":  # the same eye, radii and looks, found by geometry
+        from plugins.bench.vision import geometric_params
+
+        max_ = load_character("max", pm, override={"action": {"imitate": False}, "perception": {
+            "plugin": "synthetic-vision", **geometric_params(max_.perception)}})
     world = World(fps=30.0, pm=pm)
     target = world.add_actor(morris, "morris", MORRIS_AT, np.pi)
     watcher = world.add_actor(max_, "max", (0.0, 0.0, 0.0), 0.0)
     watcher.watch(target)
     for name, position in item["positions"].items():
-        world.add_object(WorldObject(name, name, position, radius=0.035))
+        world.add_object(WorldObject(name, name, position, radius=0.035, colour=COLOURS[name]))
     if condition == "no-line-of-sight":
-        world.add_object(WorldObject("screen", "screen", (0.0, 0.62, 1.0), radius=0.12))
+        world.add_object(WorldObject("screen", "screen", (0.0, 0.62, 1.0), radius=0.12, colour=COLOURS["screen"]))
     world.run(until_idle=True, tail=1.0, max_duration=12.0)
     truth = target.character.action.history
     first = truth[0] if truth else None
@@ -119,25 +142,27 @@ def _run_episode(item: dict[str, Any], pm: Any = None) -> dict[str, Any]:
         "true_object": first[2] if first else None,
         "identified": bool(got is not None and got.known),
         "path": list(got.path) if got is not None and got.known else None,
-        "identified_object": got.object if got is not None and got.known else None,
-        "line_of_sight": got.details.get("line_of_sight") if got is not None else None,
+        "identified_object": world_name(world, "max", got.object) if got is not None and got.known else None,
+        "line_of_sight": world_name(world, "max", got.details.get("line_of_sight")) if got is not None else None,
+        "in_sight": sorted(world_name(world, "max", n) for n in got.details.get("in_sight", {})) if got is not None else [],
     }
 
 
 def behaviour_benchmark(pm: Any, *, episodes: int = 100, seed: int = 0, progress: bool = False, jobs: int = 1,
-                        scheduler: str | None = None,
-                        conditions: tuple[str, ...] = BEHAVIOUR_CONDITIONS) -> dict[str, Any]:
+                        scheduler: str | None = None, conditions: tuple[str, ...] = BEHAVIOUR_CONDITIONS,
+                        perception: str = "own") -> dict[str, Any]:
     """Identification accuracy (tuple path, motivation, object) per condition over random episodes (B&B §6).
 
     The episodes are drawn here from ``seed`` (every condition's in :data:`BEHAVIOUR_CONDITIONS` order, whichever
     are run), then run in this process (``jobs`` 1, with ``pm``), in ``jobs`` local processes or on a Dask cluster
-    (``scheduler``): the figures do not depend on where they ran.
+    (``scheduler``): the figures do not depend on where they ran. ``perception``: ``"own"``, Max's as
+    ``characters/max.toml`` gives it (rendered vision), or ``"synthetic-vision"``, the geometric eye in its place.
     """
     from plugins.bench.jobs import run_items
 
     rng = np.random.default_rng(seed)
     drawn = [_draw(rng, c) for c in BEHAVIOUR_CONDITIONS for _ in range(episodes)]
-    items = [d for d in drawn if d["condition"] in conditions]
+    items = [{**d, "perception": perception} for d in drawn if d["condition"] in conditions]
     started = time.perf_counter()
     if jobs == 1 and not scheduler:
         rows = [_run_episode(item, pm) for item in (progress_bar(items, "behaviour episodes") if progress else items)]
@@ -155,7 +180,8 @@ def behaviour_benchmark(pm: Any, *, episodes: int = 100, seed: int = 0, progress
             "motivation": sum(bool(r["path"]) and r["path"][0] == r["true_path"][0] for r in sub) / n,
             "object": sum(r["identified_object"] == r["true_object"] for r in sub) / n,
         }
-    return {"benchmark": "behaviour", "seed": seed, "episodes_per_condition": episodes, "conditions": table,
+    return {"benchmark": "behaviour", "seed": seed, "episodes_per_condition": episodes, "perception": perception,
+            "conditions": table,
             "episodes": rows, "seconds": elapsed, "jobs": jobs, "python": platform.python_version(),
             "numpy": np.__version__}
 
@@ -164,7 +190,7 @@ def render_behaviour(r: dict[str, Any]) -> str:
     from plugins.bench import text_table
 
     head = (f"likeme bench behaviour: Max identifies what Morris does (seed {r['seed']}, {r['episodes_per_condition']} "
-            f"episodes per condition, {r['seconds']:.0f} s)")
+            f"episodes per condition, perception: {r.get('perception', 'own')}, {r['seconds']:.0f} s)")
     rows = [[c, t["episodes"], f"{t['identified']:.3f}", f"{t['path']:.3f}", f"{t['motivation']:.3f}",
              f"{t['object']:.3f}"] for c, t in r["conditions"].items()]
     columns = [("condition", "left")] + [(name, "right") for name in ("episodes", "identified", "path", "motivation",
@@ -174,7 +200,7 @@ def render_behaviour(r: dict[str, Any]) -> str:
 
 def cmd_behaviour(args: argparse.Namespace, pm: Any) -> int:
     result = behaviour_benchmark(pm, episodes=args.episodes, seed=args.seed, progress=not args.quiet,
-                                 jobs=args.jobs, scheduler=args.scheduler)
+                                 jobs=args.jobs, scheduler=args.scheduler, perception=args.perception)
     print(render_behaviour(result))
     if args.json:
         write_atomic(Path(args.json), json.dumps(result, indent=2, default=float) + "\n")

@@ -232,10 +232,31 @@ def likeme_register_commands(subparsers):
     p = sub.add_parser("behaviour", help="an observer identifies the behaviour, motivation and object of a demonstrator (B&B §6)")
     _jobs_options(p)
     p.add_argument("--episodes", type=int, default=100, help="random episodes per condition (default: 100)")
+    p.add_argument("--perception", choices=("own", "synthetic-vision"), default="own", help="Max's perception as "
+                   "his file gives it (own: rendered vision) or synthetic vision in its place, the same eye and "
+                   "looks (default: own)")
     p.add_argument("--seed", type=seed_type, default=0)
     p.add_argument("--json", metavar="FILE", help="also write the results (every episode) as JSON")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(handler=_handler("behaviour", "cmd_behaviour"))
+
+    p = sub.add_parser("learning", help="a new movement learned from one demonstration against one learned from "
+                       "several (B&B §7.3): how often fresh takes of it are recognised")
+    _jobs_options(p, "one per new movement and trial")
+    p.add_argument("--takes", type=count_type(1, 50), action="append", metavar="K",
+                   help="takes the movement is learned from, repeatable (default: 1, 2, 3, 5)")
+    p.add_argument("--generated", type=count_type(0, 100), default=3, help="generated new movements besides "
+                   "Morris's windmill (default: 3)")
+    p.add_argument("--trials", type=count_type(1, 1000), default=5, help="trials per new movement (default: 5)")
+    p.add_argument("--tests", type=count_type(1, 1000), default=20, help="fresh takes watched per trial (default: 20)")
+    p.add_argument("--noise", type=number_type(0.0, 1.0, "metres"), default=0.005,
+                   help="observation noise, metres (default: 0.005)")
+    p.add_argument("--jitter", type=number_type(0.0, 1.0, "metres"), default=0.015,
+                   help="each take's posture offset per part, metres (default: 0.015)")
+    p.add_argument("--seed", type=seed_type, default=0)
+    p.add_argument("--plot", metavar="PNG", help="also draw recognition against the number of takes")
+    p.add_argument("--json", metavar="FILE", help="also write the results as JSON")
+    p.set_defaults(handler=_handler("learning", "cmd_learning"))
 
     p = sub.add_parser("memory", help="the observer's memory against stream length: a live observer fed for "
                        "--minutes, and likeme observe on generated BVH streams")
@@ -291,6 +312,12 @@ def likeme_register_commands(subparsers):
     p.add_argument("--resolution", type=int, action="append", help="rendered-vision resolution, repeatable "
                    "(default: 240, 480, 960)")
     p.add_argument("--frames", type=int, default=240, help="frames to compare (default: 240)")
+    p.add_argument("--scenarios", action="store_true", help="instead: run every scenario with a watcher (or each "
+                   "--scenario-name) with its perception and with synthetic vision, side by side: median seconds "
+                   "and whether the conclusions are the same")
+    p.add_argument("--scenario-name", action="append", metavar="NAME", help="with --scenarios: this scenario only "
+                   "(repeatable)")
+    p.add_argument("--repeats", type=count_type(1, 100), default=3, help="with --scenarios: runs of each (default: 3)")
     p.set_defaults(handler=_handler("vision", "cmd_vision"))
 
     p = sub.add_parser("fuzz", help="mutated real-looking inputs through the commands a user runs: only documented "

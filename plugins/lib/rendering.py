@@ -21,7 +21,8 @@ import numpy as np
 
 from toolkit.body import Body
 
-__all__ = ["MAX_PIXELS", "plotter", "BodyFigure", "Movie", "part_colours", "hex_to_rgb", "GREY", "save_png", "draw_bodies", "frame_2d", "add_labels", "poses_png"]
+__all__ = ["MAX_PIXELS", "plotter", "BodyFigure", "Movie", "SphereSet", "TubeSet", "part_colours", "hex_to_rgb", "GREY",
+           "save_png", "draw_bodies", "frame_2d", "add_labels", "poses_png"]
 
 GREY = "#b0b0b0"
 MAX_PIXELS = 8192
@@ -39,8 +40,30 @@ def hex_to_rgb(colour: str) -> tuple[int, int, int]:
 
 
 def part_colours(body: Body) -> list[str]:
-    """Each part's colour: the body's own (``[body.colours]``), else a distinct palette colour."""
-    return [body.colours.get(p, _PALETTE[i % len(_PALETTE)]) for i, p in enumerate(body.parts)]
+    """Each part's colour: the body's own (``[body.colours]``), else a distinct colour of its own: part ``i`` the
+    palette's ``i``-th, and a body of more parts than the palette has colours hues spread by the golden angle (never
+    repeated: colour-coded vision tells parts apart by colour alone)."""
+    palette = _palette()
+    extra = [next(palette) for _ in range(len(body.parts))]
+    return [body.colours.get(p, extra[i]) for i, p in enumerate(body.parts)]
+
+
+def _palette():
+    """Distinct colours, endlessly: :data:`_PALETTE`, then generated ones never black and never repeated."""
+    import colorsys
+
+    yield from _PALETTE
+    seen = set(_PALETTE)
+    k = 0
+    while True:
+        k += 1
+        hue = (k * 0.381966) % 1.0
+        light = (0.45, 0.65, 0.30)[k % 3]
+        r, g, b = (round(255 * c) for c in colorsys.hls_to_rgb(hue, light, 0.9))
+        colour = f"#{r:02x}{g:02x}{b:02x}"
+        if colour not in seen and colour != "#000000":
+            seen.add(colour)
+            yield colour
 
 
 def _headless() -> None:
@@ -274,3 +297,101 @@ class Movie:
                 writer.close()
         self.pl.close()
         return self.files
+
+
+class SphereSet:
+    """Many flat-coloured spheres drawn as one mesh: moved, resized and recoloured together from arrays each frame.
+
+    For colour-coded rendering (``rendered-vision``): one actor and one vertex array however many spheres, each
+    sphere's vertices all of its colour (unlit: every pixel of it has exactly that colour). A sphere of radius 0 is
+    a point and draws nothing.
+
+    Parameters
+    ----------
+    pl : pyvista.Plotter
+    n : int
+        How many spheres.
+    resolution : (int, int)
+        The template sphere's theta and phi resolution.
+    """
+
+    def __init__(self, pl: Any, n: int, resolution: tuple[int, int] = (12, 8)) -> None:
+        import pyvista as pv
+
+        template = pv.Sphere(radius=1.0, theta_resolution=resolution[0], phi_resolution=resolution[1])
+        self.n, self.template = n, np.asarray(template.points, dtype=float)
+        v = len(self.template)
+        faces = template.faces.reshape(-1, 4)  # triangles: [3, a, b, c]
+        offsets = (np.arange(n) * v)[:, None, None]
+        all_faces = np.concatenate([faces[None, :, :1].repeat(n, 0), faces[None, :, 1:] + offsets], axis=2)
+        self.mesh = pv.PolyData(np.zeros((n * v, 3)), faces=all_faces.reshape(-1))
+        self.mesh["rgb"] = np.zeros((n * v, 3), dtype=np.uint8)
+        self.actor = pl.add_mesh(self.mesh, scalars="rgb", rgb=True, lighting=False, render=False)
+        self._points = self.mesh.points.reshape(n, v, 3)  # a view of VTK's own array: written in place each frame
+        self._colours: np.ndarray | None = None
+
+    def update(self, centres: np.ndarray, radii: np.ndarray, colours: np.ndarray | None = None) -> None:
+        """Spheres at ``centres`` (n, 3) of ``radii`` (n,) (0 or non-finite: not drawn), coloured ``colours``
+        (n, 3) uint8 when given."""
+        centres = np.nan_to_num(np.asarray(centres, dtype=float), nan=0.0, posinf=0.0, neginf=0.0)
+        radii = np.where(np.isfinite(radii), radii, 0.0)
+        np.multiply(self.template[None], radii[:, None, None], out=self._points)
+        self._points += centres[:, None, :]
+        self.mesh.GetPoints().Modified()
+        if colours is not None:
+            colours = np.asarray(colours, dtype=np.uint8)
+            if self._colours is None or not np.array_equal(colours, self._colours):
+                self.mesh.point_data["rgb"][:] = np.repeat(colours, len(self.template), axis=0)
+                self.mesh.point_data.GetArray("rgb").Modified()
+                self._colours = colours.copy()
+
+
+class TubeSet:
+    """Many flat cylinders (open tubes) between pairs of points, drawn as one mesh of one colour (limbs).
+
+    Parameters
+    ----------
+    pl : pyvista.Plotter
+    n : int
+        How many tubes.
+    colour : str
+    sides : int
+        Sides of each tube.
+    """
+
+    def __init__(self, pl: Any, n: int, colour: str, sides: int = 8) -> None:
+        import pyvista as pv
+
+        angle = np.linspace(0.0, 2 * np.pi, sides, endpoint=False)
+        self.ring = np.stack([np.cos(angle), np.sin(angle)], axis=1)  # (sides, 2)
+        self.n, self.sides = n, sides
+        a = np.arange(sides)
+        quad = np.stack([np.full(sides, 4), a, (a + 1) % sides, (a + 1) % sides + sides, a + sides], axis=1)
+        self.mesh = self.actor = None
+        if n:  # nothing to draw without tubes
+            faces = np.concatenate([quad + np.r_[0, [2 * sides * k] * 4] for k in range(n)])
+            self.mesh = pv.PolyData(np.zeros((n * 2 * sides, 3)), faces=faces.reshape(-1))
+            self.actor = pl.add_mesh(self.mesh, color=colour, lighting=False, render=False)
+            self._points = self.mesh.points.reshape(n, 2, sides, 3)  # VTK's own array, written in place
+
+    def update(self, starts: np.ndarray, ends: np.ndarray, radius: float) -> None:
+        """Tubes of ``radius`` from ``starts`` (n, 3) to ``ends`` (n, 3); a tube with a non-finite or equal end is
+        not drawn."""
+        if not self.n:
+            return
+        starts, ends = np.asarray(starts, dtype=float), np.asarray(ends, dtype=float)
+        along = ends - starts
+        length = np.linalg.norm(along, axis=1)
+        ok = np.isfinite(length) & (length > 1e-9)
+        d = np.where(ok[:, None], along, [0.0, 1.0, 0.0]) / np.where(ok, length, 1.0)[:, None]
+        helper = np.where((np.abs(d[:, 0]) < 0.9)[:, None], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0])
+        x = np.cross(d, helper)
+        x /= np.linalg.norm(x, axis=1, keepdims=True)
+        z = np.cross(x, d)
+        r = np.where(ok, radius, 0.0)[:, None, None]
+        circle = (self.ring[None, :, :1] * x[:, None, :] + self.ring[None, :, 1:] * z[:, None, :]) * r  # (n, sides, 3)
+        base = np.where(ok[:, None], starts, 0.0)[:, None, :]
+        top = np.where(ok[:, None], ends, 0.0)[:, None, :]
+        np.add(base, circle, out=self._points[:, 0])
+        np.add(top, circle, out=self._points[:, 1])
+        self.mesh.GetPoints().Modified()

@@ -26,6 +26,19 @@ relative to the root, m/s, measured at the clip's own frame rate) and
 Learning (§5.2.3, §7.3): :meth:`Posegraph.learn` adds an observed path as a new
 movement (new nodes from the observed poses, entered from and returning to the
 hub), and :meth:`Posegraph.play_path` plays any path.
+
+Learning from repeated demonstrations (§7.3: "The problem of distinguishing genuinely novel movements could be
+lessened through repeated demonstration and observation. This would allow the observing character to develop a model
+of the new movement, allowing for more reliable comparisons"): a learned movement keeps its *takes*, the
+demonstrations it was learned from. Each later demonstration recognised as it (announced through the
+``likeme_movement_recognised`` hook, :func:`likeme_movement_recognised`) is one more take, up to ``takes``; the
+movement is then learned again from the takes together (:meth:`Posegraph.learn_takes`, also callable with several
+takes at once): its path is their *mean*, the DTW barycentre of the takes (Petitjean et al. 2011,
+:func:`dtaidistance.dtw_barycenter.dba_loop`, started from the take nearest the others), and each take stays in the
+graph as a path of the same movement, so a demonstration is compared with the typical path and with the ways it was
+seen performed, as clips of one movement are. Its *spread* is the mean eq. 1 distance of the takes from the mean
+path, aligned. The movement is performed along the mean path. With ``takes = 1`` a movement is what its first
+demonstration showed (the paper's learning).
 """
 
 from __future__ import annotations
@@ -58,6 +71,9 @@ class Posegraph(MotorSystem):
                   "(false: every path leaves through a hub, the paper's posegraph)."),
         Parameter("node_rate", float, 10.0, "Pose nodes per second of movement: the graph's resolution. Higher "
                   "recognises finer timing at the cost of search time.", minimum=1.0, maximum=120.0),
+        Parameter("takes", int, 3, "Demonstrations a learned movement is made from (§7.3): each later one recognised as "
+                  "it is one more take, until this many, and its path is the takes' mean (DTW barycentre); 1: the "
+                  "first demonstration alone (the paper's learning).", minimum=1, maximum=50),
     )
 
     def attach(self, owner: Any) -> None:
@@ -97,6 +113,8 @@ class Posegraph(MotorSystem):
         clips = self.clips.clips if self.clips is not None else ()
         for clip in clips:
             self._add_clip(clip.movement, clip.motion, rows)
+        for name, entry in getattr(self, "learned", {}).items():  # what it learned by watching, again
+            self._add_learned(name, entry, rows)
         self._set_rows(rows)
 
     def _set_rows(self, rows: _NodeRows) -> None:
@@ -234,7 +252,7 @@ class Posegraph(MotorSystem):
 
     def learn(self, name: str, poses: np.ndarray, visible: np.ndarray | None = None, *, source: str = "",
               announce: bool = True) -> list[str]:
-        """Add an observed movement as a new path through new nodes (§5.2.3, §7.3).
+        """Add an observed movement as a new path through new nodes (§5.2.3, §7.3): its first take.
 
         Parameters
         ----------
@@ -247,50 +265,114 @@ class Posegraph(MotorSystem):
 
         Returns the new path.
         """
+        return self.learn_takes(name, [poses], None if visible is None else [visible], source=source, announce=announce)
+
+    def learn_takes(self, name: str, takes: list[np.ndarray], visible: list[np.ndarray | None] | None = None, *,
+                    source: str = "", announce: bool = True, mean: np.ndarray | None = None) -> list[str]:
+        """Learn a new movement from several demonstrations at once (§7.3): its path is their mean, each stays a take.
+
+        ``takes``: each an array (K_i, P, 3) as :meth:`learn` takes one (root-relative, at ``node_rate``, the first
+        and last frames the hub); ``visible`` their masks. At most ``takes`` of them are kept (the first ones).
+        ``mean``: the mean path's interior poses (M, P, 3), root-relative, when known (a saved state); else made from
+        the takes. Returns the movement's (mean) path.
+        """
         if name in self.paths or name in self.movements():
             raise ConfigError(f"movement {name!r} already exists", expected="a new movement name", available=self.movements())
+        if not takes:
+            raise ValueError("nothing to learn: no take")
+        visible = list(visible) if visible is not None else [None] * len(takes)
+        interiors = [self._interior(t, v) for t, v in zip(takes, visible)][: self.params["takes"]]
+        self.learned[name] = {"source": source, "takes": interiors}
+        self._settle(name, mean)
+        if announce and self.owner is not None:
+            self.owner.announce("likeme_movement_learned", character=self.owner, movement=name,
+                                details=self._learned_details(name))
+        return self.paths[name]
+
+    def add_take(self, name: str, poses: np.ndarray, visible: np.ndarray | None = None, *, announce: bool = True
+                 ) -> bool:
+        """One more demonstration of the learned movement ``name`` (poses as :meth:`learn` takes them): it becomes a
+        take and the movement's path the mean of its takes. False (nothing changes) when the movement already has
+        ``takes`` takes, or this one shows nothing between the hubs."""
+        entry = self.learned.get(name)
+        if entry is None:
+            raise ConfigError(f"no learned movement {name!r}", expected="a movement learned by watching",
+                              available=sorted(self.learned))
+        if len(entry["takes"]) >= self.params["takes"]:
+            return False
+        try:
+            entry["takes"].append(self._interior(poses, visible))
+        except ValueError:
+            return False
+        self._settle(name)
+        if announce and self.owner is not None:
+            self.owner.announce("likeme_movement_learned", character=self.owner, movement=name,
+                                details=self._learned_details(name))
+        return True
+
+    def _interior(self, poses: np.ndarray, visible: np.ndarray | None) -> np.ndarray:
+        """A demonstration's poses between its hub ends, root-relative, each hidden part filled from the nearest
+        node over the visible ones (K, P, 3)."""
         poses = np.asarray(poses, dtype=float)
         if visible is None:
             visible = np.isfinite(poses).all(axis=-1)
-        root = self.body.root_index
-        rest_root = self.rest_pose()[root]
+        visible = np.asarray(visible, dtype=bool) & np.isfinite(poses).all(axis=-1)
         interior = []
         for pose, vis in zip(poses[1:-1], visible[1:-1]):
             if not vis.any():
                 continue
             if not vis.all():
-                from plugins.lib.pose_distance import pose_distance
-
                 nearest = int(np.nanargmin(pose_distance(self.node_root_relative, np.nan_to_num(pose), vis)))
                 pose = np.where(vis[:, None], pose, self.node_root_relative[nearest])
-            interior.append(pose + rest_root)
+            interior.append(pose)
         if not interior:
             raise ValueError("nothing to learn: no visible pose between the hubs")
-        interior = np.stack(interior)
-        rows = _NodeRows.of(self)
-        motion = derivative(interior - interior[:, root : root + 1], self.params["node_rate"])
-        self._add_path(name, self.hubs[0], interior, self.hubs[0], rows, np.zeros((len(interior), 3)), motion,
-                       np.full(len(interior), np.nan))
-        self._set_rows(rows)
-        self.learned[name] = {"nodes": len(interior), "source": source}
-        if announce and self.owner is not None:
-            self.owner.announce("likeme_movement_learned", character=self.owner, movement=name, details=dict(self.learned[name]))
-        return self.paths[name]
+        return np.stack(interior)
+
+    def _settle(self, name: str, mean: np.ndarray | None = None) -> None:
+        """The learned movement's mean path (made from its takes unless given) and spread, and the graph made again
+        with them."""
+        entry = self.learned[name]
+        entry["mean"], entry["spread"] = mean_path(entry["takes"], mean)
+        self._build()
+
+    def _add_learned(self, name: str, entry: dict[str, Any], rows: _NodeRows) -> None:
+        """A learned movement's paths: its mean path (named as the movement), and with several takes each take
+        (``NAME/take-K``), all labelled with the movement; from the hub and back, travelling nowhere, each node's
+        parts' motion from the path's own poses, its turn not known."""
+        lift = self.rest_pose()[self.body.root_index]
+        hub = self.hubs[0]
+        root = self.body.root_index
+        paths = [(f"{name}/take-{k}", take) for k, take in enumerate(entry["takes"], 1)] if len(entry["takes"]) > 1 \
+            else []
+        for path, poses in (*paths, (name, entry["mean"])):
+            motion = derivative(poses - poses[:, root : root + 1], self.params["node_rate"])
+            self._add_path(path, hub, poses + lift, hub, rows, np.zeros((len(poses), 3)), motion,
+                           np.full(len(poses), np.nan), label=name)
+
+    def _learned_details(self, name: str) -> dict[str, Any]:
+        entry = self.learned[name]
+        return {"nodes": len(entry["mean"]), "source": entry["source"], "takes": len(entry["takes"]),
+                "spread": round(float(entry["spread"]), 6)}
 
     def get_state(self) -> dict[str, Any]:
-        """The learned movements: for each, its interior node poses (local frame) and where it came from."""
+        """The learned movements: for each, where it came from and its takes (interior node poses, root-relative
+        and lifted to the rest root as the graph holds them); the mean path and spread follow from the takes."""
+        lift = self.rest_pose()[self.body.root_index]
         return {
             "learned": {
                 name: {
-                    "source": info["source"],
-                    "poses": self.node_poses[[self.node_index(n) for n in self.paths[name][1:-1]]].round(6).tolist(),
+                    "source": entry["source"],
+                    "poses": (entry["mean"] + lift).round(6).tolist(),
+                    "takes": [(take + lift).round(6).tolist() for take in entry["takes"]],
                 }
-                for name, info in self.learned.items()
+                for name, entry in self.learned.items()
             }
         }
 
     def set_state(self, state: dict[str, Any], *, check: bool = False) -> None:
-        """Learn the saved movements (new names only); every entry is checked before the first is learned."""
+        """Learn the saved movements (new names only) from their takes (a state of one path only: that path, one
+        take); every entry is checked before the first is learned."""
         if not isinstance(state, dict):
             raise ConfigError("invalid posegraph state", expected="a table {learned = ...}")
         for key in state:
@@ -300,8 +382,6 @@ class Posegraph(MotorSystem):
         if not isinstance(learned, dict):
             raise ConfigError("invalid learned movements", key=("learned",),
                               expected="a table of learned movements by name")
-        root = self.body.root_index
-        shape = f"an array of shape (nodes >= 1, {self.body.n_parts}, 3) of finite numbers (metres, below 1e6)"
         known = set(self.paths) | set(self.movements())
         plans = []
         for name, entry in learned.items():
@@ -311,25 +391,40 @@ class Posegraph(MotorSystem):
                                   expected="a movement the character does not know yet", available=sorted(known))
             if not isinstance(entry, dict) or not isinstance(entry.get("source", ""), str):
                 raise ConfigError(f"invalid learned movement {name!r}", key=key,
-                                  expected="{source = text, poses = ...}")
+                                  expected="{source = text, poses = ..., takes = [...]}")
             for k in entry:
-                if k not in ("source", "poses"):
+                if k not in ("source", "poses", "takes"):
                     raise ConfigError(f"unknown key {k!r}", key=(*key, k), expected="a learned movement's key",
-                                      available=["source", "poses"])
-            try:
-                poses = np.asarray(entry.get("poses"), dtype=float)
-            except (TypeError, ValueError, OverflowError):
-                poses = np.zeros(0)
-            if (poses.ndim != 3 or poses.shape[1:] != (self.body.n_parts, 3) or not len(poses)
-                    or not np.isfinite(poses).all() or np.abs(poses).max() >= 1e6):
-                raise ConfigError(f"invalid poses of learned movement {name!r}", key=(*key, "poses"), expected=shape)
-            plans.append((name, poses, entry.get("source", "")))
+                                      available=["source", "poses", "takes"])
+            poses = self._state_poses(entry.get("poses"), (*key, "poses"), name)
+            takes = entry.get("takes")
+            if takes is None:
+                takes = [poses]
+            elif not isinstance(takes, list) or not takes:
+                raise ConfigError(f"invalid takes of learned movement {name!r}", key=(*key, "takes"),
+                                  expected="a list of takes, each an array of poses")
+            else:
+                takes = [self._state_poses(t, (*key, "takes", i), name) for i, t in enumerate(takes)]
+            plans.append((name, poses, takes, entry.get("source", "")))
         if check:
             return
+        root = self.body.root_index
         hub = self.rest_pose() - self.rest_pose()[root]
-        for name, poses, source in plans:
-            interior = poses - self.rest_pose()[root]  # learn() stores root-relative poses lifted to the rest root
-            self.learn(name, np.concatenate([[hub], interior, [hub]]), source=source, announce=False)
+        for name, mean, takes, source in plans:
+            lift = self.rest_pose()[root]  # held lifted to the rest root, as the graph holds them
+            self.learn_takes(name, [np.concatenate([[hub], t - lift, [hub]]) for t in takes], source=source,
+                             announce=False, mean=mean - lift)
+
+    def _state_poses(self, value: Any, key: tuple, name: str) -> np.ndarray:
+        shape = f"an array of shape (nodes >= 1, {self.body.n_parts}, 3) of finite numbers (metres, below 1e6)"
+        try:
+            poses = np.asarray(value, dtype=float)
+        except (TypeError, ValueError, OverflowError):
+            poses = np.zeros(0)
+        if (poses.ndim != 3 or poses.shape[1:] != (self.body.n_parts, 3) or not len(poses)
+                or not np.isfinite(poses).all() or np.abs(poses).max() >= 1e6):
+            raise ConfigError(f"invalid poses of learned movement {name!r}", key=key, expected=shape)
+        return poses
 
     def describe(self) -> dict[str, Any]:
         return {
@@ -339,6 +434,7 @@ class Posegraph(MotorSystem):
             "edges": self.graph.number_of_edges(),
             "hubs": list(self.hubs),
             "learned": sorted(self.learned),
+            "takes": {name: len(entry["takes"]) for name, entry in self.learned.items()},
         }
 
 
@@ -349,12 +445,6 @@ class _NodeRows:
         self.blocks: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
         self.count = 0
 
-    @classmethod
-    def of(cls, graph: Posegraph) -> _NodeRows:
-        rows = cls()
-        rows.add(graph.node_poses, graph.node_travel, graph.node_motion, graph.node_heading)
-        return rows
-
     def add(self, poses: np.ndarray, travel: np.ndarray, motion: np.ndarray, heading: np.ndarray) -> None:
         self.blocks.append((np.asarray(poses, dtype=float), np.asarray(travel, dtype=float),
                             np.asarray(motion, dtype=float), np.asarray(heading, dtype=float)))
@@ -362,6 +452,55 @@ class _NodeRows:
 
     def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         return tuple(np.concatenate(column) for column in zip(*self.blocks))  # type: ignore[return-value]
+
+
+def mean_path(takes: list[np.ndarray], mean: np.ndarray | None = None) -> tuple[np.ndarray, float]:
+    """The mean of several takes of one movement (each (K_i, P, 3)), and their spread (m).
+
+    The mean is the DTW barycentre of the takes (:func:`dtaidistance.dtw_barycenter.dba_loop`, every pose flattened
+    to one vector), started from the take with the least summed DTW distance to the others (the medoid), so it has
+    that take's length; or ``mean`` when given. The spread is the mean, over the takes, of the mean eq. 1 distance
+    between each take's poses and the mean poses they are aligned with. One take is its own mean, of spread 0.
+    """
+    from dtaidistance import dtw_barycenter, dtw_ndim
+
+    takes = [np.asarray(t, dtype=float) for t in takes]
+    if len(takes) == 1 and mean is None:
+        return takes[0].copy(), 0.0
+    shape = takes[0].shape[1:]
+    flat = [np.ascontiguousarray(t.reshape(len(t), -1)) for t in takes]
+    if mean is None:
+        total = [sum(dtw_ndim.distance(a, b) for b in flat) for a in flat]
+        start = flat[int(np.argmin(total))]
+        mean = np.asarray(dtw_barycenter.dba_loop(flat, c=start.copy(), max_it=10, use_c=False), dtype=float)
+    else:
+        mean = np.ascontiguousarray(np.asarray(mean, dtype=float).reshape(len(mean), -1))
+    spreads = []
+    for t in flat:
+        pairs = np.array(dtw_ndim.warping_path(t, mean))
+        spreads.append(float(np.mean(pose_distance(t[pairs[:, 0]].reshape(-1, *shape), mean[pairs[:, 1]].reshape(-1, *shape)))))
+    return mean.reshape(-1, *shape), float(np.mean(spreads))
+
+
+@hookimpl
+def likeme_movement_recognised(world: Any, observer: Any, target: Any, segment: Any, match: Any) -> None:
+    """A later demonstration of a movement the observer's posegraph learned by watching is one more take of it
+    (§7.3, :meth:`Posegraph.add_take`): the segment's root-relative poses from working memory, sampled at the
+    node rate. The demonstration that taught the movement (``details["learned"]``) is its first take already."""
+    motor = getattr(getattr(observer, "character", None), "motor", None)
+    if (not isinstance(motor, Posegraph) or segment is None or not match.known or match.movement not in motor.learned
+            or match.details.get("learned") or observer.memory is None):
+        return
+    memory = observer.memory
+    start, stop = max(segment.start, memory.offset), min(segment.end, memory.n)
+    if stop - start < 3:
+        return
+    motion = memory.motion(start, stop)
+    t = np.arange(motion.n_frames) / motion.fps
+    keep = np.unique(np.clip(np.round(np.arange(0.0, t[-1] + 1e-9, 1.0 / motor.node_rate) * motion.fps), 0,
+                             motion.n_frames - 1).astype(int))
+    if len(keep) >= 3:
+        motor.add_take(match.movement, motion.positions[keep], motion.visible[keep])
 
 
 @hookimpl

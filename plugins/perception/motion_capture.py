@@ -1,7 +1,8 @@
 """Perception ``motion-capture``: every part of the target, exactly, as a tracking suit reports it.
 
 The perfect-input baseline for the perception stage: no field of view, no
-occlusion, no noise. The world positions are converted to root-relative
+occlusion, no noise. Objects are tracked too, exactly, and known by their look (colour and size,
+:mod:`plugins.perception.object_looks`) under the observer's own names, as the vision perceptions know them. The world positions are converted to root-relative
 coordinates with the facing found from the body's facing parts (Buchsbaum &
 Blumberg 2005, §5.1, see :mod:`plugins.lib.root_frame`), so the result is what the
 ``synthetic-vision`` perception gives when nothing is hidden.
@@ -12,6 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from plugins.lib.root_frame import HeadingFilter, root_relative
+from plugins.perception.object_looks import rgb_of
+from plugins.perception.object_tracking import OBJECT_PARAMETERS, Detections, tracker_for
 from toolkit import Parameter, Percept, Perception, hookimpl
 
 
@@ -24,10 +27,16 @@ class MotionCapture(Perception):
         Parameter("facing_window", float, 3.0, "Seconds over which the target's facing is a running median "
                   "(steady through kicks and head turns; a real turn is followed after half of it; 0: every "
                   "frame on its own).", minimum=0.0, maximum=60.0),
+        *OBJECT_PARAMETERS,
     )
+
+    def attach(self, owner) -> None:
+        super().attach(owner)
+        self._objects = tracker_for(self.params)  # checks the looks now, at the character's load
 
     def reset(self, fps: float) -> None:
         self._facing = HeadingFilter(round(self.params["facing_window"] * fps))
+        self._objects = tracker_for(self.params, fps)
 
     def _smooth(self, headings: np.ndarray) -> np.ndarray:
         """The facing's running median over the frames so far (made by :meth:`reset`)."""
@@ -40,9 +49,10 @@ class MotionCapture(Perception):
 
     def perceive(self, observer, target, world) -> Percept:
         percept = self.perceive_pose(target.world_pose(), None, target.body, world.time)
-        objects = {name: obj.position.copy() for name, obj in world.objects.items()}
-        kinds = {name: obj.kind for name, obj in world.objects.items()}
-        sizes = {name: float(obj.radius) for name, obj in world.objects.items()}
+        shown = list(world.objects.values())  # every object's marker: where, how big, what colour (not its name or kind)
+        objects, kinds, sizes = self._objects.update(Detections(
+            np.array([o.position for o in shown], dtype=float).reshape(-1, 3), np.array([o.radius for o in shown], dtype=float),
+            np.array([rgb_of(o.colour) for o in shown], dtype=float).reshape(-1, 3)))
         return Percept(percept.time, percept.pose, percept.visible, percept.world, percept.root, percept.heading, objects,
                        kinds, sizes)
 

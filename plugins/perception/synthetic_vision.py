@@ -1,4 +1,4 @@
-"""Perception ``synthetic-vision``: what the observer's eye can see of the target.
+"""Perception ``synthetic-vision``: what the observer's eye can see of the target, found by geometry (the fast setting).
 
 Buchsbaum & Blumberg 2005, §4.2 and §5.1. The observer sees the target's
 colour-coded body parts from its own eye: only parts inside its field of view
@@ -10,8 +10,10 @@ and converts what it sees to root-relative coordinates.
 
 This plugin computes visibility geometrically: every part and object is a
 sphere, and a part is occluded when the line of sight from the eye to it passes
-through a nearer sphere. (``rendered-vision`` will render the colour-coded image
-and read it back, as the paper does.) Optional Gaussian noise and random
+through a nearer sphere. ``rendered-vision`` renders the colour-coded image and reads it back, as the paper does
+(the B&B characters' default); this one is its fast geometric stand-in. Objects are seen as what they look like
+(their colour and size, :mod:`plugins.perception.object_looks`) and named by the observer
+(:mod:`plugins.perception.object_tracking`), never by what the world calls them. Optional Gaussian noise and random
 dropouts make the input as bad as real vision; a sensory buffer
 (:mod:`plugins.perception.sensory_buffer`) bridges dropouts shorter than ``buffer`` seconds.
 """
@@ -23,11 +25,13 @@ from typing import Any
 import numpy as np
 
 from plugins.lib.root_frame import HeadingFilter, root_relative
+from plugins.perception.object_looks import rgb_of
+from plugins.perception.object_tracking import OBJECT_PARAMETERS, Detections, ObjectTracker, tracker_for
 from plugins.perception.sensory_buffer import SensoryBuffer
 from toolkit import ConfigError, Parameter, Percept, Perception, hookimpl
 from toolkit.motion import facing_vector
 
-__all__ = ["SyntheticVision", "appearance", "line_of_sight_blocked"]
+__all__ = ["SyntheticVision", "line_of_sight_blocked"]
 
 
 def line_of_sight_blocked(eye: np.ndarray, targets: np.ndarray, target_radii: np.ndarray,
@@ -84,6 +88,7 @@ class SyntheticVision(Perception):
                   "(steady through kicks and head turns; a real turn is followed after half of it; 0: every "
                   "frame on its own).", minimum=0.0),
         Parameter("seed", int, 0, "Seed of noise and dropouts."),
+        *OBJECT_PARAMETERS,
     )
 
     def attach(self, owner: Any) -> None:
@@ -93,12 +98,14 @@ class SyntheticVision(Perception):
             if isinstance(r, bool) or not isinstance(r, (int, float)) or r < 0:
                 raise ConfigError(f"invalid radius {r!r}", key=("radii", part), expected="a radius in metres >= 0")
         self._facing: HeadingFilter | None = None  # made by reset(fps), when watching begins
+        self._objects: ObjectTracker = tracker_for(self.params)  # checks the looks now, at the character's load
 
     def reset(self, fps: float) -> None:
         self._rng = np.random.default_rng(self.params["seed"])
         self._fps = float(fps)
         self._buffer: SensoryBuffer | None = None
         self._facing = HeadingFilter(round(self.params["facing_window"] * fps))
+        self._objects = tracker_for(self.params, fps)  # a new stream: the objects are named afresh
 
     def _radii(self, body: Any) -> np.ndarray:
         """Sphere radius of every part; 0 for fingers, which are joint angles carried by a wrist, not places."""
@@ -123,34 +130,38 @@ class SyntheticVision(Perception):
         seen = np.where(angles, seen[body.carriers], seen)
         return np.where(angles[:, None] & seen[:, None], truth, positions), seen
 
-    def look(self, observer: Any, target: Any, world: Any) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
+    def look(self, observer: Any, target: Any, world: Any) -> tuple[np.ndarray, np.ndarray, Detections]:
         """What the eye gets now, before noise and dropouts: the target's part positions (P, 3), which of them it
-        sees (P,), and the objects it sees (name to position)."""
+        sees (P,), and the objects it sees (:class:`~plugins.perception.object_tracking.Detections`: where, how big,
+        what colour; never what the world calls them or what they are)."""
         truth = target.world_pose()
         positions = self._places(target.body, truth)
-        eye = observer.world_pose()[observer.body.index(self.params["eye"])]
+        eye = self.eye(observer)
         seen = self._in_view(eye, observer.heading, positions)
-        names = list(world.objects)
-        centres = np.array([world.objects[n].position for n in names]).reshape(-1, 3)
-        sizes = np.array([world.objects[n].radius for n in names])
-        objects_seen = self._in_view(eye, observer.heading, centres) if names else np.zeros(0, dtype=bool)
+        shown = [o for o in world.objects.values() if o.held_by != observer.id]  # not what the observer holds itself
+        centres = np.array([o.position for o in shown], dtype=float).reshape(-1, 3)
+        sizes = np.array([o.radius for o in shown], dtype=float)
+        objects_seen = self._in_view(eye, observer.heading, centres) if shown else np.zeros(0, dtype=bool)
         if self.params["occlusion"]:
             radii = self._radii(target.body)
             if seen.any():
-                others = np.array([world.objects[n].held_by != observer.id for n in names], dtype=bool)
-                all_centres = np.concatenate([positions, centres[others]])
-                all_radii = np.concatenate([radii, sizes[others]])
+                all_centres = np.concatenate([positions, centres])
+                all_radii = np.concatenate([radii, sizes])
                 same = np.zeros((len(positions), len(all_centres)), dtype=bool)
                 same[np.arange(len(positions)), np.arange(len(positions))] = True
                 seen &= ~line_of_sight_blocked(eye, positions, radii, all_centres, all_radii, same=same)
             if objects_seen.any():  # objects hidden behind the target's body
                 objects_seen &= ~line_of_sight_blocked(eye, centres, sizes, positions, radii)
-            if objects_seen.any() and len(names) > 1:  # and behind other objects (a screen, a box)
-                others = np.array([world.objects[n].held_by != observer.id for n in names], dtype=bool)
-                same = np.eye(len(names), dtype=bool)[:, others]
-                objects_seen &= ~line_of_sight_blocked(eye, centres, sizes, centres[others], sizes[others], same=same)
+            if objects_seen.any() and len(shown) > 1:  # and behind other objects (a screen, a box)
+                objects_seen &= ~line_of_sight_blocked(eye, centres, sizes, centres, sizes, same=np.eye(len(shown), dtype=bool))
         positions, seen = self._hand_percepts(target.body, truth, positions, seen)
-        return positions, seen, {n: centres[i].copy() for i, n in enumerate(names) if objects_seen[i]}
+        colours = np.array([rgb_of(o.colour) for o in shown], dtype=float).reshape(-1, 3)
+        return positions, seen, Detections(centres[objects_seen].copy(), sizes[objects_seen].copy(),
+                                           colours[objects_seen])
+
+    def eye(self, observer: Any) -> np.ndarray:
+        """Where the observer's eye is now (world, (3,))."""
+        return observer.world_pose()[observer.body.index(self.params["eye"])]
 
     def _in_view(self, eye: np.ndarray, heading: float, points: np.ndarray) -> np.ndarray:
         ray = points - eye
@@ -164,10 +175,11 @@ class SyntheticVision(Perception):
     def perceive(self, observer: Any, target: Any, world: Any) -> Percept:
         if self._facing is None:
             raise RuntimeError("perceive before reset(fps): an observer resets its perception when it begins watching")
-        positions, seen, objects = self.look(observer, target, world)
+        positions, seen, detections = self.look(observer, target, world)
         p = self.params
         if p["noise"] > 0:
             positions = positions + self._rng.normal(0.0, p["noise"], positions.shape)
+            detections.positions = detections.positions + self._rng.normal(0.0, p["noise"], detections.positions.shape)
         if p["dropout"] > 0:
             seen &= self._rng.random(len(seen)) >= p["dropout"]
         if self._buffer is None or len(self._buffer.last) != len(positions):
@@ -175,16 +187,23 @@ class SyntheticVision(Perception):
         positions, seen = self._buffer.update(positions, seen)
         # one frame (P, 3): the facing's running median takes this frame's estimate
         pose, mask, root, heading = root_relative(positions, seen, target.body, lambda h: self._facing.update(float(h)))
-        kinds, sizes = appearance(world, objects)
+        objects, kinds, sizes = self._objects.update(detections)
         return Percept(world.time, pose, mask, np.where(seen[:, None], positions, np.nan), root, float(heading), objects,
                        kinds, sizes)
+
+    def position_uncertainty(self, distance: np.ndarray | float) -> tuple[np.ndarray, np.ndarray]:
+        """The standard deviation (m) of a seen position at ``distance`` (m) from the eye, across the line of sight
+        and along it: the Gaussian ``noise`` both ways (the geometric eye is otherwise exact)."""
+        d = np.asarray(distance, dtype=float)
+        sigma = np.full(d.shape, float(self.params["noise"]))
+        return sigma, sigma.copy()
 
     def in_view(self, observer: Any, target: Any, world: Any, points: np.ndarray) -> np.ndarray:
         """Whether an object at each of ``points`` (n, 3) would be seen now: in the field of view and range, and
         (with ``occlusion``) not behind the target's body or an object, as :meth:`look` decides for the objects it
         sees."""
         points = np.asarray(points, dtype=float).reshape(-1, 3)
-        eye = observer.world_pose()[observer.body.index(self.params["eye"])]
+        eye = self.eye(observer)
         seen = self._in_view(eye, observer.heading, points)
         if self.params["occlusion"] and seen.any():
             parts = self._places(target.body, target.world_pose())
@@ -193,13 +212,6 @@ class SyntheticVision(Perception):
             radii = np.concatenate([self._radii(target.body), [o.radius for o in shown]])
             seen &= ~line_of_sight_blocked(eye, points, np.zeros(len(points)), centres, radii)
         return seen
-
-
-def appearance(world: Any, seen: dict[str, np.ndarray]) -> tuple[dict[str, str], dict[str, float]]:
-    """What each seen object looks like: its kind (colour-coded vision tells a cheese from a ball, B&B §4.2) and
-    its apparent radius."""
-    objects = world.objects
-    return ({n: objects[n].kind for n in seen if n in objects}, {n: float(objects[n].radius) for n in seen if n in objects})
 
 
 @hookimpl

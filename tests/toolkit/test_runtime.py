@@ -168,7 +168,12 @@ def test_percept_of_motion_capture_is_root_relative(pm, watch_scene):
     world = scenario.world
     world.step()
     max_, morris = world.actors["max"], world.actors["morris"]
-    percept = max_.character.perception.perceive(max_, morris, world)
+    from plugins.perception.motion_capture import MotionCapture
+
+    perception = MotionCapture()  # exact (Max's own eye is a camera, off by its pixels)
+    perception.attach(max_.character)
+    perception.reset(world.fps)
+    percept = perception.perceive(max_, morris, world)
     assert isinstance(percept, Percept)
     rest = morris.character.motor.rest_pose()
     np.testing.assert_allclose(percept.pose, rest - rest[morris.body.root_index], atol=1e-9)

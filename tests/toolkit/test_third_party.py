@@ -48,6 +48,12 @@ extends = "{CHARACTERS / 'max.toml'}"
 [segmenter]
 plugin = "stillness"
 hold = 0.3
+
+[perception]   # the exact geometric eye: this segmenter thresholds the raw speed between two frames, which a
+               # camera's pixels exceed once Max moves his head (imitating) and everything he sees shifts a little
+plugin = "synthetic-vision"
+eye = "head"
+radii = {{ head = 0.06, left_hand = 0.045, right_hand = 0.045 }}
 """
 
 

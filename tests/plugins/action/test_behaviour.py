@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import pytest
 
+from plugins.bench.behaviour import world_name
 from tests.conftest import CHARACTERS, make_plugin
 from toolkit import ConfigError, Trigger, create_plugin_manager, load_character, load_scenario
 from toolkit.manager import PluginInfo
@@ -93,7 +94,7 @@ def test_fig13_ambiguous_motion_the_height_of_the_food_decides(write):
     (first, d1), (second, d2) = match.candidates[:2]
     assert match.movement == first == "reach" and second == "jump" and d2 <= (1 + MARGIN) * d1  # the motion: a reach
     assert jump.known and jump.movement == "jump" and jump.path == ("satisfy_hunger", "get", "jump")
-    assert jump.object == "cheese" and jump.details["candidates"] == ["reach", "jump"]
+    assert jump.object == "cheese" and jump.details["candidates"][:2] == ["reach", "jump"]
     assert "satisfy_hunger > get > reach" in jump.details["tried"]  # tried first, impossible: the cheese is high
     # the same leap for cheese within reach: a reach
     world, (reach, _) = _variant(write, "reach_or_jump", ("position = [0.05, 0.88, 1.3]", "position = [0.05, 0.40, 1.3]"))
@@ -106,8 +107,9 @@ def test_fig13_ambiguous_motion_the_height_of_the_food_decides(write):
 
 def test_several_pieces_of_cheese_the_closest():
     """§6.1.2: without line of sight Max picks the one he would attend to: the closest."""
-    _, (reach, _) = run("several_cheeses")
-    assert reach.object == "near_cheese"
+    world, (reach, _) = run("several_cheeses")
+    assert reach.details["line_of_sight"] is None  # the screen hides Morris's head
+    assert world_name(world, "max", reach.object) == "near_cheese" and reach.object.startswith("cheese")
 
 
 def test_ice_cream_shrug_learn_identify():
@@ -117,24 +119,78 @@ def test_ice_cream_shrug_learn_identify():
     assert not first_reach.known and first_reach.movement == "reach"
     assert world.actors["max"].performed[0][1].movement == "shrug"
     assert first_eat.known and first_eat.details["learned"] == {"ice_cream": "food"}
-    assert first_eat.motivation == ("hunger",) and first_eat.object == "ice_cream_1"
+    assert first_eat.motivation == ("hunger",) and world_name(world, "max", first_eat.object) == "ice_cream_1"
     assert second_reach.known and second_reach.path == ("satisfy_hunger", "get", "reach")
-    assert second_reach.object == "ice_cream_2"
+    assert world_name(world, "max", second_reach.object) == "ice_cream_2"
     assert world.actors["max"].character.action.beliefs["ice_cream"] == "food"
 
 
-def test_failure_objects_close_together_give_the_wrong_motivation():
-    """§7.3.1: a natural mistake: the ball lies next to the cheese and Max goes by his habits."""
+def test_failure_objects_close_together_give_the_wrong_motivation(write):
+    """§7.3.1: a natural mistake: the ball lies next to the cheese. Max sees where Morris looks (no screen), but the
+    gaze he reads from the head and nose he sees is uncertain by a few degrees, both objects lie within that, and he
+    goes by his habits (he reaches to play more often): play, the ball. With the ball far from the cheese he is right."""
     world, (reach, _) = run("objects_close_together")
+    assert not any(o.kind == "screen" for o in world.objects.values())  # nothing hides Morris's head
     assert [r.object for _, r in world.actors["morris"].performed][0] == "cheese"
+    assert sorted(reach.details["in_sight"]) == ["ball", "cheese"] and reach.details["line_of_sight"] is None
     assert reach.path[0] == "play" and reach.object == "ball"
+    world, (reach, _) = _variant(write, "objects_close_together", ("position = [0.11, 0.40, 1.26]", "position = [-0.30, 0.40, 1.30]"))
+    assert list(reach.details["in_sight"]) == ["cheese"] and reach.details["line_of_sight"] == "cheese"
+    assert reach.path == ("satisfy_hunger", "get", "reach") and reach.object == "cheese"
+
+
+def test_a_cheese_above_a_ball_is_told_apart_by_the_height_of_the_gaze(write):
+    """§6.1.2 in 3D: the cheese lies above the ball, in the same direction from Morris; both are within his reach, so
+    only where his head and nose point up or down tells them apart, and Max concludes hunger and the cheese."""
+    world, (reach, _) = _variant(write, "objects_close_together",
+                                 ("position = [0.08, 0.40, 1.26]", "position = [0.10, 0.58, 1.26]"),
+                                 ("position = [0.11, 0.40, 1.26]", "position = [0.10, 0.28, 1.26]"))
+    assert [(r.movement, r.object) for _, r in world.actors["morris"].performed][0] == ("reach", "cheese")
+    assert reach.details["line_of_sight"] == "cheese" and "ball" not in reach.details["in_sight"]
+    assert reach.path == ("satisfy_hunger", "get", "reach") and reach.object == "cheese"
+
+
+def test_a_ball_painted_cheese_yellow_is_taken_for_cheese(write):
+    """B&B §4.2: Max knows things by their look, not by what they are. Playful Morris reaches for his ball, painted
+    cheese-yellow, and plays with it: Max takes it for a cheese (its colour is a cheese's and so is its size), says
+    why, and concludes hunger; the dance that follows, with no toy in sight, he cannot explain."""
+    world, (reach, dance) = _variant(write, "hungry_morris",
+                                     ("hunger = { level = 0.6, rate = 0.0 }\nplay = { level = 0.0, rate = 0.0 }",
+                                      "hunger = { level = 0.0, rate = 0.0 }\nplay = { level = 0.6, rate = 0.0 }"),
+                                     ('name = "cheese"\nkind = "cheese"', 'name = "ball"\nkind = "ball"'))
+    assert [(r.movement, r.object) for _, r in world.actors["morris"].performed] == [("reach", "ball"), ("dance", "ball")]
+    assert reach.known and reach.path == ("satisfy_hunger", "get", "reach") and reach.object == "cheese"
+    assert reach.details["seen_as"]["cheese"].startswith("cheese: colour #ffd700 is 0 from cheese (#ffd700")
+    assert world_name(world, "max", reach.object) == "ball"  # what it really was
+    assert dance.movement == "dance" and not dance.known
+    # painted as it is (red), the same ball is a ball, and Max is right
+    world, (reach, dance) = _variant(write, "hungry_morris",
+                                     ("hunger = { level = 0.6, rate = 0.0 }\nplay = { level = 0.0, rate = 0.0 }",
+                                      "hunger = { level = 0.0, rate = 0.0 }\nplay = { level = 0.6, rate = 0.0 }"),
+                                     ('name = "cheese"\nkind = "cheese"', 'name = "ball"\nkind = "ball"'),
+                                     ('colour = "#ffd700"', 'colour = "#ff4040"'))
+    assert reach.path == ("play", "get", "reach") and reach.object == "ball" and dance.known
+
+
+def test_a_toy_max_has_never_seen_is_learned_as_a_toy_by_its_look(write):
+    """§6.3 with a look Max does not know: a silver toy (no colour given: the world's default) is a thing of its
+    colour to him; he shrugs at the reach for it and learns from the dance that follows that such a thing is a toy."""
+    world, (reach, dance) = _variant(write, "hungry_morris",
+                                     ("hunger = { level = 0.6, rate = 0.0 }\nplay = { level = 0.0, rate = 0.0 }",
+                                      "hunger = { level = 0.0, rate = 0.0 }\nplay = { level = 0.6, rate = 0.0 }"),
+                                     ('name = "cheese"\nkind = "cheese"', 'name = "top"\nkind = "baton"'),
+                                     ('colour = "#ffd700"\n', ""))
+    assert [r.movement for _, r in world.actors["morris"].performed] == ["reach", "dance"]
+    assert not reach.known and world.actors["max"].performed[0][1].movement == "shrug"
+    assert dance.known and dance.object == "thing #c0c0c0" and dance.details["learned"] == {"thing #c0c0c0": "toy"}
+    assert world.actors["max"].character.action.beliefs["thing #c0c0c0"] == "toy"
 
 
 def test_failure_different_preferences_give_the_wrong_object():
     """§7.3.1: Morris goes for the biggest piece, Max identifies what he himself would do: the closest."""
     world, (reach, _) = run("different_preferences")
     assert world.actors["morris"].performed[0][1].object == "big_cheese"
-    assert reach.known and reach.object == "small_cheese"
+    assert reach.known and world_name(world, "max", reach.object) == "small_cheese"
 
 
 def test_failure_unknown_object_shrug():
@@ -150,7 +206,7 @@ def test_failure_perceptual_failure_shrug(write):
     assert [(r.movement, r.object) for _, r in world.actors["morris"].performed] == [("reach", "cheese"), ("eat", "cheese")]
     assert not reach.known and reach.movement == "reach"
     assert reach.details["tried"] == ["play > get > reach", "satisfy_hunger > get > reach"]
-    assert reach.details["objects_seen"] == ["box"]  # the cheese was never seen
+    assert reach.details["objects_seen"] == ["box"]  # the cheese was never seen (the box he knows by its look)
     assert world.actors["max"].performed[0][1].movement == "shrug"
     assert eat.known and eat.path == ("satisfy_hunger", "eat") and eat.object == "cheese"
     # without the box the same reach is understood: the failure is Max's perception, nothing else

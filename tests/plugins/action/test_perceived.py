@@ -6,6 +6,9 @@ The lying world: while Max's action system interprets and answers what he saw, t
 
 from __future__ import annotations
 
+import dataclasses
+import functools
+
 import numpy as np
 import pytest
 
@@ -80,9 +83,15 @@ def lying(method):
     return wrapped
 
 
+@functools.lru_cache(maxsize=None)
+def honest_run(name):
+    """What Max concludes in scenario ``name`` when nothing lies (run once per test session and worker)."""
+    return run(name)[1]
+
+
 @pytest.mark.parametrize("name", SCENARIOS)
 def test_max_concludes_the_same_when_the_world_lies(monkeypatch, name):
-    _, honest = run(name)
+    honest = honest_run(name)
     interpret, respond = lying(Hierarchical.interpret), lying(Hierarchical.respond)
     monkeypatch.setattr(Hierarchical, "interpret", interpret)
     monkeypatch.setattr(Hierarchical, "respond", respond)
@@ -90,6 +99,39 @@ def test_max_concludes_the_same_when_the_world_lies(monkeypatch, name):
     assert interpret.calls > 0 and respond.calls > 0  # the lie was told
     assert lied_to == honest
     assert honest  # there was something to conclude
+
+
+def lying_names(method):
+    """``method`` of the perception, called while the world's objects carry names and kinds that lie (a cheese
+    called "o3", of kind "rock"): only where they are, how big and what colour is true."""
+
+    def wrapped(self, observer, target, world, *args):
+        target.world_pose()  # the pose Morris shows this frame, his head turned to what he wants, before the lie
+        objects = world.objects
+        world.objects = {f"o{i}": dataclasses.replace(o, name=f"o{i}", kind="rock")
+                         for i, o in enumerate(objects.values())}
+        try:
+            wrapped.calls += 1
+            return method(self, observer, target, world, *args)
+        finally:
+            world.objects = objects
+
+    wrapped.calls = 0
+    return wrapped
+
+
+@pytest.mark.parametrize("name", SCENARIOS)
+def test_max_sees_objects_by_their_look_never_by_their_names_or_kinds(monkeypatch, name):
+    """B&B §4.2: Max knows an object by its colour and its size as seen; while he looks, the world's names and kinds
+    of its objects lie, and he concludes exactly what he concludes when they do not."""
+    from plugins.perception.rendered_vision import RenderedVision
+
+    perceive, in_view = lying_names(RenderedVision.perceive), lying_names(RenderedVision.in_view)
+    monkeypatch.setattr(RenderedVision, "perceive", perceive)
+    monkeypatch.setattr(RenderedVision, "in_view", in_view)
+    _, lied_to = run(name)
+    assert perceive.calls > 0
+    assert lied_to == honest_run(name) and lied_to
 
 
 def test_the_lying_world_would_catch_a_reader(monkeypatch):
@@ -109,10 +151,13 @@ def test_sightings_remember_last_seen_positions_and_forget_gone_objects():
     s.record(1, 0.0, {})  # hidden: still where it was last seen
     assert set(s.at(1)) == {"cheese"} and s.at(1)["cheese"].row == 0 and s.at(1)["cheese"].kind == "cheese"
     assert s.at(-1) == {}  # never seen before row 0: it does not exist
-    s.record(2, 0.0, {}, missed=["cheese"])  # not there where it should have been seen: gone
-    assert s.at(2) == {} and set(s.at(1)) == {"cheese"}
-    s.record(3, 0.0, {"cheese": [0, 0.3, 1]})  # seen again
-    assert np.allclose(s.at(3)["cheese"].position, [0, 0.3, 1])
+    s.record(2, 0.0, {}, missed=["cheese"])  # missed a moment after it was seen: it may have been carried off
+    assert set(s.at(2)) == {"cheese"}
+    for row in range(3, 7):  # missed for more than CARRIED (0.5 s): gone from then on
+        s.record(row, 0.0, {}, missed=["cheese"])
+    assert s.at(6) == {} and set(s.at(5)) == {"cheese"} and set(s.at(1)) == {"cheese"}
+    s.record(7, 0.0, {"cheese": [0, 0.3, 1]})  # seen again
+    assert np.allclose(s.at(7)["cheese"].position, [0, 0.3, 1])
 
 
 def test_sightings_are_bounded_and_keep_each_objects_last_sighting():
@@ -184,7 +229,7 @@ def test_max_perceives_morris_the_cheese_where_it_lay_and_then_in_his_hand():
     reach, eat = (e.data["segment"] for e in world.events_of("segment_found", "max"))
     before = perceived_objects(max_, morris, reach.start, reach.end - 1)
     assert set(before) == {"cheese"} and before["cheese"].held_by is None and before["cheese"].kind == "cheese"
-    assert np.allclose(before["cheese"].position, [0.08, 0.40, 1.26])  # where it lay (no noise in Max's vision)
+    assert np.allclose(before["cheese"].position, [0.08, 0.40, 1.26], atol=0.015)  # where it lay, as a camera sees
     during = perceived_objects(max_, morris, eat.start, eat.end - 1)
     assert during["cheese"].held_by == "morris"
     assert "cheese" not in max_.sightings.at(max_.memory.n - 1)  # eaten: not where Max should see it

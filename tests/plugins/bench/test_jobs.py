@@ -20,7 +20,7 @@ from toolkit.cli import main
 from toolkit.manager import create_plugin_manager
 
 SUB_COMMANDS = ("recognition", "segmentation", "stream", "sweep", "make-data", "bandai", "watch", "facilitation",
-                "memory", "posegraph", "startup", "vision", "fuzz", "scaling", "behaviour")
+                "memory", "posegraph", "startup", "vision", "fuzz", "scaling", "behaviour", "learning")
 """Every ``likeme bench`` sub-command (a test checks the list against the command's own)."""
 TIMED = ("memory", "posegraph", "startup", "vision", "scaling")
 """The sub-commands whose figures are timings or memory."""

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from plugins.lib.rendering import draw_bodies, frame_2d, hex_to_rgb, part_colours, plotter
-from tests.conftest import ROOT, STICK
+from tests.conftest import CHARACTERS, ROOT, STICK
 from toolkit import World, create_plugin_manager, load_character
 from toolkit.cli import main
 from toolkit.scenario import load_scenario
@@ -186,10 +186,12 @@ def test_rendered_vision_hides_a_part_behind_an_object_and_outside_the_field_of_
         assert seen.all()
         head = target.world_pose()[target.body.index("head")]
         eye = observer.world_pose()[observer.body.index("head")]
-        world.add_object(WorldObject("board", "board", position=eye + (head - eye) * 0.5, radius=0.15))
+        world.add_object(WorldObject("board", "board", position=eye + (head - eye) * 0.5, radius=0.15, colour="#336699"))
         _, seen, objects = vision.look(observer, target, world)
-        assert not seen[target.body.index("head")] and seen[target.body.index("lk")] and "board" in objects
-        np.testing.assert_allclose(objects["board"], eye + (head - eye) * 0.5, atol=0.03)
+        assert not seen[target.body.index("head")] and seen[target.body.index("lk")] and len(objects) == 1
+        np.testing.assert_allclose(objects.positions[0], eye + (head - eye) * 0.5, atol=0.03)
+        assert objects.radii[0] == pytest.approx(0.15, abs=0.02)  # its size as seen: the blob and its depth
+        np.testing.assert_array_equal(objects.colours[0], [0x33, 0x66, 0x99])
         observer.heading = np.pi  # turn away: nothing of the target is in view
         _, seen, _ = vision.look(observer, target, world)
         assert not seen.any()
@@ -197,19 +199,37 @@ def test_rendered_vision_hides_a_part_behind_an_object_and_outside_the_field_of_
         vision.close()
 
 
-def test_a_character_can_watch_with_rendered_vision(write):
+def test_max_watches_with_rendered_vision_and_synthetic_vision_is_the_fast_setting(write):
+    """Max's own perception is the colour-coded rendering (§4.2); the geometric synthetic vision, his eye, part radii
+    and looks kept, finds the same two movements."""
+    from plugins.perception.rendered_vision import RenderedVision
+    from tests.test_synthetic_vision import geometric
+
     pm = create_plugin_manager(autoload=False)
     scenario = load_scenario("jump_then_cover_face", pm)
-    max_ = scenario.world.actors["max"].character
-    from plugins.perception.rendered_vision import RenderedVision
-
-    max_.perception = RenderedVision(resolution=320, facing_window=max_.perception.params["facing_window"])
-    max_.perception.attach(max_)
-    max_.perception.reset(scenario.world.fps)  # watching had begun: the new perception starts a stream too
+    assert isinstance(scenario.world.actors["max"].character.perception, RenderedVision)
     world = scenario.run()
-    recognised = [e.data["match"].movement for e in world.events_of("movement_recognised", "max")]
-    max_.perception.close()
-    assert recognised == ["jump", "cover_face"]
+    assert [e.data["match"].movement for e in world.events_of("movement_recognised", "max")] == ["jump", "cover_face"]
+    text = (CHARACTERS / "scenarios" / "jump_then_cover_face.toml").read_text().replace('"../', f'"{CHARACTERS}/')
+    table = "".join(f"{k} = {_toml(v)}\n" for k, v in geometric(pm).items())
+    path = write("geometric.toml", text + "[actors.override.perception]\n" + table)
+    scenario = load_scenario(path, pm)
+    assert scenario.world.actors["max"].character.perception.name == "synthetic-vision"
+    world = scenario.run()
+    assert [e.data["match"].movement for e in world.events_of("movement_recognised", "max")] == ["jump", "cover_face"]
+
+
+def _toml(value):
+    """A value written as TOML (the few kinds a perception table holds)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return f'"{value}"'
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{k} = {_toml(v)}" for k, v in value.items()) + " }"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml(v) for v in value) + "]"
+    return repr(value)
 
 
 def test_a_third_party_view_registers_through_the_hook_and_draws(tmp_path):
@@ -242,3 +262,13 @@ def test_the_vision_benchmark_compares_both_perceptions_on_the_same_frames():
     rows = vision_benchmark(create_plugin_manager(autoload=False), "jump_then_cover_face", "max", [240], 20)
     assert [r["perception"] for r in rows] == ["synthetic-vision", "rendered-vision 240 px"]
     assert rows[1]["agreement"] > 0.9 and 0 < rows[1]["median_mm"] < 30 and rows[1]["ms_per_frame"] > 0
+
+
+def test_every_scenario_runs_with_either_eye_and_concludes_the_same():
+    """``likeme bench vision --scenarios`` on one scenario: Max's rendered eye and the geometric one in its place
+    find the same movements and behaviours about the same objects of the world."""
+    from plugins.bench.vision import scenario_benchmark
+
+    (row,) = scenario_benchmark(create_plugin_manager(autoload=False), ["cheese_or_ball"], repeats=1)
+    assert row["perception"] == "rendered-vision" and row["same"]
+    assert row["seconds"] > 0 and row["synthetic_seconds"] > 0
