@@ -64,6 +64,10 @@ PLAY_FPS = 30.0
 TRAVEL = 0.25
 """Seconds over which the root's velocity is averaged (:func:`plugins.lib.travel.body_velocity`'s window)."""
 
+BLOCK = 0.3
+"""Seconds of frames the watching loop's rows are taken in at once, live (three samples): the frame each answer is
+decided at stays the sample's; it is reported up to this much later, for a tenth of the work per frame."""
+
 RECENT = 0.5
 """Seconds over which a committed take's prediction is held to the threshold to tell a deviation."""
 
@@ -344,9 +348,8 @@ class Following:
         samples = watched.frames(rows)
         before = self.warping.samples
         means, ends, local = self.warping.advance(samples)
-        stills = np.concatenate([self._stills, [float(self.comparison.still(samples.take(slice(i, i + 1)))[0])
-                                                for i in range(len(rows))]])
-        self._stills = stills  # each sample's distance to standing still, one at a time: the same numbers
+        stills = np.concatenate([self._stills, self.comparison.still(samples)])  # each row on its own: the same
+        self._stills = stills  # numbers whatever the rows come in
         self._still = np.cumsum(stills) / np.arange(1, len(stills) + 1)  # whatever the rows come in
         events = []
         self._local = np.concatenate([self._local, local]) if len(self._local) else local
@@ -456,23 +459,27 @@ class Following:
 class Streaming:
     """:class:`Following` as the watching loop drives a streaming matcher (:class:`toolkit.components.Matcher`):
     ``begin`` at a segment's onset, ``observe`` after each frame, ``replay`` for rows given at once, ``conclude`` at
-    its end; each commitment or deviation at the frame it was decided."""
+    its end; each commitment or deviation at the frame it was decided (``Match.decided_at``), reported when the
+    rows are taken in (every :data:`BLOCK` seconds)."""
 
     def __init__(self, following: Following) -> None:
         self.following = following
         self.memory = None
         self.given = 0
+        self.block = 1
 
     def begin(self, memory) -> None:
         self.memory, self.given = memory, 0
         self.following.begin(memory.fps)
+        self.block = max(1, int(round(BLOCK * memory.fps)))
 
-    def _take(self, memory) -> list[tuple[int, Match]]:
-        """The rows of ``memory`` not given yet; what they decided, at their rows of working memory."""
+    def _take(self, memory, every: bool = False) -> list[tuple[int, Match]]:
+        """The rows of ``memory`` not given yet, once :data:`BLOCK` seconds of them have come (``every``: all of
+        them now); what they decided, at their rows of working memory."""
         if memory is not self.memory:
             self.begin(memory)
         n = memory.n
-        if n <= self.given:
+        if n <= self.given or (not every and n - self.given < self.block):
             return []
         world, visible = memory.world[self.given : n], memory.visible[self.given : n]
         self.given = n
@@ -497,8 +504,12 @@ class Streaming:
         if self.memory is None:  # concluded without having followed the segment: all of it now
             return self.following.match(motion)
         try:
+            late = self._take(self.memory, every=True)  # the rows not taken in yet
             with one_thread():
-                return self.following.conclude(motion.n_frames)
+                final = self.following.conclude(motion.n_frames)
+            if final is None and any(m is self.following.commitment for _, m in late):
+                return self.following.commitment  # committed in the last rows: not reported yet
+            return final
         finally:
             self.memory = None
 
