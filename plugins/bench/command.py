@@ -329,7 +329,7 @@ def likeme_register_commands(subparsers):
     p.add_argument("--targets", default="bvh,toml,profile,scenario,state,csv", help="comma-separated: bvh, toml, "
                    "profile, scenario, state, csv (default: all)")
     p.add_argument("--timeout", type=float, default=10.0, help="seconds a case may take (default: 10)")
-    p.add_argument("--memory", type=int, default=1024, help="address-space limit of the worker, MB (default: 1024)")
+    p.add_argument("--memory", type=int, default=1024, help="address space a case may add to the worker, MB (default: 1024; 0: no limit)")
     p.add_argument("--out", metavar="DIR", dest="out_dir", help="write every failing input and its stderr into this "
                    "folder (created if missing), to replay")
     p.add_argument("--quiet", action="store_true", help="no progress bar")

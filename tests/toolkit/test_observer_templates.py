@@ -119,6 +119,7 @@ def test_observe_and_bench_watch_with_the_template_named(data, write, capsys):
         extends = "observers/recordings"
         name = "strict"
         [matcher]
+        comparison = "poses"
         decision = "distance"
         [matcher.distance]
         max_distance = 1e-9

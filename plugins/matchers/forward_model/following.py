@@ -335,6 +335,9 @@ class Following:
         self.commitment: Match | None = None
         self.deviated = False
         self.means = np.full(len(self.prediction.chains), np.inf)
+        self.trace: list[tuple[int, np.ndarray]] = []  # each sample's frame and every movement's score then
+        self.committed_at: int | None = None  # frames seen when committed / when it deviated
+        self.deviated_at: int | None = None
 
     def add(self, world: np.ndarray, visible: np.ndarray, ended: bool = False) -> list[tuple[int, Match]]:
         """The next frames of the demonstration; what the forward models decide on the samples they complete, with
@@ -379,6 +382,7 @@ class Following:
     def _decide(self, frame: int, sample: int) -> Match | None:
         limit = self.decision.threshold()
         scores = self._scores(sample)
+        self.trace.append((frame, scores))
         order = np.argsort(scores, kind="stable")
         if self.committed is not None:
             if self.deviated:
@@ -389,6 +393,7 @@ class Following:
             other = float(np.min(np.delete(recent, index))) if len(recent) > 1 else np.inf
             if scores[index] > limit or mine > limit or mine >= LEAD * other:  # it fails, or another now leads
                 self.deviated = True  # it as far as it led when committed to
+                self.deviated_at = frame + 1
                 return Match(self.committed, 0.0, frame, stop=True, reason="deviation", score=mine,
                              threshold=limit, measure=self.decision.measure)
             return None
@@ -403,6 +408,7 @@ class Following:
         if progress < self.min_progress:
             return None
         self.committed = movement = self.movements[first]
+        self.committed_at = frame + 1
         ranked = tuple((self.movements[i], float(scores[i])) for i in order)
         self.commitment = Match(movement, max(0.0, 1.0 - score / limit) if 0 < limit < np.inf else 1.0, frame,
                                 candidates=ranked, score=score, threshold=limit, measure=self.decision.measure,
@@ -513,9 +519,19 @@ class Streaming:
         finally:
             self.memory = None
 
-    def inspect(self) -> dict[str, Any]:
+    def inspect(self, shown: int = 5) -> dict[str, Any]:
+        """The segment followed last, as the forward model's views read it: each movement's score at every sample
+        (``trace``, for the movements among the ``shown`` best at some sample), the commitment and when it came (frames
+        seen), whether and when it deviated, the threshold both are held to and what it measures."""
         f = self.following
-        scores = dict(zip(f.movements, (f._scores(len(f._still) - 1) if len(getattr(f, "_still", ())) else
-                                       np.full(len(f.movements), np.inf)).tolist()))
-        return {"committed": f.committed, "deviated": f.deviated, "scores": scores,
-                "threshold": f.decision.threshold()}
+        trace = getattr(f, "trace", [])
+        scores = trace[-1][1] if trace else np.full(len(f.movements), np.inf)
+        kept = sorted({int(i) for _, s in trace for i in np.argsort(s, kind="stable")[:shown] if np.isfinite(s[i])})
+        limit = f.decision.threshold()
+        return {"committed": f.committed, "committed_path": (f.committed,) if f.committed else (),
+                "deviated": f.deviated, "committed_at": getattr(f, "committed_at", None),
+                "deviated_at": getattr(f, "deviated_at", None), "scores": dict(zip(f.movements, scores.tolist())),
+                "trace": tuple((frame, {(f.movements[i],): float(s[i]) for i in kept if np.isfinite(s[i])})
+                               for frame, s in trace),
+                "threshold": limit, "deviation": limit, "measure": f.decision.measure, "unit": "",
+                "predicting": "the takes it learned"}

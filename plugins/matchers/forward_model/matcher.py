@@ -173,6 +173,9 @@ class ForwardModel(Matcher):
                     "anchors": {k: v.copy() for k, v in {**begun.anchors, **track.anchors}.items()}}
         memory = self.observation.memory
         return MappingProxyType({**view(self.main), "frames": 0 if memory is None else memory.n,
+                                 "threshold": self.params["threshold"], "deviation": self.params["deviation"],
+                                 "measure": "prediction error of the guiding strokes", "unit": " m",
+                                 "predicting": "the edges of the active node",
                                  "tracks": {name: view(track) for name, track in self.tracks.items()}})
 
     def observe(self, memory: WorkingMemory) -> Match | None:

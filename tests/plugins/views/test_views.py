@@ -203,7 +203,7 @@ def test_max_watches_with_rendered_vision_and_synthetic_vision_is_the_fast_setti
     """Max's own perception is the colour-coded rendering (§4.2); the geometric synthetic vision, his eye, part radii
     and looks kept, finds the same two movements."""
     from plugins.perception.rendered_vision import RenderedVision
-    from tests.test_synthetic_vision import geometric
+    from tests.plugins.perception.test_synthetic_vision import geometric
 
     pm = create_plugin_manager(autoload=False)
     scenario = load_scenario("jump_then_cover_face", pm)
