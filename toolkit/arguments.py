@@ -161,8 +161,8 @@ def observer_options(p: argparse.ArgumentParser) -> None:
     ``likeme bench``: ``--observer``, ``--correspondence``, ``--lengths-for-height`` and ``--set``."""
     p.add_argument("--observer", metavar="TEMPLATE", default=None,
                    help="the observer template: a TOML file or the name of one in characters/observers/ (default: "
-                   "recordings, the papers' observer; several-takes: real people, a repertoire of several takes "
-                   "of each movement; docs/correspondence.md)")
+                   "recordings, for real people; papers: the papers' own comparisons and decisions; "
+                   "docs/matchers.md)")
     p.add_argument("--correspondence", metavar="NAME", default="", help="correspondence (default: the observer "
                    "template's; none: the papers' plain observer)")
     p.add_argument("--lengths-for-height", type=number_type(0.0, 1000.0, "metres"), default=None, metavar="M",

@@ -189,7 +189,7 @@ def _why_unknown(observation: Any) -> dict[str, Any]:
     for key in ("score", "threshold"):
         value = getattr(match, key)
         if isinstance(value, (int, float)) and math.isfinite(value):
-            out[key] = round(float(value), 4)
+            out[key] = float(f"{float(value):.4g}")  # four significant digits: a threshold of 1e-9 stays one
     if match.measure and ("score" in out or "threshold" in out):
         out["measure"] = str(match.measure)
     return out

@@ -72,6 +72,17 @@ TIMING_NOTE = ("parallel workers share the machine's cores: each item is timed a
 """What ``--jobs`` says in the ``--help`` of a benchmark whose figures are timings or memory."""
 
 
+def _protocol(text: str) -> str:
+    """``--protocol``: closed, open, groups or takes:N (N >= 1)."""
+    name, _, takes = text.partition(":")
+    if name in ("closed", "open", "groups") and not takes:
+        return text
+    if name == "takes" and takes.isdigit() and int(takes) >= 1:
+        return f"takes:{int(takes)}"
+    raise argparse.ArgumentTypeError(f"{text!r} is not a protocol: closed, open, groups or takes:N (N >= 1 clips of "
+                                     "each movement as the repertoire)")
+
+
 def _scheduler(text: str) -> str:
     """``--scheduler``: ``local:N`` (N >= 1) or an address with a port (``tcp://HOST:PORT``, ``HOST:PORT``); whether
     a scheduler answers there is found when the benchmark connects (``plugins.bench.jobs``)."""
@@ -118,11 +129,12 @@ def _motion_capture_commands(sub: Any) -> None:
     p.add_argument("--demos", metavar="DIR", help="demo clips: one folder per true movement (not with --protocol "
                    "groups)")
     p.add_argument("--matcher", action="append", metavar="NAME", help=f"matcher (repeatable; default: {', '.join(MATCHERS)})")
-    p.add_argument("--protocol", choices=("closed", "open", "groups"), default="closed",
+    p.add_argument("--protocol", type=_protocol, default="closed", metavar="{closed,open,groups,takes:N}",
                    help="closed: every demo against the whole repertoire; open: the demos of each movement against "
                    "the repertoire without it (leave one movement out: only 'unknown' is right); groups: each group "
                    "of the repertoire's clips (--group) against a repertoire of the other groups (leave one group "
-                   "out: a style, a performer)")
+                   "out: a style, a performer); takes:N: the first N clips of each movement's folder (by name) as the "
+                   "repertoire, its other clips and every demo (--demos, optional) as demos")
     p.add_argument("--group", metavar="REGEX", help="with --protocol groups: a regular expression whose first "
                    "capture group, searched in a clip's file name, names its group")
     p.set_defaults(handler=_handler("mocap", "run", "recognition"))
@@ -317,7 +329,7 @@ def likeme_register_commands(subparsers):
     p.add_argument("--targets", default="bvh,toml,profile,scenario,state,csv", help="comma-separated: bvh, toml, "
                    "profile, scenario, state, csv (default: all)")
     p.add_argument("--timeout", type=float, default=10.0, help="seconds a case may take (default: 10)")
-    p.add_argument("--memory", type=int, default=1024, help="address-space limit of the worker, MB (default: 1024)")
+    p.add_argument("--memory", type=int, default=1024, help="address space a case may add to the worker, MB (default: 1024; 0: no limit)")
     p.add_argument("--out", metavar="DIR", dest="out_dir", help="write every failing input and its stderr into this "
                    "folder (created if missing), to replay")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -336,7 +348,7 @@ def likeme_register_commands(subparsers):
     p.add_argument("--segmenter", metavar="NAME", help="the observer's segmenter (default: the observer template's)")
     p.add_argument("--matcher", metavar="NAME", help="the observer's matcher (default: the template's)")
     p.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE", dest="settings",
-                   help="override an observer parameter, e.g. --set matcher.per_movement=false (repeatable; checked "
+                   help="override an observer parameter, e.g. --set matcher.search=k-best (repeatable; checked "
                    "when the observer is composed)")
     p.add_argument("--json", metavar="FILE", help="also write the results as JSON")
     p.set_defaults(handler=_handler("scaling", "cmd_scaling"))

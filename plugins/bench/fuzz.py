@@ -15,8 +15,10 @@ joint-position files. Case ``i`` of seed ``s`` mutates one seed with :func:`plug
 - ``state``: ``likeme run learn_windmill --load F --duration 1``;
 - ``csv``: ``toolkit.recordings.positions.read_positions(F, fps=30.0)``.
 
-Cases run one after another in one long-lived worker process that calls the ``likeme`` command's ``main`` in-process (:func:`command_line`), under
-``RLIMIT_AS`` of ``--memory`` MB; the parent kills and restarts it on a timeout or a crash. With ``--jobs N`` (or
+Cases run one after another in one long-lived worker process that calls the ``likeme`` command's ``main``
+in-process (:func:`command_line`), each with ``--memory`` MB of address space beyond what the worker holds when the
+case begins (``RLIMIT_AS``, set again before every case: a case's budget does not depend on which cases ran before it
+in the same worker); the parent kills and restarts it on a timeout or a crash. With ``--jobs N`` (or
 ``--scheduler``) blocks of cases run in N processes, each with a fuzz worker of its own; the results come back in
 the cases' order. Outcomes:
 
@@ -379,12 +381,17 @@ def _worker_main(memory_mb: int, warm: list[list[str]], stacks: str = "") -> Non
     with tempfile.TemporaryDirectory() as tmp:
         for argv in warm:  # import what the commands import before the memory limit and the first timeout
             run_one({"argv": argv, "cwd": tmp})
-    if memory_mb > 0:
-        limit = memory_mb * 1024 * 1024
-        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+    page = os.sysconf("SC_PAGE_SIZE")
     proto.write(json.dumps({"ready": True}) + "\n")
     for line in requests:
         request = json.loads(line)
+        if memory_mb > 0:  # the soft limit only: raised again for the next case (the code under test never does)
+            try:
+                with open("/proc/self/statm", encoding="ascii") as statm:
+                    held = int(statm.read().split()[0]) * page
+            except OSError:  # no /proc (not Linux): the limit counts from nothing
+                held = 0
+            resource.setrlimit(resource.RLIMIT_AS, (held + memory_mb * 1024 * 1024, resource.RLIM_INFINITY))
         result = run_one(request)
         try:
             proto.write(json.dumps(result) + "\n")

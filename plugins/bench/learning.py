@@ -95,7 +95,7 @@ def _trial(item: dict[str, Any], pm: Any) -> dict[str, Any]:
     for k in item["takes"]:
         max_ = load_character("max", pm, override={"motor": {"takes": max(item["takes"])}})  # keeps every take given
         matcher = max_.matcher
-        samples = [matcher.samples(t.onto(max_.body.parts), styled=False) for t in training[:k]]
+        samples = [matcher.samples(t.onto(max_.body.parts))[1] for t in training[:k]]
         max_.motor.learn_takes(NAME, [s[0] for s in samples], [s[1] for s in samples], source="bench", announce=False)
         matcher._refresh()
         answers = [matcher.match(t.onto(max_.body.parts)) for t in tests]

@@ -135,7 +135,12 @@ def _progress(items: list, label: str, quiet: bool):
     return progress_bar(items, label)
 
 
-PROTOCOLS = ("closed", "open", "groups")
+PROTOCOLS = ("closed", "open", "groups", "takes")
+
+
+def _finite(value: float | None) -> float | None:
+    """A matcher's score or threshold for a JSON row: six significant digits, or ``None`` where there is none."""
+    return float(f"{float(value):.6g}") if value is not None and np.isfinite(value) else None
 
 
 def recognition(pm, profile, repertoire: Path, demos: Path | None, matchers: Sequence[str], *, settings=None,
@@ -149,7 +154,10 @@ def recognition(pm, profile, repertoire: Path, demos: Path | None, matchers: Seq
     a movement the observer does not know and only "unknown" is right: the rejection rate; ``"groups"`` (leave one
     group out, no ``demos``) takes the repertoire's own clips, groups them by the first capture group of the
     regular expression ``group`` searched in each file's name (a style, a performer, a session), and classifies
-    each group's clips against a repertoire of every other group's clips. ``observer``: further arguments of
+    each group's clips against a repertoire of every other group's clips; ``"takes:N"`` takes the first N clips
+    of each movement's folder (sorted by name: takes recorded one after another) as the repertoire, and classifies
+    the folder's other clips and every demo (``demos``, optional) against it: what a user with N takes of each
+    movement has. ``observer``: further arguments of
     :func:`toolkit.observe.compose_observer` (``correspondence``, ``lengths_for_height``, ``template``).
     """
     observer, settings = dict(observer or {}), _with_clip_rate(settings, fps)
@@ -168,13 +176,15 @@ def recognition(pm, profile, repertoire: Path, demos: Path | None, matchers: Seq
                     truth.append(expected)
                     predicted.append(obs.movement or UNKNOWN)
                     fractions.append(obs.decision_fraction)
-                    details = obs.match.details if obs.match else {}
+                    match = obs.match
                     rows.append({"plugin": name, "item": path.name, "truth": expected, "movement": label,
                                  "group": run_group or "",
                                  "recognised": obs.movement or UNKNOWN,
-                                 "nearest": str(details.get("nearest", obs.movement or "")),
-                                 "reason": str(details.get("reason", "")),
-                                 "confidence": round(obs.match.confidence, 4) if obs.match else 0.0,
+                                 "nearest": str((match.nearest if match else None) or obs.movement or ""),
+                                 "reason": str(match.reason if match else ""),
+                                 "score": _finite(match.score if match else None),
+                                 "threshold": _finite(match.threshold if match else None),
+                                 "confidence": round(match.confidence, 4) if match else 0.0,
                                  "decision_fraction": round(obs.decision_fraction, 4), "frames": motion.n_frames})
                 frames, seconds = frames + clock.frames, seconds + clock.seconds
         labels = sorted(set(truth) | set(predicted))
@@ -197,11 +207,14 @@ UNKNOWN = "unknown"
 
 def _runs(profile, repertoire: Path, demos: Path | None, protocol: str, group: str | None, fps: float | None = None):
     """The protocol's runs: ((movement left out, files left out, group), [(label, path, motion)...]) each."""
-    if protocol not in PROTOCOLS:
+    name, _, takes = protocol.partition(":")
+    if name not in PROTOCOLS or (name == "takes") != bool(takes) or (takes and not takes.isdigit()):
         raise ConfigError(f"unknown protocol {protocol!r}", key=("protocol",), expected="a protocol",
-                          available=list(PROTOCOLS))
+                          available=["closed", "open", "groups", "takes:N"])
     if protocol == "groups":
         return _group_runs(profile, repertoire, group, fps)
+    if name == "takes":
+        return _take_runs(profile, repertoire, demos, int(takes), fps)
     if demos is None:
         raise ConfigError(f"protocol {protocol!r} needs demo clips", key=("demos",),
                           expected="--demos DIR: one folder of clips per true movement")
@@ -247,6 +260,21 @@ def _group_runs(profile, repertoire: Path, group: str | None, fps: float | None 
                           expected="at least two groups to leave one out", available=sorted(by_group))
     return [((None, frozenset(p for _, p in items), name), [(label, p, profile.read(p, fps)) for label, p in items])
             for name, items in sorted(by_group.items())]
+
+
+def _take_runs(profile, repertoire: Path, demos: Path | None, takes: int, fps: float | None = None):
+    """The first ``takes`` clips of each movement (by name) as the repertoire; its other clips and the demos as
+    demos."""
+    if takes < 1:
+        raise ConfigError(f"takes:{takes}", key=("protocol",), expected="takes:N with N >= 1")
+    left = [(label, path) for label, paths in clip_files(repertoire).items() for path in sorted(paths)[takes:]]
+    items = [(label, path, profile.read(path, fps)) for label, path in left]
+    if demos is not None:
+        items += [(label, path, profile.read(path, fps)) for label, path in _labelled(demos)]
+    if not items:
+        raise ConfigError(f"no clip to classify with takes:{takes}", file=repertoire,
+                          expected=f"movement folders of more than {takes} clips, or --demos DIR")
+    return [((None, frozenset(path for _, path in left), None), items)]
 
 
 @contextmanager

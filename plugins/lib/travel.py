@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["frame_rotation", "body_velocity", "travel_part"]
+__all__ = ["frame_rotation", "body_velocity", "travel_part", "turned"]
 
 
 def frame_rotation(world: np.ndarray, local: np.ndarray, visible: np.ndarray, root: int) -> np.ndarray:
@@ -46,6 +46,18 @@ def frame_rotation(world: np.ndarray, local: np.ndarray, visible: np.ndarray, ro
     s = (np.conj(np.where(ok, ca, 0)) * np.where(ok, cb, 0)).sum(axis=1)
     out = np.angle(s)
     out[np.abs(s) < 1e-12] = np.nan
+    return out
+
+
+def turned(world: np.ndarray, local: np.ndarray, visible: np.ndarray, root: int) -> np.ndarray:
+    """How far the body has turned since the first frame (radians about +y, unwrapped; NaN where its facing is
+    not known), from its world and body-frame positions (:func:`frame_rotation`)."""
+    angle = frame_rotation(world, local, visible, root)
+    known = np.isfinite(angle)
+    out = np.full(len(angle), np.nan)
+    if known.any():
+        unwrapped = np.unwrap(angle[known])
+        out[known] = unwrapped[0] - unwrapped  # the body's heading turns opposite to the frame rotation
     return out
 
 

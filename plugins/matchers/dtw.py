@@ -14,9 +14,15 @@ warping path; its square is divided by the summed lengths of the two series and
 the root taken again (a root-mean-square distance per frame, in metres), so that
 long and short templates compete fairly. (Dividing the root itself by the
 length, as earlier versions did, shrinks with the template's length and made the
-longest template nearest to everything.) A segment farther than
-``max_distance`` from every template is "unknown". Every movement is a ranked
-candidate (``Match.candidates``), by the distance of its nearest example.
+longest template nearest to everything.) Whether the nearest template is near
+enough is the matchers' shared decision (:mod:`plugins.matchers.decision`):
+``distance``, unknown beyond ``[matcher.distance] max_distance`` (0, the
+default: always the nearest, what a DTW 1-NN classifier answers), or
+``calibrated`` on the templates themselves (each left out of its movement and
+each movement left out, warped against the rest), its score the distance over
+the segment's own distance to standing still (the root-mean-square distance of
+its frames from their mean pose). Every movement is a ranked candidate
+(``Match.candidates``), by the distance of its nearest example.
 
 Speed (issue 22): with numba installed and no band, :func:`warp_all` warps the
 segment against every template in one compiled call, with dtaidistance's
@@ -32,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from plugins.lib.compiled import compiled
+from plugins.matchers.decision import Calibrated, Calibration, Decision, Distance
 from toolkit import Match, Matcher, Motion, Parameter, hookimpl
 
 __all__ = ["DTW", "frame_distance", "warp_all"]
@@ -171,8 +178,18 @@ class DTW(Matcher):
                   minimum=1),
         Parameter("window", float, 0.0, "Sakoe-Chiba band as a share of the longer series (0: no band).",
                   minimum=0.0, maximum=1.0),
-        Parameter("max_distance", float, 0.0, "Root-mean-square per-frame distance (m) above which a segment is unknown "
-                  "(0: always the nearest).", minimum=0.0, length=True),
+        Parameter("decision", str, "distance", "When the nearest template is 'unknown' (plugins.matchers.decision): "
+                  "'distance', beyond [matcher.distance] max_distance; 'calibrated', beyond a threshold calibrated on "
+                  "the templates themselves ([matcher.calibrated]).", choices=("distance", "calibrated")),
+        Parameter("distance", doc="The limit of decision = 'distance'.", parameters=(
+            Parameter("max_distance", float, 0.0, "Root-mean-square per-frame distance (m) above which a segment is "
+                      "unknown (0: always the nearest).", minimum=0.0, length=True),
+        )),
+        Parameter("calibrated", doc="The calibration of decision = 'calibrated'.", parameters=(
+            Parameter("known_rejected", float, 0.05, "The share of a known movement's performances that may be "
+                      "called unknown, as far as the repertoire's takes of one movement show how they vary.",
+                      minimum=0.0, maximum=1.0),
+        )),
     )
 
     def attach(self, owner: Any) -> None:
@@ -192,6 +209,48 @@ class DTW(Matcher):
         import dtaidistance.dtw_ndim  # noqa: F401  loaded when the observer is composed, not at the first match
 
         _kernel()
+        if self.params["decision"] == "calibrated":
+            self.decision: Decision = Calibrated(self.params["calibrated"]["known_rejected"])
+            self.decision.calibrate(self._calibration())
+        else:
+            self.decision = Distance(self.params["distance"]["max_distance"], MEASURE)
+
+    def _calibration(self) -> Calibration:
+        """Each template as a segment: against its movement's other templates (leave one take out) and against the
+        other movements' (leave one movement out), each over its distance to standing still."""
+        own, other = [], []
+        labels = np.array(self.labels, dtype=object)
+        for i, series in enumerate(self.templates):
+            distances = self._distances(series)
+            still = _still(series)
+            mine = labels == labels[i]
+            mine_others = mine.copy()
+            mine_others[i] = False
+            for out, chosen in ((own, mine_others), (other, ~mine)):
+                if chosen.any():
+                    out.append(float(distances[chosen].min()) / still if still > 0 else np.inf)
+        return Calibration.of(own, other)
+
+    def _distances(self, series: np.ndarray) -> np.ndarray:
+        """The root-mean-square distance per frame of ``series`` to every template after warping."""
+        prep = self._prepared()
+        window, n = self.params["window"], len(series)
+        templates = prep.templates
+        if prep.dropped is not None and not series[:, prep.dropped].any():
+            # the coordinates that are 0 in every template and in the segment (the root's, root-relative) add an
+            # exact +0.0 to each frame pair's sum of squares, taken in dtaidistance's order: left out, the same bits
+            series, templates = np.ascontiguousarray(series[:, prep.kept]), prep.reduced
+        lengths = n + prep.sizes
+        summed = np.empty(len(templates))
+        kernel = None if window else _kernel()
+        if kernel is not None:
+            # every example warped in full, in one call: each movement's nearest is the same example at the same
+            # distance as with early abandoning (an abandoned example is surely farther), so the same Match
+            columns, starts = prep.columns(templates is prep.reduced)
+            kernel(series, columns, starts, summed)
+        else:
+            self._warp_one_by_one(series, templates, prep, lengths, summed)
+        return np.sqrt(summed * summed / lengths)  # frame_distance of each template, element by element
 
     def _series(self, rel: np.ndarray) -> np.ndarray:
         series = rel[:: self.params["stride"]].reshape(-1, rel.shape[1] * 3)
@@ -234,30 +293,15 @@ class DTW(Matcher):
         # every part seen in every frame: nothing to fill (fill_hidden would copy the same coordinates)
         positions = np.asarray(motion.positions, dtype=float) if motion.visible.all() else motion.filled().positions
         series = self._series(positions)
-        window, n = self.params["window"], len(series)
-        templates = prep.templates
-        if prep.dropped is not None and not series[:, prep.dropped].any():
-            # the coordinates that are 0 in every template and in the segment (the root's, root-relative) add an
-            # exact +0.0 to each frame pair's sum of squares, taken in dtaidistance's order: left out, the same bits
-            series, templates = np.ascontiguousarray(series[:, prep.kept]), prep.reduced
-        lengths = n + prep.sizes
-        summed = np.empty(len(templates))
-        kernel = None if window else _kernel()
-        if kernel is not None:
-            # every example warped in full, in one call: each movement's nearest is the same example at the same
-            # distance as with early abandoning (an abandoned example is surely farther), so the same Match
-            columns, starts = prep.columns(templates is prep.reduced)
-            kernel(series, columns, starts, summed)
-        else:
-            self._warp_one_by_one(series, templates, prep, lengths, summed)
-        distances = np.sqrt(summed * summed / lengths)  # frame_distance of each template, element by element
+        distances = self._distances(series)
         best = int(np.argmin(distances))
         per_frame = float(distances[best])
-        limit = self.params["max_distance"] or None
-        if limit is not None and per_frame > limit:
-            return Match.unknown("too far from every example", nearest=prep.labels[best], score=per_frame,
-                                 threshold=limit, measure=MEASURE, details={"distance": per_frame})
         label = prep.labels[best]
+        verdict = self.decision.decide(label, per_frame, _still(series) if self.decision.relative else 1.0)
+        measure = self.decision.measure
+        if verdict.movement is None:
+            return Match.unknown("too far from every example", nearest=label, score=verdict.score,
+                                 threshold=verdict.threshold, measure=measure, details={"distance": per_frame})
         # each movement's nearest example (Fig. 13's ranked candidates), ranked by distance, ties by name
         nearest = np.minimum.reduceat(distances[prep.order], prep.starts)
         others = nearest.copy()
@@ -265,8 +309,15 @@ class DTW(Matcher):
         runner_up = float(others.min())
         confidence = float(1.0 - per_frame / runner_up) if np.isfinite(runner_up) and runner_up > 0 else 1.0
         ranked = sorted(zip(nearest.tolist(), prep.names.tolist()))
+        threshold = verdict.threshold if np.isfinite(verdict.threshold) else None
         return Match(label, max(0.0, confidence), None, details={"distance": per_frame, "runner_up": runner_up},
-                     candidates=tuple((lab, d) for d, lab in ranked), score=per_frame, threshold=limit, measure=MEASURE)
+                     candidates=tuple((lab, d) for d, lab in ranked), score=verdict.score, threshold=threshold,
+                     measure=measure)
+
+
+def _still(series: np.ndarray) -> float:
+    """A series' distance to standing still: the root-mean-square distance of its frames from their mean (m)."""
+    return float(np.sqrt(((series - series.mean(axis=0)) ** 2).sum(axis=1).mean())) if len(series) else 0.0
 
 
 class _Prepared:

@@ -45,12 +45,12 @@ from plugins.lib.guiding_stroke import GuidingStroke, progress
 from plugins.lib.hand_transition import HandTransition
 from plugins.lib.inverse_model import commands_from_segment
 from plugins.lib.strokes import StrokeCriteria, breaks
-from plugins.lib.travel import body_velocity
+from plugins.lib.travel import body_velocity, turned
 from plugins.motor.key_poses import parse_poses
 from toolkit import ConfigError, Motion, MotorSystem, Parameter, hookimpl
 from toolkit.motion import fill_hidden
 
-__all__ = ["MotorCommandGraph", "Edge", "place_elbows", "command_from_dict", "clip_travel"]
+__all__ = ["MotorCommandGraph", "Edge", "place_elbows", "command_from_dict", "clip_travel", "clip_turn"]
 
 Command = GuidingStroke | HandTransition
 
@@ -78,6 +78,10 @@ class Edge:
     travel at the point of the command it predicts the parts at (K&G §4.1's forward model, extended to the root as
     the correspondence problem of K&G §6 and B&B §7.1 asks). ``None``: not known (no world positions were seen);
     the command is then taken as performed on the spot.
+
+    ``turn``: how far the demonstrator's body had turned about +y since the command began (radians), one per frame of
+    ``shown`` (n,): a walk that turns left and one that turns right have alike strokes and travel, and differ by it
+    (:func:`plugins.lib.travel.turned`). ``None``: not known.
     """
 
     name: str
@@ -89,6 +93,7 @@ class Edge:
     shown: np.ndarray | None = None
     shown_fps: float = 0.0
     travel: np.ndarray | None = None
+    turn: np.ndarray | None = None
 
     @property
     def duration(self) -> float:
@@ -103,6 +108,19 @@ def clip_travel(motion: Motion, root: int) -> np.ndarray | None:
     if motion.world is None:
         return None
     return np.nan_to_num(body_velocity(motion.world, motion.positions, motion.visible, root, motion.fps))
+
+
+def clip_turn(motion: Motion, root: int) -> np.ndarray | None:
+    """How far the body of a clip had turned at each frame since its first (F,), radians
+    (:func:`plugins.lib.travel.turned`), frames where it is not known as the last known; ``None`` without world
+    positions."""
+    if motion.world is None:
+        return None
+    turn = turned(motion.world, motion.positions, motion.visible, root)
+    known = np.isfinite(turn)
+    if not known.any():
+        return None
+    return np.interp(np.arange(len(turn)), np.flatnonzero(known), turn[known])
 
 
 def command_from_dict(entry: dict[str, Any]) -> GuidingStroke | HandTransition:
@@ -218,7 +236,8 @@ class MotorCommandGraph(MotorSystem):
             observed = fill_hidden(m.positions[:, idx], m.visible[:, idx], default=self.rest[idx])
             names = self.learn_observed(subsystem, "hub", observed, m.fps, criteria=criteria, origin=str(clip.source),
                                         hub_tolerance=self.params["hub_radius"], refine=False,
-                                        travel=clip_travel(m, self.body.root_index))
+                                        travel=clip_travel(m, self.body.root_index),
+                                        turn=clip_turn(m, self.body.root_index))
             if not names:
                 continue
             n = sum(1 for label in self.labels.values() if label == clip.movement)
@@ -268,26 +287,32 @@ class MotorCommandGraph(MotorSystem):
 
     def learn(self, subsystem: str, start: str, commands: list[Command], *, end: str | None = None,
               origin: str = "", shown: np.ndarray | None = None, shown_fps: float = 0.0,
-              travel: np.ndarray | None = None) -> str:
+              travel: np.ndarray | None = None, turn: np.ndarray | None = None) -> str:
         """Add an edge of ``commands`` (one per part of the subsystem) from node ``start``; returns its movement name.
 
         Guiding strokes for a wrist subsystem, hand transitions for a hand. The edge ends in ``end`` if given
         (a hub, say), else in the node at the commands' targets (an existing one within :meth:`tolerance`, or a new one).
         ``shown`` and ``shown_fps``: the piece of the demonstration it was learned from (:attr:`Edge.shown`);
-        ``travel``: where the body went meanwhile, one row per frame of ``shown`` (:attr:`Edge.travel`).
+        ``travel``: where the body went meanwhile, one row per frame of ``shown`` (:attr:`Edge.travel`); ``turn``:
+        how far it turned since the edge began, one per frame (:attr:`Edge.turn`).
         """
         if travel is not None:
             travel = np.array(travel, dtype=float)
             if shown is None or travel.shape != (len(shown), 3):
                 raise ValueError(f"an edge's travel needs one [x, y, z] per frame of its demonstration, not shape "
                                  f"{travel.shape}")
+        if turn is not None:
+            turn = np.array(turn, dtype=float)
+            if shown is None or turn.shape != (len(shown),):
+                raise ValueError(f"an edge's turn needs one angle per frame of its demonstration, not shape "
+                                 f"{turn.shape}")
         if end is None:
             target = np.stack([c.target for c in commands])
             end = self._near_node(subsystem, target) or self._new_node(subsystem, target)
         self._counter += 1
         edge = Edge(f"{subsystem}:e{self._counter}", subsystem, start, end, tuple(commands), origin,
                     None if shown is None else np.array(shown, dtype=float), float(shown_fps) if shown is not None else 0.0,
-                    travel)
+                    travel, turn)
         self._add(edge)
         if self.owner is not None:
             self.owner.announce("likeme_movement_learned", character=self.owner, movement=edge.name,
@@ -301,7 +326,7 @@ class MotorCommandGraph(MotorSystem):
     def learn_observed(self, subsystem: str, start: str, observed: np.ndarray, fps: float, *,
                        criteria: StrokeCriteria = StrokeCriteria(), origin: str = "inverse model",
                        hub_tolerance: float = 0.05, refine: bool = True,
-                       travel: np.ndarray | None = None) -> list[str]:
+                       travel: np.ndarray | None = None, turn: np.ndarray | None = None) -> list[str]:
         """True imitation (K&G §4.3): an observed movement of the subsystem's parts becomes new edges from ``start``.
 
         ``observed`` (n, k, 3) holds the positions (a hand: the fingers' joint angles) of the subsystem's k parts.
@@ -310,7 +335,9 @@ class MotorCommandGraph(MotorSystem):
         the commands become a chain of edges from ``start``; the last ends in the hub when the movement came back
         within ``hub_tolerance`` metres of it (a hand: within :meth:`tolerance`). Each edge keeps its piece of the
         demonstration (:attr:`Edge.shown`) and, with ``travel`` (n, 3: the root's velocity in the body's frame at
-        each frame of ``observed``), where the body went meanwhile (:attr:`Edge.travel`). Returns the new edges' names.
+        each frame of ``observed``), where the body went meanwhile (:attr:`Edge.travel`), and with ``turn`` (n,: how
+        far it had turned at each frame) how far it turned during each edge (:attr:`Edge.turn`). Returns the new
+        edges' names.
         """
         n, k, _ = observed.shape
         hand = self.is_hand(subsystem)
@@ -326,7 +353,8 @@ class MotorCommandGraph(MotorSystem):
         for (commands, last), (a, b) in zip(pieces, spans):
             name = self.learn(subsystem, node, commands, end="hub" if last and home else None, origin=origin,
                               shown=observed[a: b + 1], shown_fps=fps,
-                              travel=None if travel is None else travel[a: b + 1])
+                              travel=None if travel is None else travel[a: b + 1],
+                              turn=None if turn is None else turn[a: b + 1] - turn[a])
             names.append(name)
             node = self.edge(name).target
         return names
@@ -515,6 +543,9 @@ class MotorCommandGraph(MotorSystem):
                               if e.shown is not None and e.origin in ("inverse model", "loaded") else {}),
                            **({"travel": e.travel.round(6).tolist()}
                               if e.travel is not None and e.shown is not None
+                              and e.origin in ("inverse model", "loaded") else {}),
+                           **({"turn": e.turn.round(6).tolist()}
+                              if e.turn is not None and e.shown is not None
                               and e.origin in ("inverse model", "loaded") else {})}
                           for e in self.edges(name)],
                 "sequences": sequences,
@@ -618,8 +649,18 @@ class MotorCommandGraph(MotorSystem):
                             or np.abs(travel).max() >= 1e6):
                         raise bad("invalid travel", (*key, "travel"), "where the body went at each frame of shown "
                                   "(an edge with shown): one [x, y, z] of finite m/s per frame")
+                turn = e.get("turn")
+                if turn is not None:
+                    try:
+                        turn = np.asarray(turn, dtype=float)
+                    except (TypeError, ValueError, OverflowError):
+                        turn = np.zeros(0)
+                    if (shown is None or turn.shape != (len(shown),) or not np.isfinite(turn).all()
+                            or np.abs(turn).max() >= 1e6):
+                        raise bad("invalid turn", (*key, "turn"), "how far the body turned at each frame of shown "
+                                  "(an edge with shown): one finite angle (radians) per frame")
                 edges[e["name"]] = (Edge(e["name"], name, e["from"], e["to"], built, "loaded", shown,
-                                           float(shown_fps) if shown is not None else 0.0, travel), int(number))
+                                           float(shown_fps) if shown is not None else 0.0, travel, turn), int(number))
         known_edges = set(self._edges) | set(edges)
         sequences, labels, together = {}, {}, {}
         for name, entry in state.items():
@@ -647,7 +688,7 @@ class MotorCommandGraph(MotorSystem):
                 if edge.shown is None and known.shown is not None:  # a clip's demonstration is not saved: kept,
                     # and the edge is still the clip's
                     edge = Edge(edge.name, edge.subsystem, edge.source, edge.target, edge.commands, known.origin,
-                                known.shown, known.shown_fps, known.travel)
+                                known.shown, known.shown_fps, known.travel, known.turn)
             self._add(edge)
             self._counter = max(self._counter, number)
         self.sequences.update(sequences)

@@ -17,6 +17,11 @@ into that array, their movement and whether they are hubs. ``node_travel`` (N, 3
 holds each node's *travel*, the root's velocity in the body's own frame
 (:mod:`plugins.lib.travel`; zero at the hubs), which the root-relative poses
 leave out: a walk forwards and a walk backwards have nearly the same poses.
+``node_motion`` (N, P, 3) holds how each part was moving at the node (its velocity
+relative to the root, m/s, measured at the clip's own frame rate) and
+``node_heading`` (N,) how far the body had turned since its movement began
+(radians; NaN where not known): what a comparison that sees motion compares
+(:mod:`plugins.matchers.comparison`), which the poses alone do not show.
 
 Learning (§5.2.3, §7.3): :meth:`Posegraph.learn` adds an observed path as a new
 movement (new nodes from the observed poses, entered from and returning to the
@@ -45,8 +50,8 @@ import numpy as np
 from plugins.lib.clip_repertoire import CLIP_PARAMETERS, example_name, repertoire_for
 from plugins.motor.key_poses import REPERTOIRE_PARAMETERS, KeyPoses, interpolate, play, read_repertoire
 from plugins.lib.pose_distance import pose_distance
-from plugins.lib.style import frequency, rescale
-from plugins.lib.travel import body_velocity
+from plugins.lib.travel import body_velocity, turned
+from plugins.lib.velocity import derivative
 from toolkit import ConfigError, Motion, MotorSystem, Parameter, hookimpl
 
 _OPTIONAL = {"poses": {}, "movements": {}}  # with clips, the key-pose repertoire is not needed
@@ -64,12 +69,6 @@ class Posegraph(MotorSystem):
                   "(one cycle of a walk or a run, cropped from a longer recording), loops: an edge leads from its "
                   "last pose back to its first, so a path can follow the movement for as many cycles as it is seen "
                   "(false: every path leaves through a hub, the paper's posegraph)."),
-        Parameter("tempo", float, 0.0, "Sample each clip at its own tempo: a clip's nodes come at node_rate times "
-                  "its frequency (its RMS speed over its RMS distance from its mean posture, plugins.lib.style) over "
-                  "the repertoire's median clip frequency, kept within this factor either way, so a node is a step of "
-                  "the movement's own time rather than a tenth of a second; path search samples a demonstration the "
-                  "same way. 0: every clip at node_rate (the paper).", minimum=0.0,
-                  check=lambda v: None if v == 0 or v >= 1 else "0 (off) or a factor of at least 1"),
         Parameter("node_rate", float, 10.0, "Pose nodes per second of movement: the graph's resolution. Higher "
                   "recognises finer timing at the cost of search time.", minimum=1.0, maximum=120.0),
         Parameter("takes", int, 3, "Demonstrations a learned movement is made from (§7.3): each later one recognised as "
@@ -97,32 +96,31 @@ class Posegraph(MotorSystem):
         import networkx as nx
 
         rate = self.params["node_rate"]
-        poses: list[np.ndarray] = [self.key_poses[h] for h in self.hubs]
-        travel: list[np.ndarray] = [np.zeros(3) for _ in self.hubs]  # at rest in the hubs
+        n_parts = self.body.n_parts
+        rows = _NodeRows()
+        for hub in self.hubs:  # at rest in the hubs: no travel, no motion, no turn
+            rows.add(self.key_poses[hub][None], np.zeros((1, 3)), np.zeros((1, n_parts, 3)), np.zeros(1))
         self.graph = nx.DiGraph()
         for i, hub in enumerate(self.hubs):
             self.graph.add_node(hub, index=i, movement=None, hub=True)
         self.paths: dict[str, list[str]] = {}
         self.paths_label: dict[str, str] = {}  # path name -> movement (several clips of one movement)
-        root = self.body.root_index
         for name, m in self.repertoire.items():
             sampled = play(self.key_poses, m, self.body.parts, fps=rate).positions
-            self._add_path(name, m.poses[0], sampled[1:-1], m.poses[-1], poses, travel,
-                           self._key_pose_travel(m, len(sampled))[1:-1])
+            travel, motion = self._key_pose_motion(m, len(sampled))
+            self._add_path(name, m.poses[0], sampled[1:-1], m.poses[-1], rows, travel[1:-1], motion[1:-1],
+                           np.zeros(len(sampled) - 2))
         clips = self.clips.clips if self.clips is not None else ()
-        self.reference_frequency = 0.0
-        rates = [rate] * len(clips)
-        if self.params["tempo"] > 0 and clips:
-            found = [self.frequency(*self._sampled(clip.motion)) for clip in clips]
-            moving = [f for f in found if f > 0]
-            self.reference_frequency = float(np.median(moving)) if moving else 0.0
-            rates = [rate * self.tempo_factor(f) for f in found]
-        for clip, at in zip(clips, rates):
-            self._add_clip(clip.movement, clip.motion, poses, travel, at)
+        for clip in clips:
+            self._add_clip(clip.movement, clip.motion, rows)
         for name, entry in getattr(self, "learned", {}).items():  # what it learned by watching, again
-            self._add_learned(name, entry, poses, travel)
-        self.node_poses = np.stack(poses)
-        self.node_travel = np.stack(travel)
+            self._add_learned(name, entry, rows)
+        self._set_rows(rows)
+
+    def _set_rows(self, rows: _NodeRows) -> None:
+        """The node arrays from ``rows`` (one row per node, in node order)."""
+        root = self.body.root_index
+        self.node_poses, self.node_travel, self.node_motion, self.node_heading = rows.arrays()
         self.node_root_relative = self.node_poses - self.node_poses[:, root : root + 1]
 
     def _sampled(self, motion: Motion, rate: float | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -135,37 +133,21 @@ class Posegraph(MotorSystem):
         filled = motion.filled(default=self.rest_pose()).positions
         return keep, filled
 
-    def frequency(self, keep: np.ndarray, positions: np.ndarray, visible: np.ndarray | None = None) -> float:
-        """A movement's frequency (1/s, :func:`plugins.lib.style.frequency`): the RMS speed of its root-relative parts
-        over their RMS distance from their mean posture, from its frames ``keep`` taken ``node_rate`` times a second;
-        0 when it does not move. The same movement performed twice as fast has twice the frequency, at any size."""
-        root = self.body.root_index
-        rel = positions[keep] - positions[keep][:, root : root + 1]
-        seen = np.ones(rel.shape[:2], dtype=bool) if visible is None else np.asarray(visible, dtype=bool)[keep]
-        return frequency(rel, seen, self.params["node_rate"])
-
-    def tempo_factor(self, frequency: float) -> float:
-        """How many times ``node_rate`` a movement of ``frequency`` is sampled at with ``tempo``: its frequency over
-        the repertoire's median clip frequency, kept within ``tempo`` times either way; 1 without ``tempo`` or when
-        either frequency is 0."""
-        if not (self.params["tempo"] > 0 and self.reference_frequency > 0 and frequency > 0):
-            return 1.0
-        return 1.0 / rescale(frequency, self.reference_frequency, self.params["tempo"])
-
-    def _key_pose_travel(self, movement: Any, n: int, fps: float = 30.0) -> np.ndarray:
-        """The travel of a key-pose movement at its ``n`` nodes (n, 3): key poses are in the body's own frame, so
-        the root's motion there is its travel, measured as an observer measures it (at ``fps``, then taken at the
-        nodes' times)."""
+    def _key_pose_motion(self, movement: Any, n: int, fps: float = 30.0) -> tuple[np.ndarray, np.ndarray]:
+        """The travel (n, 3) and the parts' motion (n, P, 3) of a key-pose movement at its ``n`` nodes: key poses are
+        in the body's own frame, so the root's motion there is its travel, measured as an observer measures it (at
+        ``fps``, then taken at the nodes' times); each part's motion is its velocity relative to the root."""
         fine = play(self.key_poses, movement, self.body.parts, fps=fps).positions
-        velocity = body_velocity(fine, fine, np.ones(fine.shape[:2], dtype=bool), self.body.root_index, fps)
+        root = self.body.root_index
+        velocity = body_velocity(fine, fine, np.ones(fine.shape[:2], dtype=bool), root, fps)
         at = np.minimum(np.round(np.arange(n) * fps / self.params["node_rate"]).astype(int), len(fine) - 1)
-        return np.nan_to_num(velocity[at])
+        motion = derivative(fine - fine[:, root : root + 1], fps)
+        return np.nan_to_num(velocity[at]), motion[at]
 
-    def _add_clip(self, movement: str, motion: Motion, poses: list[np.ndarray], travel: list[np.ndarray],
-                  rate: float | None = None) -> None:
-        """One example clip as a path between the hubs nearest its ends, sampled at ``rate`` (default
-        ``node_rate``); its travel from its world positions (none known: at rest)."""
-        keep, filled = self._sampled(motion, rate)  # hidden parts held (docs/conventions.md)
+    def _add_clip(self, movement: str, motion: Motion, rows: _NodeRows) -> None:
+        """One example clip as a path between the hubs nearest its ends, sampled at ``node_rate``; its travel and
+        turn from its world positions (none known: at rest, turn unknown), its parts' motion from its frames."""
+        keep, filled = self._sampled(motion)  # hidden parts held (docs/conventions.md)
         sampled = filled[keep]
         hub_rel = self.key_poses.array - self.key_poses.array[:, self.body.root_index : self.body.root_index + 1]
         root = self.body.root_index
@@ -174,11 +156,15 @@ class Posegraph(MotorSystem):
         ends = [self.hubs[int(np.argmin(d))] for d in to_hubs]
         n = sum(1 for p in self.paths if self.paths_label.get(p) == movement)
         velocity = np.zeros((len(keep), 3))
+        heading = np.full(len(keep), np.nan)
         if motion.world is not None:
             velocity = np.nan_to_num(body_velocity(motion.world, motion.positions, motion.visible, root,
                                                    motion.fps)[keep])
+            heading = turned(motion.world, motion.positions, motion.visible, root)[keep]
+        parts = derivative(filled - filled[:, root : root + 1], motion.fps)[keep]
         name = example_name(movement, n)
-        self._add_path(name, ends[0], sampled[1:-1], ends[1], poses, travel, velocity[1:-1], label=movement)
+        self._add_path(name, ends[0], sampled[1:-1], ends[1], rows, velocity[1:-1], parts[1:-1], heading[1:-1],
+                       label=movement)
         whole = filled[[0, -1]] - filled[[0, -1], root : root + 1]
         cycle = float(pose_distance(whole[0], whole[1], True))  # its very first and last frames
         radius = self.params["hub_radius"]
@@ -187,18 +173,18 @@ class Posegraph(MotorSystem):
             path = self.paths[name]
             self.graph.add_edge(path[-2], path[1], movement=movement, cycle=True)
 
-    def _add_path(self, name: str, start: str, interior: np.ndarray, end: str, poses: list[np.ndarray],
-                  travel: list[np.ndarray], velocity: np.ndarray, *, label: str | None = None) -> None:
+    def _add_path(self, name: str, start: str, interior: np.ndarray, end: str, rows: _NodeRows,
+                  travel: np.ndarray, motion: np.ndarray, heading: np.ndarray, *, label: str | None = None) -> None:
         import networkx as nx
 
         label = label or name
         path = [start]
-        for j, (pose, v) in enumerate(zip(interior, velocity), 1):
+        first = rows.count
+        for j in range(1, len(interior) + 1):
             node = f"{name}/{j}"
-            self.graph.add_node(node, index=len(poses), movement=label, hub=False)
-            poses.append(pose)
-            travel.append(v)
+            self.graph.add_node(node, index=first + j - 1, movement=label, hub=False)
             path.append(node)
+        rows.add(interior, travel, motion, heading)
         path.append(end)
         nx.add_path(self.graph, path, movement=label)
         self.paths[name] = path
@@ -350,16 +336,19 @@ class Posegraph(MotorSystem):
         entry["mean"], entry["spread"] = mean_path(entry["takes"], mean)
         self._build()
 
-    def _add_learned(self, name: str, entry: dict[str, Any], poses: list[np.ndarray], travel: list[np.ndarray]) -> None:
+    def _add_learned(self, name: str, entry: dict[str, Any], rows: _NodeRows) -> None:
         """A learned movement's paths: its mean path (named as the movement), and with several takes each take
-        (``NAME/take-K``), all labelled with the movement; from the hub and back, travelling nowhere."""
+        (``NAME/take-K``), all labelled with the movement; from the hub and back, travelling nowhere, each node's
+        parts' motion from the path's own poses, its turn not known."""
         lift = self.rest_pose()[self.body.root_index]
         hub = self.hubs[0]
-        if len(entry["takes"]) > 1:
-            for k, take in enumerate(entry["takes"], 1):
-                self._add_path(f"{name}/take-{k}", hub, take + lift, hub, poses, travel, np.zeros((len(take), 3)),
-                               label=name)
-        self._add_path(name, hub, entry["mean"] + lift, hub, poses, travel, np.zeros((len(entry["mean"]), 3)))
+        root = self.body.root_index
+        paths = [(f"{name}/take-{k}", take) for k, take in enumerate(entry["takes"], 1)] if len(entry["takes"]) > 1 \
+            else []
+        for path, poses in (*paths, (name, entry["mean"])):
+            motion = derivative(poses - poses[:, root : root + 1], self.params["node_rate"])
+            self._add_path(path, hub, poses + lift, hub, rows, np.zeros((len(poses), 3)), motion,
+                           np.full(len(poses), np.nan), label=name)
 
     def _learned_details(self, name: str) -> dict[str, Any]:
         entry = self.learned[name]
@@ -447,6 +436,22 @@ class Posegraph(MotorSystem):
             "learned": sorted(self.learned),
             "takes": {name: len(entry["takes"]) for name, entry in self.learned.items()},
         }
+
+
+class _NodeRows:
+    """The posegraph's per-node arrays while it is built: poses, travel, motion and heading, a block per path."""
+
+    def __init__(self) -> None:
+        self.blocks: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
+        self.count = 0
+
+    def add(self, poses: np.ndarray, travel: np.ndarray, motion: np.ndarray, heading: np.ndarray) -> None:
+        self.blocks.append((np.asarray(poses, dtype=float), np.asarray(travel, dtype=float),
+                            np.asarray(motion, dtype=float), np.asarray(heading, dtype=float)))
+        self.count += len(poses)
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        return tuple(np.concatenate(column) for column in zip(*self.blocks))  # type: ignore[return-value]
 
 
 def mean_path(takes: list[np.ndarray], mean: np.ndarray | None = None) -> tuple[np.ndarray, float]:

@@ -53,7 +53,9 @@ class PredictionErrorView(View):
         observer, found = watch(character, demo, each=lambda o: segments.append({"observation": o,
                                                                                **matcher.inspect()}))
         fps = observer.fps
-        threshold, deviation = matcher.params["threshold"], matcher.params["deviation"]
+        shown = matcher.inspect()  # the limits and what they measure: metres of the guiding strokes (the paper's
+        # comparison) or a score relative to standing still (comparison = "motion")
+        threshold, deviation, unit = shown["threshold"], shown["deviation"], shown["unit"]
         fig, (top, ax) = figure(self.params["width"], self.params["height"], (1, 4))
         timeline(top, demo, found, fps, recognised=character.matcher is not None)
         colour: dict[str, str] = {}
@@ -103,18 +105,18 @@ class PredictionErrorView(View):
                         transform=ax.get_xaxis_transform(), fontsize=8, ha="center", va="top", color="#404040")
         for name, c in colour.items():
             ax.plot([], [], color=c, label=f"candidate {_short(name)}")
-        ax.plot([], [], color="#e6194b", label=f"threshold {threshold:.3g} m")
-        ax.plot([], [], color="#e6194b", ls="--", label=f"deviation limit {deviation:.3g} m (while imitating, thick)")
+        ax.plot([], [], color="#e6194b", label=f"threshold {threshold:.3g}{unit}")
+        ax.plot([], [], color="#e6194b", ls="--", label=f"deviation limit {deviation:.3g}{unit} (while imitating, thick)")
         ax.plot([], [], color="black", label="commits (response facilitation)")
         ax.plot([], [], color="black", ls=":", label="deviates: stops imitating")
         ax.scatter([], [], marker="x", color="black", label="drops out / deviates")
         ax.set_ylim(0, highest * 1.5)
         ax.set_xlim(0, demo.motion.duration)
         ax.set_xlabel("time (s)")
-        ax.set_ylabel("prediction error (m)")
+        ax.set_ylabel(f"prediction error ({unit.strip()})" if unit.strip() else shown["measure"])
         ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, ncols=1 + len(colour) // 16)  # outside:
         # the commitments and drop-outs stay in view
-        ax.set_title(f"{character.name} predicting with the edges of the active node: {len(found)} segment(s)",
+        ax.set_title(f"{character.name} predicting with {shown['predicting']}: {len(found)} segment(s)",
                      fontsize=10, loc="left")
         return [save_figure(fig, out)]
 

@@ -133,7 +133,8 @@ def test_labels_that_are_numbers_come_back_as_numbers(data):
     predicted = clf.predict(X[:5])
     assert predicted.tolist() == numbers[:5].tolist() and predicted.dtype.kind == "i"
     assert clf.score(X[:5], numbers[:5]) == 1.0
-    rejecting = clone(clf).set_params(matcher__max_distance=0.0, matcher__spread=0.0).fit(X, numbers)
+    rejecting = clone(clf).set_params(matcher__comparison="poses", matcher__decision="distance",
+                                      matcher__distance__max_distance=1e-9).fit(X, numbers)
     assert rejecting.predict(X[:3]).tolist() == [-1, -1, -1]
     with pytest.raises(EstimatorInputError, match="the label -1"):
         clf.fit(X[:2], [0, -1])
@@ -204,20 +205,21 @@ def test_cross_val_score_across_performers(performers, data):
 
 
 def test_grid_search_over_a_plugin_parameter(performers, data):
-    """A max_distance far below the noise rejects every demo of a movement known from one take ("unknown"); the
-    search finds the working one. (A movement of several takes is accepted within twice its takes' spread: the
-    template's ``spread``.)"""
+    """The papers' max_distance far below the noise rejects every demo of a movement known from one take
+    ("unknown"); the search finds the working decision, the template's calibrated one."""
     _, profile = data
     X, y, groups = performers
-    search = GridSearchCV(MovementClassifier(profile), {"matcher__max_distance": [0.0005, 0.05]},
+    search = GridSearchCV(MovementClassifier(profile), {"matcher__decision": ["distance", "calibrated"],
+                                                        "matcher__comparison": ["poses"],
+                                                        "matcher__distance__max_distance": [0.0005]},
                           cv=LeaveOneGroupOut())
     search.fit(X, y, groups=groups)
-    assert search.best_params_ == {"matcher__max_distance": 0.05}
+    assert search.best_params_["matcher__decision"] == "calibrated"
     results = search.cv_results_  # split 1 holds Morris out: the observer knows Max's one take of each
     assert results["split1_test_score"][0] == 0.0 < results["split1_test_score"][1]
     assert results["mean_test_score"][0] < results["mean_test_score"][1]
-    assert search.best_estimator_.get_params()["matcher__max_distance"] == 0.05
-    assert search.best_estimator_.settings == {"matcher": {"max_distance": 0.05}}
+    assert search.best_estimator_.get_params()["matcher__decision"] == "calibrated"
+    assert search.best_estimator_.settings["matcher"]["decision"] == "calibrated"
 
 
 def test_clone_keeps_plugin_parameters(data):
@@ -229,8 +231,8 @@ def test_clone_keeps_plugin_parameters(data):
     assert not hasattr(copy, "character_")
 
 
-PARAMS = {"matcher__k": st.integers(1, 20), "matcher__max_skip": st.integers(1, 5),
-          "matcher__max_distance": st.floats(0.0, 1.0), "matcher__per_movement": st.booleans(),
+PARAMS = {"matcher__beam__k": st.integers(1, 20), "matcher__beam__max_skip": st.integers(1, 5),
+          "matcher__calibrated__known_rejected": st.floats(0.0, 1.0), "matcher__candidates": st.integers(0, 10),
           "segmenter__threshold": st.floats(0.001, 0.5), "motor__hub_radius": st.floats(0.0, 0.5),
           "matcher": st.just("path-search"), "fps": st.floats(1.0, 240.0)}
 
@@ -268,10 +270,10 @@ def test_segmenter_get_set_params_round_trip(data, params):
 def test_plugin_parameters_follow_the_plugin(data):
     _, profile = data
     clf = MovementClassifier(profile)
-    assert "matcher__k" in clf.get_params()
+    assert "matcher__beam__k" in clf.get_params()
     clf.set_params(matcher="dtw")
     params = clf.get_params()
-    assert "matcher__k" not in params and "matcher__window" in params
+    assert "matcher__beam__k" not in params and "matcher__window" in params
     assert "motor__clips" not in params and "motor__profile" not in params
     seg = MovementSegmenter(profile, segmenter="velocity-direction")
     assert not any(k.startswith("matcher__") for k in seg.get_params())
@@ -295,13 +297,13 @@ def test_errors(data):
     with pytest.raises(EstimatorInputError) as err:
         clf.set_params(matcher__kk=3)
     assert "unknown parameter 'matcher__kk' of matcher plugin 'path-search'" in str(err.value)
-    assert "matcher__k" in err.value.available and "segmenter__threshold" in err.value.available
+    assert "matcher__beam__k" in err.value.available and "segmenter__threshold" in err.value.available
     with pytest.raises(EstimatorInputError, match="unknown parameter 'nosuch__k'"):
         clf.set_params(nosuch__k=3)
     with pytest.raises(EstimatorInputError, match="unknown parameter 'matchr'"):
         clf.set_params(matchr="dtw")
     with pytest.raises(EstimatorInputError, match="out of range"):
-        clf.set_params(matcher__k=0)
+        clf.set_params(matcher__candidates=-1)
     with pytest.raises(EstimatorInputError, match="has no capture group"):
         load_recordings(dest / "repertoire", profile, group="max")
     streams, truth = load_streams(dest / "streams", profile)

@@ -27,7 +27,7 @@ def games():
         def likeme_world_stepped(self, world):
             max_ = world.actors["max"]
             self.edges.append(max_.character.motor.graphs["left_wrist"].number_of_edges())
-            memory = max_.character.matcher._memory
+            memory = max_.character.matcher.observation.memory
             if memory is not None:
                 for _, errors in max_.character.matcher.inspect()["trace"]:
                     self.paths.setdefault(memory.start, set()).update(errors)

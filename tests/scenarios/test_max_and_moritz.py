@@ -99,7 +99,7 @@ def test_the_graph_after_the_games_and_where_max_ends_up(games):
 
 
 def test_a_familiar_movement_at_another_speed_is_recognised_not_learned_again(write):
-    from tests.test_speed_reparameterisation import _world
+    from tests.plugins.matchers.forward_model.test_speed import _world
 
     world = _world(write, "left_front")
     edges = world.actors["max"].character.motor.graphs["left_wrist"].number_of_edges()

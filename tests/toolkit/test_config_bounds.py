@@ -123,9 +123,9 @@ def test_a_number_parameter_refuses_non_finite_values_even_without_bounds(text):
 
 def test_set_is_checked_against_every_named_plugin(pm):
     plugins = {"matcher": ["path-search", "dtw"], "segmenter": ["hub-threshold"]}
-    check_settings({"matcher": {"max_distance": 0.1}, "segmenter": {"floor": 0.0}}, pm, plugins)  # both have it
-    with pytest.raises(ConfigError, match=r"key --set.matcher.spread: unknown parameter 'spread' for matcher 'dtw'"):
-        check_settings({"matcher": {"spread": 2.0}}, pm, plugins)
+    check_settings({"matcher": {"decision": "distance"}, "segmenter": {"floor": 0.0}}, pm, plugins)  # both have it
+    with pytest.raises(ConfigError, match=r"key --set.matcher.search: unknown parameter 'search' for matcher 'dtw'"):
+        check_settings({"matcher": {"search": "k-best"}}, pm, plugins)
     with pytest.raises(ConfigError, match=r"key --set.matchr: unknown table 'matchr'.*available: motor, perception"):
         check_settings({"matchr": {"k": 3}}, pm, plugins)
     with pytest.raises(ConfigError, match=r"key --set.perception: no \[perception\] component to set"):
@@ -136,8 +136,8 @@ def test_set_naming_a_plugin_is_checked_against_that_plugin(pm):
     check_settings({"matcher": {"plugin": "dtw", "window": 0.2}}, pm, {"matcher": ["path-search"]})
     with pytest.raises(ConfigError, match=r"key --set.matcher.plugin: unknown matcher 'dtwx'"):
         check_settings({"matcher": {"plugin": "dtwx"}}, pm, {})
-    with pytest.raises(ConfigError, match=r"key --set.matcher.k: value 0 out of range for matcher 'path-search'"):
-        check_settings({"matcher": {"k": 0}}, pm, {"matcher": ["path-search"]})
+    with pytest.raises(ConfigError, match=r"key --set.matcher.beam.k: value 0 out of range"):
+        check_settings({"matcher": {"beam": {"k": 0}}}, pm, {"matcher": ["path-search"]})
 
 
 def test_a_bad_list_element_in_set_names_its_key(pm):

@@ -158,18 +158,21 @@ def test_nan_frames_and_hidden_parts_are_not_seen_rather_than_a_crash(data, prof
 
 
 def test_the_forward_model_commits_before_a_familiar_demo_ends(data, profile, pm):
-    character = compose_observer(pm, profile, data / "repertoire", matcher="forward-model",
-                                 settings={"matcher": {"error": "mean"}})
+    character = compose_observer(pm, profile, data / "repertoire", matcher="forward-model")
     motion = profile.read(data / "repertoire" / "jump" / "max.bvh")  # his own jump, watched
     obs = Observer(character, profile.body, motion.fps).classify(motion)
     assert obs.movement == "jump"
     assert obs.decision_fraction < 1.0
 
 
+STROKES = {"matcher": {"comparison": "strokes"}}
+"""The paper's forward model (K&G §4.4: guiding strokes, drop-out at a threshold in metres)."""
+
+
 def test_every_clip_is_watched_from_the_hub_whatever_came_before(data, profile, pm):
     """Observer.reset puts the motor system back at rest: the forward model's candidates are the hub's edges for
     every clip, so a clip's answer does not depend on the clips classified before it."""
-    character = compose_observer(pm, profile, data / "repertoire", matcher="forward-model")
+    character = compose_observer(pm, profile, data / "repertoire", matcher="forward-model", settings=STROKES)
     observer = Observer(character, profile.body, 30.0)
     nod = profile.read(data / "demos" / "nod" / "morris_1.0.bvh")
     alone = observer.classify(nod)
@@ -184,7 +187,7 @@ def test_a_demonstration_watched_from_a_few_frames_in_is_still_predicted(data, p
     """A segment often begins after its movement did (a hub threshold is crossed once the body has left the hub):
     each part is predicted from the point of its stroke nearest to where it was first seen, so the forward model
     still commits early. Predicted from the strokes' starts, every candidate dropped out at once."""
-    character = compose_observer(pm, profile, data / "repertoire", matcher="forward-model")
+    character = compose_observer(pm, profile, data / "repertoire", matcher="forward-model", settings=STROKES)
     observer = Observer(character, profile.body, 30.0)
     for movement in ("salute", "stretch", "jump"):
         motion = profile.read(data / "demos" / movement / "morris_1.0.bvh")
@@ -199,7 +202,7 @@ def test_a_demonstration_watched_from_a_few_frames_in_is_still_predicted(data, p
 def test_a_movement_begun_at_the_hub_is_followed_from_the_hub_wherever_the_last_one_left_off(data, profile, pm):
     """Within a stream the forward model's active node is where the last movement it followed ended; one that
     ended away from it (a posture that differs at the end) must not make the next, begun at the hub, unreadable."""
-    character = compose_observer(pm, profile, data / "repertoire", matcher="forward-model")
+    character = compose_observer(pm, profile, data / "repertoire", matcher="forward-model", settings=STROKES)
     motor, matcher = character.motor, character.matcher
     nod = profile.read(data / "demos" / "nod" / "morris_1.0.bvh")
     elsewhere = motor.edge(motor.sequences["bow"][0]).target

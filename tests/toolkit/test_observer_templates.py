@@ -1,9 +1,8 @@
 """Observer templates chosen per run (``--observer``) and extending one another (``[observer] extends``).
 
 The observer template (``characters/observers/recordings.toml``) is what ``likeme observe`` and ``likeme bench``
-compose when told nothing; ``--observer NAME|FILE`` names another, such as the shipped ``several-takes`` (real
-people, several takes of each movement; issue 18, docs/correspondence.md). Everything runs on data the project
-generates itself.
+compose when told nothing; ``--observer NAME|FILE`` names another, such as the shipped ``papers`` (the papers'
+own comparisons and decisions; docs/matchers.md). Everything runs on data the project generates itself.
 """
 
 from __future__ import annotations
@@ -37,23 +36,25 @@ def test_a_template_extending_another_gets_its_tables_and_changes_only_what_it_w
         min_duration = 0.3
         [matcher]
         plugin = "path-search"
+        [matcher.beam]
         k = 3
+        [matcher.distance]
         max_distance = 0.05
         """)
     child = write("child.toml", """
         [observer]
         extends = "parent.toml"
         name = "child"
-        [matcher]
+        [matcher.beam]
         k = 5
         """)
     table, files = read_observer_template(child, pm)
     assert files == (child.resolve(), parent.resolve())
     assert table["observer"] == {"name": "child", "description": "the parent"}  # extends is not passed on
-    assert table["matcher"] == {"plugin": "path-search", "k": 5, "max_distance": 0.05}
+    assert table["matcher"] == {"plugin": "path-search", "beam": {"k": 5}, "distance": {"max_distance": 0.05}}
     observer = compose_observer(pm, profile, data / "repertoire", template=child)
     assert observer.name == "child"
-    assert observer.matcher.declared["k"] == 5 and observer.matcher.declared["max_distance"] == 0.05
+    assert observer.matcher.params["beam"]["k"] == 5 and observer.matcher.params["distance"]["max_distance"] == 0.05
     assert observer.segmenter.declared["min_duration"] == 0.3
     other = write("other.toml", """
         [observer]
@@ -63,15 +64,15 @@ def test_a_template_extending_another_gets_its_tables_and_changes_only_what_it_w
         plugin = "dtw"
         """)
     dtw = compose_observer(pm, profile, data / "repertoire", template=other)
-    assert dtw.matcher.name == "dtw" and "k" not in dtw.matcher.declared  # another plugin: a table of its own
+    assert dtw.matcher.name == "dtw" and "beam" not in dtw.matcher.declared  # another plugin: a table of its own
 
 
 def test_a_mistake_is_named_in_the_file_that_makes_it(pm, write):
-    write("parent.toml", '[observer]\nname = "p"\n[matcher]\nplugin = "path-search"\nk = 0\n')
+    write("parent.toml", '[observer]\nname = "p"\n[matcher]\nplugin = "path-search"\n[matcher.beam]\nk = 0\n')
     child = write("child.toml", '[observer]\nextends = "parent.toml"\nname = "c"\n[segmenter]\nplugin = "hub-threshold"\n')
-    with pytest.raises(ConfigError, match=r"parent\.toml:5: key matcher\.k: value 0 out of range"):
+    with pytest.raises(ConfigError, match=r"parent\.toml:6: key matcher\.beam\.k: value 0 out of range"):
         check_observer_template(child, pm)
-    mine = write("mine.toml", '[observer]\nextends = "parent.toml"\nname = "c"\n[matcher]\nk = 2\nbeam = 0\n')
+    mine = write("mine.toml", '[observer]\nextends = "parent.toml"\nname = "c"\n[matcher]\ncandidates = 2\nbeam = 0\n')
     with pytest.raises(ConfigError, match=r"mine\.toml:6: key matcher\.beam"):
         check_observer_template(mine, pm)
     write("a.toml", '[observer]\nname = "a"\nextends = "b.toml"\n')
@@ -87,30 +88,29 @@ def test_a_template_is_found_by_its_name_its_path_or_its_file(pm, write):
     assert observer_template_path(shipped, pm) == shipped
     mine = write("mine.toml", '[observer]\nname = "mine"\n')
     assert observer_template_path(mine, pm) == mine.resolve()
-    assert {"recordings", "several-takes"} <= set(observer_templates(pm))
+    assert {"papers", "recordings"} <= set(observer_templates(pm))
     with pytest.raises(ConfigError, match=r"key --observer: cannot find observer template 'recording'.*"
-                                          r"available: recordings, several-takes"):
+                                          r"available: papers, recordings"):
         observer_template_path("recording", pm)
 
 
-def test_several_takes_is_the_template_with_the_comparisons_for_real_people(data, profile, pm):
-    """The shipped template for real people with several takes of each movement: the observer template's own
-    settings kept (travel, per_movement, max_stay), path search's styled comparison and farthest-take decision
-    added, and the forward model's settings for real people when it is named instead."""
+def test_papers_is_the_template_with_the_papers_comparisons_and_decisions(data, profile, pm):
+    """The shipped template of the papers' own matchers: the observer template's segmenter and perception kept,
+    each matcher's comparison, search and decision the papers' (the plugins' own defaults)."""
+    from toolkit.params import validate_params
+
     template = read_toml(resolve_file("observers/recordings.toml", None, pm))
-    observer = compose_observer(pm, profile, data / "repertoire", template="several-takes")
-    declared = observer.matcher.declared
-    assert observer.matcher.name == "path-search" and observer.segmenter.name == "hub-threshold"
-    assert {k: declared[k] for k in ("travel", "per_movement", "max_stay")} == \
-        {k: template["matcher"][k] for k in ("travel", "per_movement", "max_stay")}
-    assert (declared["posture"], declared["amplitude"], declared["still_spread"], declared["spread_quantile"],
-            declared["spread"]) == ("still", 2.0, True, 1.0, 1.0)
-    assert observer.motor.declared["tempo"] == 2.0
+    observer = compose_observer(pm, profile, data / "repertoire", template="papers")
+    matcher = observer.matcher
+    assert matcher.name == "path-search" and observer.segmenter.name == "hub-threshold"
+    defaults = validate_params("path-search", type(matcher).parameters, {})
+    assert {k: matcher.params[k] for k in ("comparison", "search", "decision")} == \
+        {k: defaults[k] for k in ("comparison", "search", "decision")} == \
+        {"comparison": "poses", "search": "k-best", "decision": "distance"}
     assert observer.segmenter.declared["units"] == template["segmenter"]["units"]
-    follows = compose_observer(pm, profile, data / "repertoire", template="several-takes", matcher="forward-model")
-    fm = follows.matcher.declared
-    assert (fm["dropout"], fm["relative"], fm["error"], fm["tempo"], fm["posture"], fm["spread"], fm["unexplained"]) \
-        == ("relative", True, "moving", 2.0, "removed", 2.0, 1.0)
+    real = compose_observer(pm, profile, data / "repertoire")
+    assert {k: real.matcher.params[k] for k in ("comparison", "search", "decision")} == \
+        {"comparison": "motion", "search": "per-movement", "decision": "calibrated"}
 
 
 def test_observe_and_bench_watch_with_the_template_named(data, write, capsys):
@@ -121,8 +121,10 @@ def test_observe_and_bench_watch_with_the_template_named(data, write, capsys):
         extends = "observers/recordings"
         name = "strict"
         [matcher]
+        comparison = "poses"
+        decision = "distance"
+        [matcher.distance]
         max_distance = 1e-9
-        spread = 0.0
         """)
     demos = sorted((data / "demos").rglob("*.bvh"))[:4]
     answers = {}
@@ -158,7 +160,7 @@ def test_a_sweep_grid_names_its_observer_relative_to_itself(data, write):
     loaded = load_grid(grid)
     assert loaded["observer"] == str(grid.parent / "strict.toml")
     assert all(c["observer"]["template"] == loaded["observer"] for c in cells(loaded))
-    named = write("named.toml", 'benchmark = "recognition"\nobserver = "several-takes"\n'
+    named = write("named.toml", 'benchmark = "recognition"\nobserver = "papers"\n'
                   f'[data.gen]\nbody = "{data / "profile.toml"}"\nrepertoire = "{data / "repertoire"}"\n'
                   f'demos = "{data / "demos"}"\n')
-    assert load_grid(named)["observer"] == "several-takes"
+    assert load_grid(named)["observer"] == "papers"

@@ -32,34 +32,45 @@ def giant(generated, tmp_path_factory):
     return load_profile(path)
 
 
+PAPER = {"matcher": {"comparison": "poses", "search": "k-best", "decision": "distance"}}
+"""The papers' path search (eq. 1 in metres, the k best paths, max_distance), whose lengths are scaled."""
+
+
 def test_length_parameters_scale_with_the_observers_height_and_nothing_else_does(generated, pm):
+    from toolkit.params import length_names
+
     profile = load_profile(generated / "profile.toml")
-    plain = compose_observer(pm, profile, generated / "repertoire")
-    halved = compose_observer(pm, profile, generated / "repertoire", lengths_for_height=plain.height / 2)
+    plain = compose_observer(pm, profile, generated / "repertoire", settings=PAPER)
+    halved = compose_observer(pm, profile, generated / "repertoire", lengths_for_height=plain.height / 2,
+                              settings=PAPER)
     assert plain.length_scale == 1.0 and halved.length_scale == pytest.approx(2.0)
     for key in ("matcher", "segmenter"):
         before, after = getattr(plain, key), getattr(halved, key)
-        lengths = {p.name for p in type(after).parameters if p.length}
+        lengths = length_names(type(after).parameters)
         assert lengths, f"the {key} declares its lengths"
-        for name, value in after.params.items():
-            expected = 2 * before.params[name] if name in lengths else before.params[name]
-            assert value == pytest.approx(expected), name
+        for path in lengths:
+            a, b = after.params, before.params
+            for k in path:
+                a, b = a[k], b[k]
+            assert a == pytest.approx(2 * b), path
         assert dict(after.declared) == dict(before.params)  # as written
     assert dict(halved.motor.params) == dict(plain.motor.params)  # the motor system measures the body itself
-    assert "max_distance" in {p.name for p in type(plain.matcher).parameters if p.length}
+    assert ("distance", "max_distance") in length_names(type(plain.matcher).parameters)
 
 
 def test_the_same_observer_file_recognises_a_body_three_times_as_tall(generated, giant, pm):
-    """Every eq. 1 distance of the giant is ten times Max's: in metres the thresholds written for Max reject
-    almost everything; written for Max's height and scaled to the giant's, the answers are Max's own."""
+    """Every eq. 1 distance of the giant is ten times Max's: with the papers' path search, in metres the thresholds
+    written for Max reject almost everything; written for Max's height and scaled to the giant's, the answers are
+    Max's own. The observer template's comparison is in the demonstrator's own body sizes and its decision
+    calibrated: the giant gets Max's answers with no height given at all."""
     from plugins.bench.mocap import recognition
 
     small = load_profile(generated / "profile.toml")
     height = compose_observer(pm, small, generated / "repertoire").height
 
-    def answers(profile, lengths_for_height):
+    def answers(profile, lengths_for_height, settings=PAPER):
         result = recognition(pm, profile, generated / "repertoire", generated / "demos", ["path-search"],
-                             observer={"lengths_for_height": lengths_for_height})
+                             observer={"lengths_for_height": lengths_for_height}, settings=settings)
         return [item["recognised"] for item in result["items"]], result["plugins"][0]["accuracy"]
 
     own, accuracy = answers(small, height)
@@ -68,6 +79,9 @@ def test_the_same_observer_file_recognises_a_body_three_times_as_tall(generated,
     metres, metres_accuracy = answers(giant, None)
     assert sum(a == b for a, b in zip(own, scaled)) >= 0.95 * len(own)
     assert metres_accuracy < 0.5 * accuracy and metres.count("unknown") > 0.5 * len(metres)
+    template, _ = answers(small, None, settings=None)
+    giant_template, _ = answers(giant, None, settings=None)
+    assert giant_template == template
 
 
 @pytest.mark.parametrize("value", [0, -1.0, "tall", True, math.inf, math.nan])
@@ -114,71 +128,24 @@ def test_a_group_pattern_that_cannot_split_the_clips_is_refused(generated, pm, g
     assert err.value.key == ("group",)
 
 
-# -- path search relative to the repertoire's spread between takes -------------------------------------------
+# -- what path search needs of a posegraph -------------------------------------------------------------------
 
 
-@pytest.fixture(scope="module")
-def takes_observer(generated):
-    """An observer whose repertoire is Morris's demos: three takes of each movement (three speeds)."""
-    pm = create_plugin_manager(autoload=False, trace=False)
-    profile = load_profile(generated / "profile.toml")
-    return compose_observer(pm, profile, generated / "demos", settings={"matcher": {"spread": 2.0}})
-
-
-def test_every_movement_of_several_takes_has_a_spread_and_a_threshold_from_it(takes_observer):
-    matcher = takes_observer.matcher
-    matcher._refresh()
-    takes = takes_observer.motor.takes()
-    assert set(matcher.spreads) == {m for m, t in takes.items() if len(t) >= 2} == set(takes)
-    for movement, spread in matcher.spreads.items():
-        assert spread > 0
-        assert matcher.threshold(movement) == pytest.approx(2.0 * spread)
-    assert matcher.threshold("not a movement") == matcher.params["max_distance"]
-
-
-def test_a_take_left_out_of_the_search_is_never_on_the_path(takes_observer):
-    import numpy as np
-
-    matcher = takes_observer.matcher
-    matcher._refresh()
-    index = {n: i for i, n in enumerate(matcher.node_names)}
-    nodes = matcher.nodes_compared  # the poses as search compares them (with travel, one part more)
-    for movement, takes in list(takes_observer.motor.takes().items())[:5]:
-        own = np.array([index[n] for n in takes[0]])
-        exclude = np.zeros(len(nodes), bool)
-        exclude[own] = True
-        path, cost, _ = matcher.search(nodes[own], np.ones(nodes[own].shape[:2], bool), None, exclude)
-        assert not exclude[path].any() and np.isfinite(cost)
-        free, free_cost, _ = matcher.search(nodes[own], np.ones(nodes[own].shape[:2], bool))
-        assert free_cost == pytest.approx(0.0, abs=1e-9) and cost > 1e-6  # without the exclusion it finds itself
-
-
-@pytest.mark.benchmark
-def test_spread_thresholds_accept_known_movements_and_reject_left_out_ones(generated, pm):
-    """Max's own clips against three takes of Morris's: a movement in the repertoire is accepted within twice its
-    spread between takes; with the movement left out, most are answered unknown."""
-    from plugins.bench.mocap import recognition
-
-    profile = load_profile(generated / "profile.toml")
-    settings = {"matcher": {"spread": 2.0}}
-    closed = recognition(pm, profile, generated / "demos", generated / "repertoire", ["path-search"],
-                         settings=settings)["plugins"][0]
-    opened = recognition(pm, profile, generated / "demos", generated / "repertoire", ["path-search"],
-                         settings=settings, protocol="open")["plugins"][0]
-    assert closed["accuracy"] > 0.8 and opened["rejection"] > 0.5
-
-
-def test_spread_needs_a_motor_system_that_knows_its_takes(takes_observer):
-    """A posegraph without takes() (a third party's) serves path search, but not its spread."""
+def test_the_exact_search_needs_a_posegraph_that_knows_its_takes(generated, pm):
+    """A posegraph with only what the paper needs (a third party's) serves the papers' path search, but not the
+    per-movement search, the motion comparison or the calibrated decision, each refused by its key."""
     from types import SimpleNamespace
 
     from plugins.matchers.path_search import PathSearch, PoseGraph
     from toolkit.components import protocol_members
 
-    motor = takes_observer.motor
+    profile = load_profile(generated / "profile.toml")
+    observer = compose_observer(pm, profile, generated / "repertoire")
+    motor = observer.motor
     bare = SimpleNamespace(**{name: getattr(motor, name) for name in protocol_members(PoseGraph)})
-    owner = SimpleNamespace(motor=bare, body=takes_observer.body)
-    PathSearch().attach(owner)  # the paper's threshold needs no takes
-    with pytest.raises(ConfigError, match="takes") as err:
-        PathSearch(spread=2.0).attach(owner)
-    assert err.value.key == ("spread",)
+    owner = SimpleNamespace(motor=bare, body=observer.body)
+    PathSearch().attach(owner)  # the paper's search and threshold need no takes
+    for key, value in (("search", "per-movement"), ("decision", "calibrated")):
+        with pytest.raises(ConfigError, match="takes") as err:
+            PathSearch(**{key: value}).attach(owner)
+        assert err.value.key == (key,)

@@ -97,7 +97,7 @@ def test_a_settled_first_stroke_is_concluded_as_if_fed_again(pm_, data, profile,
     runs = []
     for shortcut in (False, True):
         character = compose_observer(pm_, profile, data / "repertoire", segmenter="velocity-direction",
-                                     matcher="forward-model", settings={"matcher": dict(settings),
+                                     matcher="forward-model", settings={"matcher": {"comparison": "strokes", **settings},
                                                                                "segmenter": {"level": "stroke"}})
         assert isinstance(character.matcher, ForwardModel)
         runs.append(watched(character, profile, streams, monkeypatch, shortcut))

@@ -1,6 +1,6 @@
 """Observer templates: the components an observer of recordings has when a command names none.
 
-A template (``characters/observers/recordings.toml``, ``several-takes.toml``, or a file of one's own) is an
+A template (``characters/observers/recordings.toml``, ``papers.toml``, or a file of one's own) is an
 ``[observer]`` table and a character's component tables without a ``[body]``: the body comes from the recordings'
 body profile and the repertoire from a folder of labelled clips when the observer is composed
 (:func:`toolkit.observe.compose_observer`). A template may ``extends`` another, as a character file does, and may
@@ -30,7 +30,7 @@ OBSERVER_TEMPLATE = "observers/recordings.toml"
 
 OBSERVER_FOLDER = "observers"
 """The folder of observer templates in each folder of the character path (:func:`toolkit.config.search.character_paths`):
-a template named without a path (``--observer several-takes``) is looked up there."""
+a template named without a path (``--observer papers``) is looked up there."""
 
 
 def observer_templates(pm: Any = None) -> list[str]:
@@ -40,7 +40,7 @@ def observer_templates(pm: Any = None) -> list[str]:
 
 def observer_template_path(template: str | Path | None, pm: Any = None, *, key: tuple = ("--observer",)) -> Path:
     """The file of an observer template: a path, a name on the character path (``observers/recordings``), or the
-    name of a template in an ``observers`` folder of the character path (``recordings``, ``several-takes``);
+    name of a template in an ``observers`` folder of the character path (``recordings``, ``papers``);
     ``None`` or ``""``: :data:`OBSERVER_TEMPLATE`. A :class:`ConfigError` naming ``key`` and listing the templates
     found otherwise."""
     ref = str(template or OBSERVER_TEMPLATE)

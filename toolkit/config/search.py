@@ -1,6 +1,6 @@
 """Where declarations are found and how they extend one another: the character path, ``extends`` chains, merging.
 
-A file named without a path (``extends = "max"``, ``character = "morris"``, ``--observer several-takes``) is looked up
+A file named without a path (``extends = "max"``, ``character = "morris"``, ``--observer papers``) is looked up
 on the character path (:func:`character_paths`): ``$LIKEME_CHARACTERS``, the project's ``characters/``, the installed
 copy, then the folders plugins add (``likeme_character_paths``). A file that ``extends`` another is merged onto it
 (:func:`merge_tables`): tables key by key, a component table naming another ``plugin`` replacing the inherited one.

@@ -569,7 +569,7 @@ class VelocityDirection(Segmenter):
         return self._close(self._frame + 1, "the stream ended")
 
     def _close(self, end: int, reason: str = "at rest again") -> list[Segment]:
-        """The movement under way ends at ``end`` (``reason``: why): its segments (itself, or its strokes)."""
+        """The movement under way ends at ``end``: its segments (itself, or its strokes); ``reason``: why it ends."""
         return self._close_pieces([(self._start, end)], end, reason)
 
     def _close_pieces(self, pieces: list[tuple[int, int]], end: int, reason: str = "at rest again") -> list[Segment]:

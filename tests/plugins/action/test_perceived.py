@@ -175,10 +175,10 @@ def test_sightings_are_bounded_and_keep_each_objects_last_sighting():
 
 def test_path_search_ranks_the_runner_up_as_the_best_path_without_the_winner(write, pm):
     """The second candidate is what path search answers when the first movement is not in the graph at all."""
-    from tests.test_path_search import STICK, observed
+    from tests.plugins.matchers.path_search.stick import STICK, observed
     from toolkit import load_character
 
-    stick = load_character(write("stick.toml", STICK + "candidates = 1\nmax_distance = 0.2\n"), pm)
+    stick = load_character(write("stick.toml", STICK + "candidates = 1\n[matcher.distance]\nmax_distance = 0.2\n"), pm)
     up, front = observed(stick, "raise"), observed(stick, "reach")  # the hand goes up and forward, more up
     seen = Motion(0.55 * up.positions + 0.45 * front.positions, up.fps, up.parts, up.visible)
     match = stick.matcher.match(seen)
@@ -188,14 +188,14 @@ def test_path_search_ranks_the_runner_up_as_the_best_path_without_the_winner(wri
     without = STICK.replace('[motor.movements.raise]\nkeys = [{ pose = "stand", at = 0.0 }, { pose = "up", at = 0.5 }, '
                             '{ pose = "stand", at = 1.0 }]\n', "")
     assert without != STICK
-    alone = load_character(write("reach_only.toml", without + "max_distance = 0.2\n"), pm).matcher.match(seen.onto(stick.body.parts))
+    alone = load_character(write("reach_only.toml", without + "[matcher.distance]\nmax_distance = 0.2\n"), pm).matcher.match(seen.onto(stick.body.parts))
     assert alone.movement == "reach" and d2 == pytest.approx(alone.details["mean_distance"])
-    plain = load_character(write("plain.toml", STICK + "max_distance = 0.2\n"), pm).matcher.match(seen)
+    plain = load_character(write("plain.toml", STICK + "[matcher.distance]\nmax_distance = 0.2\n"), pm).matcher.match(seen)
     assert plain.movement == "raise" and plain.candidates == ()  # by default the best only
 
 
 def test_dtw_ranks_every_movement_by_its_nearest_example(write, pm):
-    from tests.test_path_search import STICK, observed
+    from tests.plugins.matchers.path_search.stick import STICK, observed
     from toolkit import load_character
 
     stick = load_character(write("stick.toml", STICK.replace('plugin = "path-search"', 'plugin = "dtw"')), pm)

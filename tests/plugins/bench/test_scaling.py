@@ -96,7 +96,7 @@ def test_set_reaches_the_observer(tmp_path, capsys):
     from likeme.cli import main
 
     assert main(["bench", "scaling", "--quick", "--minutes", "0.05", "--minutes", "0.1", "--movements", "3",
-                 "--movements", "6", "--set", "matcher.per_movement=false"]) == 0
-    assert "--set matcher.per_movement=false" in capsys.readouterr().out
+                 "--movements", "6", "--set", "matcher.candidates=1"]) == 0
+    assert "--set matcher.candidates=1" in capsys.readouterr().out
     assert main(["bench", "scaling", "--quick", "--set", "matcher.no_such_key=1"]) == 1
     assert "no_such_key" in capsys.readouterr().err

@@ -15,7 +15,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from plugins.correspondence.body_mapping import BodyMapping
-from plugins.lib.attention import movement_weights
 from plugins.lib.body_size import RunningLengths, bone_lengths, bone_tree, retarget, rigid_pairs
 from plugins.lib.pose_distance import pose_distance
 from plugins.lib.rest_posture import RestPosture
@@ -126,16 +125,6 @@ def test_rest_posture_is_where_the_body_dwells():
     assert pose_distance(early[30], REST) < 0.05  # never still: one's own rest is assumed
 
 
-def test_attention_weights_what_moves():
-    poses = wave()
-    weights = movement_weights(poses, np.ones(poses.shape[:2], bool), 1.0)
-    assert np.argmax(weights) == PARTS.index("left_hand") and np.isclose(weights.sum(), 1.0)
-    plain = movement_weights(poses, np.ones(poses.shape[:2], bool), 0.0)
-    np.testing.assert_allclose(plain, 1 / len(PARTS))
-    a, b = poses[30], REST
-    assert np.isclose(pose_distance(a, b, None, plain), pose_distance(a, b))  # attention 0 is eq. 1
-
-
 # -- the plugin --------------------------------------------------------------------------------------------
 
 
@@ -236,7 +225,7 @@ def test_open_protocol_counts_unknown_as_right_for_a_movement_left_out(generated
 
     profile = load_profile(generated / "profile.toml")
     result = recognition(pm, profile, generated / "repertoire", generated / "demos", ["path-search"],
-                         protocol="open")
+                         protocol="open", observer={"template": "papers"})
     row = result["plugins"][0]
     assert {item["truth"] for item in result["items"]} == {"unknown"}
     right = [item["recognised"] == "unknown" for item in result["items"]]
@@ -252,15 +241,15 @@ def test_observe_says_why_a_segment_is_unknown(generated, capsys):
     profile = generated / "profile.toml"
     demo = sorted((generated / "demos").glob("*/*.bvh"))[0]
     assert main(["observe", str(demo), "--body", str(profile), "--repertoire", str(generated / "repertoire"),
-                 "--set", "matcher.max_distance=0", "--json"]) == 0
+                 "--observer", "papers", "--set", "matcher.distance.max_distance=1e-9", "--json"]) == 0
     import json
 
     segments = json.loads(capsys.readouterr().out)[0]["segments"]
     assert segments and all(s["movement"] == "unknown" for s in segments)
-    assert all(s["reason"] == "too far from every path" and s["nearest"] and s["score"] > s["threshold"] == 0
+    assert all(s["reason"] == "too far from every path" and s["nearest"] and s["score"] > s["threshold"] == 1e-9
                and s["measure"] == "mean pose distance along the path (eq. 3)" for s in segments)
     assert main(["observe", str(demo), "--body", str(profile), "--repertoire", str(generated / "repertoire"),
-                 "--set", "matcher.max_distance=0"]) == 0
+                 "--observer", "papers", "--set", "matcher.distance.max_distance=1e-9"]) == 0
     assert "rejected: too far from every path (mean pose distance along the path (eq. 3) 0." in capsys.readouterr().out
 
 
@@ -320,7 +309,7 @@ def test_the_pictures_larger_stooped_demonstrator_is_mapped_onto_maxs_size_and_r
     text = (Path(__file__).resolve().parents[3] / "docs" / "correspondence.md").read_text(encoding="utf-8")
     block = re.search(r"On the project's own data.*?```python\n(.*?)```", text, re.S).group(1)
     monkeypatch.chdir(tmp_path)
-    exec(block.replace("/tmp/gen", str(generated)), {})  # writes wave_stooped.csv here
+    exec(block.replace('"gen/', f'"{generated}/'), {})  # writes wave_stooped.csv here
     profile = load_profile(generated / "profile.toml")
     seen = profile.read(tmp_path / "wave_stooped.csv")
     mapped = {}

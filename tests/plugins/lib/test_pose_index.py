@@ -172,11 +172,12 @@ def test_path_search_answers_the_same_with_the_index_forced_on_and_off(max_and_m
     answers = {}
     for forced, threshold in (("on", 0), ("off", 10**9)):
         monkeypatch.setattr(matcher, "index_min_nodes", threshold)
-        matcher._cache_version = -1
+        matcher._version = -1  # the beam is built again with the new size
         answers[forced] = [matcher.match(m) for m in motions]
+        beam = matcher.searcher.kbest
         if forced == "on":
-            assert matcher._index is not None and matcher._index._trees  # the trees answered
-    assert matcher._index is None  # off: never built
+            assert beam._index is not None and beam._index._trees  # the trees answered
+    assert beam._index is None  # off: never built
     for on, off in zip(answers["on"], answers["off"]):
         assert (on.movement, on.path, on.confidence) == (off.movement, off.path, off.confidence)
 

@@ -71,7 +71,7 @@ def _windmill_takes(pm, n: int, seed: int = 0):
     rng = np.random.default_rng(seed)
     keys, times = _movement_keys(morris, "windmill")
     motions = [take(keys, times, morris, rng, noise=0.005, jitter=0.01) for _ in range(n)]
-    return max_, [max_.matcher.samples(m.onto(max_.body.parts), styled=False) for m in motions]
+    return max_, [max_.matcher.samples(m.onto(max_.body.parts))[1] for m in motions]
 
 
 def test_learned_from_several_takes_the_movement_is_one_mean_path_and_its_takes(pm):

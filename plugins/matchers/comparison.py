@@ -1,0 +1,458 @@
+"""What a matcher compares: a demonstration's frames against one's own, frame by frame (the *comparison*).
+
+A matcher is a comparison, a search and a decision (``docs/matchers.md``). The comparison turns a sequence of
+root-relative poses into *frames* (:class:`Frames`) and gives the distance of every frame of one sequence to every
+frame of another (:meth:`Comparison.costs`); the search aligns the two sequences through time, and the decision
+says whether the best alignment is near enough to be a known movement. Two comparisons, chosen once, when a matcher
+is attached (``comparison = "poses"`` or ``"motion"``):
+
+:class:`Poses` (the papers)
+    Buchsbaum & Blumberg 2005, §5.1, eq. 1: the mean over the parts seen of the Euclidean distance between the two
+    root-relative positions of each part (eq. 2), in metres. Where a hand is held is what counts; how it moves is
+    seen only through the sequence of places.
+
+:class:`Motion` (real people, the observer template's)
+    Each part is seen by *where it goes*, *how it moves* and *how the body carries it*, in the demonstrator's own
+    body sizes, so that a tall and a short performer, a stooped and an upright one, compare alike:
+
+    - **shape**: the part's position about its own mean over the sequence (the held posture removed: a stoop, a hand
+      held higher through a wave cancel; the excursion of the movement stays), over the body size;
+    - **motion**: the part's velocity relative to the root in the body's frame, times :data:`HORIZON` seconds, over
+      the body size: the displacement it is making. What tells a wave from a raise of the same hand is this: the
+      reversals of a wave, which positions barely show. The velocity is a Savitzky-Golay derivative
+      (:mod:`plugins.lib.velocity`), so a tracker's frame-to-frame jitter does not pass for motion;
+    - **carry**: where the body goes and where it turns, which root-relative coordinates (§5.1) leave out and which
+      move every part alike: the root's velocity in the body's own frame times :data:`HORIZON` over the body size
+      (a walk forward, backward, sideways; a run), and the turn since the sequence began as the chord
+      ``(cos θ - 1, sin θ)`` a point one body size ahead of the root moves along (a walk that turns left or right).
+
+    The distance of two frames is eq. 1 over these with the root of the mean square in place of the mean: the root
+    of the mean, over the parts seen in both, of the squared Euclidean norm of each part's difference in shape,
+    motion and carry together (every part is carried by the body, so the carry enters each part's norm). The root
+    mean square lets the parts that differ most, the ones that move, count most, where eq. 1's plain mean lets the
+    many still parts of a whole body outweigh a waving hand; and it is a few matrix products for all frame pairs at
+    once. Unit-free: one body size is 1. Nothing in it depends on the frame rate, which is taken out by the
+    derivative, nor on the tempo, which the search's time warping takes up.
+
+:data:`HORIZON` is 0.25 s: motion and shape count alike for a part swinging at ``1 / (2π · 0.25 s)``, about
+0.64 Hz, the middle of the frequencies of human gestures and steps (half a hertz to a few hertz), so neither
+outweighs the other for any of them. It was not chosen on data (``docs/matchers.md``).
+"""
+
+from __future__ import annotations
+
+import warnings
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from functools import cached_property
+from typing import ClassVar
+
+import numpy as np
+
+from plugins.lib.body_size import body_scale
+from plugins.lib.root_frame import root_relative, smooth_heading
+from plugins.lib.travel import body_velocity, turned
+from plugins.lib.velocity import derivative
+
+__all__ = ["COMPARISONS", "Comparison", "Frames", "HORIZON", "Motion", "Poses", "comparison", "sequence_size"]
+
+HORIZON = 0.25
+"""Seconds over which a velocity counts as a displacement (the motion and the travel of :class:`Motion`)."""
+
+@dataclass(frozen=True)
+class Frames:
+    """A sequence as a comparison sees it.
+
+    Attributes
+    ----------
+    parts : array, shape (n, P, D)
+        Each part's features per frame (:class:`Poses`: its position, D = 3; :class:`Motion`: shape and motion,
+        D = 6).
+    seen : array of bool, shape (n, P)
+        The parts seen in each frame; a frame with none seen carries no evidence.
+    carry : array, shape (n, C)
+        The body's features, shared by every part (:class:`Motion`'s travel and turn, C = 5; C = 0 for
+        :class:`Poses`).
+    carried : array of bool, shape (n,)
+        Whether the carry is known (where the body goes needs its world positions).
+    """
+
+    parts: np.ndarray
+    seen: np.ndarray
+    carry: np.ndarray
+    carried: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.parts)
+
+    @cached_property
+    def products(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """What :meth:`Motion.costs` multiplies, kept with the frames (a repertoire's are computed once): the parts
+        with the unseen ones zeroed, flat (n, P * D); their squared norms (n, P); the mask as numbers (n, P); the
+        carry with the unknown ones zeroed (n, C) and its squared norms (n,)."""
+        seen = self.seen.astype(float)
+        masked = self.parts * seen[..., None]
+        carry = np.where(self.carried[:, None], self.carry, 0.0)
+        return (masked.reshape(len(self), -1), np.einsum("npd,npd->np", masked, masked), seen, carry,
+                np.einsum("nc,nc->n", carry, carry))
+
+    @cached_property
+    def flat(self) -> tuple[np.ndarray, np.ndarray]:
+        """The parts' features a frame after another, contiguous (n, P * D), and the carry with the unknown ones
+        zeroed and a last column of 1 where it is known (n, C + 1), in single precision (a distance in body sizes
+        needs no more than seven digits, and half the numbers to read): what :func:`_rms_full` reads."""
+        carry = np.zeros((len(self), self.carry.shape[1] + 1), dtype=np.float32)
+        carry[:, :-1] = np.where(self.carried[:, None], self.carry, 0.0)
+        carry[:, -1] = self.carried
+        return np.ascontiguousarray(self.parts.reshape(len(self), -1), dtype=np.float32), carry
+
+    def take(self, rows: np.ndarray | slice) -> Frames:
+        """The frames ``rows`` of this sequence."""
+        return Frames(self.parts[rows], self.seen[rows], self.carry[rows], self.carried[rows])
+
+    @staticmethod
+    def join(sequences: list[Frames]) -> Frames:
+        """Sequences one after another (each keeps the features it was given: a take's shape about its own mean)."""
+        return Frames(*(np.concatenate([getattr(s, f) for s in sequences]) for f in
+                        ("parts", "seen", "carry", "carried")))
+
+
+class Comparison(ABC):
+    """How frames are compared: :meth:`frames` of a sequence, :meth:`costs` between two."""
+
+    name: ClassVar[str]
+    unit: ClassVar[str]
+    """What a distance is measured in ("m": metres; "body": the demonstrator's body sizes)."""
+
+    @abstractmethod
+    def frames(self, poses: np.ndarray, visible: np.ndarray, fps: float, *, velocity: np.ndarray | None = None,
+               travel: np.ndarray | None = None, heading: np.ndarray | None = None,
+               size: float | None = None) -> Frames:
+        """The frames of a sequence of root-relative poses.
+
+        Parameters
+        ----------
+        poses : array, shape (n, P, 3)
+            Root-relative poses in the body's frame (hidden parts held where last seen, NaN if never seen).
+        visible : array of bool, shape (n, P)
+        fps : float
+            Frames per second of the sequence.
+        velocity : array, shape (n, P, 3), optional
+            Each part's velocity relative to the root (m/s), where it is known better than from ``poses`` (a
+            posegraph's nodes keep their clip's, measured at the clip's frame rate); ``None``: derived here.
+        travel : array, shape (n, 3), optional
+            The root's velocity in the body's own frame (m/s); ``None`` or NaN rows: not known.
+        heading : array, shape (n,), optional
+            The body's heading (radians, about +y) relative to the sequence's first frame; ``None`` or NaN: not known.
+        size : float, optional
+            The body size the lengths are measured in (:func:`plugins.lib.body_size.body_scale`); ``None``: from
+            the sequence's own median pose.
+        """
+
+    def costs(self, a: Frames, b: Frames) -> np.ndarray:
+        """Every frame of ``a`` against every frame of ``b``: eq. 1 over the parts seen in both, (len(a), len(b)).
+        A pair with no part seen in both costs 0 (no evidence either way). Compiled (:func:`_eq1`)."""
+        out = np.empty((len(a), len(b)))
+        if out.size:
+            _kernel()(np.ascontiguousarray(a.parts, dtype=np.float64), a.seen, np.ascontiguousarray(a.carry,
+                      dtype=np.float64), a.carried, np.ascontiguousarray(b.parts, dtype=np.float64), b.seen,
+                      np.ascontiguousarray(b.carry, dtype=np.float64), b.carried, out)
+        return out
+
+    @abstractmethod
+    def still(self, frames: Frames) -> np.ndarray:
+        """Each frame's distance to standing still: how much there is to explain, (n,). The share of a
+        demonstration that a movement leaves unexplained is its distance over this one
+        (:mod:`plugins.matchers.decision`)."""
+
+
+def _eq1(a, a_seen, a_carry, a_carried, b, b_seen, b_carry, b_carried, out):
+    """eq. 1 of every frame pair: ``out[i, j]`` the mean over the parts seen in both of the Euclidean norm of the
+    part's difference, the carries' difference (where both are known) added to each part's squared norm; 0 where
+    no part is seen in both. Plain Python as written (the reference), compiled by :func:`_kernel`."""
+    n, parts, dims = a.shape
+    m = b.shape[0]
+    width = a_carry.shape[1]
+    for i in range(n):
+        for j in range(m):
+            carry = 0.0
+            if width and a_carried[i] and b_carried[j]:
+                for c in range(width):
+                    d = a_carry[i, c] - b_carry[j, c]
+                    carry += d * d
+            total = 0.0
+            count = 0
+            for p in range(parts):
+                if a_seen[i, p] and b_seen[j, p]:
+                    sq = carry
+                    for k in range(dims):
+                        d = a[i, p, k] - b[j, p, k]
+                        sq += d * d
+                    total += np.sqrt(sq)
+                    count += 1
+            out[i, j] = total / count if count else 0.0
+
+
+_compiled = None
+
+
+def _kernel():
+    """:func:`_eq1` compiled by numba (:func:`plugins.lib.compiled.compiled`), or the reference without it."""
+    global _compiled
+    if _compiled is None:
+        from plugins.lib.compiled import compiled
+
+        found = compiled(_eq1)
+        _compiled = found[0] if found is not None else _eq1
+    return _compiled
+
+
+class Poses(Comparison):
+    """Buchsbaum & Blumberg 2005, eq. 1-2: root-relative positions, in metres (the papers)."""
+
+    name = "poses"
+    unit = "m"
+
+    def frames(self, poses, visible, fps, *, velocity=None, travel=None, heading=None, size=None) -> Frames:
+        poses = np.asarray(poses, dtype=float)
+        seen = np.asarray(visible, dtype=bool) & np.isfinite(poses).all(axis=-1)
+        n = len(poses)
+        return Frames(np.where(seen[..., None], poses, 0.0), seen, np.zeros((n, 0)), np.zeros(n, dtype=bool))
+
+    def still(self, frames: Frames) -> np.ndarray:
+        """Each frame's eq. 1 distance to the sequence's mean pose (its own posture held still), (n,)."""
+        counts = frames.seen.sum(axis=0)
+        mean = (frames.parts * frames.seen[..., None]).sum(axis=0) / np.maximum(counts, 1)[:, None]
+        d = np.sqrt(((frames.parts - mean) ** 2).sum(axis=-1))
+        count = frames.seen.sum(axis=1)
+        return np.where(count > 0, (d * frames.seen).sum(axis=1) / np.maximum(count, 1), 0.0)
+
+
+class Motion(Comparison):
+    """Shape, motion and carry of every part, in body sizes (see the module).
+
+    ``shape = False``: motion and carry only, what can be compared before a movement is over (the shape needs the
+    whole movement's mean posture): the forward model's, which predicts while the demonstration comes in."""
+
+    name = "motion"
+    unit = "body"
+
+    def __init__(self, shape: str = "mean") -> None:
+        if shape not in ("mean", "onset", "none"):
+            raise ValueError(f"shape must be 'mean', 'onset' or 'none', not {shape!r}")
+        self.shape = shape
+
+    def frames(self, poses, visible, fps, *, velocity=None, travel=None, heading=None, size=None,
+               origin=None) -> Frames:
+        """:meth:`Comparison.frames`; ``origin`` (P, 3): with ``shape = "onset"``, the pose the shape is measured
+        from (default: the first frame's)."""
+        poses = np.asarray(poses, dtype=float)
+        seen = np.asarray(visible, dtype=bool) & np.isfinite(poses).all(axis=-1)
+        n = len(poses)
+        filled = np.where(seen[..., None], poses, 0.0)
+        if size is None:
+            size = sequence_size(filled, seen)
+        scale = 1.0 / size if size > 0 else 0.0
+        if self.shape == "onset":
+            shape = (filled - (filled[:1] if origin is None else np.asarray(origin, dtype=float))) * scale
+        else:
+            counts = seen.sum(axis=0)
+            mean = (filled * seen[..., None]).sum(axis=0) / np.maximum(counts, 1)[:, None]
+            shape = (filled - mean) * scale
+        if velocity is None:
+            velocity = derivative(filled, fps)
+        motion = np.nan_to_num(np.asarray(velocity, dtype=float)) * (HORIZON * scale)
+        carry = np.zeros((n, 5))
+        carried = np.zeros(n, dtype=bool)
+        if travel is not None and heading is not None:
+            travel = np.asarray(travel, dtype=float)
+            heading = np.asarray(heading, dtype=float)
+            carried = np.isfinite(travel).all(axis=1) & np.isfinite(heading)
+            carry[:, :3] = np.where(carried[:, None], travel, 0.0) * (HORIZON * scale)
+            turn = np.where(carried, heading, 0.0)
+            carry[:, 3] = np.cos(turn) - 1.0
+            carry[:, 4] = np.sin(turn)
+        return Frames(motion if self.shape == "none" else np.concatenate([shape, motion], axis=2), seen, carry,
+                      carried)
+
+
+    def costs(self, a: Frames, b: Frames) -> np.ndarray:
+        """Every frame of ``a`` against every frame of ``b``: the root mean square over the parts seen in both of
+        each part's difference with the carries' (where both are known) added, (len(a), len(b)); 0 where no part
+        is seen in both. As matrix products: the sum over the parts seen in both of ``|x|^2 + |y|^2 - 2 x.y``
+        (:attr:`Frames.products`); best on one BLAS thread (:func:`plugins.lib.compiled.one_thread`)."""
+        xa, na, sa, ca, qa = a.products
+        xb, nb, sb, cb, qb = b.products
+        count = sa @ sb.T
+        square = na @ sb.T + sa @ nb.T - 2.0 * (xa @ xb.T)
+        if ca.shape[1]:
+            carry = qa[:, None] + qb[None, :] - 2.0 * (ca @ cb.T)
+            square += np.where(np.outer(a.carried, b.carried), carry, 0.0) * count
+        with np.errstate(invalid="ignore", divide="ignore"):
+            mean = np.where(count > 0, square / np.maximum(count, 1.0), 0.0)
+        return np.sqrt(np.maximum(mean, 0.0))
+
+    def row_costs(self, a: Frames, b: Frames) -> np.ndarray:
+        """:meth:`costs` computed pair by pair in a compiled loop (:func:`_rms`): each row's numbers the same whatever
+        rows come with it (a matrix product's rounding depends on how many rows it multiplies), for a forward model
+        fed rows one by one or at once; slower than :meth:`costs` for many rows."""
+        out = np.empty((len(a), len(b)))
+        if out.size and a.seen.all() and b.seen.all():  # every part seen: one contiguous run of numbers a frame
+            flat_a, carry_a = a.flat
+            flat_b, carry_b = b.flat
+            _full_kernel()(flat_a, carry_a, flat_b, carry_b, a.parts.shape[1], out)
+        elif out.size:
+            _rms_kernel()(np.ascontiguousarray(a.parts, dtype=np.float64), a.seen,
+                          np.ascontiguousarray(np.where(a.carried[:, None], a.carry, 0.0)), a.carried,
+                          np.ascontiguousarray(b.parts, dtype=np.float64), b.seen,
+                          np.ascontiguousarray(np.where(b.carried[:, None], b.carry, 0.0)), b.carried, out)
+        return out
+
+    def still(self, frames: Frames) -> np.ndarray:
+        """Each frame's distance to standing still, every feature zero (no excursion from the mean posture, no
+        motion, no carry): the root mean square of its parts' norms with the carry's, (n,)."""
+        norm2 = np.einsum("npd,npd->np", frames.parts, frames.parts)
+        if frames.carry.shape[1]:
+            norm2 = norm2 + np.where(frames.carried, np.einsum("nc,nc->n", frames.carry, frames.carry), 0.0)[:, None]
+        count = frames.seen.sum(axis=1)
+        return np.sqrt(np.where(count > 0, (norm2 * frames.seen).sum(axis=1) / np.maximum(count, 1), 0.0))
+
+    def of_motion(self, motion, body, rows: np.ndarray, fps: float) -> Frames:
+        """The frames of a whole observed motion (a segment in working memory, with its world positions) at its
+        frames ``rows``, given as a sequence of ``fps`` frames a second.
+
+        Where the world positions are known, the body's frame is found again from them over the whole segment, as
+        it is for the clips a repertoire is built from (:func:`plugins.lib.clip_repertoire.root_relative_motion`:
+        the facing a centred running median over :data:`FACING_WINDOW`): a perception that watches live can only
+        look back, so its facing lags behind a turn, and the parts would be seen swinging sideways as the body
+        turns. Each part's motion is derived at the motion's own frame rate before the rows are taken, and the
+        body size is the segment's."""
+        positions, visible = motion.positions, motion.visible
+        travel = heading = None
+        if motion.world is not None and np.isfinite(motion.world).any():
+            window = max(1, int(round(FACING_WINDOW * motion.fps)))
+            local, seen, _, _ = root_relative(motion.world, motion.visible, body,
+                                              lambda h: smooth_heading(h, window))
+            if seen.any():
+                positions, visible = local, seen
+                travel = body_velocity(motion.world, local, seen, body.root_index, motion.fps, frames=rows)
+                heading = turned(motion.world, local, seen, body.root_index)[rows]
+        seen = visible & np.isfinite(positions).all(axis=-1)
+        relative = np.where(seen[..., None], positions, 0.0)
+        root = body.root_index
+        held = _held(relative, seen)
+        velocity = derivative(held - held[:, root : root + 1], motion.fps)[rows]
+        return self.frames(held[rows], seen[rows], fps, velocity=velocity, travel=travel, heading=heading,
+                           size=sequence_size(relative, seen))
+
+
+FACING_WINDOW = 1.0
+"""Seconds of the centred running median of the facing when a whole segment's frame is found again."""
+
+
+def _held(positions: np.ndarray, seen: np.ndarray) -> np.ndarray:
+    """Each part held where it was last seen (first seen, before that), docs/conventions.md; 0 if never seen."""
+    out = positions.copy()
+    for p in np.flatnonzero(~seen.all(axis=0)):
+        rows = np.flatnonzero(seen[:, p])
+        if not len(rows):
+            out[:, p] = 0.0
+            continue
+        last = np.maximum.accumulate(np.where(seen[:, p], np.arange(len(seen)), -1))
+        out[:, p] = positions[np.where(last >= 0, last, rows[0]), p]
+    return out
+
+
+def _rms(a, a_seen, a_carry, a_carried, b, b_seen, b_carry, b_carried, out):
+    """:meth:`Motion.costs` of every frame pair, pair by pair: ``out[i, j]`` the root of the mean over the parts seen
+    in both of each part's squared difference plus the carries' (where both are known); 0 where no part is seen in
+    both. Plain Python as written (the reference), compiled by :func:`_rms_kernel`."""
+    n, parts, dims = a.shape
+    m = b.shape[0]
+    width = a_carry.shape[1]
+    for i in range(n):
+        for j in range(m):
+            carry = 0.0
+            if a_carried[i] and b_carried[j]:
+                for c in range(width):
+                    d = a_carry[i, c] - b_carry[j, c]
+                    carry += d * d
+            total = 0.0
+            count = 0
+            for p in range(parts):
+                if a_seen[i, p] and b_seen[j, p]:
+                    sq = carry
+                    for k in range(dims):
+                        d = a[i, p, k] - b[j, p, k]
+                        sq += d * d
+                    total += sq
+                    count += 1
+            out[i, j] = np.sqrt(total / count) if count else 0.0
+
+
+def _rms_full(a, a_carry, b, b_carry, parts, out):
+    """:func:`_rms` where every part is seen in both: ``a`` (n, P * D) and ``b`` (m, P * D) a frame's features in
+    one run, the carries with a last column of 1 where known (:attr:`Frames.flat`). The same numbers as
+    :func:`_rms` up to the order of the sums, which the compiled loop takes side by side (the same order at every
+    call: a row's numbers do not depend on the rows beside it). Plain Python, compiled by :func:`_full_kernel`."""
+    n, width = a.shape
+    m = b.shape[0]
+    c = a_carry.shape[1] - 1
+    for i in range(n):
+        for j in range(m):
+            sq = np.float32(0.0)
+            for k in range(width):
+                d = a[i, k] - b[j, k]
+                sq += d * d
+            carry = np.float32(0.0)
+            if a_carry[i, c] > 0 and b_carry[j, c] > 0:
+                for k in range(c):
+                    d = a_carry[i, k] - b_carry[j, k]
+                    carry += d * d
+            out[i, j] = np.sqrt(np.float64(sq) / parts + np.float64(carry))
+
+
+_full_compiled = None
+
+
+def _full_kernel():
+    """:func:`_rms_full` compiled by numba, or the reference without it."""
+    global _full_compiled
+    if _full_compiled is None:
+        from plugins.lib.compiled import compiled
+
+        found = compiled(_rms_full, reordered=True)
+        _full_compiled = found[0] if found is not None else _rms_full
+    return _full_compiled
+
+
+_rms_compiled = None
+
+
+def _rms_kernel():
+    """:func:`_rms` compiled by numba (:func:`plugins.lib.compiled.compiled`), or the reference without it."""
+    global _rms_compiled
+    if _rms_compiled is None:
+        from plugins.lib.compiled import compiled
+
+        found = compiled(_rms)
+        _rms_compiled = found[0] if found is not None else _rms
+    return _rms_compiled
+
+
+def sequence_size(poses: np.ndarray, seen: np.ndarray) -> float:
+    """A sequence's body size: :func:`plugins.lib.body_size.body_scale` of each part's median position over the
+    frames it is seen (0 when fewer than two parts are ever seen)."""
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # a part never seen: its median is NaN, and left out
+        median = np.nanmedian(np.where(seen[..., None], poses, np.nan), axis=0)
+    return float(body_scale(median))
+
+
+COMPARISONS: dict[str, type[Comparison]] = {"poses": Poses, "motion": Motion}
+"""The comparisons by the name a matcher's ``comparison`` parameter takes."""
+
+
+def comparison(name: str) -> Comparison:
+    """The comparison called ``name`` (:data:`COMPARISONS`)."""
+    return COMPARISONS[name]()

@@ -1,0 +1,178 @@
+"""Whether the nearest movement is near enough: a matcher's *decision* for "unknown".
+
+Every matcher ranks its own movements by how near each comes to the demonstration (its comparison and search);
+the decision says whether the nearest is near enough to be that movement, or whether the demonstration is a
+movement the observer does not know (Buchsbaum & Blumberg 2005, §5.2.3 and §7.3: what is unknown can then be
+learned; Kopp & Graeser 2006, §4.3: true imitation learning of what no forward model predicts). Two decisions,
+chosen once when a matcher is attached (``decision = "distance"`` or ``"calibrated"``), shared by ``path-search``,
+``forward-model`` and ``dtw``:
+
+:class:`Distance` (the papers)
+    Unknown beyond a fixed distance in the comparison's own unit (B&B's ``max_distance`` of eq. 3, metres on one's
+    own body; K&G's drop-out ``threshold``). Right for the papers' characters, who watch bodies like their own;
+    a length does not carry over to another data set, skeleton or performer.
+
+:class:`Calibrated` (real people, the observer template's)
+    Calibrated from the repertoire itself, so the same setting holds for one take of each movement, two, or
+    fourteen, on any skeleton. The score is unit-free: the distance to the nearest movement over the
+    demonstration's distance to standing still (:meth:`plugins.matchers.comparison.Comparison.still`), the share of
+    the demonstration its nearest movement leaves unexplained. The matcher measures, with its own comparison and
+    search, two sets of scores on its repertoire (:class:`Calibration`):
+
+    - *own*: each take of a movement of several takes, against the movement's other takes (leave one take out):
+      how far performances of one movement lie from each other;
+    - *other*: each take against the repertoire without its movement (leave one movement out): how near a
+      movement the repertoire does not hold comes to the nearest it does hold.
+
+    A demonstration is unknown when its score is above the threshold (:meth:`Calibrated.threshold`): the
+    ``1 - known_rejected`` quantile of the *own* scores and of the *other* scores, the larger of the two, and never
+    above 1 (a movement that explains a demonstration no better than standing still does not stand for it). The
+    meaning a user sets is ``known_rejected``: at most that share of the performances of a known movement are
+    called unknown, as far as the repertoire shows how far a performance may lie from its movement. Where a
+    movement has several takes, their spread shows it; takes recorded one after another differ by almost nothing,
+    and one take shows nothing, so the repertoire's movements stand for it too: a performance of a movement is
+    taken to lie no farther from it than the repertoire's movements lie from their nearest neighbours, all but
+    ``known_rejected`` of them. The same setting then holds with one take of each movement, two, or fourteen. A
+    movement the repertoire does not hold is unknown where it lies farther from every known movement than that;
+    one as near to a known movement as the repertoire's own movements are to each other cannot be told from a
+    performance of it (``docs/matchers.md`` has the figures).
+
+The decision's answer, with the score and the threshold it was decided on, goes into the typed fields of
+:class:`toolkit.Match` (``score``, ``threshold``, ``nearest``, ``measure``), which ``likeme observe`` prints for
+every "unknown".
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Calibrated", "Calibration", "DECISIONS", "Decision", "Distance", "Verdict"]
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """Scores a matcher measured on its own repertoire (see the module), each a demonstration's distance to its
+    nearest movement over its distance to standing still.
+
+    Attributes
+    ----------
+    own : tuple of float
+        Leave one take out: each take of a movement of several takes against the movement's other takes.
+    other : tuple of float
+        Leave one movement out: each take against the repertoire without its movement.
+    """
+
+    own: tuple[float, ...] = ()
+    other: tuple[float, ...] = ()
+
+    @classmethod
+    def of(cls, own: Sequence[float], other: Sequence[float]) -> Calibration:
+        """The finite scores of ``own`` and ``other``."""
+        return cls(tuple(float(x) for x in own if np.isfinite(x)), tuple(float(x) for x in other if np.isfinite(x)))
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """What a decision says of the nearest movement: the movement (``None``: unknown), the nearest one, the score
+    the verdict was decided on and the threshold it was held to (in :attr:`Decision.measure`)."""
+
+    movement: str | None
+    nearest: str | None
+    score: float
+    threshold: float
+
+
+class Decision(ABC):
+    """Known or unknown, from each movement's distance to a demonstration."""
+
+    name: str
+    relative: bool
+    """Whether the score is relative to standing still (:class:`Calibrated`) rather than a distance."""
+
+    @property
+    @abstractmethod
+    def measure(self) -> str:
+        """What :attr:`Verdict.score` and :attr:`Verdict.threshold` are, for people."""
+
+    @abstractmethod
+    def threshold(self) -> float:
+        """The largest score accepted as a known movement."""
+
+    def decide(self, nearest: str | None, distance: float, still: float = 1.0) -> Verdict:
+        """The verdict on the ``nearest`` movement at ``distance`` (in the comparison's unit) from the
+        demonstration; ``still``: the demonstration's distance to standing still, which a relative decision divides
+        by. No nearest movement (nothing came near): unknown."""
+        limit = self.threshold()
+        if nearest is None or not np.isfinite(distance):
+            return Verdict(None, nearest, float("inf"), limit)
+        score = self.score(distance, still)
+        return Verdict(nearest if score <= limit else None, nearest, score, limit)
+
+    def score(self, distance: float, still: float) -> float:
+        """The score a distance is decided on."""
+        if not self.relative:
+            return float(distance)
+        return float(distance / still) if still > 0 else (0.0 if distance <= 0 else float("inf"))
+
+
+class Distance(Decision):
+    """Unknown beyond ``max_distance`` in the comparison's unit (the papers; 0: never unknown)."""
+
+    name = "distance"
+    relative = False
+
+    def __init__(self, max_distance: float, measure: str = "mean distance (m)") -> None:
+        self.max_distance = float(max_distance)
+        self._measure = measure
+
+    @property
+    def measure(self) -> str:
+        return self._measure
+
+    def threshold(self) -> float:
+        return self.max_distance if self.max_distance > 0 else float("inf")
+
+
+class Calibrated(Decision):
+    """Unknown beyond a threshold calibrated on the repertoire's own takes (see the module)."""
+
+    name = "calibrated"
+    relative = True
+
+    def __init__(self, known_rejected: float = 0.05) -> None:
+        if not 0.0 <= known_rejected <= 1.0:
+            raise ValueError(f"known_rejected must be in [0, 1], not {known_rejected!r}")
+        self.known_rejected = float(known_rejected)
+        self.calibrate(Calibration())
+
+    @property
+    def measure(self) -> str:
+        return "distance to the nearest movement over the distance to standing still"
+
+    def calibrate(self, calibration: Calibration) -> None:
+        """Take the scores measured on the repertoire (:class:`Calibration`)."""
+        self.calibration = calibration
+        self._threshold = self._limit()
+
+    def threshold(self) -> float:
+        return self._threshold
+
+    def _limit(self) -> float:
+        """The larger of the ``1 - known_rejected`` quantiles of the own and of the other scores, at most
+        :data:`STILL` (1: no better than standing still); :data:`STILL` while the repertoire has neither two
+        movements nor two takes of one."""
+        scores = [np.asarray(s) for s in (self.calibration.own, self.calibration.other) if len(s)]
+        limits = [float(np.quantile(s, 1.0 - self.known_rejected)) for s in scores]
+        return min(max(limits), STILL) if limits else STILL
+
+
+STILL = 1.0
+"""The largest calibrated threshold: a score of 1 is a demonstration its nearest movement explains no better than
+standing still would."""
+
+DECISIONS = {"distance": Distance, "calibrated": Calibrated}
+"""The decisions by the name a matcher's ``decision`` parameter takes."""

@@ -1,0 +1,537 @@
+"""The forward model following real people: every command predicts the demonstration, compared by its motion.
+
+Kopp & Graeser 2006, §4.4: when a demonstration begins, the commands one knows predict it in parallel, each by its
+forward model; a candidate whose prediction parts from what is seen drops out, and when one movement prevails it is
+imitated at once, before the demonstration is over (*response facilitation*). The paper's own mechanism follows the
+wrist's guiding strokes of a body like one's own and drops a candidate beyond a fixed error in metres
+(:mod:`plugins.matchers.forward_model.tracks`). Another person's body, stance, style and tempo put every such
+prediction off from the first frame. Here the same parallel prediction and drop-out work with the comparison and
+the decision the matchers share:
+
+- **prediction**: each take one has learned (a chain of commands, :meth:`MotorCommandGraph.takes`) is played by its
+  commands' forward models (the guiding strokes' positions over the command's time) at :data:`RATE` samples a
+  second, with where the body went and how far it turned while the command was shown (:attr:`Edge.travel`,
+  :attr:`Edge.turn`);
+- **comparison**: what a forward model can compare before a movement is over (:class:`plugins.matchers.comparison.
+  Motion` with its shape taken from the onset, K&G's prediction from the active node, rather than about the whole
+  movement's mean posture, which is not known yet): where each part has gone since the movement began, how it
+  moves, how the body carries it, in the demonstrator's own body sizes; the demonstration's frames are taken as they
+  arrive, the body's facing from a running median over the last :data:`FACING` seconds;
+- **tempo**: each prediction is followed at whatever pace the demonstration goes, by time warping advanced sample by
+  sample (:class:`plugins.matchers.warping.Warping`): K&G re-parameterise a command by the path length seen (§4.4),
+  the warping finds for every sample the point of each prediction that fits best so far;
+- **drop-out and commitment**: each movement's score is its best take's distance so far over the demonstration's
+  own distance to standing still, held to the calibrated threshold (:class:`plugins.matchers.decision.Calibrated`,
+  calibrated on the predictions themselves, each take left out of its movement and each movement left out). A
+  movement is committed to when it is within the threshold, every other movement is :data:`LEAD` times as far off
+  and ``min_progress`` of its take has been followed (``Match.decided_at``: response facilitation). A committed
+  movement that goes beyond the threshold, or that another now leads as far, is a deviation (``stop``);
+- **the answer at the end**: when nothing was committed or the commitment did not hold, every movement's score over
+  the whole demonstration, decided as path search decides (:mod:`plugins.matchers.decision`).
+
+The candidates are the takes a motor command graph learned from labelled clips (:meth:`MotorCommandGraph.takes`):
+this is the forward model for a repertoire of recordings; a character who learns by watching follows the paper's
+guiding strokes (``comparison = "strokes"``).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Protocol
+
+import numpy as np
+
+from plugins.lib.compiled import one_thread
+from plugins.lib.root_frame import HeadingFilter, facing_heading, to_root_relative
+from plugins.lib.velocity import SMOOTHING, derivative
+from plugins.matchers.comparison import Frames, Motion
+from plugins.matchers.decision import Calibrated, Calibration, Decision
+from plugins.matchers.warping import Chains, Warping, chain_distances
+from toolkit import Match
+from toolkit import Motion as Recording
+
+__all__ = ["FACING", "Following", "LEAD", "RATE", "Streaming"]
+
+RATE = 10.0
+"""Samples a second at which predictions and demonstrations are compared: the posegraph's node rate (B&B §4.1),
+fine enough for human movements (the velocities are smoothed over :data:`plugins.lib.velocity.SMOOTHING` first)."""
+
+FACING = 0.5
+"""Seconds of the running median of the facing while a demonstration comes in (looking back only)."""
+
+PLAY_FPS = 30.0
+"""Frames a second at which a command's prediction is played before its velocities are taken and it is sampled."""
+
+TRAVEL = 0.25
+"""Seconds over which the root's velocity is averaged (:func:`plugins.lib.travel.body_velocity`'s window)."""
+
+BLOCK = 0.3
+"""Seconds of frames the watching loop's rows are taken in at once, live (three samples): the frame each answer is
+decided at stays the sample's; it is reported up to this much later, for a tenth of the work per frame."""
+
+RECENT = 0.5
+"""Seconds over which a committed take's prediction is held to the threshold to tell a deviation."""
+
+LEAD = 1.5
+"""How far ahead the best movement must be to be committed to: every other movement's score at least this many
+times its own (half again as far off: a clear lead, not a matter of noise)."""
+
+
+class Takes(Protocol):
+    """What following real people needs of a motor system: a motor command graph that learned takes from clips."""
+
+    body: Any
+    subsystems: dict[str, Any]
+
+    def takes(self) -> dict[str, list[tuple[tuple[str, ...], str, Any, float]]]:
+        """Movement -> one ``(edges, subsystem, observed, fps)`` per clip it was learned from."""
+
+    def edge(self, movement: str) -> Any:
+        """The edge record of a movement (edge) name: its commands, travel and turn."""
+
+    def rest_pose(self) -> np.ndarray:
+        """The body's rest pose, local frame (P, 3)."""
+
+
+class Prediction:
+    """Every take's predicted frames, chain after chain (:class:`plugins.matchers.warping.Chains`)."""
+
+    def __init__(self, motor: Any, comparison: Motion) -> None:
+        root = motor.body.root_index
+        rest = np.asarray(motor.rest_pose(), dtype=float)
+        takes, movements, lengths = [], [], []
+        for movement, chains in motor.takes().items():
+            for edges, subsystem, _, _ in chains:
+                frames = self._take(motor, edges, subsystem, rest, root, comparison)
+                if frames is not None and len(frames):
+                    takes.append(frames)
+                    movements.append(movement)
+                    lengths.append(len(frames))
+        self.takes = takes
+        self.chains = Chains.of_lengths(lengths, movements)
+        self.frames = Frames.join(takes) if takes else None
+
+    @staticmethod
+    def _take(motor, edges, subsystem, rest, root, comparison) -> Frames | None:
+        """One take's commands played: the parts' positions predicted by their commands (the others held at rest),
+        their velocities, the travel and the turn shown with each command, sampled at :data:`RATE`."""
+        idx = motor.subsystems[subsystem]
+        pieces, travel, turn, shown, turned = [], [], [], [], 0.0
+        for name in edges:
+            edge = motor.edge(name)
+            t = np.arange(0.0, edge.duration + 0.5 / PLAY_FPS, 1.0 / PLAY_FPS)
+            frames = np.repeat(rest[None], len(t), axis=0)
+            frames[:, idx] = np.stack([c.position(t) for c in edge.commands], axis=1)
+            pieces.append(frames)
+            at = np.linspace(0.0, 1.0, len(t))
+            travel.append(_along(edge.travel, at, 3))
+            turn.append(turned + _along(edge.turn, at, 1)[:, 0])
+            turned = turn[-1][-1]
+            if edge.shown is not None:
+                shown.append(edge.shown)
+        if not pieces:
+            return None
+        played = np.concatenate(pieces)
+        relative = played - played[:, root : root + 1]
+        velocity = derivative(relative, PLAY_FPS)
+        keep = np.round(np.arange(0.0, len(played) / PLAY_FPS, 1.0 / RATE) * PLAY_FPS).astype(int)
+        keep = keep[keep < len(played)]
+        size = _size(np.concatenate(shown) if shown else relative[:, idx])
+        return comparison.frames(relative[keep], np.ones((len(keep), relative.shape[1]), dtype=bool), RATE,
+                                 velocity=velocity[keep], travel=np.concatenate(travel)[keep],
+                                 heading=np.concatenate(turn)[keep], size=size)
+
+
+def _along(values: np.ndarray | None, at: np.ndarray, width: int) -> np.ndarray:
+    """``values`` (m, width) or (m,) read at the shares ``at`` (0..1) of their length; NaN rows where not known."""
+    if values is None or len(values) == 0:
+        return np.full((len(at), width), np.nan)
+    values = np.asarray(values, dtype=float).reshape(len(values), -1)
+    where = at * (len(values) - 1)
+    return np.stack([np.interp(where, np.arange(len(values)), values[:, k]) for k in range(values.shape[1])], axis=1)
+
+
+def _size(poses: np.ndarray) -> float:
+    """The body size of poses (n, k, 3): :func:`plugins.lib.body_size.body_scale` of their median."""
+    from plugins.lib.body_size import body_scale
+
+    return float(body_scale(np.median(poses, axis=0)))
+
+
+class Watched:
+    """A demonstration as it comes in: its frames at :data:`RATE` once everything they need has been seen.
+
+    The body's frame from the world positions with the facing a running median over the last :data:`FACING`
+    seconds (as a perception watching live finds it, but over a shorter window: what the frame lags behind a turn,
+    the turn's prediction would miss); each part held where it was last seen (docs/conventions.md); each sample's
+    velocity a Savitzky-Golay derivative centred on it (:data:`plugins.lib.velocity.SMOOTHING`), the root's
+    velocity averaged over :data:`TRAVEL` seconds centred on it, so a sample is given :attr:`delay` frames after
+    its own. The body size is that of the median pose of the frames the first sample needs (the onset's).
+    """
+
+    def __init__(self, body: Any, fps: float, comparison: Motion) -> None:
+        from scipy.signal import savgol_coeffs
+
+        self.body, self.fps, self.comparison = body, float(fps), comparison
+        self.root = body.root_index
+        self.filter = HeadingFilter(max(1, int(round(FACING * fps))))
+        taps = max(5, int(round(SMOOTHING * fps)) | 1)
+        self.half = taps // 2
+        self.coeffs = savgol_coeffs(taps, 2, deriv=1, delta=1.0 / fps, use="dot")
+        self.reach = max(1, int(round(TRAVEL * fps / 2)))
+        self.delay = max(self.half, self.reach)
+        parts = len(body.parts)
+        self.n = 0
+        self.relative = np.zeros((64, parts, 3))  # root-relative in the body's frame, each part held
+        self.seen = np.zeros((64, parts), dtype=bool)
+        self.roots = np.zeros((64, 3))
+        self.headings = np.zeros(64)
+        self.last = np.full((parts, 3), np.nan)  # where each part was last seen
+        self.size = 0.0
+        self.sampled = 0  # samples given so far
+
+    def __len__(self) -> int:
+        return self.n
+
+    def _grow(self, more: int) -> None:
+        need = self.n + more
+        if need <= len(self.roots):
+            return
+        size = max(need, 2 * len(self.roots))
+        for name in ("relative", "seen", "roots", "headings"):
+            old = getattr(self, name)
+            new = np.zeros((size, *old.shape[1:]), dtype=old.dtype)
+            new[: self.n] = old[: self.n]
+            setattr(self, name, new)
+
+    def add(self, world: np.ndarray, visible: np.ndarray) -> None:
+        """The next frames (k, P, 3) of world positions and their visibility."""
+        world = np.asarray(world, dtype=float)
+        visible = np.asarray(visible, dtype=bool) & np.isfinite(world).all(axis=-1)
+        k = len(world)
+        if not k:
+            return
+        found = facing_heading(np.where(visible[..., None], world, 0.0), visible, self.body)
+        local, seen, root, heading = to_root_relative(world, visible, self.body, self.filter.update_many(found))
+        held = np.empty_like(local)
+        last = self.last
+        for i in range(k):  # each part held where it was last seen (not seen yet: 0, and not compared)
+            last = np.where(seen[i][:, None], local[i], last)
+            held[i] = last
+        self.last = last
+        held = np.nan_to_num(held)
+        self._grow(k)
+        rows = slice(self.n, self.n + k)
+        self.relative[rows] = held - held[:, self.root : self.root + 1]
+        self.seen[rows] = seen
+        self.roots[rows] = root
+        previous = self.headings[self.n - 1] if self.n else None
+        unwrapped = np.unwrap(np.concatenate([[previous], heading])) [1:] if previous is not None else np.unwrap(heading)
+        self.headings[rows] = unwrapped
+        self.n += k
+        if self.size <= 0 and self.n > self.delay:  # from the frames the first sample needs, however they come
+            self.size = _size(self.relative[: self.delay + 1])
+
+    def due(self, ended: bool) -> np.ndarray:
+        """The frames of the samples not given yet whose frames are all there (``ended``: every sample left)."""
+        last = self.n - 1 if ended else self.n - 1 - self.delay
+        step = self.fps / RATE
+        count = int(np.floor(last / step + 0.5 + 1e-9)) + 1 if last >= 0 else 0
+        rows = np.round(np.arange(self.sampled, max(count, self.sampled)) * step).astype(np.intp)
+        return rows[rows <= last]
+
+    def frames(self, rows: np.ndarray) -> Frames:
+        """The frames of the samples at ``rows`` (frames of the demonstration), given in order."""
+        n, rows = self.n, np.asarray(rows, dtype=np.intp)
+        relative, headings, roots = self.relative[:n], self.headings[:n], self.roots[:n]
+        if self.size <= 0:  # a segment shorter than the first sample needs: what there is of it
+            self.size = _size(relative)
+        taps = len(self.coeffs)
+        if n >= taps:
+            starts = np.clip(rows - self.half, 0, n - taps)
+            windows = relative[starts[:, None] + np.arange(taps)]  # (r, taps, P, 3)
+            velocity = np.einsum("t,rtpd->rpd", self.coeffs, windows)
+            edge = starts != rows - self.half
+            if edge.any():  # near an end: the window's own fit at the row
+                whole = derivative(relative[: n], self.fps)
+                velocity[edge] = whole[rows[edge]]
+        else:
+            velocity = derivative(relative, self.fps)[rows]
+        a = np.maximum(rows - self.reach, 0)
+        b = np.minimum(rows + self.reach, n - 1)
+        span = np.maximum(b - a, 1)
+        v = (roots[b] - roots[a]) * (self.fps / span)[:, None]
+        c, s = np.cos(headings[rows]), np.sin(headings[rows])
+        travel = np.stack([c * v[:, 0] - s * v[:, 2], v[:, 1], s * v[:, 0] + c * v[:, 2]], axis=1)
+        travel[b <= a] = np.nan
+        turn = headings[0] - headings[rows]
+        self.sampled += len(rows)
+        return self.comparison.frames(relative[rows], self.seen[rows], RATE, velocity=velocity, travel=travel,
+                                      heading=turn, size=self.size, origin=relative[0])
+
+
+class Following:
+    """K&G §4.4's parallel forward models with the shared comparison and decision (see the module).
+
+    Parameters
+    ----------
+    motor : MotorCommandGraph
+        Its takes (one chain of commands per clip learned from) are the candidates.
+    body : Body
+        The observer's body (the demonstration's parts are mapped onto it).
+    decision : Decision
+        Calibrated on the predictions (a :class:`Calibrated` decision) or a fixed distance.
+    min_progress : float
+        The share of a take that must be followed before committing to it.
+    """
+
+    def __init__(self, motor: Any, body: Any, decision: Decision, min_progress: float) -> None:
+        self.motor, self.body, self.decision, self.min_progress = motor, body, decision, float(min_progress)
+        self.comparison = Motion(shape="onset")
+        with one_thread():
+            self.rebuild()
+
+    def rebuild(self) -> None:
+        """The predictions and the calibration, from the takes as they are now."""
+        self.prediction = Prediction(self.motor, self.comparison)
+        names = np.asarray(self.prediction.chains.movements, dtype=object)
+        self._order = np.argsort(names, kind="stable")  # the chains grouped by movement, for reduceat
+        ordered = names[self._order]
+        self._heads = np.flatnonzero(np.r_[True, ordered[1:] != ordered[:-1]]) if len(ordered) else np.zeros(0, int)
+        self.movements = [str(m) for m in ordered[self._heads]]
+        self._index = {m: i for i, m in enumerate(self.movements)}
+        if isinstance(self.decision, Calibrated):
+            self.decision.calibrate(self.calibration())
+        self.watched: Watched | None = None
+
+    def calibration(self) -> Calibration:
+        """Each take's prediction as a demonstration: against its movement's other takes and without its movement."""
+        p = self.prediction
+        own, other = [], []
+        if p.frames is None:
+            return Calibration()
+        movements = np.asarray(p.chains.movements, dtype=object)
+        for c, take in enumerate(p.takes):
+            skip = np.zeros(len(p.chains), dtype=bool)
+            skip[c] = True
+            distances, _ = chain_distances(self.comparison, take, p.frames, p.chains, skip)
+            still = float(np.mean(self.comparison.still(take)))
+            mine = movements == movements[c]
+            for out, chosen in ((own, mine & ~skip), (other, ~mine)):
+                if chosen.any():
+                    out.append(float(distances[chosen].min()) / still if still > 0 else np.inf)
+        return Calibration.of(own, other)
+
+    # -- following a demonstration ------------------------------------------------------------
+
+    def begin(self, fps: float) -> None:
+        """A demonstration begins."""
+        self.watched = Watched(self.body, fps, self.comparison)
+        self.warping = Warping(self.comparison, self.prediction.frames, self.prediction.chains) \
+            if self.prediction.frames is not None else None
+        self._still = np.zeros(0)  # the demonstration's mean distance to standing still, after each sample
+        self._stills = np.zeros(0)
+        self._local = np.zeros((0, len(self.prediction.chains)))  # each sample's own distance to each take's frame
+        self.committed: str | None = None
+        self.commitment: Match | None = None
+        self.deviated = False
+        self.means = np.full(len(self.prediction.chains), np.inf)
+        self.trace: list[tuple[int, np.ndarray]] = []  # each sample's frame and every movement's score then
+        self.committed_at: int | None = None  # frames seen when committed / when it deviated
+        self.deviated_at: int | None = None
+
+    def add(self, world: np.ndarray, visible: np.ndarray, ended: bool = False) -> list[tuple[int, Match]]:
+        """The next frames of the demonstration; what the forward models decide on the samples they complete, with
+        the frame (within the demonstration) each was decided at."""
+        watched = self.watched
+        if len(world):
+            watched.add(world, visible)
+        rows = watched.due(ended)
+        if not len(rows) or self.warping is None:
+            return []
+        samples = watched.frames(rows)
+        before = self.warping.samples
+        means, ends, local = self.warping.advance(samples)
+        stills = np.concatenate([self._stills, self.comparison.still(samples)])  # each row on its own: the same
+        self._stills = stills  # numbers whatever the rows come in
+        self._still = np.cumsum(stills) / np.arange(1, len(stills) + 1)  # whatever the rows come in
+        events = []
+        self._local = np.concatenate([self._local, local]) if len(self._local) else local
+        for i, row in enumerate(rows):
+            self.means, self.ends = means[i], ends[i]
+            match = self._decide(row + (watched.delay if not ended else 0), before + i)
+            if match is not None:
+                events.append((row, match))
+        return events
+
+    def _scores(self, upto: int) -> np.ndarray:
+        """Each movement's score so far (in :attr:`movements` order): its best take's distance over the
+        demonstration's distance to standing still."""
+        best = np.minimum.reduceat(self.means[self._order], self._heads)
+        if not self.decision.relative:
+            return best
+        still = self._still[upto] if len(self._still) else 0.0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(still > 0, best / still, np.where(best <= 0, 0.0, np.inf))
+
+    def _take(self, movement: int) -> int:
+        """The chain of a movement's best take so far."""
+        a = self._heads[movement]
+        b = self._heads[movement + 1] if movement + 1 < len(self._heads) else len(self._order)
+        return int(self._order[a + int(np.argmin(self.means[self._order[a:b]]))])
+
+    def _decide(self, frame: int, sample: int) -> Match | None:
+        limit = self.decision.threshold()
+        scores = self._scores(sample)
+        self.trace.append((frame, scores))
+        order = np.argsort(scores, kind="stable")
+        if self.committed is not None:
+            if self.deviated:
+                return None
+            index = self._index[self.committed]
+            recent = self._recent(sample)  # each movement's prediction over the last while
+            mine = float(recent[index])
+            other = float(np.min(np.delete(recent, index))) if len(recent) > 1 else np.inf
+            if scores[index] > limit or mine > limit or mine >= LEAD * other:  # it fails, or another now leads
+                self.deviated = True  # it as far as it led when committed to
+                self.deviated_at = frame + 1
+                return Match(self.committed, 0.0, frame, stop=True, reason="deviation", score=mine,
+                             threshold=limit, measure=self.decision.measure)
+            return None
+        first = int(order[0])
+        score = float(scores[first])
+        runner = float(scores[order[1]]) if len(order) > 1 else np.inf
+        if not (score <= limit and runner >= LEAD * score):
+            return None
+        c = self._take(first)
+        length = self.prediction.chains.starts[c + 1] - self.prediction.chains.starts[c]
+        progress = (self.ends[c] + 1) / length
+        if progress < self.min_progress:
+            return None
+        self.committed = movement = self.movements[first]
+        self.committed_at = frame + 1
+        ranked = tuple((self.movements[i], float(scores[i])) for i in order)
+        self.commitment = Match(movement, max(0.0, 1.0 - score / limit) if 0 < limit < np.inf else 1.0, frame,
+                                candidates=ranked, score=score, threshold=limit, measure=self.decision.measure,
+                                details={"progress": float(progress)})
+        return self.commitment
+
+    def _recent(self, sample: int) -> np.ndarray:
+        """Each movement's prediction over the last :data:`RECENT` seconds (in :attr:`movements` order): its best
+        take's samples' own distances to the frames they were aligned with, over their distances to standing still
+        (K&G §4.4's deviation: the imitated command parting from the demonstration now, not its average since the
+        onset)."""
+        a = max(0, sample + 1 - max(1, int(round(RECENT * RATE))))
+        moving = float(self._stills[a : sample + 1].sum())
+        error = self._local[a : sample + 1].sum(axis=0)
+        if self.decision.relative:
+            with np.errstate(divide="ignore", invalid="ignore"):
+                per_take = error / moving if moving > 0 else np.where(error <= 0, 0.0, np.inf)
+        else:
+            per_take = error / (sample + 1 - a)
+        return np.minimum.reduceat(per_take[self._order], self._heads)
+
+    def conclude(self, frames: int) -> Match | None:
+        """The demonstration has ended (``frames`` long): the last samples, then the answer on all of it when
+        nothing was committed or the commitment did not hold (``None``: the commitment stands)."""
+        self.add(np.zeros((0, len(self.body.parts), 3)), np.zeros((0, len(self.body.parts)), dtype=bool), ended=True)
+        if self.committed is not None and not self.deviated:
+            return None
+        if not len(self._still):
+            return Match.unknown("nothing seen", details={"reason": "nothing seen"})
+        scores = self._scores(len(self._still) - 1)
+        ranked = tuple(sorted(zip(self.movements, scores.tolist()), key=lambda kv: (kv[1], kv[0])))
+        limit = self.decision.threshold()
+        nearest, score = ranked[0] if ranked else (None, np.inf)
+        if nearest is None or score > limit:
+            return Match.unknown("no prediction fits", nearest=nearest, score=score, threshold=limit,
+                                 measure=self.decision.measure, candidates=ranked)
+        confidence = max(0.0, 1.0 - score / limit) if limit > 0 and np.isfinite(limit) else 1.0
+        return Match(nearest, confidence, None, candidates=ranked, score=score, threshold=limit,
+                     measure=self.decision.measure)
+
+    def match(self, motion: Recording) -> Match:
+        """A whole segment at once: followed sample by sample, as it would have been live."""
+        with one_thread():
+            return self._match(motion)
+
+    def _match(self, motion: Recording) -> Match:
+        world = motion.world if motion.world is not None else motion.positions
+        self.begin(motion.fps)
+        self.add(world, motion.visible)
+        final = self.conclude(motion.n_frames)
+        return final if final is not None else self.commitment
+
+
+class Streaming:
+    """:class:`Following` as the watching loop drives a streaming matcher (:class:`toolkit.components.Matcher`):
+    ``begin`` at a segment's onset, ``observe`` after each frame, ``replay`` for rows given at once, ``conclude`` at
+    its end; each commitment or deviation at the frame it was decided (``Match.decided_at``), reported when the
+    rows are taken in (every :data:`BLOCK` seconds)."""
+
+    def __init__(self, following: Following) -> None:
+        self.following = following
+        self.memory = None
+        self.given = 0
+        self.block = 1
+
+    def begin(self, memory) -> None:
+        self.memory, self.given = memory, 0
+        self.following.begin(memory.fps)
+        self.block = max(1, int(round(BLOCK * memory.fps)))
+
+    def _take(self, memory, every: bool = False) -> list[tuple[int, Match]]:
+        """The rows of ``memory`` not given yet, once :data:`BLOCK` seconds of them have come (``every``: all of
+        them now); what they decided, at their rows of working memory."""
+        if memory is not self.memory:
+            self.begin(memory)
+        n = memory.n
+        if n <= self.given or (not every and n - self.given < self.block):
+            return []
+        world, visible = memory.world[self.given : n], memory.visible[self.given : n]
+        self.given = n
+        with one_thread():
+            events = self.following.add(world, visible)
+        return [(memory.start + min(frame, n - 1), match) for frame, match in events]
+
+    def observe(self, memory) -> Match | None:
+        events = self._take(memory)
+        return events[-1][1] if events else None
+
+    def replay(self, memory, stop: int) -> list[tuple[int, Match]]:
+        if memory is not self.memory:
+            self.begin(memory)
+        memory.feed(stop)
+        return self._take(memory)
+
+    def settled(self) -> int | None:
+        return None
+
+    def conclude(self, motion: Recording) -> Match | None:
+        if self.memory is None:  # concluded without having followed the segment: all of it now
+            return self.following.match(motion)
+        try:
+            late = self._take(self.memory, every=True)  # the rows not taken in yet
+            with one_thread():
+                final = self.following.conclude(motion.n_frames)
+            if final is None and any(m is self.following.commitment for _, m in late):
+                return self.following.commitment  # committed in the last rows: not reported yet
+            return final
+        finally:
+            self.memory = None
+
+    def inspect(self, shown: int = 5) -> dict[str, Any]:
+        """The segment followed last, as the forward model's views read it: each movement's score at every sample
+        (``trace``, for the movements among the ``shown`` best at some sample), the commitment and when it came (frames
+        seen), whether and when it deviated, the threshold both are held to and what it measures."""
+        f = self.following
+        trace = getattr(f, "trace", [])
+        scores = trace[-1][1] if trace else np.full(len(f.movements), np.inf)
+        kept = sorted({int(i) for _, s in trace for i in np.argsort(s, kind="stable")[:shown] if np.isfinite(s[i])})
+        limit = f.decision.threshold()
+        return {"committed": f.committed, "committed_path": (f.committed,) if f.committed else (),
+                "deviated": f.deviated, "committed_at": getattr(f, "committed_at", None),
+                "deviated_at": getattr(f, "deviated_at", None), "scores": dict(zip(f.movements, scores.tolist())),
+                "trace": tuple((frame, {(f.movements[i],): float(s[i]) for i in kept if np.isfinite(s[i])})
+                               for frame, s in trace),
+                "threshold": limit, "deviation": limit, "measure": f.decision.measure, "unit": "",
+                "predicting": "the takes it learned"}

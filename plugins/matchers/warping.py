@@ -1,0 +1,350 @@
+"""Time warping of a demonstration's frames against chains of one's own frames: the search matchers share.
+
+A *chain* is one take of one's own movement as a sequence of frames (a posegraph's nodes, a motor command's
+predicted trajectory): its frames in order, the movement it belongs to, and whether its last frame leads back to its
+first (a looping take, a walk's cycle). The warping aligns the samples of a demonstration with a chain by dynamic
+time warping (the steps: the next sample on the next frame of the chain, the next sample on the same frame, the
+same sample on the next frame), free to begin at any frame of the chain and to end at any: a movement seen only in
+part, or with frames before and after it, still finds its part (B&B 2005 §5.2.3). A chain's distance is its best
+path's summed frame distance (the comparison's, :mod:`plugins.matchers.comparison`) over the path's length, so a
+slower performance, which stays on frames, and a faster one, which passes several frames per sample, compare alike;
+no limit is set on either.
+
+- :func:`chain_distances`: every chain against a whole demonstration at once (path search's per-movement search,
+  :mod:`plugins.matchers.path_search.per_movement`; the calibration of a decision);
+- :func:`chain_path`: the frames of one chain's best path;
+- :class:`Warping`: the same warping advanced sample by sample as a demonstration comes in, each chain's distance
+  so far after every sample (the forward model following real people, K&G 2006 §4.4).
+
+The loops are plain Python, their own reference, compiled by :mod:`plugins.lib.compiled`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from plugins.lib.compiled import compiled
+from plugins.matchers.comparison import Comparison, Frames
+
+__all__ = ["Chains", "Warping", "chain_distances", "chain_path"]
+
+
+@dataclass(frozen=True)
+class Chains:
+    """Takes as chains of frames (a posegraph's nodes, hubs left out; a command's predicted samples).
+
+    Attributes
+    ----------
+    nodes : array of int, shape (M,)
+        Frame indices (a posegraph's node indices; else 0..M-1), chain after chain, each chain in its take's order.
+    starts : array of int, shape (C + 1,)
+        Chain ``c`` is ``nodes[starts[c]:starts[c + 1]]``.
+    movements : tuple of str
+        Each chain's movement.
+    cyclic : array of bool, shape (C,)
+        Whether the chain's last node leads back to its first (a looping clip).
+    """
+
+    nodes: np.ndarray
+    starts: np.ndarray
+    movements: tuple[str, ...]
+    cyclic: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.movements)
+
+    @classmethod
+    def of_lengths(cls, lengths, movements, cyclic=None) -> Chains:
+        """Chains of the given lengths over frames 0..M-1 in order (each chain's frames after the previous one's)."""
+        starts = np.concatenate([[0], np.cumsum(lengths)]).astype(np.intp)
+        cyclic = np.zeros(len(movements), dtype=bool) if cyclic is None else np.asarray(cyclic, dtype=bool)
+        return cls(np.arange(starts[-1], dtype=np.intp), starts, tuple(movements), cyclic)
+
+    def chain(self, c: int) -> np.ndarray:
+        """The frame indices of chain ``c``."""
+        return self.nodes[self.starts[c] : self.starts[c + 1]]
+
+
+def _warp(cost, starts, cyclic, best, end):
+    """Subsequence dynamic time warping of the samples (rows of ``cost``, (n, M)) on every chain (columns
+    ``starts[c]:starts[c + 1]``): for each chain, the least summed cost over the path's length of a path that
+    begins at any node with the first sample and ends at any node with the last (``best[c]``) and the column it
+    ends in (``end[c]``). Steps: (i-1, j-1), (i-1, j), (i, j-1); a cyclic chain's first node also follows its
+    last. Ties keep the diagonal, then the vertical step. Plain Python as written (the reference), compiled by
+    :func:`_kernel`."""
+    n = cost.shape[0]
+    for c in range(len(starts) - 1):
+        a = starts[c]
+        m = starts[c + 1] - a
+        before = np.empty(m)
+        before_len = np.empty(m)
+        now = np.empty(m)
+        now_len = np.empty(m)
+        for j in range(m):
+            before[j] = cost[0, a + j]
+            before_len[j] = 1.0
+        for i in range(1, n):
+            for j in range(m):
+                if j > 0:
+                    d, dl = before[j - 1], before_len[j - 1]
+                elif cyclic[c] and m > 1:
+                    d, dl = before[m - 1], before_len[m - 1]
+                else:
+                    d, dl = np.inf, 0.0
+                v, vl = before[j], before_len[j]
+                if v < d:
+                    d, dl = v, vl
+                if j > 0 and now[j - 1] < d:
+                    d, dl = now[j - 1], now_len[j - 1]
+                now[j] = d + cost[i, a + j]
+                now_len[j] = dl + 1.0
+            if cyclic[c] and m > 1:  # the same sample on from the last node to the first, then on along the chain
+                j = 0
+                while j < m:
+                    left = m - 1 if j == 0 else j - 1
+                    value = now[left] + cost[i, a + j]
+                    if value < now[j]:
+                        now[j] = value
+                        now_len[j] = now_len[left] + 1.0
+                        j += 1
+                    else:
+                        break
+            for j in range(m):
+                before[j] = now[j]
+                before_len[j] = now_len[j]
+        chosen = -1
+        value = np.inf
+        for j in range(m):
+            mean = before[j] / before_len[j]
+            if mean < value:
+                value = mean
+                chosen = j
+        best[c] = value
+        end[c] = chosen
+
+
+_compiled = None
+
+
+def _kernel():
+    global _compiled
+    if _compiled is None:
+        found = compiled(_warp)
+        _compiled = found[0] if found is not None else _warp
+    return _compiled
+
+
+def chain_distances(comparison: Comparison, samples: Frames, nodes: Frames, chains: Chains,
+                    skip: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray | None]:
+    """Each chain's distance to the samples (C,): its best path's summed frame distance over the path's length;
+    and the frame distances it was found from (samples by the nodes kept, ``None`` when nothing was compared).
+
+    ``nodes``: the frames of every node of the chains, in chain order (``Frames.join`` of the takes'); ``skip``
+    (C,) bool: chains left out (infinite)."""
+    keep = np.ones(len(chains), dtype=bool) if skip is None else ~np.asarray(skip, dtype=bool)
+    best = np.full(len(chains), np.inf)
+    if len(samples) == 0 or not keep.any():
+        return best, None
+    if keep.all():
+        cost, starts, cyclic = comparison.costs(samples, nodes), chains.starts, chains.cyclic
+    else:
+        kept = np.flatnonzero(keep)
+        columns = np.concatenate([np.arange(chains.starts[c], chains.starts[c + 1]) for c in kept])
+        cost = comparison.costs(samples, nodes.take(columns))
+        starts = np.concatenate([[0], np.cumsum(np.diff(chains.starts)[kept])]).astype(np.intp)
+        cyclic = chains.cyclic[kept]
+    cost = np.ascontiguousarray(cost, dtype=np.float64)
+    found = np.empty(len(starts) - 1)
+    end = np.empty(len(starts) - 1, dtype=np.intp)
+    _kernel()(cost, starts, cyclic, found, end)
+    best[keep] = found
+    return best, cost
+
+
+def _warp_path(cost, cyclic, out):
+    """The warping of :func:`_warp` on one chain (``cost`` (n, m)), its steps kept and followed back from the best
+    end: ``out[i]`` the column the sample ``i`` was last aligned with. Plain Python as written, compiled by
+    :func:`_path_kernel`."""
+    n, m = cost.shape
+    total = np.empty((n, m))
+    length = np.empty((n, m))
+    step = np.zeros((n, m), dtype=np.int8)  # 0 start, 1 diagonal, 2 vertical, 3 horizontal
+    for j in range(m):
+        total[0, j] = cost[0, j]
+        length[0, j] = 1.0
+    for i in range(1, n):
+        for j in range(m):
+            if j > 0:
+                d, dl, s = total[i - 1, j - 1], length[i - 1, j - 1], 1
+            elif cyclic and m > 1:
+                d, dl, s = total[i - 1, m - 1], length[i - 1, m - 1], 1
+            else:
+                d, dl, s = np.inf, 0.0, 1
+            if total[i - 1, j] < d:
+                d, dl, s = total[i - 1, j], length[i - 1, j], 2
+            if j > 0 and total[i, j - 1] < d:
+                d, dl, s = total[i, j - 1], length[i, j - 1], 3
+            total[i, j] = d + cost[i, j]
+            length[i, j] = dl + 1.0
+            step[i, j] = s
+        if cyclic and m > 1:
+            j = 0
+            while j < m:
+                left = m - 1 if j == 0 else j - 1
+                value = total[i, left] + cost[i, j]
+                if value < total[i, j]:
+                    total[i, j] = value
+                    length[i, j] = length[i, left] + 1.0
+                    step[i, j] = 3
+                    j += 1
+                else:
+                    break
+    j = 0
+    best = np.inf
+    for c in range(m):
+        mean = total[n - 1, c] / length[n - 1, c]
+        if mean < best:
+            best = mean
+            j = c
+    i = n - 1
+    for r in range(n):
+        out[r] = -1
+    while True:
+        if out[i] < 0:  # the last node aligned with sample i (a horizontal step aligns it with several)
+            out[i] = j
+        s = step[i, j]
+        if s == 0:
+            break
+        if s == 1:
+            i -= 1
+            j = j - 1 if j > 0 else m - 1
+        elif s == 2:
+            i -= 1
+        else:
+            j = j - 1 if j > 0 else m - 1
+
+
+_compiled_path = None
+
+
+def _path_kernel():
+    global _compiled_path
+    if _compiled_path is None:
+        found = compiled(_warp_path)
+        _compiled_path = found[0] if found is not None else _warp_path
+    return _compiled_path
+
+
+def chain_path(cost: np.ndarray, chains: Chains, c: int) -> np.ndarray:
+    """The node indices of chain ``c``'s best path, one per sample (the node each sample was last aligned with),
+    found by the same warping as :func:`chain_distances` with its steps kept and followed back; ``cost``: the frame
+    distances :func:`chain_distances` returned (every chain kept)."""
+    block = np.ascontiguousarray(cost[:, chains.starts[c] : chains.starts[c + 1]])
+    out = np.empty(len(block), dtype=np.intp)
+    _path_kernel()(block, bool(chains.cyclic[c]), out)
+    return chains.chain(c)[out]
+
+
+def _advance(cost, starts, cyclic, total, length, fresh, means, ends):
+    """The warping of :func:`_warp`, advanced by the samples of ``cost`` (r, M) from the state ``total`` and
+    ``length`` (M,) after the samples before them (``fresh``: none yet). After each sample, each chain's best
+    summed cost over its path's length so far, and the column it ends in, go into ``means`` and ``ends`` (r, C).
+    ``total`` and ``length`` are left as the state after the last sample. Plain Python, compiled by
+    :func:`_advance_kernel`."""
+    rows = cost.shape[0]
+    width = total.shape[0]
+    now = np.empty(width)
+    now_len = np.empty(width)
+    for i in range(rows):
+        for c in range(len(starts) - 1):
+            a = starts[c]
+            m = starts[c + 1] - a
+            if fresh and i == 0:
+                for j in range(m):
+                    now[a + j] = cost[i, a + j]
+                    now_len[a + j] = 1.0
+            else:
+                for j in range(m):
+                    if j > 0:
+                        d, dl = total[a + j - 1], length[a + j - 1]
+                    elif cyclic[c] and m > 1:
+                        d, dl = total[a + m - 1], length[a + m - 1]
+                    else:
+                        d, dl = np.inf, 0.0
+                    if total[a + j] < d:
+                        d, dl = total[a + j], length[a + j]
+                    if j > 0 and now[a + j - 1] < d:
+                        d, dl = now[a + j - 1], now_len[a + j - 1]
+                    now[a + j] = d + cost[i, a + j]
+                    now_len[a + j] = dl + 1.0
+                if cyclic[c] and m > 1:
+                    j = 0
+                    while j < m:
+                        left = a + (m - 1 if j == 0 else j - 1)
+                        value = now[left] + cost[i, a + j]
+                        if value < now[a + j]:
+                            now[a + j] = value
+                            now_len[a + j] = now_len[left] + 1.0
+                            j += 1
+                        else:
+                            break
+            best = np.inf
+            at = -1
+            for j in range(m):
+                mean = now[a + j] / now_len[a + j]
+                if mean < best:
+                    best = mean
+                    at = j
+            means[i, c] = best
+            ends[i, c] = at
+        for k in range(width):
+            total[k] = now[k]
+            length[k] = now_len[k]
+
+
+_compiled_advance = None
+
+
+def _advance_kernel():
+    global _compiled_advance
+    if _compiled_advance is None:
+        found = compiled(_advance)
+        _compiled_advance = found[0] if found is not None else _advance
+    return _compiled_advance
+
+
+class Warping:
+    """The warping of a demonstration against every chain, advanced sample by sample as the demonstration comes in
+    (:func:`chain_distances` of the samples so far, after each sample, without warping them again).
+
+    Parameters
+    ----------
+    comparison : Comparison
+    frames : Frames
+        The frames of every chain, chain after chain (``Frames.join`` of the takes').
+    chains : Chains
+    """
+
+    def __init__(self, comparison: Comparison, frames: Frames, chains: Chains) -> None:
+        self.comparison, self.frames, self.chains = comparison, frames, chains
+        self.total = np.zeros(len(frames))
+        self.length = np.zeros(len(frames))
+        self.samples = 0
+
+    def advance(self, samples: Frames) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Take the next samples; after each of them (arrays (len(samples), C)): each chain's distance so far, the
+        frame (the index within its chain) its best path ends on, and the sample's own distance to that frame."""
+        means = np.full((len(samples), len(self.chains)), np.inf)
+        ends = np.full((len(samples), len(self.chains)), -1, dtype=np.intp)
+        local = np.full((len(samples), len(self.chains)), np.inf)
+        if len(samples) and len(self.frames):
+            # pair by pair: the same numbers whatever the samples come in (row_costs)
+            cost = self.comparison.row_costs(samples, self.frames)
+            _advance_kernel()(cost, self.chains.starts, self.chains.cyclic, self.total, self.length,
+                              self.samples == 0, means, ends)
+            rows, chains = np.nonzero(ends >= 0)
+            local[rows, chains] = cost[rows, self.chains.starts[:-1][chains] + ends[rows, chains]]
+            self.samples += len(samples)
+        return means, ends, local

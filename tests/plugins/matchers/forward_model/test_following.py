@@ -1,0 +1,130 @@
+"""The forward model following real people (plugins.matchers.forward_model.following): every take played by its
+commands, followed by time warping with the shared comparison and calibrated decision (K&G 2006, §4.4).
+
+On the project's generated recordings (Max's movements as the repertoire, one take each; Morris's versions as
+demonstrations): the predictions are the takes' commands played; the calibration leaves each take out; a familiar
+movement is committed to early; rows given at once give what rows fed one by one give; a movement that begins as
+one and goes on as another is a deviation.
+"""
+
+from __future__ import annotations
+
+import types
+
+import numpy as np
+import pytest
+
+from plugins.bench.data import make_data
+from plugins.bench.mocap import _streams
+from plugins.matchers.forward_model.following import RATE, Following
+from plugins.matchers.warping import chain_distances
+from toolkit import Matcher, Motion, create_plugin_manager
+from toolkit.observe import Observer, compose_observer
+from toolkit.recordings.profile import load_profile
+
+
+@pytest.fixture(scope="module")
+def pm():
+    return create_plugin_manager(autoload=False, trace=False)
+
+
+@pytest.fixture(scope="module")
+def generated(tmp_path_factory, pm):
+    data = make_data(pm, tmp_path_factory.mktemp("following"), seed=6, streams=2, per_stream=4)
+    return data, load_profile(data / "profile.toml")
+
+
+@pytest.fixture(scope="module")
+def observer(generated, pm):
+    data, profile = generated
+    character = compose_observer(pm, profile, data / "repertoire", matcher="forward-model")
+    assert character.matcher.params["comparison"] == "motion"  # the observer template's
+    return character
+
+
+def following(character) -> Following:
+    return character.matcher.match.__self__
+
+
+def test_every_take_is_predicted_by_its_commands_at_the_sample_rate(observer):
+    f = following(observer)
+    takes = observer.motor.takes()
+    chains = f.prediction.chains
+    assert len(chains) == sum(len(t) for t in takes.values())
+    for c, (movement, take) in enumerate(zip(chains.movements, f.prediction.takes)):
+        edges = next(edges for edges, *_ in takes[movement])
+        duration = sum(observer.motor.edge(e).duration for e in edges)
+        assert len(take) == pytest.approx(duration * RATE, abs=len(edges) + 1)
+        assert take.parts.shape[1:] == (len(observer.body.parts), 6)  # shape from the onset, and motion
+
+
+def test_the_calibration_leaves_each_take_out(observer):
+    """One take of each movement: each take's prediction against the other movements' (leave one movement out),
+    over its distance to standing still; no take of its own movement to leave out."""
+    f = following(observer)
+    p = f.prediction
+    want = []
+    for c, take in enumerate(p.takes):
+        skip = np.array([m == p.chains.movements[c] for m in p.chains.movements])
+        d, _ = chain_distances(f.comparison, take, p.frames, p.chains, skip)
+        want.append(d.min() / np.mean(f.comparison.still(take)))
+    assert f.decision.calibration.own == ()
+    assert f.decision.calibration.other == pytest.approx(want)
+
+
+def test_a_familiar_movement_is_committed_to_before_it_ends(observer, generated):
+    """Max watching his own movements: each is committed to, most well before it ends (response facilitation)."""
+    data, profile = generated
+    watcher = Observer(observer, profile.body, 30.0)
+    fractions = []
+    for clip in sorted((data / "repertoire").glob("*/max.bvh"))[:12]:
+        obs = watcher.classify(profile.read(clip, None))
+        assert obs.movement == clip.parent.name
+        fractions.append(obs.decision_fraction)
+    assert np.median(fractions) < 0.5
+
+
+def test_rows_given_at_once_give_what_rows_fed_one_by_one_give(observer, generated):
+    """The watching loop gives a streaming matcher rows at once (replay) or one by one (observe after each): the
+    same observations, the same commitments at the same frames, the same answers."""
+    data, profile = generated
+    streams = [profile.read(path, None) for path, _ in _streams(data / "streams")]
+    matcher = observer.matcher
+    streaming = matcher.replay
+    runs = []
+    for at_once in (True, False):
+        if not at_once:
+            matcher.replay = types.MethodType(Matcher.replay, matcher)  # observe after every row
+        try:
+            found = []
+            for motion in streams:
+                for o in Observer(observer, profile.body, motion.fps).watch(motion):
+                    found.append((o.segment, o.movement, o.decided_at, repr(o.match)))
+            runs.append(found)
+        finally:
+            matcher.replay = streaming
+    assert runs[0] and runs[0] == runs[1]
+
+
+def test_a_movement_that_goes_on_as_another_is_a_deviation(observer, generated):
+    """The first half of a wave, then a jump from where it was: the forward model commits to the wave and, when the
+    jump's prediction fits the last while :data:`LEAD` times as well, reports the deviation (``stop``, K&G Fig. 3's
+    "stop imitation") at a later frame; at the end it answers on the whole demonstration."""
+    data, profile = generated
+    f = following(observer)
+    first = profile.read(data / "repertoire" / "wave" / "max.bvh", None)
+    second = profile.read(data / "repertoire" / "jump" / "max.bvh", None)
+    half = first.n_frames // 2
+    start = second.positions - second.positions[:1] + first.positions[half - 1 : half]
+    joined = np.concatenate([first.positions[:half], start])
+    visible = np.concatenate([first.visible[:half], second.visible])
+    motion = Motion(joined, first.fps, first.parts, visible, joined)
+    f.begin(motion.fps)
+    events = f.add(motion.world, motion.visible)
+    final = f.conclude(motion.n_frames)
+    commits = [(frame, m) for frame, m in events if not m.stop]
+    stops = [(frame, m) for frame, m in events if m.stop]
+    assert commits and commits[0][1].movement == "wave" and commits[0][0] < half
+    assert stops and stops[0][1].movement == "wave" and stops[0][1].reason == "deviation"
+    assert stops[0][0] > commits[0][0] and stops[0][1].score > 0
+    assert final is not None and final.decided_at is None  # the answer on all of it, not a commitment

@@ -1,0 +1,143 @@
+"""The decisions matchers share (plugins.matchers.decision), and path search's calibration on its repertoire."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from plugins.matchers.decision import Calibrated, Calibration, Distance
+from plugins.matchers.warping import chain_distances
+from toolkit import load_character
+from toolkit.observe import Observer, compose_observer
+from toolkit.recordings.profile import load_profile
+from tests.plugins.matchers.path_search.stick import STICK, observed
+
+scores = st.lists(st.floats(0.0, 5.0), max_size=30)
+
+
+def test_distance_is_the_papers_limit_and_zero_is_none():
+    decision = Distance(0.03)
+    assert decision.threshold() == 0.03
+    assert decision.decide("wave", 0.029).movement == "wave"
+    verdict = decision.decide("wave", 0.031)
+    assert verdict.movement is None and verdict.nearest == "wave" and verdict.score == 0.031
+    assert Distance(0.0).threshold() == np.inf and Distance(0.0).decide("wave", 1e9).movement == "wave"
+    assert decision.decide(None, 0.0).movement is None  # nothing came near
+
+
+@given(scores, scores, st.floats(0.0, 1.0))
+def test_the_calibrated_threshold_is_the_larger_quantile_of_the_own_and_other_scores_at_most_one(own, other, rate):
+    decision = Calibrated(rate)
+    decision.calibrate(Calibration.of(own, other))
+    limits = [np.quantile(scores, 1.0 - rate) for scores in (own, other) if scores]
+    assert decision.threshold() == (min(max(limits), 1.0) if limits else 1.0)
+
+
+def test_the_calibrated_score_is_the_share_left_unexplained():
+    """The distance to the nearest movement over the distance to standing still: unit-free, so the same
+    demonstration measured in other units (both distances scaled) gets the same verdict."""
+    decision = Calibrated(0.5)
+    decision.calibrate(Calibration.of([0.2, 0.25, 0.3], [0.6, 0.7, 0.8]))
+    assert decision.threshold() == pytest.approx(0.7)
+    for unit in (1.0, 100.0):
+        assert decision.decide("wave", 0.5 * unit, 1.0 * unit).movement == "wave"
+        assert decision.decide("wave", 0.75 * unit, 1.0 * unit).movement is None
+    assert decision.decide("wave", 0.0, 0.0).movement == "wave"  # nothing to explain, nothing left unexplained
+    assert decision.decide("wave", 0.1, 0.0).movement is None
+
+
+def test_calibration_keeps_finite_scores_only():
+    assert Calibration.of([0.1, np.inf, np.nan], [np.inf, 0.5]) == Calibration((0.1,), (0.5,))
+
+
+THIRD = """
+[motor.poses.knee]
+base = "stand"
+lk = [0.1, 0.8, 0.3]
+
+[motor.movements.kick]
+keys = [{ pose = "stand", at = 0.0 }, { pose = "knee", at = 0.5 }, { pose = "stand", at = 1.0 }]
+"""
+
+REAL_PEOPLE = """
+[matcher]
+plugin = "path-search"
+comparison = "motion"
+search = "per-movement"
+decision = "calibrated"
+"""
+
+
+@pytest.fixture
+def stick(write, pm):
+    text = STICK.replace("[matcher]", THIRD + "\n[matcher]", 1)
+    text = text.replace('[matcher]\nplugin = "path-search"\n', REAL_PEOPLE)
+    return load_character(write("stick.toml", text), pm)
+
+
+def test_with_one_take_of_each_movement_path_search_calibrates_by_leaving_each_movement_out(stick):
+    """One take each: no take to leave out of its own movement; each movement left out in turn gives how near a
+    movement the repertoire does not hold comes: its take's distance to the nearest other movement over its
+    distance to standing still. The threshold is their 95th percentile (known_rejected = 0.05), at most 1."""
+    matcher = stick.matcher
+    calibration = matcher.decision.calibration
+    assert calibration.own == ()
+    search = matcher.searcher
+    want = []
+    for c, take in enumerate(search.takes):
+        skip = np.array([m == search.chains.movements[c] for m in search.chains.movements])
+        distances, _ = chain_distances(matcher.comparison, take, search.nodes, search.chains, skip)
+        want.append(distances.min() / np.mean(matcher.comparison.still(take)))
+    assert calibration.other == pytest.approx(want)
+    assert matcher.decision.threshold() == pytest.approx(min(np.quantile(want, 0.95), 1.0))
+
+
+def test_a_known_movement_performed_otherwise_is_taken_for_it_and_a_new_one_is_unknown(stick):
+    """Against the stick's raise, reach and kick (one take each): its raise performed slower and with the hand held
+    higher is a raise; a movement it does not know (the hand swung out to the side and back, twice) is unknown,
+    with the raise or the reach as the nearest and the score above the threshold."""
+    styled = observed(stick, "raise", speed=0.6, offset=(0.0, 0.1, 0.0))
+    match = stick.matcher.match(styled)
+    assert match.movement == "raise" and match.score <= match.threshold
+    new = observed(stick, "raise")
+    positions = new.positions.copy()
+    t = np.linspace(0.0, 1.0, new.n_frames)
+    hand = stick.body.index("hand")
+    positions[:, hand] = positions[0, hand] + np.stack([0.4 * np.sin(2 * np.pi * 2 * t), 0 * t, 0 * t], axis=1)
+    unknown = stick.matcher.match(type(new)(positions, new.fps, new.parts, new.visible))
+    assert unknown.movement is None and unknown.reason == "too far from every path"
+    assert unknown.score > unknown.threshold and unknown.nearest in ("raise", "reach", "kick")
+
+
+@pytest.fixture(scope="module")
+def generated(tmp_path_factory):
+    """The project's generated recordings: Max's movements (one take each), Morris's versions of them."""
+    from plugins.bench.data import make_data
+    from toolkit import create_plugin_manager
+
+    pm = create_plugin_manager(autoload=False, trace=False)
+    return pm, make_data(pm, tmp_path_factory.mktemp("generated"), seed=3, streams=1, per_stream=2)
+
+
+def test_with_two_takes_the_own_takes_count_too(generated, tmp_path):
+    """A repertoire of two takes of each movement (Max's take and a Morris take): each take left out of its own
+    movement gives an own score, and the threshold is at least their 95th percentile."""
+    pm, folder = generated
+    profile = load_profile(folder / "profile.toml")
+    repertoire = tmp_path / "two"
+    for movement in sorted(p.name for p in (folder / "repertoire").iterdir()):
+        (repertoire / movement).mkdir(parents=True)
+        (repertoire / movement / "max.bvh").symlink_to(folder / "repertoire" / movement / "max.bvh")
+        morris = sorted((folder / "demos" / movement).glob("*.bvh"))[0]
+        (repertoire / movement / "morris.bvh").symlink_to(morris)
+    character = compose_observer(pm, profile, repertoire)
+    decision = character.matcher.decision
+    movements = len(list(repertoire.iterdir()))
+    assert len(decision.calibration.own) == 2 * movements and len(decision.calibration.other) == 2 * movements
+    assert decision.threshold() >= np.quantile(decision.calibration.own, 0.95)
+    observer = Observer(character, profile.body, 30.0)
+    demos = sorted((folder / "demos").glob("*/*.bvh"))
+    right = [observer.classify(profile.read(p, None)).movement == p.parent.name for p in demos]
+    assert np.mean(right) >= 0.9
