@@ -97,6 +97,18 @@ def _anchors(page):
     return anchors
 
 
+def test_the_benchmark_page_holds_todays_figures_a_newcomer_can_rerun():
+    """docs/benchmarks.md: at most 400 lines, every table after a command that prints it, no scratch paths."""
+    text = (ROOT / "docs" / "benchmarks.md").read_text()
+    lines = text.splitlines()
+    assert len(lines) <= 400, f"docs/benchmarks.md has {len(lines)} lines; history belongs in git"
+    assert "/tmp/" not in text and "/work/" not in text, "a path a reader cannot recreate"
+    tables = [i for i, line in enumerate(lines) if line.startswith("|") and (i == 0 or not lines[i - 1].startswith("|"))]
+    for i in tables:  # a table's command: in its header, or in the text or code block above it
+        before = "\n".join(lines[max(0, i - 40):i + 1])
+        assert "likeme bench" in before or "likeme " in lines[i], f"table at line {i + 1} has no command above it"
+
+
 def test_anchors_are_made_as_github_makes_them(tmp_path):
     page = tmp_path / "page.md"
     page.write_text("# Max watches Morris (B&B §5)\n## The posegraph's pose index\n```sh\n# a comment\n```\n"
