@@ -29,29 +29,29 @@ observer is what a character gets unless it asks:
 
 - ``reference = "rest"``: the distance is measured from *the demonstrator's own rest posture*, not from the observer's
   hub. It is estimated online and causally (:class:`plugins.lib.rest_posture.DwellingRest`): one's own hub until the
-  demonstrator is seen *standing* (every part stays within ``stillness`` times the start threshold of its mean for
-  ``stand_time`` seconds) somewhere else, then the mean pose of where they stand. When they stand near their rest
+  demonstrator is seen *standing* (every part stays within ``rest.stillness`` times the start threshold of its mean for
+  ``rest.stand_time`` seconds) somewhere else, then the mean pose of where they stand. When they stand near their rest
   while a segment is under way, the segment ends where the standing began. A stance away from the rest (a stooped,
-  wide-legged or proud one, or a new one) must (``stance = "returned"``, the default) also be *returned to*, as B&B's
-  hubs are the poses movements leave and come back to: a pose held elsewhere is a candidate; when the demonstrator,
-  after moving, stands near it again, it becomes the rest and the segment under way is cut in two, the movement into
-  the stance (up to where they first stood in it) and the movement from it back to it (from where they left it); if
-  they return to the old rest instead, it was a hold and nothing is cut. Standing in it for ``settle`` seconds makes
-  it the rest too (the segment then ends where they first stood in it). ``stance = "held"`` takes any held pose as the
-  new rest at once (quicker, and a gesture's hold longer than ``stand_time`` cuts it). ``stand_time = 0.5`` s: a
-  stroke's turning point is slow for about a tenth of a second (K&G §4.1's sensory memory), people pause between
-  gestures for half a second or more. ``settle = 2`` s: longer than a gesture holds a pose (a bow, a pointing hand:
-  about a second), short enough for a live observer. ``stillness = 0.25``: with the start threshold at 0.1 body sizes,
-  every part stays within about a centimetre of where it was on a standing adult (0.45 m body size): standing sway
-  (1-2 cm/s) and marker noise over half a second, far below a gesture's tens of cm/s. A noisier tracker (a Kinect)
-  moves every part more than that when nobody moves, so the radius is at least ``noise = 2`` times the smallest spread
-  seen over the last ``floor`` seconds (what this demonstrator and this tracker show when they stand; the spread of a
-  still body fluctuates around its level, a gesture's is many times larger). Where that is more than half the start
-  threshold, standing cannot be told from noise and nobody is seen standing: the rest stays where it was (one's own
-  hub, the paper's, if it never moved).
+  wide-legged or proud one, or a new one) must (``rest.stance = "returned"``, the default) also be *returned to*, as
+  B&B's hubs are the poses movements leave and come back to: a pose held elsewhere is a candidate; when the
+  demonstrator, after moving, stands near it again, it becomes the rest and the segment under way is cut in two, the
+  movement into the stance (up to where they first stood in it) and the movement from it back to it (from where they
+  left it); if they return to the old rest instead, it was a hold and nothing is cut. Standing in it for ``rest.settle``
+  seconds makes it the rest too (the segment then ends where they first stood in it). ``rest.stance = "held"`` takes any
+  held pose as the new rest at once (quicker, and a gesture's hold longer than ``rest.stand_time`` cuts it).
+  ``rest.stand_time = 0.5`` s: a stroke's turning point is slow for about a tenth of a second (K&G §4.1's sensory
+  memory), people pause between gestures for half a second or more. ``rest.settle = 2`` s: longer than a gesture holds a
+  pose (a bow, a pointing hand: about a second), short enough for a live observer. ``rest.stillness = 0.25``: with the
+  start threshold at 0.1 body sizes, every part stays within about a centimetre of where it was on a standing adult
+  (0.45 m body size): standing sway (1-2 cm/s) and marker noise over half a second, far below a gesture's tens of cm/s.
+  A noisier tracker (a Kinect) moves every part more than that when nobody moves, so the radius is at least ``noise =
+  2`` times the smallest spread seen over the last ``floor`` seconds (what this demonstrator and this tracker show when
+  they stand; the spread of a still body fluctuates around its level, a gesture's is many times larger). Where that is
+  more than half the start threshold, standing cannot be told from noise and nobody is seen standing: the rest stays
+  where it was (one's own hub, the paper's, if it never moved).
 - ``units = "body"``: the distance is measured in the demonstrator's body sizes
   (:func:`plugins.lib.body_size.body_scale` of the reference pose: the root-mean-square distance of the parts from
-  their centroid, about 0.45 m for a standing adult, 0.20 m for Max) and compared with ``size_threshold``. The
+  their centroid, about 0.45 m for a standing adult, 0.20 m for Max) and compared with ``body.threshold``. The
   default 0.1 is the paper's 0.02 m on Max (0.02 / 0.20), so Max watching Morris is unchanged, and the same file
   holds for a mouse, a humanoid or a Kinect skeleton whatever units its recordings are in (a Kinect's noise is
   the ``floor``'s to absorb).
@@ -96,28 +96,31 @@ class HubThreshold(Segmenter):
                   "taken as the noise floor and subtracted (0: no floor, the paper's plain threshold).", minimum=0.0),
         Parameter("hub", str, "", "The hub pose to compare with (default: the observer's rest pose)."),
         Parameter("reference", str, "hub", "What the distance is measured from: the observer's own hub (the paper) "
-                  "or the demonstrator's own rest, re-anchored wherever they stand still for `stand_time` seconds.",
+                  "or the demonstrator's own rest, re-anchored wherever they stand still for `rest.stand_time` seconds.",
                   choices=("hub", "rest")),
-        Parameter("stand_time", float, 0.5, "With reference = rest: seconds every part must stay put to count as "
-                  "standing (a new rest). Shorter follows a new stance sooner and cuts gestures at shorter holds.",
-                  minimum=0.05),
-        Parameter("stance", str, "returned", "With reference = rest: a pose held away from the rest becomes the new "
-                  "rest once a movement returns to it (or it is held for `settle`), or at once when held.",
-                  choices=("returned", "held")),
-        Parameter("settle", float, 2.0, "With stance = returned: seconds of standing in a new stance after which it "
-                  "is the rest without a return (0: only a return).", minimum=0.0),
-        Parameter("stillness", float, 0.25, "With reference = rest: standing means every part stays within this "
-                  "share of the start threshold of its mean pose over `stand_time`.", minimum=0.0, maximum=1.0),
-        Parameter("noise", float, 2.0, "With reference = rest: the standing radius is at least this many times the "
-                  "smallest spread of the demonstrator's parts over `stand_time` seen in the last `floor` seconds "
-                  "(their sway and the tracker's noise); above half the start threshold nobody is seen standing "
-                  "(0: `stillness` alone).",
-                  minimum=0.0),
+        Parameter("rest", doc="With reference = rest: how the demonstrator's own rest is found and followed.",
+                  parameters=(
+            Parameter("stand_time", float, 0.5, "Seconds every part must stay put to count as standing (a new rest). "
+                      "Shorter follows a new stance sooner and cuts gestures at shorter holds.", minimum=0.05),
+            Parameter("stance", str, "returned", "A pose held away from the rest becomes the new rest once a movement "
+                      "returns to it (or it is held for `settle`), or at once when held.",
+                      choices=("returned", "held")),
+            Parameter("settle", float, 2.0, "With stance = returned: seconds of standing in a new stance after which "
+                      "it is the rest without a return (0: only a return).", minimum=0.0),
+            Parameter("stillness", float, 0.25, "Standing means every part stays within this share of the start "
+                      "threshold of its mean pose over `stand_time`.", minimum=0.0, maximum=1.0),
+            Parameter("noise", float, 2.0, "The standing radius is at least this many times the smallest spread of "
+                      "the demonstrator's parts over `stand_time` seen in the last `floor` seconds (their sway and the "
+                      "tracker's noise); above half the start threshold nobody is seen standing (0: `stillness` "
+                      "alone).", minimum=0.0),
+        )),
         Parameter("units", str, "metres", "Distances in metres against `threshold` (the paper), or in the "
-                  "demonstrator's body sizes against `size_threshold`.", choices=("metres", "body")),
-        Parameter("size_threshold", float, 0.1, "With units = body: the start threshold in body sizes (the root-mean-"
-                  "square distance of the parts from their centroid in the reference pose; 0.1 = the paper's "
-                  "0.02 m on Max).", minimum=0.0),
+                  "demonstrator's body sizes against `body.threshold`.", choices=("metres", "body")),
+        Parameter("body", doc="With units = body: the thresholds in the demonstrator's body sizes (the root-mean-"
+                  "square distance of the parts from their centroid in the reference pose).", parameters=(
+            Parameter("threshold", float, 0.1, "The start threshold in body sizes (0.1 = the paper's 0.02 m on Max).",
+                      minimum=0.0),
+        )),
     )
 
     def attach(self, owner: Any) -> None:
@@ -164,10 +167,10 @@ class HubThreshold(Segmenter):
         self._start: int | None = None
         self._below = 0
         self._on, self._off = self.thresholds
-        self._rest = DwellingRest(len(self.template), self._fps, dwell=self.params["stand_time"],
+        self._rest = DwellingRest(len(self.template), self._fps, dwell=self.params["rest"]["stand_time"],
                                   prior=self.template,
-                                  positions=self._positions, confirm=self.params["stance"] == "returned",
-                                  settle=self.params["settle"]) if self.params["reference"] == "rest" else None
+                                  positions=self._positions, confirm=self.params["rest"]["stance"] == "returned",
+                                  settle=self.params["rest"]["settle"]) if self.params["reference"] == "rest" else None
 
     @property
     def rest(self) -> np.ndarray:
@@ -237,9 +240,10 @@ class HubThreshold(Segmenter):
             if body:
                 dist = dist / max(self._hub_size, 1e-12)
         else:
-            on = self.params["size_threshold"] if body else self.params["threshold"]
-            rests, events = self._rest.update(poses, self.params["stillness"] * on, near=on, relative=body,
-                                              noise=self.params["noise"], cap=0.5 * on, floor=self.params["floor"])
+            on = self.params["body"]["threshold"] if body else self.params["threshold"]
+            rest = self.params["rest"]
+            rests, events = self._rest.update(poses, rest["stillness"] * on, near=on, relative=body,
+                                              noise=rest["noise"], cap=0.5 * on, floor=self.params["floor"])
             dist = pose_distance(poses, rests, visible)
             if body:
                 dist = dist / np.maximum(body_scale(rests, self._positions), 1e-12)
@@ -321,7 +325,7 @@ class HubThreshold(Segmenter):
     def thresholds(self) -> tuple[float, float]:
         """The level at which a movement begins and the level below which it ends (hysteresis): metres, or body
         sizes with units = body."""
-        on = self.params["size_threshold"] if self.params["units"] == "body" else self.params["threshold"]
+        on = self.params["body"]["threshold"] if self.params["units"] == "body" else self.params["threshold"]
         return on, on * self.params["release"]
 
     def segment(self, motion: Motion) -> list[Segment]:

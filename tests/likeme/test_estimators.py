@@ -168,12 +168,12 @@ def test_segmenter_with_a_repertoire_given(data):
 
 def test_grid_search_over_a_segmenter_parameter(data):
     """A threshold above every movement's distance from the hub finds nothing (F1 0); the search keeps the other.
-    (The template's hub-threshold measures in body sizes: its ``size_threshold``.)"""
+    (The template's hub-threshold measures in body sizes: its ``body.threshold``.)"""
     dest, profile = data
     streams, truth = load_streams(dest / "streams", profile)
-    search = GridSearchCV(MovementSegmenter(profile), {"segmenter__size_threshold": [0.1, 50.0]}, cv=2)
+    search = GridSearchCV(MovementSegmenter(profile), {"segmenter__body__threshold": [0.1, 50.0]}, cv=2)
     search.fit(streams, truth)
-    assert search.best_params_ == {"segmenter__size_threshold": 0.1}
+    assert search.best_params_ == {"segmenter__body__threshold": 0.1}
     assert list(search.cv_results_["mean_test_score"]) == [1.0, 0.0]
     assert search.best_estimator_.predict(streams[:1])[0]
 

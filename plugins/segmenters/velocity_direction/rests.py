@@ -6,10 +6,10 @@ normally starts and ends" (after Buchsbaum & Blumberg 2005's hubs, §4.1). A rea
 changes it between gestures, and holds poses half-way through a gesture (a bow, a pointing hand). So a rest ends the
 movement under way only where it is a hub of this demonstrator:
 
-- near the pose the movement began from, or near any rest they have been seen in (``rest_radius`` body sizes, eq. 1's
+- near the pose the movement began from, or near any rest they have been seen in (``rest.radius`` body sizes, eq. 1's
   mean distance over the chosen parts): a rest there ends it where the rest began;
 - elsewhere the rest is a *hold* and the movement goes on, unless they leave it (some part farther than twice
-  ``rest_radius``: a movement from it, not a hand fidgeting there) and come to rest near it again later: then it
+  ``rest.radius``: a movement from it, not a hand fidgeting there) and come to rest near it again later: then it
   was a new stance (movements leave it and come back to it), if they had held it a stance's time (``stance``; the
   segmenter's ``STANCE``, 0.2 s). The movement is cut where they first rested there, and the one from it back to it
   follows;
@@ -19,9 +19,9 @@ movement under way only where it is a hub of this demonstrator:
   take that ends in another stance than it began, then the shift to the next one's).
 
 A *shift* of stance is not a movement: a piece that goes straight from one rest to another (no part farther from the
-straight line between its first and last positions than ``rest_radius`` body sizes plus a quarter of its way: an arc
+straight line between its first and last positions than ``rest.radius`` body sizes plus a quarter of its way: an arc
 of up to about 100 degrees) is dropped, and one that ends away from where it began with such a shift after a hold
-ends at the hold. A piece that never leaves where it began (no part farther than twice ``rest_radius``) is motion at
+ends at the hold. A piece that never leaves where it began (no part farther than twice ``rest.radius``) is motion at
 rest (sway, fidgeting) and is dropped too. So two takes joined through a transition between their stances give the
 two takes, and a stance change between two gestures gives the two gestures.
 
@@ -84,7 +84,7 @@ class Rests:
     back to, the latest ``keep``) and the holds of the movement under way.
 
     ``radius``: how near (in the units of the poses) a pose must be to a hub to be there; the segmenter sets it to
-    ``rest_radius`` times the body's size when a movement begins. ``stance``: the frames a hold must last to be a
+    ``rest.radius`` times the body's size when a movement begins. ``stance``: the frames a hold must last to be a
     stance that movements leave and come back to (shorter: a pause in a gesture, a hand fidgeting). ``smooth``: the
     frames of the moving average the working memory is seen through (the tracker's jitter averaged out) when it is
     asked whether a piece leaves where it began, is a shift, or comes back to a hold.

@@ -35,7 +35,7 @@ parameter, off by default (the paper); the observer template (``characters/obser
 ``[segmenters.velocity-direction]``) sets ``level = "movement"``, ``units = "body"``, ``window = 0.2``, ``jitter =
 3`` and ``end = "rest"``:
 
-- ``units = "body"``: the rest speed is ``size_rest_speed`` of the demonstrator's own body sizes per second
+- ``units = "body"``: the rest speed is ``body.rest_speed`` of the demonstrator's own body sizes per second
   (:func:`plugins.lib.body_size.body_scale` of the poses seen, a running mean: about 0.45 m for a standing adult,
   0.20 m for Max). 0.1 body sizes/s (4.5 cm/s on an adult) lies between standing sway (1-2 cm/s) and a gesture
   (tens of cm/s).
@@ -54,13 +54,13 @@ parameter, off by default (the paper); the observer template (``characters/obser
   so a movement begins and ends only at a *real rest* of about ``p`` seconds.
 - ``end = "rest"``: a rest ends the movement under way only where it is a *hub* of this demonstrator's
   (:mod:`.rests`; K&G §4.2's hub nodes, "typical start states ... in which a complete movement normally starts and
-  ends"): near the pose it began from or another rest they were seen in (``rest_radius`` body sizes, eq. 1's mean
+  ends"): near the pose it began from or another rest they were seen in (``rest.radius`` body sizes, eq. 1's mean
   distance over the chosen parts; poses at rest are compared as their mean over the sensory memory or the line
   fit's window, so the jitter is averaged out). A rest elsewhere is a *hold* (a bow, a pointing hand held half-way:
   one movement, not two) unless they leave it and come to rest there again (a new stance: the movement is cut where
   they first rested there) or rest there ``settle`` seconds. A straight *shift* from one stance to another is no
   movement and is dropped, and a piece that never leaves where it began (some part farther than twice
-  ``rest_radius``) is motion at rest (sway, fidgeting), dropped too. ``rest_radius = 0.1``: B&B's hub threshold
+  ``rest.radius``) is motion at rest (sway, fidgeting), dropped too. ``rest.radius = 0.1``: B&B's hub threshold
   (0.02 m on Max, 0.20 m body size); ``settle = 2`` s: longer than a gesture holds a pose (about a second), as
   ``hub-threshold``'s ``settle``. The paper's ``"still"`` (any rest ends it) is the default.
 
@@ -126,10 +126,11 @@ class VelocityDirection(Segmenter):
         Parameter("level", str, "stroke", "Report strokes (break points) or whole movements (onset to end; a walk, "
                   "which never rests, is one movement).", choices=("stroke", "movement")),
         Parameter("units", str, "metres", "The rest speed in m/s (`rest_speed`, the paper) or in the demonstrator's "
-                  "body sizes per second (`size_rest_speed`).", choices=("metres", "body")),
-        Parameter("size_rest_speed", float, 0.1, "With units = body: the rest speed in body sizes per second (the "
-                  "root-mean-square distance of the parts from their centroid, running mean over the poses seen).",
-                  minimum=0.0),
+                  "body sizes per second (`body.rest_speed`).", choices=("metres", "body")),
+        Parameter("body", doc="With units = body: speeds in the demonstrator's body sizes (the root-mean-square "
+                  "distance of the parts from their centroid, running mean over the poses seen).", parameters=(
+            Parameter("rest_speed", float, 0.1, "The rest speed in body sizes per second.", minimum=0.0),
+        )),
         Parameter("noise", float, 0.0, "The rest speed is at least this many times the slowest the demonstrator "
                   "has been over the last `floor` seconds (0: off, the paper; in a walk that is a stride's slow "
                   "phase, so walks are cut into strides).", minimum=0.0),
@@ -139,13 +140,15 @@ class VelocityDirection(Segmenter):
                   "paper).", minimum=0.0),
         Parameter("end", str, "still", "Where a movement ends: at any rest (`still`, the paper) or only at one of "
                   "the demonstrator's own rests (`rest`): near where it began or another rest they were seen in, a "
-                  "stance they left and came back to, or after `settle` seconds; a rest elsewhere is a hold, and a "
+                  "stance they left and came back to, or after `rest.settle` seconds; a rest elsewhere is a hold, and a "
                   "straight shift of stance is no movement.", choices=("still", "rest")),
-        Parameter("rest_radius", float, 0.1, "With end = rest: how near (eq. 1's mean distance of the chosen parts, "
-                  "in the demonstrator's body sizes) a pose at rest must be to one of their rests to be there; twice "
-                  "it, for one part, is leaving (0.1: B&B's hub threshold, 0.02 m on Max).", minimum=0.0),
-        Parameter("settle", float, 2.0, "With end = rest: seconds of rest away from the demonstrator's rests after "
-                  "which a movement ends anyway (a new stance: longer than a gesture holds a pose).", minimum=0.0),
+        Parameter("rest", doc="With end = rest: where the demonstrator's own rests are.", parameters=(
+            Parameter("radius", float, 0.1, "How near (eq. 1's mean distance of the chosen parts, in the "
+                      "demonstrator's body sizes) a pose at rest must be to one of their rests to be there; twice it, "
+                      "for one part, is leaving (0.1: B&B's hub threshold, 0.02 m on Max).", minimum=0.0),
+            Parameter("settle", float, 2.0, "Seconds of rest away from the demonstrator's rests after which a "
+                      "movement ends anyway (a new stance: longer than a gesture holds a pose).", minimum=0.0),
+        )),
         Parameter("window", float, 0.0, "Seconds over which each part's velocity is the slope of a least-squares "
                   "line through its positions (a tracker's jitter averaged out; 0: the displacement over the sensory "
                   "memory, the paper).", minimum=0.0),
@@ -210,7 +213,7 @@ class VelocityDirection(Segmenter):
             if self.params["end"] == "rest" else None
         # end = rest: the hubs and holds
         self._holding = False  # end = rest: the rest under way is a hold (away from the hubs)
-        self._settle = max(1, int(round(self.params["settle"] * self._fps)))
+        self._settle = max(1, int(round(self.params["rest"]["settle"] * self._fps)))
 
     @property
     def active_since(self) -> int | None:
@@ -286,7 +289,7 @@ class VelocityDirection(Segmenter):
         """:meth:`_step` for every frame of a block without ``pause`` and ``noise`` (the observer template's): the
         same segments at the same frames, with only the frames where something can happen stepped.
 
-        Without them the rest speed of every frame is known for the block at once (``size_rest_speed`` times the
+        Without them the rest speed of every frame is known for the block at once (``body.rest_speed`` times the
         running mean of the body's size, summed in the same order as frame by frame, or ``rest_speed``; at least
         the jitter's ``floors``), and so are the counts of fast and slow frames that :meth:`_step` keeps. A frame
         can change something only where a movement begins (no movement under way, moving for the sensory memory),
@@ -304,7 +307,7 @@ class VelocityDirection(Segmenter):
                 take[int(np.argmax(size > 0))] = True  # the first size there is, whatever the frame
             sums = np.cumsum(np.concatenate([[self._size_sum], np.where(take, size, 0.0)]))  # in order, as one by one
             counts = self._size_n + np.concatenate([[0], np.cumsum(take)])
-            rest = p["size_rest_speed"] * np.where(counts[1:] > 0, sums[1:] / np.maximum(counts[1:], 1), 0.0)
+            rest = p["body"]["rest_speed"] * np.where(counts[1:] > 0, sums[1:] / np.maximum(counts[1:], 1), 0.0)
         else:
             sums, counts = np.full(n + 1, self._size_sum), np.full(n + 1, self._size_n)
             rest = np.full(n, float(p["rest_speed"]))
@@ -490,12 +493,12 @@ class VelocityDirection(Segmenter):
 
     def _began(self, pose: np.ndarray, points: np.ndarray) -> None:
         """With ``end = "rest"``: a movement begins where the chosen parts are ``points`` (3m,), a rest of the
-        demonstrator's (:class:`.rests.Rests`), near which is ``rest_radius`` times the body's size (from
+        demonstrator's (:class:`.rests.Rests`), near which is ``rest.radius`` times the body's size (from
         ``pose``)."""
         if self._rests is None:
             return
         size = body_scale(pose, self._positions) if len(self._positions) == len(pose) else body_scale(pose)
-        self._rests.began(points, self.params["rest_radius"] * float(size))
+        self._rests.began(points, self.params["rest"]["radius"] * float(size))
         self._holding = False
 
     def _rested(self, began: int, points: np.ndarray) -> list[Segment]:
@@ -537,7 +540,7 @@ class VelocityDirection(Segmenter):
         return []
 
     def _rest_speed(self, pose: np.ndarray, speed: float, size: float | None = None) -> float:
-        """The speed below which the parts are at rest now: ``rest_speed`` (m/s), or ``size_rest_speed`` body sizes
+        """The speed below which the parts are at rest now: ``rest_speed`` (m/s), or ``body.rest_speed`` body sizes
         per second; at least ``noise`` times the slowest (mean over ``pause``) speed of the last ``floor`` seconds.
         Records this frame's speed and size (``size``: the body's in ``pose``, if known) first."""
         p = self.params
@@ -547,7 +550,7 @@ class VelocityDirection(Segmenter):
                     size = body_scale(pose, self._positions) if len(self._positions) == len(pose) else body_scale(pose)
                 if size > 0:
                     self._size_sum, self._size_n = self._size_sum + size, self._size_n + 1
-            rest = p["size_rest_speed"] * (self._size_sum / self._size_n if self._size_n else 0.0)
+            rest = p["body"]["rest_speed"] * (self._size_sum / self._size_n if self._size_n else 0.0)
         else:
             rest = p["rest_speed"]
         if not np.isnan(speed):

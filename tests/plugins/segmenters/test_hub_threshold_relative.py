@@ -107,7 +107,7 @@ def test_a_styled_stance_that_changes_reads_as_rest():
     assert gestures_found(segmenter(floor=0.0), motion, gestures, shifts)[0] < 0.5
     assert gestures_found(segmenter(), motion, gestures, shifts)[0] < 0.9
     for units, stance_ in (("metres", "returned"), ("body", "returned"), ("metres", "held"), ("body", "held")):
-        seg = segmenter(reference="rest", units=units, stance=stance_)
+        seg = segmenter(reference="rest", units=units, rest={"stance": stance_})
         f1, error = gestures_found(seg, motion, gestures, shifts)
         assert f1 == 1.0 and error <= 10, (units, seg.segment(motion), gestures)  # a third of a gesture
     # the rest it ends with is the last stance, not one's own hub
@@ -125,7 +125,7 @@ def test_a_hold_is_not_rest_unless_held_for_settle():
         held = np.repeat(up[-1:], int(round(hold * FPS)), axis=0)
         still = np.repeat(rest[None], 30, axis=0)
         motion = Motion(np.concatenate([still, up, held, down, still]), FPS, PARTS)
-        found = segmenter(reference="rest", stance=stance_).segment(motion)
+        found = segmenter(reference="rest", rest={"stance": stance_}).segment(motion)
         assert len(found) == pieces, (hold, stance_, found)
 
 
@@ -211,11 +211,11 @@ def test_a_new_stance_is_a_candidate_until_returned_to():
 def test_blocks_and_frames_give_the_same_segments(sizes, units, stance_, seed):
     """Block-wise and frame-by-frame feeding give the same segments at the same frames, and the same rest."""
     motion, _, _ = stream(STANCES[seed:seed + 3], seed=seed)
-    whole = segmenter(reference="rest", units=units, stance=stance_)
+    whole = segmenter(reference="rest", units=units, rest={"stance": stance_})
     whole.reset(motion.parts, motion.fps)
     one = [(f, s) for f in range(motion.n_frames) for s in whole.push(motion.positions[f], motion.visible[f])]
     one += [(motion.n_frames, s) for s in whole.flush()]
-    blocks = segmenter(reference="rest", units=units, stance=stance_)
+    blocks = segmenter(reference="rest", units=units, rest={"stance": stance_})
     blocks.reset(motion.parts, motion.fps)
     got, at, k = [], 0, 0
     while at < motion.n_frames:
@@ -236,7 +236,7 @@ def test_a_noisy_tracker_still_shows_standing_up_to_a_point():
     paper's segments)."""
     for seed in range(3):
         motion, gestures, shifts = stream(STANCES, noise=0.0028, seed=seed)
-        assert gestures_found(segmenter(reference="rest", noise=0.0), motion, gestures, shifts)[0] < 0.95
+        assert gestures_found(segmenter(reference="rest", rest={"noise": 0.0}), motion, gestures, shifts)[0] < 0.95
         assert gestures_found(segmenter(reference="rest"), motion, gestures, shifts)[0] == 1.0
     motion, gestures, shifts = stream(STANCES, noise=0.004)
     noisy = segmenter(reference="rest")

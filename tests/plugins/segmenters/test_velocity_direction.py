@@ -179,7 +179,7 @@ def test_the_rest_speed_in_body_sizes_and_above_the_noise_by_hand():
     """Two parts 1 m apart: body size 0.5 m, so 0.1 body sizes/s is 0.05 m/s. Still for the first frames (speed 0),
     then moving 0.3 m/s: with noise = 2 the rest speed stays 0.05 (twice the slowest, 0, is less); a body whose
     slowest speed over the floor is 0.3 m/s (sway and noise) rests below 0.6 m/s."""
-    seg = VelocityDirection(units="body", size_rest_speed=0.1, noise=2.0, memory=0.1)
+    seg = VelocityDirection(units="body", body={"rest_speed": 0.1}, noise=2.0, memory=0.1)
     seg.reset(("root", "wrist"), FPS)
     pose = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
     assert seg._rest_speed(pose, 0.0) == pytest.approx(0.05)
@@ -248,7 +248,7 @@ def _in_blocks(segmenter, poses, visible, cuts):
        params=st.sampled_from([{}, {"level": "movement"}, {"units": "body", "noise": 2.0, "pause": 0.3},
                                {"max_movement": 1.0, "memory": 0.2}, {"parts": ["wrist"], "rest_speed": 0.05},
                                {"level": "movement", "end": "rest", "units": "body", "noise": 2.0},
-                               {"end": "rest", "settle": 0.5, "max_movement": 1.0},
+                               {"end": "rest", "rest": {"settle": 0.5}, "max_movement": 1.0},
                                {"level": "movement", "end": "rest", "units": "body", "noise": 2.0, "window": 0.2,
                                 "jitter": 3.0}, {"window": 0.3, "jitter": 2.0, "memory": 0.2}]),
        hidden=st.booleans())
@@ -344,9 +344,9 @@ class _Stepped(VelocityDirection):
 
 @given(seed=st.integers(0, 10_000), cuts=st.lists(st.integers(1, 60), min_size=1, max_size=8),
        params=st.sampled_from([{"level": "movement", "end": "rest", "units": "body", "window": 0.2, "jitter": 3.0},
-                               {"end": "rest", "settle": 0.5, "max_movement": 1.0, "jitter": 2.0},
+                               {"end": "rest", "rest": {"settle": 0.5}, "max_movement": 1.0, "jitter": 2.0},
                                {"units": "body", "window": 0.3}, {"level": "movement", "max_movement": 1.5},
-                               {"end": "rest", "units": "body", "memory": 0.2, "rest_radius": 0.3}]),
+                               {"end": "rest", "units": "body", "memory": 0.2, "rest": {"radius": 0.3}}]),
        hidden=st.booleans())
 @settings(max_examples=30, deadline=None)
 def test_a_block_walked_is_its_frames_stepped(seed, cuts, params, hidden):

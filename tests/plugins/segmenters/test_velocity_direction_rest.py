@@ -2,7 +2,7 @@
 
 Kopp & Graeser 2006 (§4.1) end a movement wherever the sensory memory finds the parts at rest, so a gesture that
 holds a pose half-way (a salute, a bow, a pointing hand) is two movements. ``end = "rest"`` ends it only at a rest
-near the pose it began from (B&B's hub, the demonstrator's own), or after ``settle`` seconds of rest elsewhere (a new
+near the pose it began from (B&B's hub, the demonstrator's own), or after ``rest.settle`` seconds of rest elsewhere (a new
 stance). The paper's rule stays the default.
 """
 
@@ -86,17 +86,17 @@ def test_a_new_stance_ends_the_movement_after_settle():
     assert len(found) == 2
     assert abs(found[0].end - arrived) <= 6  # where the rest began, not settle later
     assert segmentation_scores([(s.start, s.end) for s in found], truth)["f1"] == pytest.approx(1.0)
-    never = VelocityDirection(level="movement", end="rest", settle=60.0).segment(motion)
+    never = VelocityDirection(level="movement", end="rest", rest={"settle": 60.0}).segment(motion)
     assert len(never) == 1  # without settle it never comes back to where it began: one movement to the end
 
 
 def test_the_papers_end_is_the_default():
-    """``end = "still"`` is the default, and any rest ends a movement there, whatever ``rest_radius`` and
-    ``settle`` say."""
+    """``end = "still"`` is the default, and any rest ends a movement there, whatever ``rest.radius`` and
+    ``rest.settle`` say."""
     motion, _ = movements_with_holds(np.random.default_rng(5), 2, 0.6, noise=0.001)
     plain = VelocityDirection(level="movement")
     assert plain.params["end"] == "still"
-    odd = VelocityDirection(level="movement", end="still", rest_radius=0.0, settle=0.0)
+    odd = VelocityDirection(level="movement", end="still", rest={"radius": 0.0, "settle": 0.0})
     assert plain.segment(motion) == odd.segment(motion)
 
 
