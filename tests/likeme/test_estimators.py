@@ -241,11 +241,13 @@ PARAMS = {"matcher__beam__k": st.integers(1, 20), "matcher__beam__max_skip": st.
           "matcher__calibrated__known_rejected": st.floats(0.0, 1.0), "matcher__candidates": st.integers(0, 10),
           "segmenter__threshold": st.floats(0.001, 0.5), "motor__hub_radius": st.floats(0.0, 0.5),
           "matcher": st.just("path-search"), "fps": st.floats(1.0, 240.0)}
+PARAM_SETS = st.dictionaries(st.sampled_from(sorted(PARAMS)), st.none()).flatmap(
+    lambda keys: st.fixed_dictionaries({k: PARAMS[k] for k in keys}))
+"""Some of PARAMS, each with a value drawn."""
 
 
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(st.dictionaries(st.sampled_from(sorted(PARAMS)), st.none()).flatmap(
-    lambda keys: st.fixed_dictionaries({k: PARAMS[k] for k in keys})))
+@given(PARAM_SETS)
 def test_get_set_params_round_trip(data, params):
     _, profile = data
     clf = MovementClassifier(profile).set_params(**params)
@@ -402,8 +404,7 @@ def test_a_fitted_segmenter_round_trips(data):
 
 
 @settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(st.dictionaries(st.sampled_from(sorted(PARAMS)), st.none()).flatmap(
-    lambda keys: st.fixed_dictionaries({k: PARAMS[k] for k in keys})))
+@given(PARAM_SETS)
 def test_unfitted_estimators_round_trip_with_their_params(data, params):
     _, profile = data
     clf = MovementClassifier(profile).set_params(**params)
