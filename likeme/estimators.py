@@ -16,9 +16,14 @@ constructor's arguments and, as ``TABLE__KEY``, every parameter of the plugin ea
 :func:`sklearn.base.clone`, :func:`sklearn.model_selection.cross_val_score` and
 :class:`~sklearn.model_selection.GridSearchCV` work over them.
 
+A fitted estimator pickles (``pickle``, ``joblib``, ``copy.deepcopy``): its repertoire and its observer's learned
+state are kept, and the observer is composed again when it is loaded. A list of grids may name components and
+their own parameters together: naming another plugin for a table drops the old plugin's parameters.
+
 ``X`` is a sequence of :class:`~toolkit.motion.Motion` (world positions of the profile's parts, metres, +y up, as
 :meth:`BodyProfile.read` gives them) or of arrays shaped (frames, parts, 3) in the profile's part order (NaN where a
-part is not seen) at the estimator's ``fps``. :func:`load_recordings` and :func:`load_streams` read folders.
+part is not seen) at the estimator's ``fps``; complex, string or object arrays, sparse matrices and a continuous
+``y`` are refused by name. :func:`load_recordings` and :func:`load_streams` read folders.
 """
 
 from __future__ import annotations
@@ -26,12 +31,15 @@ from __future__ import annotations
 import copy
 import functools
 import re
+import warnings
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from scipy import sparse
 from sklearn.base import BaseEstimator, ClassifierMixin
+from sklearn.utils.multiclass import type_of_target
 from sklearn.utils.validation import check_is_fitted
 
 from plugins.bench.metrics import segmentation_scores
@@ -44,6 +52,7 @@ from toolkit.params import flat_parameters
 from toolkit.recordings import is_recording
 from toolkit.recordings.profile import BodyProfile, load_profile
 from toolkit.recordings.segments import read_segments, segments_of
+from toolkit.state import apply_state, character_state
 
 __all__ = ["MovementClassifier", "MovementSegmenter", "EstimatorInputError", "load_recordings", "load_streams",
            "to_breakpoints", "UNKNOWN"]
@@ -69,9 +78,44 @@ def _plugin_manager() -> Any:
 
 
 class _ObserverEstimator(BaseEstimator):
-    """What both estimators share: the observer's arguments, the plugin parameters as params, the input checks."""
+    """What both estimators share: the observer's arguments, the plugin parameters as params, the input checks,
+    the tags and the pickled state."""
 
     _composed: dict[str, Any] = {}  # extra compose_observer arguments of the kind (segmenter-only: matcher=None)
+    _components = ("matcher", "segmenter", "motor", "correspondence")  # arguments naming a table's plugin
+
+    # -- what scikit-learn may assume ----------------------------------------------------------------
+
+    def __sklearn_tags__(self) -> Any:
+        """``X`` is a sequence of motions, each (frames, parts, 3) with NaN where a part is not seen; not a 2-D
+        array of features. Sparse, categorical, string or dict input is not accepted."""
+        tags = super().__sklearn_tags__()
+        tags.input_tags.two_d_array = False
+        tags.input_tags.three_d_array = True
+        tags.input_tags.allow_nan = True
+        tags.requires_fit = True
+        return tags
+
+    # -- pickling (pickle, joblib, copy.deepcopy) ------------------------------------------------------
+
+    def __getstate__(self) -> dict[str, Any]:
+        """The estimator's state without the composed observer (it holds the plugin manager, which cannot be
+        pickled): its learned state (:func:`toolkit.state.character_state`) is kept instead, and
+        :meth:`__setstate__` composes the observer again from the same arguments and repertoire."""
+        state = dict(super().__getstate__())  # object.__getstate__ gives the instance's own __dict__
+        character = state.pop("character_", None)
+        if character is not None:
+            state["_learned_"] = {"actors": {"observer": character_state(character)}}
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        state = dict(state)
+        learned = state.pop("_learned_", None)
+        super().__setstate__(state)
+        if learned is not None:
+            character = self._compose(self.repertoire_)
+            apply_state(character, learned, f"<pickled {type(self).__name__}>")
+            self.character_ = character
 
     # -- the observer ------------------------------------------------------------------------------
 
@@ -91,6 +135,10 @@ class _ObserverEstimator(BaseEstimator):
     def _tables(self) -> dict[str, dict[str, Any]]:
         """The component tables the observer will have: plugin and parameters given, per table."""
         return observer_tables(_plugin_manager(), **self._observer_args())[1]
+
+    def _plugins(self) -> dict[str, str | None]:
+        """The plugin of each component table the observer will have (the arguments' or the template's)."""
+        return {table: values.get("plugin") for table, values in self._tables().items()}
 
     def _plugin_parameters(self) -> dict[str, dict[str, Any]]:
         """Every parameter (:class:`toolkit.params.Parameter`) of each table's plugin, by table and name; the
@@ -132,7 +180,12 @@ class _ObserverEstimator(BaseEstimator):
     def set_params(self, **params: Any) -> _ObserverEstimator:
         """Set constructor arguments (``matcher="dtw"``) and plugin parameters (``matcher__k=4``); a plugin
         parameter is checked against the parameters of the plugin its table has (after the arguments given
-        here), an unknown one is an :class:`EstimatorInputError` listing the available ones."""
+        here), an unknown one is an :class:`EstimatorInputError` listing the available ones.
+
+        An argument that puts another plugin in a table (``matcher="dtw"`` after ``path-search``) drops the
+        parameters set for the old plugin, as replacing a pipeline's step drops the old step's parameters: a list
+        of grids ``[{"matcher": ["dtw"]}, {"matcher": ["path-search"], "matcher__beam__k": [2, 8]}]`` runs from
+        any base estimator. Naming a plugin and a parameter it lacks in one call is still an error."""
         names = self._get_param_names()
         nested = {k: v for k, v in params.items() if "__" in k}
         for key, value in params.items():
@@ -142,7 +195,18 @@ class _ObserverEstimator(BaseEstimator):
                 raise EstimatorInputError(f"unknown parameter {key!r} of {type(self).__name__}", key=(key,),
                                           expected="an argument or a TABLE__KEY plugin parameter",
                                           available=names)
-            setattr(self, key, value)
+        swapped = "settings" not in params and any(k in (*self._components, "template") for k in params)
+        before = self._plugins() if swapped else {}
+        for key, value in params.items():
+            if "__" not in key:
+                setattr(self, key, value)
+        if before and self.settings:
+            # another plugin in a table: the old one's parameters go with it (as a pipeline step's do when the
+            # step is replaced), so that a grid may name a component and its own parameters together
+            after = self._plugins()
+            changed = {t for t in self.settings if before.get(t) != after.get(t)}
+            if changed:
+                self.settings = {t: v for t, v in self.settings.items() if t not in changed}
         if nested:
             available = self._plugin_parameters()
             settings = copy.deepcopy({k: dict(v) for k, v in (self.settings or {}).items()})
@@ -172,6 +236,9 @@ class _ObserverEstimator(BaseEstimator):
     def _motions(self, X: Any, what: str = "X") -> list[Motion]:
         """``X`` as motions in the profile's parts, each checked."""
         parts = tuple(self._profile().body.parts)
+        if sparse.issparse(X):
+            raise EstimatorInputError(f"{what} is a sparse matrix: sparse input is not supported", key=(what,),
+                                      expected="a sequence of motions, each an array (frames, parts, 3)")
         if isinstance(X, (Motion, str, bytes)) or (isinstance(X, np.ndarray) and X.ndim == 3):
             raise EstimatorInputError(f"{what} is one {'motion' if not isinstance(X, (str, bytes)) else 'string'}",
                                       key=(what,), expected="a sequence of motions (a list, or an array "
@@ -186,6 +253,7 @@ class _ObserverEstimator(BaseEstimator):
         out = []
         for i, item in enumerate(items):
             if isinstance(item, Motion):
+                _real_array(item.positions, what, i)
                 missing = [p for p in parts if p not in item.parts]
                 if missing:
                     raise EstimatorInputError(f"{what}[{i}] lacks parts {missing}", key=(what, i),
@@ -193,7 +261,7 @@ class _ObserverEstimator(BaseEstimator):
                                               available=list(item.parts))
                 out.append(item if item.parts == parts else item.select(parts))
                 continue
-            array = np.asarray(item, dtype=float) if not isinstance(item, (str, bytes)) else np.empty(0)
+            array = _real_array(item, what, i)
             if array.ndim != 3 or array.shape[1:] != (len(parts), 3):
                 raise EstimatorInputError(f"{what}[{i}] has shape {array.shape}", key=(what, i),
                                           expected=f"(frames, {len(parts)}, 3): the profile's parts {list(parts)}")
@@ -318,6 +386,8 @@ class MovementSegmenter(_ObserverEstimator):
     ----------
     character_ : Character
         The observer composed by :meth:`fit` (no matcher).
+    repertoire_ : ClipRepertoire
+        The repertoire whose hubs it uses.
     """
 
     _composed = {"matcher": None}
@@ -352,6 +422,7 @@ class MovementSegmenter(_ObserverEstimator):
         else:
             raise EstimatorInputError(f"a repertoire of type {type(given).__name__}", key=("repertoire",),
                                       expected="a ClipRepertoire or a (motions, labels) pair")
+        self.repertoire_ = repertoire
         self.character_ = self._compose(repertoire)
         return self
 
@@ -408,9 +479,33 @@ def to_breakpoints(segments: Sequence[tuple[int, int]], n_frames: int) -> list[i
     return sorted(cuts) + [int(n_frames)]
 
 
+def _real_array(item: Any, what: str, i: int) -> np.ndarray:
+    """One motion's positions as a float array: real numbers (NaN and infinity are parts not seen), never complex
+    numbers, strings or objects."""
+    if sparse.issparse(item):
+        raise EstimatorInputError(f"{what}[{i}] is a sparse matrix: sparse input is not supported", key=(what, i),
+                                  expected="an array (frames, parts, 3) of real numbers")
+    if isinstance(item, (str, bytes)):
+        raise EstimatorInputError(f"{what}[{i}] is a string", key=(what, i),
+                                  expected="an array (frames, parts, 3) of real numbers")
+    try:
+        raw = np.asarray(item)
+    except ValueError:  # ragged nested lists
+        raise EstimatorInputError(f"{what}[{i}] is a ragged sequence", key=(what, i),
+                                  expected="an array (frames, parts, 3) of real numbers") from None
+    if raw.dtype.kind not in "biuf":
+        kind = {"c": "complex numbers", "U": "strings", "S": "bytes", "O": "objects", "M": "dates",
+                "m": "time spans", "V": "records"}.get(raw.dtype.kind, f"dtype {raw.dtype}")
+        raise EstimatorInputError(f"{what}[{i}] holds {kind}", key=(what, i),
+                                  expected="an array (frames, parts, 3) of real numbers (NaN where a part is not seen)")
+    return raw.astype(float, copy=False)
+
+
 def _labels(y: Any, n: int, what: str = "y", *, unknown: Any = UNKNOWN) -> list[str]:
     if isinstance(y, (str, bytes)):
         raise EstimatorInputError(f"{what} is one string", key=(what,), expected="one movement label per motion")
+    if np.ndim(y) == 1 and len(y) == n:
+        _check_target(y, what)
     labels = [str(v) for v in np.asarray(y, dtype=object).ravel()] if np.ndim(y) <= 1 else None
     if labels is None:
         raise EstimatorInputError(f"{what} has shape {np.shape(y)}", key=(what,), expected="one label per motion")
@@ -425,6 +520,24 @@ def _labels(y: Any, n: int, what: str = "y", *, unknown: Any = UNKNOWN) -> list[
         raise EstimatorInputError(f"labels {odd}", key=(what,), expected="non-empty movement labels without '#' "
                                   "(a movement's second take is named bow#2)")
     return labels
+
+
+def _check_target(y: Any, what: str) -> None:
+    """Labels ``y`` are classes (:func:`sklearn.utils.multiclass.type_of_target` says binary or multiclass): not
+    continuous (floats that are not whole numbers), complex, NaN or infinite."""
+    expected = "movement labels (strings or integers), one per motion: a classifier of movements, not a regression"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # NaN cast while sklearn looks
+        try:
+            kind = type_of_target(y, input_name=what)
+        except ValueError as err:  # complex numbers, NaN or infinity
+            raise EstimatorInputError(f"{what} is not labels ({err})", key=(what,), expected=expected) from None
+        except TypeError:  # strings and numbers mixed: no order
+            raise EstimatorInputError(f"{what} mixes labels of several types", key=(what,),
+                                      expected="labels of one type: all strings or all integers") from None
+    if kind not in ("binary", "multiclass"):
+        raise EstimatorInputError(f"{what} is {kind}" if kind == "continuous" else f"{what} is of type {kind!r}",
+                                  key=(what,), expected=expected)
 
 
 def _segments(y: Any, streams: Sequence[Motion]) -> list[list[tuple[int, int]]]:

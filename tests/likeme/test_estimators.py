@@ -6,11 +6,17 @@ estimators must behave as scikit-learn estimators (clone, cross_val_score, GridS
 
 from __future__ import annotations
 
+import copy
+import pickle
 
+import joblib
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from scipy import sparse
+from sklearn.exceptions import NotFittedError
+from sklearn.utils import estimator_checks
 from sklearn.base import clone
 from sklearn.model_selection import GridSearchCV, LeaveOneGroupOut, cross_val_score
 
@@ -235,11 +241,13 @@ PARAMS = {"matcher__beam__k": st.integers(1, 20), "matcher__beam__max_skip": st.
           "matcher__calibrated__known_rejected": st.floats(0.0, 1.0), "matcher__candidates": st.integers(0, 10),
           "segmenter__threshold": st.floats(0.001, 0.5), "motor__hub_radius": st.floats(0.0, 0.5),
           "matcher": st.just("path-search"), "fps": st.floats(1.0, 240.0)}
+PARAM_SETS = st.dictionaries(st.sampled_from(sorted(PARAMS)), st.none()).flatmap(
+    lambda keys: st.fixed_dictionaries({k: PARAMS[k] for k in keys}))
+"""Some of PARAMS, each with a value drawn."""
 
 
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(st.dictionaries(st.sampled_from(sorted(PARAMS)), st.none()).flatmap(
-    lambda keys: st.fixed_dictionaries({k: PARAMS[k] for k in keys})))
+@given(PARAM_SETS)
 def test_get_set_params_round_trip(data, params):
     _, profile = data
     clf = MovementClassifier(profile).set_params(**params)
@@ -327,3 +335,195 @@ def test_a_parameters_own_table_is_set_key_by_key(data):
     assert clone(clf).get_params() == params
     with pytest.raises(EstimatorInputError, match="correspondence__dwell__sped"):
         clf.set_params(correspondence__dwell__sped=1.0)
+
+
+# -- estimators a notebook user can keep (issue 37) -----------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def fitted(data):
+    dest, profile = data
+    X, y, _ = load_recordings(dest / "repertoire", profile)
+    Xd, yd, _ = load_recordings(dest / "demos", profile)
+    return MovementClassifier(profile).fit(X, y), Xd[::4]
+
+
+def _same_answers(a, b, X):
+    assert list(a.predict(X)) == list(b.predict(X))
+    np.testing.assert_array_equal(a.decision_function(X), b.decision_function(X))
+    assert [o.decided_at for o in a.observe(X)] == [o.decided_at for o in b.observe(X)]
+
+
+@pytest.mark.parametrize("how", ["pickle", "joblib", "deepcopy"])
+def test_a_fitted_classifier_round_trips(fitted, tmp_path, how):
+    clf, X = fitted
+    if how == "pickle":
+        again = pickle.loads(pickle.dumps(clf))
+    elif how == "joblib":
+        joblib.dump(clf, tmp_path / "clf.joblib")
+        again = joblib.load(tmp_path / "clf.joblib")
+    else:
+        again = copy.deepcopy(clf)
+    assert again is not clf and again.character_ is not clf.character_
+    assert hasattr(clf, "character_"), "pickling must leave the original fitted"
+    assert again.get_params() == clf.get_params()
+    assert list(again.classes_) == list(clf.classes_)
+    _same_answers(clf, again, X)
+
+
+def test_a_fitted_classifier_with_its_own_plugin_parameters_round_trips(data):
+    dest, profile = data
+    X, y, _ = load_recordings(dest / "repertoire", profile)
+    Xd, _, _ = load_recordings(dest / "demos", profile)
+    clf = MovementClassifier(profile, matcher="dtw").set_params(matcher__window=0.3).fit(X, y)
+    again = pickle.loads(pickle.dumps(clf))
+    assert again.character_.matcher.name == "dtw" and again.get_params()["matcher__window"] == 0.3
+    _same_answers(clf, again, Xd[::5])
+
+
+def test_what_the_fitted_observer_learned_is_pickled(fitted):
+    """A movement the observer learned after fit (its posegraph's learned state) comes back with it; the
+    original is not changed by pickling it."""
+    clf, X = fitted
+    learner = copy.deepcopy(clf)
+    motor = learner.character_.motor
+    take = X[0].positions[:: max(1, X[0].n_frames // 6)] - X[0].positions[:1, :1]
+    motor.learn("windmill", take, announce=False)
+    again = pickle.loads(pickle.dumps(learner))
+    assert "windmill" in again.character_.motor.movements()
+    assert again.character_.motor.get_state() == motor.get_state()
+    assert "windmill" not in clf.character_.motor.movements()
+
+
+def test_a_fitted_segmenter_round_trips(data):
+    dest, profile = data
+    streams, _ = load_streams(dest / "streams", profile)
+    seg = MovementSegmenter(profile).fit(streams)
+    for again in (pickle.loads(pickle.dumps(seg)), copy.deepcopy(seg)):
+        assert again.predict(streams) == seg.predict(streams)
+
+
+@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(PARAM_SETS)
+def test_unfitted_estimators_round_trip_with_their_params(data, params):
+    _, profile = data
+    clf = MovementClassifier(profile).set_params(**params)
+    again = pickle.loads(pickle.dumps(clf))
+    assert again.get_params() == clf.get_params()
+    assert not hasattr(again, "character_")
+    with pytest.raises(NotFittedError):
+        again.predict([np.zeros((3, len(profile.body.parts), 3))])
+
+
+def test_tags_say_what_the_input_is(data):
+    """Lists of (frames, parts, 3) arrays with NaN where a part is not seen; not a 2-D feature matrix."""
+    _, profile = data
+    for est, kind in ((MovementClassifier(profile), "classifier"), (MovementSegmenter(profile), None)):
+        tags = est.__sklearn_tags__()
+        assert tags.input_tags.three_d_array and tags.input_tags.allow_nan
+        assert not tags.input_tags.two_d_array and not tags.input_tags.sparse
+        assert tags.requires_fit and tags.estimator_type == kind
+    assert MovementClassifier(profile).__sklearn_tags__().target_tags.required
+    assert not MovementSegmenter(profile).__sklearn_tags__().target_tags.required
+
+
+@pytest.mark.parametrize("check", [
+    "check_no_attributes_set_in_init", "check_get_params_invariance", "check_set_params",
+    "check_parameters_default_constructible", "check_estimator_cloneable", "check_estimator_repr",
+    "check_estimator_tags_renamed", "check_valid_tag_types", "check_estimator_sparse_tag",
+    "check_do_not_raise_errors_in_init_or_set_params", "check_mixin_order"])
+def test_scikit_learns_api_checks_that_need_no_2d_data(data, check):
+    """check_estimator itself runs nothing more on an estimator whose tags say it takes no 2-D arrays; these
+    checks of the API need none (or, the sparse one, check that sparse input is refused by name)."""
+    _, profile = data
+    run = getattr(estimator_checks, check)
+    run("MovementClassifier", MovementClassifier(profile))
+    run("MovementSegmenter", MovementSegmenter(profile))
+
+
+def test_nan_is_a_part_not_seen(fitted, data):
+    """NaN and infinity in X are parts not seen: accepted, and a motion whose hands are hidden in a few frames is
+    still recognised."""
+    clf, X = fitted
+    _, profile = data
+    parts = list(profile.body.parts)
+    arrays = [m.positions.copy() for m in X]
+    for a in arrays:
+        a[1:4, parts.index("left_hand")] = np.nan
+        a[5, parts.index("right_hand")] = np.inf
+    assert list(MovementClassifier(profile, fps=X[0].fps).fit(X, clf.predict(X)).predict(arrays)) == \
+        list(clf.predict(X))
+
+
+def test_complex_sparse_and_odd_input_is_refused_by_name(fitted, data):
+    clf, X = fitted
+    _, profile = data
+    y = list(clf.predict(X))
+    with pytest.raises(EstimatorInputError, match=r"X\[0\] holds complex numbers") as err:
+        MovementClassifier(profile).fit([X[0].positions.astype(complex)] + X[1:], y)
+    assert err.value.key == ("X", 0) and "real numbers" in str(err.value)
+    with pytest.raises(ValueError, match=r"X\[1\] holds strings"):
+        clf.predict([X[0].positions, np.full((3, len(profile.body.parts), 3), "a")])
+    with pytest.raises(EstimatorInputError, match=r"X\[0\] holds objects"):
+        clf.predict([np.array([[[None] * 3] * len(profile.body.parts)])])
+    with pytest.raises(EstimatorInputError, match=r"X\[0\] is a ragged sequence"):
+        clf.predict([[[[0.0, 0.0, 0.0]], [[0.0, 0.0]]]])
+    with pytest.raises(EstimatorInputError, match="sparse input is not supported"):
+        clf.predict(sparse.csr_matrix(np.eye(3)))
+
+
+@pytest.mark.parametrize("y, message", [
+    (lambda n: np.linspace(0.0, 1.0, n), "y is continuous"),
+    (lambda n: np.arange(n) + 0.5, "y is continuous"),
+    (lambda n: np.arange(n) * (1 + 1j), "y is not labels"),
+    (lambda n: [np.nan] + [1.0] * (n - 1), "y is not labels"),
+    (lambda n: np.array(["bow"] + [1] * (n - 1), dtype=object), "mixes labels of several types"),
+])
+def test_targets_that_are_not_classes_are_refused(fitted, data, y, message):
+    clf, X = fitted
+    _, profile = data
+    with pytest.raises(EstimatorInputError, match=message) as err:
+        MovementClassifier(profile).fit(X, y(len(X)))
+    assert err.value.key == ("y",)
+    assert "movement labels" in str(err.value) or "one type" in str(err.value)
+
+
+def test_whole_floats_are_classes(fitted, data):
+    """Labels 0.0, 1.0, ... are classes (scikit-learn's multiclass), as integers are."""
+    clf, X = fitted
+    _, profile = data
+    names = sorted(set(clf.predict(X)))
+    y = np.array([float(names.index(label)) for label in clf.predict(X)])
+    assert MovementClassifier(profile, unknown=-1.0).fit(X, y).score(X, y) == 1.0
+
+
+def test_grid_search_over_a_list_of_grids_mixing_matchers_and_their_parameters(performers, data):
+    """A list of grids, as scikit-learn takes it: dtw alone, path-search with its own beam width; the base's
+    path-search parameters do not follow the candidate that puts dtw in the matcher's table."""
+    _, profile = data
+    X, y, groups = performers
+    base = MovementClassifier(profile).set_params(matcher__beam__k=5)
+    grid = [{"matcher": ["dtw"]}, {"matcher": ["path-search"], "matcher__beam__k": [1, 8]}]
+    search = GridSearchCV(base, grid, cv=LeaveOneGroupOut(), error_score="raise").fit(X, y, groups=groups)
+    assert search.cv_results_["params"] == [{"matcher": "dtw"}, {"matcher": "path-search", "matcher__beam__k": 1},
+                                            {"matcher": "path-search", "matcher__beam__k": 8}]
+    for params, score in zip(search.cv_results_["params"], search.cv_results_["mean_test_score"]):
+        alone = cross_val_score(clone(base).set_params(**params), X, y, groups=groups, cv=LeaveOneGroupOut())
+        assert score == pytest.approx(alone.mean())
+    assert min(search.cv_results_["mean_test_score"]) > 0.5
+    assert search.best_estimator_.character_.matcher.name == search.best_params_["matcher"]
+
+
+def test_another_plugin_drops_the_old_ones_parameters(data):
+    _, profile = data
+    clf = MovementClassifier(profile).set_params(matcher__beam__k=5, segmenter__threshold=0.1)
+    clf.set_params(matcher="dtw")
+    assert clf.settings == {"segmenter": {"threshold": 0.1}}
+    assert "matcher__beam__k" not in clf.get_params() and "matcher__window" in clf.get_params()
+    same = MovementClassifier(profile).set_params(matcher__beam__k=5)
+    same.set_params(matcher="path-search")  # the same plugin: its parameters stay
+    assert same.get_params()["matcher__beam__k"] == 5
+    given = MovementClassifier(profile).set_params(matcher="dtw", settings={"matcher": {"window": 0.2}})
+    assert given.get_params()["matcher__window"] == 0.2  # settings given with it are kept as given
+    with pytest.raises(EstimatorInputError, match="unknown parameter 'matcher__beam__k' of matcher plugin 'dtw'"):
+        MovementClassifier(profile).set_params(matcher="dtw", matcher__beam__k=3)

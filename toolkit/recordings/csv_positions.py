@@ -4,6 +4,11 @@ A header names ``JOINT_x``, ``JOINT_y``, ``JOINT_z`` for each joint (any order, 
 too); the frame rate comes from a ``time`` column in seconds, else from the ``fps`` the caller gives. Commas,
 semicolons or tabs separate the fields (whichever the header has most of); double quotes are allowed.
 
+Tracker output as it comes (issue 37): a ``time`` column with dropped frames (steps of two or more frames) places
+each row on the frame grid and leaves the frames between missing (NaN: not visible); a file whose first line is
+numbers has no header, and its columns are x, y, z of each joint the caller names, in that order (a body
+profile's ``joints``), after an optional time column.
+
 Reading is bounded and streaming (issue 21): lines, columns and joints are bounded (:data:`MAX_LINE_CHARS`,
 :data:`MAX_COLUMNS`, :data:`~toolkit.recordings.recording.MAX_JOINTS`); numbers are parsed into arrays a block of
 lines at a time (``numpy.loadtxt``), never kept as one Python object per value. A line is scanned field by field
@@ -28,7 +33,8 @@ from toolkit.files import check_regular_file, open_regular
 from toolkit.recordings.recording import (FPS_HINT, MAX_FPS, MAX_JOINTS, Recording, check_fps, check_names,
                                           shortened)
 
-__all__ = ["open_file", "parse_header", "parse_rows", "MAX_COLUMNS", "MAX_LINE_CHARS", "TIME_TOLERANCE"]
+__all__ = ["open_file", "has_header", "parse_header", "parse_rows", "frame_grid", "MAX_COLUMNS", "MAX_LINE_CHARS",
+           "TIME_TOLERANCE"]
 
 MAX_COLUMNS = 100_000
 """The most columns a CSV header may have (joint coordinates and ignored columns together)."""
@@ -37,7 +43,8 @@ MAX_LINE_CHARS = 1 << 20
 """The longest CSV line accepted, in characters (without its line break)."""
 
 TIME_TOLERANCE = 0.25
-"""How far a step of a CSV time column may differ from the median step, as a fraction of the median step."""
+"""How far a step of a CSV time column may be from a whole number of frames (one, or more where frames were
+dropped), as a fraction of a frame."""
 
 _BLOCK_CHARS = 1 << 20  # a CSV block ends after about this many characters even if it has fewer than ``frames`` rows
 _AXES = "xyz"
@@ -55,6 +62,7 @@ class _Layout:
     joints: tuple[str, ...]
     columns: tuple[int, ...]  # the field index of joint j's axis a at 3 j + a
     time: int | None
+    header: bool = True  # False: the first line is a frame, and the cells are names made for messages
 
     def column_name(self, field: int) -> str:
         return self.cells[field]
@@ -118,7 +126,56 @@ def _field_starts(line: str, delimiter: str) -> list[int]:
 def _layout(path: Path, names: tuple[str, ...] | None) -> _Layout:
     with _open(path) as f:
         line = _read_line(f, 1, path)
+    if line.strip() and _is_frame(line):
+        return _headerless(line, path, names)
     return parse_header(line, path, names)
+
+
+def has_header(path: str | Path) -> bool:
+    """Whether a CSV file's first line is a header (else it is a frame, and the joints must be named in column
+    order: a body profile's ``joints``). A file that cannot be read counts as having one: reading it reports why."""
+    try:
+        with _open(Path(path)) as f:
+            line = _read_line(f, 1, Path(path))
+    except (ConfigError, OSError):
+        return True
+    return not (line.strip() and _is_frame(line))
+
+
+def _is_frame(line: str) -> bool:
+    """Whether a first line is a frame rather than a header: every field a number or a missing value (empty,
+    ``nan``, infinite), at least one a number."""
+    fields = [c.strip() for c in line.rstrip("\n").split(_detect_delimiter(line))]
+    numbers = 0
+    for cell in fields:
+        if not cell:
+            continue
+        try:
+            value = float(cell.strip('"'))
+        except ValueError:
+            return False
+        numbers += bool(np.isfinite(value))
+    return numbers > 0
+
+
+def _headerless(line: str, path: Path, names: tuple[str, ...] | None) -> _Layout:
+    """The layout of a CSV without a header: x, y, z of each of ``names`` in order, after a time column when the
+    line has one field more."""
+    delimiter = _detect_delimiter(line)
+    n_fields = len(_split(line, delimiter, path, 1))
+    if names is None:
+        raise ConfigError("the file has no header (its first line is numbers)", file=path, line=1,
+                          expected="a header naming the columns JOINT_x, JOINT_y, JOINT_z, or the joints in column "
+                                   "order (a body profile's [profile] joints = [...])")
+    if n_fields not in (3 * len(names), 3 * len(names) + 1):
+        raise ConfigError(f"{n_fields} fields in a file without a header", file=path, line=1, column=1,
+                          expected=f"x, y and z of each of the {len(names)} joints named, in order "
+                                   f"({3 * len(names)} fields), or a time in seconds first ({3 * len(names) + 1})",
+                          available=shortened(names))
+    time = 0 if n_fields == 3 * len(names) + 1 else None
+    cells = (("time",) if time is not None else ()) + tuple(f"{j}_{a}" for j in names for a in _AXES)
+    first = 1 if time is not None else 0
+    return _Layout(path, line, delimiter, cells, names, tuple(range(first, n_fields)), time, header=False)
 
 
 def parse_header(line: str, path: Path, names: tuple[str, ...] | None) -> _Layout:
@@ -175,15 +232,17 @@ def parse_header(line: str, path: Path, names: tuple[str, ...] | None) -> _Layou
 def open_file(path: Path, *, names: Sequence[str] | None = None, fps: float | None = None, frames: int = 4096,
               need_fps: bool = True) -> Recording:
     """A CSV of joint positions (:func:`toolkit.recordings.open_recording`): ``names`` the joints to read, in this
-    order (default: every joint of the header); the frame rate from a ``time`` column, else ``fps``. A CSV with a time
-    column is read twice: once for the times (to know the frame rate before the first block), once for the
-    positions."""
+    order (default: every joint of the header), or of a file without a header its joints in column order
+    (required there); the frame rate from a ``time`` column, else ``fps``. A CSV with a time column is read twice:
+    once for the times (to know the frame rate and the frame grid before the first block), once for the
+    positions; rows after dropped frames are placed at their frames (:func:`frame_grid`), the frames between NaN."""
     check_regular_file(path, "recording of joint positions", "motion")
     if fps is not None:
         fps = check_fps(fps, path, "the frame rate given")
     layout = _layout(path, check_names(names, path))
+    grid = None  # each row's frame on the time grid, where frames were dropped
     if layout.time is not None:
-        measured = _rate_from_time(layout, frames)
+        measured, grid = _rate_from_time(layout, frames)
         if measured is not None:
             fps = measured
     if fps is None and need_fps:
@@ -191,17 +250,37 @@ def open_file(path: Path, *, names: Sequence[str] | None = None, fps: float | No
                           "no frame rate: the time column has fewer than 2 rows", file=path, expected=FPS_HINT)
     n_joints = len(layout.joints)
 
-    def blocks() -> Iterator[np.ndarray]:
+    def rows() -> Iterator[np.ndarray]:
         for values, _ in _row_blocks(layout, layout.columns, frames):
             values[~np.isfinite(values)] = np.nan
             yield values.reshape(-1, n_joints, 3)
 
-    return Recording(layout.joints, fps, str(path), "CSV", blocks())
+    blocks = rows() if grid is None else _on_grid(rows(), grid, n_joints, frames)
+    n_frames = None if grid is None else int(grid[-1]) + 1
+    return Recording(layout.joints, fps, str(path), "CSV", blocks, n_frames=n_frames)
 
 
-def _rate_from_time(layout: _Layout, frames: int) -> float | None:
-    """Frames per second from the time column (steps within TIME_TOLERANCE of the median step; the rate is the number
-    of steps over the time they span), or None with fewer than two rows."""
+def _on_grid(rows: Iterator[np.ndarray], grid: np.ndarray, n_joints: int, frames: int) -> Iterator[np.ndarray]:
+    """The rows' positions placed at their frames of ``grid`` (increasing, from 0), the frames between them NaN
+    (not visible); blocks of at most ``frames`` frames."""
+    done = 0  # frames yielded
+    row = 0  # rows placed
+    for block in rows:
+        at = grid[row:row + len(block)]
+        row += len(block)
+        end = int(at[-1]) + 1
+        for start in range(done, end, frames):
+            stop = min(start + frames, end)
+            out = np.full((stop - start, n_joints, 3), np.nan)
+            inside = (at >= start) & (at < stop)
+            out[at[inside] - start] = block[inside]
+            yield out
+        done = end
+
+
+def _rate_from_time(layout: _Layout, frames: int) -> tuple[float | None, np.ndarray | None]:
+    """Frames per second from the time column (:func:`frame_grid`: the rows' frames, the rate the number of frames
+    over the time they span), or None with fewer than two rows; with each row's frame where frames were dropped."""
     path, name = layout.source, layout.column_name(layout.time)
     chunks = list(_row_blocks(layout, (layout.time,), frames, lines=True))
     times = np.concatenate([v[:, 0] for v, _ in chunks]) if chunks else np.empty(0)
@@ -214,29 +293,74 @@ def _rate_from_time(layout: _Layout, frames: int) -> float | None:
         raise ConfigError(f"time {'missing' if np.isnan(times[k]) else times[k]} in column {name!r}", file=path,
                           line=int(lines[k]), column=column, expected="a finite time in seconds on every row")
     if times.size < 2:
-        return None
-    steps = np.diff(times)
-    back = np.flatnonzero(steps <= 0)
-    if back.size:
-        k = int(back[0]) + 1
-        raise ConfigError(f"time {times[k]:.9g} s does not increase from {times[k - 1]:.9g} s", file=path,
-                          line=int(lines[k]), column=column, expected=f"increasing times in column {name!r}")
-    step = float(np.median(steps))
-    off = np.flatnonzero(np.abs(steps - step) > TIME_TOLERANCE * step)
-    if off.size:
-        k = int(off[0]) + 1
-        raise ConfigError(f"irregular timing: a step of {steps[k - 1]:.6g} s from the row before", file=path,
-                          line=int(lines[k]), column=column,
-                          expected=f"steps of {step:.6g} s (the median) within {TIME_TOLERANCE:.0%}; "
-                                   "for a recording with dropped frames, drop the time column and give fps")
-    # the rate from the mean step (the span over the steps), not the median: with times rounded to a few digits the
-    # median is one of the rounded steps (%.6g times at 120 fps: steps of 0.008 and 0.009 s, median 0.008 s, 125 fps)
-    rate = (times.size - 1) / float(times[-1] - times[0])
+        return None, None
+    try:
+        grid, step = frame_grid(times)
+    except _OffGrid as err:
+        k = err.row
+        expected = {"back": f"increasing times in column {name!r}",
+                    "off": f"steps of whole frames of {err.step:.6g} s (one, or more where frames were dropped) "
+                           f"within {TIME_TOLERANCE:.0%} of a frame",
+                    "sparse": "at least as many rows as frames missing between them (a frame grid whose step is "
+                              "the median step)"}[err.kind]
+        raise ConfigError(err.problem, file=path, line=int(lines[k]), column=column, expected=expected) from None
+    rate = 1.0 / step
     if not rate <= MAX_FPS:
-        raise ConfigError(f"the time column's median step of {step:.6g} s is {rate:.6g} frames per second",
+        raise ConfigError(f"the time column's step of {step:.6g} s is {rate:.6g} frames per second",
                           file=path, line=int(lines[1]), column=column,
                           expected=f"times in seconds at a frame rate in (0, {MAX_FPS:g}] Hz")
-    return rate
+    return rate, (grid if grid[-1] != times.size - 1 else None)
+
+
+class _OffGrid(Exception):
+    """Times that are not a frame grid: at ``row``, of ``kind`` back (not increasing), off (not a whole number of
+    frames from the row before) or sparse (more frames missing than rows)."""
+
+    def __init__(self, kind: str, row: int, problem: str, step: float = float("nan")) -> None:
+        super().__init__(problem)
+        self.kind, self.row, self.problem, self.step = kind, row, problem, step
+
+
+def frame_grid(times: np.ndarray) -> tuple[np.ndarray, float]:
+    """Place rows with ``times`` (seconds, increasing, at least two) on a grid of frames: (each row's frame from 0,
+    the frame step in seconds).
+
+    The frame step is guessed as the median step (most frames kept), else as the shortest step (more gaps than
+    single steps), then made the mean of the steps within :data:`TIME_TOLERANCE` of the guess (the single steps:
+    times rounded to 1 ms at 30 fps have steps of 33 and 34 ms, and a gap of a hundred frames must count a
+    hundred); every step must be a whole number of frames within the tolerance, the frames of a longer step
+    dropped. The step returned is the time from the first row to the last over the frames between them (not the
+    median: rounded times at 120 fps have steps of 8 and 9 ms, whose median says 125 fps). At most as many frames
+    may be missing as there are rows (a time column of a few rows spread over hours is no recording).
+
+    Raises a private ``_OffGrid`` naming the row where the times stop being a grid.
+    """
+    steps = np.diff(times)
+    back = np.flatnonzero(~(steps > 0))
+    if back.size:
+        k = int(back[0]) + 1
+        raise _OffGrid("back", k, f"time {times[k]:.9g} s does not increase from {times[k - 1]:.9g} s")
+    failed = None
+    for guess in (float(np.median(steps)), float(np.min(steps))):  # most steps single; else the shortest step
+        single = np.abs(steps - guess) <= TIME_TOLERANCE * guess
+        step = float(np.mean(steps[single])) if single.any() else guess
+        counts = np.rint(steps / step)
+        off = np.flatnonzero((counts < 1) | (np.abs(steps / step - counts) > TIME_TOLERANCE))
+        if not off.size:
+            break
+        if failed is None:  # the error names the row where the median step's grid fails
+            k = int(off[0]) + 1
+            failed = _OffGrid("off", k, f"irregular timing: a step of {steps[k - 1]:.6g} s from the row before is "
+                                        f"{steps[k - 1] / step:.3g} frames", step)
+    else:
+        raise failed
+    missing = float(np.sum(counts)) + 1 - times.size  # a float: a fuzzed gap may exceed any integer
+    if missing > times.size:
+        k = int(np.argmax(counts)) + 1
+        raise _OffGrid("sparse", k, f"{missing:.6g} frames missing between {times.size} rows (the longest gap, "
+                                    f"{counts[k - 1] - 1:.6g} frames, before this row)")
+    grid = np.concatenate(([0], np.cumsum(counts))).astype(np.int64)
+    return grid, float(times[-1] - times[0]) / int(grid[-1])
 
 
 def _row_blocks(layout: _Layout, columns: Sequence[int], frames: int,
@@ -246,8 +370,8 @@ def _row_blocks(layout: _Layout, columns: Sequence[int], frames: int,
     path, delimiter = layout.source, layout.delimiter
     blank = " \t\f\v\n".replace(delimiter, "")
     with _open(path) as f:
-        number = 1
-        if _read_line(f, 1, path) != layout.header_line:
+        number = 1 if layout.header else 0
+        if layout.header and _read_line(f, 1, path) != layout.header_line:
             raise ConfigError("the header changed while the file was read", file=path, line=1)
         done = False
         while not done:

@@ -45,6 +45,7 @@ from toolkit.files import check_regular_file
 from toolkit.motion import Motion
 from toolkit.params import finite_number
 from toolkit.recordings import BLOCK, MAX_FPS, open_recording, recording_format
+from toolkit.recordings.csv_positions import has_header
 from toolkit.recordings.bvh import BVH
 
 __all__ = ["BodyProfile", "MotionStream", "is_profile", "load_profile", "UNITS", "UP_AXES"]
@@ -89,8 +90,9 @@ class BodyProfile:
         the ``[profile]`` table's ``fps`` key. A ``fps`` argument of :meth:`read` and :meth:`stream` wins over it;
         a BVH's ``Frame Time`` and a CSV's ``time`` column win over both.
     array_joints : tuple of str or None
-        The joints of a ``.npy`` array, in the array's order (the ``[profile]`` table's ``joints`` key); without
-        it, an array's joints are the mapped joints, in the order of ``[parts]`` (each once).
+        The joints of a ``.npy`` array or a CSV without a header, in the file's order (the ``[profile]`` table's
+        ``joints`` key); without it, such a file's joints are the mapped joints, in the order of ``[parts]`` (each
+        once).
     """
 
     name: str
@@ -161,7 +163,8 @@ class BodyProfile:
         grow with the file. A bad value raises the error reading the whole file raises.
         """
         block = BLOCK if block is None else max(1, int(block))
-        names = self.npy_joints if recording_format(path) == ".npy" else None  # an array has no names of its own
+        suffix = recording_format(path)  # an array, and a CSV without a header, have no names of their own
+        names = self.npy_joints if suffix == ".npy" or (suffix == ".csv" and not has_header(path)) else None
         recording = open_recording(path, names=names, fps=fps if fps is not None else self.fps, frames=block)
         try:
             self.check(recording)

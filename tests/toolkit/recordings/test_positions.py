@@ -208,14 +208,14 @@ def test_csv_errors(tmp_path, text, message):
 
 
 @pytest.mark.parametrize(("times", "message"), [
-    ([0, 0.1, 0.2, 0.4, 0.5], r"t.csv:6:1: irregular timing: a step of 0.2 s from the row before; expected steps of "
-                              r"0.1 s \(the median\) within 25%"),
+    ([0, 0.1, 0.2, 0.35, 0.45], r"t.csv:6:1: irregular timing: a step of 0.15 s from the row before is 1.5 frames; "
+                                r"expected steps of whole frames of 0.1 s"),
     ([0, 0.1, 0.1, 0.2], r"t.csv:5:1: time 0.1 s does not increase from 0.1 s"),
     ([0, 0.1, 0.05, 0.2], r"t.csv:5:1: time 0.05 s does not increase"),
     ([0, 0.1, "", 0.3], r"t.csv:5:1: time missing in column 'time'"),
     ([0, 0.1, "inf", 0.3], r"t.csv:5:1: time inf in column 'time'"),
     ([0, 0.1, "x", 0.3], r"t.csv:5:1: found 'x' in column 'time'; expected a time in seconds"),
-    ([0, 1e-5, 2e-5], r"t.csv:4:1: the time column's median step of 1e-05 s is 100000 frames per second; expected "
+    ([0, 1e-5, 2e-5], r"t.csv:4:1: the time column's step of 1e-05 s is 100000 frames per second; expected "
                       r"times in seconds at a frame rate in \(0, 10000\] Hz"),
 ])
 def test_time_errors_name_the_row(tmp_path, times, message):
