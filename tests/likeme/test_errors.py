@@ -230,6 +230,11 @@ CASES = [
     ("state-huge-int", "a huge integer", {"st.json": state(frame=10**40)}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["st.json: key frame: integer too large (41 digits)"]),
     ("state-load-device", "--load of a device", {}, ["run", "demo", "--load", "/dev/zero"], ["/dev/zero: is a character device, not a file; expected a regular file (state file written by --save)"]),
     ("state-nan", "NaN in a state file", {"st.json": state(time=float("nan"))}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["not JSON likeme reads: NaN is not a finite number"]),
+    ("state-save-empty", "--save with an empty name", {}, ["run", "demo", "--duration", "0.1", "--save", ""], ["key --save: an empty file name", "expected --save FILE"]),
+    ("state-load-empty", "--load with an empty name", {}, ["run", "demo", "--duration", "0.1", "--load", ""], ["key --load: an empty file name", "expected --load STATE"]),
+    ("state-save-long-name", "--save with a 300-character name", {}, ["run", "demo", "--duration", "0.1", "--save", "s" * 300], ["a file name of 300 bytes is too long", "expected a name of at most"]),
+    ("state-load-long-name", "--load with a 300-character name", {}, ["run", "demo", "--duration", "0.1", "--load", "s" * 300], ["cannot read file (File name too long)"]),
+    ("state-surrogate", "a lone surrogate in a state file", {"st.json": state(actors={"max\ud800": {"character": "Max", "components": {}}})}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["st.json: key actors: a key holding the lone surrogate \\ud800", "expected strings of Unicode characters"]),
     # -- profiling: profiles that check themselves (issue 20)
     ("bvh-end-site-name", "a joint named like an end site", {"m.bvh": BVH.replace("  }\n}\nMOTION", "  }\n  JOINT head_end\n  {\n    OFFSET 0 1 0\n    CHANNELS 0\n  }\n}\nMOTION")}, ["validate", "m.bvh"], ["m.bvh:15:9", "duplicate joint name 'head_end', the name of the end site of joint 'head' at line 10", "expected unique joint names"]),
     ("profile-npy", "likeme profile of a .npy array", {"a.npy": "x"}, ["profile", "a.npy"], ["a.npy: key FILE", "cannot propose a profile for a .npy file", "expected a BVH file, a CSV of joint positions or a C3D file (a .npy array has no joint names)"]),
