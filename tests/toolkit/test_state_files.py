@@ -656,3 +656,47 @@ def test_a_component_that_returns_a_lone_surrogate_is_named_when_saving(tmp_path
                                           r"surrogate \\ud800"):
         save_state(world, tmp_path / "s.json")
     assert not (tmp_path / "s.json").exists()
+
+
+def _reference_refuses(value, depth=0):
+    """The schema's bounds on a JSON value, written plainly (recursively): True if any is broken."""
+    if depth > MAX_DEPTH:
+        return True
+    if isinstance(value, bool) or value is None:
+        return False
+    if isinstance(value, int):
+        return abs(value) > 2**53
+    if isinstance(value, float):
+        return value != value or value in (float("inf"), float("-inf"))
+    if isinstance(value, str):
+        return len(value) > 4096 or any("\ud800" <= c <= "\udfff" for c in value)
+    if isinstance(value, dict):
+        return any(_reference_refuses(k) or _reference_refuses(v, depth + 1) for k, v in value.items())
+    return any(_reference_refuses(v, depth + 1) for v in value)
+
+
+JSON_VALUES = st.recursive(
+    st.none() | st.booleans() | st.integers(-(2**60), 2**60) | st.floats()
+    | st.text(alphabet=st.characters(codec=None, categories=None), max_size=4) | st.sampled_from(["\ud800", "x" * 4097]),
+    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=2) | st.just("\udfff"), inner,
+                                                                  max_size=3),
+    max_leaves=12)
+
+
+@settings(max_examples=300, deadline=None)
+@given(value=JSON_VALUES, depth=st.integers(0, MAX_DEPTH + 2))
+def test_the_walk_refuses_exactly_what_the_schema_bounds_refuse(value, depth):
+    """The iterative walk that checks every value of a state file (one step per value, key paths spelt out only for
+    an error) refuses exactly what a plain recursive reading of the bounds refuses."""
+    from toolkit.state import _walk
+
+    nested = value
+    for _ in range(depth):
+        nested = [nested]
+    try:
+        _walk(nested, (), Path("s.json"))
+    except ConfigError:
+        refused = True
+    else:
+        refused = False
+    assert refused == _reference_refuses(nested)
