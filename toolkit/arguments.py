@@ -79,16 +79,15 @@ def count_type(low: int, high: int) -> Any:
 
 
 def fps_type(text: str) -> float:
-    """``--fps``: a frame rate in (0, :data:`toolkit.recordings.MAX_FPS`] Hz, the range every reader accepts."""
-    from toolkit.recordings import MAX_FPS
+    """``--fps``: a frame rate in [1/60, :data:`toolkit.recordings.MAX_FPS`] Hz, the range every reader accepts."""
+    from toolkit.recordings.recording import FPS_RANGE, MAX_FPS, MIN_FPS
 
     try:
         value = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"invalid number: {text!r}") from None
-    if not (math.isfinite(value) and 0.0 < value <= MAX_FPS):
-        raise argparse.ArgumentTypeError(f"invalid frame rate {text!r}: expected frames per second in "
-                                         f"(0, {MAX_FPS:g}]")
+    if not (math.isfinite(value) and MIN_FPS <= value <= MAX_FPS):
+        raise argparse.ArgumentTypeError(f"invalid frame rate {text!r}: expected frames per second in {FPS_RANGE}")
     return value
 
 

@@ -50,6 +50,7 @@ a :class:`~toolkit.errors.ConfigError` naming the file and the reason.
 from __future__ import annotations
 
 import contextlib
+import errno
 import fcntl
 import glob
 import hashlib
@@ -57,6 +58,7 @@ import inspect
 import json
 import math
 import os
+import re
 import stat
 import sys
 import tempfile
@@ -71,7 +73,8 @@ from toolkit.hookspecs import hookimpl
 
 __all__ = ["FORMAT", "VERSION", "READS", "MAX_BYTES", "MAX_DEPTH", "MAX_INT", "MAX_STRING", "write_atomic",
            "canonical", "checksum", "character_state", "world_state", "state_text", "save_state", "read_state",
-           "check_state_data", "apply_state", "load_state", "check_save_target", "StateFile", "Checkpoint"]
+           "check_state_data", "apply_state", "load_state", "check_save_target", "lock_path", "StateFile",
+           "Checkpoint"]
 
 FORMAT = "likeme-state"
 VERSION = 2
@@ -163,23 +166,50 @@ def state_text(target: Any) -> str:
         data = world_state(target)
     try:
         data["checksum"] = checksum(data)
-    except ValueError:  # NaN or infinity: a file no likeme could load again
+    except ValueError:  # NaN, infinity or a lone surrogate: a file no likeme could load again
         characters = [target] if isinstance(target, Character) else [a.character for a in target.actors.values()]
         for character in characters:
             for component in character.components().values():
                 try:
                     canonical(component.get_state())
+                except UnicodeEncodeError as exc:
+                    raise PluginError(component.name, "get_state", f"returned a string holding the lone surrogate "
+                                      f"{ascii(exc.object[exc.start])[1:-1]}, which is not Unicode text") from None
                 except ValueError:
                     raise PluginError(component.name, "get_state", "returned a number that is not finite") from None
         raise
     return json.dumps(data, indent=1, sort_keys=True, allow_nan=False) + "\n"
 
 
+def lock_path(path: str | Path) -> Path:
+    """The advisory lock file of state file ``path``: ``.NAME.lock`` beside it."""
+    path = Path(path)
+    return path.with_name(f".{path.name}.lock")
+
+
+def _open_lock(lock: Path) -> int:
+    """Open (create) a lock file without following a symbolic link (``O_NOFOLLOW``): a link planted under the
+    lock's name would otherwise make every save create or open the file it points to. Anything but a regular file
+    is refused too. Raises :class:`OSError` naming the lock."""
+    flags = os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_NONBLOCK", 0)
+    try:
+        fd = os.open(lock, flags, 0o666)
+    except OSError as exc:
+        if exc.errno == errno.ELOOP or os.path.islink(lock):
+            raise OSError(errno.ELOOP, f"the lock file {lock} is a symbolic link; not following it", str(lock)) from None
+        raise
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        raise OSError(errno.EINVAL, f"the lock file {lock} is not a regular file", str(lock))
+    os.set_blocking(fd, True)
+    return fd
+
+
 @contextlib.contextmanager
 def _locked(path: Path) -> Iterator[None]:
     """Hold the advisory lock of state file ``path`` (``fcntl.flock`` on ``.NAME.lock`` beside it)."""
-    lock = path.with_name(f".{path.name}.lock")
-    fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o666)
+    lock = lock_path(path)
+    fd = _open_lock(lock)
     try:
         fcntl.flock(fd, fcntl.LOCK_EX)
         yield
@@ -230,20 +260,57 @@ def _probe_folder(folder: Path, name: str, path: Path) -> None:
                           expected="--save into a folder this user can write") from None
 
 
+NAME_MARGIN = 32
+"""How many bytes a save adds to a state file's name at most: ``.NAME.lock``, ``.NAME.XXXXXXXX.tmp`` and the
+temporary file of ``NAME.conflict-PID.json`` (:class:`StateFile`)."""
+
+
+def _check_name_length(path: Path, folder: Path) -> None:
+    """A name the file system takes with every suffix a save adds (``NAME_MAX`` less :data:`NAME_MARGIN` bytes)."""
+    try:
+        name_max = os.pathconf(folder if folder.is_dir() else ".", "PC_NAME_MAX")
+    except (OSError, ValueError):
+        name_max = 255
+    size = len(os.fsencode(path.name))
+    if size + NAME_MARGIN > name_max:
+        raise ConfigError(f"a file name of {size} bytes is too long", file=path,
+                          expected=f"a name of at most {name_max - NAME_MARGIN} bytes (this file system's "
+                                   f"{name_max} less {NAME_MARGIN} for the lock and temporary files beside it)")
+
+
 def check_save_target(path: str | Path) -> Path:
     """Check that state can be saved to ``path`` before a run starts; :class:`ConfigError` if not.
 
-    Refused: an empty name, a folder that does not exist or is a file, a directory as the file, something that is
+    Refused: an empty name, a name too long for the lock and temporary files beside it, a loop of symbolic links,
+    a lock file that is a symbolic link (a save does not follow it), a folder that does not exist or is a file, a directory as the file, something that is
     not a regular file, a read-only file (no write permission bit, whoever runs), a file that is not a likeme
     state file (it would be overwritten), a folder this user cannot create a file in (probed by creating and
     removing a temporary file). Returns the path to write (a symbolic link's target).
     """
+    if not str(path):
+        raise ConfigError("an empty file name", key=("--save",), expected="--save FILE (a state file to write)")
     path = Path(path)
-    if not str(path) or path.name in ("", ".", ".."):
+    if path.name in ("", ".", ".."):
         raise ConfigError("not a file name", file=path, expected="--save FILE (a state file to write)")
+    try:
+        return _check_save_target(path)
+    except OSError as exc:  # a name too long for the file system, a folder that vanished, ...
+        raise ConfigError(f"cannot save here: {_reason(exc)}", file=path,
+                          expected="--save FILE (a state file to write)") from None
+
+
+def _check_save_target(path: Path) -> Path:
+    _check_name_length(path, path.parent if str(path.parent) else Path("."))
     if path.is_symlink():
-        path = path.resolve()
+        try:
+            path = path.resolve(strict=True)
+        except FileNotFoundError:  # a link to a file not written yet: the save creates it
+            path = path.resolve()
+        except (OSError, RuntimeError):  # RuntimeError: Python before 3.13 on a loop
+            raise ConfigError("a loop of symbolic links", file=path,
+                              expected="--save FILE (a state file to write, or a link to one)") from None
     folder = path.parent if str(path.parent) else Path(".")
+    _check_name_length(path, folder)
     ancestor = folder
     while True:  # the nearest ancestor that exists says why the folder cannot be used
         try:
@@ -280,6 +347,15 @@ def check_save_target(path: str | Path) -> Path:
             if not isinstance(head, dict) or head.get("format") != FORMAT:
                 raise ConfigError("exists and is not a likeme state file; refusing to overwrite it", file=path,
                                   expected="a state file written by --save, or a new file name")
+    lock = lock_path(path)
+    try:
+        lock_mode = os.lstat(lock).st_mode
+    except FileNotFoundError:
+        lock_mode = None
+    if lock_mode is not None and not stat.S_ISREG(lock_mode):
+        what = "a symbolic link, which a save does not follow" if stat.S_ISLNK(lock_mode) else "not a regular file"
+        raise ConfigError(f"its lock file {lock} is {what}", file=path,
+                          expected="no file of that name, or the lock file a save made (remove it)")
     _probe_folder(folder, path.name, path)
     return path
 
@@ -350,11 +426,17 @@ def _warn(message: str) -> None:
 # -- reading -----------------------------------------------------------------------------------------
 
 
-def _read_bytes(path: Path) -> bytes:
+def _read_bytes(path: str | Path) -> bytes:
     """The file's bytes: a regular file within the state files' size cap (:func:`toolkit.files.open_regular`)."""
     what = "state file written by --save"
-    if not path.exists() and not path.is_symlink():
-        raise ConfigError("file not found", file=path, expected=f"an existing {what}")
+    if not str(path):
+        raise ConfigError("an empty file name", key=("--load",), expected=f"--load STATE (a {what})")
+    try:
+        os.lstat(path)
+    except FileNotFoundError:
+        raise ConfigError("file not found", file=path, expected=f"an existing {what}") from None
+    except OSError as exc:  # a name too long, a folder in the path that is a file, ...
+        raise ConfigError(f"cannot read file ({_reason(exc)})", file=path, expected=f"a readable {what}") from None
     try:
         with open_regular(path, what, "state") as handle:
             return handle.read()
@@ -366,37 +448,89 @@ def _no_constant(name: str) -> Any:
     raise ValueError(f"{name} is not a finite number")
 
 
+_SURROGATE = re.compile("[\ud800-\udfff]")
+
+
+def _text(value: str, what: str, key: tuple, path: Path) -> None:
+    """A string that is Unicode text: JSON's ``"\\ud800"`` escape decodes to a lone surrogate, which no UTF-8
+    file (nor the checksum's canonical JSON) can hold."""
+    found = _SURROGATE.search(value)
+    if found:
+        raise ConfigError(f"a {what} holding the lone surrogate {ascii(found.group())[1:-1]} at character "
+                          f"{found.start()}, which is not Unicode text", file=path, key=key,
+                          expected="strings of Unicode characters (a surrogate only in a pair)")
+
+
 def _walk(value: Any, key: tuple, path: Path) -> None:
-    """Every value is JSON of bounded depth, size and magnitude (iteratively: no recursion on hostile input)."""
-    stack = [(value, key)]
+    """Every value is JSON of bounded depth, size and magnitude (iteratively: no recursion on hostile input).
+
+    Only objects and lists go on the stack, each with its depth and a link to its parent's entry (the key path is
+    spelt out only for an error); numbers and strings are checked where they stand. So the walk costs one step per
+    value: a state of 20,000 learned movements holds millions of numbers."""
+    stack: list[tuple[Any, int, Any]] = [(value, len(key), (None, key))]
     while stack:
-        value, key = stack.pop()
-        if len(key) > MAX_DEPTH:
-            raise ConfigError(f"nested more than {MAX_DEPTH} deep below here", file=path, key=key[:4],
+        value, depth, link = stack.pop()
+        if depth > MAX_DEPTH or (depth == MAX_DEPTH and isinstance(value, (dict, list)) and value):
+            raise ConfigError(f"nested more than {MAX_DEPTH} deep below here", file=path, key=_key(link)[:4],
                               expected="a state file written by likeme")
-        if isinstance(value, bool) or value is None:
-            continue
-        if isinstance(value, int):
-            if abs(value) > MAX_INT:
-                raise ConfigError(f"integer too large ({len(str(abs(value)))} digits)", file=path, key=key,
-                                  expected=f"an integer of magnitude at most 2**{MAX_INT.bit_length() - 1}")
-        elif isinstance(value, float):
-            if not math.isfinite(value):
-                raise ConfigError(f"not a finite number: {value}", file=path, key=key, expected="a finite number")
-        elif isinstance(value, str):
-            if len(value) > MAX_STRING:
-                raise ConfigError(f"string of {len(value)} characters", file=path, key=key,
-                                  expected=f"at most {MAX_STRING} characters")
-        elif isinstance(value, dict):
-            for k, v in value.items():
+        if isinstance(value, dict):
+            for k in value:
                 if len(k) > MAX_STRING:
-                    raise ConfigError(f"key of {len(k)} characters", file=path, key=key,
+                    raise ConfigError(f"key of {len(k)} characters", file=path, key=_key(link),
                                       expected=f"at most {MAX_STRING} characters")
-                stack.append((v, (*key, k)))
+                if _SURROGATE.search(k):
+                    _text(k, "key", _key(link), path)
+            items: Any = value.items()
         elif isinstance(value, list):
-            stack.extend((v, (*key, i)) for i, v in enumerate(value))
-        else:  # pragma: no cover - json.loads makes nothing else
-            raise ConfigError(f"unexpected value {type(value).__name__}", file=path, key=key)
+            items = enumerate(value)
+        else:
+            _leaf(value, _key(link), path)
+            continue
+        below = depth + 1
+        for k, v in items:
+            kind = type(v)
+            if kind is float:
+                if v - v != 0.0:  # NaN or infinity (json reads 1e999 as infinity)
+                    _leaf(v, (*_key(link), k), path)
+            elif kind is dict or kind is list:
+                stack.append((v, below, (link, k)))
+            elif kind is str:
+                if len(v) > MAX_STRING or _SURROGATE.search(v):
+                    _leaf(v, (*_key(link), k), path)
+            else:
+                _leaf(v, (*_key(link), k), path)
+
+
+def _key(link: Any) -> tuple:
+    """The key path of a :func:`_walk` stack entry's link ``(parent link, key)``; the root's link holds the whole
+    starting key path."""
+    parts = []
+    while link[0] is not None:
+        link, k = link
+        parts.append(k)
+    return (*link[1], *reversed(parts))
+
+
+def _leaf(value: Any, key: tuple, path: Path) -> None:
+    """A number, string, boolean or null of a state file, within bounds."""
+    if isinstance(value, bool) or value is None:
+        return
+    if isinstance(value, int):
+        if abs(value) > MAX_INT:
+            raise ConfigError(f"integer too large ({len(str(abs(value)))} digits)", file=path, key=key,
+                              expected=f"an integer of magnitude at most 2**{MAX_INT.bit_length() - 1}")
+    elif isinstance(value, float):
+        if not math.isfinite(value):
+            raise ConfigError(f"not a finite number: {value}", file=path, key=key, expected="a finite number")
+    elif isinstance(value, str):
+        if len(value) > MAX_STRING:
+            raise ConfigError(f"string of {len(value)} characters", file=path, key=key,
+                              expected=f"at most {MAX_STRING} characters")
+        _text(value, "string", key, path)
+    elif isinstance(value, (dict, list)):  # pragma: no cover - _walk puts these on its stack
+        _walk(value, key, path)
+    else:  # pragma: no cover - json.loads makes nothing else
+        raise ConfigError(f"unexpected value {type(value).__name__}", file=path, key=key)
 
 
 def _table(value: Any, path: Path, key: tuple, what: str, keys: tuple[str, ...] | None = None,
@@ -423,8 +557,8 @@ def check_state_data(data: Any, path: str | Path) -> dict[str, Any]:
         raise ConfigError(f"unsupported state format version {version!r}", file=path, key=("version",),
                           expected="a version this likeme reads", available=[str(v) for v in READS])
     header = ("format", "version", "frame", "time", "actors") + (("checksum",) if version >= 2 else ())
-    _table(data, path, (), "a likeme state file", header, ("actors",))
     _walk(data, (), path)
+    _table(data, path, (), "a likeme state file", header, ("actors",))
     frame = data.get("frame", 0)
     if isinstance(frame, bool) or not isinstance(frame, int) or frame < 0:
         raise ConfigError(f"invalid frame {frame!r}", file=path, key=("frame",), expected="a frame number >= 0")
@@ -459,8 +593,8 @@ def check_state_data(data: Any, path: str | Path) -> dict[str, Any]:
 
 def read_state(path: str | Path) -> dict[str, Any]:
     """Read a state file and check it against the schema and its checksum; :class:`ConfigError` for anything else."""
-    path = Path(path)
     raw = _read_bytes(path)
+    path = Path(path)
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:

@@ -65,8 +65,10 @@ def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dic
                           expected="--render DIR with the settings of the view that draws the run")
     # the --save target and the --load file are checked before any work (the target first: its version is the one
     # this run may overwrite); the loaded state is applied, all or nothing, once the world is composed
-    target = StateFile(args.save, loaded=getattr(args, "load", None)) if getattr(args, "save", None) else None
-    loaded = read_state(args.load) if getattr(args, "load", None) else None
+    # (an empty name is an error naming the option, not "no --save")
+    save = getattr(args, "save", None)
+    target = StateFile(save, loaded=getattr(args, "load", None)) if save is not None else None
+    loaded = read_state(args.load) if getattr(args, "load", None) is not None else None
     scenario = load_scenario(path, pm, seed=args.seed, on_plugin_error="skip" if args.keep_going else "stop")
     if getattr(args, "duration", None) is not None:
         from toolkit.scenario import check_duration

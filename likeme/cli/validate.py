@@ -136,13 +136,9 @@ def _validate_recording(path: str, profile: Any, fps: float | None) -> str:
 def _npy_joint_names(path: str) -> list[str] | None:
     """Placeholder joint names (``joint_0``...) for a ``.npy`` array validated without a profile, or None when its
     header is not that of an array of joints (the reader then names what is wrong)."""
-    import numpy as np
-
     from toolkit.files import check_regular_file
+    from toolkit.recordings.npy_positions import read_header
 
     check_regular_file(path, "recording of joint positions", "motion")
-    try:
-        shape = np.load(path, mmap_mode="r", allow_pickle=False).shape
-    except (ValueError, OSError, EOFError):
-        return None
+    shape = read_header(Path(path)).shape  # a header that does not match its file is an error naming it
     return [f"joint_{k}" for k in range(shape[1])] if len(shape) == 3 and 0 < shape[1] <= 10_000 else None

@@ -32,6 +32,7 @@ from typing import Any
 from plugins.bench import text_table
 from plugins.bench.command import MATCHERS, SEGMENTERS
 from toolkit import ConfigError
+from toolkit.config.toml import MAX_DIGITS, NumberTooLong, loads
 
 __all__ = ["TIMING", "cells", "cmd_sweep", "load_grid", "sweep"]
 
@@ -64,7 +65,10 @@ def load_grid(path: str | Path) -> dict[str, Any]:
     """Read and check a grid file: keys, benchmark, folders (resolved against the grid's folder), plugin lists."""
     path = Path(path)
     try:
-        grid = tomllib.loads(path.read_text(encoding="utf-8"))
+        grid = loads(path.read_text(encoding="utf-8"))
+    except NumberTooLong as err:
+        raise ConfigError(str(err), file=path, line=err.line, column=err.column,
+                          expected=f"an integer of at most {MAX_DIGITS} digits") from None
     except FileNotFoundError:
         raise ConfigError("grid file not found", file=path, expected="a GRID.toml (docs/scaling.md)") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:

@@ -43,6 +43,7 @@ demonstration showed (the paper's learning).
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import numpy as np
@@ -113,8 +114,7 @@ class Posegraph(MotorSystem):
         clips = self.clips.clips if self.clips is not None else ()
         for clip in clips:
             self._add_clip(clip.movement, clip.motion, rows)
-        for name, entry in getattr(self, "learned", {}).items():  # what it learned by watching, again
-            self._add_learned(name, entry, rows)
+        self._add_learned(getattr(self, "learned", {}), rows)  # what it learned by watching, again
         self._set_rows(rows)
 
     def _set_rows(self, rows: _NodeRows) -> None:
@@ -276,18 +276,25 @@ class Posegraph(MotorSystem):
         ``mean``: the mean path's interior poses (M, P, 3), root-relative, when known (a saved state); else made from
         the takes. Returns the movement's (mean) path.
         """
-        if name in self.paths or name in self.movements():
+        if name in self.paths or name in self.paths_label.values():
             raise ConfigError(f"movement {name!r} already exists", expected="a new movement name", available=self.movements())
-        if not takes:
-            raise ValueError("nothing to learn: no take")
-        visible = list(visible) if visible is not None else [None] * len(takes)
-        interiors = [self._interior(t, v) for t, v in zip(takes, visible)][: self.params["takes"]]
-        self.learned[name] = {"source": source, "takes": interiors}
-        self._settle(name, mean)
+        self._enter(name, takes, visible, source, mean)
+        self._build()
         if announce and self.owner is not None:
             self.owner.announce("likeme_movement_learned", character=self.owner, movement=name,
                                 details=self._learned_details(name))
         return self.paths[name]
+
+    def _enter(self, name: str, takes: list[np.ndarray], visible: list[np.ndarray | None] | None, source: str,
+               mean: np.ndarray | None) -> None:
+        """Enter a learned movement's takes, mean path and spread, without making the graph again."""
+        if not takes:
+            raise ValueError("nothing to learn: no take")
+        visible = list(visible) if visible is not None else [None] * len(takes)
+        interiors = [self._interior(t, v) for t, v in zip(takes, visible)][: self.params["takes"]]
+        entry = {"source": source, "takes": interiors}
+        entry["mean"], entry["spread"] = mean_path(interiors, mean)
+        self.learned[name] = entry
 
     def add_take(self, name: str, poses: np.ndarray, visible: np.ndarray | None = None, *, announce: bool = True
                  ) -> bool:
@@ -336,19 +343,23 @@ class Posegraph(MotorSystem):
         entry["mean"], entry["spread"] = mean_path(entry["takes"], mean)
         self._build()
 
-    def _add_learned(self, name: str, entry: dict[str, Any], rows: _NodeRows) -> None:
-        """A learned movement's paths: its mean path (named as the movement), and with several takes each take
+    def _add_learned(self, learned: dict[str, dict[str, Any]], rows: _NodeRows) -> None:
+        """Each learned movement's paths: its mean path (named as the movement), and with several takes each take
         (``NAME/take-K``), all labelled with the movement; from the hub and back, travelling nowhere, each node's
-        parts' motion from the path's own poses, its turn not known."""
+        parts' motion from the path's own poses, its turn not known. The motions are differentiated together,
+        one call for the paths of each length (a saved state of thousands of movements loads in linear time)."""
         lift = self.rest_pose()[self.body.root_index]
         hub = self.hubs[0]
         root = self.body.root_index
-        paths = [(f"{name}/take-{k}", take) for k, take in enumerate(entry["takes"], 1)] if len(entry["takes"]) > 1 \
-            else []
-        for path, poses in (*paths, (name, entry["mean"])):
-            motion = derivative(poses - poses[:, root : root + 1], self.params["node_rate"])
+        paths = []
+        for name, entry in learned.items():
+            if len(entry["takes"]) > 1:
+                paths.extend((f"{name}/take-{k}", take, name) for k, take in enumerate(entry["takes"], 1))
+            paths.append((name, entry["mean"], name))
+        motions = _derivatives([poses - poses[:, root : root + 1] for _, poses, _ in paths], self.params["node_rate"])
+        for (path, poses, label), motion in zip(paths, motions):
             self._add_path(path, hub, poses + lift, hub, rows, np.zeros((len(poses), 3)), motion,
-                           np.full(len(poses), np.nan), label=name)
+                           np.full(len(poses), np.nan), label=label)
 
     def _learned_details(self, name: str) -> dict[str, Any]:
         entry = self.learned[name]
@@ -410,10 +421,10 @@ class Posegraph(MotorSystem):
             return
         root = self.body.root_index
         hub = self.rest_pose() - self.rest_pose()[root]
-        for name, mean, takes, source in plans:
-            lift = self.rest_pose()[root]  # held lifted to the rest root, as the graph holds them
-            self.learn_takes(name, [np.concatenate([[hub], t - lift, [hub]]) for t in takes], source=source,
-                             announce=False, mean=mean - lift)
+        lift = self.rest_pose()[root]  # held lifted to the rest root, as the graph holds them
+        for name, mean, takes, source in plans:  # every movement entered, then the graph made once: linear in size
+            self._enter(name, [np.concatenate([[hub], t - lift, [hub]]) for t in takes], None, source, mean - lift)
+        self._build()
 
     def _state_poses(self, value: Any, key: tuple, name: str) -> np.ndarray:
         shape = f"an array of shape (nodes >= 1, {self.body.n_parts}, 3) of finite numbers (metres, below 1e6)"
@@ -454,6 +465,31 @@ class _NodeRows:
         return tuple(np.concatenate(column) for column in zip(*self.blocks))  # type: ignore[return-value]
 
 
+@functools.cache
+def _dtw_c() -> bool:
+    """Whether dtaidistance's C library is there (its wheels have it): the same warping paths, a hundred times
+    faster than its Python loops."""
+    try:
+        from dtaidistance import dtw_cc  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+
+def _derivatives(sequences: list[np.ndarray], fps: float) -> list[np.ndarray]:
+    """:func:`~plugins.lib.velocity.derivative` of each sequence (n_i, ...), those of one length in one call."""
+    by_length: dict[tuple, list[int]] = {}
+    for i, values in enumerate(sequences):
+        by_length.setdefault(values.shape, []).append(i)
+    out: list[np.ndarray] = [np.empty(0)] * len(sequences)
+    for indices in by_length.values():
+        together = derivative(np.stack([sequences[i] for i in indices], axis=1), fps)
+        for j, i in enumerate(indices):
+            out[i] = together[:, j]
+    return out
+
+
 def mean_path(takes: list[np.ndarray], mean: np.ndarray | None = None) -> tuple[np.ndarray, float]:
     """The mean of several takes of one movement (each (K_i, P, 3)), and their spread (m).
 
@@ -477,7 +513,10 @@ def mean_path(takes: list[np.ndarray], mean: np.ndarray | None = None) -> tuple[
         mean = np.ascontiguousarray(np.asarray(mean, dtype=float).reshape(len(mean), -1))
     spreads = []
     for t in flat:
-        pairs = np.array(dtw_ndim.warping_path(t, mean))
+        if t.shape == mean.shape and np.array_equal(t, mean):  # a take that is the mean (a state's single take)
+            spreads.append(0.0)
+            continue
+        pairs = np.array(dtw_ndim.warping_path(t, mean, use_c=_dtw_c()))
         spreads.append(float(np.mean(pose_distance(t[pairs[:, 0]].reshape(-1, *shape), mean[pairs[:, 1]].reshape(-1, *shape)))))
     return mean.reshape(-1, *shape), float(np.mean(spreads))
 

@@ -230,6 +230,11 @@ CASES = [
     ("state-huge-int", "a huge integer", {"st.json": state(frame=10**40)}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["st.json: key frame: integer too large (41 digits)"]),
     ("state-load-device", "--load of a device", {}, ["run", "demo", "--load", "/dev/zero"], ["/dev/zero: is a character device, not a file; expected a regular file (state file written by --save)"]),
     ("state-nan", "NaN in a state file", {"st.json": state(time=float("nan"))}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["not JSON likeme reads: NaN is not a finite number"]),
+    ("state-save-empty", "--save with an empty name", {}, ["run", "demo", "--duration", "0.1", "--save", ""], ["key --save: an empty file name", "expected --save FILE"]),
+    ("state-load-empty", "--load with an empty name", {}, ["run", "demo", "--duration", "0.1", "--load", ""], ["key --load: an empty file name", "expected --load STATE"]),
+    ("state-save-long-name", "--save with a 300-character name", {}, ["run", "demo", "--duration", "0.1", "--save", "s" * 300], ["a file name of 300 bytes is too long", "expected a name of at most"]),
+    ("state-load-long-name", "--load with a 300-character name", {}, ["run", "demo", "--duration", "0.1", "--load", "s" * 300], ["cannot read file (File name too long)"]),
+    ("state-surrogate", "a lone surrogate in a state file", {"st.json": state(actors={"max\ud800": {"character": "Max", "components": {}}})}, ["run", "demo", "--duration", "0.1", "--load", "st.json"], ["st.json: key actors: a key holding the lone surrogate \\ud800", "expected strings of Unicode characters"]),
     # -- profiling: profiles that check themselves (issue 20)
     ("bvh-end-site-name", "a joint named like an end site", {"m.bvh": BVH.replace("  }\n}\nMOTION", "  }\n  JOINT head_end\n  {\n    OFFSET 0 1 0\n    CHANNELS 0\n  }\n}\nMOTION")}, ["validate", "m.bvh"], ["m.bvh:15:9", "duplicate joint name 'head_end', the name of the end site of joint 'head' at line 10", "expected unique joint names"]),
     ("profile-npy", "likeme profile of a .npy array", {"a.npy": "x"}, ["profile", "a.npy"], ["a.npy: key FILE", "cannot propose a profile for a .npy file", "expected a BVH file, a CSV of joint positions or a C3D file (a .npy array has no joint names)"]),
@@ -246,8 +251,11 @@ CASES = [
     ("observe-stdin-and-files", "standard input mixed with files", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "-", "m.bvh"], ["key files: '-' (standard input) with 1 other file(s)", "expected either '-' alone"]),
     ("csv-no-frame-rate", "a CSV without a time column, no --fps, no fps in the profile", {"p.toml": PROFILE, "m.csv": "hips_x,hips_y,hips_z\n0,1,2\n"}, ["validate", "--body", "p.toml", "m.csv"], ["m.csv: no frame rate: the file has no 'time' column", "--fps"]),
     ("csv-missing-joint", "a CSV without a joint the profile maps", {"p.toml": PROFILE, "m.csv": "hips_x,hips_y,hips_z,head_x,head_y,head_z\n0,1,2,0,2,0\n"}, ["validate", "--fps", "30", "--body", "p.toml", "m.csv"], ["p.toml:7: key parts.nose", "joint 'head_end' of part 'nose' is not in m.csv", "available: hips, head"]),
-    ("npy-not-an-array", "a .npy file that is text", {"m.npy": "x"}, ["validate", "--fps", "30", "m.npy"], ["m.npy: not a readable .npy array", "expected a NumPy array (frames, joints, 3) of numbers"]),
-    ("fps-option", "--fps of 0", {"m.bvh": BVH}, ["validate", "--fps", "0", "m.bvh"], ["argument --fps: invalid frame rate '0'", "expected frames per second in (0, 10000]"]),
+    ("npy-not-an-array", "a .npy file that is text", {"m.npy": "x"}, ["validate", "--fps", "30", "m.npy"], ["m.npy: not a .npy file (no NumPy header)", "expected a NumPy array (frames, joints, 3) of numbers"]),
+    ("fps-option", "--fps of 0", {"m.bvh": BVH}, ["validate", "--fps", "0", "m.bvh"], ["argument --fps: invalid frame rate '0'", "expected frames per second in [1/60, 10000]"]),
+    ("fps-option-tiny", "--fps of 1e-300", {"m.bvh": BVH}, ["validate", "--fps", "1e-300", "m.bvh"], ["argument --fps: invalid frame rate '1e-300'", "expected frames per second in [1/60, 10000]"]),
+    ("toml-huge-integer", "an integer of 5,000 digits in a TOML value", {"c.toml": CHILD + "[segmenter]\nfloor = " + "9" * 5000 + "\n"}, ["validate", "c.toml"], ["c.toml:5:9: an integer of 5,000 digits", "expected an integer of at most 4300 digits"]),
+    ("sweep-huge-integer", "an integer of 5,000 digits in a sweep grid", {"grid.toml": 'benchmark = "recognition"\nx = ' + "9" * 5000 + "\n"}, ["bench", "sweep", "grid.toml"], ["grid.toml:2:5: an integer of 5,000 digits", "expected an integer of at most 4300 digits"]),
     ("profile-fps", "a profile's fps is not a frame rate", {"p.toml": PROFILE.replace('units = "cm"', 'units = "cm"\nfps = -30')}, ["validate", "p.toml"], ["p.toml:4: key profile.fps: invalid fps -30", "expected frames per second"]),
     ("profile-joints", "a profile's joints list lacks a mapped joint", {"p.toml": PROFILE.replace('units = "cm"', 'units = "cm"\njoints = ["hips", "head"]')}, ["validate", "p.toml"], ["p.toml:4: key profile.joints: joint 'head_end' of part 'nose' is not in the joints list", "available: hips, head"]),
     # -- sweeps: likeme bench sweep, --jobs, --scheduler (issue 22)
@@ -336,6 +344,18 @@ def test_bad_input_fails_with_one_clear_line(case):
     assert "Traceback" not in err
     for fragment in fragments:
         assert fragment in lines[0], f"{fragment!r} not in {lines[0]!r}"
+
+
+@pytest.mark.parametrize("args, fragment", [
+    (["run", "demo", "--duration", "0.1", "--render", "out", "--set", "every=" + "9" * 5000], "key --set.every: "),
+    (["run", "demo", "--duration", "0.1", "--render", "out", "--set", "every=-" + "9" * 5000], "key --set.every: "),
+    (["run", "demo", "--duration", "0.1", "--render", "out", "--set", "every=" + "1_" * 4400 + "1"], "key --set.every: "),
+])
+def test_an_integer_of_thousands_of_digits_in_set_names_the_key(args, fragment):
+    """Kept out of :data:`CASES` (and so out of docs/errors.md): the command line alone is 5,000 characters."""
+    status, err, _ = run_case({}, args)
+    assert status == 1 and err.count("\n") == 1 and "Traceback" not in err, err
+    assert fragment + "an integer of " in err and "expected an integer of at most 4300 digits" in err, err
 
 
 def render() -> str:

@@ -221,3 +221,22 @@ def test_the_scenario_view_checks_object_colours_before_the_run(pm):
     assert scenario.world.frame == 0
     cheese.colour = "red"  # a name the renderer knows
     view.stop(view.start(scenario.world))
+
+
+@settings(max_examples=40, deadline=None)
+@given(digits=st.integers(4290, 4310), line=st.integers(0, 5), sign=st.sampled_from(["", "-", "+"]),
+       underscores=st.booleans())
+def test_the_one_toml_reader_bounds_integers_with_their_line_and_column(digits, line, sign, underscores):
+    """Every TOML a user gives (declarations, --set values, sweep grids) is read by toolkit.config.toml.loads: an
+    integer of more than 4,300 digits is a NumberTooLong at its own line and column, never Python's bare ValueError;
+    one of at most 4,300 digits is read as written."""
+    from toolkit.config.toml import MAX_DIGITS, NumberTooLong, loads
+
+    number = "7" * digits if not underscores else "_".join("7" * digits)
+    text = "".join(f"k{i} = {i}\n" for i in range(line)) + f"big = {sign}{number}\n"
+    if digits <= MAX_DIGITS:
+        assert loads(text)["big"] == int(sign + "7" * digits)
+    else:
+        with pytest.raises(NumberTooLong) as info:
+            loads(text)
+        assert (info.value.digits, info.value.line, info.value.column) == (digits, line + 1, 7)

@@ -377,7 +377,8 @@ def deep(n):
 
 
 HOSTILE = st.one_of(
-    st.sampled_from([[], {}, "abc", 5, -1, 0, None, True, 1.5, ["reach", "eat"], [["x"]], {"a": 1},
+    st.sampled_from([[], {}, "abc", "\ud800", "learned-\udfff", {"x\udbff": 1}, 5, -1, 0, None, True, 1.5,
+                     ["reach", "eat"], [["x"]], {"a": 1},
                      10**30, -(10**40), 2**53 + 1, 1e300, deep(MAX_DEPTH + 5), deep(40), "", "hub", [[1, 2]],
                      [1, 2, 3]]),
     st.recursive(st.none() | st.booleans() | st.integers() | st.floats(allow_nan=False, allow_infinity=False)
@@ -405,7 +406,8 @@ def corruptions(draw, texts):
         elif how == "delete":
             parent.pop(last)
         elif isinstance(parent, dict):
-            parent[draw(st.sampled_from(["x", "learned-1", "hub", "left_wrist", "beliefs", ""]))] = parent.pop(last)
+            parent[draw(st.sampled_from(["x", "learned-1", "hub", "left_wrist", "beliefs", "", "\ud800"]))] = \
+                parent.pop(last)
         if draw(st.booleans()):
             with contextlib.suppress(ValueError, RecursionError):
                 data["checksum"] = checksum(data)
@@ -549,3 +551,152 @@ def test_a_component_that_returns_nan_is_named_when_saving(tmp_path):
     with pytest.raises(PluginError, match=r"plugin 'hierarchical' failed in get_state: returned a number that is not"):
         save_state(world, tmp_path / "s.json")
     assert not (tmp_path / "s.json").exists()
+
+
+# -- hostile names: lock files, links, long names, lone surrogates (issue 38) ------------------------------------
+
+
+def test_a_lock_file_planted_as_a_symbolic_link_is_refused_before_the_run(tmp_path, no_run):
+    victim = tmp_path / "elsewhere" / "victim"
+    victim.parent.mkdir()
+    (tmp_path / ".s.json.lock").symlink_to(victim)
+    status, err = likeme(["run", "learn_windmill", "--save", tmp_path / "s.json"])
+    assert status == 1 and err.count("\n") == 1, err
+    assert f"its lock file {tmp_path}/.s.json.lock is a symbolic link, which a save does not follow" in err
+    assert not victim.exists() and not (tmp_path / "s.json").exists()
+
+
+def test_a_lock_file_planted_during_the_run_is_not_followed(tmp_path):
+    """A link put in place of the lock after the check: the save fails (reported, kept in memory), and nothing is
+    created or opened where the link points."""
+    target = StateFile(tmp_path / "s.json")
+    victim = tmp_path / "victim"
+    (tmp_path / ".s.json.lock").symlink_to(victim)
+    with pytest.raises(OSError, match=r"the lock file .*/\.s\.json\.lock is a symbolic link; not following it"):
+        target.save('{"format": "likeme-state"}\n')
+    assert not victim.exists() and not (tmp_path / "s.json").exists()
+    existing = tmp_path / "existing"
+    existing.write_text("precious\n")
+    (tmp_path / ".s.json.lock").unlink()
+    (tmp_path / ".s.json.lock").symlink_to(existing)
+    with pytest.raises(OSError, match="symbolic link"):
+        target.save('{"format": "likeme-state"}\n')
+    assert existing.read_text() == "precious\n"
+
+
+def test_the_lock_and_temporary_files_are_opened_exclusively_without_following_links(tmp_path, monkeypatch):
+    """The flags every save opens its lock and temporary files with: ``O_NOFOLLOW`` for both, ``O_EXCL`` for the
+    temporary file (created new, never an existing file or link)."""
+    real = os.open
+    opened = []
+
+    def spy(path, flags, *args, **kwargs):
+        opened.append((Path(os.fsdecode(path)).name, flags))
+        return real(path, flags, *args, **kwargs)
+
+    world = windmill()[1].world
+    monkeypatch.setattr(os, "open", spy)
+    save_state(world, tmp_path / "s.json")
+    lock = [flags for name, flags in opened if name == ".s.json.lock"]
+    temporary = [flags for name, flags in opened if name.startswith(".s.json.") and name.endswith(".tmp")]
+    assert lock and temporary, opened
+    assert all(flags & os.O_NOFOLLOW and flags & os.O_CREAT for flags in lock)
+    assert all(flags & os.O_NOFOLLOW and flags & os.O_EXCL and flags & os.O_CREAT for flags in temporary)
+
+
+def test_a_loop_of_links_is_one_line_for_save_and_load(tmp_path, no_run):
+    (tmp_path / "a.json").symlink_to(tmp_path / "b.json")
+    (tmp_path / "b.json").symlink_to(tmp_path / "a.json")
+    status, err = likeme(["run", "learn_windmill", "--save", tmp_path / "a.json"])
+    assert status == 1 and err == f"likeme: error: {tmp_path}/a.json: a loop of symbolic links; expected --save " \
+                                  "FILE (a state file to write, or a link to one)\n"
+    status, err = likeme(["run", "learn_windmill", "--load", tmp_path / "a.json"])
+    assert status == 1 and err.count("\n") == 1 and "Too many levels of symbolic links" in err, err
+
+
+def test_a_link_to_a_new_file_is_still_a_good_target(tmp_path):
+    (tmp_path / "link.json").symlink_to(tmp_path / "new.json")
+    assert check_save_target(tmp_path / "link.json") == tmp_path / "new.json"
+
+
+@pytest.mark.parametrize("length, message", [
+    (300, "a file name of 300 bytes is too long"),
+    (240, "a file name of 240 bytes is too long; expected a name of at most 223 bytes"),
+])
+def test_a_name_too_long_for_the_saves_own_files_is_refused_before_the_run(tmp_path, no_run, length, message):
+    status, err = likeme(["run", "learn_windmill", "--save", tmp_path / ("s" * length)])
+    assert status == 1 and err.count("\n") == 1 and message in err, err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_longest_name_allowed_saves_with_its_conflict_file(tmp_path):
+    """223 bytes: the lock, the temporary files and a conflict file's temporary file all fit in 255."""
+    path = tmp_path / ("s" * 218 + ".json")
+    target = StateFile(path)
+    target.save('{"format": "likeme-state"}\n')
+    path.write_text('{"format": "likeme-state", "other": 1}\n')  # another writer
+    target.report = lambda message: None
+    assert target.save('{"format": "likeme-state"}\n') == target.conflict_path
+
+
+def test_a_lone_surrogate_in_a_state_file_is_one_line(tmp_path):
+    data = {"format": "likeme-state", "version": 2, "actors": {"max": {"character": "Max\udfff", "components": {}}}}
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps(data).replace("}}}}", '}}}, "checksum": "sha256:00"}'))
+    with pytest.raises(ConfigError, match=r"key actors.max.character: a string holding the lone surrogate \\udfff"):
+        read_state(path)
+
+
+def test_a_component_that_returns_a_lone_surrogate_is_named_when_saving(tmp_path):
+    from toolkit import PluginError
+
+    world = windmill()[1].world
+    world.actors["max"].character.action.beliefs["pear\ud800"] = "food"
+    with pytest.raises(PluginError, match=r"'hierarchical' failed in get_state: returned a string holding the lone "
+                                          r"surrogate \\ud800"):
+        save_state(world, tmp_path / "s.json")
+    assert not (tmp_path / "s.json").exists()
+
+
+def _reference_refuses(value, depth=0):
+    """The schema's bounds on a JSON value, written plainly (recursively): True if any is broken."""
+    if depth > MAX_DEPTH:
+        return True
+    if isinstance(value, bool) or value is None:
+        return False
+    if isinstance(value, int):
+        return abs(value) > 2**53
+    if isinstance(value, float):
+        return value != value or value in (float("inf"), float("-inf"))
+    if isinstance(value, str):
+        return len(value) > 4096 or any("\ud800" <= c <= "\udfff" for c in value)
+    if isinstance(value, dict):
+        return any(_reference_refuses(k) or _reference_refuses(v, depth + 1) for k, v in value.items())
+    return any(_reference_refuses(v, depth + 1) for v in value)
+
+
+JSON_VALUES = st.recursive(
+    st.none() | st.booleans() | st.integers(-(2**60), 2**60) | st.floats()
+    | st.text(alphabet=st.characters(codec=None, categories=None), max_size=4) | st.sampled_from(["\ud800", "x" * 4097]),
+    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=2) | st.just("\udfff"), inner,
+                                                                  max_size=3),
+    max_leaves=12)
+
+
+@settings(max_examples=300, deadline=None)
+@given(value=JSON_VALUES, depth=st.integers(0, MAX_DEPTH + 2))
+def test_the_walk_refuses_exactly_what_the_schema_bounds_refuse(value, depth):
+    """The iterative walk that checks every value of a state file (one step per value, key paths spelt out only for
+    an error) refuses exactly what a plain recursive reading of the bounds refuses."""
+    from toolkit.state import _walk
+
+    nested = value
+    for _ in range(depth):
+        nested = [nested]
+    try:
+        _walk(nested, (), Path("s.json"))
+    except ConfigError:
+        refused = True
+    else:
+        refused = False
+    assert refused == _reference_refuses(nested)

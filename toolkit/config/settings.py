@@ -13,7 +13,7 @@ from typing import Any
 
 from toolkit.character import COMPONENT_TABLES
 from toolkit.components import KINDS
-from toolkit.config.toml import MAX_DEPTH, too_deep
+from toolkit.config.toml import MAX_DEPTH, MAX_DIGITS, NumberTooLong, loads, too_deep
 from toolkit.errors import ConfigError
 from toolkit.params import of_owner
 
@@ -37,7 +37,10 @@ def parse_settings(items: list[str], *, tables: bool = True) -> dict[str, Any]:
                               " (TABLE.KEY.KEY=VALUE inside a parameter's own table)"
                               if tables else "KEY=VALUE, like keys=4")
         try:
-            parsed = tomllib.loads(f"v = {value}")["v"]
+            parsed = loads(f"v = {value}")["v"]
+        except NumberTooLong as exc:
+            raise ConfigError(f"{exc}", key=("--set", *([table] if tables else []), *path),
+                              expected=f"an integer of at most {MAX_DIGITS} digits") from None
         except tomllib.TOMLDecodeError:
             parsed = value  # a bare word is a string
         except RecursionError:

@@ -16,11 +16,45 @@ from typing import Any
 
 from toolkit.errors import ConfigError
 
-__all__ = ["MAX_DEPTH", "read_text", "read_toml", "too_deep", "find_key_line"]
+__all__ = ["MAX_DEPTH", "MAX_DIGITS", "NumberTooLong", "loads", "read_text", "read_toml", "too_deep",
+           "find_key_line"]
 
 
 MAX_DEPTH = 32
 """The deepest nesting of arrays and tables a declaration may have."""
+
+
+MAX_DIGITS = 4300
+"""The most digits an integer may have (Python's own limit on converting text to ``int``)."""
+
+_LONG_INTEGER = re.compile(r"[-+]?[0-9][0-9_]{%d,}" % MAX_DIGITS)
+
+
+class NumberTooLong(ValueError):
+    """An integer of more than :data:`MAX_DIGITS` digits, where it stands in the text."""
+
+    def __init__(self, digits: int, line: int | None, column: int | None) -> None:
+        self.digits, self.line, self.column = digits, line, column
+        super().__init__(f"an integer of {digits:,} digits")
+
+
+def loads(text: str) -> dict[str, Any]:
+    """:func:`tomllib.loads`, with numbers bounded: an integer of more than :data:`MAX_DIGITS` digits is a
+    :class:`NumberTooLong` with its line and column (``tomllib`` raises Python's bare ``ValueError`` for it).
+    The one TOML reader of declarations, ``--set`` values and sweep grids; also raises
+    :class:`tomllib.TOMLDecodeError` and :class:`RecursionError` as ``tomllib`` does."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError:
+        raise
+    except ValueError:  # int() past its digit limit: the only ValueError tomllib lets through
+        found = _LONG_INTEGER.search(text)
+        if found is None:
+            raise
+        line = text.count("\n", 0, found.start()) + 1
+        column = found.start() - (text.rfind("\n", 0, found.start()) + 1) + 1
+        digits = sum(c.isdigit() for c in found.group())
+        raise NumberTooLong(digits, line, column) from None
 
 
 def read_text(path: str | Path, what: str, *, kind: str = "config") -> str:
@@ -44,9 +78,12 @@ def read_toml(path: str | Path) -> dict[str, Any]:
     path = Path(path)
     text = read_text(path, "TOML file")
     try:
-        table = tomllib.loads(text)
+        table = loads(text)
     except RecursionError:
         table = None
+    except NumberTooLong as exc:
+        return _raise(ConfigError(str(exc), file=path, line=exc.line, column=exc.column,
+                                  expected=f"an integer of at most {MAX_DIGITS} digits"))
     except tomllib.TOMLDecodeError as exc:
         msg = str(exc)
         m = re.search(r"\(at line (\d+), column (\d+)\)", msg)

@@ -28,7 +28,7 @@ import numpy as np
 
 from toolkit.errors import ConfigError
 from toolkit.recordings.csv_positions import MAX_LINE_CHARS, parse_header, parse_rows
-from toolkit.recordings.recording import MAX_FPS
+from toolkit.recordings.recording import FPS_RANGE, MAX_FPS, MIN_FPS
 
 __all__ = ["LiveInput", "SOURCE"]
 
@@ -148,9 +148,12 @@ class LiveInput:
 
     def _json(self, text: str) -> tuple[np.ndarray, list[str]]:
         try:
-            frame = json.loads(text)
+            frame = json.loads(text, parse_int=_integer)
         except json.JSONDecodeError as exc:
             raise ConfigError(f"not JSON ({exc.msg})", file=self.path, line=self.line, column=exc.colno,
+                              expected='one JSON object per line, {"JOINT": [x, y, z], ...}') from None
+        except RecursionError:
+            raise ConfigError("JSON nested too deeply", file=self.path, line=self.line,
                               expected='one JSON object per line, {"JOINT": [x, y, z], ...}') from None
         if not isinstance(frame, dict):
             raise ConfigError(f"a JSON {type(frame).__name__}, not an object", file=self.path, line=self.line,
@@ -192,8 +195,15 @@ class LiveInput:
             yield self._convert(frame)
 
 
+def _integer(text: str) -> int | float:
+    """A JSON integer, bounded: one of more than 18 digits is read as a float (a coordinate of 400 or 5,000 digits
+    is then infinite: not seen on that frame; such a time an error naming the line), never Python's ``ValueError``
+    for 4,300 digits or an ``OverflowError`` later."""
+    return int(text) if len(text) <= 18 else float(text)
+
+
 def _check_rate(rate: float, path: Path, line: int | None) -> float:
-    if not 0.0 < rate <= MAX_FPS:
+    if not MIN_FPS <= rate <= MAX_FPS:
         raise ConfigError(f"a frame rate of {rate:g} frames per second", file=path, line=line,
-                          expected=f"a frame rate in (0, {MAX_FPS:g}] Hz")
+                          expected=f"a frame rate in {FPS_RANGE} Hz")
     return rate

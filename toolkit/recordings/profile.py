@@ -46,6 +46,7 @@ from toolkit.motion import Motion
 from toolkit.params import finite_number
 from toolkit.recordings import BLOCK, MAX_FPS, open_recording, recording_format
 from toolkit.recordings.csv_positions import has_header
+from toolkit.recordings.recording import FPS_RANGE, MIN_FPS
 from toolkit.recordings.bvh import BVH
 
 __all__ = ["BodyProfile", "MotionStream", "is_profile", "load_profile", "UNITS", "UP_AXES"]
@@ -284,10 +285,10 @@ def load_profile(path: str | Path) -> BodyProfile:
         raise fail(exc.problem, key, expected=exc.expected, available=exc.available) from None
     fps = head.get("fps")
     if fps is not None:
-        if isinstance(fps, bool) or not isinstance(fps, int | float) or not 0 < fps <= MAX_FPS:  # NaN fails too
+        if isinstance(fps, bool) or not isinstance(fps, int | float) or not MIN_FPS <= fps <= MAX_FPS:  # and NaN
             raise fail(f"invalid fps {fps!r}", ("profile", "fps"),
                        expected=f"frames per second of recordings without a time of their own, a number in "
-                                f"(0, {MAX_FPS:g}]")
+                                f"{FPS_RANGE}")
         fps = float(fps)
     array_joints = head.get("joints")
     if array_joints is not None:

@@ -8,6 +8,7 @@ body profile (:mod:`toolkit.recordings.profile`) turns them into a body's parts 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterator, Sequence
 from numbers import Real
 from pathlib import Path
@@ -25,7 +26,11 @@ MAX_FPS = 10_000.0
 """The highest frame rate any reader accepts (Hz; a BVH's ``Frame Time`` of at least 0.1 ms, a CSV's time column,
 ``fps`` given): high-speed optical capture reaches a few kHz."""
 MIN_FPS = 1.0 / 60.0
-"""The lowest frame rate a BVH's ``Frame Time`` may give (at most 60 s)."""
+"""The lowest frame rate any reader accepts (a frame a minute: a BVH's ``Frame Time`` of at most 60 s, ``--fps``,
+a profile's or a live stream's rate); lower ones only overflow the seconds every plugin turns into frames."""
+
+FPS_RANGE = f"[1/60, {MAX_FPS:g}]"
+"""The frame rates every reader accepts, as messages write them."""
 
 MAX_JOINTS = 10_000
 """The most joints a recording of joint positions may have."""
@@ -85,14 +90,17 @@ class Recording:
 
 
 def check_fps(fps: object, path: str | Path, what: str) -> float:
-    """A frame rate in (0, :data:`MAX_FPS`] Hz, or a :class:`ConfigError` naming ``path`` and ``what`` gave it."""
+    """A frame rate in [:data:`MIN_FPS`, :data:`MAX_FPS`] Hz, or a :class:`ConfigError` naming ``path`` and
+    ``what`` gave it."""
     if isinstance(fps, bool) or not isinstance(fps, Real):
-        raise ConfigError(f"{what} is {fps!r}", file=path,
-                          expected=f"a number of frames per second in (0, {MAX_FPS:g}]")
-    value = float(fps)
-    if not (0.0 < value <= MAX_FPS):  # NaN fails too
+        raise ConfigError(f"{what} is {fps!r}", file=path, expected=f"a number of frames per second in {FPS_RANGE}")
+    try:
+        value = float(fps)
+    except OverflowError:  # an integer beyond a float
+        value = math.inf
+    if not (MIN_FPS <= value <= MAX_FPS):  # NaN fails too
         raise ConfigError(f"{what} is {value:g} frames per second", file=path,
-                          expected=f"a frame rate in (0, {MAX_FPS:g}] Hz")
+                          expected=f"a frame rate in {FPS_RANGE} Hz")
     return value
 
 

@@ -94,3 +94,43 @@ def test_find_hubs_block_by_block_is_the_all_pairs_answer(n, block, seed):
     whole = clip_repertoire.find_hubs(ends, 0.06, 0.2)  # the default block holds every pair of these few ends
     with mock.patch.object(clip_repertoire, "PAIR_BLOCK", block):
         np.testing.assert_array_equal(clip_repertoire.find_hubs(ends, 0.06, 0.2), whole)
+
+
+@settings(max_examples=10, deadline=None)
+@given(seed=st.integers(0, 2**16), n=st.integers(1, 12), takes=st.integers(1, 3))
+def test_loading_learned_movements_at_once_makes_the_graph_learning_them_one_by_one_makes(seed, n, takes):
+    """A state file's movements enter the graph together (one build: loading is linear in the state's size); the
+    graph, its node arrays and every movement's mean and spread are those of learning the movements one at a time."""
+    pm = create_plugin_manager(autoload=False)
+    one_by_one = load_character(CHARACTERS / "max.toml", pm).motor
+    rng = np.random.default_rng(seed)
+    base = one_by_one.node_root_relative[[one_by_one.node_index(x) for x in one_by_one.paths["wave"]]]
+    for i in range(n):
+        demos = [base[: rng.integers(4, len(base) + 1)] + rng.normal(scale=0.01, size=base.shape)[:1]
+                 for _ in range(takes)]
+        for demo in demos:
+            demo[[0, -1]] = base[0]
+        one_by_one.learn_takes(f"learned-{i}", demos, announce=False)
+    state = one_by_one.get_state()
+    loaded = load_character(CHARACTERS / "max.toml", pm).motor
+    loaded.set_state(state)
+    assert loaded.nodes == one_by_one.nodes
+    assert sorted(loaded.graph.edges) == sorted(one_by_one.graph.edges)
+    assert np.allclose(loaded.node_poses, one_by_one.node_poses, atol=2e-6)  # a state holds 6 decimals
+    assert np.allclose(loaded.node_motion, one_by_one.node_motion, atol=1e-3)
+    assert loaded.get_state() == state
+    for name, entry in one_by_one.learned.items():
+        assert loaded.learned[name]["spread"] == pytest.approx(entry["spread"], abs=1e-5)
+
+
+def test_a_take_that_is_the_mean_has_no_spread_and_the_c_warping_path_is_the_python_one():
+    from dtaidistance import dtw_ndim
+
+    from plugins.motor.posegraph import mean_path
+
+    rng = np.random.default_rng(3)
+    take = rng.normal(size=(9, 4, 3))
+    assert mean_path([take], take.copy())[1] == 0.0
+    other = take[::-1][:7] + rng.normal(scale=0.1, size=(7, 4, 3))
+    a, b = take.reshape(9, -1), np.ascontiguousarray(other.reshape(7, -1))
+    assert dtw_ndim.warping_path(a, b, use_c=True) == dtw_ndim.warping_path(a, b, use_c=False)

@@ -199,3 +199,21 @@ def test_csv_npy_and_piped_lines_give_the_same_motion(tmp_path, frames, joints, 
     lines = "".join(json.dumps({j: [None if np.isnan(v) else v for v in p.tolist()] for j, p in zip(joints, pose)})
                     + "\n" for pose in positions)
     np.testing.assert_array_equal(np.array(list(LiveInput(io.BytesIO(lines.encode()), profile, 25.0))), expected)
+
+
+def test_huge_numbers_in_json_lines_are_not_seen_or_a_time_error_never_a_traceback(data):
+    """A coordinate of 400 or 5,000 digits is read as a number too large to be finite: that joint is not seen on
+    that frame, and the stream goes on; such a time is an error naming the line. JSON nested 100,000 deep too."""
+    lines = (data / "frames.jsonl").read_text().splitlines()
+    first, second = json.loads(lines[0]), json.loads(lines[1])
+    for digits in (400, 5000):
+        huge = "9" * digits
+        text = lines[0] + "\n" + json.dumps(second).replace(json.dumps(second["head"]), f"[{huge}, 0, 0]", 1) + "\n"
+        frames = _live(data, text)
+        assert len(frames) == 2 and np.isfinite(frames[0]).all()
+        parts = list(load_profile(data / "profile.toml").body.parts)
+        assert [parts[k] for k in np.flatnonzero(~np.isfinite(frames[1]).all(axis=-1))] == ["head"]
+        with pytest.raises(ConfigError, match="-:2: time inf; expected a finite time in seconds"):
+            _live(data, lines[0] + "\n" + json.dumps({**first, "time": "@"}).replace('"@"', huge) + "\n")
+    with pytest.raises(ConfigError, match="-:1: JSON nested too deeply"):
+        _live(data, '{"time": ' + "[" * 100_000 + "]" * 100_000 + "}\n")

@@ -361,7 +361,7 @@ def test_npy_errors(tmp_path):
                                           r"joints, 3\) of numbers"):
         read_positions(tmp_path / "flat.npy", names=["a", "b"], fps=30)
     np.save(tmp_path / "obj.npy", np.array([[["a", 1, 2]]], dtype=object), allow_pickle=True)
-    with pytest.raises(ConfigError, match=r"obj.npy: not a readable .npy array \(.*Python objects"):
+    with pytest.raises(ConfigError, match=r"obj.npy: array of dtype object \(Python objects, which likeme never "):
         read_positions(tmp_path / "obj.npy", names=["a"], fps=30)
     np.save(tmp_path / "text.npy", np.array([[["a", "b", "c"]]]))
     with pytest.raises(ConfigError, match=r"text.npy: array of dtype <U1"):
@@ -379,15 +379,66 @@ def test_npy_errors(tmp_path):
         read_positions(tmp_path / "ok.npy", names="ab", fps=30)
     data = (tmp_path / "ok.npy").read_bytes()
     (tmp_path / "short.npy").write_bytes(data[:-8])
-    with pytest.raises(ConfigError, match=r"short.npy: not a readable .npy array"):
+    with pytest.raises(ConfigError, match=r"short.npy: a header declaring the shape \(5, 2, 3\) of float64 \(240 "
+                                          r"bytes\) on 232 bytes of data"):
         read_positions(tmp_path / "short.npy", names=["a", "b"], fps=30)
     np.savez(tmp_path / "z.npz", a=np.zeros((1, 1, 3)))
     (tmp_path / "z.npz").rename(tmp_path / "z.npy")
-    with pytest.raises(ConfigError, match=r"z.npy: not a readable .npy array \(the magic string is not correct"):
+    with pytest.raises(ConfigError, match=r"z.npy: a .npz archive \(zip\), not a .npy array"):
         read_positions(tmp_path / "z.npy", names=["a"], fps=30)
     (tmp_path / "empty.npy").write_bytes(b"")
-    with pytest.raises(ConfigError, match=r"empty.npy: not a readable .npy array"):
+    with pytest.raises(ConfigError, match=r"empty.npy: not a .npy file \(no NumPy header\)"):
         read_positions(tmp_path / "empty.npy", names=["a"], fps=30)
+
+
+def _npy_header(shape, *, version=(1, 0), descr="<f8", data=b"\0" * 264):
+    """A .npy file's bytes: a header declaring ``shape`` (any numbers: hostile ones too), then ``data``."""
+    import io
+
+    header = {"descr": descr, "fortran_order": False, "shape": shape}
+    buffer = io.BytesIO()
+    (np.lib.format.write_array_header_1_0 if version == (1, 0) else np.lib.format.write_array_header_2_0)(buffer, header)
+    return buffer.getvalue() + data
+
+
+@pytest.mark.parametrize("name, content, message", [
+    ("big63.npy", _npy_header((2**63, 11, 3)), r"a header declaring the shape \(9223372036854775808, 11, 3\) of "
+                                              r"float64 \(2,434,970,217,729,660,813,312 bytes\) on 264 bytes of data"),
+    ("big30.npy", _npy_header((10**30, 11, 3)), r"the shape \(a number of 31 digits, 11, 3\) of float64"),
+    ("negative.npy", _npy_header((-1, 11, 3)), r"a header declaring the shape \(-1, 11, 3\); expected a NumPy array"),
+    ("gib4.npy", _npy_header((2**32 // 264, 11, 3), version=(2, 0)), r"\(4,294,967,160 bytes\) on 264 bytes of data"),
+    ("objects.npy", _npy_header((2, 11, 3), descr="|O"), r"array of dtype object \(Python objects"),
+    ("text-shape.npy", _npy_header(("a", 11, 3)), r"not a readable .npy header \(shape is not valid: \('a', 11, 3\)"),
+    ("npz.npy", None, r"a .npz archive \(zip\), not a .npy array"),
+])
+def test_a_hostile_npy_header_is_one_line_naming_the_file_and_nothing_is_mapped(tmp_path, name, content, message):
+    """Shapes past any size, negative or not numbers, a header declaring gigabytes on a small file, an archive
+    named .npy: each refused from the header, checked against the file's size, before any data is mapped; by the
+    reader and by ``likeme validate`` (with and without a profile)."""
+    from likeme.cli import main
+
+    path = tmp_path / name
+    if content is None:
+        np.savez(tmp_path / "a.npz", a=np.zeros((2, 11, 3)))
+        (tmp_path / "a.npz").rename(path)
+    else:
+        path.write_bytes(content)
+    tracemalloc.start()
+    try:
+        with pytest.raises(ConfigError, match=message) as info:
+            read_positions(path, names=[f"j{k}" for k in range(11)], fps=30)
+        assert tracemalloc.get_traced_memory()[1] < 2**20
+    finally:
+        tracemalloc.stop()
+    assert str(info.value).startswith(str(path)) and "\n" not in str(info.value)
+    import contextlib
+    import io
+
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        status = main(["validate", "--fps", "30", str(path)])
+    assert status == 1 and err.getvalue().count("\n") == 1, err.getvalue()
+    assert err.getvalue().startswith(f"likeme: error: {path}: "), err.getvalue()
 
 
 # -- files that are not regular files ---------------------------------------------------------------
