@@ -9,9 +9,10 @@ gives the bits the reference gives. Every caller keeps a numpy path for when :fu
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import cache
 from typing import Any
 
-__all__ = ["compiled", "compiled_now", "one_thread"]
+__all__ = ["compiled", "compiled_now", "kernel", "one_thread"]
 
 
 def compiled(*functions: Callable[..., Any], reordered: bool = False) -> tuple[Callable[..., Any], ...] | None:
@@ -45,6 +46,14 @@ def compiled_now(function: Callable[..., Any], *example: Any) -> Callable[..., A
     kernel(*example)
     return kernel
 
+
+
+@cache
+def kernel(function: Callable[..., Any], reordered: bool = False) -> Callable[..., Any]:
+    """``function`` compiled by numba (:func:`compiled`) the first time it is asked for, the same compiled function
+    every time after; ``function`` itself without numba (a loop whose plain Python is its own fallback)."""
+    found = compiled(function, reordered=reordered)
+    return found[0] if found is not None else function
 
 _CONTROLLER = None
 

@@ -50,6 +50,7 @@ from typing import ClassVar
 import numpy as np
 
 from plugins.lib.body_size import body_scale
+from plugins.lib.compiled import kernel
 from plugins.lib.root_frame import root_relative, smooth_heading
 from plugins.lib.travel import body_velocity, turned
 from plugins.lib.velocity import derivative
@@ -154,7 +155,7 @@ class Comparison(ABC):
         A pair with no part seen in both costs 0 (no evidence either way). Compiled (:func:`_eq1`)."""
         out = np.empty((len(a), len(b)))
         if out.size:
-            _kernel()(np.ascontiguousarray(a.parts, dtype=np.float64), a.seen, np.ascontiguousarray(a.carry,
+            kernel(_eq1)(np.ascontiguousarray(a.parts, dtype=np.float64), a.seen, np.ascontiguousarray(a.carry,
                       dtype=np.float64), a.carried, np.ascontiguousarray(b.parts, dtype=np.float64), b.seen,
                       np.ascontiguousarray(b.carry, dtype=np.float64), b.carried, out)
         return out
@@ -169,7 +170,8 @@ class Comparison(ABC):
 def _eq1(a, a_seen, a_carry, a_carried, b, b_seen, b_carry, b_carried, out):
     """eq. 1 of every frame pair: ``out[i, j]`` the mean over the parts seen in both of the Euclidean norm of the
     part's difference, the carries' difference (where both are known) added to each part's squared norm; 0 where
-    no part is seen in both. Plain Python as written (the reference), compiled by :func:`_kernel`."""
+    no part is seen in both. Plain Python as written (the reference), compiled by
+    :func:`~plugins.lib.compiled.kernel`."""
     n, parts, dims = a.shape
     m = b.shape[0]
     width = a_carry.shape[1]
@@ -191,20 +193,6 @@ def _eq1(a, a_seen, a_carry, a_carried, b, b_seen, b_carry, b_carried, out):
                     total += np.sqrt(sq)
                     count += 1
             out[i, j] = total / count if count else 0.0
-
-
-_compiled = None
-
-
-def _kernel():
-    """:func:`_eq1` compiled by numba (:func:`plugins.lib.compiled.compiled`), or the reference without it."""
-    global _compiled
-    if _compiled is None:
-        from plugins.lib.compiled import compiled
-
-        found = compiled(_eq1)
-        _compiled = found[0] if found is not None else _eq1
-    return _compiled
 
 
 class Poses(Comparison):
@@ -300,9 +288,9 @@ class Motion(Comparison):
         if out.size and a.seen.all() and b.seen.all():  # every part seen: one contiguous run of numbers a frame
             flat_a, carry_a = a.flat
             flat_b, carry_b = b.flat
-            _full_kernel()(flat_a, carry_a, flat_b, carry_b, a.parts.shape[1], out)
+            kernel(_rms_full, reordered=True)(flat_a, carry_a, flat_b, carry_b, a.parts.shape[1], out)
         elif out.size:
-            _rms_kernel()(np.ascontiguousarray(a.parts, dtype=np.float64), a.seen,
+            kernel(_rms)(np.ascontiguousarray(a.parts, dtype=np.float64), a.seen,
                           np.ascontiguousarray(np.where(a.carried[:, None], a.carry, 0.0)), a.carried,
                           np.ascontiguousarray(b.parts, dtype=np.float64), b.seen,
                           np.ascontiguousarray(np.where(b.carried[:, None], b.carry, 0.0)), b.carried, out)
@@ -366,7 +354,7 @@ def _held(positions: np.ndarray, seen: np.ndarray) -> np.ndarray:
 def _rms(a, a_seen, a_carry, a_carried, b, b_seen, b_carry, b_carried, out):
     """:meth:`Motion.costs` of every frame pair, pair by pair: ``out[i, j]`` the root of the mean over the parts seen
     in both of each part's squared difference plus the carries' (where both are known); 0 where no part is seen in
-    both. Plain Python as written (the reference), compiled by :func:`_rms_kernel`."""
+    both. Plain Python as written (the reference), compiled by :func:`~plugins.lib.compiled.kernel`."""
     n, parts, dims = a.shape
     m = b.shape[0]
     width = a_carry.shape[1]
@@ -394,7 +382,8 @@ def _rms_full(a, a_carry, b, b_carry, parts, out):
     """:func:`_rms` where every part is seen in both: ``a`` (n, P * D) and ``b`` (m, P * D) a frame's features in
     one run, the carries with a last column of 1 where known (:attr:`Frames.flat`). The same numbers as
     :func:`_rms` up to the order of the sums, which the compiled loop takes side by side (the same order at every
-    call: a row's numbers do not depend on the rows beside it). Plain Python, compiled by :func:`_full_kernel`."""
+    call: a row's numbers do not depend on the rows beside it). Plain Python, compiled by
+    :func:`~plugins.lib.compiled.kernel`."""
     n, width = a.shape
     m = b.shape[0]
     c = a_carry.shape[1] - 1
@@ -410,34 +399,6 @@ def _rms_full(a, a_carry, b, b_carry, parts, out):
                     d = a_carry[i, k] - b_carry[j, k]
                     carry += d * d
             out[i, j] = np.sqrt(np.float64(sq) / parts + np.float64(carry))
-
-
-_full_compiled = None
-
-
-def _full_kernel():
-    """:func:`_rms_full` compiled by numba, or the reference without it."""
-    global _full_compiled
-    if _full_compiled is None:
-        from plugins.lib.compiled import compiled
-
-        found = compiled(_rms_full, reordered=True)
-        _full_compiled = found[0] if found is not None else _rms_full
-    return _full_compiled
-
-
-_rms_compiled = None
-
-
-def _rms_kernel():
-    """:func:`_rms` compiled by numba (:func:`plugins.lib.compiled.compiled`), or the reference without it."""
-    global _rms_compiled
-    if _rms_compiled is None:
-        from plugins.lib.compiled import compiled
-
-        found = compiled(_rms)
-        _rms_compiled = found[0] if found is not None else _rms
-    return _rms_compiled
 
 
 def sequence_size(poses: np.ndarray, seen: np.ndarray) -> float:

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from plugins.lib.compiled import compiled
+from plugins.lib.compiled import kernel
 from plugins.matchers.comparison import Comparison, Frames
 
 __all__ = ["Chains", "Warping", "chain_distances", "chain_path"]
@@ -73,7 +73,7 @@ def _warp(cost, starts, cyclic, best, end):
     begins at any node with the first sample and ends at any node with the last (``best[c]``) and the column it
     ends in (``end[c]``). Steps: (i-1, j-1), (i-1, j), (i, j-1); a cyclic chain's first node also follows its
     last. Ties keep the diagonal, then the vertical step. Plain Python as written (the reference), compiled by
-    :func:`_kernel`."""
+    :func:`plugins.lib.compiled.kernel`."""
     n = cost.shape[0]
     for c in range(len(starts) - 1):
         a = starts[c]
@@ -125,17 +125,6 @@ def _warp(cost, starts, cyclic, best, end):
         end[c] = chosen
 
 
-_compiled = None
-
-
-def _kernel():
-    global _compiled
-    if _compiled is None:
-        found = compiled(_warp)
-        _compiled = found[0] if found is not None else _warp
-    return _compiled
-
-
 def chain_distances(comparison: Comparison, samples: Frames, nodes: Frames, chains: Chains,
                     skip: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray | None]:
     """Each chain's distance to the samples (C,): its best path's summed frame distance over the path's length;
@@ -158,7 +147,7 @@ def chain_distances(comparison: Comparison, samples: Frames, nodes: Frames, chai
     cost = np.ascontiguousarray(cost, dtype=np.float64)
     found = np.empty(len(starts) - 1)
     end = np.empty(len(starts) - 1, dtype=np.intp)
-    _kernel()(cost, starts, cyclic, found, end)
+    kernel(_warp)(cost, starts, cyclic, found, end)
     best[keep] = found
     return best, cost
 
@@ -166,7 +155,7 @@ def chain_distances(comparison: Comparison, samples: Frames, nodes: Frames, chai
 def _warp_path(cost, cyclic, out):
     """The warping of :func:`_warp` on one chain (``cost`` (n, m)), its steps kept and followed back from the best
     end: ``out[i]`` the column the sample ``i`` was last aligned with. Plain Python as written, compiled by
-    :func:`_path_kernel`."""
+    :func:`plugins.lib.compiled.kernel`."""
     n, m = cost.shape
     total = np.empty((n, m))
     length = np.empty((n, m))
@@ -226,24 +215,13 @@ def _warp_path(cost, cyclic, out):
             j = j - 1 if j > 0 else m - 1
 
 
-_compiled_path = None
-
-
-def _path_kernel():
-    global _compiled_path
-    if _compiled_path is None:
-        found = compiled(_warp_path)
-        _compiled_path = found[0] if found is not None else _warp_path
-    return _compiled_path
-
-
 def chain_path(cost: np.ndarray, chains: Chains, c: int) -> np.ndarray:
     """The node indices of chain ``c``'s best path, one per sample (the node each sample was last aligned with),
     found by the same warping as :func:`chain_distances` with its steps kept and followed back; ``cost``: the frame
     distances :func:`chain_distances` returned (every chain kept)."""
     block = np.ascontiguousarray(cost[:, chains.starts[c] : chains.starts[c + 1]])
     out = np.empty(len(block), dtype=np.intp)
-    _path_kernel()(block, bool(chains.cyclic[c]), out)
+    kernel(_warp_path)(block, bool(chains.cyclic[c]), out)
     return chains.chain(c)[out]
 
 
@@ -252,7 +230,7 @@ def _advance(cost, starts, cyclic, total, length, fresh, means, ends):
     ``length`` (M,) after the samples before them (``fresh``: none yet). After each sample, each chain's best
     summed cost over its path's length so far, and the column it ends in, go into ``means`` and ``ends`` (r, C).
     ``total`` and ``length`` are left as the state after the last sample. Plain Python, compiled by
-    :func:`_advance_kernel`."""
+    :func:`plugins.lib.compiled.kernel`."""
     rows = cost.shape[0]
     width = total.shape[0]
     now = np.empty(width)
@@ -304,17 +282,6 @@ def _advance(cost, starts, cyclic, total, length, fresh, means, ends):
             length[k] = now_len[k]
 
 
-_compiled_advance = None
-
-
-def _advance_kernel():
-    global _compiled_advance
-    if _compiled_advance is None:
-        found = compiled(_advance)
-        _compiled_advance = found[0] if found is not None else _advance
-    return _compiled_advance
-
-
 class Warping:
     """The warping of a demonstration against every chain, advanced sample by sample as the demonstration comes in
     (:func:`chain_distances` of the samples so far, after each sample, without warping them again).
@@ -342,7 +309,7 @@ class Warping:
         if len(samples) and len(self.frames):
             # pair by pair: the same numbers whatever the samples come in (row_costs)
             cost = self.comparison.row_costs(samples, self.frames)
-            _advance_kernel()(cost, self.chains.starts, self.chains.cyclic, self.total, self.length,
+            kernel(_advance)(cost, self.chains.starts, self.chains.cyclic, self.total, self.length,
                               self.samples == 0, means, ends)
             rows, chains = np.nonzero(ends >= 0)
             local[rows, chains] = cost[rows, self.chains.starts[:-1][chains] + ends[rows, chains]]

@@ -14,7 +14,8 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from plugins.matchers.path_search.per_movement import posegraph_chains
-from plugins.matchers.warping import _kernel, _path_kernel, _warp, _warp_path
+from plugins.lib.compiled import kernel
+from plugins.matchers.warping import _warp, _warp_path
 from tests.plugins.matchers.path_search.stick import FPS, STICK, observed
 from toolkit import Motion, load_character
 
@@ -101,11 +102,11 @@ def test_the_compiled_warping_is_the_reference_and_its_path_ends_where_the_best_
     starts = np.array([0, cost.shape[1]], dtype=np.intp)
     got, want = np.empty(1), np.empty(1)
     end_got, end_want = np.empty(1, dtype=np.intp), np.empty(1, dtype=np.intp)
-    _kernel()(cost, starts, np.array([cyclic]), got, end_got)
+    kernel(_warp)(cost, starts, np.array([cyclic]), got, end_got)
     _warp(cost, starts, np.array([cyclic]), want, end_want)
     assert got[0] == want[0] and end_got[0] == end_want[0]
     out, ref = np.empty(len(cost), dtype=np.intp), np.empty(len(cost), dtype=np.intp)
-    _path_kernel()(cost, cyclic, out)
+    kernel(_warp_path)(cost, cyclic, out)
     _warp_path(cost, cyclic, ref)
     assert out.tolist() == ref.tolist()
     assert ((0 <= out) & (out < cost.shape[1])).all()
