@@ -27,8 +27,9 @@ import numpy as np
 
 from plugins.lib.compiled import kernel
 from plugins.matchers.comparison import Comparison, Frames
+from plugins.matchers.decision import Calibration
 
-__all__ = ["Chains", "Warping", "chain_distances", "chain_path"]
+__all__ = ["Chains", "Warping", "chain_calibration", "chain_distances", "chain_path"]
 
 
 @dataclass(frozen=True)
@@ -213,6 +214,25 @@ def _warp_path(cost, cyclic, out):
             i -= 1
         else:
             j = j - 1 if j > 0 else m - 1
+
+
+def chain_calibration(comparison: Comparison, takes: list[Frames], nodes: Frames, chains: Chains) -> Calibration:
+    """The calibrated decision's scores from the takes themselves (:class:`~plugins.matchers.decision.Calibration`):
+    each take (chain ``c`` is ``takes[c]``) warped against its movement's other takes (leave one take out) and
+    against the other movements (leave one movement out), each nearest distance over the take's distance to
+    standing still."""
+    own, other = [], []
+    movements = np.asarray(chains.movements, dtype=object)
+    for c, take in enumerate(takes):
+        skip = np.zeros(len(chains), dtype=bool)
+        skip[c] = True
+        distances, _ = chain_distances(comparison, take, nodes, chains, skip)
+        still = float(np.mean(comparison.still(take)))
+        mine = movements == movements[c]
+        for out, chosen in ((own, mine & ~skip), (other, ~mine)):
+            if chosen.any():
+                out.append(float(distances[chosen].min()) / still if still > 0 else np.inf)
+    return Calibration.of(own, other)
 
 
 def chain_path(cost: np.ndarray, chains: Chains, c: int) -> np.ndarray:

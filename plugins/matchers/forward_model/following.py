@@ -45,7 +45,7 @@ from plugins.lib.root_frame import HeadingFilter, facing_heading, to_root_relati
 from plugins.lib.velocity import SMOOTHING, derivative
 from plugins.matchers.comparison import Frames, Motion
 from plugins.matchers.decision import Calibrated, Calibration, Decision
-from plugins.matchers.warping import Chains, Warping, chain_distances
+from plugins.matchers.warping import Chains, Warping, chain_calibration
 from toolkit import Match
 from toolkit import Motion as Recording
 
@@ -306,20 +306,9 @@ class Following:
     def calibration(self) -> Calibration:
         """Each take's prediction as a demonstration: against its movement's other takes and without its movement."""
         p = self.prediction
-        own, other = [], []
         if p.frames is None:
             return Calibration()
-        movements = np.asarray(p.chains.movements, dtype=object)
-        for c, take in enumerate(p.takes):
-            skip = np.zeros(len(p.chains), dtype=bool)
-            skip[c] = True
-            distances, _ = chain_distances(self.comparison, take, p.frames, p.chains, skip)
-            still = float(np.mean(self.comparison.still(take)))
-            mine = movements == movements[c]
-            for out, chosen in ((own, mine & ~skip), (other, ~mine)):
-                if chosen.any():
-                    out.append(float(distances[chosen].min()) / still if still > 0 else np.inf)
-        return Calibration.of(own, other)
+        return chain_calibration(self.comparison, p.takes, p.frames, p.chains)
 
     # -- following a demonstration ------------------------------------------------------------
 

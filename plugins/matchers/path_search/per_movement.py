@@ -21,7 +21,7 @@ import numpy as np
 from plugins.matchers.comparison import Frames
 from plugins.matchers.decision import Calibration
 from plugins.matchers.path_search.search import Found, Search
-from plugins.matchers.warping import Chains, chain_distances, chain_path
+from plugins.matchers.warping import Chains, chain_calibration, chain_distances, chain_path
 
 __all__ = ["EachMovement", "posegraph_chains"]
 
@@ -67,18 +67,5 @@ class EachMovement(Search):
         path = chain_path(cost, self.chains, best)
         return Found(ranked[0][0], path, 1.0, ranked, {"mean_distance": ranked[0][1], "samples": len(samples)})
 
-    def calibration(self):
-        m = self.matcher
-        own, other = [], []
-        movements = np.asarray(self.chains.movements, dtype=object)
-        for c, take in enumerate(self.takes):
-            skip = np.zeros(len(self.chains), dtype=bool)
-            skip[c] = True
-            distances, _ = chain_distances(m.comparison, take, self.nodes, self.chains, skip)
-            still = float(np.mean(m.comparison.still(take)))
-            mine = movements == movements[c]
-            for out, chosen in ((own, mine & ~skip), (other, ~mine)):
-                if chosen.any():
-                    d = float(distances[chosen].min())
-                    out.append(d / still if still > 0 else np.inf)
-        return Calibration.of(own, other)
+    def calibration(self) -> Calibration:
+        return chain_calibration(self.matcher.comparison, self.takes, self.nodes, self.chains)
