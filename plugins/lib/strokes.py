@@ -27,8 +27,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from plugins.lib.compiled import compiled
+from toolkit import Parameter
 
-__all__ = ["StrokeCriteria", "StrokeAnalysis", "analyse", "breaks", "held", "speed_breaks", "direction_clusters",
+__all__ = ["STROKE_PARAMETERS", "StrokeCriteria", "StrokeAnalysis", "analyse", "breaks", "held", "speed_breaks", "direction_clusters",
            "direction_breaks"]
 
 
@@ -48,6 +49,16 @@ class StrokeCriteria:
     corner: float = 0.9
     min_stroke: float = 0.15
     smooth: float = 0.2
+
+
+STROKE_PARAMETERS = (
+    Parameter("drop", float, StrokeCriteria.drop, "Speed-minimum criterion of the stroke segmentation.",
+              minimum=0.0, maximum=1.0),
+    Parameter("angle", float, StrokeCriteria.angle, "Direction criterion (degrees) of the stroke segmentation.",
+              minimum=1.0, maximum=180.0),
+)
+"""The criteria a component cutting movements into strokes lets a user set, as its ``strokes`` table (the forward
+model's learning by watching, the motor command graph's clips)."""
 
 
 def speed_breaks(speed: np.ndarray, drop: float, moving: float = 0.0) -> list[int]:

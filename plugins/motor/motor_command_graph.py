@@ -44,7 +44,7 @@ from plugins.lib.clip_repertoire import CLIP_PARAMETERS, example_name, repertoir
 from plugins.lib.guiding_stroke import GuidingStroke, progress
 from plugins.lib.hand_transition import HandTransition
 from plugins.lib.inverse_model import commands_from_segment
-from plugins.lib.strokes import StrokeCriteria, breaks
+from plugins.lib.strokes import STROKE_PARAMETERS, StrokeCriteria, breaks
 from plugins.lib.travel import body_velocity, turned
 from plugins.motor.key_poses import parse_poses
 from toolkit import ConfigError, Motion, MotorSystem, Parameter, hookimpl
@@ -160,12 +160,7 @@ class MotorCommandGraph(MotorSystem):
                   "Shoulder, elbow, wrist triples whose elbow follows the wrist by inverse kinematics."),
         *CLIP_PARAMETERS,
         Parameter("strokes", doc="With clips: how each clip is cut into guiding strokes, one command each (K&G "
-                  "§4.3; plugins.lib.strokes).", parameters=(
-                      Parameter("drop", float, 0.5, "Speed-minimum criterion of the stroke segmentation.",
-                                minimum=0.0, maximum=1.0),
-                      Parameter("angle", float, 50.0, "Direction criterion (degrees) of the stroke segmentation.",
-                                minimum=1.0, maximum=180.0),
-                  )),
+                  "§4.3; plugins.lib.strokes).", parameters=STROKE_PARAMETERS),
     )
 
     def attach(self, owner: Any) -> None:

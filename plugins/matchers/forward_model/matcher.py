@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from plugins.lib.strokes import StrokeCriteria
+from plugins.lib.strokes import STROKE_PARAMETERS, StrokeCriteria
 from plugins.matchers.forward_model.anchors import Anchors
 from plugins.matchers.forward_model.command_graphs import CommandGraphs
 from plugins.matchers.decision import Calibrated
@@ -78,12 +78,7 @@ class ForwardModel(Matcher):
                   "baseline): an edge predicts at the time elapsed, at the speed it was learned, so a familiar "
                   "movement at another speed is learned as new."),
         Parameter("strokes", doc="How a movement learned by watching is cut into strokes, one edge each (K&G §4.3; "
-                  "plugins.lib.strokes).", parameters=(
-                      Parameter("drop", float, 0.5, "Speed-minimum criterion of the stroke segmentation.",
-                                minimum=0.0, maximum=1.0),
-                      Parameter("angle", float, 50.0, "Direction criterion (degrees) of the stroke segmentation.",
-                                minimum=1.0, maximum=180.0),
-                  )),
+                  "plugins.lib.strokes).", parameters=STROKE_PARAMETERS),
     )
 
     streaming = True
