@@ -37,6 +37,10 @@ chosen once when a matcher is attached (``decision = "distance"`` or ``"calibrat
     one as near to a known movement as the repertoire's own movements are to each other cannot be told from a
     performance of it (``docs/matchers.md`` has the figures).
 
+A movement that holds still (a pose held, B&B §5.2.1's hub; a command with no guiding stroke, K&G §4.1) cannot be
+judged by a score relative to standing still: it *is* standing still, so every demonstration scores 1 against it
+whether it stands or waves. :class:`Stillness` judges it by how much the demonstration moves instead.
+
 The decision's answer, with the score and the threshold it was decided on, goes into the typed fields of
 :class:`toolkit.Match` (``score``, ``threshold``, ``nearest``, ``measure``), which ``likeme observe`` prints for
 every "unknown".
@@ -50,7 +54,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Calibrated", "Calibration", "DECISIONS", "Decision", "Distance", "Verdict"]
+__all__ = ["Calibrated", "Calibration", "DECISIONS", "Decision", "Distance", "Stillness", "Verdict"]
 
 
 @dataclass(frozen=True)
@@ -168,6 +172,43 @@ class Calibrated(Decision):
         scores = [np.asarray(s) for s in (self.calibration.own, self.calibration.other) if len(s)]
         limits = [float(np.quantile(s, 1.0 - self.known_rejected)) for s in scores]
         return min(max(limits), STILL) if limits else STILL
+
+
+@dataclass(frozen=True)
+class Stillness:
+    """The repertoire's movements that hold still, and how little a demonstration must move to be one of them.
+
+    Each movement's *motion* is the mean distance to standing still of its takes (the largest of them;
+    :meth:`plugins.matchers.comparison.Comparison.still`, in the comparison's unit). A movement whose takes do not
+    move at all (0, up to rounding) holds still. A demonstration that moves ``moved`` is such a movement when it
+    moves at most half as much as the least moving of the other movements (:attr:`limit`): then, by the triangle
+    inequality, no moving movement can come nearer to it than standing still does, so the still movement is the
+    nearest there is and the relative score, which is 1 for it whatever the demonstration, has nothing to add. No
+    still movement in the repertoire: nothing holds (:attr:`limit` 0).
+    """
+
+    still: frozenset[str] = frozenset()
+    limit: float = 0.0
+
+    ROUNDING = 1e-9
+    """A take's motion at most this (in the comparison's unit, a body size or a metre) is no motion at all."""
+
+    @classmethod
+    def of(cls, motion: dict[str, float]) -> Stillness:
+        """From each movement's motion (the largest of its takes')."""
+        still = frozenset(m for m, a in motion.items() if a <= cls.ROUNDING)
+        moving = [a for m, a in motion.items() if m not in still]
+        if not still:
+            return cls()
+        return cls(still, min(moving) / 2.0 if moving else float("inf"))
+
+    @property
+    def measure(self) -> str:
+        return "the demonstration's distance to standing still, at most half the least moving movement's"
+
+    def holds(self, nearest: str | None, moved: float) -> bool:
+        """Whether a demonstration that moved ``moved`` and came nearest to ``nearest`` is that still movement."""
+        return nearest in self.still and moved <= self.limit
 
 
 STILL = 1.0

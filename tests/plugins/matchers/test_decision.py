@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from plugins.matchers.decision import Calibrated, Calibration, Distance
+from plugins.matchers.decision import Calibrated, Calibration, Distance, Stillness
 from plugins.matchers.warping import chain_distances
 from toolkit import load_character
 from toolkit.observe import Observer, compose_observer
@@ -141,3 +141,14 @@ def test_with_two_takes_the_own_takes_count_too(generated, tmp_path):
     demos = sorted((folder / "demos").glob("*/*.bvh"))
     right = [observer.classify(profile.read(p, None)).movement == p.parent.name for p in demos]
     assert np.mean(right) >= 0.9
+
+
+def test_stillness_holds_half_way_to_the_least_moving_movement():
+    """A movement that does not move at all holds still; a demonstration is it when it moves at most half as much
+    as the least moving other movement (no moving one can then come nearer than standing still)."""
+    s = Stillness.of({"stand": 0.0, "nod": 0.3, "wave": 0.9, "sway": 1e-12})
+    assert s.still == {"stand", "sway"} and s.limit == pytest.approx(0.15)
+    assert s.holds("stand", 0.15) and not s.holds("stand", 0.151) and not s.holds("nod", 0.0)
+    assert not Stillness.of({"nod": 0.3, "wave": 0.9}).holds("nod", 0.0)
+    assert Stillness.of({"stand": 0.0}).holds("stand", 5.0)  # nothing moving to be nearer
+    assert not Stillness().holds(None, 0.0)
