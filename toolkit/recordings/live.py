@@ -78,11 +78,12 @@ class LiveInput:
             positions, seen_keys = self._json(first)
             names = [k for k in seen_keys if k != "time"]
             profile.check(_Header(names))  # the first frame names every mapped joint (null when not seen)
+            self.profile = profile.for_names(names, self.path)  # each part's alias the input uses, from frame 2
             self._pending.append(positions)
         else:
             self.kind = "csv"
             self._layout = parse_header(first + "\n", self.path, None)
-            profile.check(_Header(list(self._layout.joints)))
+            self.profile = profile.for_names(list(self._layout.joints), self.path)  # aliases chosen once
         if self.fps is None:
             while len(self._pending) < 2:
                 frame = self._next_frame()
