@@ -16,7 +16,10 @@ Several naming schemes of one skeleton share a profile: a part may name a list o
 of them that a file has is the part's joint in that file (``left_hip = ["LeftUpLeg", "LeftHip"]``). Recordings
 that need other units, another up axis or other joints have a ``[files."PATTERN"]`` table, matched against each
 recording's path (:meth:`BodyProfile.for_file`): a profile per folder or per file, the body (parts, root, facing,
-bones) staying the profile's own.
+bones) staying the profile's own. A part with no joint of its own (MediaPipe's pelvis) is the mean of several:
+``root = {mean = ["left_hip", "right_hip"]}``. ``floor`` (metres, in likeme's frame) is the height of the floor in a
+recording whose origin is not on it (a camera's frame: Kinect, MediaPipe); it is subtracted so that the body stands
+on ``y = 0``.
 
 Example (the Bandai-Namco skeleton, ``characters/profiles/bandai-namco.toml``)::
 
@@ -38,7 +41,7 @@ Example (the Bandai-Namco skeleton, ``characters/profiles/bandai-namco.toml``)::
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path, PurePath
 from typing import Any
@@ -55,7 +58,8 @@ from toolkit.recordings.csv_positions import has_header
 from toolkit.recordings.recording import FPS_RANGE, MIN_FPS
 from toolkit.recordings.bvh import BVH
 
-__all__ = ["BodyProfile", "FileRule", "MotionStream", "is_profile", "load_profile", "UNITS", "UP_AXES"]
+__all__ = ["BodyProfile", "FileRule", "Joint", "MotionStream", "is_profile", "joint_names", "joint_text", "load_profile", "UNITS",
+           "UP_AXES"]
 
 UNITS: dict[str, float] = {"metre": 1.0, "meter": 1.0, "m": 1.0, "centimetre": 0.01, "centimeter": 0.01, "cm": 0.01,
                            "millimetre": 0.001, "millimeter": 0.001, "mm": 0.001, "inch": 0.0254, "in": 0.0254,
@@ -72,9 +76,26 @@ UP_AXES: dict[str, np.ndarray] = {
 }
 """Rotations taking a source whose up axis is the key to likeme's ``+y`` up (right-handed, proper rotations)."""
 
-_PROFILE_KEYS = ("name", "description", "units", "up", "fps", "joints")
+_PROFILE_KEYS = ("name", "description", "units", "up", "fps", "joints", "floor")
 _TABLES = ("profile", "parts", "facing", "bones", "colours", "files")
-_FILE_KEYS = ("units", "up", "fps", "joints", "parts")
+_FILE_KEYS = ("units", "up", "fps", "joints", "floor", "parts")
+
+Joint = str | tuple[str, ...]
+"""A part's source in a file: a joint's name, or a tuple of names whose mean is the part (``{mean = [...]}``)."""
+
+
+def joint_text(joint: Joint) -> str:
+    """A part's source as an error message names it: ``'Hips'`` or ``the mean of 'left_hip', 'right_hip'``."""
+    return repr(joint) if isinstance(joint, str) else "the mean of " + ", ".join(map(repr, joint))
+
+
+def joint_names(joints: Iterable[Joint]) -> list[str]:
+    """The file's joints that ``joints`` read, each once, in order (the joints of a mean in their order)."""
+    out: dict[str, None] = {}
+    for j in joints:
+        out.update(dict.fromkeys((j,) if isinstance(j, str) else j))
+    return list(out)
+
 """The keys of a ``[files."PATTERN"]`` table: how its recordings are read (the body is the profile's)."""
 
 
@@ -93,7 +114,8 @@ class FileRule:
     up: str | None = None
     fps: float | None = None
     array_joints: tuple[str, ...] | None = None
-    parts: tuple[tuple[str, tuple[str, ...]], ...] = ()
+    floor: float | None = None
+    parts: tuple[tuple[str, tuple[Joint, ...]], ...] = ()
 
     def matches(self, path: str | Path) -> bool:
         return PurePath(path).match(self.pattern)
@@ -123,9 +145,12 @@ class BodyProfile:
         The joints of a ``.npy`` array or a CSV without a header, in the file's order (the ``[profile]`` table's
         ``joints`` key); without it, such a file's joints are the mapped joints, in the order of ``[parts]`` (each
         once).
-    aliases : tuple of tuple of str, or None
+    aliases : tuple of tuple of Joint, or None
         Each part's joint names in order of preference (``joints`` holds the first of each): the first that a file
-        has is the part's joint in that file. None: one name per part, ``joints``.
+        has is the part's joint in that file. None: one name per part, ``joints``. A tuple among them is a mean of
+        joints (:data:`Joint`).
+    floor : float
+        The height (metres, likeme's frame) of the floor in the recordings: subtracted from every ``y``.
     files : tuple of FileRule
         The ``[files]`` tables, in the order written: the first whose pattern matches a recording's path says how
         it is read (:meth:`for_file`).
@@ -133,20 +158,21 @@ class BodyProfile:
 
     name: str
     body: Body
-    joints: tuple[str, ...]
+    joints: tuple[Joint, ...]
     scale: float = 1.0
     up: str = "+y"
     file: Path | None = None
     description: str = ""
     fps: float | None = None
     array_joints: tuple[str, ...] | None = None
-    aliases: tuple[tuple[str, ...], ...] | None = None
+    aliases: tuple[tuple[Joint, ...], ...] | None = None
     files: tuple[FileRule, ...] = ()
+    floor: float = 0.0
     rule: FileRule | None = None
     """The ``[files]`` table this profile was made for by :meth:`for_file` (None: the profile's own)."""
 
     @property
-    def names(self) -> tuple[tuple[str, ...], ...]:
+    def names(self) -> tuple[tuple[Joint, ...], ...]:
         """Each part's joint names, in order of preference (the first that a file has wins)."""
         return self.aliases if self.aliases is not None else tuple((j,) for j in self.joints)
 
@@ -163,19 +189,21 @@ class BodyProfile:
         return replace(self, joints=tuple(a[0] for a in aliases), aliases=aliases,
                        scale=self.scale if rule.scale is None else rule.scale, up=rule.up or self.up,
                        fps=self.fps if rule.fps is None else rule.fps,
+                       floor=self.floor if rule.floor is None else rule.floor,
                        array_joints=self.array_joints if rule.array_joints is None else rule.array_joints,
                        files=(), rule=rule)
 
-    def resolve(self, names: Sequence[str], source: object = "the recording") -> tuple[str, ...]:
+    def resolve(self, names: Sequence[str], source: object = "the recording") -> tuple[Joint, ...]:
         """The joint of each part in a file whose joints are ``names``: the first of the part's names (aliases) the
-        file has. A part none of whose names the file has is a :class:`ConfigError` naming the part, the names tried
-        and the file's joints."""
+        file has (a mean, when it has every joint of it). A part none of whose names the file has is a
+        :class:`ConfigError` naming the part, the names tried and the file's joints."""
         have = set(names)
         out = []
         for part, options in zip(self.body.parts, self.names):
-            found = next((j for j in options if j in have), None)
+            found = next((j for j in options if (j in have if isinstance(j, str) else have.issuperset(j))), None)
             if found is None:
-                tried = repr(options[0]) if len(options) == 1 else f"(none of {', '.join(map(repr, options))})"
+                tried = joint_text(options[0]) if len(options) == 1 else \
+                    f"(none of {', '.join(map(joint_text, options))})"
                 raise ConfigError(f"joint {tried} of part {part!r} is not in {source}", **self._where(part),
                                   expected="a joint of the file", available=list(names))
             out.append(found)
@@ -184,7 +212,12 @@ class BodyProfile:
     def for_names(self, names: Sequence[str], source: object = "the recording") -> BodyProfile:
         """This profile with each part's joint the first of its names that ``names`` (a file's joints) holds, and no
         aliases left: for a reader that looks joints up by :attr:`joints` (a live input). Raises as :meth:`resolve`."""
-        return replace(self, joints=self.resolve(names, source), aliases=None)
+        joints = self.resolve(names, source)
+        for part, joint in zip(self.body.parts, joints):
+            if not isinstance(joint, str):
+                raise ConfigError(f"part {part!r} is {joint_text(joint)}: a live input reads one joint per part",
+                                  **self._where(part), expected="a part mapped to one joint of the input")
+        return replace(self, joints=joints, aliases=None)
 
     def _where(self, part: str) -> dict[str, Any]:
         from toolkit.config.toml import find_key_line
@@ -197,7 +230,7 @@ class BodyProfile:
     def npy_joints(self) -> tuple[str, ...]:
         """The joint names of a ``.npy`` array read through this profile: :attr:`array_joints`, else the mapped
         joints in the order of ``[parts]``, each once."""
-        return self.array_joints if self.array_joints is not None else tuple(dict.fromkeys(self.joints))
+        return self.array_joints if self.array_joints is not None else tuple(joint_names(self.joints))
 
     def check(self, recording: Any) -> list[str]:
         """Raise a :class:`ConfigError` naming any part none of whose joints the recording has (with the joints it
@@ -207,7 +240,7 @@ class BodyProfile:
         :class:`~toolkit.recordings.recording.Recording` or a :class:`~toolkit.recordings.bvh.BVH` (a header is enough).
         """
         names = list(recording.names)
-        used = set(self.resolve(names, recording.source))
+        used = set(joint_names(self.resolve(names, recording.source)))
         return [n for n in names if n not in used]
 
     def convert(self, joint_positions: np.ndarray, names: list[str] | tuple[str, ...]) -> np.ndarray:
@@ -215,8 +248,11 @@ class BodyProfile:
         first of its names that ``names`` holds)."""
         return self._convert(joint_positions, _columns(names, self.resolve(names)))
 
-    def _convert(self, joint_positions: np.ndarray, index: list[int]) -> np.ndarray:
-        return (joint_positions[:, index] * self.scale) @ UP_AXES[self.up].T
+    def _convert(self, joint_positions: np.ndarray, index: list[int | tuple[int, ...]]) -> np.ndarray:
+        out = (_gather(joint_positions, index) * self.scale) @ UP_AXES[self.up].T
+        if self.floor:
+            out[..., 1] -= self.floor
+        return out
 
     def motion(self, bvh: BVH) -> Motion:
         """The world positions of the tracked parts over a BVH file's frames (read as :meth:`for_file` says for
@@ -259,10 +295,22 @@ class BodyProfile:
                             n_frames=recording.n_frames, joints=joints)
 
 
-def _columns(names: Sequence[str], joints: Sequence[str]) -> list[int]:
-    """The column of each of ``joints`` among ``names``."""
+def _columns(names: Sequence[str], joints: Sequence[Joint]) -> list[int | tuple[int, ...]]:
+    """The column of each of ``joints`` among ``names`` (a tuple of columns for a mean)."""
     where = {n: i for i, n in reversed(list(enumerate(names)))}
-    return [where[j] for j in joints]
+    return [where[j] if isinstance(j, str) else tuple(where[k] for k in j) for j in joints]
+
+
+def _gather(values: np.ndarray, index: list[int | tuple[int, ...]]) -> np.ndarray:
+    """The columns ``index`` of ``values`` (F, J, 3), a mean of columns where an index is a tuple (NaN where one of
+    them is: a mean of joints is seen when all of them are)."""
+    if all(isinstance(i, int) for i in index):
+        return values[:, index]
+    out = values[:, [i if isinstance(i, int) else i[0] for i in index]]
+    for p, i in enumerate(index):
+        if not isinstance(i, int):
+            out[:, p] = values[:, list(i)].mean(axis=1)
+    return out
 
 
 class MotionStream:
@@ -366,7 +414,16 @@ def load_profile(path: str | Path) -> BodyProfile:
     aliases = tuple(names.values())
     return BodyProfile(str(head.get("name", path.stem)), body, tuple(a[0] for a in aliases), scale, up, path,
                        str(head.get("description", "")), fps, array_joints,
-                       aliases if any(len(a) > 1 for a in aliases) else None, files)
+                       aliases if any(len(a) > 1 for a in aliases) else None, files,
+                       _read_floor(head.get("floor", 0.0), ("profile", "floor"), fail))
+
+
+def _read_floor(floor: Any, key: tuple, fail: Callable[..., ConfigError]) -> float:
+    value = finite_number(floor)
+    if value is None or isinstance(floor, bool) or abs(value) > 1000:
+        raise fail(f"invalid floor {repr(floor)[:40]}", key, expected="the floor's height in metres (likeme's frame, "
+                   "after units and up), a finite number, like floor = -1.1")
+    return float(value)
 
 
 def _read_units(units: Any, key: tuple, fail: Callable[..., ConfigError]) -> float:
@@ -390,14 +447,28 @@ def _read_up(up: Any, key: tuple, fail: Callable[..., ConfigError]) -> str:
     return up
 
 
-def _read_names(joint: Any, key: tuple, fail: Callable[..., ConfigError]) -> tuple[str, ...]:
-    """A part's joint names: one name, or a list of aliases in order of preference (each once)."""
-    options = joint if isinstance(joint, list) else [joint]
-    if not options or not all(isinstance(j, str) and j for j in options):
-        raise fail(f"invalid joint {joint!r}", key, expected='the name of a source joint, or a list of names (the '
-                                                            'first a file has wins), like ["LeftUpLeg", "LeftHip"]')
+def _read_names(joint: Any, key: tuple, fail: Callable[..., ConfigError]) -> tuple[Joint, ...]:
+    """A part's joint names: one name, a mean ``{mean = [...]}``, or a list of these (aliases) in order of
+    preference, each once."""
+    expected = ('the name of a source joint, {mean = ["A", "B"]} (the mean of joints), or a list of these (the '
+                'first a file has wins), like ["LeftUpLeg", "LeftHip"]')
+    options = []
+    for option in joint if isinstance(joint, list) else [joint]:
+        if isinstance(option, Mapping):
+            mean = option.get("mean")
+            if set(option) != {"mean"} or not isinstance(mean, list) or len(mean) < 2 or \
+                    not all(isinstance(j, str) and j for j in mean) or len(set(mean)) < len(mean):
+                raise fail(f"invalid joint {option!r}", key, expected='a mean of two or more joints, each once, like '
+                                                                     '{mean = ["left_hip", "right_hip"]}')
+            options.append(tuple(mean))
+        elif isinstance(option, str) and option:
+            options.append(option)
+        else:
+            raise fail(f"invalid joint {joint!r}", key, expected=expected)
+    if not options:
+        raise fail(f"invalid joint {joint!r}", key, expected=expected)
     if len(set(options)) < len(options):
-        raise fail(f"joint names repeated: {options}", key, expected="each alias once")
+        raise fail(f"joint names repeated: {joint}", key, expected="each alias once")
     return tuple(options)
 
 
@@ -410,7 +481,7 @@ def _read_fps(fps: Any, key: tuple, fail: Callable[..., ConfigError]) -> float |
     return float(fps)
 
 
-def _read_array_joints(array_joints: Any, names: Mapping[str, tuple[str, ...]], key: tuple,
+def _read_array_joints(array_joints: Any, names: Mapping[str, tuple[Joint, ...]], key: tuple,
                        fail: Callable[..., ConfigError]) -> tuple[str, ...] | None:
     """The ``joints`` list (a ``.npy`` array's or a headerless CSV's joints, in order): each once, and for every
     part one of its names."""
@@ -425,14 +496,14 @@ def _read_array_joints(array_joints: Any, names: Mapping[str, tuple[str, ...]], 
         raise fail(f"joints named twice: {twice}", key, expected="each joint once")
     have = set(array_joints)
     for part, options in names.items():
-        if not have.intersection(options):
+        if not any(j in have if isinstance(j, str) else have.issuperset(j) for j in options):
             joint = options[0] if len(options) == 1 else list(options)
             raise fail(f"joint {joint!r} of part {part!r} is not in the joints list", key,
                        expected="a list holding a joint of every part [parts] maps", available=array_joints)
     return tuple(array_joints)
 
 
-def _read_files(files: Any, names: Mapping[str, tuple[str, ...]], array_joints: tuple[str, ...] | None,
+def _read_files(files: Any, names: Mapping[str, tuple[Joint, ...]], array_joints: tuple[str, ...] | None,
                 fail: Callable[..., ConfigError]) -> tuple[FileRule, ...]:
     """The ``[files."PATTERN"]`` tables: for the recordings whose path matches, other units, up axis, frame rate,
     array joints and joints of some parts."""
@@ -468,5 +539,6 @@ def _read_files(files: Any, names: Mapping[str, tuple[str, ...]], array_joints: 
         rules.append(FileRule(
             pattern, None if "units" not in rule else _read_units(rule["units"], (*here, "units"), fail),
             None if "up" not in rule else _read_up(rule["up"], (*here, "up"), fail),
-            _read_fps(rule.get("fps"), (*here, "fps"), fail), joints, tuple(own.items())))
+            _read_fps(rule.get("fps"), (*here, "fps"), fail), joints,
+            None if "floor" not in rule else _read_floor(rule["floor"], (*here, "floor"), fail), tuple(own.items())))
     return tuple(rules)
