@@ -58,8 +58,8 @@ from toolkit.recordings.csv_positions import has_header
 from toolkit.recordings.recording import FPS_RANGE, MIN_FPS
 from toolkit.recordings.bvh import BVH
 
-__all__ = ["BodyProfile", "FileRule", "Joint", "MotionStream", "is_profile", "joint_names", "joint_text", "load_profile", "UNITS",
-           "UP_AXES"]
+__all__ = ["BodyProfile", "FileRule", "Joint", "MotionStream", "is_profile", "gather_joints", "joint_columns",
+           "joint_names", "joint_text", "load_profile", "UNITS", "UP_AXES"]
 
 UNITS: dict[str, float] = {"metre": 1.0, "meter": 1.0, "m": 1.0, "centimetre": 0.01, "centimeter": 0.01, "cm": 0.01,
                            "millimetre": 0.001, "millimeter": 0.001, "mm": 0.001, "inch": 0.0254, "in": 0.0254,
@@ -246,10 +246,10 @@ class BodyProfile:
     def convert(self, joint_positions: np.ndarray, names: list[str] | tuple[str, ...]) -> np.ndarray:
         """Source joint positions (F, J, 3) to part positions (F, P, 3) in metres, +y up (each part's joint the
         first of its names that ``names`` holds)."""
-        return self._convert(joint_positions, _columns(names, self.resolve(names)))
+        return self._convert(joint_positions, joint_columns(names, self.resolve(names)))
 
     def _convert(self, joint_positions: np.ndarray, index: list[int | tuple[int, ...]]) -> np.ndarray:
-        out = (_gather(joint_positions, index) * self.scale) @ UP_AXES[self.up].T
+        out = (gather_joints(joint_positions, index) * self.scale) @ UP_AXES[self.up].T
         if self.floor:
             out[..., 1] -= self.floor
         return out
@@ -259,7 +259,7 @@ class BodyProfile:
         its file)."""
         profile = self.for_file(bvh.source) if bvh.source else self
         joints = profile.resolve(bvh.names, bvh.source)
-        return Motion(profile._convert(bvh.positions(), _columns(bvh.names, joints)), bvh.fps, self.body.parts)
+        return Motion(profile._convert(bvh.positions(), joint_columns(bvh.names, joints)), bvh.fps, self.body.parts)
 
     def read(self, path: str | Path, fps: float | None = None) -> Motion:
         """Read a recording (by its suffix: :func:`toolkit.recordings.open_recording`) whole and return its motion
@@ -295,13 +295,13 @@ class BodyProfile:
                             n_frames=recording.n_frames, joints=joints)
 
 
-def _columns(names: Sequence[str], joints: Sequence[Joint]) -> list[int | tuple[int, ...]]:
+def joint_columns(names: Sequence[str], joints: Sequence[Joint]) -> list[int | tuple[int, ...]]:
     """The column of each of ``joints`` among ``names`` (a tuple of columns for a mean)."""
     where = {n: i for i, n in reversed(list(enumerate(names)))}
     return [where[j] if isinstance(j, str) else tuple(where[k] for k in j) for j in joints]
 
 
-def _gather(values: np.ndarray, index: list[int | tuple[int, ...]]) -> np.ndarray:
+def gather_joints(values: np.ndarray, index: list[int | tuple[int, ...]]) -> np.ndarray:
     """The columns ``index`` of ``values`` (F, J, 3), a mean of columns where an index is a tuple (NaN where one of
     them is: a mean of joints is seen when all of them are)."""
     if all(isinstance(i, int) for i in index):
@@ -329,7 +329,7 @@ class MotionStream:
         self.profile, self.names, self._fps = profile, list(names), float(fps)
         self._blocks, self._close, self._n_frames, self._read = blocks, close, n_frames, 0
         self.joints = tuple(joints) if joints is not None else profile.resolve(self.names)
-        self._index = _columns(self.names, self.joints)
+        self._index = joint_columns(self.names, self.joints)
 
     @property
     def fps(self) -> float:
