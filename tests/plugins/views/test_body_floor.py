@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from likeme.cli import main
-from tests.fixtures.schemes import KINECT_V2
+from tests.fixtures.schemes import KINECT_V2, KINECT_V2_PARTS
 from tests.fixtures.skeletons import NAMES, human, performance, write_skeleton_csv
 
 PROFILE = """
@@ -23,19 +23,7 @@ units = "metre"
 up = "+y"
 
 [parts]
-root = "SpineBase"
-chest = "SpineShoulder"
-head = "Head"
-left_shoulder = "ShoulderLeft"
-right_shoulder = "ShoulderRight"
-left_wrist = "WristLeft"
-right_wrist = "WristRight"
-left_hip = "HipLeft"
-right_hip = "HipRight"
-left_knee = "KneeLeft"
-right_knee = "KneeRight"
-left_foot = "AnkleLeft"
-right_foot = "AnkleRight"
+{parts}
 
 [facing]
 left = "left_hip"
@@ -68,7 +56,7 @@ def test_the_floor_is_the_lowest_part_where_it_is_lowest():
 
 @pytest.fixture
 def kinect(tmp_path):
-    (tmp_path / "kinect.toml").write_text(PROFILE)
+    (tmp_path / "kinect.toml").write_text(PROFILE.format(parts=KINECT_V2_PARTS))
     takes = [write_skeleton_csv(tmp_path / f"{m}.csv", KINECT_V2, _camera(human(m, 90)), up="+y")
              for m in ("bow", "wave")]
     return tmp_path / "kinect.toml", takes

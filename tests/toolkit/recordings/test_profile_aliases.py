@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tests.fixtures.schemes import CMU_3DSMAX, CMU_MOTIONBUILDER
+from tests.fixtures.schemes import CMU_3DSMAX, CMU_MOTIONBUILDER, KINECT_V2_PARTS
 from tests.fixtures.skeletons import human, write_skeleton_bvh, write_skeleton_csv
 from toolkit import ConfigError
 from toolkit.recordings.profile import load_profile
@@ -82,21 +82,7 @@ units = "mm"
 up = "+z"
 
 [files."kinect/*".parts]
-root = "SpineBase"
-chest = "SpineShoulder"
-left_shoulder = "ShoulderLeft"
-right_shoulder = "ShoulderRight"
-left_elbow = "ElbowLeft"
-right_elbow = "ElbowRight"
-left_wrist = "WristLeft"
-right_wrist = "WristRight"
-left_hip = "HipLeft"
-right_hip = "HipRight"
-left_knee = "KneeLeft"
-right_knee = "KneeRight"
-left_foot = "AnkleLeft"
-right_foot = "AnkleRight"
-"""))
+""" + KINECT_V2_PARTS))
     (tmp_path / "kinect").mkdir()
     kinect = profile.read(write_skeleton_csv(tmp_path / "kinect" / "wave.csv", KINECT, human("wave"), scale=1000.0,
                                              up="+z"))
