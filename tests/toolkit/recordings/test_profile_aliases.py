@@ -173,3 +173,21 @@ def test_a_live_csv_in_either_naming_scheme_gives_the_files_poses(tmp_path, writ
     path = csv(tmp_path / "take.csv", CMU_3DSMAX, human("wave"), scale=100.0)
     live = np.array(list(LiveInput(io.BytesIO(path.read_bytes()), profile)))
     np.testing.assert_allclose(live, profile.read(path).positions, atol=1e-6)
+
+
+def test_a_live_json_input_in_the_second_naming_scheme_gives_every_frame(tmp_path, write):
+    """JSON lines naming the 3dsMax joints: every frame, the first included, in the aliases the input uses."""
+    import io
+    import json
+
+    from tests.fixtures.skeletons import _skeleton_positions
+    from toolkit.recordings.live import LiveInput
+
+    profile = load_profile(write("cmu.toml", PROFILE))
+    names, _, positions = _skeleton_positions(CMU_3DSMAX, human("wave"))
+    lines = [json.dumps({"time": f / 30, **{n: list(positions[f, j] * 100) for j, n in enumerate(names)}})
+             for f in range(len(positions))]
+    live = np.array(list(LiveInput(io.BytesIO("\n".join(lines).encode()), profile)))
+    reference = profile.read(_write(tmp_path, "wave", "1", turn=0.3, scheme="mb")).positions
+    assert np.isfinite(live).all()
+    np.testing.assert_allclose(live, reference, atol=1e-4)
