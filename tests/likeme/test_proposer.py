@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
 from likeme.cli import main
 from likeme.schemes import CMU_UNIT
@@ -122,3 +124,36 @@ def test_camera_frame_data_without_feet_gets_a_floor_todo(tmp_path, capsys):
 def test_feet_on_the_floor_get_no_floor_line(tmp_path, capsys):
     profile, text, _ = _propose(capsys, tmp_path, _write(tmp_path, "Mixamo"))
     assert "floor" not in text and profile.floor == 0.0
+
+
+@settings(max_examples=20, deadline=None)
+@given(case=st.sampled_from(list(CASES)), units=st.sampled_from([1.0, 0.01, 0.001, 0.0254, CMU_UNIT]),
+       up=st.sampled_from(["+y", "+z", "-y"]), turn=st.floats(-3.0, 3.0))
+def test_a_proposal_reads_its_file_back_to_the_body_it_was_written_from(case, units, up, turn):
+    """Round trip: a body written in a scheme's names, any of the units a person is recorded in, any up axis and
+    heading; the proposal reads it back in metres, +y up, standing on the floor, as tall as it was written."""
+    import tempfile
+    from pathlib import Path
+
+    from likeme.profiles import propose_profile
+    from tests.fixtures.skeletons import _skeleton_positions, source_axes
+
+    assume(units != CMU_UNIT or case.startswith("CMU"))  # CMU's own unit is known for CMU's schemes only
+    skeleton, kind, _, _, transform, _ = CASES[case]
+    pose = human("bow", 60, turn=turn)
+    pose = transform(pose) if transform else pose
+    names, parents, positions = _skeleton_positions(skeleton, pose)
+    proposal = propose_profile(names, source_axes(positions / units, up), parents=parents if kind == "bvh" else None)
+    with tempfile.TemporaryDirectory() as tmp:
+        (Path(tmp) / "p.toml").write_text(proposal.text)
+        profile = load_profile(Path(tmp) / "p.toml")
+    assert profile.scale == pytest.approx(units) and profile.up == up
+    motion = profile.convert(source_axes(positions / units, up), names)
+    parts = list(profile.body.parts)
+    head = motion[:, parts.index("head" if "head" in parts else "nose")]
+    feet = motion[:, [parts.index("left_foot"), parts.index("right_foot")]]
+    written = pose[:, NAMES.index("head")] - pose[:, [NAMES.index("l_ankle"), NAMES.index("r_ankle")]].mean(axis=1)
+    np.testing.assert_allclose(np.linalg.norm(head - feet.mean(axis=1), axis=-1),
+                               np.linalg.norm(written, axis=-1), atol=1e-6)
+    assert (head[:, 1] > feet[..., 1].max(axis=1)).all()
+    assert abs(np.median(feet[..., 1]) - 0.08) < 0.1  # the ankles 8 cm above the floor, wherever the origin was
