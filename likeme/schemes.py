@@ -1,7 +1,7 @@
 """The joint-naming schemes that ``likeme profile`` recognises, written as data: one table per scheme.
 
 Each :class:`Scheme` maps likeme's parts (the left side only: the right side's names are mirrored,
-:func:`likeme.profiles.mirror`) to the scheme's joints in order of preference. A joint is a name, compared in lower
+``likeme.profiles._mirror``) to the scheme's joints in order of preference. A joint is a name, compared in lower
 case without a ``prefix:`` (``mixamorig:``) or separators (so ``hip_center`` is ``HipCenter``), or a tuple of names
 whose mean is the part (MediaPipe has no pelvis: its root is the mean of its hips). A scheme also says what it knows
 about its recordings: units known for it (CMU's own unit), whether its joints are a person's (whose height tells the

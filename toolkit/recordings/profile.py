@@ -79,6 +79,7 @@ UP_AXES: dict[str, np.ndarray] = {
 _PROFILE_KEYS = ("name", "description", "units", "up", "fps", "joints", "floor")
 _TABLES = ("profile", "parts", "facing", "bones", "colours", "files")
 _FILE_KEYS = ("units", "up", "fps", "joints", "floor", "parts")
+"""The keys of a ``[files."PATTERN"]`` table: how its recordings are read (the body is the profile's)."""
 
 Joint = str | tuple[str, ...]
 """A part's source in a file: a joint's name, or a tuple of names whose mean is the part (``{mean = [...]}``)."""
@@ -95,8 +96,6 @@ def joint_names(joints: Iterable[Joint]) -> list[str]:
     for j in joints:
         out.update(dict.fromkeys((j,) if isinstance(j, str) else j))
     return list(out)
-
-"""The keys of a ``[files."PATTERN"]`` table: how its recordings are read (the body is the profile's)."""
 
 
 @dataclass(frozen=True)
@@ -317,15 +316,15 @@ class MotionStream:
     """The blocks of a recording read through a profile (made by :meth:`BodyProfile.stream`).
 
     ``fps``, ``parts`` and ``joints`` (the file's joint of each part) are known before the first block; iterating
-    yields ``(positions, visible)`` blocks,
-    positions (k, P, 3) in metres with +y up and visibility (k, P), as :meth:`BodyProfile.read` would give them.
+    yields ``(positions, visible)`` blocks, positions (k, P, 3) in metres with +y up and visibility (k, P), as
+    :meth:`BodyProfile.read` would give them.
     ``n_frames`` is the file's frame count for a BVH file (from its header), for the other formats the number of
     frames read so far (all of them once iterated). A context manager: leaving it closes the file.
     """
 
     def __init__(self, profile: BodyProfile, names: Sequence[str], fps: float, blocks: Iterator[np.ndarray],
                  close: Callable[[], Any] | None = None, *, n_frames: int | None = None,
-                 joints: Sequence[str] | None = None) -> None:
+                 joints: Sequence[Joint] | None = None) -> None:
         self.profile, self.names, self._fps = profile, list(names), float(fps)
         self._blocks, self._close, self._n_frames, self._read = blocks, close, n_frames, 0
         self.joints = tuple(joints) if joints is not None else profile.resolve(self.names)
