@@ -479,6 +479,10 @@ def propose_profile(names: Sequence[str], positions: np.ndarray, *, parents: Seq
         low, high = UPRIGHT_HEIGHT if upright else OTHER_SPAN
         units_note = (f"the body is {raw:.4g} units {'tall' if upright else 'across'}: {raw * scale:.3g} m in "
                       f"{units}s")
+        person = [f"{n} would make it {raw * v:.3g} m" for v, n in _PERSON_UNITS  # an upright body of no known
+                  if upright and v != scale and PERSON_HEIGHT[0] <= raw * v <= PERSON_HEIGHT[1]]  # scheme: a person?
+        if person and not PERSON_HEIGHT[0] <= raw * scale <= PERSON_HEIGHT[1]:
+            units_note += f" (if it is a person: {'; '.join(person)})"
         if not low <= raw * scale <= high:
             todo.append(f"no unit makes the body {low:g} to {high:g} m {'tall' if upright else 'across'}")
             units_note = f"TODO: {todo[-1]} ({units_note})"
@@ -548,6 +552,10 @@ PERSON_STATURE = (0.9, 2.2)
 """The distance (m) from a person's head (the mean of the head, neck, nose) to the feet (ankles, toes, heels) when
 standing: a child to a tall adult. A ratio under 2.22 (CMU's unit to an inch), so that at most one unit of
 :func:`_person_units` fits, save for those known for the scheme, which are tried first."""
+PERSON_HEIGHT = (1.0, 2.3)
+"""The height (m) of a standing person, an older child to a tall adult: named beside the units of an upright body of
+no known scheme when another unit would make it one (a proposal cannot tell an inch file of a person from a small
+body in centimetres)."""
 _PERSON_UNITS = ((1.0, "metre"), (0.01, "centimetre"), (0.001, "millimetre"), (0.0254, "inch"))
 FLOOR_OFFSET = 0.1
 """A floor further than this (m) from ``y = 0`` is proposed as the profile's ``floor``."""

@@ -157,3 +157,18 @@ def test_a_proposal_reads_its_file_back_to_the_body_it_was_written_from(case, un
                                np.linalg.norm(written, axis=-1), atol=1e-6)
     assert (head[:, 1] > feet[..., 1].max(axis=1)).all()
     assert abs(np.median(feet[..., 1]) - 0.08) < 0.1  # the ankles 8 cm above the floor, wherever the origin was
+
+
+def test_an_upright_body_of_no_known_scheme_names_the_unit_that_makes_it_a_person(tmp_path):
+    """No scheme, no prior: centimetres stay the proposal for 67 units, but the comment names inches (1.7 m)."""
+    from likeme.profiles import propose_profile
+    from tests.fixtures.skeletons import _skeleton_positions
+
+    unknown = [(f"j{k}", None if k == 0 else "j0", point) for k, (_, _, point) in enumerate(fixture.KINECT_V2)]
+    names, parents, positions = _skeleton_positions(unknown, human("rest", 30))
+    proposal = propose_profile(names, positions / 0.0254, parents=parents)
+    units_line = next(line for line in proposal.text.splitlines() if line.startswith("units = "))
+    assert proposal.scheme is None and units_line.startswith('units = "centimetre"')
+    assert "if it is a person: inch would make it 1.58 m" in units_line  # head to toes: 1.6 - 0.02
+    metres = propose_profile(names, positions, parents=parents).text
+    assert "if it is a person" not in metres
