@@ -273,37 +273,19 @@ class Beam(Search):
         return Calibration.of(own, other)
 
 
-def _reach(graph, nodes, index, max_skip: int, *, forward: bool) -> tuple[np.ndarray, np.ndarray]:
-    """For every node, the nodes reachable in 0..max_skip steps along (or against) the edges, as a compressed
-    table: node ``i`` reaches ``indices[indptr[i]:indptr[i + 1]]`` (sorted). networkx's breadth-first search
-    bounded by ``cutoff`` finds each node's reach."""
-    g = graph if forward else graph.reverse(copy=False)
-    counts = np.empty(len(nodes), dtype=np.intp)
-    found: list[Any] = []
-    for i, node in enumerate(nodes):
-        reached = nx.single_source_shortest_path_length(g, node, cutoff=max_skip)
-        counts[i] = len(reached)
-        found.extend(reached)
-    indptr = np.zeros(len(nodes) + 1, dtype=np.intp)
-    np.cumsum(counts, out=indptr[1:])
-    # each row sorted at once: row i's indices offset by i * len(nodes), one sort, the offsets taken off again
-    offset = np.repeat(np.arange(len(nodes), dtype=np.intp) * len(nodes), counts)
-    ids = np.fromiter(map(index.__getitem__, found), dtype=np.intp, count=len(found))
-    return indptr, np.sort(ids + offset) - offset
-
-
 class Fan(NamedTuple):
-    """The reach table of :func:`_reach` factored through the wide nodes (hubs), so that a beam step need not list
-    every movement's first nodes once per path that reaches a hub.
+    """For every node, the nodes reachable in 0..max_skip steps along (or against) the edges (its *reach*), factored
+    through the wide nodes (hubs), so that a beam step need not list every movement's first nodes once per path
+    that reaches a hub, and so that the table grows with the graph, not with the graph times its largest hub.
 
     A node reaches (in 0..max_skip steps) its *local* nodes, found without passing through a wide node, and for
     each wide node ``h`` it reaches at distance ``j`` without passing through another, every node within
     ``max_skip - j`` steps of ``h``: the *rings* of ``h`` at distances 0..max_skip - j. (A shortest path to a node
     either meets no wide node, or meets a first one at the distance found without passing through another; so the
-    union is exactly :func:`_reach`'s row.)"""
+    union is exactly the node's reach.)"""
 
     full: tuple[np.ndarray, np.ndarray]
-    """:func:`_reach`'s table: each node's whole reach, used for the nodes whose row is short."""
+    """Compressed rows (indptr, sorted node indices): each short node's whole reach (a long node's row is empty)."""
     long: np.ndarray
     """(N,) bool: the nodes whose reach is longer than :data:`LONG_ROW` and passes a wide node: listed factored."""
     local: tuple[np.ndarray, np.ndarray]
@@ -337,55 +319,79 @@ def _rows(rows: list[list[int]]) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _fan(graph, nodes, index, max_skip: int, *, forward: bool) -> Fan:
-    """:func:`_reach`'s table factored through the wide nodes (:class:`Fan`)."""
-    full = _reach(graph, nodes, index, max_skip, forward=forward)
+    """Every node's reach factored through the wide nodes (:class:`Fan`).
+
+    Each node's *local* nodes by a breadth-first search that stops at the wide nodes (recording the distance at
+    which it meets each); each wide node's rings by one breadth-first search (networkx's, bounded by ``max_skip``).
+    A node's whole reach is the union of its local nodes and the rings within ``max_skip`` minus the distance of
+    each wide node it meets; it is listed whole only where it is short (at most :data:`LONG_ROW` nodes), so no row
+    as long as a hub's fan is ever built."""
     g = graph if forward else graph.reverse(copy=False)
     succ = [[index[m] for m in g.successors(node)] for node in nodes]
     wide_nodes = [i for i, s in enumerate(succ) if len(s) > WIDE]
     number = {h: w for w, h in enumerate(wide_nodes)}
-    long = np.zeros(len(nodes), dtype=bool)
-    if wide_nodes:
-        long = np.diff(full[0]) > LONG_ROW
-    local, first, dist = [], [], []
-    for i in range(len(nodes)):
-        if not long[i]:
-            local.append([])
-            first.append([])
-            dist.append([])
-            continue
-        if i in number:  # a wide node reaches everything through itself
-            local.append([i])
-            first.append([number[i]])
-            dist.append([0])
-            continue
-        found, frontier, hubs = {i}, [i], {}
-        for depth in range(1, max_skip + 1):
-            nxt = []
-            for f in frontier:
-                for m in succ[f]:
-                    if m in found or m in hubs:
-                        continue
-                    if m in number:
-                        hubs[m] = depth  # not passed through: its rings stand for what lies beyond
-                    else:
-                        found.add(m)
-                        nxt.append(m)
-            frontier = nxt
-        local.append(list(found))
-        first.append([number[h] for h in hubs])
-        dist.append(list(hubs.values()))
-    rings = []
+    rings, within = [], []  # within[w][r]: the nodes at most r steps from wide node w, sorted
     for h in wide_nodes:
         by_distance = [[] for _ in range(max_skip + 1)]
         for m, d in nx.single_source_shortest_path_length(g, nodes[h], cutoff=max_skip).items():
             by_distance[d].append(index[m])
         rings.extend(by_distance)
+        so_far: list[int] = []
+        upto = []
+        for ring in by_distance:
+            so_far = so_far + ring
+            upto.append(np.sort(np.asarray(so_far, dtype=np.intp)))
+        within.append(upto)
+    long = np.zeros(len(nodes), dtype=bool)
+    rows, local, first, dist = [], [], [], []
+    for i in range(len(nodes)):
+        if i in number:  # a wide node reaches everything through itself
+            found, hubs = [i], {i: 0}
+            parts = [within[number[i]][max_skip]]
+        else:
+            seen, frontier, hubs = {i}, [i], {}
+            for depth in range(1, max_skip + 1):
+                nxt = []
+                for f in frontier:
+                    for m in succ[f]:
+                        if m in seen or m in hubs:
+                            continue
+                        if m in number:
+                            hubs[m] = depth  # not passed through: its rings stand for what lies beyond
+                        else:
+                            seen.add(m)
+                            nxt.append(m)
+                frontier = nxt
+            found = list(seen)
+            parts = [np.asarray(found, dtype=np.intp)] + [within[number[h]][max_skip - d] for h, d in hubs.items()]
+        sizes = [len(p) for p in parts]
+        if max(sizes) > LONG_ROW:  # long whatever the others add
+            row = None
+        else:  # short parts: their union is cheap (at most a few times LONG_ROW nodes)
+            row = np.unique(np.concatenate(parts)) if len(parts) > 1 else np.sort(parts[0])
+            if len(row) > LONG_ROW:
+                row = None
+        long[i] = row is None and bool(wide_nodes)
+        if row is None and not wide_nodes:  # no wide node to factor through: listed whole however long
+            row = np.sort(parts[0])
+        rows.append(row if row is not None else np.zeros(0, dtype=np.intp))
+        if long[i]:
+            local.append([i] if i in number else found)
+            first.append([number[h] for h in hubs])
+            dist.append(list(hubs.values()))
+        else:
+            local.append([])
+            first.append([])
+            dist.append([])
+    widths = np.array([len(r) for r in rows], dtype=np.intp)
     indptr = np.zeros(len(nodes) + 1, dtype=np.intp)
-    np.cumsum([len(r) for r in first], out=indptr[1:])
-    wide = (indptr, np.array([w for r in first for w in r], dtype=np.intp),
+    np.cumsum(widths, out=indptr[1:])
+    full = (indptr, np.concatenate(rows).astype(np.intp) if rows else np.zeros(0, dtype=np.intp))
+    wide_ptr = np.zeros(len(nodes) + 1, dtype=np.intp)
+    np.cumsum([len(r) for r in first], out=wide_ptr[1:])
+    wide = (wide_ptr, np.array([w for r in first for w in r], dtype=np.intp),
             np.array([d for r in dist for d in r], dtype=np.intp))
     padded = None
-    widths = np.diff(full[0])
     if not long.any() and widths.max(initial=0) <= LONG_ROW:
         padded = np.full((len(nodes), widths.max(initial=0)), -1, dtype=np.intp)
         padded[np.repeat(np.arange(len(nodes)), widths), np.arange(len(full[1])) - np.repeat(full[0][:-1], widths)] = \
@@ -394,7 +400,7 @@ def _fan(graph, nodes, index, max_skip: int, *, forward: bool) -> Fan:
 
 
 def _candidates(fan: Fan, ends: np.ndarray, costs: np.ndarray, score) -> tuple[np.ndarray, np.ndarray]:
-    """The (beam index, node) pairs of a beam step, in the order of :func:`_gather` on :func:`_reach`'s table (by
+    """The (beam index, node) pairs of a beam step, in the order of :func:`_gather` on each node's whole reach (by
     beam, then node), keeping of the pairs through a wide node only those that can be the best way to their node.
 
     A node ``c`` at ``d`` steps from wide node ``h`` is reached through ``h`` by every path whose end reaches ``h``
