@@ -332,9 +332,14 @@ STYLE_PATTERN = r"^dataset-1_[^_]+_([^_]+)_"
 
 
 def cmd_make_data(args, pm) -> int:
-    """``likeme bench make-data DIR``."""
-    print(make_data(pm, Path(args.dest), seed=args.seed, fmt=getattr(args, "format", "bvh"), jobs=args.jobs,
-                    scheduler=args.scheduler))
+    """``likeme bench make-data DIR``: written to a staging folder inside DIR and moved into it when complete
+    (:func:`toolkit.files.writing_folder`): a full disk leaves no half-written data set."""
+    from toolkit.files import writing_folder
+
+    with writing_folder(args.dest, "benchmark data") as stage:
+        make_data(pm, stage, seed=args.seed, fmt=getattr(args, "format", "bvh"), jobs=args.jobs,
+                  scheduler=args.scheduler)
+    print(Path(args.dest))
     return 0
 
 
@@ -344,6 +349,10 @@ def cmd_bandai(args, pm) -> int:
 
     profile = Path(args.profile) if args.profile else resolve_file("profiles/bandai-namco.toml", None, pm,
                                                                    key=("--profile",))
-    print(bandai(Path(args.src), Path(args.dest), profile, seed=args.seed, jobs=args.jobs, scheduler=args.scheduler,
-                 locomotion=Path(args.locomotion) if args.locomotion else None))
+    from toolkit.files import writing_folder
+
+    with writing_folder(args.dest, "benchmark data") as stage:
+        bandai(Path(args.src), stage, profile, seed=args.seed, jobs=args.jobs, scheduler=args.scheduler,
+               locomotion=Path(args.locomotion) if args.locomotion else None)
+    print(Path(args.dest))
     return 0

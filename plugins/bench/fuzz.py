@@ -581,12 +581,13 @@ def run_fuzz(pm: Any, *, n: int = 2000, seed: int = 0, targets: tuple[str, ...] 
     targets = tuple(targets)
     if not targets:
         return []
-    with tempfile.TemporaryDirectory(prefix="likeme-fuzz-") as tmp:
-        tmp = Path(tmp)
+    from toolkit.files import scratch_folder
+
+    with scratch_folder("likeme-fuzz-") as tmp:
         if out is not None:  # the seeds beside the failing cases, so that their commands replay them
-            Path(out).mkdir(parents=True, exist_ok=True)
-            shutil.rmtree(Path(out) / "seeds", ignore_errors=True)
-        seeds = make_seeds((Path(out).resolve() if out is not None else tmp) / "seeds", pm, seed=seed)
+            seeds = _seeds_in(Path(out), pm, seed)
+        else:
+            seeds = make_seeds(tmp / "seeds", pm, seed=seed)
         if in_process(jobs, scheduler):
             return _run_cases(list(range(n)), targets, seeds, seed, timeout=timeout, memory_mb=memory_mb, tmp=tmp,
                               out=out, progress=progress)
@@ -648,16 +649,34 @@ def _run_cases(indices: list[int], targets: tuple[str, ...], seeds: dict[str, li
     return results
 
 
+def _seeds_in(out: Path, pm: Any, seed: int) -> dict[str, list[dict[str, Any]]]:
+    """:func:`make_seeds` into ``out/seeds`` (the old seeds replaced); a failure to write them (a full disk, a
+    read-only folder) is one error naming the folder, and no part of them is left."""
+    from toolkit.files import write_error
+
+    folder = out.resolve() / "seeds"
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        shutil.rmtree(folder, ignore_errors=True)
+        return make_seeds(folder, pm, seed=seed)
+    except OSError as exc:
+        shutil.rmtree(folder, ignore_errors=True)
+        raise write_error(exc, folder, "fuzz seeds") from None
+
+
 def _keep(result: Result, out: Path) -> None:
-    """Write a failing case's input and its stderr (with the command that replays it) into ``out``."""
+    """Write a failing case's input and its stderr (with the command that replays it) into ``out`` (each file
+    written whole or not at all: :func:`toolkit.files.write_output`)."""
+    from toolkit.files import write_output
+
     case = result.case
-    (out / case.name).write_bytes(case.data)
+    write_output(out / case.name, case.data, "failing case")
     a = result.answer
     head = [f"# target: {case.target}; seed file: {case.seed_file}; mutations: {', '.join(case.mutations)}",
             f"# outcome: {result.outcome}: {result.key()}", f"# replay (in this folder): {case.command()}"]
     if a.get("message"):
         head.append(f"# message: {a['message']}")
-    (out / f"{case.name}.stderr").write_text("\n".join(head) + "\n" + a.get("stderr", ""), encoding="utf-8")
+    write_output(out / f"{case.name}.stderr", "\n".join(head) + "\n" + a.get("stderr", ""), "failing case")
 
 
 def summary_line(results: list[Result]) -> str:
@@ -716,7 +735,7 @@ def cmd_fuzz(args: Any, pm: Any) -> int:
     out_dir = _out_dir(getattr(args, "out_dir", None))
     console = Console(stderr=True)
     notes: list[str] = []
-    with Progress(console=console, transient=True, disable=args.quiet) as bar:
+    with Progress(console=console, transient=True, disable=args.quiet or not console.is_terminal) as bar:  # no blank line
         task = bar.add_task("fuzz", total=args.n)
         results = run_fuzz(pm, n=args.n, seed=args.seed, targets=targets, timeout=args.timeout,
                            memory_mb=args.memory, out=out_dir, notes=notes,

@@ -167,7 +167,8 @@ def cmd_posegraph(args: Any, pm: Any) -> int:
             print("| " + " | ".join(_row(r)) + " |", flush=True)
     if args.json:
         import json
-        from pathlib import Path
 
-        Path(args.json).write_text(json.dumps(rows, indent=2) + "\n")
+        from toolkit.files import write_output
+
+        write_output(args.json, json.dumps(rows, indent=2) + "\n")
     return 0

@@ -263,5 +263,7 @@ def cmd_scaling(args: Any, pm: Any) -> int:
                  [[r["nodes"], r["movements"], f"{r['path_search_ms']:.2f}"] for r in rep],
                  ["nodes", "movements", "query ms"], graph_slope, "query ms against nodes"), flush=True)
     if args.json:
-        Path(args.json).write_text(json.dumps(out, indent=1), encoding="utf-8")
+        from toolkit.files import write_output
+
+        write_output(args.json, json.dumps(out, indent=1) + "\n")
     return 0
