@@ -23,6 +23,7 @@ permission) into one :class:`~toolkit.errors.ConfigError` naming the target.
 from __future__ import annotations
 
 import contextlib
+import io
 import os
 import shutil
 import stat
@@ -118,10 +119,42 @@ def open_regular(path: str | Path, what: str = "file", kind: str = "config") -> 
         _check_stat(os.fstat(fd), path, what, kind)
         if hasattr(os, "set_blocking"):
             os.set_blocking(fd, True)
+        raw = _CheckedFile(fd, path, what)
     except BaseException:
         os.close(fd)
         raise
-    return os.fdopen(fd, "rb")
+    return io.BufferedReader(raw)
+
+
+class _CheckedFile(io.FileIO):
+    """A file opened for reading whose read errors (``EIO`` from ``/proc/self/mem`` behind a link, a failing disk)
+    are a :class:`ConfigError` naming it, as an unreadable file is when it is opened: whichever reader reads it (BVH,
+    CSV, C3D, TOML, state), the message is the same one line."""
+
+    def __init__(self, fd: int, path: Path, what: str) -> None:
+        super().__init__(fd, "rb", closefd=True)
+        self._path, self._what = path, what
+
+    def _failed(self, exc: OSError) -> ConfigError:
+        return ConfigError(f"cannot read ({exc.strerror or exc})", file=self._path, expected=f"a readable {self._what}")
+
+    def read(self, size: int = -1) -> bytes:
+        try:
+            return super().read(size)
+        except OSError as exc:
+            raise self._failed(exc) from None
+
+    def readall(self) -> bytes:
+        try:
+            return super().readall()
+        except OSError as exc:
+            raise self._failed(exc) from None
+
+    def readinto(self, buffer: Any) -> int:
+        try:
+            return super().readinto(buffer)
+        except OSError as exc:
+            raise self._failed(exc) from None
 
 
 def probe_writable(folder: str | Path, prefix: str = ".likeme-probe-") -> None:
