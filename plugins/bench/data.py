@@ -227,6 +227,10 @@ def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams:
     known = _link_repertoire(clips, dest, with_all=True)
     pool = [p for (c, s), ps in clips.items() if s != "normal" and c in known and
             (c not in LOCOMOTION or not gestures_only) for p in ps]
+    if len(pool) < per_stream:
+        raise ConfigError(f"{len(pool)} demos of the repertoire's movements in other styles than normal", file=src,
+                          expected=f"at least {per_stream} (a stream joins {per_stream} demos, each once)",
+                          available=[p.name for p in pool])
     rng = np.random.default_rng(seed)
     items = [{"clips": [str(pool[i]) for i in rng.choice(len(pool), per_stream, replace=False)],
               "path": str(dest / "cropped" / f"stream_{k + 1:02d}.bvh")} for k in range(streams)]
@@ -244,6 +248,10 @@ def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams:
         walks = _takes(Path(locomotion), "dataset-2_*.bvh", "dataset-2_{content}_{style}_{take}.bvh files")
         _link_repertoire(walks, dest / "locomotion")
         pool = [p for (c, s), ps in walks.items() if s != "normal" for p in ps]
+        if len(pool) < 2:
+            raise ConfigError(f"{len(pool)} locomotion takes in other styles than normal", file=locomotion,
+                              expected="at least 2 (a locomotion stream joins up to 4 takes)",
+                              available=[p.name for p in pool])
         items += [_joined(rng, pool, min(4, len(pool)), dest / "locomotion" / "streams" / f"stream_{k + 1:02d}.bvh",
                           (0.0, 0.0), STRIDE, 0.0) for k in range(max(1, streams // 2))]
     for item in items:

@@ -728,10 +728,6 @@ def cmd_fuzz(args: Any, pm: Any) -> int:
     if unknown or not targets:
         raise ConfigError(f"unknown fuzz target(s) {unknown}" if unknown else "no fuzz target", key=("--targets",),
                           expected="a comma-separated list of targets", available=list(TARGETS))
-    if args.n < 1 or not (args.timeout > 0) or args.timeout == float("inf") or args.memory < 0:
-        raise ConfigError(f"--n {args.n}, --timeout {args.timeout}, --memory {args.memory}",
-                          key=("--n" if args.n < 1 else "--timeout" if not 0 < args.timeout < float("inf") else "--memory",),
-                          expected="--n >= 1, a finite --timeout > 0 (seconds), --memory >= 0 (MB, 0: no limit)")
     out_dir = _out_dir(getattr(args, "out_dir", None))
     console = Console(stderr=True)
     notes: list[str] = []
