@@ -32,8 +32,10 @@ def view_of(pm: PluginManager, name: str, subject: str, settings: list[str]) -> 
 
 def warn(source: str | Path, warnings: list[str]) -> int:
     """Print each warning as ``likeme: warning: SOURCE: ...`` on standard error; return how many."""
+    from toolkit.errors import printable
+
     for text in warnings:
-        print(f"likeme: warning: {source}: {text}", file=sys.stderr)
+        print(f"likeme: warning: {printable(source, 300)}: {printable(text)}", file=sys.stderr)
     return len(warnings)
 
 

@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 
 from toolkit.recordings import csv_positions as pos
 from toolkit.errors import ConfigError
+from toolkit.recordings.recording import MAX_COORDINATE
 from toolkit.recordings import MAX_FPS, open_recording
 from toolkit.recordings.positions import JointPositions, read_positions
 from toolkit.recordings.recording import MAX_JOINTS
@@ -54,7 +55,8 @@ def csv_text(names, positions, *, times=None, delimiter=",", axis_style="_x", ex
 
 
 names_st = st.lists(st.from_regex(r"[A-Za-z][A-Za-z0-9_]{0,6}", fullmatch=True), min_size=1, max_size=5, unique=True)
-value_st = st.one_of(st.floats(allow_nan=False, allow_infinity=False, width=64), st.just(float("nan")))
+value_st = st.one_of(st.floats(-MAX_COORDINATE, MAX_COORDINATE, width=64), st.just(float("nan")))
+"""Every coordinate a recording gives as seen (beyond ``MAX_COORDINATE`` in size it is read as not seen)."""
 
 
 @st.composite
