@@ -339,8 +339,10 @@ def likeme_register_commands(subparsers):
                   "so its outcome does not depend on N, but loaded cores reach --timeout sooner")
     p.add_argument("--n", type=count_type(1, 1_000_000), default=2000, help="number of mutated inputs (default: 2000)")
     p.add_argument("--seed", type=seed_type, default=0, help="seed of the mutations (default: 0)")
-    p.add_argument("--targets", default="bvh,toml,profile,scenario,state,csv", help="comma-separated: bvh, toml, "
-                   "profile, scenario, state, csv (default: all)")
+    p.add_argument("--targets", default="bvh,toml,profile,scenario,state,csv,npy,c3d,special,bench,output",
+                   help="comma-separated: bvh, toml, profile, scenario, state, csv, npy, c3d, special (directories, "
+                   "FIFOs, links to unreadable files), bench (hostile option values), output (writes on a full disk) "
+                   "(default: all)")
     p.add_argument("--timeout", type=number_type(0.1, 3600.0, "seconds"), default=10.0, help="seconds a case may take (default: 10)")
     p.add_argument("--memory", type=count_type(0, 1_048_576), default=1024, help="address space a case may add to the worker, MB (default: 1024; 0: no limit)")
     p.add_argument("--out", metavar="DIR", dest="out_dir", help="write every failing input and its stderr into this "
