@@ -318,9 +318,9 @@ BENCH_OPTIONS = (
     (["bench", "memory", "--no-live"], "--limit"),
     (["bench", "watch", "--movements", "1"], "--runs"),
     (["bench", "learning", "--trials", "1", "--tests", "1"], "--takes"),
-    (["bench", "fuzz"], "--n"),
-    (["bench", "fuzz", "--n", "1"], "--timeout"),
-    (["bench", "fuzz", "--n", "1"], "--memory"),
+    (["bench", "fuzz", "--targets", "none"], "--n"),  # an accepted value ends at once: no such target
+    (["bench", "fuzz", "--n", "1", "--targets", "none"], "--timeout"),
+    (["bench", "fuzz", "--n", "1", "--targets", "none"], "--memory"),
 )
 """The ``likeme bench`` options a case gives a hostile value (the last option given wins), each with options that
 keep an accepted value's run short."""
