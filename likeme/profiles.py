@@ -28,7 +28,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from likeme.schemes import SCHEMES, Candidate, Scheme
 from toolkit.body import Body, Facing
+from toolkit.recordings.profile import Joint, gather_joints, joint_columns, joint_names
 
 __all__ = ["UPRIGHT_HEIGHT", "OTHER_SPAN", "FLIP_RATE", "SCHEMES", "profile_warnings", "RecordingCheck",
            "recording_warnings", "facing_warnings", "facing_flips", "body_groups", "Proposal", "propose_profile"]
@@ -69,10 +71,10 @@ def _named(names: Sequence[str], words: Iterable[str]) -> list[int]:
     return [i for i, n in enumerate(names) if any(w in _norm(n) for w in words)]
 
 
-def body_groups(parts: Sequence[str], joints: Sequence[str]) -> dict[str, list[int]]:
+def body_groups(parts: Sequence[str], joints: Sequence[Joint]) -> dict[str, list[int]]:
     """The indices of the parts that are a head (or neck, nose), hips and feet (toes, ankles, heels), by the part's
-    name or its source joint's (``head``, ``Head``, ``mixamorig:LeftUpLeg``, ``AnkleLeft``...)."""
-    both = [f"{_norm(p)} {_norm(j)}" for p, j in zip(parts, joints)]
+    name or its source joint's (``head``, ``Head``, ``mixamorig:LeftUpLeg``, ``AnkleLeft``...; a mean's joints)."""
+    both = [" ".join(_norm(n) for n in (p, *joint_names([j]))) for p, j in zip(parts, joints)]
     return {"head": _named(both, _HEAD_WORDS), "hips": _named(both, _HIP_WORDS), "feet": _named(both, _FOOT_WORDS)}
 
 
@@ -273,49 +275,6 @@ def recording_warnings(profile, blocks: Iterable[tuple[np.ndarray, np.ndarray]])
 
 # -- proposals ----------------------------------------------------------------------------------------------------
 
-SCHEMES: dict[str, dict[str, tuple[str, ...]]] = {
-    # likeme part: the joints of the scheme that can be it, in order of preference (the left side only)
-    "Bandai-Namco": {
-        "root": ("Hips",), "chest": ("Chest",), "neck": ("Neck",), "head": ("Head",), "head_top": ("Head_end",),
-        "left_shoulder": ("UpperArm_L",), "left_elbow": ("LowerArm_L",), "left_wrist": ("Hand_L",),
-        "left_hand": ("Hand_L_end",), "left_hip": ("UpperLeg_L",), "left_knee": ("LowerLeg_L",),
-        "left_foot": ("Foot_L",), "left_toes": ("Toes_L",), "left_toe_tip": ("Toes_L_end",),
-    },
-    "Mixamo": {
-        "root": ("mixamorig:Hips",), "chest": ("mixamorig:Spine2", "mixamorig:Spine1"), "neck": ("mixamorig:Neck",),
-        "head": ("mixamorig:Head",), "head_top": ("mixamorig:HeadTop_End", "mixamorig:Head_end"),
-        "left_shoulder": ("mixamorig:LeftArm",), "left_elbow": ("mixamorig:LeftForeArm",),
-        "left_wrist": ("mixamorig:LeftHand",), "left_hip": ("mixamorig:LeftUpLeg",),
-        "left_knee": ("mixamorig:LeftLeg",),
-        "left_foot": ("mixamorig:LeftFoot",), "left_toes": ("mixamorig:LeftToeBase",),
-        "left_toe_tip": ("mixamorig:LeftToe_End", "mixamorig:LeftToeBase_end"),
-    },
-    "CMU": {
-        "root": ("Hips",), "chest": ("Spine1", "Spine"), "neck": ("Neck1", "Neck"), "head": ("Head",),
-        "head_top": ("Head_end",), "left_shoulder": ("LeftArm",), "left_elbow": ("LeftForeArm",),
-        "left_wrist": ("LeftHand",), "left_hand": ("LeftFingerBase", "LeftHandIndex1"), "left_hip": ("LeftUpLeg",),
-        "left_knee": ("LeftLeg",), "left_foot": ("LeftFoot",), "left_toes": ("LeftToeBase",),
-        "left_toe_tip": ("LeftToeBase_end",),
-    },
-    "Kinect": {  # Kinect v2 (v1 and Azure Kinect names where they differ)
-        "root": ("SpineBase", "HipCenter", "PELVIS"), "chest": ("SpineShoulder", "ShoulderCenter", "SPINE_CHEST"),
-        "neck": ("Neck",), "head": ("Head",), "nose": ("NOSE",), "left_shoulder": ("ShoulderLeft",),
-        "left_elbow": ("ElbowLeft",), "left_wrist": ("WristLeft",), "left_hand": ("HandLeft",),
-        "left_hand_tip": ("HandTipLeft",), "left_hip": ("HipLeft",), "left_knee": ("KneeLeft",),
-        "left_foot": ("AnkleLeft",), "left_toes": ("FootLeft",),
-    },
-    "COCO/MediaPipe keypoints": {  # COCO's 17 and MediaPipe's 33 (left_shoulder, LEFT_SHOULDER), OpenPose's BODY_25
-        "root": ("mid_hip", "MidHip", "pelvis"), "nose": ("nose",), "neck": ("Neck",),
-        "left_eye": ("left_eye", "LEye"), "left_ear": ("left_ear", "LEar"),
-        "left_shoulder": ("left_shoulder", "LShoulder"), "left_elbow": ("left_elbow", "LElbow"),
-        "left_wrist": ("left_wrist", "LWrist"), "left_hand": ("left_index", "left_pinky"),
-        "left_hip": ("left_hip", "LHip"), "left_knee": ("left_knee", "LKnee"), "left_foot": ("left_ankle", "LAnkle"),
-        "left_heel": ("left_heel", "LHeel"), "left_toes": ("left_foot_index", "LBigToe"),
-    },
-}
-"""The joint-naming schemes a proposal knows: likeme part to the scheme's joint names (the right side's come from
-the left's, :func:`_mirror`). Compared in lower case, without a ``prefix:`` and without separators."""
-
 _PARENTS: dict[str, tuple[str, ...]] = {
     # a part's bone in a scheme without a hierarchy (joint positions): the first of these parts that is present
     "chest": ("root",), "neck": ("chest", "root"), "head": ("neck", "chest", "root"), "head_top": ("head",),
@@ -341,12 +300,12 @@ def _mirror_part(part: str) -> str:
     return "left_" + part[6:] if part.startswith("right_") else part
 
 
-def _with_right(table: Mapping[str, tuple[str, ...]]) -> dict[str, tuple[str, ...]]:
-    out: dict[str, tuple[str, ...]] = {}
+def _with_right(table: Mapping[str, tuple[Candidate, ...]]) -> dict[str, tuple[Candidate, ...]]:
+    out: dict[str, tuple[Candidate, ...]] = {}
     for part, joints in table.items():
         out[part] = joints
         if part.startswith("left_"):
-            out[_mirror(part)] = tuple(_mirror(j) for j in joints)
+            out[_mirror(part)] = tuple(_mirror(j) if isinstance(j, str) else tuple(map(_mirror, j)) for j in joints)
     return out
 
 
@@ -358,19 +317,26 @@ PARTS_ORDER = ("root", "chest", "neck", "head", "head_top", "nose", "left_eye", 
 """The order of the parts in a proposed profile."""
 
 
-def _match(names: Sequence[str]) -> tuple[str | None, dict[str, str]]:
-    """The scheme that names most of ``names``, and its part -> joint mapping (joints as the file spells them)."""
+def _match(names: Sequence[str]) -> tuple[Scheme | None, dict[str, Joint]]:
+    """The scheme (of :data:`SCHEMES`) that names most of ``names``, and its part -> joint mapping (joints as the
+    file spells them; a tuple for a part that is the mean of joints). Ties go to the scheme that spells more names
+    exactly as the file does (CMU's ``Hips`` is not ``mixamorig:Hips``)."""
     by_norm: dict[str, str] = {}
     for n in names:
         by_norm.setdefault(_norm(n), n)
-    best: tuple[tuple[int, int], str | None, dict[str, str]] = ((0, 0), None, {})
-    for scheme, table in SCHEMES.items():
-        mapping: dict[str, str] = {}
-        exact = 0  # names spelt exactly as the scheme spells them: CMU's Hips is not mixamorig:Hips
-        for part, candidates in _with_right(table).items():
+    best: tuple[tuple[int, int], Scheme | None, dict[str, Joint]] = ((0, 0), None, {})
+    for scheme in SCHEMES.values():
+        mapping: dict[str, Joint] = {}
+        exact = 0
+        for part, candidates in _with_right(scheme.parts).items():
             for c in candidates:
-                if _norm(c) in by_norm and by_norm[_norm(c)] not in mapping.values():
-                    mapping[part] = by_norm[_norm(c)]
+                if isinstance(c, str):
+                    if _norm(c) in by_norm and by_norm[_norm(c)] not in mapping.values():
+                        mapping[part] = by_norm[_norm(c)]
+                        exact += mapping[part] == c
+                        break
+                elif all(_norm(j) in by_norm for j in c):
+                    mapping[part] = tuple(by_norm[_norm(j)] for j in c)
                     exact += mapping[part] == c
                     break
         if (len(mapping), exact) > best[0]:
@@ -397,6 +363,8 @@ def _side_pair(parts: Sequence[str], joints: Sequence[str]) -> tuple[str, str] |
     """A left/right pair of parts whose joint names differ only by the side (the one nearest the start)."""
     index = {j: p for p, j in zip(parts, joints)}
     for p, j in zip(parts, joints):
+        if not isinstance(j, str):  # a mean of joints: on the body's midline
+            continue
         right = _mirror(j)
         if right != j and right in index:
             return p, index[right]
@@ -410,6 +378,8 @@ class Proposal:
     text: str
     scheme: str | None
     todo: list[str]
+    warnings: list[str] = field(default_factory=list)
+    """What is probably wrong even after the proposal (a body of implausible height for its scheme's units)."""
 
 
 def propose_profile(names: Sequence[str], positions: np.ndarray, *, parents: Sequence[int] | None = None,
@@ -436,11 +406,13 @@ def propose_profile(names: Sequence[str], positions: np.ndarray, *, parents: Seq
     names = list(names)
     positions = np.asarray(positions, dtype=float)
     todo: list[str] = []
-    scheme, mapping = _match(names)
+    warnings: list[str] = []
+    found, mapping = _match(names)
     if len(mapping) < 5:  # too few to be that scheme: every joint a part of its own name
-        scheme, mapping = None, _generic(names)
-        todo.append("no known joint-naming scheme (CMU, Mixamo, Bandai-Namco, Kinect, COCO/MediaPipe): every joint "
-                    "is a part named after it; rename the parts you use (head, left_hip...) and drop the others")
+        found, mapping = None, _generic(names)
+        todo.append(f"no known joint-naming scheme ({', '.join(SCHEMES)}): every joint is a part named after it; "
+                    "rename the parts you use (head, left_hip...) and drop the others")
+    scheme = found.name if found is not None else None
     ordered = {p: mapping[p] for p in PARTS_ORDER if p in mapping}
     ordered.update({p: j for p, j in mapping.items() if p not in ordered})
     mapping = ordered
@@ -457,8 +429,7 @@ def propose_profile(names: Sequence[str], positions: np.ndarray, *, parents: Seq
             root_note = f"TODO: the root is the hierarchy's root joint {mapping['root']!r}: choose the body's centre"
         todo.append(root_note[6:])
     parts, joints = list(mapping), list(mapping.values())
-    cols = [names.index(j) for j in joints]
-    data = positions[:, cols]
+    data = gather_joints(positions, joint_columns(names, joints))
     groups = body_groups(parts, joints)
 
     # up: the direction from the feet (else the hips, the root) to the head, in the file's axes
@@ -491,15 +462,27 @@ def propose_profile(names: Sequence[str], positions: np.ndarray, *, parents: Seq
     rotate = UP_AXES[up]
     world = data @ rotate.T  # the file's units, +y up
 
-    # units: the body's size in the file's units, made plausible for its kind
+    # units: a person's height from the head to the feet where the scheme is a person's, else the body's size in
+    # the file's units made plausible for its kind
     vertical, span = _extents(world, seen, _UP)
-    if np.isfinite(span).any():
+    person = _person_units(world, seen, groups, found) if found is not None and found.person else None
+    if person is not None:
+        units, scale, units_note, unsure = person
+        if unsure:
+            todo.append(unsure)
+            warnings.append(f"{unsure}: check units (the comment beside it gives the height in the file's units)")
+            units_note = f"TODO: {unsure} ({units_note})"
+    elif np.isfinite(span).any():
         upright, height, size = _size_kind(vertical, span)
         raw = height if upright else size
         units, scale = _best_unit(raw, upright)
         low, high = UPRIGHT_HEIGHT if upright else OTHER_SPAN
         units_note = (f"the body is {raw:.4g} units {'tall' if upright else 'across'}: {raw * scale:.3g} m in "
                       f"{units}s")
+        person = [f"{n} would make it {raw * v:.3g} m" for v, n in _PERSON_UNITS  # an upright body of no known
+                  if upright and v != scale and PERSON_HEIGHT[0] <= raw * v <= PERSON_HEIGHT[1]]  # scheme: a person?
+        if person and not PERSON_HEIGHT[0] <= raw * scale <= PERSON_HEIGHT[1]:
+            units_note += f" (if it is a person: {'; '.join(person)})"
         if not low <= raw * scale <= high:
             todo.append(f"no unit makes the body {low:g} to {high:g} m {'tall' if upright else 'across'}")
             units_note = f"TODO: {todo[-1]} ({units_note})"
@@ -507,6 +490,13 @@ def propose_profile(names: Sequence[str], positions: np.ndarray, *, parents: Seq
         units, scale, units_note = "metre", 1.0, "TODO: no frame with two joints seen: the units are a guess"
         todo.append("no frame with two joints seen to tell the units by")
     world = world * scale
+
+    # the floor: where the feet stand, when it is not at the origin (a camera's frame)
+    floor, floor_note = _floor(world, seen, groups)
+    if floor is None and not floor_note and found is not None and found.camera:
+        todo.append(f"{found.name} records in a camera's frame and no feet were seen to find the floor by: give "
+                    "floor = HEIGHT (metres) where the floor is, for pictures")
+        floor_note = f"TODO: {todo[-1]}"
 
     # facing: a left/right pair across the body, and a forward marker that is in front of it in every frame
     facing_note = ""
@@ -552,9 +542,84 @@ def propose_profile(names: Sequence[str], positions: np.ndarray, *, parents: Seq
             parent = next((q for q in sided if q in mapping), None)
             if parent is not None:
                 bones.append((parent, p))
+    used = set(joint_names(joints))
     text = _format(name, source, scheme, units, units_note, up, up_note, mapping, body_facing, facing_note, bones,
-                   [n for n in names if n not in joints], root_note, fps, len(positions))
-    return Proposal(text, scheme, todo)
+                   [n for n in names if n not in used], root_note, fps, len(positions), floor, floor_note)
+    return Proposal(text, scheme, todo, warnings)
+
+
+PERSON_STATURE = (0.9, 2.2)
+"""The distance (m) from a person's head (the mean of the head, neck, nose) to the feet (ankles, toes, heels) when
+standing: a child to a tall adult. A ratio under 2.22 (CMU's unit to an inch), so that at most one unit of
+:func:`_person_units` fits, save for those known for the scheme, which are tried first."""
+PERSON_HEIGHT = (1.0, 2.3)
+"""The height (m) of a standing person, an older child to a tall adult: named beside the units of an upright body of
+no known scheme when another unit would make it one (a proposal cannot tell an inch file of a person from a small
+body in centimetres)."""
+_PERSON_UNITS = ((1.0, "metre"), (0.01, "centimetre"), (0.001, "millimetre"), (0.0254, "inch"))
+FLOOR_OFFSET = 0.1
+"""A floor further than this (m) from ``y = 0`` is proposed as the profile's ``floor``."""
+
+
+def _person_units(world: np.ndarray, seen: np.ndarray, groups: Mapping[str, list[int]], scheme: Scheme
+                  ) -> tuple[str, float, str, str] | None:
+    """``(units as the profile writes them, metres per unit, comment, unsure)`` for a person's skeleton, from the
+    distance between the head and the feet in the frames where it is longest (its 90th percentile: standing), in
+    the file's units (``world``: +y up). The first unit (the scheme's own, then metre, centimetre, millimetre, inch)
+    that makes it a person's (:data:`PERSON_STATURE`); ``unsure`` says why when none does. None without a head and
+    feet."""
+    if not groups["head"] or not groups["feet"]:
+        return None
+    head, feet = _mean_of(world, seen, groups["head"]), _mean_of(world, seen, groups["feet"])
+    length = np.linalg.norm(head - feet, axis=-1)
+    if not np.isfinite(length).any():
+        return None
+    raw = float(np.nanpercentile(length, 90))
+    if raw <= 0:
+        return None
+    candidates: list[tuple[float, str]] = list(scheme.units)
+    candidates += [(v, n) for v, n in _PERSON_UNITS if not any(np.isclose(v, c) for c, _ in scheme.units)]
+    low, high = PERSON_STATURE
+    fits = [(v, n) for v, n in candidates if low <= raw * v <= high]
+    if fits:
+        value, label = fits[0]
+        unsure = ""
+    else:
+        value, label = min(candidates, key=lambda c: max(np.log(low / (raw * c[0])), np.log(raw * c[0] / high)))
+        unsure = (f"the head is {raw * value:.3g} m from the feet with units {label.split(',')[0]}, and a person's is "
+                  f"{low:g} to {high:g} m: no unit known for {scheme.name} fits")
+    text = next((n for v, n in _PERSON_UNITS if np.isclose(v, value)), repr(value))
+    note = f"the head is {raw:.4g} units from the feet: {raw * value:.3g} m in {label}"
+    others = [f"{n.split(',')[0]} would make it {raw * v:.3g} m" for v, n in fits[1:]]
+    if others:
+        note += f" (also a person's: {'; '.join(others)})"
+    return text, value, note, unsure
+
+
+def _floor(world: np.ndarray, seen: np.ndarray, groups: Mapping[str, list[int]]) -> tuple[float | None, str]:
+    """The floor's height (m, +y up) where the feet stand (the 5th percentile over frames of the lowest foot joint
+    seen), and its comment; None when the floor is within :data:`FLOOR_OFFSET` of 0 (a comment says so) or there
+    are no feet seen (no comment)."""
+    if not groups["feet"]:
+        return None, ""
+    y = np.where(seen[:, groups["feet"]], world[:, groups["feet"], 1], np.nan)
+    lowest = np.nanmin(np.where(np.isfinite(y).any(axis=1, keepdims=True), y, np.inf), axis=1)
+    lowest = lowest[np.isfinite(lowest)]
+    if not len(lowest):
+        return None, ""
+    floor = round(float(np.percentile(lowest, 5)), 2)
+    if abs(floor) <= FLOOR_OFFSET:
+        return None, f"the feet stand on y = 0 (within {FLOOR_OFFSET:g} m): no floor offset"
+    return floor, (f"the feet stand at y = {floor:g} m, not on y = 0 (a camera's frame?): this puts them on the "
+                   "floor")
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def _choose_facing(parts: list[str], pair: tuple[str, str], candidates: list[tuple[str, str | None]],
@@ -582,7 +647,8 @@ def _choose_facing(parts: list[str], pair: tuple[str, str], candidates: list[tup
 
 def _format(name: str, source: str, scheme: str | None, units: str, units_note: str, up: str, up_note: str,
             mapping: Mapping[str, str], facing: Facing, facing_note: str, bones: list[tuple[str, str]],
-            unmapped: list[str], root_note: str, fps: float | None, frames: int) -> str:
+            unmapped: list[str], root_note: str, fps: float | None, frames: int, floor: float | None = None,
+            floor_note: str = "") -> str:
     q = json.dumps
     lines = [f"# Body profile proposed by `likeme profile` for {source or 'a recording'} ({frames} frames; "
              f"{'joint names of the ' + scheme + ' scheme' if scheme else 'joint names of no known scheme'}).",
@@ -593,11 +659,17 @@ def _format(name: str, source: str, scheme: str | None, units: str, units_note: 
                                                  for i in range(0, len(bones), 3)) + "]")
     lines += ["", "[profile]", f"name = {q(name)}",
               f"description = {q('proposed by likeme profile' + (' from ' + source if source else ''))}",
-              f"units = {q(units)}   # {units_note}", f"up = {q(up)}   # {up_note}", "",
+              f"units = {units if _is_number(units) else q(units)}   # {units_note}", f"up = {q(up)}   # {up_note}"]
+    if floor is not None:
+        lines.append(f"floor = {floor:g}   # {floor_note}")
+    elif floor_note.startswith("TODO"):
+        lines.append(f"# {floor_note}")
+    lines += ["",
               "# likeme part = source joint", "[parts]"]
     if root_note:
         lines.append(f"# {root_note}")
-    lines += [f"{_key(p)} = {q(j)}" for p, j in mapping.items()]
+    lines += [f"{_key(p)} = {q(j) if isinstance(j, str) else '{mean = ' + q(list(j)) + '}'}"
+              for p, j in mapping.items()]
     if unmapped:
         shown = ", ".join(unmapped[:30]) + (f" and {len(unmapped) - 30} more" if len(unmapped) > 30 else "")
         lines.append(f"# joints not mapped: {shown}")

@@ -338,10 +338,28 @@ def guarded(component: Any, method: str, *args: Any, **kwargs: Any) -> Any:
 
 
 def _answer(segment: Segment, early: Match | None, late: Match | None, cut: bool = False) -> Observation:
-    """The matcher's answer for a segment: what it concluded at the end, else what it committed to early."""
+    """The matcher's answer for a segment: what it concluded at the end, else what it committed to early. A
+    commitment the matcher decided at a frame but could report only at the end (decided on rows it had not taken in
+    yet, :meth:`Matcher.conclude <toolkit.components.Matcher.conclude>`) keeps that frame, so the answer is the same
+    whatever packets the rows came in."""
     if late is None and early is not None:
         return Observation(segment, early, early.decided_at, cut)
-    return Observation(segment, late if late is not None else Match.unknown(), None, cut)
+    if late is None:
+        return Observation(segment, Match.unknown(), None, cut)
+    return Observation(segment, late, late.decided_at if late.movement is not None and not late.stop else None, cut)
+
+
+def _eventful(closed: Sequence[tuple[int, Any]], onsets: Sequence[int], n: int) -> list[int]:
+    """The frames of a block of ``n`` where something happens, and each frame just before them: a segment closes
+    (``closed``: frame in block, segment), the onset of the segment under way changes (``onsets``: one per frame,
+    -1: none), the last frame. Between two of them the onset stays what it was."""
+    at = {0, n - 1}
+    for i, _ in closed:
+        at.update((i - 1, i))
+    change = np.flatnonzero(np.diff(np.asarray(onsets, dtype=np.int64))) + 1
+    at.update(change.tolist())
+    at.update((change - 1).tolist())
+    return sorted(i for i in at if 0 <= i < n)
 
 
 def _seconds(value: float | None, name: str) -> float | None:
@@ -482,6 +500,11 @@ class WatchingLoop:
             # of the segment under way, which the next such frame sets again. The frames that close segments and
             # the last frame leave the same state, the same observations in the same order.
             frames = sorted({i for i, _ in closed} | {n - 1})
+        elif self._max_frames is None:
+            # a streaming matcher, nothing cut: the rows between two frames where something happens (a segment
+            # closes, the onset changes) and the frames before those are given at once (_follow: Matcher.replay),
+            # which leaves the state and the reports that giving them one by one leaves, in the same order
+            frames = _eventful(closed, onsets, n)
         for i in frames:
             if k < len(closed) and closed[k][0] == i:  # segments closed at this frame
                 here = []
@@ -564,6 +587,8 @@ class WatchingLoop:
         if self._open != since:
             self._begin(since)
             self._replay(row + 1)  # the rows since the onset, all there already
+        elif self._view is not None and row > self._view.start + self._view.n:  # rows skipped by push: at once
+            self._replay(row + 1)
         else:
             self._feed(row)
 

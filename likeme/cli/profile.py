@@ -86,5 +86,5 @@ def handle(args: argparse.Namespace, pm: PluginManager) -> int:
               file=sys.stderr)
     for text in proposal.todo:
         print(f"likeme: note: {args.file}: TODO: {text}", file=sys.stderr)
-    warn(args.file, warnings)
+    warn(args.file, proposal.warnings + warnings)  # the proposal's own (an implausible height), then the checks'
     return 0

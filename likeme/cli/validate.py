@@ -55,8 +55,8 @@ def handle(args: argparse.Namespace, pm: PluginManager) -> int:
         try:
             if Path(path).suffix.lower() in SUFFIXES:
                 print(_validate_recording(path, profile, args.fps))
-                if profile is not None and recording_format(path) == ".bvh":  # where the profile is probably wrong
-                    warned += warn(path, _recording_warnings(profile, path, flips))  # for it (likeme.profiles)
+                if profile is not None:  # where the profile is probably wrong for it, in every format
+                    warned += warn(path, _recording_warnings(profile, path, flips, args.fps))  # (likeme.profiles)
                 continue
             table = read_toml(check_regular_file(path, "TOML file", "config"))
             if is_scenario(table):
@@ -92,13 +92,15 @@ def _profile_warnings(profile: Any) -> list[str]:
     return profile_warnings(profile)
 
 
-def _recording_warnings(profile: Any, path: str | Path, flips: list[tuple[str, Any, int]]) -> list[str]:
-    """Where ``profile`` is probably wrong for the recording ``path`` (units, up axis), read a block at a time; the
+def _recording_warnings(profile: Any, path: str | Path, flips: list[tuple[str, Any, int]],
+                        fps: float | None = None) -> list[str]:
+    """Where ``profile`` is probably wrong for the recording ``path`` (units, up axis), read a block at a time as
+    :meth:`BodyProfile.stream` gives it in any format (BVH, CSV, .npy, C3D; its ``[files]`` table applied); the
     frames where its facing flips are added to ``flips``, to be counted over every recording."""
     from likeme.profiles import RecordingCheck
 
-    check = RecordingCheck(profile)
-    with profile.stream(path) as blocks:
+    with profile.stream(path, fps=fps) as blocks:
+        check = RecordingCheck(blocks.profile)  # the profile as it reads this file
         for positions, visible in blocks:
             check.update(positions, visible)
     flips.append((str(path), *check.flips()))
@@ -111,12 +113,16 @@ def _validate_recording(path: str, profile: Any, fps: float | None) -> str:
     import numpy as np
 
     from toolkit.recordings import open_recording, recording_format
+    from toolkit.recordings.csv_positions import has_header
 
     fmt = recording_format(path)
+    profile = profile.for_file(path) if profile is not None else None  # its [files] table for this file
     rate = fps if fps is not None or profile is None else profile.fps
     names = None
     if fmt == ".npy":
         names = profile.npy_joints if profile is not None else _npy_joint_names(path)
+    elif fmt == ".csv" and profile is not None and not has_header(path):
+        names = profile.npy_joints
     with open_recording(path, names=names, fps=rate) as recording:
         unmapped = profile.check(recording) if profile is not None else []
         frames = hidden = 0

@@ -285,11 +285,17 @@ class Motion(Comparison):
         rows come with it (a matrix product's rounding depends on how many rows it multiplies), for a forward model
         fed rows one by one or at once; slower than :meth:`costs` for many rows."""
         out = np.empty((len(a), len(b)))
-        if out.size and a.seen.all() and b.seen.all():  # every part seen: one contiguous run of numbers a frame
+        if not out.size:
+            return out
+        whole = a.seen.all(axis=1) if b.seen.all() else np.zeros(len(a), dtype=bool)
+        if whole.all():  # every part seen: one contiguous run of numbers a frame
             flat_a, carry_a = a.flat
             flat_b, carry_b = b.flat
             kernel(_rms_full, reordered=True)(flat_a, carry_a, flat_b, carry_b, a.parts.shape[1], out)
-        elif out.size:
+        elif whole.any():  # each row by the kernel its own parts call for, whatever rows come with it
+            out[whole] = self.row_costs(a.take(whole), b)
+            out[~whole] = self.row_costs(a.take(~whole), b)
+        else:
             kernel(_rms)(np.ascontiguousarray(a.parts, dtype=np.float64), a.seen,
                           np.ascontiguousarray(np.where(a.carried[:, None], a.carry, 0.0)), a.carried,
                           np.ascontiguousarray(b.parts, dtype=np.float64), b.seen,

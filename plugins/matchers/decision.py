@@ -24,18 +24,30 @@ chosen once when a matcher is attached (``decision = "distance"`` or ``"calibrat
     - *other*: each take against the repertoire without its movement (leave one movement out): how near a
       movement the repertoire does not hold comes to the nearest it does hold.
 
-    A demonstration is unknown when its score is above the threshold (:meth:`Calibrated.threshold`): the
-    ``1 - known_rejected`` quantile of the *own* scores and of the *other* scores, the larger of the two, and never
-    above 1 (a movement that explains a demonstration no better than standing still does not stand for it). The
-    meaning a user sets is ``known_rejected``: at most that share of the performances of a known movement are
-    called unknown, as far as the repertoire shows how far a performance may lie from its movement. Where a
-    movement has several takes, their spread shows it; takes recorded one after another differ by almost nothing,
-    and one take shows nothing, so the repertoire's movements stand for it too: a performance of a movement is
-    taken to lie no farther from it than the repertoire's movements lie from their nearest neighbours, all but
-    ``known_rejected`` of them. The same setting then holds with one take of each movement, two, or fourteen. A
-    movement the repertoire does not hold is unknown where it lies farther from every known movement than that;
-    one as near to a known movement as the repertoire's own movements are to each other cannot be told from a
-    performance of it (``docs/matchers.md`` has the figures).
+    A demonstration is unknown when its score is above the threshold (:meth:`Calibrated.threshold`), never above 1
+    (a movement that explains a demonstration no better than standing still does not stand for it). The meaning a
+    user sets is ``known_rejected``, a share, read both ways as the repertoire allows:
+
+    - *the repertoire shows a gap*: all but ``known_rejected`` of the own scores lie below all but
+      ``known_rejected`` of the other scores (several takes of each movement, each nearer its own movement than
+      any other movement comes). Any threshold in the gap calls at most that share of a known movement's
+      performances unknown and takes at most that share of movements like the repertoire's own for known, as far
+      as the repertoire shows; the threshold is the gap's far side (the ``known_rejected`` quantile of the other
+      scores), because takes recorded one after another lie nearer each other than performances in other styles
+      or by other people do;
+    - *no gap* (one take of each movement, or takes that lie as far apart as movements do): the larger of the
+      ``1 - known_rejected`` quantiles of the own and the other scores. One take shows nothing of how far a
+      performance may lie, so the repertoire's movements stand for it: a performance of a movement is taken to
+      lie no farther from it than the repertoire's movements lie from their nearest neighbours, all but
+      ``known_rejected`` of them. A movement the repertoire does not hold is unknown where it lies farther than
+      that; one as near to a known movement as the repertoire's own movements are to each other cannot be told from
+      a performance of it.
+
+    The same setting holds with one take of each movement, two, or fourteen (``docs/matchers.md`` has the figures).
+
+A movement that holds still (a pose held, B&B §5.2.1's hub; a command with no guiding stroke, K&G §4.1) cannot be
+judged by a score relative to standing still: it *is* standing still, so every demonstration scores 1 against it
+whether it stands or waves. :class:`Stillness` judges it by how much the demonstration moves instead.
 
 The decision's answer, with the score and the threshold it was decided on, goes into the typed fields of
 :class:`toolkit.Match` (``score``, ``threshold``, ``nearest``, ``measure``), which ``likeme observe`` prints for
@@ -50,7 +62,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Calibrated", "Calibration", "DECISIONS", "Decision", "Distance", "Verdict"]
+__all__ = ["Calibrated", "Calibration", "DECISIONS", "Decision", "Distance", "Stillness", "Verdict"]
 
 
 @dataclass(frozen=True)
@@ -162,12 +174,58 @@ class Calibrated(Decision):
         return self._threshold
 
     def _limit(self) -> float:
-        """The larger of the ``1 - known_rejected`` quantiles of the own and of the other scores, at most
-        :data:`STILL` (1: no better than standing still); :data:`STILL` while the repertoire has neither two
-        movements nor two takes of one."""
-        scores = [np.asarray(s) for s in (self.calibration.own, self.calibration.other) if len(s)]
-        limits = [float(np.quantile(s, 1.0 - self.known_rejected)) for s in scores]
+        """At most :data:`STILL` (1: no better than standing still), and :data:`STILL` while the repertoire has
+        neither two movements nor two takes of one:
+
+        - where the repertoire shows a gap (the ``1 - known_rejected`` quantile of the own scores at most the
+          ``known_rejected`` quantile of the other scores), the gap's far side, the ``known_rejected`` quantile of
+          the other scores;
+        - else the larger of the ``1 - known_rejected`` quantiles of the own and of the other scores."""
+        rate = self.known_rejected
+        own, other = np.asarray(self.calibration.own), np.asarray(self.calibration.other)
+        if len(own) and len(other):
+            unknown = float(np.quantile(other, rate))
+            if float(np.quantile(own, 1.0 - rate)) <= unknown:
+                return min(unknown, STILL)
+        limits = [float(np.quantile(s, 1.0 - rate)) for s in (own, other) if len(s)]
         return min(max(limits), STILL) if limits else STILL
+
+
+@dataclass(frozen=True)
+class Stillness:
+    """The repertoire's movements that hold still, and how little a demonstration must move to be one of them.
+
+    Each movement's *motion* is the mean distance to standing still of its takes (the largest of them;
+    :meth:`plugins.matchers.comparison.Comparison.still`, in the comparison's unit). A movement whose takes do not
+    move at all (0, up to rounding) holds still. A demonstration that moves ``moved`` is such a movement when it
+    moves at most half as much as the least moving of the other movements (:attr:`limit`): then, by the triangle
+    inequality, no moving movement can come nearer to it than standing still does, so the still movement is the
+    nearest there is and the relative score, which is 1 for it whatever the demonstration, has nothing to add. No
+    still movement in the repertoire: nothing holds (:attr:`limit` 0).
+    """
+
+    still: frozenset[str] = frozenset()
+    limit: float = 0.0
+
+    ROUNDING = 1e-9
+    """A take's motion at most this (in the comparison's unit, a body size or a metre) is no motion at all."""
+
+    @classmethod
+    def of(cls, motion: dict[str, float]) -> Stillness:
+        """From each movement's motion (the largest of its takes')."""
+        still = frozenset(m for m, a in motion.items() if a <= cls.ROUNDING)
+        moving = [a for m, a in motion.items() if m not in still]
+        if not still:
+            return cls()
+        return cls(still, min(moving) / 2.0 if moving else float("inf"))
+
+    @property
+    def measure(self) -> str:
+        return "the demonstration's distance to standing still, at most half the least moving movement's"
+
+    def holds(self, nearest: str | None, moved: float) -> bool:
+        """Whether a demonstration that moved ``moved`` and came nearest to ``nearest`` is that still movement."""
+        return nearest in self.still and moved <= self.limit
 
 
 STILL = 1.0

@@ -273,7 +273,7 @@ def _keypoints(tmp_path, scheme_names):
     return path
 
 
-def test_profile_maps_coco_and_mediapipe_keypoints_and_says_the_root_is_a_choice(tmp_path, capsys):
+def test_profile_maps_coco_and_mediapipe_keypoints_with_the_root_between_the_hips(tmp_path, capsys):
     coco = [("nose", "head"), ("left_shoulder", "l_shoulder"), ("right_shoulder", "r_shoulder"),
             ("left_elbow", "l_elbow"), ("right_elbow", "r_elbow"), ("left_wrist", "l_wrist"),
             ("right_wrist", "r_wrist"),
@@ -282,14 +282,15 @@ def test_profile_maps_coco_and_mediapipe_keypoints_and_says_the_root_is_a_choice
     for names in (coco, [(n.upper(), p) for n, p in coco]):  # COCO's names, MediaPipe's
         status, out, err = run(capsys, "profile", _keypoints(tmp_path, names))
         assert status == 0
-        assert "COCO/MediaPipe keypoints scheme" in out
-        assert re.search(r"# TODO: no pelvis joint in this scheme: the root is '(left_hip|LEFT_HIP)'", out)
+        assert "MediaPipe/COCO keypoints scheme" in out and "TODO: no pelvis" not in out
+        assert re.search(r'root = \{mean = \["(left_hip|LEFT_HIP)", "(right_hip|RIGHT_HIP)"\]\}', out)
         (tmp_path / "p.toml").write_text(out)
         profile = load_profile(tmp_path / "p.toml")
         parts = dict(zip(profile.body.parts, profile.joints))
-        assert parts["left_foot"].lower() == "left_ankle" and "left_hip" not in parts
+        assert parts["left_foot"].lower() == "left_ankle" and parts["left_hip"].lower() == "left_hip"
+        assert [j.lower() for j in parts["chest"]] == ["left_shoulder", "right_shoulder"]
         assert (profile.body.facing.left, profile.body.facing.right, profile.body.facing.forward) == \
-            ("left_shoulder", "right_shoulder", "nose")
+            ("left_hip", "right_hip", "nose")
 
 
 @pytest.mark.parametrize("prefix, names", [
@@ -311,7 +312,7 @@ def test_profile_maps_mixamo_and_cmu_names(prefix, names):
         side = "l_" if j.startswith("Left") else "r_" if j.startswith("Right") else ""
         cols.append(pose[:, NAMES.index(side + points[j.removeprefix("Left").removeprefix("Right")])])
     proposal = propose_profile([prefix + j for j in joints], np.stack(cols, axis=1))
-    assert proposal.scheme == ("Mixamo" if prefix else "CMU")
+    assert proposal.scheme == ("Mixamo" if prefix else "CMU (cgspeed, MotionBuilder names)")
     for part, joint in names.items():
         assert f'{part} = "{prefix}{joint}"' in proposal.text
 
@@ -331,8 +332,9 @@ def test_a_skeleton_of_no_known_scheme_gets_todos_and_still_loads(tmp_path, caps
 
 def test_every_scheme_names_a_root_or_its_proposal_says_so():
     """Every scheme's table maps its parts to joints; a scheme without a pelvis still gets a root (a TODO)."""
-    for scheme, table in SCHEMES.items():
-        assert table and all(isinstance(j, tuple) and j for j in table.values()), scheme
+    for name, scheme in SCHEMES.items():
+        assert scheme.name == name and "root" in scheme.parts, name
+        assert all(isinstance(j, tuple) and j for j in scheme.parts.values()), name
 
 
 @pytest.mark.skipif(not BANDAI.is_dir(), reason=f"Bandai-Namco motion capture not found at {BANDAI}")

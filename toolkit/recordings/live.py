@@ -78,11 +78,15 @@ class LiveInput:
             positions, seen_keys = self._json(first)
             names = [k for k in seen_keys if k != "time"]
             profile.check(_Header(names))  # the first frame names every mapped joint (null when not seen)
+            self.profile = profile.for_names(names, self.path)  # each part's alias the input uses
+            if self.profile.joints != profile.joints:  # the first frame again, by those names
+                self._times.clear()
+                positions = self._json(first)[0]
             self._pending.append(positions)
         else:
             self.kind = "csv"
             self._layout = parse_header(first + "\n", self.path, None)
-            profile.check(_Header(list(self._layout.joints)))
+            self.profile = profile.for_names(list(self._layout.joints), self.path)  # aliases chosen once
         if self.fps is None:
             while len(self._pending) < 2:
                 frame = self._next_frame()

@@ -27,7 +27,10 @@ the decision the matchers share:
   and ``min_progress`` of its take has been followed (``Match.decided_at``: response facilitation). A committed
   movement that goes beyond the threshold, or that another now leads as far, is a deviation (``stop``);
 - **the answer at the end**: when nothing was committed or the commitment did not hold, every movement's score over
-  the whole demonstration, decided as path search decides (:mod:`plugins.matchers.decision`).
+  the whole demonstration, decided as path search decides (:mod:`plugins.matchers.decision`);
+- **standing still**: a movement whose commands predict no motion at all (a pose held) is never committed to early;
+  when it comes nearest at the end, the demonstration is it if it moved at most half as much as the least moving
+  other movement (:class:`plugins.matchers.decision.Stillness`), else unknown.
 
 The candidates are the takes a motor command graph learned from labelled clips (:meth:`MotorCommandGraph.takes`):
 this is the forward model for a repertoire of recordings; a character who learns by watching follows the paper's
@@ -44,7 +47,7 @@ from plugins.lib.compiled import one_thread
 from plugins.lib.root_frame import HeadingFilter, facing_heading, to_root_relative
 from plugins.lib.velocity import SMOOTHING, derivative
 from plugins.matchers.comparison import Frames, Motion
-from plugins.matchers.decision import Calibrated, Calibration, Decision
+from plugins.matchers.decision import Calibrated, Calibration, Decision, Stillness
 from plugins.matchers.warping import Chains, Warping, chain_calibration
 from toolkit import Match
 from toolkit import Motion as Recording
@@ -301,6 +304,11 @@ class Following:
         self._index = {m: i for i, m in enumerate(self.movements)}
         if isinstance(self.decision, Calibrated):
             self.decision.calibrate(self.calibration())
+        motion: dict[str, float] = {}
+        for take, movement in zip(self.prediction.takes, self.prediction.chains.movements):
+            moved = float(self.comparison.still(take).mean()) if len(take) else 0.0
+            motion[movement] = max(motion.get(movement, 0.0), moved)
+        self.stillness = Stillness.of(motion) if self.decision.relative else Stillness()
         self.watched: Watched | None = None
 
     def calibration(self) -> Calibration:
@@ -389,8 +397,8 @@ class Following:
         first = int(order[0])
         score = float(scores[first])
         runner = float(scores[order[1]]) if len(order) > 1 else np.inf
-        if not (score <= limit and runner >= LEAD * score):
-            return None
+        if not (score <= limit and runner >= LEAD * score) or self.movements[first] in self.stillness.still:
+            return None  # a still movement is told by how little the whole demonstration moved (conclude)
         c = self._take(first)
         length = self.prediction.chains.starts[c + 1] - self.prediction.chains.starts[c]
         progress = (self.ends[c] + 1) / length
@@ -422,21 +430,25 @@ class Following:
     def conclude(self, frames: int) -> Match | None:
         """The demonstration has ended (``frames`` long): the last samples, then the answer on all of it when
         nothing was committed or the commitment did not hold (``None``: the commitment stands)."""
+        was = self.committed
         self.add(np.zeros((0, len(self.body.parts), 3)), np.zeros((0, len(self.body.parts)), dtype=bool), ended=True)
         if self.committed is not None and not self.deviated:
-            return None
+            return self.commitment if was is None else None  # committed on the last samples: not reported yet
         if not len(self._still):
             return Match.unknown("nothing seen", details={"reason": "nothing seen"})
         scores = self._scores(len(self._still) - 1)
         ranked = tuple(sorted(zip(self.movements, scores.tolist()), key=lambda kv: (kv[1], kv[0])))
         limit = self.decision.threshold()
         nearest, score = ranked[0] if ranked else (None, np.inf)
+        if nearest in self.stillness.still:  # it scores 1 whatever is shown: how little was there to explain
+            score, limit, measure = float(self._still[-1]), self.stillness.limit, self.stillness.measure
+        else:
+            measure = self.decision.measure
         if nearest is None or score > limit:
             return Match.unknown("no prediction fits", nearest=nearest, score=score, threshold=limit,
-                                 measure=self.decision.measure, candidates=ranked)
+                                 measure=measure, candidates=ranked)
         confidence = max(0.0, 1.0 - score / limit) if limit > 0 and np.isfinite(limit) else 1.0
-        return Match(nearest, confidence, None, candidates=ranked, score=score, threshold=limit,
-                     measure=self.decision.measure)
+        return Match(nearest, confidence, None, candidates=ranked, score=score, threshold=limit, measure=measure)
 
     def match(self, motion: Recording) -> Match:
         """A whole segment at once: followed sample by sample, as it would have been live."""

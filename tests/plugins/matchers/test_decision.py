@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from plugins.matchers.decision import Calibrated, Calibration, Distance
+from plugins.matchers.decision import Calibrated, Calibration, Distance, Stillness
 from plugins.matchers.warping import chain_distances
 from toolkit import load_character
 from toolkit.observe import Observer, compose_observer
@@ -28,11 +28,26 @@ def test_distance_is_the_papers_limit_and_zero_is_none():
 
 
 @given(scores, scores, st.floats(0.0, 1.0))
-def test_the_calibrated_threshold_is_the_larger_quantile_of_the_own_and_other_scores_at_most_one(own, other, rate):
+def test_the_calibrated_threshold_is_the_gaps_far_side_else_the_larger_quantile_at_most_one(own, other, rate):
     decision = Calibrated(rate)
     decision.calibrate(Calibration.of(own, other))
     limits = [np.quantile(scores, 1.0 - rate) for scores in (own, other) if scores]
-    assert decision.threshold() == (min(max(limits), 1.0) if limits else 1.0)
+    if own and other and np.quantile(own, 1.0 - rate) <= np.quantile(other, rate):
+        assert decision.threshold() == min(np.quantile(other, rate), 1.0)
+    else:
+        assert decision.threshold() == (min(max(limits), 1.0) if limits else 1.0)
+
+
+def test_a_gap_between_own_takes_and_other_movements_puts_unknown_at_its_far_side():
+    """Two takes of each movement, each pair nearer each other than any other movement comes: at most 5% of
+    movements like the repertoire's own are taken for known (and at most 5% of the own takes rejected)."""
+    decision = Calibrated(0.05)
+    decision.calibrate(Calibration.of([0.17, 0.19, 0.24, 0.25, 0.36], [0.66, 0.69, 0.70, 0.73, 0.76]))
+    assert decision.threshold() == pytest.approx(np.quantile([0.66, 0.69, 0.70, 0.73, 0.76], 0.05))
+    assert decision.decide("walk", 0.6, 1.0).movement == "walk"  # a styled walk between the two
+    assert decision.decide("walk", 0.7, 1.0).movement is None  # as far as the repertoire's other movements lie
+    decision.calibrate(Calibration.of([0.17, 0.70], [0.66, 0.69, 0.70, 0.73, 0.76]))  # overlap: no gap
+    assert decision.threshold() == pytest.approx(np.quantile([0.66, 0.69, 0.70, 0.73, 0.76], 0.95))
 
 
 def test_the_calibrated_score_is_the_share_left_unexplained():
@@ -141,3 +156,14 @@ def test_with_two_takes_the_own_takes_count_too(generated, tmp_path):
     demos = sorted((folder / "demos").glob("*/*.bvh"))
     right = [observer.classify(profile.read(p, None)).movement == p.parent.name for p in demos]
     assert np.mean(right) >= 0.9
+
+
+def test_stillness_holds_half_way_to_the_least_moving_movement():
+    """A movement that does not move at all holds still; a demonstration is it when it moves at most half as much
+    as the least moving other movement (no moving one can then come nearer than standing still)."""
+    s = Stillness.of({"stand": 0.0, "nod": 0.3, "wave": 0.9, "sway": 1e-12})
+    assert s.still == {"stand", "sway"} and s.limit == pytest.approx(0.15)
+    assert s.holds("stand", 0.15) and not s.holds("stand", 0.151) and not s.holds("nod", 0.0)
+    assert not Stillness.of({"nod": 0.3, "wave": 0.9}).holds("nod", 0.0)
+    assert Stillness.of({"stand": 0.0}).holds("stand", 5.0)  # nothing moving to be nearer
+    assert not Stillness().holds(None, 0.0)

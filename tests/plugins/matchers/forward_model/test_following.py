@@ -128,3 +128,34 @@ def test_a_movement_that_goes_on_as_another_is_a_deviation(observer, generated):
     assert stops and stops[0][1].movement == "wave" and stops[0][1].reason == "deviation"
     assert stops[0][0] > commits[0][0] and stops[0][1].score > 0
     assert final is not None and final.decided_at is None  # the answer on all of it, not a commitment
+
+
+def test_every_take_of_the_repertoire_is_its_own_movement_standing_still_too(observer, generated):
+    """Max watching his own takes, each as one whole segment: every one is answered as itself. ``stand`` predicts
+    no motion at all, so its score against standing still is 1 whatever is shown: it is judged by how little the
+    demonstration moves (:class:`plugins.matchers.decision.Stillness`), and an answer decided on the last samples
+    is reported rather than lost."""
+    data, profile = generated
+    watcher = Observer(observer, profile.body, 30.0)
+    f = following(observer)
+    assert f.stillness.still == {"stand"}
+    answers = {}
+    for clip in sorted((data / "repertoire").glob("*/max.bvh")):
+        answers[clip.parent.name] = watcher.classify(profile.read(clip, None)).movement
+    assert answers == {name: name for name in answers}
+    stand = watcher.classify(profile.read(data / "repertoire" / "stand" / "max.bvh", None)).match
+    assert stand.measure == f.stillness.measure and stand.score <= stand.threshold == f.stillness.limit
+
+
+def test_a_moving_demonstration_is_not_the_still_movement(observer, generated):
+    """A wave moves far more than half the least moving movement: were standing still the nearest, it would not
+    be ``stand``; a demonstration that does not move is ``stand``, and never a moving movement by stillness."""
+    data, profile = generated
+    f = following(observer)
+    wave = profile.read(data / "repertoire" / "wave_both" / "max.bvh", None)
+    f.begin(wave.fps)
+    f.add(wave.world if wave.world is not None else wave.positions, wave.visible)
+    f.conclude(wave.n_frames)
+    assert float(f._still[-1]) > f.stillness.limit
+    assert not f.stillness.holds("stand", float(f._still[-1]))
+    assert f.stillness.holds("stand", 0.0) and not f.stillness.holds("nod", 0.0)
