@@ -10,6 +10,12 @@ specific subclass.
 - :class:`PluginError`: a plugin could not be loaded, registers something
   invalid, or raised inside a hook or component method. It names the plugin and
   the hook or method.
+
+A message echoes what the user gave (a key, a value, a file name, a CSV header cell), so it is made safe to print
+(:func:`printable`): a character a terminal would act on (an escape sequence, a bell, a line break, a right-to-left
+override) is shown escaped, ``\x1b`` as the four characters ``\x1b``, so the message stays one line that cannot
+retitle or clear the terminal; a part of it longer than :data:`MAX_PART` characters is cut, and a list of available
+names longer than :data:`MAX_LISTED` ends with "and N more".
 """
 
 from __future__ import annotations
@@ -17,7 +23,35 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
-__all__ = ["LikemeError", "ConfigError", "PluginError", "format_key"]
+__all__ = ["LikemeError", "ConfigError", "PluginError", "format_key", "printable", "listed", "MAX_PART",
+           "MAX_LISTED"]
+
+MAX_PART = 1000
+"""The most characters of one part of a message (the problem, the file, what was expected) before it is cut."""
+MAX_LISTED = 60
+"""The most names a message lists as available before it says how many more there are."""
+
+
+def printable(text: object, limit: int = MAX_PART) -> str:
+    """``str(text)`` safe for a terminal, on one line: every character that is not printable (controls such as ESC
+    and BEL, line and paragraph breaks, bidirectional overrides, lone surrogates) shown as Python writes it escaped
+    (``\x1b``, ``\n``, ``\u202e``); cut after ``limit`` characters with how many more there were."""
+    text = str(text)
+    extra = len(text) - limit
+    if extra > 0:
+        text = text[:limit]
+    if not text.isprintable():
+        text = "".join(c if c.isprintable() else c.encode("unicode_escape", "backslashreplace").decode("ascii")
+                       for c in text)
+    return text + (f"... ({extra:,} more characters)" if extra > 0 else "")
+
+
+def listed(names: Iterable[object], limit: int = MAX_LISTED) -> str:
+    """Names joined with commas, each :func:`printable` (and cut at 100 characters), at most ``limit`` of them and
+    then "and N more"."""
+    names = list(names)
+    shown = ", ".join(printable(n, 100) for n in names[:limit])
+    return shown + (f" and {len(names) - limit:,} more" if len(names) > limit else "")
 
 
 class LikemeError(Exception):
@@ -81,21 +115,23 @@ class ConfigError(LikemeError):
 
     @property
     def message(self) -> str:
+        """The one line: ``FILE:LINE:COLUMN: key KEY: PROBLEM; expected EXPECTED; available: NAMES``, every part
+        :func:`printable` and bounded."""
         where = ""
         if self.file is not None:
-            where = str(self.file)
+            where = printable(self.file, 300)
             if self.line is not None:
                 where += f":{self.line}"
                 if self.column is not None:
                     where += f":{self.column}"
         if self.key:
-            where += (": " if where else "") + f"key {format_key(self.key)}"
-        text = f"{where}: {self.problem}" if where else self.problem
+            where += (": " if where else "") + f"key {printable(format_key(self.key), 300)}"
+        problem = printable(self.problem)
+        text = f"{where}: {problem}" if where else problem
         if self.expected:
-            text += f"; expected {self.expected}"
+            text += f"; expected {printable(self.expected)}"
         if self.available is not None:
-            listed = ", ".join(self.available) if self.available else "(none)"
-            text += f"; available: {listed}"
+            text += f"; available: {listed(self.available) if self.available else '(none)'}"
         return text
 
     def __reduce__(self) -> tuple:
@@ -139,7 +175,7 @@ class PluginError(LikemeError):
         self.plugin = plugin
         self.where = where
         self.problem = problem
-        super().__init__(f"plugin {plugin!r} failed in {where}: {problem}")
+        super().__init__(f"plugin {printable(plugin, 100)!r} failed in {printable(where, 200)}: {printable(problem)}")
 
     def __reduce__(self) -> tuple:
         """Pickled with its three fields (an error raised in a worker process)."""

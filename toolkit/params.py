@@ -22,7 +22,19 @@ from typing import Any
 from toolkit.errors import ConfigError
 
 __all__ = ["Parameter", "REQUIRED", "validate_params", "finite_number", "length_names", "scaled", "flat_parameters",
-           "of_owner"]
+           "of_owner", "MAX_SECONDS", "MAX_MAGNITUDE"]
+
+MAX_SECONDS = 3600.0
+"""The longest duration a ``seconds`` parameter takes unless it declares its own maximum: an hour. Plugins turn a
+duration into frames (``round(seconds * fps)``, at up to 10,000 frames per second) and size windows and buffers by it;
+an hour keeps every such count an integer of at most 3.6e7, where ``1e308`` seconds gave an infinity inside the
+plugin."""
+
+MAX_MAGNITUDE = 1e9
+"""The largest magnitude a number parameter without a maximum of its own takes. No setting of a toolkit of bodies in
+metres, seconds and hertz means anything beyond a billion of its unit, and a bound this far below a float's range keeps
+every product a plugin forms with it (by a frame rate, a body size, a count of frames) finite: ``1e308`` is refused by
+key before the plugin runs instead of overflowing inside it."""
 
 
 class _Required:
@@ -65,6 +77,10 @@ class Parameter:
         Element type for ``list`` parameters.
     check : callable, optional
         ``check(value) -> str | None``: a further check returning a problem or ``None``.
+    seconds : bool
+        A duration in seconds, which the plugin turns into frames: at most :data:`MAX_SECONDS` unless ``maximum``
+        says otherwise (Kopp & Graeser 2006, §4.1's sensory memory and Buchsbaum & Blumberg 2005, §5.1's filter are
+        such durations).
     length : bool
         A length on the observer's own body (metres, or metres per second or per radian): a character whose file
         gives ``[character] lengths_for_height`` reads it as meant for a body that tall and scales it to its own
@@ -84,10 +100,13 @@ class Parameter:
     choices: Sequence[Any] | None = None
     items: type | None = None
     check: Callable[[Any], str | None] | None = None
+    seconds: bool = False
     length: bool = False
     parameters: Sequence[Parameter] = ()
 
     def __post_init__(self) -> None:
+        if self.seconds and self.maximum is None:
+            object.__setattr__(self, "maximum", MAX_SECONDS)
         if self.parameters:  # a table: its value is the table with every default filled in
             object.__setattr__(self, "parameters", tuple(self.parameters))
             given = {} if self.default is REQUIRED else self.default
@@ -146,6 +165,11 @@ class Parameter:
         if self.type in (int, float):
             if self.minimum is not None and value < self.minimum or self.maximum is not None and value > self.maximum:
                 raise ConfigError(f"value {value!r} out of range", key=(self.name,), expected=self._expected())
+            if self.type is float and self.maximum is None and abs(value) > MAX_MAGNITUDE:
+                low = -MAX_MAGNITUDE if self.minimum is None else self.minimum
+                raise ConfigError(f"value {value!r} too large", key=(self.name,),
+                                  expected=f"a number in [{low:g}, {MAX_MAGNITUDE:g}] (no parameter without a maximum "
+                                           "of its own takes more)")
         if self.choices is not None and value not in self.choices:
             raise ConfigError(
                 f"value {value!r} not allowed",

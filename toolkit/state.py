@@ -68,7 +68,7 @@ from typing import Any
 
 from toolkit.character import Character
 from toolkit.errors import ConfigError, PluginError
-from toolkit.files import LIMITS, max_bytes, open_regular, probe_writable
+from toolkit.files import LIMITS, max_bytes, open_regular, probe_writable, replace_atomically
 from toolkit.hookspecs import hookimpl
 
 __all__ = ["FORMAT", "VERSION", "READS", "MAX_BYTES", "MAX_DEPTH", "MAX_INT", "MAX_STRING", "write_atomic",
@@ -88,43 +88,15 @@ MAX_STRING = 4096  #: the longest string (names, sources)
 # -- writing -----------------------------------------------------------------------------------
 
 
-def _umask() -> int:
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
 def write_atomic(path: str | Path, text: str) -> None:
-    """Write ``text`` to ``path`` so that readers see the old or the new content, never a part.
+    """Write ``text`` to ``path`` so that readers see the old or the new content, never a part
+    (:func:`toolkit.files.replace_atomically`, the one writer).
 
     The temporary file ``.NAME.*.tmp`` is removed whatever fails; an existing file keeps its permission bits, a
-    new one gets ``0o666`` under the umask (not :func:`tempfile.mkstemp`'s ``0o600``).
+    new one gets ``0o666`` under the umask (not :func:`tempfile.mkstemp`'s ``0o600``). An :class:`OSError` is raised
+    as it was (a save reports it and tries again).
     """
-    path = Path(path)
-    folder = path.parent if str(path.parent) else Path(".")
-    try:
-        mode = stat.S_IMODE(os.stat(path).st_mode)
-    except OSError:
-        mode = 0o666 & ~_umask()
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            os.fchmod(handle.fileno(), mode)
-            handle.write(text)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    try:  # make the rename itself durable
-        dir_fd = os.open(folder, os.O_RDONLY)
-        try:
-            os.fsync(dir_fd)
-        finally:
-            os.close(dir_fd)
-    except OSError:
-        pass
+    replace_atomically(path, text.encode("utf-8"))
 
 
 def canonical(data: Any) -> bytes:

@@ -29,6 +29,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from likeme.cli import observe, plugins, profile, run, show, validate
+from likeme.cli.common import guarded_output
 from toolkit import __version__
 from toolkit.arguments import CommandParser, check_outputs
 from toolkit.errors import LikemeError
@@ -65,6 +66,7 @@ def create_plugin_manager() -> PluginManager:
     return create(lazy=True)
 
 
+@guarded_output
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``likeme`` command; returns the exit status.
 

@@ -59,14 +59,11 @@ def _read_recording(path: str) -> tuple[list[str], Any, list[int] | None, float 
 def handle(args: argparse.Namespace, pm: PluginManager) -> int:
     """Propose a body profile for a recording (``likeme.profiles.propose_profile``), check it on the same
     recording, and print it or write it to ``--out``; what it could not decide is marked ``# TODO``."""
-    import tempfile
-
     import numpy as np
 
     from likeme.profiles import propose_profile, recording_warnings
-    from toolkit.files import check_regular_file
+    from toolkit.files import check_regular_file, scratch_folder, write_output
     from toolkit.recordings.profile import load_profile
-    from toolkit.state import write_atomic
 
     check_regular_file(args.file, "recording", "motion")
     names, positions, parents, fps, frames = _read_recording(args.file)
@@ -74,17 +71,16 @@ def handle(args: argparse.Namespace, pm: PluginManager) -> int:
         raise ConfigError("no frames", file=args.file, expected="a recording with at least one frame")
     stem = re.sub(r"[^A-Za-z0-9_-]+", "-", Path(args.out or args.file).stem).strip("-") or "proposed"
     proposal = propose_profile(names, positions, parents=parents, name=stem, source=Path(args.file).name, fps=fps)
-    with tempfile.TemporaryDirectory() as tmp:  # the proposal must load and pass its own checks on this recording
-        draft = Path(tmp) / f"{stem}.toml"
-        draft.write_text(proposal.text, encoding="utf-8")
-        profile = load_profile(draft)
+    text = proposal.text if proposal.text.endswith("\n") else proposal.text + "\n"  # a text file ends its last line
+    with scratch_folder() as tmp:  # the proposal must load and pass its own checks on this recording
+        profile = load_profile(write_output(tmp / f"{stem}.toml", text, "draft profile"))
     converted = profile.convert(positions, names)
     warnings = recording_warnings(profile, [(converted, np.isfinite(converted).all(axis=-1))])
     if args.out:
-        write_atomic(args.out, proposal.text)
+        write_output(args.out, text, "profile")
         print(f"wrote {args.out}", file=sys.stderr)
     else:
-        print(proposal.text, end="")
+        print(text, end="")
     if len(positions) < frames:
         print(f"likeme: note: {args.file}: proposed from the first {len(positions)} of {frames} frames",
               file=sys.stderr)

@@ -83,8 +83,12 @@ def _run_scenario(path: str, pm: PluginManager, args: argparse.Namespace) -> dic
     view = view_of(pm, args.view, "scenario", args.set) if getattr(args, "render", None) else None
     files = []
     try:
-        if view is not None:  # a scenario view runs the scenario while it records it, then draws it
-            files = view.draw(scenario, Path(args.render))
+        if view is not None:  # a scenario view runs the scenario while it records it, then draws it, all files at once
+            from toolkit.files import writing_folder
+
+            folder = Path(args.render)
+            with writing_folder(folder, "render") as stage:
+                files = [folder / Path(f).relative_to(stage) for f in view.draw(scenario, stage)]
         else:
             scenario.run()
     finally:

@@ -14,6 +14,8 @@ from toolkit.arguments import check_output_dir, check_output_file
 from toolkit.errors import ConfigError
 
 if TYPE_CHECKING:  # pragma: no cover
+    from collections.abc import Callable
+
     from toolkit.manager import PluginManager
 
 __all__ = ["add_parser", "handle"]
@@ -95,7 +97,8 @@ def handle(args: argparse.Namespace, pm: PluginManager) -> int:
     if args.view:
         view = view_of(pm, args.view, "character", args.set)
         name = re.sub(r"[^a-z0-9]+", "-", character.name.lower()).strip("-")
-        for path in view.draw(character, _show_out(args.out_path, name, args.view)):
+        out = _show_out(args.out_path, name, args.view)
+        for path in _drawn([out], lambda staged: view.draw(character, staged[0])):
             print(f"wrote {path}")
         return 0
     if args.actions:
@@ -107,6 +110,19 @@ def handle(args: argparse.Namespace, pm: PluginManager) -> int:
         return 0
     print(json.dumps(describe_character(character), indent=2))
     return 0
+
+
+def _drawn(outs: list[Path], draw: Callable[[list[Path]], list[Path]]) -> list[Path]:
+    """The files ``draw`` writes for the pictures ``outs`` (all in one folder), drawn into a staging folder there
+    and moved in when all are written (:func:`toolkit.files.writing_folder`): a full disk or a read-only folder is
+    one error naming it, and no half-written picture is left."""
+    from toolkit.files import writing_folder
+
+    folder = outs[0].parent
+    what = "picture " + ", ".join(o.name for o in outs[:3]) + (f" and {len(outs) - 3} more" if len(outs) > 3 else "")
+    with writing_folder(folder, what) as stage:
+        written = [Path(w) for w in draw([stage / o.name for o in outs])]
+    return [folder / w.relative_to(stage) if w.is_relative_to(stage) else w for w in written]
 
 
 def _show_out(out: str | None, name: str, view: str, several: bool = False) -> Path:
@@ -154,11 +170,10 @@ def _show_recordings(args: argparse.Namespace, pm: PluginManager, template: str 
     character = compose_observer(pm, profile, repertoire, template=template,
                                  segmenter=segmenter, matcher=matcher, correspondence=args.correspondence or "")
     if each == "all":
-        written = view.draw(character, outs[0], recordings=demos)
+        written = _drawn(outs, lambda staged: view.draw(character, staged[0], recordings=demos))
     else:
-        written = []
-        for out, demo in zip(outs, demos):
-            written += view.draw(character, out, recording=demo)
+        written = _drawn(outs, lambda staged: [w for out, demo in zip(staged, demos)
+                                               for w in view.draw(character, out, recording=demo)])
     for path in written:
         print(f"wrote {path}")
     return 0

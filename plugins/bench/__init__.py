@@ -24,11 +24,17 @@ __all__ = ["text_table", "progress"]
 
 def progress(items: Iterable[T], label: str) -> Iterable[T]:
     """``items`` with a progress bar on standard error (never standard output: a piped table starts with the table),
-    cleared when done; the bar is drawn only where standard error is a terminal."""
+    cleared when done; the bar is drawn only where standard error is a terminal (elsewhere nothing is written: rich's
+    live display would still end with a blank line, issue 37)."""
+    import sys
+
     from rich.console import Console
     from rich.progress import track
 
-    return track(items, description=label, transient=True, console=Console(stderr=True))
+    console = Console(stderr=True)
+    if not console.is_terminal or sys.stderr is None:
+        return items
+    return track(items, description=label, transient=True, console=console)
 
 
 def text_table(rows: Sequence[Sequence[Any]], columns: Sequence[tuple[str, str]], *, header: bool = True,

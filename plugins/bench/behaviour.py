@@ -23,7 +23,7 @@ import numpy as np
 
 from plugins.bench import progress as progress_bar
 from toolkit import World, load_character
-from toolkit.state import write_atomic
+from toolkit.files import write_output
 
 __all__ = ["BEHAVIOUR_CONDITIONS", "behaviour_benchmark", "render_behaviour", "cmd_behaviour", "world_name"]
 
@@ -203,5 +203,5 @@ def cmd_behaviour(args: argparse.Namespace, pm: Any) -> int:
                                  jobs=args.jobs, scheduler=args.scheduler, perception=args.perception)
     print(render_behaviour(result))
     if args.json:
-        write_atomic(Path(args.json), json.dumps(result, indent=2, default=float) + "\n")
+        write_output(args.json, json.dumps(result, indent=2, default=float) + "\n")
     return 0

@@ -13,6 +13,11 @@ from typing import Any
 from toolkit import hookimpl
 from toolkit.arguments import count_type, fps_type, number_type, observer_options, seed_type
 
+MAX_NODES = 500_000
+"""The most poses ``likeme bench posegraph --nodes`` builds an index of: half a million poses of the body's 11 parts
+take about 0.75 GB with their k-d tree (a million took 1.46 GB); ``--nodes`` times ``--parts`` is held to the same
+5.5 million joint positions."""
+
 MATCHERS = ("path-search", "forward-model", "dtw")
 """The matchers ``likeme bench recognition`` and ``stream`` compare when none is named."""
 SEGMENTERS = ("hub-threshold", "velocity-direction", "ruptures")
@@ -217,12 +222,17 @@ def likeme_register_commands(subparsers):
     p.add_argument("--runs", type=count_type(1, 10_000), default=1, metavar="R",
                    help="independent runs, each a fresh Max who learns his own repertoire, run r with seed --seed + r; "
                    "the figures pool every run's demonstrations (default: 1)")
-    p.add_argument("--demonstrations", type=int, default=200, help="demonstrations after the repertoire (default: 200)")
-    p.add_argument("--repertoire", type=int, default=6, help="random movements learned first (default: 6)")
-    p.add_argument("--noise", type=float, default=0.002, help="observation noise, metres (default: 0.002)")
-    p.add_argument("--hands", type=float, default=0.3, help="share of finger movements of the left hand among the "
+    p.add_argument("--demonstrations", type=count_type(1, 100_000), default=200,
+                   help="demonstrations after the repertoire (default: 200)")
+    p.add_argument("--repertoire", type=count_type(1, 100), default=6,
+                   help="random movements learned first (default: 6)")
+    p.add_argument("--noise", type=number_type(0.0, 1.0, "metres"), default=0.002,
+                   help="observation noise, metres (default: 0.002)")
+    p.add_argument("--hands", type=number_type(0.0, 1.0, "a share of the demonstrations"), default=0.3,
+                   help="share of finger movements of the left hand among the "
                    "demonstrations (default: 0.3; 0: arms only)")
-    p.add_argument("--angle-noise", type=float, default=0.005, help="observation noise on finger joint angles, radians "
+    p.add_argument("--angle-noise", type=number_type(0.0, 1.0, "radians"), default=0.005,
+                   help="observation noise on finger joint angles, radians "
                    "(default: 0.005)")
     p.add_argument("--seed", type=seed_type, default=0)
     p.add_argument("--json", metavar="FILE", help="also write the results as JSON")
@@ -231,7 +241,8 @@ def likeme_register_commands(subparsers):
 
     p = sub.add_parser("behaviour", help="an observer identifies the behaviour, motivation and object of a demonstrator (B&B §6)")
     _jobs_options(p)
-    p.add_argument("--episodes", type=int, default=100, help="random episodes per condition (default: 100)")
+    p.add_argument("--episodes", type=count_type(1, 100_000), default=100,
+                   help="random episodes per condition (default: 100)")
     p.add_argument("--perception", choices=("own", "synthetic-vision"), default="own", help="Max's perception as "
                    "his file gives it (own: rendered vision) or synthetic vision in its place, the same eye and "
                    "looks (default: own)")
@@ -261,18 +272,20 @@ def likeme_register_commands(subparsers):
     p = sub.add_parser("memory", help="the observer's memory against stream length: a live observer fed for "
                        "--minutes, and likeme observe on generated BVH streams")
     _jobs_options(p, "the live observer and each --observe-minutes stream", timing=True)
-    p.add_argument("--minutes", type=float, default=60.0, help="simulated minutes fed to the live observer "
+    p.add_argument("--minutes", type=number_type(1e-3, 1440.0, "minutes"), default=60.0,
+                   help="simulated minutes fed to the live observer "
                    "(default: 60)")
-    p.add_argument("--every", type=float, default=10.0, help="print a line every this many minutes (default: 10)")
-    p.add_argument("--fps", type=float, default=120.0, help="frames per second of the streams (default: 120)")
-    p.add_argument("--block", type=int, default=120, help="frames a packet for the live observer (default: 120)")
+    p.add_argument("--every", type=number_type(1e-3, 1440.0, "minutes"), default=10.0,
+                   help="print a line every this many minutes (default: 10)")
+    p.add_argument("--fps", type=fps_type, default=120.0, help="frames per second of the streams (default: 120)")
+    p.add_argument("--block", type=count_type(1, 100_000), default=120, help="frames a packet for the live observer (default: 120)")
     p.add_argument("--tracemalloc", action="store_true", help="also trace Python allocations (slower)")
     p.add_argument("--no-live", action="store_true", help="skip the live observer")
-    p.add_argument("--observe-minutes", type=float, action="append", metavar="MIN", help="also run likeme "
+    p.add_argument("--observe-minutes", type=number_type(1e-3, 600.0, "minutes"), action="append", metavar="MIN", help="also run likeme "
                    "observe on a generated stream this long (repeatable; e.g. 1 and 60)")
-    p.add_argument("--limit", type=float, default=4.0, help="address space cap of the observe subprocess, GB "
+    p.add_argument("--limit", type=number_type(0.1, 1024.0, "GB"), default=4.0, help="address space cap of the observe subprocess, GB "
                    "(default: 4)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=seed_type, default=0)
     p.add_argument("--segmenter", metavar="NAME", help="the live observer's segmenter (default: the observer "
                    "template's)")
     p.add_argument("--matcher", metavar="NAME", help="the live observer's matcher (default: the template's)")
@@ -285,7 +298,7 @@ def likeme_register_commands(subparsers):
     p = sub.add_parser("posegraph", help="the k nearest poses of a posegraph of --nodes poses: the spatial index "
                        "(plugins.lib.pose_index) against the exhaustive scan; build time, query time, memory")
     _jobs_options(p, "one per --nodes, a table row each", timing=True)
-    p.add_argument("--nodes", type=count_type(1, 10_000_000), action="append", metavar="N",
+    p.add_argument("--nodes", type=count_type(1, MAX_NODES), action="append", metavar="N",
                    help="poses in the graph (repeatable, one table row each; default: 100000)")
     p.add_argument("--parts", type=count_type(1, 100), default=None, help="parts per pose (default: the body's, 11)")
     p.add_argument("--k", type=count_type(1, 1000), default=8, help="poses asked for (default: 8, path search's k)")
@@ -309,9 +322,9 @@ def likeme_register_commands(subparsers):
     _jobs_options(p, "one per --resolution, each stepping the scenario itself", timing=True)
     p.add_argument("--scenario", default="jump_then_cover_face", help="scenario to watch (default: jump_then_cover_face)")
     p.add_argument("--observer", default="max", help="the watching actor (default: max)")
-    p.add_argument("--resolution", type=int, action="append", help="rendered-vision resolution, repeatable "
+    p.add_argument("--resolution", type=count_type(16, 2048), action="append", help="rendered-vision resolution, repeatable "
                    "(default: 240, 480, 960)")
-    p.add_argument("--frames", type=int, default=240, help="frames to compare (default: 240)")
+    p.add_argument("--frames", type=count_type(1, 10_000), default=240, help="frames to compare (default: 240)")
     p.add_argument("--scenarios", action="store_true", help="instead: run every scenario with a watcher (or each "
                    "--scenario-name) with its perception and with synthetic vision, side by side: median seconds "
                    "and whether the conclusions are the same")
@@ -324,12 +337,14 @@ def likeme_register_commands(subparsers):
                        "errors allowed (docs/robustness.md)")
     _jobs_options(p, "blocks of cases, each through its own worker process; a case is made from its number alone, "
                   "so its outcome does not depend on N, but loaded cores reach --timeout sooner")
-    p.add_argument("--n", type=int, default=2000, help="number of mutated inputs (default: 2000)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the mutations (default: 0)")
-    p.add_argument("--targets", default="bvh,toml,profile,scenario,state,csv", help="comma-separated: bvh, toml, "
-                   "profile, scenario, state, csv (default: all)")
-    p.add_argument("--timeout", type=float, default=10.0, help="seconds a case may take (default: 10)")
-    p.add_argument("--memory", type=int, default=1024, help="address space a case may add to the worker, MB (default: 1024; 0: no limit)")
+    p.add_argument("--n", type=count_type(1, 1_000_000), default=2000, help="number of mutated inputs (default: 2000)")
+    p.add_argument("--seed", type=seed_type, default=0, help="seed of the mutations (default: 0)")
+    p.add_argument("--targets", default="bvh,toml,profile,scenario,state,csv,npy,c3d,special,bench,output",
+                   help="comma-separated: bvh, toml, profile, scenario, state, csv, npy, c3d, special (directories, "
+                   "FIFOs, links to unreadable files), bench (hostile option values), output (writes on a full disk) "
+                   "(default: all)")
+    p.add_argument("--timeout", type=number_type(0.1, 3600.0, "seconds"), default=10.0, help="seconds a case may take (default: 10)")
+    p.add_argument("--memory", type=count_type(0, 1_048_576), default=1024, help="address space a case may add to the worker, MB (default: 1024; 0: no limit)")
     p.add_argument("--out", metavar="DIR", dest="out_dir", help="write every failing input and its stderr into this "
                    "folder (created if missing), to replay")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -339,7 +354,7 @@ def likeme_register_commands(subparsers):
                        "log-log slope of each (1.0 = linear)")
     _jobs_options(p, "each stream length and each repertoire size", timing=True)
     p.add_argument("--fps", type=fps_type, default=30.0, help="frame rate of the streams and clips (default: 30)")
-    p.add_argument("--minutes", type=number_type(1e-6, 1e6, "minutes"), action="append", metavar="MIN",
+    p.add_argument("--minutes", type=number_type(1e-3, 600.0, "minutes"), action="append", metavar="MIN",
                    help="stream length (repeatable; default: 1, 10, 60)")
     p.add_argument("--movements", type=count_type(1, 100_000), action="append", metavar="N",
                    help="repertoire size (repeatable; default: 5, 50, 500)")

@@ -227,6 +227,10 @@ def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams:
     known = _link_repertoire(clips, dest, with_all=True)
     pool = [p for (c, s), ps in clips.items() if s != "normal" and c in known and
             (c not in LOCOMOTION or not gestures_only) for p in ps]
+    if len(pool) < per_stream:
+        raise ConfigError(f"{len(pool)} demos of the repertoire's movements in other styles than normal", file=src,
+                          expected=f"at least {per_stream} (a stream joins {per_stream} demos, each once)",
+                          available=[p.name for p in pool])
     rng = np.random.default_rng(seed)
     items = [{"clips": [str(pool[i]) for i in rng.choice(len(pool), per_stream, replace=False)],
               "path": str(dest / "cropped" / f"stream_{k + 1:02d}.bvh")} for k in range(streams)]
@@ -244,6 +248,10 @@ def bandai(src: Path, dest: Path, profile_path: Path, *, seed: int = 0, streams:
         walks = _takes(Path(locomotion), "dataset-2_*.bvh", "dataset-2_{content}_{style}_{take}.bvh files")
         _link_repertoire(walks, dest / "locomotion")
         pool = [p for (c, s), ps in walks.items() if s != "normal" for p in ps]
+        if len(pool) < 2:
+            raise ConfigError(f"{len(pool)} locomotion takes in other styles than normal", file=locomotion,
+                              expected="at least 2 (a locomotion stream joins up to 4 takes)",
+                              available=[p.name for p in pool])
         items += [_joined(rng, pool, min(4, len(pool)), dest / "locomotion" / "streams" / f"stream_{k + 1:02d}.bvh",
                           (0.0, 0.0), STRIDE, 0.0) for k in range(max(1, streams // 2))]
     for item in items:
@@ -332,9 +340,14 @@ STYLE_PATTERN = r"^dataset-1_[^_]+_([^_]+)_"
 
 
 def cmd_make_data(args, pm) -> int:
-    """``likeme bench make-data DIR``."""
-    print(make_data(pm, Path(args.dest), seed=args.seed, fmt=getattr(args, "format", "bvh"), jobs=args.jobs,
-                    scheduler=args.scheduler))
+    """``likeme bench make-data DIR``: written to a staging folder inside DIR and moved into it when complete
+    (:func:`toolkit.files.writing_folder`): a full disk leaves no half-written data set."""
+    from toolkit.files import writing_folder
+
+    with writing_folder(args.dest, "benchmark data") as stage:
+        make_data(pm, stage, seed=args.seed, fmt=getattr(args, "format", "bvh"), jobs=args.jobs,
+                  scheduler=args.scheduler)
+    print(Path(args.dest))
     return 0
 
 
@@ -344,6 +357,10 @@ def cmd_bandai(args, pm) -> int:
 
     profile = Path(args.profile) if args.profile else resolve_file("profiles/bandai-namco.toml", None, pm,
                                                                    key=("--profile",))
-    print(bandai(Path(args.src), Path(args.dest), profile, seed=args.seed, jobs=args.jobs, scheduler=args.scheduler,
-                 locomotion=Path(args.locomotion) if args.locomotion else None))
+    from toolkit.files import writing_folder
+
+    with writing_folder(args.dest, "benchmark data") as stage:
+        bandai(Path(args.src), stage, profile, seed=args.seed, jobs=args.jobs, scheduler=args.scheduler,
+               locomotion=Path(args.locomotion) if args.locomotion else None)
+    print(Path(args.dest))
     return 0

@@ -23,7 +23,7 @@ import numpy as np
 from plugins.bench import progress as progress_bar
 from plugins.bench import text_table
 from toolkit import World, load_character
-from toolkit.state import write_atomic
+from toolkit.files import write_output
 
 __all__ = ["facilitation_benchmark", "facilitation_runs", "render_facilitation", "cmd_facilitation"]
 
@@ -363,5 +363,5 @@ def cmd_facilitation(args: argparse.Namespace, pm: Any) -> int:
                                runs=args.runs, jobs=args.jobs, scheduler=args.scheduler)
     print(render_facilitation(result))
     if args.json:
-        write_atomic(Path(args.json), json.dumps(result, indent=2, default=float) + "\n")
+        write_output(args.json, json.dumps(result, indent=2, default=float) + "\n")
     return 0

@@ -59,15 +59,17 @@ __all__ = ["TARGETS", "OUTCOMES", "Case", "Result", "make_seeds", "make_case", "
 ROOT = Path(__file__).resolve().parents[2]  # where the toolkit and plugins packages are (the source tree or site-packages)
 CHARACTERS = builtin_characters()
 
-TARGETS = ("bvh", "toml", "profile", "scenario", "state", "csv")
+TARGETS = ("bvh", "toml", "profile", "scenario", "state", "csv", "npy", "c3d", "special", "bench", "output")
 """What can be fuzzed, in the order cases are dealt out."""
 OUTCOMES = ("ok", "documented", "traceback", "hang", "memory")
 """How a case can end (see the module docstring)."""
 BAD = ("traceback", "hang", "memory")
 """The outcomes that make ``likeme bench fuzz`` fail."""
 
-FORMAT = {"bvh": "bvh", "toml": "toml", "profile": "toml", "scenario": "toml", "state": "json", "csv": "csv"}
-SUFFIX = {"bvh": ".bvh", "toml": ".toml", "json": ".json", "csv": ".csv"}
+FORMAT = {"bvh": "bvh", "toml": "toml", "profile": "toml", "scenario": "toml", "state": "json", "csv": "csv",
+          "npy": "npy", "c3d": "c3d", "special": "special", "bench": "none", "output": "bvh"}
+SUFFIX = {"bvh": ".bvh", "toml": ".toml", "json": ".json", "csv": ".csv", "npy": ".npy", "c3d": ".c3d",
+          "none": ".txt"}
 
 
 # -- seeds -----------------------------------------------------------------------------------------------------------
@@ -204,6 +206,23 @@ def make_seeds(dest: Path, pm: Any, *, seed: int = 0) -> dict[str, list[dict[str
         f = dest / "csv" / f"stream{'_time' if with_time else ''}.csv"
         f.write_text(_positions_csv(motion.names, positions, motion.fps, with_time), encoding="utf-8")
         seeds["csv"].append({"path": f})
+
+    # the same positions as a .npy array (its profile names the joints and the rate) and as a C3D file
+    from plugins.bench.data import write_positions
+
+    (dest / "npy").mkdir(exist_ok=True)
+    (dest / "c3d").mkdir(exist_ok=True)
+    array = write_positions(dest / "npy" / "stream.npy", list(motion.names), positions)
+    npy_profile = dest / "npy-profile.toml"
+    npy_profile.write_text(max_profile.read_text(encoding="utf-8").replace(
+        "[profile]\n", f"[profile]\nfps = {motion.fps!r}\njoints = {json.dumps(list(motion.names))}\n", 1),
+        encoding="utf-8")
+    seeds["npy"] = [{"path": array, "profile": npy_profile, "repertoire": repertoire}]
+    markers = write_positions(dest / "c3d" / "stream.c3d", list(motion.names), positions, motion.fps)
+    seeds["c3d"] = [{"path": markers, "profile": max_profile, "repertoire": repertoire}]
+    seeds["special"] = [{"path": hand}]  # the input is made a special file (SPECIAL_FILES), its content unused
+    seeds["bench"] = [{"path": hand}]  # the input is the command line (BENCH_OPTIONS)
+    seeds["output"] = [{"path": hand, "state": state}]
     return seeds
 
 
@@ -225,6 +244,10 @@ class Case:
     """The ``likeme`` arguments (``{input}`` stands for the input file), or None for a direct call."""
     call: str | None = None
     """``module:function`` called as ``function(input, fps=30.0)`` instead of a command (the csv target)."""
+    special: str | None = None
+    """What the input is made instead of a file (:data:`SPECIAL_FILES`), or None."""
+    full: bool = False
+    """Whether the case runs on a full disk (every write to a file fails: ``RLIMIT_FSIZE`` of 0)."""
 
     def command(self) -> str:
         """The command that replays the case from the folder its input was written to."""
@@ -260,7 +283,96 @@ def _command(target: str, seed: dict[str, Any], rng: np.random.Generator) -> lis
         return ["run", f, "--duration", _duration(rng)] if rng.random() < 0.75 else ["validate", f]
     if target == "state":
         return ["run", "learn_windmill", "--load", f, "--duration", _duration(rng)]
+    if target in ("npy", "c3d"):
+        options = [["validate", f], ["validate", "--body", str(seed["profile"]), f],
+                   ["observe", "--body", str(seed["profile"]), "--repertoire", str(seed["repertoire"]), f]]
+        if target == "npy":
+            options[0] = ["validate", "--fps", "30", f]
+        return options[int(rng.integers(len(options)))]
+    if target == "bench":
+        base, option = BENCH_OPTIONS[int(rng.integers(len(BENCH_OPTIONS)))]
+        return [*base, option, BENCH_VALUES[int(rng.integers(len(BENCH_VALUES)))]]
+    if target == "output":
+        return [a.replace("{state}", str(seed["state"])) for a in OUTPUTS[int(rng.integers(len(OUTPUTS)))]]
     return ["validate", f]
+
+
+BENCH_OPTIONS = (
+    (["bench", "vision", "--resolution", "16", "--frames", "2"], "--frames"),
+    (["bench", "vision", "--frames", "2"], "--resolution"),
+    (["bench", "facilitation", "--demonstrations", "2", "--repertoire", "1"], "--noise"),
+    (["bench", "facilitation", "--demonstrations", "2", "--repertoire", "1"], "--hands"),
+    (["bench", "facilitation", "--demonstrations", "2", "--repertoire", "1"], "--angle-noise"),
+    (["bench", "facilitation", "--demonstrations", "2"], "--repertoire"),
+    (["bench", "facilitation", "--repertoire", "1"], "--demonstrations"),
+    (["bench", "behaviour"], "--episodes"),
+    (["bench", "scaling", "--quick"], "--minutes"),
+    (["bench", "scaling", "--quick"], "--movements"),
+    (["bench", "scaling", "--quick"], "--fps"),
+    (["bench", "posegraph", "--queries", "3", "--no-scan"], "--nodes"),
+    (["bench", "posegraph", "--queries", "3", "--no-scan", "--nodes", "200"], "--parts"),
+    (["bench", "posegraph", "--queries", "3", "--no-scan", "--nodes", "200"], "--k"),
+    (["bench", "memory", "--no-live"], "--minutes"),
+    (["bench", "memory", "--no-live"], "--observe-minutes"),
+    (["bench", "memory", "--no-live"], "--block"),
+    (["bench", "memory", "--no-live"], "--limit"),
+    (["bench", "watch", "--movements", "1"], "--runs"),
+    (["bench", "learning", "--trials", "1", "--tests", "1"], "--takes"),
+    (["bench", "fuzz", "--targets", "none"], "--n"),  # an accepted value ends at once: no such target
+    (["bench", "fuzz", "--n", "1", "--targets", "none"], "--timeout"),
+    (["bench", "fuzz", "--n", "1", "--targets", "none"], "--memory"),
+)
+"""The ``likeme bench`` options a case gives a hostile value (the last option given wins), each with options that
+keep an accepted value's run short."""
+BENCH_VALUES = ("0", "-0", "-1", "-3", "nan", "-nan", "inf", "-inf", "1e999", "1e300", "-1e300", "1e6", "10000000",
+                "2147483648", "-2147483649", "99999999999999999999999", "1" + "0" * 5000, "1e-320", "", "abc",
+                "\u00b2", "\u0663\u0663\u0663\u0663\u0663\u0663\u0663", "0x10", "1e", "--1", ".", "\x1b[2J")
+"""The values given: out of every option's range, not finite, beyond 64 bits, malformed (``²``; seven Arabic-Indic
+threes, which ``int`` reads as 3,333,333); none a valid small size (``１``, a full-width one, is a valid 1 and would
+run a whole benchmark)."""
+
+OUTPUTS = (
+    ["profile", "{input}", "--out", "out/p.toml"],
+    ["bench", "posegraph", "--nodes", "200", "--queries", "3", "--no-scan", "--json", "out/p.json"],
+    ["run", "learn_windmill", "--duration", "0.2", "--save", "out/s.json"],
+    ["run", "learn_windmill", "--duration", "0.2", "--load", "{state}", "--save", "out/s.json"],
+    ["bench", "make-data", "out/gen"],
+    ["show", "max", "--view", "posegraph", "--out", "out/g.png"],
+)
+"""Commands that write a file or a folder, run on a full disk (every write to a file fails) in one case in two."""
+
+SPECIAL_FILES = ("directory", "fifo", "dangling link", "link loop", "link to /proc/self/mem", "link to /dev/zero",
+                 "unreadable")
+"""What the input of a ``special`` case is instead of a file, named with each format's suffix."""
+SPECIAL_COMMANDS = (
+    (".bvh", ["validate", "{input}"]), (".csv", ["validate", "{input}"]), (".c3d", ["validate", "{input}"]),
+    (".npy", ["validate", "--fps", "30", "{input}"]), (".toml", ["validate", "{input}"]),
+    (".json", ["run", "learn_windmill", "--duration", "0.2", "--load", "{input}"]),
+    (".toml", ["run", "{input}", "--duration", "0.2"]),
+)
+
+
+def make_special(path: Path, kind: str) -> None:
+    """Turn ``path`` (a file just written) into the special file ``kind`` (:data:`SPECIAL_FILES`)."""
+    path.unlink(missing_ok=True)
+    if kind == "directory":
+        path.mkdir()
+    elif kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "dangling link":
+        path.symlink_to(path.parent / "nowhere")
+    elif kind == "link loop":
+        other = path.with_name("loop" + path.suffix)
+        other.unlink(missing_ok=True)
+        path.symlink_to(other)
+        other.symlink_to(path)
+    elif kind == "link to /proc/self/mem":
+        path.symlink_to("/proc/self/mem")
+    elif kind == "link to /dev/zero":
+        path.symlink_to("/dev/zero")
+    else:
+        path.write_bytes(b"x")
+        path.chmod(0)
 
 
 HOSTILE_DURATIONS = ("nan", "inf", "-1", "0", "1e300", "1e-9")
@@ -279,6 +391,16 @@ def make_case(index: int, target: str, seeds: dict[str, list[dict[str, Any]]], s
     pool = seeds[target]
     chosen = pool[int(rng.integers(len(pool)))]
     fmt = FORMAT[target]
+    if target == "special":
+        kind = SPECIAL_FILES[int(rng.integers(len(SPECIAL_FILES)))]
+        suffix, argv = SPECIAL_COMMANDS[int(rng.integers(len(SPECIAL_COMMANDS)))]
+        return Case(index, target, kind, [kind], b"", f"case{index:05d}{suffix}", argv=list(argv), special=kind)
+    if target in ("bench", "output"):
+        full = target == "output" and rng.random() < 0.5
+        argv = _command(target, chosen, rng)
+        what = [f"{argv[-2]} {argv[-1]!r}"] if target == "bench" else ["full disk" if full else "disk with room"]
+        return Case(index, target, Path(chosen["path"]).name, what, Path(chosen["path"]).read_bytes(),
+                    f"case{index:05d}.bvh", argv=argv, full=full)
     data, applied = mutate(Path(chosen["path"]).read_bytes(), fmt, rng)
     name = f"case{index:05d}{SUFFIX[fmt]}"
     if target == "csv":
@@ -373,6 +495,7 @@ def _worker_main(memory_mb: int, warm: list[list[str]], stacks: str = "") -> Non
 
     if stacks:
         faulthandler.register(signal.SIGUSR1, file=open(stacks, "a", encoding="utf-8"), all_threads=False)  # noqa: SIM115
+    signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past RLIMIT_FSIZE fails (EFBIG), it does not kill
     proto = os.fdopen(os.dup(1), "w", buffering=1, encoding="utf-8")
     requests = os.fdopen(os.dup(0), "r", encoding="utf-8")
     devnull = os.open(os.devnull, os.O_RDWR)
@@ -392,7 +515,12 @@ def _worker_main(memory_mb: int, warm: list[list[str]], stacks: str = "") -> Non
             except OSError:  # no /proc (not Linux): the limit counts from nothing
                 held = 0
             resource.setrlimit(resource.RLIMIT_AS, (held + memory_mb * 1024 * 1024, resource.RLIM_INFINITY))
-        result = run_one(request)
+        if request.get("full"):  # a full disk for this case: every write to a file fails (EFBIG), none is cut short
+            resource.setrlimit(resource.RLIMIT_FSIZE, (0, resource.RLIM_INFINITY))
+        try:
+            result = run_one(request)
+        finally:
+            resource.setrlimit(resource.RLIMIT_FSIZE, (resource.RLIM_INFINITY, resource.RLIM_INFINITY))
         try:
             proto.write(json.dumps(result) + "\n")
         except MemoryError:
@@ -581,12 +709,13 @@ def run_fuzz(pm: Any, *, n: int = 2000, seed: int = 0, targets: tuple[str, ...] 
     targets = tuple(targets)
     if not targets:
         return []
-    with tempfile.TemporaryDirectory(prefix="likeme-fuzz-") as tmp:
-        tmp = Path(tmp)
+    from toolkit.files import scratch_folder
+
+    with scratch_folder("likeme-fuzz-") as tmp:
         if out is not None:  # the seeds beside the failing cases, so that their commands replay them
-            Path(out).mkdir(parents=True, exist_ok=True)
-            shutil.rmtree(Path(out) / "seeds", ignore_errors=True)
-        seeds = make_seeds((Path(out).resolve() if out is not None else tmp) / "seeds", pm, seed=seed)
+            seeds = _seeds_in(Path(out), pm, seed)
+        else:
+            seeds = make_seeds(tmp / "seeds", pm, seed=seed)
         if in_process(jobs, scheduler):
             return _run_cases(list(range(n)), targets, seeds, seed, timeout=timeout, memory_mb=memory_mb, tmp=tmp,
                               out=out, progress=progress)
@@ -633,7 +762,9 @@ def _run_cases(indices: list[int], targets: tuple[str, ...], seeds: dict[str, li
             shutil.rmtree(case_dir, ignore_errors=True)
             case_dir.mkdir()
             (case_dir / case.name).write_bytes(case.data)
-            request = {"cwd": str(case_dir), "input": case.name, "call": case.call,
+            if case.special:
+                make_special(case_dir / case.name, case.special)
+            request = {"cwd": str(case_dir), "input": case.name, "call": case.call, "full": case.full,
                        "argv": None if case.argv is None else [a.replace("{input}", case.name) for a in case.argv]}
             started = time.monotonic()
             answer = worker.run(request, timeout)
@@ -648,16 +779,34 @@ def _run_cases(indices: list[int], targets: tuple[str, ...], seeds: dict[str, li
     return results
 
 
+def _seeds_in(out: Path, pm: Any, seed: int) -> dict[str, list[dict[str, Any]]]:
+    """:func:`make_seeds` into ``out/seeds`` (the old seeds replaced); a failure to write them (a full disk, a
+    read-only folder) is one error naming the folder, and no part of them is left."""
+    from toolkit.files import write_error
+
+    folder = out.resolve() / "seeds"
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        shutil.rmtree(folder, ignore_errors=True)
+        return make_seeds(folder, pm, seed=seed)
+    except OSError as exc:
+        shutil.rmtree(folder, ignore_errors=True)
+        raise write_error(exc, folder, "fuzz seeds") from None
+
+
 def _keep(result: Result, out: Path) -> None:
-    """Write a failing case's input and its stderr (with the command that replays it) into ``out``."""
+    """Write a failing case's input and its stderr (with the command that replays it) into ``out`` (each file
+    written whole or not at all: :func:`toolkit.files.write_output`)."""
+    from toolkit.files import write_output
+
     case = result.case
-    (out / case.name).write_bytes(case.data)
+    write_output(out / case.name, case.data, "failing case")
     a = result.answer
     head = [f"# target: {case.target}; seed file: {case.seed_file}; mutations: {', '.join(case.mutations)}",
             f"# outcome: {result.outcome}: {result.key()}", f"# replay (in this folder): {case.command()}"]
     if a.get("message"):
         head.append(f"# message: {a['message']}")
-    (out / f"{case.name}.stderr").write_text("\n".join(head) + "\n" + a.get("stderr", ""), encoding="utf-8")
+    write_output(out / f"{case.name}.stderr", "\n".join(head) + "\n" + a.get("stderr", ""), "failing case")
 
 
 def summary_line(results: list[Result]) -> str:
@@ -709,14 +858,10 @@ def cmd_fuzz(args: Any, pm: Any) -> int:
     if unknown or not targets:
         raise ConfigError(f"unknown fuzz target(s) {unknown}" if unknown else "no fuzz target", key=("--targets",),
                           expected="a comma-separated list of targets", available=list(TARGETS))
-    if args.n < 1 or not (args.timeout > 0) or args.timeout == float("inf") or args.memory < 0:
-        raise ConfigError(f"--n {args.n}, --timeout {args.timeout}, --memory {args.memory}",
-                          key=("--n" if args.n < 1 else "--timeout" if not 0 < args.timeout < float("inf") else "--memory",),
-                          expected="--n >= 1, a finite --timeout > 0 (seconds), --memory >= 0 (MB, 0: no limit)")
     out_dir = _out_dir(getattr(args, "out_dir", None))
     console = Console(stderr=True)
     notes: list[str] = []
-    with Progress(console=console, transient=True, disable=args.quiet) as bar:
+    with Progress(console=console, transient=True, disable=args.quiet or not console.is_terminal) as bar:  # no blank line
         task = bar.add_task("fuzz", total=args.n)
         results = run_fuzz(pm, n=args.n, seed=args.seed, targets=targets, timeout=args.timeout,
                            memory_mb=args.memory, out=out_dir, notes=notes,

@@ -17,7 +17,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-__all__ = ["HOSTILE_NUMBERS", "MUTATIONS", "mutate", "mutation_names"]
+__all__ = ["HOSTILE_NUMBERS", "HOSTILE_STRINGS", "MUTATIONS", "mutate", "mutation_names", "NPY_SHAPES",
+           "C3D_FIELDS"]
 
 Mutation = Callable[[bytes, np.random.Generator], bytes]
 
@@ -434,7 +435,13 @@ def _hostile_json(rng: np.random.Generator):
         return [0] * int(_pick(rng, (1000, 100000)))
     if choice == 13:
         return (_DEEP, int(_pick(rng, (100, 1000, 100000))))
-    return [[], {}, "abc", "", None, True, -1, 0, 10 ** 400, 1e308, float("nan"), float("inf")][choice]
+    return [[], {}, _pick(rng, HOSTILE_STRINGS), "", None, True, -1, 0, 10 ** 400, 1e308, float("nan"),
+            float("inf")][choice]
+
+
+HOSTILE_STRINGS = ("abc", "\ud800", "\udfff", "\x1b]0;owned\x07\x1b[2J", "a" * 5000, "\u202e", "line\nbreak", "\x00")
+"""Strings a state file's value or key is replaced with: a lone surrogate (which UTF-8 cannot hold), terminal
+escapes, a long string, a right-to-left override, a line break, NUL."""
 
 
 def _paths(node, path=()):
@@ -474,7 +481,7 @@ def json_node(data: bytes, rng: np.random.Generator) -> bytes:
     elif choice == 2:
         del parent[key]
     elif choice == 3 and isinstance(parent, dict):
-        parent[_pick(rng, ("", "x", str(key).upper(), str(key) + " "))] = parent.pop(key)
+        parent[_pick(rng, ("", "x", str(key).upper(), str(key) + " ", *HOSTILE_STRINGS))] = parent.pop(key)
     elif isinstance(parent, list):
         parent.extend([parent[key]] * int(_pick(rng, (10, 1000))))
     else:
@@ -549,19 +556,131 @@ def csv_rows(data: bytes, rng: np.random.Generator) -> bytes:
 
 CSV_MUTATIONS: dict[str, Mutation] = {f.__name__: f for f in (csv_header, csv_cells, csv_rows)}
 
+# -- .npy arrays ------------------------------------------------------------------------------------------------------
+
+_NPY_MAGIC = b"\x93NUMPY"
+NPY_SHAPES = ("(9223372036854775808, 11, 3)", "(1000000000000000000000000000000, 11, 3)", "(-1, 11, 3)",
+              "(0, 11, 3)", "(4294967296, 11, 3)", "(457, 0, 3)", "(457, 11)", "()", "(457, 11, 3, 2)", "(457, 11, 4)",
+              "(457, 100000, 3)", "(1e3, 11, 3)", "[457, 11, 3]", "(457,, 3)")
+"""What an ``.npy`` header's shape is replaced with: beyond 64 bits, beyond any file, negative, empty, the wrong
+number of axes, not a tuple, malformed."""
+NPY_DESCRS = ("'|O'", "'<U3'", "'>f8'", "'<f4'", "'<i8'", "'|b1'", "'<c16'", "'V8'", "'<f16'", "'xyz'", "None")
+"""What its dtype is replaced with: Python objects (pickles), strings, other byte orders and sizes, nonsense."""
+
+
+def npy_header(data: bytes, rng: np.random.Generator) -> bytes:
+    """The header of an ``.npy`` file: its shape, dtype or ``fortran_order`` hostile, its declared header length or
+    version wrong (version 2 and 3 headers read with a 4-byte length), or the header alone (no data)."""
+    if not data.startswith(_NPY_MAGIC) or len(data) < 10:
+        return data
+    major = data[6]
+    size = int.from_bytes(data[8:10], "little") if major == 1 else int.from_bytes(data[8:12], "little")
+    start = 10 if major == 1 else 12
+    header, body = data[start:start + size], data[start + size:]
+    choice = int(rng.integers(6))
+    if choice == 0:
+        header = re.sub(rb"'shape': \([^)]*\)", b"'shape': " + _pick(rng, NPY_SHAPES).encode(), header)
+    elif choice == 1:
+        header = re.sub(rb"'descr': '[^']*'", b"'descr': " + _pick(rng, NPY_DESCRS).encode(), header)
+    elif choice == 2:
+        header = header.replace(b"False", b"True") if b"False" in header else header.replace(b"True", b"False")
+    elif choice == 3:  # a declared header length that does not match
+        size = int(_pick(rng, (0, 1, size - 1, size + 1, 65535)))
+    elif choice == 4:  # another version: 2.0 (a 4-byte length), 3.0, or one numpy does not know
+        major = int(_pick(rng, (2, 3, 9)))
+        return _NPY_MAGIC + bytes([major, 0]) + len(header).to_bytes(4, "little") + header + body
+    else:
+        body = b""
+    return _NPY_MAGIC + bytes([major, data[7]]) + (size.to_bytes(2, "little") if major == 1 else
+                                                   size.to_bytes(4, "little")) + header + body
+
+
+def npy_archive(data: bytes, rng: np.random.Generator) -> bytes:
+    """An ``.npz`` archive (a zip of arrays) in place of the array: what ``np.savez`` writes, named ``.npy``."""
+    import io
+    import zipfile
+
+    out = io.BytesIO()
+    with zipfile.ZipFile(out, "w") as archive:
+        archive.writestr("positions.npy", data)
+    return out.getvalue()
+
+
+NPY_MUTATIONS: dict[str, Mutation] = {f.__name__: f for f in (npy_header, npy_archive)}
+
+
+# -- C3D -------------------------------------------------------------------------------------------------------------
+
+C3D_FIELDS = (  # (what, offset: "h" header byte offset or "p" parameter section byte, struct format, values)
+    ("parameter block", "h", 0, "B", (0, 1, 3, 200, 255)),
+    ("key", "h", 1, "B", (0, 0x51, 255)),
+    ("points", "h", 2, "<H", (0, 1, 65535)),
+    ("analog channels", "h", 4, "<H", (1, 64, 65535)),
+    ("first frame", "h", 6, "<H", (0, 2, 500, 65535)),
+    ("last frame", "h", 8, "<H", (0, 1, 458, 65535)),
+    ("scale", "h", 12, "<f", (0.0, 1.0, -1e30, float("nan"), float("inf"))),
+    ("data start", "h", 16, "<H", (0, 1, 2, 5, 65535)),
+    ("analog per frame", "h", 18, "<H", (1, 65535)),
+    ("rate", "h", 20, "<f", (0.0, -30.0, 1e-30, 1e30, float("nan"), float("inf"))),
+    ("parameter blocks", "p", 2, "B", (0, 1, 255)),
+    ("processor", "p", 3, "B", (0, 83, 85, 86, 87, 255)),
+)
+"""The C3D header's fields (C3D.org: header words 1-12; the parameter section's bytes 3 and 4) and their hostile
+values."""
+
+
+def c3d_header(data: bytes, rng: np.random.Generator) -> bytes:
+    """One field of a C3D file's header or parameter section set to a hostile value."""
+    import struct
+
+    if len(data) < 512:
+        return data
+    _, where, offset, fmt, values = C3D_FIELDS[int(rng.integers(len(C3D_FIELDS)))]
+    if where == "p":
+        offset += (data[0] - 1) * 512
+    if offset + struct.calcsize(fmt) > len(data):
+        return data
+    out = bytearray(data)
+    struct.pack_into(fmt, out, offset, _pick(rng, values))
+    return bytes(out)
+
+
+def c3d_cut(data: bytes, rng: np.random.Generator) -> bytes:
+    """The file cut at a block boundary, inside the header or parameters, or inside a frame."""
+    cut = int(_pick(rng, (0, 100, 511, 512, 1024, 2048, 2560, len(data) // 2, len(data) - 1)))
+    return data[:max(0, min(cut, len(data)))]
+
+
+C3D_MUTATIONS: dict[str, Mutation] = {f.__name__: f for f in (c3d_header, c3d_cut)}
+
 MUTATIONS: dict[str, dict[str, Mutation]] = {
-    "bvh": BVH_MUTATIONS, "toml": TOML_MUTATIONS, "json": JSON_MUTATIONS, "csv": CSV_MUTATIONS}
+    "bvh": BVH_MUTATIONS, "toml": TOML_MUTATIONS, "json": JSON_MUTATIONS, "csv": CSV_MUTATIONS, "npy": NPY_MUTATIONS,
+    "c3d": C3D_MUTATIONS}
 """The format-aware mutations by format (every format also gets :data:`GENERIC`)."""
 
 
 def mutation_names(fmt: str) -> list[str]:
     """The names of the mutations a file of format ``fmt`` can get."""
-    return sorted(GENERIC) + sorted(MUTATIONS.get(fmt, {}))
+    return sorted(BYTE_LEVEL if fmt in BINARY else GENERIC) + sorted(MUTATIONS.get(fmt, {}))
+
+
+BINARY = ("npy", "c3d")
+"""The formats whose files are bytes, not text: only their own mutations, and the byte-level generic ones."""
+BYTE_LEVEL = ("truncate", "flip_bytes", "random_bytes", "repeat_block", "empty")
 
 
 def mutate(data: bytes, fmt: str, rng: np.random.Generator) -> tuple[bytes, list[str]]:
     """Apply one to three mutations to ``data`` (two in three format-aware); return the bytes and their names."""
     aware = MUTATIONS.get(fmt, {})
+    if fmt in BINARY:
+        generic = {k: v for k, v in GENERIC.items() if k in BYTE_LEVEL}
+        applied = []
+        for _ in range(int(rng.choice([1, 1, 2]))):
+            pool = aware if rng.random() < 3 / 4 else generic
+            name = _pick(rng, sorted(pool))
+            data = pool[name](data, rng)
+            applied.append(name)
+        return data, applied
     applied = []
     for _ in range(int(rng.choice([1, 1, 2, 3]))):
         pool = aware if aware and rng.random() < 2 / 3 else GENERIC

@@ -31,7 +31,7 @@ import numpy as np
 
 from plugins.bench import text_table
 from toolkit import Motion, load_character
-from toolkit.state import write_atomic
+from toolkit.files import write_output
 
 __all__ = ["learning_benchmark", "render_learning", "cmd_learning", "take"]
 
@@ -166,11 +166,14 @@ def plot_learning(r: dict[str, Any], out: str | Path) -> Path:
     ax.legend(loc="center right")
     ax.set_title("A new movement learned from repeated demonstrations (B&B §7.3)", fontsize=10)
     fig.tight_layout()
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
-    return out
+    from toolkit.files import writing
+
+    try:
+        with writing(out, "plot") as tmp:
+            fig.savefig(tmp, dpi=110, format="png")
+    finally:
+        plt.close(fig)
+    return Path(out)
 
 
 def cmd_learning(args: argparse.Namespace, pm: Any) -> int:
@@ -181,5 +184,5 @@ def cmd_learning(args: argparse.Namespace, pm: Any) -> int:
     if args.plot:
         print(f"wrote {plot_learning(result, args.plot)}")
     if args.json:
-        write_atomic(Path(args.json), json.dumps(result, indent=2, default=float) + "\n")
+        write_output(args.json, json.dumps(result, indent=2, default=float) + "\n")
     return 0

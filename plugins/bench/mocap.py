@@ -29,7 +29,6 @@ import io
 import json
 import platform
 import re
-import tempfile
 import time
 from collections.abc import Mapping, Sequence
 from contextlib import contextmanager
@@ -283,7 +282,9 @@ def _repertoire_without(folder: Path, movement: str | None, files: frozenset[Pat
     if movement is None and not files:
         yield folder
         return
-    with tempfile.TemporaryDirectory(prefix="likeme-left-out-") as tmp:
+    from toolkit.files import scratch_folder
+
+    with scratch_folder("likeme-left-out-") as tmp:
         for name, clips in clip_files(folder).items():
             kept = [f for f in clips if f not in files]
             if name == movement or not kept:
@@ -397,12 +398,12 @@ def table(result: dict[str, Any]) -> str:
 
 
 def write_outputs(result: dict[str, Any], args: Any) -> None:
-    from toolkit.state import write_atomic as atomic_write_text
+    from toolkit.files import write_output
 
     result = {**result, "settings": {"seed": getattr(args, "seed", None), "versions": _versions(),
                                      "set": list(getattr(args, "set", []))}}
     if args.json:
-        atomic_write_text(Path(args.json), json.dumps(result, indent=1, default=float) + "\n")
+        write_output(args.json, json.dumps(result, indent=1, default=float) + "\n")
     if args.csv:
         keys = ["kind", "plugin", "item"] + sorted({k for r in result["plugins"] + result["items"] for k in r}
                                                    - {"plugin", "item", "labels", "confusion"})
@@ -414,7 +415,7 @@ def write_outputs(result: dict[str, Any], args: Any) -> None:
         for r in rows:
             writer.writerow(r)
         out.write(f"# versions: {json.dumps(result['settings']['versions'])}\n")
-        atomic_write_text(Path(args.csv), out.getvalue())
+        write_output(args.csv, out.getvalue())
     if args.plot:
         plot(result, Path(args.plot))
 

@@ -152,10 +152,18 @@ def _row(r: dict[str, Any]) -> list[str]:
 
 def cmd_posegraph(args: Any, pm: Any) -> int:
     """``likeme bench posegraph``: print one table row per ``--nodes``."""
+    from plugins.bench.command import MAX_NODES
+    from plugins.bench.jobs import in_process, run_with_pm
+    from toolkit.errors import ConfigError
+
+    parts = args.parts or 11
+    for n in args.nodes or []:
+        if n * parts > MAX_NODES * 11:
+            raise ConfigError(f"{n:,} nodes of {parts} parts are {n * parts:,} joint positions", key=("--nodes",),
+                              expected=f"at most {MAX_NODES * 11:,} (--nodes x --parts; {MAX_NODES:,} nodes of 11 "
+                                       "parts)")
     print("| " + " | ".join(HEADER) + " |")
     print("|" + "---|" * len(HEADER))
-    from plugins.bench.jobs import in_process, run_with_pm
-
     items = [{"n": n, "parts": args.parts, "k": args.k, "queries": args.queries, "noise": args.noise,
               "seed": args.seed, "scan": not args.no_scan} for n in args.nodes or [100_000]]
     # one --nodes a row, each measured in the process that runs it (--jobs, --scheduler); here, printed as it ends
@@ -167,7 +175,8 @@ def cmd_posegraph(args: Any, pm: Any) -> int:
             print("| " + " | ".join(_row(r)) + " |", flush=True)
     if args.json:
         import json
-        from pathlib import Path
 
-        Path(args.json).write_text(json.dumps(rows, indent=2) + "\n")
+        from toolkit.files import write_output
+
+        write_output(args.json, json.dumps(rows, indent=2) + "\n")
     return 0

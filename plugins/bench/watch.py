@@ -32,7 +32,7 @@ from plugins.bench.metrics import edit_distance, match_segments, movement_error_
 from toolkit import World, load_character
 from toolkit.config.search import merge_tables
 from toolkit.config.settings import parse_settings
-from toolkit.state import write_atomic
+from toolkit.files import write_output
 from toolkit.answers import check_match
 from toolkit.watching import call_component
 
@@ -266,5 +266,5 @@ def cmd_watch(args: argparse.Namespace, pm: Any) -> int:
     )
     print(render_watch(result))
     if args.json:
-        write_atomic(Path(args.json), json.dumps(result, indent=2, default=float) + "\n")
+        write_output(args.json, json.dumps(result, indent=2, default=float) + "\n")
     return 0

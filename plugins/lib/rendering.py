@@ -270,7 +270,8 @@ class Movie:
             import imageio.v2 as imageio
 
             path = self.folder / f"{name}.mp4"
-            self._mp4 = imageio.get_writer(path, fps=self.fps, codec="libx264", quality=7, macro_block_size=8)
+            self._mp4 = imageio.get_writer(path, fps=self.fps, codec="libx264", quality=7, macro_block_size=8,
+                                           ffmpeg_log_level="quiet")  # its failures are raised, not printed
             self.files.append(path)
 
     def frame(self) -> np.ndarray:

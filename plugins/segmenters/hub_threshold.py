@@ -90,10 +90,10 @@ class HubThreshold(Segmenter):
         Parameter("release", float, 0.75, "End threshold as a fraction of `threshold` (hysteresis; 1 = none).", minimum=0.0, maximum=1.0),
         Parameter("cutoff", float, 4.0, "Low-pass cut-off frequency in Hz (second-order Butterworth). "
                   "Lower smooths more noise but delays and merges boundaries.", minimum=0.1),
-        Parameter("min_duration", float, 0.25, "Segments shorter than this (s) are dropped as noise.", minimum=0.0),
-        Parameter("max_gap", float, 0.1, "Dips below the end threshold shorter than this (s) do not end a segment.", minimum=0.0),
+        Parameter("min_duration", float, 0.25, "Segments shorter than this (s) are dropped as noise.", minimum=0.0, seconds=True),
+        Parameter("max_gap", float, 0.1, "Dips below the end threshold shorter than this (s) do not end a segment.", minimum=0.0, seconds=True),
         Parameter("floor", float, 10.0, "Seconds over which the running minimum of the filtered distance is "
-                  "taken as the noise floor and subtracted (0: no floor, the paper's plain threshold).", minimum=0.0),
+                  "taken as the noise floor and subtracted (0: no floor, the paper's plain threshold).", minimum=0.0, seconds=True),
         Parameter("hub", str, "", "The hub pose to compare with (default: the observer's rest pose)."),
         Parameter("reference", str, "hub", "What the distance is measured from: the observer's own hub (the paper) "
                   "or the demonstrator's own rest, re-anchored wherever they stand still for `rest.stand_time` seconds.",
@@ -101,12 +101,12 @@ class HubThreshold(Segmenter):
         Parameter("rest", doc="With reference = rest: how the demonstrator's own rest is found and followed.",
                   parameters=(
             Parameter("stand_time", float, 0.5, "Seconds every part must stay put to count as standing (a new rest). "
-                      "Shorter follows a new stance sooner and cuts gestures at shorter holds.", minimum=0.05),
+                      "Shorter follows a new stance sooner and cuts gestures at shorter holds.", minimum=0.05, seconds=True),
             Parameter("stance", str, "returned", "A pose held away from the rest becomes the new rest once a movement "
                       "returns to it (or it is held for `settle`), or at once when held.",
                       choices=("returned", "held")),
             Parameter("settle", float, 2.0, "With stance = returned: seconds of standing in a new stance after which "
-                      "it is the rest without a return (0: only a return).", minimum=0.0),
+                      "it is the rest without a return (0: only a return).", minimum=0.0, seconds=True),
             Parameter("stillness", float, 0.25, "Standing means every part stays within this share of the start "
                       "threshold of its mean pose over `stand_time`.", minimum=0.0, maximum=1.0),
             Parameter("noise", float, 2.0, "The standing radius is at least this many times the smallest spread of "

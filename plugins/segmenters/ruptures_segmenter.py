@@ -66,10 +66,10 @@ class RupturesSegmenter(Segmenter):
     parameters = (
         Parameter("penalty", float, 3.0, "Penalty per change point (larger: fewer segments).", minimum=0.0),
         Parameter("kernel", str, "rbf", "The kernel of the cost.", choices=("rbf", "linear", "cosine")),
-        Parameter("min_length", float, 0.5, "Shortest segment in seconds.", minimum=0.0),
+        Parameter("min_length", float, 0.5, "Shortest segment in seconds.", minimum=0.0, seconds=True),
         Parameter("stride", int, 2, "Use every n-th frame (KernelCPD is quadratic in length).", minimum=1),
         Parameter("window", float, 60.0, "Seconds of stream held and searched at once (memory is bounded by it; "
-                  "no segment is longer); 0: the whole stream, held until it ends.", minimum=0.0),
+                  "no segment is longer); 0: the whole stream, held until it ends.", minimum=0.0, seconds=True),
     )
 
     def attach(self, owner: Any) -> None:

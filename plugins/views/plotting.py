@@ -9,8 +9,6 @@ watcher found with what it recognised and when it decided.
 
 from __future__ import annotations
 
-import os
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -178,25 +176,13 @@ def fit_labels(fig: Any, pad: float = 3.0) -> int:
 def save_figure(fig: Any, out: str | Path) -> Path:
     """Fit the labels (:func:`fit_labels`), then write ``fig`` to ``out`` as PNG atomically (a temporary file in the
     same folder, then a rename)."""
+    from toolkit.files import writing
+
     out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
     fit_labels(fig)
-    fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".png", dir=out.parent)
-    os.close(fd)
-    try:
+    with writing(out, "picture") as tmp:
         fig.savefig(tmp, format="png")
-        os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, out)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
     return out
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
 
 
 UNKNOWN_COLOUR = "#a0a0a0"

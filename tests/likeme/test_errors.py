@@ -199,9 +199,9 @@ CASES = [
     ("character-name-long", "a character reference of 5,000 characters", {"s.toml": SCENE.replace(MAX, "x" * 5000)}, ["validate", "s.toml"], ["key actors[0].character", "(5000 characters)", "available:"]),
     ("set-value-nan", "--set with a NaN value", {}, ["bench", "watch", "--movements", "1", "--set", "perception.noise=nan"], ["key --set.perception.noise", "value nan is not a finite number for perception 'synthetic-vision'"]),
     # -- watching: bounded working memory and the memory benchmark
-    ("bench-memory-minutes", "memory benchmark for nan minutes", {}, ["bench", "memory", "--minutes", "nan"], ["key --minutes", "value nan", "expected a finite number > 0"]),
-    ("bench-memory-block", "memory benchmark with packets of 0 frames", {}, ["bench", "memory", "--block", "0"], ["key --block", "value 0", "expected a whole number >= 1"]),
-    ("observe-ruptures-window", "ruptures with a negative window", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "ruptures", "--set", "segmenter.window=-1", "m.bvh"], ["key --set.segmenter.window", "value -1.0 out of range", "expected a number in [0, inf]"]),
+    ("bench-memory-minutes", "memory benchmark for nan minutes", {}, ["bench", "memory", "--minutes", "nan"], ["argument --minutes: invalid value 'nan'", "expected minutes in [0.001, 1440]"]),
+    ("bench-memory-block", "memory benchmark with packets of 0 frames", {}, ["bench", "memory", "--block", "0"], ["argument --block: invalid value 0", "expected an integer in [1, 100000]"]),
+    ("observe-ruptures-window", "ruptures with a negative window", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "ruptures", "--set", "segmenter.window=-1", "m.bvh"], ["key --set.segmenter.window", "value -1.0 out of range", "expected a number in [0, 3600]"]),
     ("observe-max-movement", "velocity-direction with a negative max_movement", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "velocity-direction", "--set", "segmenter.max_movement=-5", "m.bvh"], ["key --set.segmenter.max_movement", "value -5.0 out of range"]),
     # -- reading: bounded, streaming BVH and profile reading (issue 21)
     ("bvh-frame-rate", "a frame time of 0.1 microseconds (10 MHz)", {"m.bvh": BVH.replace("Frame Time: 0.0333333", "Frame Time: 1e-7")}, ["validate", "m.bvh"], ["m.bvh:18:13", "frame time 1e-07 s (1e+07 frames per second)", "expected a frame time of 0.0001 to 60 seconds"]),
@@ -254,6 +254,25 @@ CASES = [
     ("npy-not-an-array", "a .npy file that is text", {"m.npy": "x"}, ["validate", "--fps", "30", "m.npy"], ["m.npy: not a .npy file (no NumPy header)", "expected a NumPy array (frames, joints, 3) of numbers"]),
     ("fps-option", "--fps of 0", {"m.bvh": BVH}, ["validate", "--fps", "0", "m.bvh"], ["argument --fps: invalid frame rate '0'", "expected frames per second in [1/60, 10000]"]),
     ("fps-option-tiny", "--fps of 1e-300", {"m.bvh": BVH}, ["validate", "--fps", "1e-300", "m.bvh"], ["argument --fps: invalid frame rate '1e-300'", "expected frames per second in [1/60, 10000]"]),
+    ("param-seconds-overflow", "a segmenter's floor of 1e308 seconds", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--set", "segmenter.floor=1e308", "m.bvh"], ["key --set.segmenter.floor: value 1e+308 out of range for segmenter 'hub-threshold'", "expected a number in [0, 3600]"]),
+    ("param-max-gap-overflow", "a segmenter's max_gap of 1e308 seconds", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--set", "segmenter.max_gap=1e308", "m.bvh"], ["key --set.segmenter.max_gap: value 1e+308 out of range", "expected a number in [0, 3600]"]),
+    ("param-memory-overflow", "velocity-direction's sensory memory of 1e308 seconds", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "velocity-direction", "--set", "segmenter.memory=1e308", "m.bvh"], ["key --set.segmenter.memory: value 1e+308 out of range", "expected a number in [0, 3600]"]),
+    ("param-max-movement-overflow", "velocity-direction's max_movement of 1e308 seconds", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "velocity-direction", "--set", "segmenter.max_movement=1e308", "m.bvh"], ["key --set.segmenter.max_movement: value 1e+308 out of range", "expected a number in [0, 3600]"]),
+    ("param-window-overflow", "ruptures' window of 1e308 seconds", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "--segmenter", "ruptures", "--set", "segmenter.window=1e308", "m.bvh"], ["key --set.segmenter.window: value 1e+308 out of range", "expected a number in [0, 3600]"]),
+    ("param-huge-number", "a number parameter of 1e308 in a character file", {"c.toml": CHILD + "[perception]\nbuffer = 1e308\n"}, ["validate", "c.toml"], ["c.toml:5: key perception.buffer: value 1e+308 too large", "expected a number in [0, 1e+09]"]),
+    ("bench-vision-frames-zero", "bench vision --frames 0", {}, ["bench", "vision", "--frames", "0"], ["argument --frames: invalid value 0", "expected an integer in [1, 10000]"]),
+    ("bench-facilitation-noise-nan", "bench facilitation --noise nan", {}, ["bench", "facilitation", "--noise", "nan"], ["argument --noise: invalid value 'nan'", "expected metres in [0, 1]"]),
+    ("bench-facilitation-repertoire", "bench facilitation --repertoire -3", {}, ["bench", "facilitation", "--repertoire", "-3"], ["argument --repertoire: invalid value -3", "expected an integer in [1, 100]"]),
+    ("bench-facilitation-hands", "bench facilitation --hands 5", {}, ["bench", "facilitation", "--hands", "5"], ["argument --hands: invalid value '5'", "expected a share of the demonstrations in [0, 1]"]),
+    ("bench-behaviour-episodes", "bench behaviour --episodes -1", {}, ["bench", "behaviour", "--episodes", "-1"], ["argument --episodes: invalid value -1", "expected an integer in [1, 100000]"]),
+    ("bench-scaling-minutes", "bench scaling --minutes 1e6", {}, ["bench", "scaling", "--minutes", "1e6"], ["argument --minutes: invalid value '1e6'", "expected minutes in [0.001, 600]"]),
+    ("bench-scaling-frames", "bench scaling with a stream of too many frames", {}, ["bench", "scaling", "--minutes", "600", "--fps", "120"], ["key --minutes: 600 minutes at 120 fps are 4,320,000 frames", "expected at most 1,000,000 frames a stream"]),
+    ("bench-posegraph-nodes", "bench posegraph --nodes 10000000", {}, ["bench", "posegraph", "--nodes", "10000000"], ["argument --nodes: invalid value 10000000", "expected an integer in [1, 500000]"]),
+    ("bench-bandai-few-clips", "bench bandai with too few clips", {"dataset-1_bow_normal_001.bvh": BVH, "dataset-1_bow_angry_001.bvh": BVH}, ["bench", "bandai", ".", "out"], [": 1 demos of the repertoire's movements in other styles than normal", "expected at least 5", "available: dataset-1_bow_angry_001.bvh"]),
+    ("bench-fuzz-timeout", "bench fuzz --timeout inf", {}, ["bench", "fuzz", "--timeout", "inf"], ["argument --timeout: invalid value 'inf'", "expected seconds in [0.1, 3600]"]),
+    ("csv-header-escapes", "a CSV header cell holding terminal escapes", {"e.csv": "time,\x1b]0;pwn\x07\x1b[2J_x,b_y\n0,1,2\n"}, ["validate", "e.csv"], ["e.csv:1: joint '\\x1b]0;pwn\\x07\\x1b[2J' has no y or z column"]),
+    ("long-available-list", "an error whose list of names is 1,004 long", {"c.toml": BODY.replace('parts = ["root", "head", "lk", "rk"]', "parts = [" + ", ".join(f'"{n}"' for n in ["root", "head", "lk", "rk"] + [f"p{i}" for i in range(1000)]) + "]").replace('root = "root"', 'root = "pelvis"')}, ["validate", "c.toml"], ["key body.root: unknown body part 'pelvis'", "available: root, head, lk, rk, p0, p1", "p55 and 944 more"]),
+    ("template-lengths-datetime", "an observer template's lengths_for_height a date", {"o.toml": '[observer]\nname = "o"\nlengths_for_height = 1979-05-27T07:32:00Z\n'}, ["validate", "o.toml"], ["o.toml:3: key observer.lengths_for_height: invalid value datetime.datetime(1979", "expected a positive number"]),
     ("toml-huge-integer", "an integer of 5,000 digits in a TOML value", {"c.toml": CHILD + "[segmenter]\nfloor = " + "9" * 5000 + "\n"}, ["validate", "c.toml"], ["c.toml:5:9: an integer of 5,000 digits", "expected an integer of at most 4300 digits"]),
     ("sweep-huge-integer", "an integer of 5,000 digits in a sweep grid", {"grid.toml": 'benchmark = "recognition"\nx = ' + "9" * 5000 + "\n"}, ["bench", "sweep", "grid.toml"], ["grid.toml:2:5: an integer of 5,000 digits", "expected an integer of at most 4300 digits"]),
     ("profile-fps", "a profile's fps is not a frame rate", {"p.toml": PROFILE.replace('units = "cm"', 'units = "cm"\nfps = -30')}, ["validate", "p.toml"], ["p.toml:4: key profile.fps: invalid fps -30", "expected frames per second"]),
@@ -356,6 +375,23 @@ def test_an_integer_of_thousands_of_digits_in_set_names_the_key(args, fragment):
     status, err, _ = run_case({}, args)
     assert status == 1 and err.count("\n") == 1 and "Traceback" not in err, err
     assert fragment + "an integer of " in err and "expected an integer of at most 4300 digits" in err, err
+
+
+def test_an_error_line_shows_terminal_escapes_escaped():
+    """No control character of the input reaches the terminal: the line is checked character by character."""
+    status, err, _ = run_case({"e.csv": "time,\x1b]0;pwn\x07\x1b[2J_x,b_y\n0,1,2\n"}, ["validate", "e.csv"])
+    line = err.rstrip("\n")
+    assert status == 1 and line.isprintable() and "\\x1b]0;pwn\\x07" in line, err
+
+
+def test_a_set_value_holding_a_line_break_is_refused():
+    """Kept out of :data:`CASES` (docs/errors.md shows each command on one line): ``--set $'matcher.k=1\\n[x]\\ny=2'``
+    was read as ``k = 1`` and a table ``[x]`` silently dropped."""
+    files = {"p.toml": PROFILE, "m.bvh": BVH}
+    for value in ("matcher.k=1\n[x]\ny=2", "matcher.k=1\r\nz=3", "matcher.k=1\u2028"):
+        status, err, _ = run_case(files, ["observe", "--body", "p.toml", "--repertoire", ".", "--set", value, "m.bvh"])
+        assert status == 1 and err.count("\n") == 1, err
+        assert "key --set: a setting holding a line break" in err and "expected TABLE.KEY=VALUE on one line" in err
 
 
 def render() -> str:

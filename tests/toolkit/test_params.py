@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from toolkit import ConfigError, Parameter
 from toolkit.params import validate_params
@@ -145,3 +147,27 @@ def test_a_set_inside_a_table_keeps_the_templates_other_keys(pm, write):
         """)
     tables = observer_tables(pm, settings={"correspondence": {"dwell": {"memory": 5.0}}}, template=template)[1]
     assert tables["correspondence"]["dwell"] == {"window": 2.0, "memory": 5.0}
+
+
+def test_a_duration_is_bounded_by_an_hour_unless_it_says_otherwise():
+    from toolkit.params import MAX_SECONDS
+
+    assert Parameter("t", float, 1.0, seconds=True).maximum == MAX_SECONDS == 3600.0
+    assert Parameter("t", float, 1.0, seconds=True, maximum=5.0).maximum == 5.0
+    assert Parameter("t", float, 1.0, seconds=True).coerce(3600) == 3600.0
+    with pytest.raises(ConfigError, match=r"value 1e\+308 out of range.*expected a number in \[-inf, 3600\]"):
+        Parameter("t", float, 1.0, seconds=True).coerce(1e308)
+
+
+@given(st.floats(min_value=1e9, max_value=1.7e308, exclude_min=True))
+def test_a_number_without_a_maximum_is_at_most_a_billion(value):
+    from toolkit.params import MAX_MAGNITUDE
+
+    p = Parameter("x", float, 1.0, minimum=0.0)
+    assert p.coerce(MAX_MAGNITUDE) == MAX_MAGNITUDE
+    for v in (value, -value):
+        with pytest.raises(ConfigError) as err:
+            Parameter("x", float, 1.0).coerce(v)
+        assert err.value.key == ("x",) and "too large" in str(err.value) and "[-1e+09, 1e+09]" in str(err.value)
+    with pytest.raises(ConfigError, match=r"\[0, 1e\+09\]"):
+        p.coerce(value)

@@ -354,3 +354,64 @@ def test_mutated_profiles_raise_only_config_errors(tmp_path, data):
         _read_all(text, profile)
     except ConfigError:
         pass
+
+
+# -- issue 38: numbers no body has, and messages a terminal shows --------------------------------------------------
+
+
+def test_coordinates_no_body_has_are_not_seen_and_warn_nothing(tmp_path):
+    """A joint coordinate of 1e308 (any beyond ``MAX_COORDINATE``) is read as not seen in its frame: the observer
+    goes on with no RuntimeWarning (each numpy overflow is turned into an error here: one would fail the run)."""
+    import contextlib
+    import io
+    import warnings
+
+    from likeme.cli import main
+    from tests.conftest import STICK_PARTS, write_stick_clip, write_stick_profile
+    from toolkit.recordings.recording import MAX_COORDINATE
+
+    profile = write_stick_profile(tmp_path)
+    stand = np.array([[0, 1, 0], [0, 1.6, 0.1], [0.1, 0.5, 0], [-0.1, 0.5, 0], [0.3, 1.0, 0], [0.1, 0, 0],
+                      [-0.1, 0, 0]], float)
+    t = np.linspace(0, 1, 31)
+    bob = stand[None] + np.sin(np.pi * t)[:, None, None] * np.array([0.0, -0.2, 0.0])
+    write_stick_clip(tmp_path / "rep" / "bob" / "a.bvh", bob)
+    stream = np.concatenate([np.repeat(stand[None], 20, 0), bob, np.repeat(stand[None], 20, 0)])
+    stream[25, 1] = [1e308, -1e308, 1e308]
+    stream[26, 4] = [2 * MAX_COORDINATE, 0.0, 0.0]
+    path = tmp_path / "s.npy"
+    np.save(path, stream)
+    from toolkit.recordings.positions import read_positions
+
+    got = read_positions(path, names=list(STICK_PARTS), fps=30.0)
+    assert np.isnan(got.positions[25, 1]).all() and np.isnan(got.positions[26, 4]).all()
+    assert np.isfinite(np.delete(got.positions, [25, 26], axis=0)).all()
+    (tmp_path / "profile.toml").write_text(profile.read_text().replace("[parts]", f"fps = 30.0\njoints = "
+                                           f"{list(STICK_PARTS)!r}\n\n[parts]".replace("'", '"'), 1))
+    err = io.StringIO()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+            status = main(["observe", "--body", str(profile), "--repertoire", str(tmp_path / "rep"), str(path)])
+    assert status == 0 and "Warning" not in err.getvalue(), err.getvalue()
+
+
+@given(st.text(max_size=3000), st.integers(1, 2000))
+def test_a_message_part_is_printable_and_bounded(text, limit):
+    from toolkit.errors import printable
+
+    out = printable(text, limit)
+    assert out.isprintable() and "\n" not in out
+    kept = out.split("... (")[0] if len(text) > limit else out
+    assert len(kept) <= 10 * limit  # each character kept or escaped (at most \U0010ffff: 10 characters)
+    if len(text) > limit:
+        assert out.endswith(f"... ({len(text) - limit:,} more characters)")
+    if text.isprintable() and len(text) <= limit:
+        assert out == text
+
+
+def test_a_list_of_names_ends_with_how_many_more():
+    from toolkit.errors import ConfigError
+
+    err = ConfigError("unknown", available=[f"n{i}" for i in range(1_000_000)])
+    assert str(err).endswith("n59 and 999,940 more") and len(str(err)) < 1000

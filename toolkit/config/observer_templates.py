@@ -18,6 +18,7 @@ from toolkit.character import COMPONENT_TABLES, build_component
 from toolkit.config.search import character_paths, load_chain, resolve_file
 from toolkit.config.toml import find_key_line
 from toolkit.errors import ConfigError
+from toolkit.params import finite_number
 
 __all__ = ["OBSERVER_TEMPLATE", "OBSERVER_FOLDER", "OBSERVER_KEYS", "ALTERNATIVES", "observer_templates",
            "observer_template_path", "read_observer_template", "is_observer_template", "check_observer_template",
@@ -128,6 +129,11 @@ def checked_template(path: str | Path | None, pm: Any) -> tuple[dict[str, Any], 
             if key not in OBSERVER_KEYS:
                 raise ConfigError(f"unknown key {key!r}", key=("observer", key), expected="an [observer] key",
                                   available=OBSERVER_KEYS)
+        lengths_for = head.get("lengths_for_height")  # what composing the observer refuses, refused here too
+        if lengths_for is not None and (finite_number(lengths_for) or 0.0) <= 0:
+            raise ConfigError(f"invalid value {lengths_for!r}", key=("observer", "lengths_for_height"),
+                              expected="a positive number: the standing height (m) the length parameters were "
+                                       "written for")
         for key in COMPONENT_TABLES:
             if key in table:
                 if not isinstance(table[key], Mapping):

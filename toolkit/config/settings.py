@@ -27,6 +27,9 @@ def parse_settings(items: list[str], *, tables: bool = True) -> dict[str, Any]:
     """
     out: dict[str, Any] = {}
     for item in items:
+        if any(c in item for c in "\n\r\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029"):  # str.splitlines' line breaks
+            raise ConfigError(f"a setting holding a line break: {item!r}", key=("--set",),
+                              expected="TABLE.KEY=VALUE on one line (one value; no TOML tables after it)")
         key, sep, value = item.partition("=")
         table, dot, name = key.strip().partition(".")
         if not tables:
@@ -37,7 +40,7 @@ def parse_settings(items: list[str], *, tables: bool = True) -> dict[str, Any]:
                               " (TABLE.KEY.KEY=VALUE inside a parameter's own table)"
                               if tables else "KEY=VALUE, like keys=4")
         try:
-            parsed = loads(f"v = {value}")["v"]
+            parsed = loads(f"v = {value}")["v"]  # one line (no line break, above): one value, nothing after it
         except NumberTooLong as exc:
             raise ConfigError(f"{exc}", key=("--set", *([table] if tables else []), *path),
                               expected=f"an integer of at most {MAX_DIGITS} digits") from None

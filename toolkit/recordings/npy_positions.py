@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import os
+import tokenize
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import NamedTuple
@@ -59,7 +60,8 @@ def read_header(path: Path) -> NpyHeader:
             size = os.fstat(handle.fileno()).st_size
     except ConfigError:
         raise
-    except (ValueError, OSError, EOFError, OverflowError, TypeError, SyntaxError) as exc:
+    except (ValueError, OSError, EOFError, OverflowError, TypeError, SyntaxError, KeyError, IndexError, AttributeError,
+            RecursionError, tokenize.TokenError) as exc:  # what numpy's header parser raises on a damaged header
         problem = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise ConfigError(f"not a readable .npy header ({problem})", file=path, expected=EXPECTED) from None
     if dtype.hasobject:

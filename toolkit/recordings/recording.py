@@ -16,8 +16,8 @@ from typing import Any
 
 from toolkit.errors import ConfigError
 
-__all__ = ["Recording", "BLOCK", "MAX_FPS", "MIN_FPS", "MAX_JOINTS", "FPS_HINT", "check_fps", "check_names",
-           "shortened"]
+__all__ = ["Recording", "BLOCK", "MAX_FPS", "MIN_FPS", "MAX_JOINTS", "MAX_COORDINATE", "FPS_HINT", "check_fps",
+           "check_names", "shortened"]
 
 BLOCK = 4096
 """Frames per block when a recording is read a block at a time (and a BVH's forward kinematics is run)."""
@@ -72,8 +72,13 @@ class Recording:
         self._blocks, self._close = blocks, close
 
     def blocks(self) -> Iterator[Any]:
-        """The joint positions (k, J, 3), float64, in the file's units and axes, NaN where missing; once."""
-        return self._blocks
+        """The joint positions (k, J, 3), float64, in the file's units and axes, NaN where missing; once.
+
+        A joint position with a coordinate beyond :data:`MAX_COORDINATE` in size is missing too (a bad frame is not
+        visible): no body is a billion units across, and such a number (``1e308``) overflows the first sum or
+        square the observer takes of it."""
+        for block in self._blocks:
+            yield _without_absurd(block)
 
     def close(self) -> None:
         if self._close is not None:
@@ -87,6 +92,24 @@ class Recording:
 
     def __repr__(self) -> str:
         return f"Recording({self.source!r}, {self.kind}, {len(self.names)} joints, {self.fps} fps)"
+
+
+MAX_COORDINATE = 1e9
+"""The largest size of a joint coordinate a recording gives (in its own units: a thousand kilometres in millimetres);
+a position with a larger one is read as not seen in that frame (:meth:`Recording.blocks`)."""
+
+
+def _without_absurd(block: Any) -> Any:
+    """``block`` (k, J, 3) with every position that has a coordinate beyond :data:`MAX_COORDINATE` in size NaN."""
+    import numpy as np
+
+    block = np.asarray(block, dtype=float)
+    with np.errstate(invalid="ignore"):
+        absurd = (np.abs(block) > MAX_COORDINATE).any(axis=-1)
+    if absurd.any():
+        block = block.copy() if not block.flags.writeable else block
+        block[absurd] = np.nan
+    return block
 
 
 def check_fps(fps: object, path: str | Path, what: str) -> float:

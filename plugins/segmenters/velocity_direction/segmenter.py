@@ -111,16 +111,16 @@ class VelocityDirection(Segmenter):
         Parameter("parts", list, [], "Parts whose velocity is used (the wrists...); empty: every part.", items=str),
         Parameter("rest_speed", float, 0.08, "Speed (m/s, over the sensory memory) below which the parts are at rest.", minimum=0.0, length=True),
         Parameter("memory", float, 0.1, "Seconds of the sensory memory: how long motion (or rest) must last to count "
-                  "as the onset (or the end) of a movement.", minimum=0.0),
+                  "as the onset (or the end) of a movement.", minimum=0.0, seconds=True),
         Parameter("drop", float, 0.5, "A speed minimum is a break point when below this share of its neighbouring "
                   "maxima. Higher cuts more, lower only at near stops.", minimum=0.0, maximum=1.0),
         Parameter("angle", float, 50.0, "Degrees between movement directions that makes a new direction cluster.",
                   minimum=1.0, maximum=180.0),
         Parameter("corner", float, 0.9, "A direction break needs a speed minimum within 0.1 s that is below this "
                   "share of its neighbouring maxima (a gentler dip than `drop`).", minimum=0.0, maximum=1.0),
-        Parameter("min_stroke", float, 0.15, "Shortest stroke (s); shorter pieces merge with a neighbour.", minimum=0.0),
+        Parameter("min_stroke", float, 0.15, "Shortest stroke (s); shorter pieces merge with a neighbour.", minimum=0.0, seconds=True),
         Parameter("smooth", float, 0.2, "Seconds of Savitzky-Golay smoothing of the working memory before it is "
-                  "segmented (0: none).", minimum=0.0),
+                  "segmented (0: none).", minimum=0.0, seconds=True),
         Parameter("angle_scale", float, 0.25, "Metres one radian of a finger's joint angles counts as (0.25: a finger "
                   "turning at 0.6 rad/s moves as fast as a wrist at 0.15 m/s).", minimum=0.0, length=True),
         Parameter("level", str, "stroke", "Report strokes (break points) or whole movements (onset to end; a walk, "
@@ -134,10 +134,10 @@ class VelocityDirection(Segmenter):
         Parameter("noise", float, 0.0, "The rest speed is at least this many times the slowest the demonstrator "
                   "has been over the last `floor` seconds (0: off, the paper; in a walk that is a stride's slow "
                   "phase, so walks are cut into strides).", minimum=0.0),
-        Parameter("floor", float, 10.0, "Seconds over which the slowest speed is taken for `noise`.", minimum=0.1),
+        Parameter("floor", float, 10.0, "Seconds over which the slowest speed is taken for `noise`.", minimum=0.1, seconds=True),
         Parameter("pause", float, 0.0, "Seconds the speed is averaged over before it is compared with the rest "
                   "speed: a movement begins and ends at a rest of about this long (0: the sensory memory, the "
-                  "paper).", minimum=0.0),
+                  "paper).", minimum=0.0, seconds=True),
         Parameter("end", str, "still", "Where a movement ends: at any rest (`still`, the paper) or only at one of "
                   "the demonstrator's own rests (`rest`): near where it began or another rest they were seen in, a "
                   "stance they left and came back to, or after `rest.settle` seconds; a rest elsewhere is a hold, and a "
@@ -147,16 +147,16 @@ class VelocityDirection(Segmenter):
                       "demonstrator's body sizes) a pose at rest must be to one of their rests to be there; twice it, "
                       "for one part, is leaving (0.1: B&B's hub threshold, 0.02 m on Max).", minimum=0.0),
             Parameter("settle", float, 2.0, "Seconds of rest away from the demonstrator's rests after which a "
-                      "movement ends anyway (a new stance: longer than a gesture holds a pose).", minimum=0.0),
+                      "movement ends anyway (a new stance: longer than a gesture holds a pose).", minimum=0.0, seconds=True),
         )),
         Parameter("window", float, 0.0, "Seconds over which each part's velocity is the slope of a least-squares "
                   "line through its positions (a tracker's jitter averaged out; 0: the displacement over the sensory "
-                  "memory, the paper).", minimum=0.0),
+                  "memory, the paper).", minimum=0.0, seconds=True),
         Parameter("jitter", float, 0.0, "The rest speed is at least this many times the root-mean-square speed the "
                   "tracker's jitter alone gives a part standing still, the jitter measured from the positions' second "
                   "differences over `floor` seconds (0: off, the paper).", minimum=0.0),
         Parameter("max_movement", float, 60.0, "Seconds after which a movement that has not ended is closed there and "
-                  "the next begins at once (the working memory's bound; 0: none).", minimum=0.0),
+                  "the next begins at once (the working memory's bound; 0: none).", minimum=0.0, seconds=True),
     )
 
     def attach(self, owner: Any) -> None:

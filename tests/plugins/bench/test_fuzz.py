@@ -242,7 +242,7 @@ def test_seeds_are_good_inputs(seeds):
     """Every seed, unmutated, passes the command the fuzzer runs it through (so a failure is the mutation's)."""
     from plugins.bench.fuzz import _command  # noqa: PLC2701
 
-    for target in ("bvh", "toml", "profile", "scenario", "state"):
+    for target in ("bvh", "toml", "profile", "scenario", "state", "npy", "c3d"):
         for seed in seeds[target]:
             argv = [a.replace("{input}", str(seed["path"])) for a in _command(target, seed, np.random.default_rng(0))]
             answer = fuzz.run_one({"cwd": str(Path(seed["path"]).parent), "argv": argv})
@@ -284,3 +284,28 @@ def test_bench_fuzz_refuses_unknown_targets(capsys):
     assert main(["bench", "fuzz", "--targets", "bvh,yaml"]) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "unknown fuzz target(s) ['yaml']" in err[0] and "available: bvh, toml" in err[0]
+
+
+def test_the_new_shapes_are_made(seeds):
+    """Issue 38's shapes: .npy headers and archives, C3D header fields and cuts, special files, hostile bench option
+    values, writes on a full disk, hostile strings in state files."""
+    from plugins.bench.fuzz_mutate import mutation_names
+
+    assert {"npy_header", "npy_archive"} <= set(mutation_names("npy"))
+    assert {"c3d_header", "c3d_cut"} <= set(mutation_names("c3d"))
+    cases = [fuzz.make_case(i, t, seeds, 5) for t in ("special", "bench", "output") for i in range(60)]
+    specials = {c.special for c in cases if c.target == "special"}
+    assert specials == set(fuzz.SPECIAL_FILES)
+    assert any(c.full for c in cases if c.target == "output") and not all(c.full for c in cases if c.target == "output")
+    options = {c.argv[-2] for c in cases if c.target == "bench"}
+    assert {"--frames", "--noise", "--nodes", "--minutes", "--episodes"} <= options
+
+
+@pytest.mark.parametrize("target", ["special", "bench", "output", "npy", "c3d"])
+def test_the_new_targets_find_nothing(tmp_path, target):
+    """A few cases of each new target through the harness: every one is ok or a documented one-line error."""
+    from toolkit import create_plugin_manager
+
+    results = fuzz.run_fuzz(create_plugin_manager(), n=6, seed=3, targets=(target,), timeout=60.0, memory_mb=1024)
+    assert [r.outcome for r in results if r.outcome not in ("ok", "documented")] == [], \
+        [(r.case.command(), r.answer.get("stderr", "")[-500:]) for r in results]
