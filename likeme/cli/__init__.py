@@ -83,7 +83,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             parser.print_help()
             return 1
         check_outputs(args)
-        pm.load_all()
+        if getattr(args, "loads_plugins", True):  # a command that loads what it needs itself says so
+            pm.load_all()
         return int(args.handler(args, pm) or 0)
     except LikemeError as err:
         print(f"likeme: error: {err}", file=sys.stderr)

@@ -1,12 +1,13 @@
 """``likeme bench latency``: how long after the segmenter closes a segment ``likeme observe -`` prints it.
 
-A frame-paced producer writes each stream's frames, one CSV line at a time at the stream's frame rate (the clock
-each frame is due on: ``start + k / fps``), into ``likeme observe ... -`` running as a tracker's reader would run it,
-and notes when each frame was written; a reader notes when each segment's line arrives. Which frame closes each
+A frame-paced producer writes each stream's frames, one CSV line at a time at the stream's frame rate, into
+``likeme observe ... -`` running as a tracker's reader would run it; each frame is taken as made when it is due
+(``start + k / fps``), as a tracker makes it whether or not the reader has taken the frames before it (a full pipe
+delays the writing, not the frame); a reader notes when each segment's line arrives. Which frame closes each
 segment (the segmenter's decision) is found by the same observer fed the same frames one at a time in this process
 (the observations of ``observe -`` are those of the files, frame for frame: ``tests/toolkit/recordings/
-test_live_input.py``). The latency of a segment is the time from the writing of the frame that closed it to the
-arrival of its line; the time from its last frame is printed beside it (it holds the segmenter's own wait: the
+test_live_input.py``). The latency of a segment is the time from the frame that closed it to the arrival of its
+line; the time from its last frame is printed beside it (it holds the segmenter's own wait: the
 frames it needs to see before it decides).
 
 ``--start ready`` (the default) starts the frames when ``observe`` says it is watching (its first line); ``--start
@@ -91,11 +92,11 @@ def stream_latencies(command: list[str], path: Path, closed: dict[tuple[int, int
             ready.wait(timeout)
         t0 = time.perf_counter()
         for k, row in enumerate(rows):
-            delay = t0 + k / fps - time.perf_counter()
+            written[k] = t0 + k / fps  # when the frame is due: a tracker makes it then, whether the pipe takes it
+            delay = written[k] - time.perf_counter()
             if delay > 0:
                 time.sleep(delay)
             proc.stdin.write((row + "\n").encode())
-            written[k] = time.perf_counter()
         proc.stdin.close()
         proc.wait(timeout)
     except (BrokenPipeError, subprocess.TimeoutExpired):
