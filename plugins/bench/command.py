@@ -299,6 +299,7 @@ def likeme_register_commands(subparsers):
 
     p = sub.add_parser("latency", help="how long after the segmenter closes a segment likeme observe - prints it, "
                        "fed by a frame-paced producer (median and p95)")
+    _jobs_options(p, "each feeding of a stream", timing=True)
     p.add_argument("--body", metavar="PROFILE", help="body profile of --streams (default: data made here)")
     p.add_argument("--repertoire", metavar="DIR", help="the observer's clips (with --streams)")
     p.add_argument("--streams", metavar="PATH", help="a BVH stream or a folder of them (default: made here)")

@@ -12,7 +12,9 @@ frames it needs to see before it decides).
 
 ``--start ready`` (the default) starts the frames when ``observe`` says it is watching (its first line); ``--start
 now`` starts them at once, as a tracker that does not wait would: the first segments then also wait for the
-observer to be composed and to catch up. Segments closed by the end of the input are left out. Without
+observer to be composed and to catch up. Segments closed by the end of the input are left out. Each feeding of a
+stream is an item of ``--jobs`` / ``--scheduler`` (:func:`plugins.bench.jobs.run_items`): streams fed at once share
+the machine, so the default is one after another. Without
 ``--streams`` the streams are made here (``likeme bench make-data``) from the project's own characters.
 """
 
@@ -119,11 +121,18 @@ def stream_latencies(command: list[str], path: Path, closed: dict[tuple[int, int
             "after_end_s": after_end, "startup_s": (started[0] - spawned) if started else float("nan")}
 
 
+def _feed(item: tuple) -> dict[str, Any]:
+    """One stream fed once (an item of :func:`plugins.bench.jobs.run_items`)."""
+    command, path, closed, fps, start = item
+    return stream_latencies(command, Path(path), closed, fps, start=start)
+
+
 def _percentile(values: list[float], q: float) -> float:
     return float(np.percentile(values, q)) if values else float("nan")
 
 
 def cmd_latency(args: argparse.Namespace, pm: Any) -> int:
+    from plugins.bench.jobs import run_items
     from plugins.bench.startup import likeme_command
     from toolkit.observe import compose_observer
     from toolkit.recordings.profile import load_profile
@@ -148,15 +157,15 @@ def cmd_latency(args: argparse.Namespace, pm: Any) -> int:
         options = [*(["--segmenter", args.segmenter] if args.segmenter else []),
                    *(["--matcher", args.matcher] if args.matcher else [])]
         character = compose_observer(pm, profile, repertoire, segmenter=args.segmenter, matcher=args.matcher or "")
-        rows = []
+        items = []
         for path in streams:
             motion = profile.read(path)
             fps = args.fps or motion.fps
             closed = closing_frames(character, profile, motion)
             command = [*likeme_command(), "observe", "--body", str(body), "--repertoire", str(repertoire),
                        "--fps", f"{fps:g}", *options, "-"]
-            for _ in range(args.runs):
-                rows.append(stream_latencies(command, path, closed, fps, start=args.start))
+            items += [(command, str(path), closed, fps, args.start)] * args.runs
+        rows = run_items(_feed, items, jobs=args.jobs, scheduler=args.scheduler)
     decision = [x for r in rows for x in r["after_decision_s"]]
     end = [x for r in rows for x in r["after_end_s"]]
     startup = [r["startup_s"] for r in rows if np.isfinite(r["startup_s"])]
