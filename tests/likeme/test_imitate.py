@@ -234,3 +234,32 @@ right = "right_knee"
 forward = "nose"
 """)
     return load_profile(path)
+
+
+def test_a_learned_movement_is_retargeted_to_the_observers_body_by_its_correspondence(generated, pm, tmp_path):
+    """A demonstrator 1.3 times Max's size: with the body-mapping correspondence (B&B §7.1) the movement learned from
+    them is performed at Max's own bone lengths; the papers' plain observer takes their poses as they are."""
+    from plugins.lib.body_size import bone_lengths, bone_tree
+
+    profile = load_profile(generated / "profile.toml")
+    body = profile.body
+    tree = bone_tree(body.parts, body.bones, body.parts[body.root_index])
+    path, truth = _stream(generated)
+    missing = truth[-1][2]
+    repertoire = tmp_path / "repertoire"
+    shutil.copytree(generated / "repertoire", repertoire, ignore=lambda d, names: [missing] if d.endswith(
+        "repertoire") else [])
+    demo = profile.read(path)
+    big = Motion(demo.positions * 1.3, demo.fps, demo.parts)
+    own = profile.read(generated / "repertoire" / missing / "max.bvh")
+
+    def lengths(m):
+        return np.nanmedian(bone_lengths(m.positions, m.visible, tree), axis=0)
+
+    result = imitate(profile, repertoire, big, pm=pm, correspondence="body-mapping")
+    assert len(result.learned) == 1
+    ratio = np.median(lengths(next(iter(result.learned.values()))) / lengths(own))
+    assert abs(ratio - 1.0) < 0.05
+    learned = [s for s in result.segments if s.learned][0]
+    plain = Motion(big.positions[learned.start : learned.end], big.fps, big.parts)
+    assert np.median(lengths(plain) / lengths(own)) > 1.25  # what the plain observer would have performed
