@@ -21,8 +21,8 @@ from toolkit.errors import ConfigError
 from toolkit.motion import Motion
 from toolkit.recordings.profile import load_profile
 from toolkit.recordings.segments import read_segments
+from tests.conftest import BANDAI, ROOT
 
-PUBLIC = Path("/work/data/bn36")
 
 
 @pytest.fixture(scope="module")
@@ -197,14 +197,19 @@ def test_cli_errors(generated, tmp_path, capsys, monkeypatch, extra, message):
     assert message in capsys.readouterr().err
 
 
-@pytest.mark.skipif(not (PUBLIC / "profile.toml").is_file(),
-                    reason="the public Bandai-Namco clips prepared by `likeme bench bandai` (/work/data/bn36) are absent")
-def test_public_clip_imitated_and_validated(tmp_path, pm):
-    profile = load_profile(PUBLIC / "profile.toml")
-    demo = sorted((PUBLIC / "demos" / "bow").glob("*.bvh"))[0]
-    result = imitate(profile, PUBLIC / "repertoire", demo, pm=pm)
+@pytest.mark.skipif(not BANDAI.is_dir(), reason=f"Bandai-Namco motion capture not found at {BANDAI}")
+def test_public_clips_imitated_validated_and_read_back(tmp_path, pm):
+    """The Bandai-Namco clips (links, nothing copied: ``likeme bench bandai``): a styled demonstration imitated with
+    the normal-style repertoire, written as BVH in the skeleton, accepted by ``likeme validate`` and read back."""
+    from plugins.bench.data import bandai
+
+    profile_path = ROOT / "characters" / "profiles" / "bandai-namco.toml"
+    data = bandai(BANDAI, tmp_path / "bn", profile_path, streams=1, per_stream=2)
+    profile = load_profile(profile_path)
+    demo = sorted((data / "demos" / "bow").glob("*.bvh"))[0]
+    result = imitate(profile, data / "repertoire", demo, pm=pm)
     out = write_motion(result.motion, profile, tmp_path / "bow.bvh")
-    assert main(["validate", "--body", str(PUBLIC / "profile.toml"), str(out)]) == 0
+    assert main(["validate", "--body", str(profile_path), str(out)]) == 0
     assert profile.read(out).n_frames == result.demonstration.n_frames
     assert result.segments and np.isfinite(result.error())
 
