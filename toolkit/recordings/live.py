@@ -168,8 +168,9 @@ class LiveInput:
     def _start(self, early: list[tuple[np.ndarray, float | None, int]]) -> None:
         """Read the frames the rate or the frame step needs (none when the rate is given and the first frame has no
         time), measure them, and place them on the grid."""
-        if not early and self.fps is None or early and early[0][1] is not None:
-            while len(early) < RATE_FRAMES and (self.fps is None or len(early) < 1 or early[-1][1] is not None):
+        with_times = early[0][1] is not None if early else self._layout is not None and self._layout.time is not None
+        if self.fps is None or with_times:
+            while len(early) < RATE_FRAMES and (not early or early[-1][1] is not None):
                 frame = self._next_frame()
                 if frame is None:
                     break

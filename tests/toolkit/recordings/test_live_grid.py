@@ -46,6 +46,15 @@ def test_dropped_frames_are_placed_on_the_grid_not_visible_as_a_file_reads_them(
     np.testing.assert_array_equal(live, from_file.positions)
 
 
+def test_dropped_frames_are_placed_with_a_rate_given_too(profile):
+    kept = [0, 1, 2, 4, 5, 8]
+    text = _csv([k / 30 for k in kept], np.ones((6, 3, 3)))
+    live = LiveInput(io.BytesIO(text.encode()), profile, 30.0)
+    frames = list(live)
+    assert live.fps == 30.0 and len(frames) == 9
+    assert [bool(np.isfinite(f).all()) for f in frames] == [k in kept for k in range(9)]
+
+
 def test_a_frame_dropped_among_the_first_gives_the_right_rate(profile):
     kept = [0, 2, 3, 4]
     text = _csv([k / 25 for k in kept], np.zeros((4, 3, 3)))
