@@ -72,7 +72,8 @@ def imitate(profile: str | Path | BodyProfile, repertoire: Any, demonstration: s
             segmenter: str | None = None, matcher: str | None = "", correspondence: str | None = "",
             template: str | Path | None = None, settings: Mapping[str, Mapping[str, Any]] | None = None,
             learn: bool = True, transition: float = 0.2, fps: float | None = None,
-            lengths_for_height: float | None | str = "", pm: Any = None) -> Imitation:
+            lengths_for_height: float | None | str = "", demonstration_profile: str | Path | BodyProfile | None = None,
+            pm: Any = None) -> Imitation:
     """The demonstration imitated by the observer ``likeme observe`` composes with these arguments.
 
     Parameters
@@ -93,6 +94,10 @@ def imitate(profile: str | Path | BodyProfile, repertoire: Any, demonstration: s
         Seconds over which each join between movements and hubs is blended.
     fps : float, optional
         The frame rate of recordings without one of their own.
+    demonstration_profile : path or BodyProfile, optional
+        The body profile the demonstration is read through when it was recorded with another skeleton than the
+        observer's (another suit, another naming, a tracker): it must give the same parts (by name; their order may
+        differ). The imitation is in ``profile``'s skeleton all the same.
     """
     from toolkit import create_plugin_manager
     from toolkit.config.observer_templates import OBSERVER_TEMPLATE
@@ -113,11 +118,26 @@ def imitate(profile: str | Path | BodyProfile, repertoire: Any, demonstration: s
         motion, source = demonstration, Path("<motion>")
     else:
         source = Path(demonstration)
-        motion = profile.read(source, fps)
+        theirs = profile if demonstration_profile is None else demonstration_profile \
+            if isinstance(demonstration_profile, BodyProfile) else load_profile(demonstration_profile)
+        motion = _in_parts(theirs.read(source, fps), profile, theirs)
     if motion.n_frames < 2:
         raise ConfigError(f"{motion.n_frames} frame(s)", file=source, expected="a demonstration of two frames or more")
     done = imitate_motion(Observer(character, profile.body, motion.fps), motion, transition=float(transition))
     return Imitation(done.motion, done.segments, done.learned, done.demonstration, profile, source)
+
+
+def _in_parts(motion: Motion, profile: BodyProfile, theirs: BodyProfile) -> Motion:
+    """A demonstration read through another profile, its columns in ``profile``'s parts (the same names)."""
+    if tuple(motion.parts) == tuple(profile.body.parts):
+        return motion
+    missing = [p for p in profile.body.parts if p not in motion.parts]
+    if missing:
+        raise ConfigError(f"the demonstration's profile has no part {missing[0]!r}", file=theirs.file,
+                          key=("parts",), expected=f"the observer's parts ({profile.name}): "
+                          f"{', '.join(profile.body.parts)}", available=list(motion.parts))
+    index = [list(motion.parts).index(p) for p in profile.body.parts]
+    return Motion(motion.positions[:, index], motion.fps, profile.body.parts, motion.visible[:, index])
 
 
 def _learning(pm: Any, settings: dict, learn: bool, matcher: str | None, template: Any) -> dict:

@@ -31,6 +31,8 @@ def add_parser(sub: Any) -> None:
                    "the repertoire (the observer's skeleton)")
     p.add_argument("--repertoire", required=True, metavar="DIR", help="the observer's movements: one folder of "
                    "clips per movement")
+    p.add_argument("--demo-body", metavar="PROFILE", dest="demo_body", help="body profile of the demonstration when "
+                   "it was recorded with another skeleton (the same parts by name; default: --body)")
     p.add_argument("--out", required=True, metavar="FILE", help="where the imitation is written: .bvh or .csv")
     p.add_argument("--learn-into", metavar="DIR", dest="learn_into", help="write each movement learned into this "
                    "repertoire folder (DIR/NAME/FILE.bvh; the repertoire itself, to know them next time)")
@@ -75,7 +77,8 @@ def handle(args: argparse.Namespace, pm: PluginManager) -> int:
     result = imitate(profile, args.repertoire, args.file, segmenter=args.segmenter, matcher=args.matcher or "",
                      correspondence=args.correspondence or "", template=args.observer, settings=settings,
                      learn=not args.no_learn, transition=args.transition, fps=args.fps, pm=pm,
-                     lengths_for_height="" if args.lengths_for_height is None else args.lengths_for_height)
+                     lengths_for_height="" if args.lengths_for_height is None else args.lengths_for_height,
+                     demonstration_profile=args.demo_body)
     written = write_motion(result.motion, profile, args.out)
     saved = save_learned(result, args.learn_into) if args.learn_into else []
     error = result.error()

@@ -268,3 +268,55 @@ def test_a_learned_movement_is_retargeted_to_the_observers_body_by_its_correspon
     learned = [s for s in result.segments if s.learned][0]
     plain = Motion(big.positions[learned.start : learned.end], big.fps, big.parts)
     assert np.median(lengths(plain) / lengths(own)) > 1.25  # what the plain observer would have performed
+
+
+def test_a_demonstration_in_another_skeleton_is_imitated_in_the_observers(generated, tmp_path, capsys):
+    """The demonstration recorded with another naming and in centimetres with +z up (its own profile, the same
+    parts): read through that profile, imitated and written in the observer's skeleton."""
+    import tomllib
+
+    from toolkit.recordings.bvh import read_bvh
+
+    profile = load_profile(generated / "profile.toml")
+    path, truth = _stream(generated)
+    theirs = _renamed(generated / "profile.toml", tmp_path / "theirs.toml")
+    demo = profile.read(path)
+    other = Motion(demo.positions, demo.fps, demo.parts)
+    write_motion(other, load_profile(theirs), tmp_path / "demo.bvh")  # the same motion in their skeleton
+    assert "tracker_root" in read_bvh(tmp_path / "demo.bvh").names
+    out = tmp_path / "imitation.bvh"
+    assert main(["imitate", "--body", str(generated / "profile.toml"), "--demo-body", str(theirs), "--repertoire",
+                 str(generated / "repertoire"), str(tmp_path / "demo.bvh"), "--out", str(out), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert [s["movement"] for s in report["segments"]] == [m for _, _, m in truth]
+    assert read_bvh(out).names[0] == "root" and profile.read(out).n_frames == demo.n_frames
+    table = tomllib.loads(theirs.read_text())
+    table["parts"].pop("nose")
+    table["facing"].pop("forward")
+    table["bones"] = [b for b in table["bones"] if "nose" not in b]
+    (tmp_path / "fewer.toml").write_text(_toml(table))
+    assert main(["imitate", "--body", str(generated / "profile.toml"), "--demo-body", str(tmp_path / "fewer.toml"),
+                 "--repertoire", str(generated / "repertoire"), str(tmp_path / "demo.bvh"), "--out", str(out)]) == 1
+    assert "has no part 'nose'" in capsys.readouterr().err
+
+
+def _renamed(source: Path, dest: Path) -> Path:
+    """``source``'s profile with every joint renamed tracker_JOINT, in centimetres with +z up."""
+    import tomllib
+
+    table = tomllib.loads(source.read_text())
+    table["profile"].update(name="tracker", units="centimetre", up="+z")
+    table["parts"] = {part: f"tracker_{joint}" for part, joint in table["parts"].items()}
+    dest.write_text(_toml(table))
+    return dest
+
+
+def _toml(table: dict) -> str:
+    import json as _json
+
+    lines = [f"bones = {_json.dumps(table['bones'])}"] if "bones" in table else []
+    for name, values in table.items():
+        if isinstance(values, dict):
+            lines.append(f"[{name}]")
+            lines += [f"{k} = {_json.dumps(v)}" for k, v in values.items()]
+    return "\n".join(lines) + "\n"
