@@ -73,7 +73,7 @@ def imitate(profile: str | Path | BodyProfile, repertoire: Any, demonstration: s
             template: str | Path | None = None, settings: Mapping[str, Mapping[str, Any]] | None = None,
             learn: bool = True, transition: float = 0.2, fps: float | None = None,
             lengths_for_height: float | None | str = "", demonstration_profile: str | Path | BodyProfile | None = None,
-            pm: Any = None) -> Imitation:
+            timing: str = "duration", pm: Any = None) -> Imitation:
     """The demonstration imitated by the observer ``likeme observe`` composes with these arguments.
 
     Parameters
@@ -94,6 +94,9 @@ def imitate(profile: str | Path | BodyProfile, repertoire: Any, demonstration: s
         Seconds over which each join between movements and hubs is blended.
     fps : float, optional
         The frame rate of recordings without one of their own.
+    timing : str
+        How each recognised movement is timed to its segment: ``"duration"`` (played evenly over it, the speed
+        re-parameterised, K&G §4.4) or ``"aligned"`` (time-warped onto the demonstrator's poses, pose by pose).
     demonstration_profile : path or BodyProfile, optional
         The body profile the demonstration is read through when it was recorded with another skeleton than the
         observer's (another suit, another naming, a tracker): it must give the same parts (by name; their order may
@@ -103,8 +106,10 @@ def imitate(profile: str | Path | BodyProfile, repertoire: Any, demonstration: s
     from toolkit.config.observer_templates import OBSERVER_TEMPLATE
     from toolkit.observe import Observer, compose_observer
 
-    from plugins.action.imitation import imitate_motion
+    from plugins.action.imitation import TIMINGS, imitate_motion
 
+    if timing not in TIMINGS:
+        raise ConfigError(f"timing {timing!r}", key=("timing",), expected="a timing", available=sorted(TIMINGS))
     if not (isinstance(transition, (int, float)) and np.isfinite(transition) and transition >= 0):
         raise ConfigError(f"transition {transition!r}", key=("transition",), expected="seconds, 0 or more")
     pm = pm if pm is not None else create_plugin_manager()
@@ -123,7 +128,8 @@ def imitate(profile: str | Path | BodyProfile, repertoire: Any, demonstration: s
         motion = _in_parts(theirs.read(source, fps), profile, theirs)
     if motion.n_frames < 2:
         raise ConfigError(f"{motion.n_frames} frame(s)", file=source, expected="a demonstration of two frames or more")
-    done = imitate_motion(Observer(character, profile.body, motion.fps), motion, transition=float(transition))
+    done = imitate_motion(Observer(character, profile.body, motion.fps), motion, transition=float(transition),
+                          timing=TIMINGS[timing]())
     return Imitation(done.motion, done.segments, done.learned, done.demonstration, profile, source)
 
 

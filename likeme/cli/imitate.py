@@ -40,6 +40,10 @@ def add_parser(sub: Any) -> None:
                    "are left standing in the hub)")
     p.add_argument("--transition", type=number_type(0.0, 10.0, "seconds"), default=0.2, metavar="S",
                    help="seconds over which each join between movements is blended (default 0.2)")
+    p.add_argument("--timing", choices=("duration", "aligned"), default="duration",
+                   help="how each recognised movement is timed to its segment: duration (played evenly over it, the "
+                   "speed re-parameterised, K&G §4.4; the default) or aligned (time-warped onto the demonstrator's "
+                   "poses, pose by pose)")
     p.add_argument("--fps", type=fps_type, default=None, metavar="HZ", help="frame rate of recordings without one "
                    "of their own")
     p.add_argument("--segmenter", metavar="NAME", help="segmenter (default: the observer template's)")
@@ -78,7 +82,7 @@ def handle(args: argparse.Namespace, pm: PluginManager) -> int:
                      correspondence=args.correspondence or "", template=args.observer, settings=settings,
                      learn=not args.no_learn, transition=args.transition, fps=args.fps, pm=pm,
                      lengths_for_height="" if args.lengths_for_height is None else args.lengths_for_height,
-                     demonstration_profile=args.demo_body)
+                     demonstration_profile=args.demo_body, timing=args.timing)
     written = write_motion(result.motion, profile, args.out)
     saved = save_learned(result, args.learn_into) if args.learn_into else []
     error = result.error()

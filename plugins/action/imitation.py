@@ -127,6 +127,41 @@ def time_warp(poses: np.ndarray, n: int) -> np.ndarray:
     return poses[i] * (1.0 - w) + poses[i + 1] * w
 
 
+class Duration:
+    """Timing ``duration`` (the papers'): the performed movement played evenly over the demonstrated segment, its
+    speed re-parameterised to the segment's duration (K&G §4.4)."""
+
+    name = "duration"
+
+    def timed(self, performed: np.ndarray, demonstrated: np.ndarray) -> np.ndarray:
+        return time_warp(performed, len(demonstrated))
+
+
+class Aligned:
+    """Timing ``aligned``: the performed movement time-warped onto the demonstrated segment pose by pose (dynamic time
+    warping of the root-relative poses, :func:`dtaidistance.dtw_ndim.warping_path`), so that it is quick where the
+    demonstrator was quick and holds where they held; each demonstrated frame gets the mean of the performed frames
+    matched to it."""
+
+    name = "aligned"
+
+    def timed(self, performed: np.ndarray, demonstrated: np.ndarray) -> np.ndarray:
+        from dtaidistance import dtw_ndim
+
+        n = len(demonstrated)
+        a = np.ascontiguousarray(demonstrated.reshape(n, -1), dtype=np.double)
+        b = np.ascontiguousarray(performed.reshape(len(performed), -1), dtype=np.double)
+        path = np.array(dtw_ndim.warping_path(a, b))
+        sums = np.zeros((n, *performed.shape[1:]))
+        np.add.at(sums, path[:, 0], performed[path[:, 1]])
+        counts = np.bincount(path[:, 0], minlength=n)[:, None, None]
+        return sums / np.maximum(counts, 1)
+
+
+TIMINGS = {"duration": Duration, "aligned": Aligned}
+"""The timing strategies by name."""
+
+
 def blend_joins(local: np.ndarray, starts: list[int], frames: int) -> np.ndarray:
     """Each piece starting at a frame of ``starts`` joined to the pose before it: the jump between them spread over
     the piece's first ``frames`` frames, fading linearly (the poses stay continuous; the timing does not change)."""
@@ -141,12 +176,13 @@ def blend_joins(local: np.ndarray, starts: list[int], frames: int) -> np.ndarray
     return out
 
 
-def imitate_motion(observer: Any, demonstration: Motion, *, transition: float = 0.2) -> RecordedImitation:
+def imitate_motion(observer: Any, demonstration: Motion, *, transition: float = 0.2,
+                   timing: Duration | Aligned | None = None) -> RecordedImitation:
     """The demonstration watched, recognised and performed by the observer with its own movements.
 
     Buchsbaum & Blumberg 2005, §5.3 and Kopp & Graeser 2006, §4.4: every segment the observer's segmenter closes and
     its matcher recognises is performed as its own movement (its repertoire's take, :func:`performer_for`), time
-    warped to the segment's duration (:func:`time_warp`); between segments it stands in the hub it is nearest (all
+    warped to the segment's duration (``timing``: :class:`Duration`, the default, or :class:`Aligned`); between segments it stands in the hub it is nearest (all
     movements begin and end in a hub, §4.1), and each join is blended over ``transition`` seconds
     (:func:`blend_joins`). A segment that is unknown is learned when the matcher learns (``learn = true``: B&B §7.3,
     K&G §4.3): the first time it is performed as the demonstrator did it (their poses as the observer perceived
@@ -168,6 +204,7 @@ def imitate_motion(observer: Any, demonstration: Motion, *, transition: float = 
     rest = np.asarray(motor.rest_pose(), dtype=float)
     lift = rest[root]  # local frame: the root at its standing height
     performer = performer_for(motor)
+    timing = timing if timing is not None else Duration()
     local = np.repeat(rest[None], n, axis=0)
     pieces, segments, learned = [], [], {}
     for o in observations:
@@ -180,7 +217,8 @@ def imitate_motion(observer: Any, demonstration: Motion, *, transition: float = 
             poses = perceived[s:e] - perceived[s:e, root : root + 1] + lift
             learned[movement] = poses
         else:
-            poses = time_warp(performer.local(movement, o.match, fps), e - s)
+            seen = perceived[s:e] - perceived[s:e, root : root + 1] + lift
+            poses = timing.timed(performer.local(movement, o.match, fps), seen)
         local[s:e] = poses
         pieces.append((s, e))
         segments.append(ImitatedSegment(s, e, movement, first, float(o.match.confidence) if o.match else 0.0))
