@@ -4,7 +4,7 @@ parameter's own table nested under it), or as the Markdown reference ``docs/comp
 The listing without parameters is kept in a cache (``plugins.json`` in ``$LIKEME_CACHE_DIR``, else
 ``$XDG_CACHE_HOME/likeme``, else ``~/.cache/likeme``) with a digest of everything it depends on
 (:meth:`toolkit.manager.PluginManager.entries_fingerprint`: the entry points, their distributions and versions, the
-sizes and times of their source files and the core's); while the digest is the same the listing is printed from
+sizes and times of their source files and the core's, and of this module); while the digest is the same the listing is printed from
 the cache without importing a plugin or the libraries they import (numpy, scipy, networkx...), so that it starts
 as fast as ``likeme --help``. Any change (an install, an edit, another environment variable) lists again from the
 plugins and refreshes the cache; a listing in which a plugin failed to load is never cached; a cache that cannot be
@@ -135,6 +135,8 @@ def _cached_table(pm: PluginManager) -> tuple[dict[str, Any] | None, dict[str, s
     key = pm.entries_fingerprint() if path is not None else None
     if key is None:
         return None, None, None
+    own = os.stat(__file__)  # the listing is made here too: an edit of this file lists again
+    key = f"{key}:{own.st_size}:{own.st_mtime_ns}"
     try:
         cached = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
