@@ -176,7 +176,7 @@ def test_bench_startup_times_each_command_in_a_fresh_process(tmp_path, capsys):
     out = tmp_path / "startup.json"
     assert main(["bench", "startup", "--runs", "2", "--json", str(out)]) == 0
     rows = json.loads(out.read_text())["rows"]
-    assert [r["command"] for r in rows] == ["likeme --version", "likeme --help", "likeme plugins"]
+    assert [r["command"] for r in rows] == ["likeme --version", "likeme --help", "likeme plugins", "likeme plugins --params"]
     for r in rows:
         assert r["runs"] == 2 and 0 < r["min_s"] <= r["median_s"] <= r["max_s"]
     text = capsys.readouterr().out
