@@ -251,6 +251,48 @@ class PluginManager(pluggy.PluginManager):
             entries.append((info, ep))
         self._entries = entries
 
+    def entries_fingerprint(self) -> str | None:
+        """A digest of everything a listing of the registered components depends on, read without importing any
+        plugin: every entry found (name, module, distribution, version), the size and modification time of every
+        source file of its module (a package's files under it), of the core (:mod:`toolkit`), the Python version and
+        whether third-party entries are left out. ``None`` when it cannot be told (a manager that never looked for
+        entries, plugins registered in Python, a module whose files cannot be found)."""
+        import hashlib
+        from importlib.util import find_spec
+        from pathlib import Path
+
+        if self._entries is None or self._extra:
+            return None
+        entries = {info.name for info, _ in self._entries}
+        if any(name not in entries for name, _ in self.list_name_plugin()):  # registered in Python
+            return None
+        digest = hashlib.sha256(f"{sys.version}|{self._third_party}".encode())
+        folders = [Path(__file__).resolve().parent]
+        files: list[Path] = []
+        for info, _ in self._entries:
+            digest.update(f"|{info.name}={info.module}@{info.distribution}=={info.version}".encode())
+            try:
+                spec = find_spec(info.module.split(":")[0])
+            except (ImportError, ValueError, AttributeError):
+                return None
+            if spec is None or not spec.origin or not spec.has_location:
+                return None
+            if spec.submodule_search_locations:
+                folders.extend(Path(f) for f in spec.submodule_search_locations)
+            else:
+                files.append(Path(spec.origin))
+        for folder in dict.fromkeys(folders):
+            files.extend(sorted(folder.rglob("*.py")))
+        for skipped in self.skipped:
+            digest.update(f"|skipped {skipped.name}".encode())
+        for path in files:
+            try:
+                stat = path.stat()
+            except OSError:
+                return None
+            digest.update(f"|{path}:{stat.st_size}:{stat.st_mtime_ns}".encode())
+        return digest.hexdigest()
+
     def load_entry_points(self, *, third_party: bool = True) -> None:
         """Import and register every entry of the ``likeme`` group (only the built-ins if ``third_party`` is false),
         in the order :meth:`find_entry_points` gives (built-ins first); those registered early for the command line

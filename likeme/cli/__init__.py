@@ -10,6 +10,7 @@ command       module                      what it does
 ``plugins``   :mod:`likeme.cli.plugins`   every registered component, with its parameters
 ``show``      :mod:`likeme.cli.show`      a character, an observer or recordings, as text or a picture
 ``observe``   :mod:`likeme.cli.observe`   recordings (or frames piped in) watched by an observer
+``imitate``   :mod:`likeme.cli.imitate`   a recording performed with the observer's own movements
 ``validate``  :mod:`likeme.cli.validate`  character, scenario, profile and template files, recordings
 ``profile``   :mod:`likeme.cli.profile`   a body profile proposed for a recording
 ============  ==========================  ============================================================
@@ -28,7 +29,7 @@ import sys
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from likeme.cli import observe, plugins, profile, run, show, validate
+from likeme.cli import imitate, observe, plugins, profile, run, show, validate
 from likeme.cli.common import guarded_output
 from toolkit import __version__
 from toolkit.arguments import CommandParser, check_outputs
@@ -41,7 +42,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = ["main", "build_parser", "COMMANDS"]
 
-COMMANDS = (run, plugins, show, observe, validate, profile)
+COMMANDS = (run, plugins, show, observe, imitate, validate, profile)
 """The command modules, in the order ``likeme --help`` lists their commands."""
 
 
@@ -84,7 +85,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             parser.print_help()
             return 1
         check_outputs(args)
-        pm.load_all()
+        if getattr(args, "loads_plugins", True):  # a command that loads what it needs itself says so
+            pm.load_all()
         return int(args.handler(args, pm) or 0)
     except LikemeError as err:
         print(f"likeme: error: {err}", file=sys.stderr)

@@ -133,7 +133,12 @@ def _observe_file(path: str, args: argparse.Namespace, character: Any, profile: 
 
 
 def _observe_live(args: argparse.Namespace, character: Any, profile: Any, observer_class: Any) -> int:
-    """``likeme observe -``: frames on standard input, each observation printed (and flushed) as its segment closes."""
+    """``likeme observe -``: frames on standard input, each observation printed (and flushed) as its segment closes.
+
+    The frames are read as they arrive and watched a block of those that have arrived at a time
+    (:meth:`toolkit.recordings.live.LiveInput.blocks`; one frame when the observer keeps up): the observations are
+    those of pushing them one by one (:meth:`toolkit.observe.Observer.push_block`), and an observer that fell behind
+    (while it was composed, or on a slow frame) catches up at the speed of its block paths."""
     import numpy as np
 
     from toolkit.recordings.live import SOURCE, LiveInput
@@ -152,9 +157,9 @@ def _observe_live(args: argparse.Namespace, character: Any, profile: Any, observ
 
     if not args.json:
         print(f"{SOURCE}: standard input at {live.fps:g} fps", flush=True)
-    for positions in live:
-        frames += 1
-        emit(observer.push(positions, np.isfinite(positions).all(axis=-1)))
+    for block in live.blocks():  # every frame that has arrived at once: a reader that fell behind catches up
+        frames += len(block)
+        emit(observer.push_block(block, np.isfinite(block).all(axis=-1)))
     emit(observer.flush())
     if not args.json:
         print(f"{SOURCE}: {frames} frames at {round(live.fps, 3):g} fps, {count} segment{'' if count == 1 else 's'}",

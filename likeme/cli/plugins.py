@@ -1,17 +1,31 @@
 """``likeme plugins``: every registered component by kind, with its distribution, its parameters (``--params``; a
-parameter's own table nested under it), or as the Markdown reference ``docs/components.md`` (``--markdown``)."""
+parameter's own table nested under it), or as the Markdown reference ``docs/components.md`` (``--markdown``).
+
+The listing without parameters is kept in a cache (``plugins.json`` in ``$LIKEME_CACHE_DIR``, else
+``$XDG_CACHE_HOME/likeme``, else ``~/.cache/likeme``) with a digest of everything it depends on
+(:meth:`toolkit.manager.PluginManager.entries_fingerprint`: the entry points, their distributions and versions, the
+sizes and times of their source files and the core's, and of this module); while the digest is the same the listing is printed from
+the cache without importing a plugin or the libraries they import (numpy, scipy, networkx...), so that it starts
+as fast as ``likeme --help``. Any change (an install, an edit, another environment variable) lists again from the
+plugins and refreshes the cache; a listing in which a plugin failed to load is never cached; a cache that cannot be
+read or written is ignored. ``LIKEME_CACHE_DIR=`` (empty) turns it off."""
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 from collections.abc import Sequence
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # pragma: no cover
     from toolkit.manager import PluginManager
 
-__all__ = ["add_parser", "handle", "plugins_table", "components_markdown"]
+__all__ = ["add_parser", "handle", "plugins_table", "components_markdown", "cache_path", "ENV_CACHE"]
+
+ENV_CACHE = "LIKEME_CACHE_DIR"
+"""Where ``likeme plugins`` keeps its listing (empty: no cache)."""
 
 
 def add_parser(sub: Any) -> None:
@@ -20,7 +34,7 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--params", action="store_true", help="also list each component's parameters")
     p.add_argument("--json", action="store_true", help="print as JSON")
     p.add_argument("--markdown", action="store_true", help="print a Markdown reference of every component and its parameters")
-    p.set_defaults(handler=handle)
+    p.set_defaults(handler=handle, loads_plugins=False)  # it loads them itself, unless the cache answers
 
 
 def plugins_table(pm: PluginManager, *, params: bool = False) -> dict[str, Any]:
@@ -106,18 +120,65 @@ def components_markdown(pm: PluginManager) -> str:
     return "\n".join(lines)
 
 
-def handle(args: argparse.Namespace, pm: PluginManager) -> int:
-    from toolkit.components import KINDS
+def cache_path() -> Path | None:
+    """The file the listing is cached in (``None``: no cache, ``LIKEME_CACHE_DIR`` set empty)."""
+    folder = os.environ.get(ENV_CACHE)
+    if folder is None:
+        base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+        folder = os.path.join(base, "likeme")
+    return Path(folder) / "plugins.json" if folder else None
 
+
+def _cached_table(pm: PluginManager) -> tuple[dict[str, Any] | None, dict[str, str] | None, str | None]:
+    """The cached listing and the kinds' labels if its digest is the manager's (else ``None``), and the digest."""
+    path = cache_path()
+    key = pm.entries_fingerprint() if path is not None else None
+    if key is None:
+        return None, None, None
+    own = os.stat(__file__)  # the listing is made here too: an edit of this file lists again
+    key = f"{key}:{own.st_size}:{own.st_mtime_ns}"
+    try:
+        cached = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None, None, key
+    if isinstance(cached, dict) and cached.get("key") == key and isinstance(cached.get("table"), dict) \
+            and isinstance(cached.get("labels"), dict):
+        return cached["table"], cached["labels"], key
+    return None, None, key
+
+
+def _save_table(table: dict[str, Any], labels: dict[str, str], key: str | None) -> None:
+    path = cache_path()
+    if key is None or path is None or table["failed"]:
+        return
+    from toolkit.state import write_atomic
+
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        write_atomic(path, json.dumps({"key": key, "table": table, "labels": labels}) + "\n")
+    except OSError:
+        pass  # a cache that cannot be written: listed from the plugins every time
+
+
+def handle(args: argparse.Namespace, pm: PluginManager) -> int:
+    table, labels, key = (None, None, None) if args.params or args.markdown else _cached_table(pm)
+    if table is None:
+        pm.load_all()
     if args.markdown:
         print(components_markdown(pm), end="")
         return 0
-    table = plugins_table(pm, params=args.params)
+    if table is None or labels is None:
+        from toolkit.components import KINDS
+
+        labels = {kind: info.kind for kind, info in KINDS.items()}
+        table = plugins_table(pm, params=args.params)
+        if not args.params:
+            _save_table(table, labels, key)
     if args.json:
         print(json.dumps(table, indent=2))
         return 0
     for kind, rows in table["components"].items():
-        label = KINDS[kind].kind
+        label = labels[kind]
         print(f"{label}s ([{kind}] plugin = NAME):" if kind != "trigger" else "triggers:")
         if not rows:
             print("  (none registered)")

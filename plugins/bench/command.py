@@ -310,6 +310,25 @@ def likeme_register_commands(subparsers):
     p.add_argument("--json", metavar="FILE", help="also write the rows as JSON")
     p.set_defaults(handler=_handler("posegraph_index", "cmd_posegraph"))
 
+    p = sub.add_parser("latency", help="how long after the segmenter closes a segment likeme observe - prints it, "
+                       "fed by a frame-paced producer (median and p95)")
+    _jobs_options(p, "each feeding of a stream", timing=True)
+    p.add_argument("--body", metavar="PROFILE", help="body profile of --streams (default: data made here)")
+    p.add_argument("--repertoire", metavar="DIR", help="the observer's clips (with --streams)")
+    p.add_argument("--streams", metavar="PATH", help="a BVH stream or a folder of them (default: made here)")
+    p.add_argument("--n-streams", type=count_type(1, 100), default=3, dest="n_streams",
+                   help="streams made when none are given (default: 3)")
+    p.add_argument("--runs", type=count_type(1, 100), default=1, help="times each stream is fed (default: 1)")
+    p.add_argument("--fps", type=number_type(1.0, 1000.0, "frames per second"), default=None,
+                   help="the producer's frame rate (default: each stream's)")
+    p.add_argument("--start", choices=("ready", "now"), default="ready", help="start the frames when observe is "
+                   "ready (default) or at once, as a tracker that does not wait")
+    p.add_argument("--segmenter", metavar="NAME", help="segmenter (default: the observer template's)")
+    p.add_argument("--matcher", metavar="NAME", help="matcher (default: the observer template's)")
+    p.add_argument("--seed", type=seed_type, default=0)
+    p.add_argument("--json", metavar="FILE", help="also write the latencies as JSON")
+    p.set_defaults(handler=_handler("latency", "cmd_latency"))
+
     p = sub.add_parser("startup", help="how long likeme takes to start: the medians of likeme --version, --help "
                        "and plugins, each run in a fresh process")
     _jobs_options(p, "the runs: each command once", timing=True)

@@ -1,6 +1,6 @@
 """``likeme bench startup``: how long the ``likeme`` command takes to start.
 
-Each command (``likeme --version``, ``likeme --help``, ``likeme plugins``) is run ``--runs`` times in a fresh
+Each command (``likeme --version``, ``likeme --help``, ``likeme plugins``, ``likeme plugins --params``) is run ``--runs`` times in a fresh
 process, the commands taking turns so that a change in the machine's load falls on all of them alike; the wall time
 of each run is measured from here (process start to exit) and the median printed with the fastest and slowest. The
 machine's load average is printed too: on a shared machine it is the first thing the figures depend on.
@@ -24,8 +24,10 @@ from typing import Any
 
 from toolkit.errors import LikemeError
 
-COMMANDS: tuple[tuple[str, ...], ...] = (("--version",), ("--help",), ("plugins",))
-"""What is timed: the version, the help (the parser), and a command that loads every plugin."""
+COMMANDS: tuple[tuple[str, ...], ...] = (("--version",), ("--help",), ("plugins",), ("plugins", "--params"))
+"""What is timed: the version, the help (the parser), the listing of the plugins (from its cache after the warm-up
+round: ``likeme.cli.plugins``), and a command that loads every plugin (the listing with the parameters, never
+cached)."""
 
 
 def likeme_command() -> list[str]:
@@ -70,9 +72,9 @@ def cmd_startup(args: argparse.Namespace, pm: Any) -> int:
     load_after = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(f"{' '.join(command)}: {args.runs} runs each; {os.cpu_count()} cores, load average {load:.2f} before, "
           f"{load_after:.2f} after")
-    print(f"{'command':<18} {'median ms':>10} {'min ms':>8} {'max ms':>8}")
+    print(f"{'command':<24} {'median ms':>10} {'min ms':>8} {'max ms':>8}")
     for r in rows:
-        print(f"{r['command']:<18} {r['median_s'] * 1000:10.0f} {r['min_s'] * 1000:8.0f} {r['max_s'] * 1000:8.0f}")
+        print(f"{r['command']:<24} {r['median_s'] * 1000:10.0f} {r['min_s'] * 1000:8.0f} {r['max_s'] * 1000:8.0f}")
     if args.json:
         Path(args.json).write_text(json.dumps({"load_average": [load, load_after], "rows": rows}, indent=1) + "\n")
     return 0

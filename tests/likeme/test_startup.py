@@ -18,11 +18,13 @@ from toolkit.manager import create_plugin_manager
 HEAVY = ("numpy", "scipy", "networkx", "pyvista", "matplotlib", "rich", "dtaidistance", "ruptures", "imageio")
 
 
-def _modules_after(*args: str) -> set[str]:
-    """The modules imported by ``likeme ARGS`` run in a fresh interpreter (the built-ins only)."""
+def _modules_after(*args: str, cache: str = "") -> set[str]:
+    """The modules imported by ``likeme ARGS`` run in a fresh interpreter (the built-ins only; ``cache``: the
+    folder ``likeme plugins`` caches its listing in, none by default)."""
     code = ("import sys, json\nfrom likeme.cli import main\ntry:\n    main(sys.argv[1:])\nexcept SystemExit:\n    pass\n"
             "sys.stderr.write('\\nMODULES ' + json.dumps(sorted(sys.modules)))\n")
-    env = {"PYTHONPATH": str(ROOT), "LIKEME_DISABLE_PLUGIN_AUTOLOAD": "1", "PATH": "/usr/bin:/bin"}
+    env = {"PYTHONPATH": str(ROOT), "LIKEME_DISABLE_PLUGIN_AUTOLOAD": "1", "PATH": "/usr/bin:/bin",
+           "LIKEME_CACHE_DIR": cache}
     result = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True, env=env, timeout=120)
     assert "MODULES " in result.stderr, result.stderr
     return set(json.loads(result.stderr.rsplit("MODULES ", 1)[1]))
@@ -47,10 +49,66 @@ def test_help_imports_only_the_plugins_that_add_commands():
 
 
 def test_a_command_loads_every_plugin_but_only_the_libraries_their_modules_need():
-    modules = _modules_after("plugins")
+    modules = _modules_after("plugins", "--params")
     assert {"plugins.segmenters.hub_threshold", "plugins.views.body", "plugins.bench.command", "numpy"} <= modules
     # pyvista and matplotlib (views), dtaidistance (dtw), ruptures, imageio and rich: imported when first used
     assert not {"pyvista", "vtkmodules", "matplotlib", "dtaidistance", "ruptures", "imageio", "rich"} & _top(modules)
+
+
+def test_the_plugin_listing_is_cached_and_then_imports_no_plugin_and_no_library(tmp_path):
+    """``likeme plugins`` lists from the plugins once, then from its cache until anything it depends on changes."""
+    first = _modules_after("plugins", cache=str(tmp_path))
+    assert "numpy" in first and (tmp_path / "plugins.json").is_file()
+    again = _modules_after("plugins", cache=str(tmp_path))
+    assert not set(HEAVY) & _top(again)
+    assert {m for m in again if m.startswith("plugins.") and m.count(".") == 2} == {"plugins.bench.command"}
+
+
+def test_the_cached_listing_is_the_listing_and_an_edit_refreshes_it(tmp_path, monkeypatch, capsys):
+    from likeme.cli import main
+    from likeme.cli.plugins import cache_path
+
+    monkeypatch.setenv("LIKEME_CACHE_DIR", str(tmp_path))
+    monkeypatch.setenv("LIKEME_DISABLE_PLUGIN_AUTOLOAD", "1")
+    assert cache_path() == tmp_path / "plugins.json"
+    outputs = []
+    for args in (["plugins"], ["plugins"], ["plugins", "--json"], ["plugins", "--json"]):
+        assert main(args) == 0
+        outputs.append(capsys.readouterr().out)
+    assert outputs[0] == outputs[1] and outputs[2] == outputs[3]
+    assert "hub-threshold" in outputs[0] and json.loads(outputs[2])["components"]["segmenter"]
+    cached = json.loads((tmp_path / "plugins.json").read_text())
+    cached["table"]["components"]["segmenter"][0]["summary"] = "STALE"
+    (tmp_path / "plugins.json").write_text(json.dumps(cached))
+    assert main(["plugins"]) == 0 and "STALE" in capsys.readouterr().out  # served from the cache
+    cached["key"] = "another digest"  # what an edit of a plugin's file, an install or an upgrade gives
+    (tmp_path / "plugins.json").write_text(json.dumps(cached))
+    assert main(["plugins"]) == 0 and capsys.readouterr().out == outputs[0]
+    assert json.loads((tmp_path / "plugins.json").read_text())["key"] != "another digest"
+
+
+def test_the_digest_follows_the_plugins_files(tmp_path, monkeypatch):
+    import os
+
+    from toolkit import manager
+
+    pm = create_plugin_manager(autoload=False, trace=False, lazy=True)
+    key = pm.entries_fingerprint()
+    assert key is not None and key == create_plugin_manager(autoload=False, trace=False, lazy=True).entries_fingerprint()
+    source = ROOT / "plugins" / "segmenters" / "hub_threshold.py"
+    stat = source.stat()
+    real_stat = type(source).stat
+
+    def touched(self, *args, **kwargs):
+        result = real_stat(self, *args, **kwargs)
+        if self == source:
+            return os.stat_result((*result[:8], result.st_mtime + 1, result[9]))
+        return result
+
+    monkeypatch.setattr(type(source), "stat", touched)
+    assert create_plugin_manager(autoload=False, trace=False, lazy=True).entries_fingerprint() != key
+    assert stat.st_size == source.stat().st_size
+    assert create_plugin_manager(autoload=False, trace=False, plugins=[("x", manager)]).entries_fingerprint() is None
 
 
 def _order(pm) -> list[str]:
@@ -118,7 +176,7 @@ def test_bench_startup_times_each_command_in_a_fresh_process(tmp_path, capsys):
     out = tmp_path / "startup.json"
     assert main(["bench", "startup", "--runs", "2", "--json", str(out)]) == 0
     rows = json.loads(out.read_text())["rows"]
-    assert [r["command"] for r in rows] == ["likeme --version", "likeme --help", "likeme plugins"]
+    assert [r["command"] for r in rows] == ["likeme --version", "likeme --help", "likeme plugins", "likeme plugins --params"]
     for r in rows:
         assert r["runs"] == 2 and 0 < r["min_s"] <= r["median_s"] <= r["max_s"]
     text = capsys.readouterr().out

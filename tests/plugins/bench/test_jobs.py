@@ -20,9 +20,9 @@ from likeme.cli import main
 from toolkit.manager import create_plugin_manager
 
 SUB_COMMANDS = ("recognition", "segmentation", "stream", "sweep", "make-data", "bandai", "watch", "facilitation",
-                "memory", "posegraph", "startup", "vision", "fuzz", "scaling", "behaviour", "learning")
+                "memory", "posegraph", "startup", "vision", "fuzz", "scaling", "behaviour", "learning", "latency")
 """Every ``likeme bench`` sub-command (a test checks the list against the command's own)."""
-TIMED = ("memory", "posegraph", "startup", "vision", "scaling")
+TIMED = ("memory", "posegraph", "startup", "vision", "scaling", "latency")
 """The sub-commands whose figures are timings or memory."""
 
 
@@ -195,7 +195,8 @@ def test_startup_rounds_in_workers(tmp_path, capsys):
     out = tmp_path / "startup.json"
     assert main(["bench", "startup", "--runs", "2", "--jobs", "2", "--json", str(out)]) == 0
     rows = _json(out)["rows"]
-    assert [r["command"] for r in rows] == ["likeme --version", "likeme --help", "likeme plugins"]
+    assert [r["command"] for r in rows] == ["likeme --version", "likeme --help", "likeme plugins",
+                                            "likeme plugins --params"]
     assert all(r["runs"] == 2 and 0 < r["min_s"] <= r["median_s"] <= r["max_s"] for r in rows)
 
 

@@ -96,7 +96,7 @@ def test_a_view_of_the_wrong_subject_or_an_unknown_view_is_refused(capsys):
     assert "view 'scenario' draws a scenario, not a character" in capsys.readouterr().err
     assert main(["show", "max", "--view", "bodyy"]) == 1
     err = capsys.readouterr().err
-    assert "unknown view 'bodyy'" in err and "available: body, correspondence, hub-signal, motor-command-graph" in err
+    assert "unknown view 'bodyy'" in err and "available: body, correspondence, hub-signal, imitation, motor-command-graph" in err
     assert main(["show", "moritz", "--view", "posegraph"]) == 1
     assert "has no posegraph" in capsys.readouterr().err
 
