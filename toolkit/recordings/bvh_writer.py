@@ -27,6 +27,8 @@ def format_bvh(bvh: BVH, *, precision: int = 6) -> str:
     for i, j in enumerate(bvh.joints):
         children.setdefault(j.parent, []).append(i)
     out = ["HIERARCHY"]
+    starts = np.concatenate([[0], np.cumsum([len(j.channels) for j in bvh.joints])]).astype(int)
+    columns: list[int] = []  # the value columns in the order the hierarchy names their joints (depth first)
 
     stack: list[tuple[int, int, bool]] = [(root, 0, False) for root in reversed(children.get(-1, []))]
     while stack:  # depth first, without recursion (a hierarchy may be deep)
@@ -43,11 +45,15 @@ def format_bvh(bvh: BVH, *, precision: int = 6) -> str:
         out.append(f"{pad}{{")
         out.append(f"{pad}  OFFSET {off}")
         out.append(f"{pad}  CHANNELS {len(joint.channels)} {' '.join(joint.channels)}".rstrip())
+        columns.extend(range(starts[i], starts[i + 1]))
         stack.append((i, depth, True))
         stack.extend((c, depth + 1, False) for c in reversed(children.get(i, [])))
     out += ["MOTION", f"Frames: {bvh.n_frames}", f"Frame Time: {bvh.frame_time:.9g}"]
     fmt = f"%.{precision}g"
-    out.extend(" ".join(fmt % v for v in row) for row in bvh.values)
+    values = np.asarray(bvh.values)
+    if len(columns) == values.shape[1] and columns != list(range(len(columns))):
+        values = values[:, columns]
+    out.extend(" ".join(fmt % v for v in row) for row in values)
     return "\n".join(out) + "\n"
 
 

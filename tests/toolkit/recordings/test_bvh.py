@@ -156,3 +156,29 @@ def test_a_bandai_namco_clip():
     p = bvh.positions()
     head, foot = p[0, bvh.index("Head")], p[0, bvh.index("Toes_L")]
     assert 130 < head[1] - foot[1] < 170  # a standing adult, in centimetres, +y up
+
+
+def test_a_joint_list_not_in_depth_first_order_is_written_with_its_values_under_their_joints():
+    """Joints listed root, left hip, right hip, left knee (not depth first: the hierarchy names the left knee before
+    the right hip): each joint's channel values are written in the column its place in the hierarchy gives, so the
+    file read back has every joint's own values."""
+    from toolkit.recordings.bvh import BVH, Joint, parse_bvh
+    from toolkit.recordings.bvh_writer import format_bvh
+
+    rot = ("Zrotation", "Xrotation", "Yrotation")
+    joints = [Joint("root", -1, (0.0, 1.0, 0.0), ("Xposition", "Yposition", "Zposition", *rot)),
+              Joint("left_hip", 0, (0.1, 0.0, 0.0), rot), Joint("right_hip", 0, (-0.1, 0.0, 0.0), rot),
+              Joint("left_knee", 1, (0.0, -0.4, 0.0), rot), Joint("left_foot", 3, (0.0, -0.4, 0.0), (), True)]
+    values = np.arange(2 * 15, dtype=float).reshape(2, 15)  # every column its own number
+    back = parse_bvh(format_bvh(BVH(joints, 1 / 30, values)))
+    names = [j.name for j in back.joints if not j.end_site]
+    assert names == ["root", "left_hip", "left_knee", "right_hip"]
+    columns = {"root": values[:, 0:6], "left_hip": values[:, 6:9], "right_hip": values[:, 9:12],
+               "left_knee": values[:, 12:15]}
+    at = 0
+    for joint in back.joints:
+        if joint.end_site:
+            continue
+        width = len(joint.channels)
+        assert np.array_equal(back.values[:, at : at + width], columns[joint.name]), joint.name
+        at += width
