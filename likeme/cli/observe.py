@@ -55,6 +55,11 @@ def handle(args: argparse.Namespace, pm: PluginManager) -> int:
     if "-" in args.files and len(args.files) > 1:
         raise ConfigError(f"'-' (standard input) with {len(args.files) - 1} other file(s)", key=("files",),
                           expected="either '-' alone (frames piped in) or recording files")
+    if args.files == ["-"] and sys.stdin is None:  # started with standard input closed (`<&-`): before any work
+        from toolkit.recordings.live import SOURCE
+
+        raise ConfigError("standard input is closed", file=Path(SOURCE),
+                          expected="frames on standard input (a pipe or a file), or recordings named as files")
     files, failed = [], 0
     for path in args.files if args.files != ["-"] else ():
         try:  # a FIFO, a device, a directory, a missing file or an unknown format is reported before any work
@@ -107,7 +112,7 @@ def _check_recording_path(path: str) -> None:
     from toolkit.files import check_regular_file
     from toolkit.recordings import recording_format
 
-    check_regular_file(path, "BVH file" if Path(path).suffix.lower() not in (".csv", ".npy") else
+    check_regular_file(path, "BVH file" if Path(path).suffix.lower() not in (".csv", ".npy", ".c3d") else
                        "recording of joint positions", "motion")
     recording_format(path)
 

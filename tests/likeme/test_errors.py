@@ -248,6 +248,7 @@ CASES = [
     ("show-recordings-one-png", "two recordings' pictures to one file", {"p.toml": PROFILE, "m.bvh": BVH}, ["show", "--body", "p.toml", "m.bvh", "m.bvh", "--view", "hub-signal", "--out", "x.png"], ["x.png: key --out", "one file for several pictures", "expected a folder"]),
     # -- wiring: joint-position recordings through profiles, --fps, live input (issue 20)
     ("observe-unknown-format", "a recording of an unknown format", {"p.toml": PROFILE, "m.txt": "x"}, ["observe", "--body", "p.toml", "--repertoire", ".", "m.txt"], ["m.txt: unknown recording format '.txt'", "available: .bvh, .csv, .npy"]),
+    ("observe-missing-c3d", "a C3D file named that is not there", {"p.toml": PROFILE}, ["observe", "--body", "p.toml", "--repertoire", ".", "gone.c3d"], ["gone.c3d: cannot read", "expected a readable recording of joint positions"]),
     ("observe-stdin-and-files", "standard input mixed with files", {"p.toml": PROFILE, "m.bvh": BVH}, ["observe", "--body", "p.toml", "--repertoire", ".", "-", "m.bvh"], ["key files: '-' (standard input) with 1 other file(s)", "expected either '-' alone"]),
     ("csv-no-frame-rate", "a CSV without a time column, no --fps, no fps in the profile", {"p.toml": PROFILE, "m.csv": "hips_x,hips_y,hips_z\n0,1,2\n"}, ["validate", "--body", "p.toml", "m.csv"], ["m.csv: no frame rate: the file has no 'time' column", "--fps"]),
     ("csv-missing-joint", "a CSV without a joint the profile maps", {"p.toml": PROFILE, "m.csv": "hips_x,hips_y,hips_z,head_x,head_y,head_z\n0,1,2,0,2,0\n"}, ["validate", "--fps", "30", "--body", "p.toml", "m.csv"], ["p.toml:7: key parts.nose", "joint 'head_end' of part 'nose' is not in m.csv", "available: hips, head"]),
@@ -416,6 +417,22 @@ def render() -> str:
         command = ("likeme " + " ".join(args)).replace(MAX, "characters/max.toml")
         out.append(f"| {what} | `{command}` | `{message}` |")
     return "\n".join(out) + "\n"
+
+
+def test_observe_with_standard_input_closed_is_one_line(tmp_path):
+    """`likeme observe -` started with standard input closed (`<&-`): one line, not a traceback, before the observer
+    is composed."""
+    import os
+    import subprocess
+    import sys
+
+    (tmp_path / "p.toml").write_text(PROFILE)
+    done = subprocess.run([sys.executable, "-m", "likeme", "observe", "--body", "p.toml", "--repertoire", ".", "-"],
+                          cwd=tmp_path, capture_output=False, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                          stdin=None, preexec_fn=lambda: os.close(0), text=True, timeout=120)
+    assert done.returncode == 1
+    assert done.stderr.strip().splitlines() == ["likeme: error: -: standard input is closed; expected frames on "
+                                                "standard input (a pipe or a file), or recordings named as files"]
 
 
 def test_errors_pickle_with_every_field():
