@@ -169,10 +169,13 @@ class LiveInput:
     # -- the frame rate and the frame grid -----------------------------------------------------------
 
     def _start(self, early: list[tuple[np.ndarray, float | None, int]]) -> None:
-        """Read the frames the rate or the frame step needs (none when the rate is given and the first frame has no
-        time), measure them, and place them on the grid."""
+        """Read the frames the rate and the frame step need (none when the rate is given: its step is the grid's, so
+        nothing waits for frames before the input is ready), measure them, and place them on the grid."""
         with_times = early[0][1] is not None if early else self._layout is not None and self._layout.time is not None
-        if self.fps is None or with_times:
+        if self.fps is not None and with_times and not early:  # the first frame with a time sets where the grid is
+            self._timed, self._step = True, 1.0 / self.fps
+            return
+        if self.fps is None:
             while len(early) < RATE_FRAMES and (not early or early[-1][1] is not None):
                 frame = self._next_frame()
                 if frame is None:
@@ -212,7 +215,11 @@ class LiveInput:
     def _placed(self, joints: np.ndarray, time: float | None, line: int) -> list[np.ndarray]:
         """A frame after the first ones: preceded by a frame with nothing visible for each frame its time shows
         dropped (a frame without a time follows the one before)."""
-        if self._step is None or self._last is None:
+        if self._step is None:
+            return [joints]
+        if self._last is None:  # the first frame (the rate given): the grid starts at its time
+            if time is not None:
+                self._last = (time, line)
             return [joints]
         last, _ = self._last
         if time is None:  # no time on this frame: the next one
