@@ -19,7 +19,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from plugins.bench import fuzz
+from plugins.bench import fuzz, fuzz_worker
 from plugins.bench.fuzz_mutate import GENERIC, HOSTILE_NUMBERS, MUTATIONS, mutate
 from toolkit.errors import ConfigError, LikemeError
 
@@ -183,7 +183,7 @@ def plant_ok(path, fps):
 
 @pytest.fixture(scope="module")
 def worker():
-    w = fuzz.Worker(memory_mb=1024)
+    w = fuzz_worker.Worker(memory_mb=1024)
     w.start()
     yield w
     w.close()
@@ -196,18 +196,18 @@ def _call(worker, name, timeout=20.0):
 
 def test_the_harness_classifies_planted_outcomes(worker):
     answer = _call(worker, "plant_traceback")
-    assert fuzz.classify(answer) == "traceback"
+    assert fuzz_worker.classify(answer) == "traceback"
     assert answer["exception"] == "KeyError" and answer["where"].startswith("tests/plugins/bench/test_fuzz.py:")
-    assert fuzz.classify(_call(worker, "plant_documented")) == "documented"
-    assert fuzz.classify(_call(worker, "plant_ok")) == "ok"
-    assert fuzz.classify(_call(worker, "plant_memory")) == "memory"
-    assert fuzz.classify(_call(worker, "plant_ok")) == "ok"  # a fresh worker after a MemoryError, this module imported
+    assert fuzz_worker.classify(_call(worker, "plant_documented")) == "documented"
+    assert fuzz_worker.classify(_call(worker, "plant_ok")) == "ok"
+    assert fuzz_worker.classify(_call(worker, "plant_memory")) == "memory"
+    assert fuzz_worker.classify(_call(worker, "plant_ok")) == "ok"  # a fresh worker after a MemoryError, this module imported
     restarts = worker.restarts
     started = time.monotonic()
     hang = _call(worker, "plant_hang", timeout=2.0)
-    assert fuzz.classify(hang) == "hang" and hang["where"].startswith("tests/plugins/bench/test_fuzz.py:")  # located by a stack dump
+    assert fuzz_worker.classify(hang) == "hang" and hang["where"].startswith("tests/plugins/bench/test_fuzz.py:")  # located by a stack dump
     assert time.monotonic() - started < 15 and worker.restarts == restarts + 1
-    assert fuzz.classify(_call(worker, "plant_documented")) == "documented"  # a fresh worker after the hang
+    assert fuzz_worker.classify(_call(worker, "plant_documented")) == "documented"  # a fresh worker after the hang
 
 
 def test_the_harness_runs_cli_commands(worker):
@@ -215,11 +215,11 @@ def test_the_harness_runs_cli_commands(worker):
     max_toml = str(ROOT / "characters" / "max.toml")
     with tempfile.TemporaryDirectory() as folder:
         run = lambda argv: worker.run({"cwd": folder, "input": "", "call": None, "argv": argv}, 60.0)  # noqa: E731
-        assert fuzz.classify(run(["validate", max_toml])) == "ok"
-        assert fuzz.classify(run(["validate", "gone.bvh"])) == "documented"
-        assert fuzz.classify(run(["validate"])) == "documented"  # argparse: one line, status 1
+        assert fuzz_worker.classify(run(["validate", max_toml])) == "ok"
+        assert fuzz_worker.classify(run(["validate", "gone.bvh"])) == "documented"
+        assert fuzz_worker.classify(run(["validate"])) == "documented"  # argparse: one line, status 1
         two = run(["validate", "gone.bvh", "gone.toml"])
-        assert two["rc"] == 1 and fuzz.classify(two) == "traceback"  # two error lines are not one documented error
+        assert two["rc"] == 1 and fuzz_worker.classify(two) == "traceback"  # two error lines are not one documented error
 
 
 @pytest.fixture(scope="module")
@@ -245,8 +245,8 @@ def test_seeds_are_good_inputs(seeds):
     for target in ("bvh", "toml", "profile", "scenario", "state", "npy", "c3d"):
         for seed in seeds[target]:
             argv = [a.replace("{input}", str(seed["path"])) for a in _command(target, seed, np.random.default_rng(0))]
-            answer = fuzz.run_one({"cwd": str(Path(seed["path"]).parent), "argv": argv})
-            assert fuzz.classify(answer) == "ok", (argv, answer["stderr"])
+            answer = fuzz_worker.run_one({"cwd": str(Path(seed["path"]).parent), "argv": argv})
+            assert fuzz_worker.classify(answer) == "ok", (argv, answer["stderr"])
 
 
 def test_bench_fuzz_reports_and_fails_on_findings(tmp_path, capsys):
