@@ -8,11 +8,11 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from plugins.matchers.decision import Calibrated, Calibration, Distance, Stillness
-from plugins.matchers.warping import chain_distances
 from toolkit import load_character
 from toolkit.observe import Observer, compose_observer
 from toolkit.recordings.profile import load_profile
 from tests.plugins.matchers.path_search.stick import STICK, observed
+from tests.plugins.matchers.reference import left_out_scores
 
 scores = st.lists(st.floats(0.0, 5.0), max_size=30)
 
@@ -100,11 +100,7 @@ def test_with_one_take_of_each_movement_path_search_calibrates_by_leaving_each_m
     calibration = matcher.decision.calibration
     assert calibration.own == ()
     search = matcher.searcher
-    want = []
-    for c, take in enumerate(search.takes):
-        skip = np.array([m == search.chains.movements[c] for m in search.chains.movements])
-        distances, _ = chain_distances(matcher.comparison, take, search.nodes, search.chains, skip)
-        want.append(distances.min() / np.mean(matcher.comparison.still(take)))
+    want = left_out_scores(matcher.comparison, search.takes, search.nodes, search.chains)
     assert calibration.other == pytest.approx(want)
     assert matcher.decision.threshold() == pytest.approx(min(np.quantile(want, 0.95), 1.0))
 

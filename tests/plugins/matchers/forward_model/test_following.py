@@ -17,10 +17,10 @@ import pytest
 from plugins.bench.data import make_data
 from plugins.bench.mocap import _streams
 from plugins.matchers.forward_model.following import RATE, Following
-from plugins.matchers.warping import chain_distances
 from toolkit import Matcher, Motion, create_plugin_manager
 from toolkit.observe import Observer, compose_observer
 from toolkit.recordings.profile import load_profile
+from tests.plugins.matchers.reference import left_out_scores
 
 
 @pytest.fixture(scope="module")
@@ -63,11 +63,7 @@ def test_the_calibration_leaves_each_take_out(observer):
     over its distance to standing still; no take of its own movement to leave out."""
     f = following(observer)
     p = f.prediction
-    want = []
-    for c, take in enumerate(p.takes):
-        skip = np.array([m == p.chains.movements[c] for m in p.chains.movements])
-        d, _ = chain_distances(f.comparison, take, p.frames, p.chains, skip)
-        want.append(d.min() / np.mean(f.comparison.still(take)))
+    want = left_out_scores(f.comparison, p.takes, p.frames, p.chains)
     assert f.decision.calibration.own == ()
     assert f.decision.calibration.other == pytest.approx(want)
 
