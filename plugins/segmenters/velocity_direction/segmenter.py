@@ -92,7 +92,7 @@ import numpy as np
 from plugins.lib.body_size import body_scale
 from plugins.lib.strokes import StrokeAnalysis, StrokeCriteria, _round_kernels, analyse, breaks
 from plugins.segmenters.velocity_direction.rests import Rests
-from plugins.segmenters.velocity_direction.speed import Jitter, line_speeds, line_weights, speed_noise
+from plugins.segmenters.velocity_direction.speed import Jitter, line_speeds, line_weights, longer_fits, speed_noise
 from toolkit import ConfigError, Parameter, Segment, Segmenter, hookimpl
 
 __all__ = ["VelocityDirection", "STANCE"]
@@ -101,6 +101,13 @@ STANCE = 0.2
 """Seconds a rest away from the hubs must last to be a stance that movements leave and come back to (``end =
 "rest"``): twice a gesture's pauses (a tenth of a second, K&G's sensory memory), shorter than the pauses people
 make between gestures (a third of a second and more)."""
+
+
+DOUBLING = 2.0**1.5
+"""How many times lower a line fit twice as long puts the jitter's floor (:mod:`.speed`). ``stretch`` lengthens the
+fit only where the floor lies above the demonstrator's own rest speed by more than this: there even the doubled fit
+hides their rest speed, so a slow movement is lost to the jitter, not to the rest speed (a floor within this factor
+of the rest speed is what a person's own quick changes of velocity give a generated or cleanly captured stream)."""
 
 
 class VelocityDirection(Segmenter):
@@ -155,6 +162,10 @@ class VelocityDirection(Segmenter):
         Parameter("jitter", float, 0.0, "The rest speed is at least this many times the root-mean-square speed the "
                   "tracker's jitter alone gives a part standing still, the jitter measured from the positions' second "
                   "differences over `floor` seconds (0: off, the paper).", minimum=0.0),
+        Parameter("stretch", float, 0.0, "Seconds up to which the line fit is lengthened (doubling from `window`) "
+                  "where the rest speed the tracker's measured jitter allows (`jitter`) lies above the "
+                  "demonstrator's own (`rest_speed` or `body.rest_speed`): a slow movement is still seen on a noisy "
+                  "tracker (0: `window` always).", minimum=0.0, seconds=True),
         Parameter("max_movement", float, 60.0, "Seconds after which a movement that has not ended is closed there and "
                   "the next begins at once (the working memory's bound; 0: none).", minimum=0.0, seconds=True),
     )
@@ -194,10 +205,14 @@ class VelocityDirection(Segmenter):
         window = int(round(self.params["window"] * self._fps))
         self._weights = line_weights(window, self._fps) if window >= 2 else None  # the line fit's, or displacement
         self._lag = (window - 1) // 2 if self._weights is not None else 0  # the line fit's delay (frames)
+        self._longer = longer_fits(window, int(round(self.params["stretch"] * self._fps)), self._fps) \
+            if self._weights is not None and self.params["jitter"] > 0 else []  # stretch: the lengthened line fits
+        widest = max([window] + [len(w) for w, _ in self._longer])
         self._still = max(self._memory, window)  # end = rest: poses are compared as the mean of this many frames
         pause = int(round(self.params["pause"] * self._fps))
-        self._history: deque[np.ndarray] = deque(maxlen=max(2 * self._memory + 2, window) + self._lag + pause // 2
-                                                 + self._still)  # the sensory memory (and what an onset goes back to)
+        self._history: deque[np.ndarray] = deque(maxlen=max(2 * self._memory + 2, widest) + (widest - 1) // 2
+                                                 + pause // 2 + self._still)  # the sensory memory (and what an
+        # onset goes back to)
         self._last: tuple[int, int, np.ndarray] | None = None  # the last movement closed: start, end, working memory
         self._done = 0  # the end of the last movement reported: a movement begins no earlier
         self._analysis: StrokeAnalysis | None = None
@@ -240,11 +255,7 @@ class VelocityDirection(Segmenter):
         rows = np.concatenate([np.array(self._history).reshape(before, -1), flat]) if before else flat
         speeds = np.full(n, np.nan)
         if self._weights is not None:  # the slope of a line through the last `window` frames (.speed)
-            w = len(self._weights)
-            fitted = line_speeds(rows, self._weights)  # row i: the frame whose window ends at rows[i + w - 1]
-            at = np.arange(n) + before - (w - 1)  # each block frame's row in `fitted`
-            ok = seen & (at >= 0)
-            speeds[ok] = fitted[at[ok]]
+            speeds = self._fitted(rows, before, seen, self._weights)
         else:
             # frame i of the block has i + before + 1 frames of history (at most maxlen: enough for the memory)
             ok = seen & (np.minimum(np.arange(n) + before + 1, self._history.maxlen) > m)
@@ -259,33 +270,78 @@ class VelocityDirection(Segmenter):
         if (p["units"] == "metres" and not self._pause and not p["noise"] > 0 and p["end"] == "still"
                 and self._weights is None and self._jitter is None):  # a fixed rest speed, and any rest ends a movement
             return self._follow(flat, speeds)
-        floors = (p["jitter"] * speed_noise(self._jitter.update(flat), self._weights if self._weights is not None
-                                             else self._displacement) if self._jitter is not None else np.zeros(n))
+        sigma = self._jitter.update(flat) if self._jitter is not None else None
+        floors = (p["jitter"] * speed_noise(sigma, self._weights if self._weights is not None else self._displacement)
+                  if sigma is not None else np.zeros(n))
         if p["units"] == "body":  # every frame's size at once (the running mean takes some of them)
             sizes = (body_scale(poses, self._positions) if len(self._positions) == poses.shape[1]
                      else body_scale(poses)).tolist()
         else:
             sizes = [None] * n
+        lags = np.full(n, self._lag)
+        if self._longer:  # stretch: a longer line fit where the tracker's jitter hides the rest speed
+            own = self._own_rests(sizes)[0]
+            for weights, lag in self._longer:
+                noisy = floors > DOUBLING * own  # the jitter floor still above the own rest speed after a doubling
+                if not noisy.any():
+                    break
+                longer = p["jitter"] * speed_noise(sigma, weights)
+                speeds = np.where(noisy, self._fitted(rows, before, seen, weights), speeds)
+                floors, lags = np.where(noisy, longer, floors), np.where(noisy, lag, lags)
         if not self._pause and not p["noise"] > 0:  # the rest speed known for the block at once
-            return self._walk(poses, flat, speeds, floors, sizes)
-        return self._steps(poses, flat, speeds, floors, sizes)
+            return self._walk(poses, flat, speeds, floors, sizes, lags)
+        return self._steps(poses, flat, speeds, floors, sizes, lags)
+
+    def _fitted(self, rows: np.ndarray, before: int, seen: np.ndarray, weights: np.ndarray) -> np.ndarray:
+        """Each block frame's speed by the line fit ``weights`` (:func:`.speed.line_speeds`) over ``rows`` (the
+        ``before`` rows of the sensory memory, then the block's); NaN where no chosen part is ``seen`` or the
+        memory is too short yet."""
+        n, w = len(seen), len(weights)
+        speeds = np.full(n, np.nan)
+        fitted = line_speeds(rows, weights)  # row i: the frame whose window ends at rows[i + w - 1]
+        at = np.arange(n) + before - (w - 1)  # each block frame's row in `fitted`
+        ok = seen & (at >= 0)
+        speeds[ok] = fitted[at[ok]]
+        return speeds
+
+    def _own_rests(self, sizes: list) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The demonstrator's own rest speed at each frame of a block whose bodies' sizes are ``sizes`` (None:
+        ``units = "metres"``): ``body.rest_speed`` times the running mean of the size, taken every sensory memory,
+        summed in the same order as frame by frame (or ``rest_speed``); with the running sums and counts after each
+        frame (n + 1,: the state before the block first). Not the jitter's floor, nor ``noise``."""
+        n, p, m = len(sizes), self.params, self._memory
+        first = self._frame + 1
+        if p["units"] == "body":
+            size = np.array([np.nan if x is None else x for x in sizes])
+            take = ((first + np.arange(n)) % m == 0) & (size > 0)
+            if not self._size_n and (size > 0).any():
+                take[int(np.argmax(size > 0))] = True  # the first size there is, whatever the frame
+            sums = np.cumsum(np.concatenate([[self._size_sum], np.where(take, size, 0.0)]))  # in order, as one by one
+            counts = self._size_n + np.concatenate([[0], np.cumsum(take)])
+            rest = p["body"]["rest_speed"] * np.where(counts[1:] > 0, sums[1:] / np.maximum(counts[1:], 1), 0.0)
+        else:
+            sums, counts = np.full(n + 1, self._size_sum), np.full(n + 1, self._size_n)
+            rest = np.full(n, float(p["rest_speed"]))
+        return rest, sums, counts
 
     def _steps(self, poses: np.ndarray, flat: np.ndarray, speeds: np.ndarray, floors: np.ndarray,
-               sizes: list) -> tuple[list[tuple[int, Segment]], np.ndarray]:
+               sizes: list, lags: np.ndarray) -> tuple[list[tuple[int, Segment]], np.ndarray]:
         """:meth:`_step` for every frame of a block (``flat``: the chosen parts (n, 3m); ``speeds``, ``floors`` and
-        ``sizes``: each frame's speed, jitter floor and body size): the segments closed and the onsets."""
+        ``sizes``: each frame's speed, jitter floor and body size; ``lags``: its line fit's delay): the segments
+        closed and the onsets."""
         closed: list[tuple[int, Segment]] = []
         since = np.full(len(flat), -1, dtype=int)
         for f, floor in enumerate(floors.tolist()):
             self._frame += 1
             self._history.append(flat[f])
-            closed.extend((f, s) for s in self._step(poses[f], flat[f], float(speeds[f]), floor, sizes[f]))
+            closed.extend((f, s) for s in self._step(poses[f], flat[f], float(speeds[f]), floor, sizes[f],
+                                                     int(lags[f])))
             if self._start is not None:
                 since[f] = self._start
         return closed, since
 
     def _walk(self, poses: np.ndarray, flat: np.ndarray, speeds: np.ndarray, floors: np.ndarray,
-              sizes: list) -> tuple[list[tuple[int, Segment]], np.ndarray]:
+              sizes: list, lags: np.ndarray) -> tuple[list[tuple[int, Segment]], np.ndarray]:
         """:meth:`_step` for every frame of a block without ``pause`` and ``noise`` (the observer template's): the
         same segments at the same frames, with only the frames where something can happen stepped.
 
@@ -300,17 +356,7 @@ class VelocityDirection(Segmenter):
         closed: list[tuple[int, Segment]] = []
         since = np.full(n, -1, dtype=int)
         first = self._frame + 1
-        if p["units"] == "body":
-            size = np.array([np.nan if x is None else x for x in sizes])
-            take = ((first + np.arange(n)) % m == 0) & (size > 0)
-            if not self._size_n and (size > 0).any():
-                take[int(np.argmax(size > 0))] = True  # the first size there is, whatever the frame
-            sums = np.cumsum(np.concatenate([[self._size_sum], np.where(take, size, 0.0)]))  # in order, as one by one
-            counts = self._size_n + np.concatenate([[0], np.cumsum(take)])
-            rest = p["body"]["rest_speed"] * np.where(counts[1:] > 0, sums[1:] / np.maximum(counts[1:], 1), 0.0)
-        else:
-            sums, counts = np.full(n + 1, self._size_sum), np.full(n + 1, self._size_n)
-            rest = np.full(n, float(p["rest_speed"]))
+        rest, sums, counts = self._own_rests(sizes)
         rest = np.maximum(rest, floors)
         valid = ~np.isnan(speeds)
         fast, frames = valid & (speeds > rest), np.arange(n)
@@ -352,7 +398,8 @@ class VelocityDirection(Segmenter):
             self._frame += 1
             self._history.append(flat[e])
             pushed = e + 1
-            closed.extend((e, s) for s in self._step(poses[e], flat[e], float(speeds[e]), float(floors[e]), sizes[e]))
+            closed.extend((e, s) for s in self._step(poses[e], flat[e], float(speeds[e]), float(floors[e]), sizes[e],
+                                                     int(lags[e])))
             if self._start is not None:
                 since[e] = self._start
             f = e + 1
@@ -442,10 +489,11 @@ class VelocityDirection(Segmenter):
         return closed, since
 
     def _step(self, pose: np.ndarray, points: np.ndarray, speed: float, floor: float = 0.0,
-              size: float | None = None) -> list[Segment]:
+              size: float | None = None, fit_lag: int | None = None) -> list[Segment]:
         """One frame after its sensory memory was updated: ``points`` are the chosen parts (3m,), ``speed`` the
         fastest one's over the sensory memory (NaN: none seen, or not enough frames yet), ``floor`` the least rest
-        speed the tracker's jitter allows (``jitter``). Segments it closes."""
+        speed the tracker's jitter allows (``jitter``), ``fit_lag`` the delay of the line fit that measured the
+        speed (frames; None: ``window``'s). Segments it closes."""
         cut: list[Segment] = []
         if self._start is not None:
             longest = int(round(self.params["max_movement"] * self._fps))
@@ -461,7 +509,7 @@ class VelocityDirection(Segmenter):
             speed = sum(self._speeds) / len(self._speeds)
         if np.isnan(speed):
             return cut
-        lag = self._lag + self._pause // 2
+        lag = (self._lag if fit_lag is None else fit_lag) + self._pause // 2
         if speed > rest:
             self._moving += 1
             self._resting = 0

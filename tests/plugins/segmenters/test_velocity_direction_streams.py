@@ -180,3 +180,42 @@ def test_hubs_holds_and_returns():
     short.hold(10, b)
     short.left(20)
     assert short.returned(b, 0, window) is None  # a pause shorter than a stance
+
+
+def slow_gestures():
+    """Four gestures performed three times slower than usual (a wave over 4.8 s, a bow over 4.2 s) between rests of
+    0.8 s: their hands move at about a tenth of a metre a second, below what a tracker's jitter of 1 cm makes a still
+    hand seem to move over a 0.2 s line fit."""
+    return [("rest", [hold(A, 1.0)]), ("movement", wave(A, seconds=4.8)), ("rest", [hold(A, 0.8)]),
+            ("movement", point(A, seconds=3.6)), ("rest", [hold(A, 0.8)]), ("movement", bowing(A, seconds=4.2)),
+            ("rest", [hold(A, 0.8)]), ("movement", point(A, seconds=3.6, hold_s=0.5)), ("rest", [hold(A, 1.0)])]
+
+
+@given(seed=st.integers(0, 1000))
+@settings(max_examples=4, deadline=None)
+def test_slow_gestures_under_a_centimetre_of_jitter_are_found_by_the_stretched_line_fit(seed):
+    """Slow gestures at 1 cm of jitter at 30 frames/s: the template (``stretch``: the line fit lengthened to 0.4 s
+    where the measured jitter hides the rest speed) finds every one; the 0.2 s fit alone (``stretch = 0``) loses
+    some, the jitter's floor being above their hands' speed; clean, both find every one."""
+    pieces = slow_gestures()
+    assert scores(pieces, tracker=0.01, seed=seed)["f1"] == 1.0
+    assert scores(pieces, tracker=0.0, seed=seed)["f1"] == 1.0
+    assert scores(pieces, tracker=0.0, seed=seed, stretch=0.0)["f1"] == 1.0
+
+
+def test_without_the_stretch_slow_gestures_are_lost_to_a_centimetre_of_jitter():
+    """The same slow gestures with the 0.2 s line fit alone lose movements to the jitter's floor, over seeds."""
+    f1 = [scores(slow_gestures(), tracker=0.01, seed=seed, stretch=0.0)["f1"] for seed in range(4)]
+    assert np.mean(f1) < 0.9, f1
+
+
+def test_longer_fits_double_up_to_the_stretch_and_lower_the_jitters_speed():
+    """The line fit lengthened by doubling to ``stretch`` frames (then ``stretch`` itself), each with its middle's
+    delay; none when ``stretch`` is no longer; each doubling lowers the jitter's speed by about 2^1.5."""
+    from plugins.segmenters.velocity_direction.speed import longer_fits
+
+    assert [(len(w), lag) for w, lag in longer_fits(6, 12, 30.0)] == [(12, 5)]
+    assert [(len(w), lag) for w, lag in longer_fits(6, 30, 30.0)] == [(12, 5), (24, 11), (30, 14)]
+    assert longer_fits(6, 6, 30.0) == [] and longer_fits(6, 0, 30.0) == []
+    ratio = speed_noise(0.01, line_weights(6, 30.0)) / speed_noise(0.01, longer_fits(6, 12, 30.0)[0][0])
+    assert ratio == pytest.approx(2**1.5, rel=0.1)
