@@ -194,7 +194,7 @@ def slow_gestures():
 @given(seed=st.integers(0, 1000))
 @settings(max_examples=4, deadline=None)
 def test_slow_gestures_under_a_centimetre_of_jitter_are_found_by_the_stretched_line_fit(seed):
-    """Slow gestures at 1 cm of jitter at 30 frames/s: the template (``stretch``: the line fit lengthened to 0.4 s
+    """Slow gestures at 1 cm of jitter at 30 frames/s: the template (``stretch``: the line fit lengthened to 1/3 s
     where the measured jitter hides the rest speed) finds every one; the 0.2 s fit alone (``stretch = 0``) loses
     some, the jitter's floor being above their hands' speed; clean, both find every one."""
     pieces = slow_gestures()
