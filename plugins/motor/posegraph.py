@@ -50,6 +50,7 @@ import numpy as np
 
 from plugins.lib.clip_repertoire import CLIP_PARAMETERS, example_name, repertoire_for
 from plugins.motor.key_poses import REPERTOIRE_PARAMETERS, KeyPoses, interpolate, play, read_repertoire, sample
+from plugins.lib.compiled import one_thread
 from plugins.lib.pose_distance import pose_distance
 from plugins.lib.travel import body_velocity, turned
 from plugins.lib.velocity import derivative
@@ -148,20 +149,21 @@ class Posegraph(MotorSystem):
         for name, m in self.repertoire.items():
             by_timing.setdefault(np.asarray(m.times, dtype=float).tobytes(), []).append(name)
         out = {}
-        for names in by_timing.values():
-            for first in range(0, len(names), _TOGETHER):
-                batch = names[first : first + _TOGETHER]
-                times = self.repertoire[batch[0]].times
-                keys = self.key_poses.array[[[self.key_poses.index[p] for p in self.repertoire[name].poses]
-                                             for name in batch]].swapaxes(0, 1)  # (K, M, P, 3)
-                sampled = sample(keys, times, fps=rate)
-                fine = sample(keys, times, fps=fps)
-                at = np.minimum(np.round(np.arange(len(sampled)) * fps / rate).astype(int), len(fine) - 1)
-                motion = derivative(fine - fine[:, :, root : root + 1], fps)[at]
-                seen = np.ones(fine.shape[:1] + fine.shape[2:3], dtype=bool)
-                for j, name in enumerate(batch):
-                    travel = body_velocity(fine[:, j], fine[:, j], seen, root, fps, frames=at)
-                    out[name] = (sampled[:, j], np.nan_to_num(travel), motion[:, j])
+        with one_thread():  # small least-squares fits (the derivative's ends) over many columns: threads only wait
+            for names in by_timing.values():
+                for first in range(0, len(names), _TOGETHER):
+                    batch = names[first : first + _TOGETHER]
+                    times = self.repertoire[batch[0]].times
+                    keys = self.key_poses.array[[[self.key_poses.index[p] for p in self.repertoire[name].poses]
+                                                 for name in batch]].swapaxes(0, 1)  # (K, M, P, 3)
+                    sampled = sample(keys, times, fps=rate)
+                    fine = sample(keys, times, fps=fps)
+                    at = np.minimum(np.round(np.arange(len(sampled)) * fps / rate).astype(int), len(fine) - 1)
+                    motion = derivative(fine - fine[:, :, root : root + 1], fps)[at]
+                    seen = np.ones(fine.shape[:1] + fine.shape[2:3], dtype=bool)
+                    for j, name in enumerate(batch):
+                        travel = body_velocity(fine[:, j], fine[:, j], seen, root, fps, frames=at)
+                        out[name] = (sampled[:, j], np.nan_to_num(travel), motion[:, j])
         return out
 
     def _add_clip(self, movement: str, motion: Motion, rows: _NodeRows) -> None:
@@ -503,10 +505,11 @@ def _derivatives(sequences: list[np.ndarray], fps: float) -> list[np.ndarray]:
     for i, values in enumerate(sequences):
         by_length.setdefault(values.shape, []).append(i)
     out: list[np.ndarray] = [np.empty(0)] * len(sequences)
-    for indices in by_length.values():
-        together = derivative(np.stack([sequences[i] for i in indices], axis=1), fps)
-        for j, i in enumerate(indices):
-            out[i] = together[:, j]
+    with one_thread():  # as in Posegraph._played
+        for indices in by_length.values():
+            together = derivative(np.stack([sequences[i] for i in indices], axis=1), fps)
+            for j, i in enumerate(indices):
+                out[i] = together[:, j]
     return out
 
 

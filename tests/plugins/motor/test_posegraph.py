@@ -153,12 +153,13 @@ def _random_character(rng: np.random.Generator, n: int) -> str:
     return "\n\n".join(lines) + "\n"
 
 
-@pytest.mark.parametrize("seed", range(6))
-def test_movements_played_together_give_the_nodes_each_gives_alone(tmp_path, seed):
+@pytest.mark.parametrize(("seed", "n", "together"), [*((s, None, 3) for s in range(6)), (6, 600, None)])
+def test_movements_played_together_give_the_nodes_each_gives_alone(tmp_path, seed, n, together):
     """The key-pose movements are played and differentiated in batches of one key timing
     (:meth:`Posegraph._played`): every node's pose, travel and motion is, bit for bit, what playing that movement
     alone gives (its nodes at ``node_rate``; at 30 frames/s the root's travel and the parts' motion, taken at the
-    nodes' times). Batches of 3 here, so that most movements share a call with others and some timings need two."""
+    nodes' times). Batches of 3, so that most movements share a call with others and some timings need two; and
+    600 movements in the default batches (on one BLAS thread, as the build runs them)."""
     from unittest import mock
 
     from plugins.lib.travel import body_velocity
@@ -168,8 +169,8 @@ def test_movements_played_together_give_the_nodes_each_gives_alone(tmp_path, see
 
     rng = np.random.default_rng(seed)
     path = tmp_path / "random.toml"
-    path.write_text(_random_character(rng, int(rng.integers(8, 25))))
-    with mock.patch.object(posegraph, "_TOGETHER", 3):
+    path.write_text(_random_character(rng, n or int(rng.integers(8, 25))))
+    with mock.patch.object(posegraph, "_TOGETHER", together or posegraph._TOGETHER):
         motor = load_character(path, create_plugin_manager(autoload=False)).motor
     rate, root, parts = motor.params["node_rate"], motor.body.root_index, motor.body.parts
     for name, movement in motor.repertoire.items():
