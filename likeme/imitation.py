@@ -88,7 +88,7 @@ def imitate(profile: str | Path | BodyProfile, repertoire: Any, demonstration: s
         As :func:`toolkit.observe.compose_observer` (``template=None``: ``characters/observers/recordings.toml``).
     learn : bool
         Learn a segment that is unknown as a new movement (the matcher's own learning, its ``learn`` parameter:
-        ``path-search`` names them ``learned-1``, ``learned-2``...). Without, an unknown segment is left standing in
+        ``path-search`` and ``forward-model`` name them ``learned-1``, ``learned-2``...). Without, an unknown segment is left standing in
         the hub.
     transition : float
         Seconds over which each join between movements and hubs is blended.

@@ -34,7 +34,7 @@ import numpy as np
 
 from plugins.lib.pose_distance import pose_distance
 from plugins.lib.root_frame import root_relative, smooth_heading
-from toolkit import ConfigError, Motion, Parameter
+from toolkit import Body, ConfigError, Motion, Parameter
 from toolkit.recordings.clips import ClipFolder, clip_files, example_name
 from toolkit.recordings.profile import BodyProfile, load_profile
 
@@ -83,12 +83,12 @@ class ClipRepertoire:
                                folder=self.folder)
 
 
-def root_relative_motion(world: Motion, profile: BodyProfile, facing_window: float = 1.0) -> Motion:
+def root_relative_motion(world: Motion, body: Body, facing_window: float = 1.0) -> Motion:
     """World positions to root-relative positions in the body's frame (§5.1), the facing a centred running median
     over ``facing_window`` seconds; hidden parts held (docs/conventions.md); the world positions kept beside them
     (:attr:`Motion.world`, where the body travels: :mod:`plugins.lib.travel`)."""
     window = max(1, int(round(facing_window * world.fps)))
-    pose, mask, _, _ = root_relative(world.positions, world.visible, profile.body, lambda h: smooth_heading(h, window))
+    pose, mask, _, _ = root_relative(world.positions, world.visible, body, lambda h: smooth_heading(h, window))
     return Motion(pose, world.fps, world.parts, mask, world.positions).filled()
 
 
@@ -176,7 +176,7 @@ def clip_repertoire(motions: Sequence[Motion], labels: Sequence[str], profile: s
         if tuple(world.parts) != tuple(profile.body.parts):
             raise ConfigError("the clip's parts are not the profile's parts", **where,
                               expected=f"parts {list(profile.body.parts)}", available=list(world.parts))
-        motion = root_relative_motion(world, profile)
+        motion = root_relative_motion(world, profile.body)
         if motion.n_frames < 2:
             raise ConfigError(f"clip has {motion.n_frames} frame", **where, expected="at least two frames")
         rel.append((movement, source, motion))

@@ -218,34 +218,44 @@ class MotorCommandGraph(MotorSystem):
         self._counter = 0
         self._state = self.rest.copy()
         self.labels: dict[str, str] = {}  # sequence name -> movement, for sequences learned from labelled clips
-        self._takes: dict[str, list[tuple[tuple[str, ...], str, np.ndarray, float]]] = {}  # movement -> its clips
+        self._takes: dict[str, list[tuple[tuple[str, ...], str, np.ndarray | None, float]]] = {}  # its clips
         if clips is not None:
             self._learn_clips(clips)
 
     def _learn_clips(self, clips: Any) -> None:
         """Every clip through the inverse model into a chain of edges from the hub, named by its movement."""
+        for clip in clips.clips:
+            self.learn_take(clip.movement, clip.motion, source=str(clip.source))
+
+    def learn_take(self, movement: str, motion: Motion, *, source: str = "") -> tuple[str, ...]:
+        """One performance of ``movement`` (root-relative, in the body's frame, with its world positions where it
+        travels: :func:`plugins.lib.clip_repertoire.root_relative_motion`) through the inverse model into a chain of
+        edges from the hub, one guiding stroke each (K&G §4.3), remembered as one of the movement's takes
+        (:meth:`takes`) and performed under its name. A labelled clip at composition; a demonstration no take
+        predicted when the forward model learns it (true imitation). Returns the new edges' names (none: nothing
+        moved enough to be a stroke)."""
         (subsystem, idx), = list(self.subsystems.items())[:1]
         criteria = StrokeCriteria(drop=self.params["strokes"]["drop"], angle=self.params["strokes"]["angle"])
-        for clip in clips.clips:
-            m = clip.motion
-            observed = fill_hidden(m.positions[:, idx], m.visible[:, idx], default=self.rest[idx])
-            names = self.learn_observed(subsystem, "hub", observed, m.fps, criteria=criteria, origin=str(clip.source),
-                                        hub_tolerance=self.params["hub_radius"], refine=False,
-                                        travel=clip_travel(m, self.body.root_index),
-                                        turn=clip_turn(m, self.body.root_index))
-            if not names:
-                continue
-            n = sum(1 for label in self.labels.values() if label == clip.movement)
-            self.add_sequence(names, name=example_name(clip.movement, n), label=clip.movement)
-            self._takes.setdefault(clip.movement, []).append((tuple(names), subsystem, observed, m.fps))
-            self.move_to(subsystem, "hub")
+        observed = fill_hidden(motion.positions[:, idx], motion.visible[:, idx], default=self.rest[idx])
+        names = self.learn_observed(subsystem, "hub", observed, motion.fps, criteria=criteria, origin=source,
+                                    hub_tolerance=self.params["hub_radius"], refine=False,
+                                    travel=clip_travel(motion, self.body.root_index),
+                                    turn=clip_turn(motion, self.body.root_index))
+        if not names:
+            return ()
+        n = sum(1 for label in self.labels.values() if label == movement)
+        self.add_sequence(names, name=example_name(movement, n), label=movement)
+        self._takes.setdefault(movement, []).append((tuple(names), subsystem, observed, motion.fps))
+        self.move_to(subsystem, "hub")
+        return tuple(names)
 
-    def takes(self) -> dict[str, list[tuple[tuple[str, ...], str, np.ndarray, float]]]:
-        """The takes of each movement learned from labelled clips (issue 18; not in the paper): per movement, one
-        ``(edges, subsystem, observed, fps)`` per clip: the chain of edges (names) the clip became, the
-        subsystem it moves, and the clip's own positions of that subsystem's parts (n, k, 3), as the inverse model
-        was given them. Several takes of one movement say what varies between its performances and what does not:
-        the forward model measures each take against the others' commands (``forward-model``'s ``spread``)."""
+    def takes(self) -> dict[str, list[tuple[tuple[str, ...], str, np.ndarray | None, float]]]:
+        """The takes of each movement learned from labelled clips or by watching (:meth:`learn_take`): per movement,
+        one ``(edges, subsystem, observed, fps)`` per performance: the chain of edges (names) it became, the
+        subsystem it moves, and its own positions of that subsystem's parts (n, k, 3) at ``fps``, as the inverse
+        model was given them (``None`` and 0 for a take restored from a saved state, which keeps its edges only).
+        The forward model following real people predicts with every take (:mod:`plugins.matchers.forward_model.
+        following`)."""
         return {movement: list(takes) for movement, takes in self._takes.items()}
 
     def examples(self, fps: float = 30.0) -> list[tuple[str, Motion]]:
@@ -689,6 +699,11 @@ class MotorCommandGraph(MotorSystem):
         self.sequences.update(sequences)
         self.labels.update(labels)
         self.together.update(together)
+        taken = {edges for takes in self._takes.values() for edges, *_ in takes}
+        for sequence, label in labels.items():  # a take learned by watching, saved: a take again
+            edges = tuple(self.sequences[sequence])
+            if edges and edges not in taken:
+                self._takes.setdefault(label, []).append((edges, self.subsystem_of(sequence), None, 0.0))
 
 
 @hookimpl

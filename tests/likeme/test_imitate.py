@@ -78,10 +78,12 @@ def test_each_segment_takes_the_demonstrators_duration(generated, pm):
     assert len(gap) > 5 and np.ptp(between, axis=0).max() < 1e-9
 
 
-def test_an_unknown_movement_is_learned_saved_and_known_next_time(generated, pm, tmp_path):
+@pytest.mark.parametrize("matcher", ["path-search", "forward-model"])
+def test_an_unknown_movement_is_learned_saved_and_known_next_time(generated, pm, tmp_path, matcher):
     """True imitation: a movement missing from the repertoire is learned from its first segment, performed as the
     demonstrator did it, recognised as the learned movement when it comes again, saved into a repertoire folder,
-    and known from the start by an observer given that folder."""
+    and known from the start by an observer given that folder; by either matcher (the forward model learns the
+    segment as a new movement's take: plugins.matchers.forward_model.learning.TakeLearning)."""
     profile = load_profile(generated / "profile.toml")
     path, truth = _stream(generated)
     missing = truth[-1][2]
@@ -93,7 +95,7 @@ def test_an_unknown_movement_is_learned_saved_and_known_next_time(generated, pm,
     s, e = truth[-1][:2]
     again = np.concatenate([demo.positions, demo.positions[s - 5 : e + 5] - demo.positions[s - 5 : s - 4]
                             + demo.positions[-1:]])
-    result = imitate(profile, repertoire, Motion(again, demo.fps, demo.parts), pm=pm)
+    result = imitate(profile, repertoire, Motion(again, demo.fps, demo.parts), pm=pm, matcher=matcher)
     learned = [seg for seg in result.segments if seg.learned]
     assert len(learned) == 1 and list(result.learned) == [learned[0].movement]
     name = learned[0].movement
@@ -109,7 +111,7 @@ def test_an_unknown_movement_is_learned_saved_and_known_next_time(generated, pm,
         save_learned(result, repertoire)
     clip = profile.read(saved[0])
     assert clip.n_frames == learned[0].end - learned[0].start
-    next_time = imitate(profile, repertoire, path, pm=pm)
+    next_time = imitate(profile, repertoire, path, pm=pm, matcher=matcher)
     assert [seg.movement for seg in next_time.segments][-1] == name and not next_time.learned
 
 

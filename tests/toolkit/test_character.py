@@ -171,3 +171,28 @@ def test_find_key_line(write):
     assert find_key_line(path, ("motor", "poses", "bob", "shift")) == 20
     assert find_key_line(path, ("body", "facing", "left")) == 7
     assert find_key_line(path, ("nothing",)) is None
+
+
+def test_find_key_line_reads_quoted_and_dotted_keys_as_toml_does(write):
+    path = write("q.toml", '''[files."*.bvh"]
+scale = 2
+
+[parts]
+"left hand" = "LHand"
+a.b = [
+  1,
+  [2, 3],
+]
+[[takes]]
+name = 'x'  # a comment
+[ 'odd.name' . inner ]
+deep = 1
+''')
+    assert find_key_line(path, ("files", "*.bvh", "scale")) == 2
+    assert find_key_line(path, ("files", "*.bvh")) == 1
+    assert find_key_line(path, ("parts", "left hand")) == 5
+    assert find_key_line(path, ("parts", "a", "b")) == 6
+    assert find_key_line(path, ("takes", 0, "name")) == 11
+    assert find_key_line(path, ("odd.name", "inner", "deep")) == 13
+    assert find_key_line(path, ("parts", "missing")) == 4  # the nearest table written
+    assert find_key_line(path, ("odd",)) is None  # a quoted dot is not a table

@@ -113,31 +113,66 @@ def _raise(err: Exception) -> Any:
 
 
 def find_key_line(path: Path, key: tuple) -> int | None:
-    """Best-effort line number of ``key`` in a TOML file (table headers and ``name =`` lines)."""
+    """Best-effort line number of ``key`` in a TOML file: the deepest table header (``[a."b c"]``, ``[[a]]``) or
+    ``name =`` line whose key path is a prefix of ``key``. Keys are read by :mod:`tomllib` itself, so quoted keys
+    (``[files."*.bvh"]``, ``"left hand" = ...``) and dotted ones are found as TOML reads them."""
     try:
         lines = path.read_text(encoding="utf-8").splitlines()
     except OSError:
         return None
     names = [k for k in key if isinstance(k, str)]
-    header = re.compile(r"^\s*\[\[?\s*([^\]]+?)\s*\]\]?\s*(#.*)?$")
     current: list[str] = []
     best: tuple[int, int] | None = None  # (matched depth, line)
     for number, text in enumerate(lines, 1):
-        m = header.match(text)
-        if m:
-            current = [p.strip().strip('"') for p in m.group(1).split(".")]
-            depth = _prefix_depth(current, names)
-            if depth == len(current) and (best is None or depth > best[0]):
-                best = (depth, number)
+        header = _HEADER.match(text)
+        found = _header_path(text) if header else _key_path(text)
+        if found is None:
             continue
-        m = re.match(r"^\s*([A-Za-z0-9_\-\"\.]+)\s*=", text)
-        if m:
-            dotted = [p.strip().strip('"') for p in m.group(1).split(".")]
-            full = current + dotted
-            depth = _prefix_depth(full, names)
-            if depth == len(full) and (best is None or depth > best[0]):
-                best = (depth, number)
+        if header:
+            current = found
+            full = found
+        else:
+            full = current + found
+        depth = _prefix_depth(full, names)
+        if depth == len(full) and (best is None or depth > best[0]):
+            best = (depth, number)
     return best[1] if best is not None and best[0] > 0 else None
+
+
+_HEADER = re.compile(r"^\s*\[")
+_KEY_PART = r"""\s*(?:"(?:[^"\\]|\\.)*"|'[^']*'|[A-Za-z0-9_-]+)\s*"""
+_KEY = re.compile(r"^(%s(?:\.%s)*)=" % (_KEY_PART, _KEY_PART))
+
+
+def _walk(table: Any) -> list[str]:
+    """The one key path of a table parsed from a single header or ``key = 0`` line."""
+    path: list[str] = []
+    while True:
+        if isinstance(table, list) and table:  # an array of tables: its last one
+            table = table[-1]
+        if not isinstance(table, dict) or len(table) != 1:
+            return path
+        name, table = next(iter(table.items()))
+        path.append(name)
+
+
+def _header_path(text: str) -> list[str] | None:
+    """The key path of a table header line (``[a.b]``, ``[[a]]``), or ``None`` if it is not one."""
+    try:
+        return _walk(tomllib.loads(text)) or None
+    except tomllib.TOMLDecodeError:
+        return None
+
+
+def _key_path(text: str) -> list[str] | None:
+    """The key path of a ``key = value`` line (the value may go on over later lines), or ``None``."""
+    m = _KEY.match(text)
+    if not m:
+        return None
+    try:
+        return _walk(tomllib.loads(m.group(1) + "= 0")) or None
+    except tomllib.TOMLDecodeError:
+        return None
 
 
 def _prefix_depth(path: list[str], key: list[str]) -> int:

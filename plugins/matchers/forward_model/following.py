@@ -285,16 +285,22 @@ class Following:
         Calibrated on the predictions (a :class:`Calibrated` decision) or a fixed distance.
     min_progress : float
         The share of a take that must be followed before committing to it.
+    learning : TakeLearning, optional
+        Learns a demonstration no take predicts as a new movement's take (K&G §4.3, true imitation), a candidate
+        from the next demonstration on; ``None``: nothing is learned.
     """
 
-    def __init__(self, motor: Any, body: Any, decision: Decision, min_progress: float) -> None:
+    def __init__(self, motor: Any, body: Any, decision: Decision, min_progress: float,
+                 learning: Any | None = None) -> None:
         self.motor, self.body, self.decision, self.min_progress = motor, body, decision, float(min_progress)
+        self.learning = learning
         self.comparison = Motion(shape="onset")
         with one_thread():
             self.rebuild()
 
     def rebuild(self) -> None:
         """The predictions and the calibration, from the takes as they are now."""
+        self._known = self._count()
         self.prediction = Prediction(self.motor, self.comparison)
         names = np.asarray(self.prediction.chains.movements, dtype=object)
         self._order = np.argsort(names, kind="stable")  # the chains grouped by movement, for reduceat
@@ -320,8 +326,15 @@ class Following:
 
     # -- following a demonstration ------------------------------------------------------------
 
+    def _count(self) -> int:
+        """How many takes the motor system knows (one learned, or loaded from a saved state, changes it)."""
+        return sum(len(takes) for takes in self.motor.takes().values())
+
     def begin(self, fps: float) -> None:
-        """A demonstration begins."""
+        """A demonstration begins (with every take known by now: one learned since the last is predicted too)."""
+        if self._count() != self._known:
+            with one_thread():
+                self.rebuild()
         self.watched = Watched(self.body, fps, self.comparison)
         self.warping = Warping(self.comparison, self.prediction.frames, self.prediction.chains) \
             if self.prediction.frames is not None else None
@@ -460,7 +473,15 @@ class Following:
         self.begin(motion.fps)
         self.add(world, motion.visible)
         final = self.conclude(motion.n_frames)
-        return final if final is not None else self.commitment
+        return self.learned(motion, final) if final is not None else self.commitment
+
+    def learned(self, motion: Recording, answer: Match | None) -> Match | None:
+        """``answer`` at the end of the demonstration ``motion``; an unknown one learned as a new movement when
+        this forward model learns (:class:`~plugins.matchers.forward_model.learning.TakeLearning`)."""
+        if self.learning is None or answer is None or answer.movement is not None or answer.stop \
+                or not len(self._still):
+            return answer
+        return self.learning.learn(motion, answer)
 
 
 class Streaming:
@@ -516,7 +537,7 @@ class Streaming:
                 final = self.following.conclude(motion.n_frames)
             if final is None and any(m is self.following.commitment for _, m in late):
                 return self.following.commitment  # committed in the last rows: not reported yet
-            return final
+            return self.following.learned(motion, final)
         finally:
             self.memory = None
 

@@ -23,7 +23,7 @@ from plugins.matchers.forward_model.command_graphs import CommandGraphs
 from plugins.matchers.decision import Calibrated
 from plugins.matchers.forward_model.commitment import Commitment
 from plugins.matchers.forward_model.following import Following, Streaming, Takes
-from plugins.matchers.forward_model.learning import InverseModel
+from plugins.matchers.forward_model.learning import InverseModel, TakeLearning
 from plugins.matchers.forward_model.observation import Observation
 from plugins.matchers.forward_model.path_length import norms
 from plugins.matchers.forward_model.prediction import Predictions
@@ -71,7 +71,8 @@ class ForwardModel(Matcher):
                   minimum=1),
         Parameter("together", bool, True, "Follow every subsystem that moves during a demonstration, each with its "
                   "own candidates, and imitate them at once (a hand-arm movement, §4.2); off: only the first to move."),
-        Parameter("learn", bool, True, "Learn new edges by the inverse model when no edge predicts the demonstration."),
+        Parameter("learn", bool, True, "Learn new edges by the inverse model when no edge predicts the demonstration "
+                  "(comparison = 'motion': the demonstration as the take of a new movement, learned-1, learned-2...)."),
         Parameter("reparameterise", bool, True, "Speed re-parameterisation (K&G §4.4): an edge predicts the "
                   "demonstration at the time its command covers the path length seen, so a familiar movement "
                   "performed faster or slower still fits, and is imitated at the speed measured. Off (the paper's "
@@ -96,7 +97,8 @@ class ForwardModel(Matcher):
                      "that knows the takes it learned from clips", key=("comparison",),
                      expected="a motor system with takes(), subsystems and body (motor-command-graph with clips)")
             following = Following(motor, owner.body, Calibrated(self.params["calibrated"]["known_rejected"]),
-                                  self.params["min_progress"])
+                                  self.params["min_progress"],
+                                  TakeLearning(motor, owner.body) if self.params["learn"] else None)
             stream = Streaming(following)
             for name in ("begin", "observe", "replay", "settled", "conclude", "inspect"):
                 setattr(self, name, getattr(stream, name))
