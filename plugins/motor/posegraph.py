@@ -49,11 +49,11 @@ from typing import Any
 import numpy as np
 
 from plugins.lib.clip_repertoire import CLIP_PARAMETERS, example_name, repertoire_for
-from plugins.motor.key_poses import REPERTOIRE_PARAMETERS, KeyPoses, interpolate, play, read_repertoire, sample
 from plugins.lib.compiled import one_thread
 from plugins.lib.pose_distance import pose_distance
 from plugins.lib.travel import body_velocity, turned
 from plugins.lib.velocity import derivative
+from plugins.motor.key_poses import REPERTOIRE_PARAMETERS, KeyPoses, interpolate, play, read_repertoire, sample
 from toolkit import ConfigError, Motion, MotorSystem, Parameter, hookimpl
 
 _OPTIONAL = {"poses": {}, "movements": {}}  # with clips, the key-pose repertoire is not needed
@@ -99,7 +99,6 @@ class Posegraph(MotorSystem):
     def _build(self) -> None:
         import networkx as nx
 
-        rate = self.params["node_rate"]
         n_parts = self.body.n_parts
         rows = _NodeRows()
         for hub in self.hubs:  # at rest in the hubs: no travel, no motion, no turn
