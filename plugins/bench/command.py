@@ -124,6 +124,10 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--csv", metavar="FILE", help="also write the results as CSV (one row per plugin and per item)")
     p.add_argument("--plot", metavar="PNG", help="draw the results (confusion matrices, scores per plugin)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--jitter", type=number_type(0.0, 1.0, "metres"), default=0.0, metavar="M",
+                   help="read every recording (repertoire, demos, streams) with M metres of a tracker's jitter: "
+                   "independent Gaussian noise on each coordinate of each joint in each frame, the same for a file "
+                   "whatever reads it (plugins.bench.tracker; default 0: as recorded)")
 
 
 def _motion_capture_commands(sub: Any) -> None:

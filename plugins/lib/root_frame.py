@@ -27,6 +27,12 @@ __all__ = ["facing_heading", "to_root_relative", "root_relative", "HeadingFilter
 
 _UP = np.array([0.0, 1.0, 0.0])
 
+MARKER_MARGIN = 0.25
+"""How far behind the line through the facing parts (a share of their distance) the forward marker must lie to turn
+the facing to the other side (:func:`facing_heading`). B&B §5.1's nose is "always somewhat in front of the body": a
+mirrored recording puts it well behind; a marker the profile gives at the line (toes seen from toes) or a few
+centimetres from it is within a tracker's jitter of both sides, and the body's left and right decide."""
+
 
 def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body) -> np.ndarray:
     """Heading (radians about +y) of a body from its visible parts; NaN where it cannot be found.
@@ -40,9 +46,12 @@ def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body) -> np.nda
     Notes
     -----
     With both facing parts (knees) visible, the facing is the horizontal
-    perpendicular of the line from right to left; the forward marker (nose),
-    when visible, picks the side of that line it lies on, as seen from the root
-    (or from the middle of the knees when the root is hidden). With a knee hidden,
+    perpendicular of the line from right to left, on the side a body's left and
+    right put its front; the forward marker (nose), when visible, turns it to the
+    other side where it lies behind that line (as seen from the root, or from the
+    middle of the knees when the root is hidden) by more than :data:`MARKER_MARGIN`
+    of the knees' distance: a marker on the line, or one a tracker's jitter moves
+    across it, does not flip the facing from frame to frame. With a knee hidden,
     the horizontal direction from the root to the forward marker is used.
     ``body.facing.behind``, when given, replaces the root as the point the
     forward marker is seen from (the toes seen from the ankle).
@@ -66,8 +75,10 @@ def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body) -> np.nda
             bi = body.index(body.facing.behind)
             base = np.where(visible[..., bi, None], world[..., bi, :], base)
         ahead = world[..., fi, :] - base
-        side = np.sign(np.einsum("...i,...i->...", ahead, perp))
-        perp = perp * np.where((side < 0) & visible[..., fi], -1.0, 1.0)[..., None]
+        # the marker behind the line by more than MARKER_MARGIN of the facing parts' distance: the other side
+        # (perp's horizontal length is that distance); nearer the line it says nothing a tracker's jitter cannot flip
+        behind_line = np.einsum("...i,...i->...", ahead, perp) < -MARKER_MARGIN * np.einsum("...i,...i->...", perp, perp)
+        perp = perp * np.where(behind_line & visible[..., fi], -1.0, 1.0)[..., None]
         fallback = world[..., fi, :] - world[..., bi, :]
         fallback[..., 1] = 0.0
         use_fb = ~knees & visible[..., fi] & visible[..., bi]

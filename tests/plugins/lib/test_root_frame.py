@@ -41,6 +41,46 @@ def test_forward_marker_resolves_swapped_knees(pm):
     assert abs(facing_heading(local, np.ones(len(local), bool), c.body)) < 1e-9
 
 
+def _marker_body(forward_offset):
+    """Hips 13 cm apart facing +z (left at +x), a root between them, a marker ``forward_offset`` m ahead of its own
+    behind part (toes seen from toes, as a profile may give them)."""
+    from toolkit.body import Body, Facing
+
+    body = Body(("root", "left_hip", "right_hip", "toes", "toe_tip"), "root",
+                Facing("left_hip", "right_hip", forward="toe_tip", behind="toes"))
+    local = np.array([[0.0, 0.9, 0.0], [0.065, 0.9, 0.0], [-0.065, 0.9, 0.0], [0.1, 0.0, 0.05],
+                      [0.1, 0.0, 0.05 + forward_offset]])
+    return body, local
+
+
+@pytest.mark.parametrize("offset", [0.0, 0.02])
+def test_a_tracker_jitter_does_not_flip_the_facing_a_marker_on_the_line_gives(offset):
+    """1 cm of jitter at every joint: a marker at its behind part (0) or 2 cm ahead of it lies on either side of the
+    line from frame to frame; the hips' left and right give the facing. It turns half round in a rare frame (the
+    marker 2.3 jitters behind), which the running median over a second leaves out (before: every other frame)."""
+    body, local = _marker_body(offset)
+    rng = np.random.default_rng(3)
+    heading = 0.7
+    world = local_to_world(local, np.array([1.0, 0.0, 2.0]), heading)[None] + rng.normal(0, 0.01, (2000, 5, 3))
+    found = facing_heading(world, np.ones((2000, 5), bool), body)
+    error = np.abs(np.angle(np.exp(1j * (found - heading))))
+    assert np.mean(error > np.pi / 2) < 0.02 and np.median(error) < 0.1
+    smoothed = smooth_heading(found, 30)
+    assert np.abs(np.angle(np.exp(1j * (smoothed - heading)))).max() < 0.1
+
+
+@pytest.mark.parametrize("offset, turned", [(-0.03, False), (-0.05, True), (-0.2, True)])
+def test_a_marker_well_behind_the_line_turns_the_facing_round(offset, turned):
+    """B&B §5.1's nose is "always somewhat in front of the body": a marker behind the hips' line by more than a
+    quarter of their distance (3.25 cm here) says the recording's left and right are the other way round."""
+    body, local = _marker_body(0.0)
+    local[4, 2] = offset  # the marker itself, seen from the root (no behind part seen)
+    visible = np.ones(5, bool)
+    visible[3] = False
+    found = facing_heading(local_to_world(local, np.zeros(3), 0.0), visible, body)
+    assert abs(np.angle(np.exp(1j * (found - (np.pi if turned else 0.0))))) < 1e-9
+
+
 def test_hidden_knee_falls_back_to_root_and_nose(pm):
     c = _max(pm)
     world = local_to_world(c.motor.rest_pose(), np.zeros(3), 1.0)
