@@ -37,6 +37,15 @@ every product a plugin forms with it (by a frame rate, a body size, a count of f
 key before the plugin runs instead of overflowing inside it."""
 
 
+MAX_INT = 2**63 - 1
+"""The largest integer a parameter takes (what numpy and the plugins can hold)."""
+
+
+def _bound(value: float, kind: type) -> str:
+    """A bound as ``likeme plugins --params`` and error messages show it: an integer's in full, a number's short."""
+    return str(int(value)) if kind is int and float(value).is_integer() else f"{value:g}"
+
+
 class _Required:
     def __repr__(self) -> str:
         return "REQUIRED"
@@ -129,10 +138,9 @@ class Parameter:
         text = _TYPE_NAMES[self.type] if article else _TYPE_NAMES[self.type].split(" ", 1)[1]
         if self.items is not None:
             text += f" of {_TYPE_NAMES[self.items].split(' ', 1)[1]}s"
-        if self.minimum is not None or self.maximum is not None:
-            lo = "-inf" if self.minimum is None else f"{self.minimum:g}"
-            hi = "inf" if self.maximum is None else f"{self.maximum:g}"
-            text += f" in [{lo}, {hi}]"
+        if self.type in (int, float):
+            lo, hi = self.bounds
+            text += f" in [{_bound(lo, self.type)}, {_bound(hi, self.type)}]"
         if self.choices is not None:
             text += " (one of " + ", ".join(map(repr, self.choices)) + ")"
         if not article:
@@ -140,6 +148,19 @@ class Parameter:
             if self.length:
                 text += ", a length (scaled to the body with lengths_for_height)"
         return text
+
+    @property
+    def bounds(self) -> tuple[float, float]:
+        """The inclusive range :meth:`coerce` holds a number parameter to (what ``likeme plugins --params`` shows).
+
+        Its own ``minimum`` and ``maximum`` (a duration's maximum an hour, :data:`MAX_SECONDS`); where it gives
+        none, a number is at most :data:`MAX_MAGNITUDE` in size on that side and an integer at most :data:`MAX_INT`.
+        Not a number parameter: a ``TypeError``."""
+        if self.type not in (int, float) or self.table:
+            raise TypeError(f"parameter {self.name!r} is not a number")
+        implicit = MAX_MAGNITUDE if self.type is float else MAX_INT
+        return (-implicit if self.minimum is None else self.minimum,
+                implicit if self.maximum is None else self.maximum)
 
     def coerce(self, value: Any) -> Any:
         """Return the checked value (ints widened to float) or raise :class:`ConfigError`.
@@ -163,13 +184,12 @@ class Parameter:
         if self.items is not None:
             value = [_check_type(v, self.items, i, self._expected()) for i, v in enumerate(value)]
         if self.type in (int, float):
-            if self.minimum is not None and value < self.minimum or self.maximum is not None and value > self.maximum:
+            lo, hi = self.bounds
+            if not lo <= value <= hi:
+                if value > hi and self.maximum is None or value < lo and self.minimum is None:
+                    raise ConfigError(f"value {value!r} too large", key=(self.name,),
+                                      expected=f"{self._expected()} (no parameter without bounds of its own takes more)")
                 raise ConfigError(f"value {value!r} out of range", key=(self.name,), expected=self._expected())
-            if self.type is float and self.maximum is None and abs(value) > MAX_MAGNITUDE:
-                low = -MAX_MAGNITUDE if self.minimum is None else self.minimum
-                raise ConfigError(f"value {value!r} too large", key=(self.name,),
-                                  expected=f"a number in [{low:g}, {MAX_MAGNITUDE:g}] (no parameter without a maximum "
-                                           "of its own takes more)")
         if self.choices is not None and value not in self.choices:
             raise ConfigError(
                 f"value {value!r} not allowed",
@@ -187,8 +207,6 @@ class Parameter:
         return self.describe(article=True)
 
 
-MAX_INT = 2**63 - 1
-"""The largest integer a parameter takes (what numpy and the plugins can hold)."""
 
 
 def finite_number(value: Any) -> float | None:

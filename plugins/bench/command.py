@@ -128,6 +128,9 @@ def _common(p: argparse.ArgumentParser) -> None:
                    help="read every recording (repertoire, demos, streams) with M metres of a tracker's jitter: "
                    "independent Gaussian noise on each coordinate of each joint in each frame, the same for a file "
                    "whatever reads it (plugins.bench.tracker; default 0: as recorded)")
+    p.add_argument("--dropout", type=number_type(0.0, 0.5, "share of frames"), default=0.0, metavar="S",
+                   help="and lose each joint for S of its frames, in gaps of 0.1-0.33 s (a tracker losing a joint: "
+                   "not seen; default 0)")
 
 
 def _motion_capture_commands(sub: Any) -> None:

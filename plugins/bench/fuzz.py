@@ -13,7 +13,11 @@ joint-position files. Case ``i`` of seed ``s`` mutates one seed with :func:`plug
   BVH file it maps, or ``observe --body F``);
 - ``scenario``: ``likeme run F --duration 1`` or ``likeme validate F``;
 - ``state``: ``likeme run learn_windmill --load F --duration 1``;
-- ``csv``: ``toolkit.recordings.positions.read_positions(F, fps=30.0)``.
+- ``csv``: ``toolkit.recordings.positions.read_positions(F, fps=30.0)``;
+- ``output``: a command that writes (:data:`OUTPUTS`) on a full disk (one case in two), in a read-only folder (one
+  in four: the case's folder and its ``out/`` of mode 0o555, refused to root too by
+  :func:`plugins.bench.fuzz_worker.permission_bits_hold`; a run where that cannot be made says so in a note) or with
+  room.
 
 Cases run one after another in one long-lived worker process (:mod:`plugins.bench.fuzz_worker`) that calls the
 ``likeme`` command's ``main`` in-process, each with ``--memory`` MB of address space beyond what the worker holds
@@ -241,6 +245,9 @@ class Case:
     """What the input is made instead of a file (:data:`SPECIAL_FILES`), or None."""
     full: bool = False
     """Whether the case runs on a full disk (every write to a file fails: ``RLIMIT_FSIZE`` of 0)."""
+    read_only: bool = False
+    """Whether the case runs in a read-only folder: the case's folder and its ``out/`` of mode 0o555, which stop root
+    too (:func:`plugins.bench.fuzz_worker.permission_bits_hold`)."""
 
     def command(self) -> str:
         """The command that replays the case from the folder its input was written to."""
@@ -331,8 +338,10 @@ OUTPUTS = (
     ["run", "learn_windmill", "--duration", "0.2", "--load", "{state}", "--save", "out/s.json"],
     ["bench", "make-data", "out/gen"],
     ["show", "max", "--view", "posegraph", "--out", "out/g.png"],
+    ["show", "max", "--view", "posegraph"],  # into the working folder
 )
-"""Commands that write a file or a folder, run on a full disk (every write to a file fails) in one case in two."""
+"""Commands that write a file or a folder (``out/`` or the working folder), run on a full disk (every write to a file
+fails) in one case in two, in a read-only folder in one in four."""
 
 SPECIAL_FILES = ("directory", "fifo", "dangling link", "link loop", "link to /proc/self/mem", "link to /dev/zero",
                  "unreadable")
@@ -389,11 +398,13 @@ def make_case(index: int, target: str, seeds: dict[str, list[dict[str, Any]]], s
         suffix, argv = SPECIAL_COMMANDS[int(rng.integers(len(SPECIAL_COMMANDS)))]
         return Case(index, target, kind, [kind], b"", f"case{index:05d}{suffix}", argv=list(argv), special=kind)
     if target in ("bench", "output"):
-        full = target == "output" and rng.random() < 0.5
+        where = rng.random() if target == "output" else 1.0
+        full, read_only = where < 0.5, 0.5 <= where < 0.75
         argv = _command(target, chosen, rng)
-        what = [f"{argv[-2]} {argv[-1]!r}"] if target == "bench" else ["full disk" if full else "disk with room"]
+        what = ([f"{argv[-2]} {argv[-1]!r}"] if target == "bench" else
+                ["full disk" if full else "read-only folder" if read_only else "disk with room"])
         return Case(index, target, Path(chosen["path"]).name, what, Path(chosen["path"]).read_bytes(),
-                    f"case{index:05d}.bvh", argv=argv, full=full)
+                    f"case{index:05d}.bvh", argv=argv, full=full, read_only=read_only)
     data, applied = mutate(Path(chosen["path"]).read_bytes(), fmt, rng)
     name = f"case{index:05d}{SUFFIX[fmt]}"
     if target == "csv":
@@ -460,8 +471,10 @@ def run_fuzz(pm: Any, *, n: int = 2000, seed: int = 0, targets: tuple[str, ...] 
         else:
             seeds = make_seeds(tmp / "seeds", pm, seed=seed)
         if in_process(jobs, scheduler):
-            return _run_cases(list(range(n)), targets, seeds, seed, timeout=timeout, memory_mb=memory_mb, tmp=tmp,
-                              out=out, progress=progress)
+            results = _run_cases(list(range(n)), targets, seeds, seed, timeout=timeout, memory_mb=memory_mb, tmp=tmp,
+                                 out=out, progress=progress)
+            notes.extend(_read_only_notes(results))
+            return results
         size = BLOCK if scheduler else -(-n // (2 * jobs))  # locally two blocks a process: a slow block is shared
         items = [{"indices": list(range(i, min(i + size, n))), "targets": targets, "seeds": seeds, "seed": seed,
                   "timeout": timeout, "memory_mb": memory_mb} for i in range(0, n, size)]
@@ -473,7 +486,18 @@ def run_fuzz(pm: Any, *, n: int = 2000, seed: int = 0, targets: tuple[str, ...] 
                     _keep(result, Path(out))
                 if progress is not None:
                     progress(result)
+        notes.extend(_read_only_notes(results))
         return results
+
+
+def _read_only_notes(results: list[Result]) -> list[str]:
+    """What to say of the read-only cases whose folder did not hold (a file could be created there): how many, and
+    why (the first reason), so that a run where it could not be made is not read as one that tried it."""
+    loose = [r for r in results if r.case.read_only and r.answer.get("read_only") not in (None, "held")]
+    if not loose:
+        return []
+    return [f"{len(loose)} of {sum(1 for r in results if r.case.read_only)} read-only cases ran in a folder that "
+            f"was not read-only here: {loose[0].answer['read_only']}"]
 
 
 def _fuzz_block(item: dict[str, Any], pm: Any) -> list[Result]:
@@ -502,12 +526,18 @@ def _run_cases(indices: list[int], targets: tuple[str, ...], seeds: dict[str, li
     try:
         for i in indices:
             case = make_case(i, targets[i % len(targets)], seeds, seed)
-            shutil.rmtree(case_dir, ignore_errors=True)
+            _remove(case_dir)
             case_dir.mkdir()
             (case_dir / case.name).write_bytes(case.data)
             if case.special:
                 make_special(case_dir / case.name, case.special)
+            if case.target == "output":  # the folder the command writes into is there: the write itself is tried
+                (case_dir / "out").mkdir()
+            if case.read_only:
+                for folder in (case_dir / "out", case_dir):
+                    folder.chmod(0o555)
             request = {"cwd": str(case_dir), "input": case.name, "call": case.call, "full": case.full,
+                       "read_only": case.read_only,
                        "argv": None if case.argv is None else [a.replace("{input}", case.name) for a in case.argv]}
             started = time.monotonic()
             answer = worker.run(request, timeout)
@@ -519,7 +549,16 @@ def _run_cases(indices: list[int], targets: tuple[str, ...], seeds: dict[str, li
                 progress(result)
     finally:
         worker.close()
+        _remove(case_dir)
     return results
+
+
+def _remove(folder: Path) -> None:
+    """Remove a case's folder, made writable again first (a read-only case's, for a user who is not root)."""
+    for path in (folder, folder / "out"):
+        if path.is_dir() and not path.is_symlink():
+            path.chmod(0o755)
+    shutil.rmtree(folder, ignore_errors=True)
 
 
 def _seeds_in(out: Path, pm: Any, seed: int) -> dict[str, list[dict[str, Any]]]:

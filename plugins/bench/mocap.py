@@ -435,12 +435,13 @@ def cell(spec: dict[str, Any]) -> dict[str, Any]:
     ``spec``: ``benchmark`` (``recognition``, ``segmentation`` or ``stream``), ``body`` (a profile path),
     ``repertoire``, ``demos``, ``streams`` (folders or None), ``matchers``, ``segmenters`` (names), ``set``
     (``TABLE.KEY=VALUE`` strings), ``observer`` (arguments of :func:`toolkit.observe.compose_observer`),
-    ``protocol``, ``group``, ``fps``, ``jitter`` (:mod:`plugins.bench.tracker`). The process builds its own plugin manager (the installed plugins), profile and
+    ``protocol``, ``group``, ``fps``, ``jitter`` and ``dropout`` (:mod:`plugins.bench.tracker`). The process builds its own plugin manager (the installed plugins), profile and
     observers; the result is that of :func:`recognition`, :func:`segmentation` or :func:`stream`.
     """
     from toolkit.manager import create_plugin_manager
 
-    pm, profile = create_plugin_manager(), jittered(load_profile(spec["body"]), spec.get("jitter") or 0.0)
+    pm = create_plugin_manager()
+    profile = jittered(load_profile(spec["body"]), spec.get("jitter") or 0.0, dropout=spec.get("dropout") or 0.0)
     settings, observer, fps = _settings(spec.get("set", ())), dict(spec.get("observer") or {}), spec.get("fps")
     folder = {k: Path(spec[k]) if spec.get(k) else None for k in ("repertoire", "demos", "streams")}
     if spec["benchmark"] == "recognition":
@@ -476,7 +477,8 @@ def _parallel(kind: str, args: Any, observer: dict[str, Any]) -> dict[str, Any]:
     spec = {"benchmark": kind, "body": str(args.body), "set": list(args.set), "observer": observer, "fps": args.fps,
             "repertoire": getattr(args, "repertoire", None), "demos": getattr(args, "demos", None),
             "streams": getattr(args, "streams", None), "protocol": getattr(args, "protocol", "closed"),
-            "group": getattr(args, "group", None), "jitter": getattr(args, "jitter", 0.0)}
+            "group": getattr(args, "group", None), "jitter": getattr(args, "jitter", 0.0),
+            "dropout": getattr(args, "dropout", 0.0)}
     if kind == "recognition":
         specs = [{**spec, "matchers": [m]} for m in args.matcher or MATCHERS]
     elif kind == "segmentation":
@@ -489,7 +491,7 @@ def _parallel(kind: str, args: Any, observer: dict[str, Any]) -> dict[str, Any]:
 
 def run(kind: str, args: Any, pm: Any) -> int:
     """``likeme bench recognition|segmentation|stream``: run the benchmark, print its table, write its outputs."""
-    profile = jittered(load_profile(args.body), getattr(args, "jitter", 0.0))
+    profile = jittered(load_profile(args.body), getattr(args, "jitter", 0.0), dropout=getattr(args, "dropout", 0.0))
     settings = _settings(args.set)
     observer = {"correspondence": args.correspondence,
                 "lengths_for_height": "" if args.lengths_for_height is None else args.lengths_for_height,

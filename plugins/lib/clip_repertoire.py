@@ -32,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
+from plugins.lib.gaps import bridged
 from plugins.lib.pose_distance import pose_distance
 from plugins.lib.root_frame import root_relative, smooth_heading
 from toolkit import Body, ConfigError, Motion, Parameter
@@ -176,7 +177,7 @@ def clip_repertoire(motions: Sequence[Motion], labels: Sequence[str], profile: s
         if tuple(world.parts) != tuple(profile.body.parts):
             raise ConfigError("the clip's parts are not the profile's parts", **where,
                               expected=f"parts {list(profile.body.parts)}", available=list(world.parts))
-        motion = root_relative_motion(world, profile.body)
+        motion = root_relative_motion(bridged(world), profile.body)
         if motion.n_frames < 2:
             raise ConfigError(f"clip has {motion.n_frames} frame", **where, expected="at least two frames")
         rel.append((movement, source, motion))

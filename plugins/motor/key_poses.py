@@ -28,6 +28,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -37,7 +38,7 @@ from toolkit.errors import ConfigError
 from toolkit.motion import Motion
 from toolkit.params import Parameter
 
-__all__ = ["KeyPoses", "Movement", "REPERTOIRE_PARAMETERS", "parse_poses", "parse_movements", "read_repertoire", "interpolate"]
+__all__ = ["KeyPoses", "Movement", "REPERTOIRE_PARAMETERS", "parse_poses", "parse_movements", "read_repertoire", "interpolate", "sample"]
 
 POSE_KEYS = ("base", "shift", "offset")
 
@@ -72,7 +73,12 @@ class KeyPoses:
     array: np.ndarray
 
     def __getitem__(self, name: str) -> np.ndarray:
-        return self.array[self.names.index(name)]
+        return self.array[self.index[name]]
+
+    @cached_property
+    def index(self) -> dict[str, int]:
+        """Pose name -> its row of ``array`` (a character of thousands of poses looks each up in constant time)."""
+        return {name: i for i, name in enumerate(self.names)}
 
 
 def _vec(value: Any, key: tuple, *, angles: bool = False) -> np.ndarray:
@@ -206,16 +212,26 @@ def play(key_poses: KeyPoses, movement: Movement, parts: Sequence[str], *, fps: 
 def interpolate(
     key_poses: np.ndarray, times: np.ndarray, parts: Sequence[str], *, fps: float, speed: float = 1.0
 ) -> Motion:
-    """Sample key poses (K, P, 3) at ``times`` (K,) into a motion at ``fps``.
+    """Sample key poses (K, P, 3) at ``times`` (K,) into a motion at ``fps`` (see :func:`sample`)."""
+    values = sample(key_poses, times, fps=fps, speed=speed)
+    return Motion(values, fps, parts)
+
+
+def sample(key_poses: np.ndarray, times: np.ndarray, *, fps: float, speed: float = 1.0) -> np.ndarray:
+    """Key poses (K, ...) at ``times`` (K,) sampled at ``fps``: an array (n, ...), n = round(duration * fps) + 1.
 
     Shape-preserving cubic (PCHIP) interpolation: no overshoot past a key, zero
     velocity where the motion turns. ``speed`` > 1 plays faster. The first and
-    last frames are exactly the first and last keys.
+    last frames are exactly the first and last keys. Every coordinate is
+    interpolated on its own, so the key poses of several movements with the same
+    key times, stacked on a second axis (K, M, P, 3), are sampled in one call
+    with the numbers each would get alone.
     """
     from scipy.interpolate import PchipInterpolator
 
     if speed <= 0:
         raise ValueError("speed must be positive")
+    key_poses = np.asarray(key_poses)
     duration = float(times[-1]) / speed
     n = max(2, int(round(duration * fps)) + 1)
     t = np.linspace(0.0, float(times[-1]), n)
@@ -224,4 +240,4 @@ def interpolate(
         values = flat[0] + (t / times[-1])[:, None] * (flat[1] - flat[0])
     else:
         values = PchipInterpolator(times, flat, axis=0)(t)
-    return Motion(values.reshape(n, len(parts), 3), fps, parts)
+    return values.reshape(n, *key_poses.shape[1:])

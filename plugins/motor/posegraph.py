@@ -49,13 +49,16 @@ from typing import Any
 import numpy as np
 
 from plugins.lib.clip_repertoire import CLIP_PARAMETERS, example_name, repertoire_for
-from plugins.motor.key_poses import REPERTOIRE_PARAMETERS, KeyPoses, interpolate, play, read_repertoire
+from plugins.lib.compiled import one_thread
 from plugins.lib.pose_distance import pose_distance
 from plugins.lib.travel import body_velocity, turned
 from plugins.lib.velocity import derivative
+from plugins.motor.key_poses import REPERTOIRE_PARAMETERS, KeyPoses, interpolate, play, read_repertoire, sample
 from toolkit import ConfigError, Motion, MotorSystem, Parameter, hookimpl
 
 _OPTIONAL = {"poses": {}, "movements": {}}  # with clips, the key-pose repertoire is not needed
+_TOGETHER = 256
+"""Key-pose movements played and differentiated in one call at most (bounds the memory of a large repertoire)."""
 
 
 class Posegraph(MotorSystem):
@@ -96,7 +99,6 @@ class Posegraph(MotorSystem):
     def _build(self) -> None:
         import networkx as nx
 
-        rate = self.params["node_rate"]
         n_parts = self.body.n_parts
         rows = _NodeRows()
         for hub in self.hubs:  # at rest in the hubs: no travel, no motion, no turn
@@ -106,9 +108,9 @@ class Posegraph(MotorSystem):
             self.graph.add_node(hub, index=i, movement=None, hub=True)
         self.paths: dict[str, list[str]] = {}
         self.paths_label: dict[str, str] = {}  # path name -> movement (several clips of one movement)
+        played = self._played()
         for name, m in self.repertoire.items():
-            sampled = play(self.key_poses, m, self.body.parts, fps=rate).positions
-            travel, motion = self._key_pose_motion(m, len(sampled))
+            sampled, travel, motion = played[name]
             self._add_path(name, m.poses[0], sampled[1:-1], m.poses[-1], rows, travel[1:-1], motion[1:-1],
                            np.zeros(len(sampled) - 2))
         clips = self.clips.clips if self.clips is not None else ()
@@ -133,16 +135,35 @@ class Posegraph(MotorSystem):
         filled = motion.filled(default=self.rest_pose()).positions
         return keep, filled
 
-    def _key_pose_motion(self, movement: Any, n: int, fps: float = 30.0) -> tuple[np.ndarray, np.ndarray]:
-        """The travel (n, 3) and the parts' motion (n, P, 3) of a key-pose movement at its ``n`` nodes: key poses are
-        in the body's own frame, so the root's motion there is its travel, measured as an observer measures it (at
-        ``fps``, then taken at the nodes' times); each part's motion is its velocity relative to the root."""
-        fine = play(self.key_poses, movement, self.body.parts, fps=fps).positions
+    def _played(self, fps: float = 30.0) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+        """Each key-pose movement's nodes (n, P, 3), sampled at ``node_rate``, with their travel (n, 3) and the parts'
+        motion (n, P, 3). Key poses are in the body's own frame, so the root's motion there is its travel, measured as
+        an observer measures it (at ``fps``, then taken at the nodes' times); each part's motion is its velocity
+        relative to the root. The movements of one key timing are played and differentiated together, up to
+        :data:`_TOGETHER` at a time, with the numbers each gets alone (a character of thousands of movements loads in
+        seconds)."""
+        rate = self.params["node_rate"]
         root = self.body.root_index
-        velocity = body_velocity(fine, fine, np.ones(fine.shape[:2], dtype=bool), root, fps)
-        at = np.minimum(np.round(np.arange(n) * fps / self.params["node_rate"]).astype(int), len(fine) - 1)
-        motion = derivative(fine - fine[:, root : root + 1], fps)
-        return np.nan_to_num(velocity[at]), motion[at]
+        by_timing: dict[bytes, list[str]] = {}
+        for name, m in self.repertoire.items():
+            by_timing.setdefault(np.asarray(m.times, dtype=float).tobytes(), []).append(name)
+        out = {}
+        with one_thread():  # small least-squares fits (the derivative's ends) over many columns: threads only wait
+            for names in by_timing.values():
+                for first in range(0, len(names), _TOGETHER):
+                    batch = names[first : first + _TOGETHER]
+                    times = self.repertoire[batch[0]].times
+                    keys = self.key_poses.array[[[self.key_poses.index[p] for p in self.repertoire[name].poses]
+                                                 for name in batch]].swapaxes(0, 1)  # (K, M, P, 3)
+                    sampled = sample(keys, times, fps=rate)
+                    fine = sample(keys, times, fps=fps)
+                    at = np.minimum(np.round(np.arange(len(sampled)) * fps / rate).astype(int), len(fine) - 1)
+                    motion = derivative(fine - fine[:, :, root : root + 1], fps)[at]
+                    seen = np.ones(fine.shape[:1] + fine.shape[2:3], dtype=bool)
+                    for j, name in enumerate(batch):
+                        travel = body_velocity(fine[:, j], fine[:, j], seen, root, fps, frames=at)
+                        out[name] = (sampled[:, j], np.nan_to_num(travel), motion[:, j])
+        return out
 
     def _add_clip(self, movement: str, motion: Motion, rows: _NodeRows) -> None:
         """One example clip as a path between the hubs nearest its ends, sampled at ``node_rate``; its travel and
@@ -483,10 +504,11 @@ def _derivatives(sequences: list[np.ndarray], fps: float) -> list[np.ndarray]:
     for i, values in enumerate(sequences):
         by_length.setdefault(values.shape, []).append(i)
     out: list[np.ndarray] = [np.empty(0)] * len(sequences)
-    for indices in by_length.values():
-        together = derivative(np.stack([sequences[i] for i in indices], axis=1), fps)
-        for j, i in enumerate(indices):
-            out[i] = together[:, j]
+    with one_thread():  # as in Posegraph._played
+        for indices in by_length.values():
+            together = derivative(np.stack([sequences[i] for i in indices], axis=1), fps)
+            for j, i in enumerate(indices):
+                out[i] = together[:, j]
     return out
 
 

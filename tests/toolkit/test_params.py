@@ -31,8 +31,8 @@ def test_defaults_are_filled_and_ints_widen_to_float():
     [
         ({}, r"key table: missing required parameter of segmenter 'x'; expected a table"),
         ({"table": {}, "treshold": 1}, r"key treshold: unknown parameter 'treshold' for segmenter 'x'.*available: even, flag, k, mode, names, table, threshold"),
-        ({"table": {}, "threshold": "high"}, r"key threshold: wrong type str \(value 'high'\); expected a number in \[0, inf\]"),
-        ({"table": {}, "threshold": -1.0}, r"key threshold: value -1.0 out of range; expected a number in \[0, inf\]"),
+        ({"table": {}, "threshold": "high"}, r"key threshold: wrong type str \(value 'high'\); expected a number in \[0, 1e\+09\]"),
+        ({"table": {}, "threshold": -1.0}, r"key threshold: value -1.0 out of range; expected a number in \[0, 1e\+09\]"),
         ({"table": {}, "k": 2.5}, r"key k: wrong type float"),
         ({"table": {}, "k": True}, r"key k: wrong type bool"),
         ({"table": {}, "k": 101}, r"key k: value 101 out of range"),
@@ -98,7 +98,7 @@ def test_a_table_comes_back_whole_with_its_defaults():
 @pytest.mark.parametrize("values, message", [
     ({"dwell": {"sped": 1.0}}, r"key dwell.sped: unknown parameter 'sped' in table 'dwell' of correspondence 'c'; "
                                r"expected a parameter of table 'dwell' of correspondence 'c'; available: speed, window"),
-    ({"dwell": {"speed": -1.0}}, r"key dwell.speed: value -1.0 out of range; expected a number in \[0, inf\]"),
+    ({"dwell": {"speed": -1.0}}, r"key dwell.speed: value -1.0 out of range; expected a number in \[0, 1e\+09\]"),
     ({"dwell": 0.05}, r"key dwell: wrong type float \(value 0.05\); expected a table of speed, window"),
 ])
 def test_a_bad_key_of_a_table_is_named_with_its_path(values, message):
@@ -155,7 +155,7 @@ def test_a_duration_is_bounded_by_an_hour_unless_it_says_otherwise():
     assert Parameter("t", float, 1.0, seconds=True).maximum == MAX_SECONDS == 3600.0
     assert Parameter("t", float, 1.0, seconds=True, maximum=5.0).maximum == 5.0
     assert Parameter("t", float, 1.0, seconds=True).coerce(3600) == 3600.0
-    with pytest.raises(ConfigError, match=r"value 1e\+308 out of range.*expected a number in \[-inf, 3600\]"):
+    with pytest.raises(ConfigError, match=r"value 1e\+308 out of range.*expected a number in \[-1e\+09, 3600\]"):
         Parameter("t", float, 1.0, seconds=True).coerce(1e308)
 
 
@@ -171,3 +171,46 @@ def test_a_number_without_a_maximum_is_at_most_a_billion(value):
         assert err.value.key == ("x",) and "too large" in str(err.value) and "[-1e+09, 1e+09]" in str(err.value)
     with pytest.raises(ConfigError, match=r"\[0, 1e\+09\]"):
         p.coerce(value)
+
+
+def test_every_range_listed_is_the_range_the_check_holds():
+    """``likeme plugins --params`` (and docs/components.md) show each number parameter's range from
+    :attr:`Parameter.bounds`, the range :meth:`Parameter.coerce` holds it to: for every registered component, both
+    ends are listed, both are taken, and the next number past either end is refused naming the key."""
+    import math
+
+    from likeme.cli.plugins import plugins_table
+    from toolkit import create_plugin_manager
+    from toolkit.components import KINDS
+    from toolkit.params import flat_parameters
+
+    pm = create_plugin_manager(autoload=False)
+    listed = {}
+
+    def collect(rows, prefix):
+        for row in rows:
+            listed[(*prefix, row["name"])] = row["type"]
+            collect(row.get("parameters", []), (*prefix, row["name"]))
+
+    for kind, rows in plugins_table(pm, params=True)["components"].items():
+        for row in rows:
+            collect(row["parameters"], (kind, row["name"]))
+    checked = 0
+    for kind in KINDS:
+        for info in pm.registry.infos(kind):
+            for key, p in flat_parameters(info.cls.parameters):
+                if p.type not in (int, float) or p.choices is not None:
+                    continue
+                lo, hi = p.bounds
+                shown = listed[(kind, info.name, *key)]
+                assert "inf" not in shown and f"in [{lo if p.type is int else format(lo, 'g')}, " in shown, shown
+                assert f", {hi if p.type is int else format(hi, 'g')}]" in shown, shown
+                past = (lo - 1, hi + 1) if p.type is int else (math.nextafter(lo, -math.inf), math.nextafter(hi, math.inf))
+                for value in past:
+                    with pytest.raises(ConfigError) as err:
+                        p.coerce(value)
+                    assert err.value.key == (p.name,)
+                if p.check is None:
+                    assert p.coerce(lo) == lo and p.coerce(hi) == hi
+                checked += 1
+    assert checked > 100

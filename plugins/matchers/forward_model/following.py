@@ -46,7 +46,7 @@ import numpy as np
 from plugins.lib.compiled import one_thread
 from plugins.lib.root_frame import HeadingFilter, facing_heading, to_root_relative
 from plugins.lib.velocity import SMOOTHING, derivative
-from plugins.matchers.comparison import Frames, Motion
+from plugins.matchers.comparison import Frames, Motion, sequence_size
 from plugins.matchers.decision import Calibrated, Calibration, Decision, Stillness
 from plugins.matchers.warping import Chains, Warping, chain_calibration
 from toolkit import Match
@@ -189,6 +189,8 @@ class Watched:
         self.roots = np.zeros((64, 3))
         self.headings = np.zeros(64)
         self.last = np.full((parts, 3), np.nan)  # where each part was last seen
+        self.origin = np.zeros((parts, 3))  # where each part was first seen (root-relative): its onset
+        self.found = np.zeros(parts, dtype=bool)
         self.size = 0.0
         self.sampled = 0  # samples given so far
 
@@ -225,6 +227,11 @@ class Watched:
         self._grow(k)
         rows = slice(self.n, self.n + k)
         self.relative[rows] = held - held[:, self.root : self.root + 1]
+        new = seen.any(axis=0) & ~self.found
+        if new.any():  # a part's onset is where it was first seen, not frame 0's 0 when it was hidden there
+            first = np.argmax(seen, axis=0)
+            self.origin[new] = self.relative[self.n + first[new], np.flatnonzero(new)]
+            self.found |= new
         self.seen[rows] = seen
         self.roots[rows] = root
         previous = self.headings[self.n - 1] if self.n else None
@@ -232,7 +239,7 @@ class Watched:
         self.headings[rows] = unwrapped
         self.n += k
         if self.size <= 0 and self.n > self.delay:  # from the frames the first sample needs, however they come
-            self.size = _size(self.relative[: self.delay + 1])
+            self.size = sequence_size(self.relative[: self.delay + 1], self.seen[: self.delay + 1])
 
     def due(self, ended: bool) -> np.ndarray:
         """The frames of the samples not given yet whose frames are all there (``ended``: every sample left)."""
@@ -247,7 +254,7 @@ class Watched:
         n, rows = self.n, np.asarray(rows, dtype=np.intp)
         relative, headings, roots = self.relative[:n], self.headings[:n], self.roots[:n]
         if self.size <= 0:  # a segment shorter than the first sample needs: what there is of it
-            self.size = _size(relative)
+            self.size = sequence_size(relative, self.seen[:n])
         taps = len(self.coeffs)
         if n >= taps:
             starts = np.clip(rows - self.half, 0, n - taps)
@@ -269,7 +276,7 @@ class Watched:
         turn = headings[0] - headings[rows]
         self.sampled += len(rows)
         return self.comparison.frames(relative[rows], self.seen[rows], RATE, velocity=velocity, travel=travel,
-                                      heading=turn, size=self.size, origin=relative[0])
+                                      heading=turn, size=self.size, origin=self.origin)
 
 
 class Following:
@@ -359,6 +366,11 @@ class Following:
         if not len(rows) or self.warping is None:
             return []
         samples = watched.frames(rows)
+        evidence = samples.seen.any(axis=1)
+        if not evidence.all():  # a sample with no part seen carries no evidence: the warping does not advance on it
+            rows, samples = rows[evidence], samples.take(evidence)
+            if not len(rows):
+                return []
         before = self.warping.samples
         means, ends, local = self.warping.advance(samples)
         stills = np.concatenate([self._stills, self.comparison.still(samples)])  # each row on its own: the same

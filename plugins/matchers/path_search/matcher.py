@@ -204,6 +204,9 @@ class PathSearch(Matcher):
             return Match.unknown("nothing visible", details={"reason": "nothing visible"})
         self._refresh()
         samples, raw = self.samples(motion)
+        evidence = samples.seen.any(axis=1)
+        if not evidence.all():  # a sample with no part seen (its root hidden, say) carries no evidence: left out,
+            samples = samples.take(evidence)  # not a free step the warping could stretch along a long take
         found = self.searcher.find(samples)
         if found is None:
             return Match.unknown("nothing visible", details={"reason": "nothing visible"})

@@ -297,6 +297,9 @@ def test_the_new_shapes_are_made(seeds):
     specials = {c.special for c in cases if c.target == "special"}
     assert specials == set(fuzz.SPECIAL_FILES)
     assert any(c.full for c in cases if c.target == "output") and not all(c.full for c in cases if c.target == "output")
+    places = {c.mutations[0] for c in cases if c.target == "output"}
+    assert places == {"full disk", "read-only folder", "disk with room"}
+    assert not any(c.full and c.read_only for c in cases) and not any(c.read_only for c in cases if c.target != "output")
     options = {c.argv[-2] for c in cases if c.target == "bench"}
     assert {"--frames", "--noise", "--nodes", "--minutes", "--episodes"} <= options
 
@@ -309,3 +312,45 @@ def test_the_new_targets_find_nothing(tmp_path, target):
     results = fuzz.run_fuzz(create_plugin_manager(), n=6, seed=3, targets=(target,), timeout=60.0, memory_mb=1024)
     assert [r.outcome for r in results if r.outcome not in ("ok", "documented")] == [], \
         [(r.case.command(), r.answer.get("stderr", "")[-500:]) for r in results]
+
+
+def test_a_read_only_folder_refuses_root_as_every_user(tmp_path):
+    """``permission_bits_hold``: a folder of mode 0o555 refuses a file to this process inside (root's capabilities
+    to pass permission bits lowered there), and root, if it is root, writes there again once out."""
+    import os
+
+    folder = tmp_path / "out"
+    folder.mkdir()
+    folder.chmod(0o555)
+    try:
+        with fuzz_worker.permission_bits_hold(folder) as held:
+            assert held == "held"
+            with pytest.raises(PermissionError):
+                (folder / "x").write_text("x")
+            assert (tmp_path / "elsewhere").write_text("y") == 1  # only the mode stops it: the rest is writable
+        if os.geteuid() == 0:
+            (folder / "x").write_text("x")  # root's capabilities are back
+            (folder / "x").unlink()
+    finally:
+        folder.chmod(0o755)
+
+
+def test_read_only_cases_are_one_line_naming_the_folder():
+    """Output cases in a read-only folder (as root too): every command that writes is refused in one documented
+    line naming what it could not write and why (one case of each command); none ran as if it had written."""
+    from toolkit import create_plugin_manager
+
+    pm = create_plugin_manager()
+    with tempfile.TemporaryDirectory() as tmp:
+        seeds = fuzz.make_seeds(Path(tmp) / "seeds", pm, seed=21)
+        chosen = [i for i in range(400) if fuzz.make_case(i, "output", seeds, 21).read_only]
+        commands = {}
+        for i in chosen:  # one case of each command
+            commands.setdefault(" ".join(fuzz.make_case(i, "output", seeds, 21).argv), i)
+        results = fuzz._run_cases(sorted(commands.values()), ("output",), seeds, 21, timeout=120.0, memory_mb=1024,
+                                  tmp=Path(tmp))
+    assert len(results) == len(fuzz.OUTPUTS)
+    for r in results:
+        lines = [x for x in r.answer["stderr"].splitlines() if x.startswith("likeme: error: ")]
+        assert r.outcome == "documented" and r.answer["read_only"] == "held", (r.case.command(), r.answer)
+        assert len(lines) == 1 and "Permission denied" in lines[0], (r.case.command(), lines)

@@ -57,3 +57,18 @@ def test_a_benchmark_run_in_another_process_reads_the_same_jitter(generated):
     answers = lambda result: [(r["item"], r["recognised"]) for r in result["items"]]  # noqa: E731
     assert answers(noisy) == answers(again)
     assert [r["score"] for r in noisy["items"]] != [r["score"] for r in clean["items"]]
+
+
+def test_a_tracker_loses_each_joint_for_its_share_of_frames_in_short_gaps(generated):
+    from plugins.bench.tracker import GAP
+
+    profile = load_profile(generated / "profile.toml")
+    clip = generated / "streams" / "stream_1.bvh"
+    lost = ~np.isfinite(jittered(profile, 0.0, dropout=0.1).read(clip).positions).all(axis=-1)
+    fps = profile.read(clip).fps
+    assert np.allclose(lost.mean(axis=0), 0.1, atol=0.04)  # each joint on its own
+    for part in range(lost.shape[1]):
+        edges = np.flatnonzero(np.diff(np.r_[0, lost[:, part].astype(int), 0]))
+        lengths = edges[1::2] - edges[::2]
+        assert lengths.min() >= 1 and np.median(lengths) <= round(GAP[1] * fps) + 1
+    assert not np.array_equal(lost[:, 0], lost[:, 1])

@@ -134,3 +134,54 @@ def test_a_take_that_is_the_mean_has_no_spread_and_the_c_warping_path_is_the_pyt
     other = take[::-1][:7] + rng.normal(scale=0.1, size=(7, 4, 3))
     a, b = take.reshape(9, -1), np.ascontiguousarray(other.reshape(7, -1))
     assert dtw_ndim.warping_path(a, b, use_c=True) == dtw_ndim.warping_path(a, b, use_c=False)
+
+
+def _random_character(rng: np.random.Generator, n: int) -> str:
+    """A character extending Max with ``n`` random key-pose movements: 2 to 5 keys, some sharing their key times
+    (played together) and some not, poses that move the root (travel) and the hands, a random node rate."""
+    lines = ['[character]\nname = "Random"\nextends = ' + repr(str(CHARACTERS / "max.toml")).replace("'", '"'),
+             f"[motor]\nnode_rate = {rng.choice([1.0, 7.5, 10.0, 24.0])}"]
+    timings = [[0.0, 0.5, 1.0], [0.0, 0.4], [0.0, 0.3, 0.7, 1.3], [0.0, 0.05, 0.1]]
+    for i in range(n):
+        lines.append(f'[motor.poses.p{i}]\nbase = "stand"\nshift = {rng.normal(scale=0.03, size=3).round(4).tolist()}\n'
+                     f"right_hand = {rng.normal([-0.1, 0.4, 0.1], 0.05).round(4).tolist()}")
+        times = timings[rng.integers(len(timings))] if rng.random() < 0.7 else np.cumsum(
+            np.r_[0.0, rng.uniform(0.05, 0.8, size=rng.integers(1, 5))]).round(3).tolist()
+        poses = ["stand", *(f"p{rng.integers(i + 1)}" for _ in times[2:]), f"p{i}"][: len(times) - 1] + ["stand"]
+        keys = ", ".join(f'{{ pose = "{p}", at = {t} }}' for p, t in zip(poses, times))
+        lines.append(f"[motor.movements.m{i}]\nkeys = [{keys}]")
+    return "\n\n".join(lines) + "\n"
+
+
+@pytest.mark.parametrize(("seed", "n", "together"), [*((s, None, 3) for s in range(6)), (6, 600, None)])
+def test_movements_played_together_give_the_nodes_each_gives_alone(tmp_path, seed, n, together):
+    """The key-pose movements are played and differentiated in batches of one key timing
+    (:meth:`Posegraph._played`): every node's pose, travel and motion is, bit for bit, what playing that movement
+    alone gives (its nodes at ``node_rate``; at 30 frames/s the root's travel and the parts' motion, taken at the
+    nodes' times). Batches of 3, so that most movements share a call with others and some timings need two; and
+    600 movements in the default batches (on one BLAS thread, as the build runs them)."""
+    from unittest import mock
+
+    from plugins.lib.travel import body_velocity
+    from plugins.lib.velocity import derivative
+    from plugins.motor import posegraph
+    from plugins.motor.key_poses import play
+
+    rng = np.random.default_rng(seed)
+    path = tmp_path / "random.toml"
+    path.write_text(_random_character(rng, n or int(rng.integers(8, 25))))
+    with mock.patch.object(posegraph, "_TOGETHER", together or posegraph._TOGETHER):
+        motor = load_character(path, create_plugin_manager(autoload=False)).motor
+    rate, root, parts = motor.params["node_rate"], motor.body.root_index, motor.body.parts
+    for name, movement in motor.repertoire.items():
+        sampled = play(motor.key_poses, movement, parts, fps=rate).positions
+        fine = play(motor.key_poses, movement, parts, fps=30.0).positions
+        at = np.minimum(np.round(np.arange(len(sampled)) * 30.0 / rate).astype(int), len(fine) - 1)
+        travel = np.nan_to_num(body_velocity(fine, fine, np.ones(fine.shape[:2], dtype=bool), root, 30.0)[at])
+        motion = derivative(fine - fine[:, root : root + 1], 30.0)[at]
+        nodes = [motor.node_index(node) for node in motor.paths[name][1:-1]]
+        assert len(nodes) == len(sampled) - 2
+        np.testing.assert_array_equal(motor.node_poses[nodes], sampled[1:-1])
+        np.testing.assert_array_equal(motor.node_travel[nodes], travel[1:-1])
+        np.testing.assert_array_equal(motor.node_motion[nodes], motion[1:-1])
+    assert motor.node_travel.any() and motor.node_motion.any()  # the roots travel, the parts move

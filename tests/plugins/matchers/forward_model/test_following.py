@@ -155,3 +155,30 @@ def test_a_moving_demonstration_is_not_the_still_movement(observer, generated):
     assert float(f._still[-1]) > f.stillness.limit
     assert not f.stillness.holds("stand", float(f._still[-1]))
     assert f.stillness.holds("stand", 0.0) and not f.stillness.holds("nod", 0.0)
+
+
+def test_a_part_hidden_at_the_onset_is_measured_from_where_it_was_first_seen(observer, generated):
+    """The onset shape is each part's position since the movement began; a part a tracker did not see in the first
+    frames begins where it was first seen (before: at 0, its whole root-relative position read as movement)."""
+    from plugins.matchers.comparison import Motion as Comparison
+    from plugins.matchers.forward_model.following import Watched
+
+    data, profile = generated
+    motion = profile.read(data / "demos" / "wave" / "morris_1.0.bvh")
+    hand = profile.body.index("right_hand")
+    world = motion.positions.copy()
+    world[:7, hand] = np.nan
+    visible = np.isfinite(world).all(axis=-1)
+    watched = Watched(observer.body, motion.fps, Comparison(shape="onset"))
+    watched.add(world, visible)
+    frames = watched.frames(watched.due(True))
+    whole = Watched(observer.body, motion.fps, Comparison(shape="onset"))
+    whole.add(motion.positions, np.ones(visible.shape, dtype=bool))
+    later = whole.frames(whole.due(True))
+    assert watched.size == pytest.approx(whole.size, rel=0.02)  # the body's size from the parts seen
+    seen = frames.seen[:, hand]
+    assert not seen[0] and seen[3:].all()
+    # seen, the hand is where it has gone since it was first seen (frame 7), not since frame 0 where it was hidden
+    since = (whole.relative[7, hand] - whole.relative[0, hand]) / whole.size
+    np.testing.assert_allclose(frames.parts[seen, hand, :3] * watched.size / whole.size,
+                               later.parts[seen, hand, :3] - since, atol=1e-9)
