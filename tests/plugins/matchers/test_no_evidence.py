@@ -42,16 +42,21 @@ def test_a_hidden_root_for_a_few_frames_changes_no_answer(generated, matcher):
     assert not changed
 
 
-@pytest.mark.parametrize("matcher", ["path-search", "forward-model"])
-def test_a_repertoire_whose_clips_lost_joints_for_a_while_recognises_as_the_whole_one(generated, matcher):
-    """Every joint of every repertoire clip lost for a tenth of its frames, in gaps of 0.1-0.33 s
+def test_a_repertoire_whose_clips_lost_joints_for_a_while_recognises_as_the_whole_one(generated):
+    """Every joint of every repertoire clip lost for a fifth of its frames, in gaps of 0.1-0.33 s
     (plugins.bench.tracker): the clips are read whole, so the gaps are bridged (plugins.lib.gaps) and no held
-    joint jumps back into place, which a posegraph's node velocities or a command's strokes would read as motion."""
+    joint jumps back into place, which the posegraph's node velocities would read as motion (without the bridges 5
+    of Morris's 31 movements changed)."""
     from plugins.bench.tracker import jittered
+    from plugins.lib.clip_repertoire import load_clip_repertoire
 
     pm, data, profile = generated
-    whole = compose_observer(pm, profile, data / "repertoire", matcher=matcher)
-    gaps = compose_observer(pm, jittered(profile, 0.0, dropout=0.1), data / "repertoire", matcher=matcher)
+    lossy = jittered(profile, 0.0, dropout=0.2)
+    clips = load_clip_repertoire(data / "repertoire", lossy).clips
+    read = [lossy.read(c.source) for c in clips]
+    assert sum((~c.motion.visible).sum() for c in clips) < 0.2 * sum((~r.visible).sum() for r in read)
+    whole = compose_observer(pm, profile, data / "repertoire", matcher="path-search")
+    gaps = compose_observer(pm, lossy, data / "repertoire", matcher="path-search")
     changed = []
     for clip in sorted((data / "demos").glob("*/morris_1.0.bvh")):
         motion = profile.read(clip)
@@ -59,4 +64,4 @@ def test_a_repertoire_whose_clips_lost_joints_for_a_while_recognises_as_the_whol
         b = Observer(gaps, profile.body, motion.fps).classify(motion)
         if a.movement != b.movement:
             changed.append((clip.parent.name, a.movement, b.movement))
-    assert len(changed) <= 1, changed
+    assert not changed
