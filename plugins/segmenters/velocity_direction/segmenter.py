@@ -32,8 +32,8 @@ move; a part not seen yet carries no evidence.
 Real people (the correspondence problem, K&G §6): the paper's rest is an absolute speed, which a noisy tracker
 never falls below and a large body's sway may exceed, and the paper ends a movement at any rest. Each of these is a
 parameter, off by default (the paper); the observer template (``characters/observers/recordings.toml``,
-``[segmenters.velocity-direction]``) sets ``level = "movement"``, ``units = "body"``, ``window = 0.2``, ``jitter =
-3`` and ``end = "rest"``:
+``[segmenters.velocity-direction]``) sets ``level = "movement"``, ``units = "body"``, ``window = 0.2``, ``stretch =
+0.33``, ``jitter = 3`` and ``end = "rest"``:
 
 - ``units = "body"``: the rest speed is ``body.rest_speed`` of the demonstrator's own body sizes per second
   (:func:`plugins.lib.body_size.body_scale` of the poses seen, a running mean: about 0.45 m for a standing adult,
@@ -47,6 +47,10 @@ parameter, off by default (the paper); the observer template (``characters/obser
   gives a part standing still, the jitter measured from the chosen parts' own positions (the median of their second
   differences over ``floor`` seconds, whether the person moves or not; :class:`.speed.Jitter`). ``k = 3``: a still
   part seems to move that fast about once in 100,000 frames.
+- ``stretch = s > w``: where the jitter's floor (``jitter``) lies above the demonstrator's own rest speed by more
+  than a doubling of the window lowers it (:data:`DOUBLING`), the line fit is lengthened (twice ``w``, ... up to
+  ``s`` seconds; :func:`.speed.longer_fits`): a slow movement is still seen on a noisy tracker. The template's 1/3 s
+  is no longer than the shortest pause people make between gestures, which must still be seen as a rest.
 - ``noise = k > 0``: the rest speed is at least ``k`` times the slowest the demonstrator has been over the last
   ``floor`` seconds (their own speed distribution: sway plus the tracker's noise, whatever their units). It reads a
   walk's slow phase (a stride's turning point) as rest, so the template leaves it off.
