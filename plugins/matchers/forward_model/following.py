@@ -30,7 +30,13 @@ the decision the matchers share:
   the whole demonstration, decided as path search decides (:mod:`plugins.matchers.decision`);
 - **standing still**: a movement whose commands predict no motion at all (a pose held) is never committed to early;
   when it comes nearest at the end, the demonstration is it if it moved at most half as much as the least moving
-  other movement (:class:`plugins.matchers.decision.Stillness`), else unknown.
+  other movement (:class:`plugins.matchers.decision.Stillness`), else unknown;
+- **a tracker's gaps**: a sample in which no part is seen (the root lost: nothing is root-relative) carries no
+  evidence and the warping does not advance on it; each part's onset, and the body's size, are taken from where the
+  part was first seen;
+- **learning** (``learn = true``, as ``likeme imitate`` sets it): a demonstration whose answer at the end is unknown
+  becomes the take of a new movement (K&G §4.3, :class:`~plugins.matchers.forward_model.learning.TakeLearning`),
+  predicted from the next demonstration on.
 
 The candidates are the takes a motor command graph learned from labelled clips (:meth:`MotorCommandGraph.takes`):
 this is the forward model for a repertoire of recordings; a character who learns by watching follows the paper's
