@@ -83,10 +83,11 @@ class SyntheticVision(Perception):
         Parameter("radii", dict, {}, "Per-part radius overrides, e.g. { left_hand = 0.045 }."),
         Parameter("noise", float, 0.0, "Standard deviation (m) of Gaussian noise on every seen position.", minimum=0.0),
         Parameter("dropout", float, 0.0, "Probability that a visible part is missed in a frame.", minimum=0.0, maximum=1.0),
-        Parameter("buffer", float, 0.1, "Seconds the sensory buffer bridges a part's dropout (0: off).", minimum=0.0),
+        Parameter("buffer", float, 0.1, "Seconds the sensory buffer bridges a part's dropout (0: off).", minimum=0.0,
+                  seconds=True),
         Parameter("facing_window", float, 3.0, "Seconds over which the target's facing is a running median "
                   "(steady through kicks and head turns; a real turn is followed after half of it; 0: every "
-                  "frame on its own).", minimum=0.0),
+                  "frame on its own).", minimum=0.0, seconds=True),
         Parameter("seed", int, 0, "Seed of noise and dropouts."),
         *OBJECT_PARAMETERS,
     )
