@@ -283,17 +283,18 @@ class VelocityDirection(Segmenter):
         else:
             sizes = [None] * n
         lags = np.full(n, self._lag)
+        walk = not self._pause and not p["noise"] > 0  # the rest speed known for the block at once
+        own = self._own_rests(sizes) if walk or self._longer else None  # once for the block: stretch and _walk
         if self._longer:  # stretch: a longer line fit where the tracker's jitter hides the rest speed
-            own = self._own_rests(sizes)[0]
             for weights, lag in self._longer:
-                noisy = floors > DOUBLING * own  # the jitter floor still above the own rest speed after a doubling
+                noisy = floors > DOUBLING * own[0]  # the jitter floor still above the own rest speed after a doubling
                 if not noisy.any():
                     break
                 longer = p["jitter"] * speed_noise(sigma, weights)
                 speeds = np.where(noisy, self._fitted(rows, before, seen, weights), speeds)
                 floors, lags = np.where(noisy, longer, floors), np.where(noisy, lag, lags)
-        if not self._pause and not p["noise"] > 0:  # the rest speed known for the block at once
-            return self._walk(poses, flat, speeds, floors, sizes, lags)
+        if walk:
+            return self._walk(poses, flat, speeds, floors, sizes, lags, own)
         return self._steps(poses, flat, speeds, floors, sizes, lags)
 
     def _fitted(self, rows: np.ndarray, before: int, seen: np.ndarray, weights: np.ndarray) -> np.ndarray:
@@ -345,9 +346,11 @@ class VelocityDirection(Segmenter):
         return closed, since
 
     def _walk(self, poses: np.ndarray, flat: np.ndarray, speeds: np.ndarray, floors: np.ndarray,
-              sizes: list, lags: np.ndarray) -> tuple[list[tuple[int, Segment]], np.ndarray]:
+              sizes: list, lags: np.ndarray, own: tuple[np.ndarray, np.ndarray, np.ndarray]
+              ) -> tuple[list[tuple[int, Segment]], np.ndarray]:
         """:meth:`_step` for every frame of a block without ``pause`` and ``noise`` (the observer template's): the
-        same segments at the same frames, with only the frames where something can happen stepped.
+        same segments at the same frames, with only the frames where something can happen stepped (``own``: the
+        block's :meth:`_own_rests`).
 
         Without them the rest speed of every frame is known for the block at once (``body.rest_speed`` times the
         running mean of the body's size, summed in the same order as frame by frame, or ``rest_speed``; at least
@@ -360,7 +363,7 @@ class VelocityDirection(Segmenter):
         closed: list[tuple[int, Segment]] = []
         since = np.full(n, -1, dtype=int)
         first = self._frame + 1
-        rest, sums, counts = self._own_rests(sizes)
+        rest, sums, counts = own
         rest = np.maximum(rest, floors)
         valid = ~np.isnan(speeds)
         fast, frames = valid & (speeds > rest), np.arange(n)

@@ -339,7 +339,8 @@ class _Stepped(VelocityDirection):
     """The reference for ``_walk``: every frame of a block stepped (``_steps``), as the segmenter does with ``pause``
     or ``noise``."""
 
-    _walk = VelocityDirection._steps
+    def _walk(self, poses, flat, speeds, floors, sizes, lags, own):
+        return self._steps(poses, flat, speeds, floors, sizes, lags)
 
 
 @given(seed=st.integers(0, 10_000), cuts=st.lists(st.integers(1, 60), min_size=1, max_size=8),
