@@ -435,8 +435,9 @@ def cell(spec: dict[str, Any]) -> dict[str, Any]:
     ``spec``: ``benchmark`` (``recognition``, ``segmentation`` or ``stream``), ``body`` (a profile path),
     ``repertoire``, ``demos``, ``streams`` (folders or None), ``matchers``, ``segmenters`` (names), ``set``
     (``TABLE.KEY=VALUE`` strings), ``observer`` (arguments of :func:`toolkit.observe.compose_observer`),
-    ``protocol``, ``group``, ``fps``, ``jitter`` and ``dropout`` (:mod:`plugins.bench.tracker`). The process builds its own plugin manager (the installed plugins), profile and
-    observers; the result is that of :func:`recognition`, :func:`segmentation` or :func:`stream`.
+    ``protocol``, ``group``, ``fps``, ``jitter`` and ``dropout`` (:mod:`plugins.bench.tracker`). The process builds
+    its own plugin manager (the installed plugins), profile and observers; the result is that of
+    :func:`recognition`, :func:`segmentation` or :func:`stream`.
     """
     from toolkit.manager import create_plugin_manager
 
