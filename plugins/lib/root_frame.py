@@ -385,6 +385,13 @@ class HeadingFilter:
         median follows a turn after half a window). NaN before the first flag."""
         flags = np.asarray(flags, dtype=float)
         block = flags.reshape(-1)
+        if len(block) == 1:  # one frame (a world's step): the same numbers on floats (flags are 0 and 1: sums exact)
+            flag = float(block[0])
+            if np.isfinite(flag):
+                self._flags.append(flag)
+                if len(self._flags) > self.window:
+                    del self._flags[0]
+            return np.full(flags.shape, sum(self._flags) / self.window if self._flags else np.nan)
         given = block[np.isfinite(block)]
         history = np.concatenate([np.asarray(self._flags, dtype=float), given])
         ends = len(self._flags) + np.cumsum(np.isfinite(block))  # flags there were after each frame
