@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from plugins.lib.gaps import bridged
+from plugins.lib.lowpass import low_passed
 from plugins.lib.pose_distance import pose_distance
 from plugins.lib.root_frame import RecordingFacing, root_relative
 from toolkit import Body, ConfigError, Motion, Parameter
@@ -87,12 +88,14 @@ class ClipRepertoire:
 def root_relative_motion(world: Motion, body: Body, facing_window: float = 1.0) -> Motion:
     """A motion known whole (a repertoire's clip, a demonstration learned as a take) from world positions to
     root-relative positions in the body's frame (§5.1): a tracker's short gaps bridged first
-    (:func:`plugins.lib.gaps.bridged`), the facing a centred running median over ``facing_window`` seconds, parts
-    hidden longer held (docs/conventions.md); the world positions kept beside them (:attr:`Motion.world`, where the
-    body travels: :mod:`plugins.lib.travel`)."""
+    (:func:`plugins.lib.gaps.bridged`) and its jitter filtered out (:func:`plugins.lib.lowpass.low_passed`), the
+    facing a centred running median over ``facing_window`` seconds, parts hidden longer held (docs/conventions.md);
+    the world positions as seen (gaps bridged, not filtered: a repertoire rebuilt from them is the same) kept
+    beside them (:attr:`Motion.world`, where the body travels: :mod:`plugins.lib.travel`)."""
     world = bridged(world)
+    smooth = low_passed(world, keep=body.angle_mask)
     window = max(1, int(round(facing_window * world.fps)))
-    pose, mask, _, _ = root_relative(world.positions, world.visible, body, RecordingFacing(window))
+    pose, mask, _, _ = root_relative(smooth.positions, smooth.visible, body, RecordingFacing(window))
     return Motion(pose, world.fps, world.parts, mask, world.positions).filled()
 
 

@@ -207,8 +207,10 @@ class Stillness:
     still: frozenset[str] = frozenset()
     limit: float = 0.0
 
-    ROUNDING = 1e-9
-    """A take's motion at most this (in the comparison's unit, a body size or a metre) is no motion at all."""
+    ROUNDING = 1e-6
+    """A take's motion at most this (in the comparison's unit, a body size or a metre: a micrometre or two) is no
+    motion at all: rounding, and the ringing a clip's low-pass (:mod:`plugins.lib.lowpass`) leaves in a held pose
+    from a movement at its edge (1e-9 body sizes in Max's ``stand``)."""
 
     @classmethod
     def of(cls, motion: dict[str, float]) -> Stillness:
