@@ -13,7 +13,9 @@ movement under way only where it is a hub of this demonstrator:
   was a new stance (movements leave it and come back to it), if they had held it a stance's time (``stance``; the
   segmenter's ``STANCE``, 0.2 s). The movement is cut where they first rested there, and the one from it back to it
   follows;
-- or they rest ``settle`` seconds in one place (a new stance they stay in): the movement ends where that rest began;
+- or they rest ``settle`` seconds in one place (a new stance they stay in): the movement ends where that rest began.
+  A rest stays in one place: a hold from which some part drifts farther than twice ``rest.radius`` was no rest (a
+  movement slower than a tracker's jitter lets the speed show) and a new hold begins where they are (``still``);
 - or they have rested a stance's time at a hold reached by a shift (below) from a hold before it that lasted as
   long and where the movement had come at least half-way back to its first pose: the movement ended at that hold (a
   take that ends in another stance than it began, then the shift to the next one's).
@@ -140,6 +142,16 @@ class Rests:
             if since.size and np.nanmax(np.append(away.ravel(), -np.inf)) > 2.0 * self.radius:
                 return i
         return None
+
+    def still(self, pose: np.ndarray) -> bool:
+        """Whether ``pose`` (3m,) is still where the hold under way began: no part farther than twice the radius
+        from where it was (what leaving is). A rest stays in one place; one that drifts farther is a movement too
+        slow for the speed to show (a tracker's jitter hides it), not a rest."""
+        if not self.holds or self.holds[-1].end is not None:
+            return True
+        with np.errstate(all="ignore"):
+            away = np.linalg.norm((np.asarray(pose) - self.holds[-1].pose).reshape(-1, 3), axis=1)
+        return not np.nanmax(np.append(away, -np.inf)) > 2.0 * self.radius
 
     def hold(self, frame: int, pose: np.ndarray) -> None:
         """A rest away from the hubs began at ``frame`` in ``pose``."""
