@@ -98,7 +98,7 @@ class Rests:
     keep: int = 8
     hubs: list[np.ndarray] = field(default_factory=list)
     holds: list[Hold] = field(default_factory=list)
-    _stacked: np.ndarray | None = field(default=None, repr=False)  # the hubs as one array (k, m, 3)
+    _stacked: np.ndarray | None = field(default=None, repr=False)  # the hubs (and the hold under way) (k, m, 3)
 
     def began(self, pose: np.ndarray, radius: float) -> None:
         """A movement begins from ``pose`` (3m,), where the demonstrator was: a hub."""
@@ -114,18 +114,35 @@ class Rests:
 
     def at_hub(self, pose: np.ndarray) -> bool:
         """Whether ``pose`` is near one of the hubs (nothing to compare with: the paper's rule, any rest)."""
-        if not self.hubs:
-            return True
-        if self._stacked is None or len(self._stacked) != len(self.hubs):
-            self._stacked = np.array(self.hubs).reshape(len(self.hubs), -1, 3)
+        return self.place(pose)[0]
+
+    def still(self, pose: np.ndarray) -> bool:
+        """Whether ``pose`` (3m,) is still where the hold under way began: no part farther than twice the radius
+        from where it was (what leaving is). A rest stays in one place; one that drifts farther is a movement too
+        slow for the speed to show (a tracker's jitter hides it), not a rest. True with no hold under way."""
+        return self.place(pose)[1]
+
+    def place(self, pose: np.ndarray) -> tuple[bool, bool]:
+        """:meth:`at_hub` and :meth:`still` of ``pose`` (3m,) at once: its distances to the hubs and to the hold
+        under way, one array (the segmenter asks both at every frame of a hold)."""
+        holding = bool(self.holds) and self.holds[-1].end is None
+        if not self.hubs and not holding:
+            return True, True
+        if self._stacked is None or len(self._stacked) != len(self.hubs) + holding:
+            rows = self.hubs + ([self.holds[-1].pose] if holding else [])
+            self._stacked = np.array(rows).reshape(len(rows), -1, 3)
         apart = self._stacked - np.asarray(pose).reshape(-1, 3)
-        d = np.sqrt((apart * apart).sum(axis=2))
+        d2 = (apart * apart).sum(axis=2)  # (hubs [+ the hold], m); NaN: a part not seen in both
+        still = not holding or not bool((d2[-1] > 4.0 * self.radius * self.radius).any())  # NaN: not counted
+        if not self.hubs:
+            return True, still
+        d = np.sqrt(d2[: len(self.hubs)])
         if np.isfinite(d).all():
-            return float(d.mean(axis=1).min()) <= self.radius
+            return float(d.mean(axis=1).min()) <= self.radius, still
         with np.errstate(all="ignore"):
             near = np.nanmean(np.where(np.isfinite(d), d, np.nan), axis=1)  # eq. 1 over the parts seen in both
         near = near[np.isfinite(near)]
-        return not near.size or float(near.min()) <= self.radius
+        return not near.size or float(near.min()) <= self.radius, still
 
     def returned(self, pose: np.ndarray, start: int, window: np.ndarray) -> int | None:
         """The index of the last finished hold near ``pose`` that the demonstrator held a stance's time, left (some
@@ -143,24 +160,16 @@ class Rests:
                 return i
         return None
 
-    def still(self, pose: np.ndarray) -> bool:
-        """Whether ``pose`` (3m,) is still where the hold under way began: no part farther than twice the radius
-        from where it was (what leaving is). A rest stays in one place; one that drifts farther is a movement too
-        slow for the speed to show (a tracker's jitter hides it), not a rest."""
-        if not self.holds or self.holds[-1].end is not None:
-            return True
-        with np.errstate(all="ignore"):
-            away = np.linalg.norm((np.asarray(pose) - self.holds[-1].pose).reshape(-1, 3), axis=1)
-        return not np.nanmax(np.append(away, -np.inf)) > 2.0 * self.radius
-
     def hold(self, frame: int, pose: np.ndarray) -> None:
         """A rest away from the hubs began at ``frame`` in ``pose``."""
         self.holds.append(Hold(frame, np.array(pose, dtype=float)))
+        self._stacked = None
 
     def left(self, frame: int) -> None:
         """The demonstrator moves again at ``frame``: the hold under way (if any) ends there."""
         if self.holds and self.holds[-1].end is None:
             self.holds[-1].end = frame
+            self._stacked = None
 
     def pieces(self, start: int, end: int, window: np.ndarray, upto: int | None = None,
                shifts: bool = True) -> list[tuple[int, int]]:

@@ -572,7 +572,8 @@ class VelocityDirection(Segmenter):
         hold; else the rest is a hold and the movement goes on (:mod:`.rests`)."""
         rests = self._rests
         start = self._start
-        if self._holding and not rests.still(points):  # it drifted away: no rest, a new hold begins here
+        hub, still = rests.place(points)
+        if self._holding and not still:  # it drifted away: no rest, a new hold begins here
             fresh = max(self._memory, self._pause)
             began = max(start + 1, began + self._here() - fresh)
             self._drift = self._frame - fresh
@@ -581,10 +582,10 @@ class VelocityDirection(Segmenter):
         resting = self._here()
         if self._holding and resting < self._settle and (
                 resting != max(self._memory, self._pause) + rests.stance or len(rests.holds) < 2):
-            if not rests.at_hub(points):  # a hold goes on (the working memory is not needed)
+            if not hub:  # a hold goes on (the working memory is not needed)
                 return []
         window = np.array(self._buffer)
-        if rests.at_hub(points):
+        if hub:
             return self._close_pieces(rests.pieces(start, began, window), began)
         back = None if self._holding else rests.returned(points, start, window)
         if back is not None:
