@@ -18,6 +18,7 @@ from plugins.segmenters.velocity_direction import VelocityDirection
 from plugins.segmenters.velocity_direction.rests import Rests, straight
 from plugins.segmenters.velocity_direction.speed import Jitter, line_speeds, line_weights, speed_noise
 from tests.conftest import CHARACTERS
+from tests.plugins.segmenters.test_velocity_direction import _in_blocks, _Stepped
 from tests.fixtures.gesture_streams import FPS, bowing, hold, move, point, reach, stance, stream, wave
 
 TEMPLATE = tomllib.loads((CHARACTERS / "observers" / "recordings.toml").read_text())["segmenters"][
@@ -252,3 +253,21 @@ def test_a_hold_that_drifts_is_still_no_longer():
     assert rests.still(pose + np.array([np.nan, 0.0, 0.0, 0.01, 0.0, 0.0]))  # a part not seen is not counted
     rests.left(20)
     assert rests.still(pose + 1.0)  # the hold was left: nothing to drift from
+
+
+@given(seed=st.integers(0, 1000), cuts=st.lists(st.integers(1, 60), min_size=1, max_size=8))
+@settings(max_examples=8, deadline=None)
+def test_a_drifting_hold_walked_is_its_frames_stepped(seed, cuts):
+    """The slow rise under 2 cm of jitter, where holds drift and count again: the block walked (only the frames
+    where something can happen stepped) closes the same segments at the same frames as every frame stepped,
+    whatever the packet sizes."""
+    motion, _ = stream(slow_rise(), jitter=0.02, seed=seed)
+    visible = np.isfinite(motion.positions[..., 0])
+    results = []
+    for kind in (VelocityDirection, _Stepped):
+        seg = kind(**TEMPLATE)
+        seg.reset(motion.parts, FPS)
+        got, since = _in_blocks(seg, motion.positions, visible, cuts)
+        results.append((got, since, seg.flush(), seg._drift, seg._frame))
+    assert results[0] == results[1]
+    assert results[0][3] > 0  # a hold drifted
