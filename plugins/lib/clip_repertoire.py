@@ -85,9 +85,12 @@ class ClipRepertoire:
 
 
 def root_relative_motion(world: Motion, body: Body, facing_window: float = 1.0) -> Motion:
-    """World positions to root-relative positions in the body's frame (§5.1), the facing a centred running median
-    over ``facing_window`` seconds; hidden parts held (docs/conventions.md); the world positions kept beside them
-    (:attr:`Motion.world`, where the body travels: :mod:`plugins.lib.travel`)."""
+    """A motion known whole (a repertoire's clip, a demonstration learned as a take) from world positions to
+    root-relative positions in the body's frame (§5.1): a tracker's short gaps bridged first
+    (:func:`plugins.lib.gaps.bridged`), the facing a centred running median over ``facing_window`` seconds, parts
+    hidden longer held (docs/conventions.md); the world positions kept beside them (:attr:`Motion.world`, where the
+    body travels: :mod:`plugins.lib.travel`)."""
+    world = bridged(world)
     window = max(1, int(round(facing_window * world.fps)))
     pose, mask, _, _ = root_relative(world.positions, world.visible, body, lambda h: smooth_heading(h, window))
     return Motion(pose, world.fps, world.parts, mask, world.positions).filled()
@@ -177,7 +180,7 @@ def clip_repertoire(motions: Sequence[Motion], labels: Sequence[str], profile: s
         if tuple(world.parts) != tuple(profile.body.parts):
             raise ConfigError("the clip's parts are not the profile's parts", **where,
                               expected=f"parts {list(profile.body.parts)}", available=list(world.parts))
-        motion = root_relative_motion(bridged(world), profile.body)
+        motion = root_relative_motion(world, profile.body)
         if motion.n_frames < 2:
             raise ConfigError(f"clip has {motion.n_frames} frame", **where, expected="at least two frames")
         rel.append((movement, source, motion))

@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from plugins.lib.clip_repertoire import root_relative_motion
+from plugins.lib.learned_names import learned_name
 from plugins.lib.strokes import StrokeCriteria
 from plugins.matchers.forward_model.tracks import Track
 from toolkit import Match, Motion
@@ -29,10 +30,7 @@ from toolkit import Match, Motion
 if TYPE_CHECKING:
     from plugins.matchers.forward_model.matcher import ForwardModel
 
-__all__ = ["LEARNED", "InverseModel", "TakeLearning"]
-
-LEARNED = "learned"
-"""The name of a movement learned by watching, before its number: ``learned-1``, ``learned-2``..."""
+__all__ = ["InverseModel", "TakeLearning"]
 
 
 class InverseModel:
@@ -82,11 +80,7 @@ class TakeLearning:
         when nothing moved enough to be a stroke."""
         world = motion.world if motion.world is not None else motion.positions
         take = root_relative_motion(Motion(world, motion.fps, motion.parts, motion.visible), self.body)
-        known = set(self.motor.movements())
-        number = 1
-        while f"{LEARNED}-{number}" in known:
-            number += 1
-        name = f"{LEARNED}-{number}"
+        name = learned_name(self.motor.movements())
         edges = self.motor.learn_take(name, take, source="forward model")
         if not edges:
             return answer

@@ -18,6 +18,7 @@ import networkx as nx
 import numpy as np
 
 from plugins.lib.compiled import one_thread
+from plugins.lib.learned_names import learned_name
 from plugins.matchers.comparison import Comparison, Frames, comparison
 from plugins.matchers.comparison import Motion as MotionComparison
 from plugins.matchers.decision import Calibrated, Decision, Distance
@@ -235,8 +236,7 @@ class PathSearch(Matcher):
                      score=verdict.score, threshold=verdict.threshold, measure=measure)
 
     def _learn(self, obs: np.ndarray, vis: np.ndarray, details: dict[str, Any]) -> Match:
-        n = sum(1 for m in self.motor.movements() if m.startswith(self.params["learn_prefix"] + "-")) + 1
-        name = f"{self.params['learn_prefix']}-{n}"
+        name = learned_name(self.motor.movements(), self.params["learn_prefix"])
         path = self.motor.learn(name, obs, vis, source="path-search")
         self._refresh()
         return Match(name, 1.0, None, tuple(path), {"learned": True, **details})

@@ -57,3 +57,24 @@ def test_a_bridged_gap_lies_between_its_two_sightings(start, length, part):
     for k, row in enumerate(range(start, end), 1):
         t = k / (length + 1)
         np.testing.assert_allclose(out.positions[row, part], (1 - t) * a + t * b)
+
+
+def test_a_motion_known_whole_is_bridged_before_its_body_frame_is_found(tmp_path):
+    """A repertoire's clip and a demonstration learned as a take (plugins.lib.clip_repertoire.root_relative_motion):
+    a hand lost for a sixth of a second moves on along its line in the body's frame, as if it had been seen."""
+    from plugins.lib.clip_repertoire import root_relative_motion
+    from tests.conftest import STICK_PARTS, write_stick_profile
+    from toolkit.recordings.profile import load_profile
+
+    body = load_profile(write_stick_profile(tmp_path)).body
+    n = 40
+    stand = {"root": [0, 1, 0], "head": [0, 1.6, 0.05], "lk": [0.1, 0.5, 0], "rk": [-0.1, 0.5, 0], "hand": [0.3, 1, 0.2],
+             "lf": [0.1, 0, 0], "rf": [-0.1, 0, 0]}
+    positions = np.repeat(np.array([stand[p] for p in STICK_PARTS], dtype=float)[None], n, axis=0)
+    hand = STICK_PARTS.index("hand")
+    positions[:, hand] += np.arange(n)[:, None] / 30 * [0.0, 0.6, 0.3]  # raised along a line
+    clean = Motion(positions, 30.0, list(STICK_PARTS))
+    lost = _hide(clean, hand, slice(10, 15))
+    whole, bridged_ = root_relative_motion(clean, body), root_relative_motion(lost, body)
+    assert bridged_.visible[:, hand].all()
+    np.testing.assert_allclose(bridged_.positions[:, hand], whole.positions[:, hand], atol=1e-9)
