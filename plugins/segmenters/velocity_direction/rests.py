@@ -132,13 +132,13 @@ class Rests:
             rows = self.hubs + ([self.holds[-1].pose] if holding else [])
             self._stacked = np.array(rows).reshape(len(rows), -1, 3)
         apart = self._stacked - np.asarray(pose).reshape(-1, 3)
-        d2 = (apart * apart).sum(axis=2)  # (hubs [+ the hold], m); NaN: a part not seen in both
+        d2 = np.einsum("kmj,kmj->km", apart, apart)  # (hubs [+ the hold], m); NaN: a part not seen in both
         still = not holding or not bool((d2[-1] > 4.0 * self.radius * self.radius).any())  # NaN: not counted
         if not self.hubs:
             return True, still
         d = np.sqrt(d2[: len(self.hubs)])
-        if np.isfinite(d).all():
-            return float(d.mean(axis=1).min()) <= self.radius, still
+        if np.isfinite(d).all():  # eq. 1: the mean over the parts (np.mean's sum and division, without its overhead)
+            return float(np.add.reduce(d, axis=1).min()) / d.shape[1] <= self.radius, still
         with np.errstate(all="ignore"):
             near = np.nanmean(np.where(np.isfinite(d), d, np.nan), axis=1)  # eq. 1 over the parts seen in both
         near = near[np.isfinite(near)]
