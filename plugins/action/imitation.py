@@ -246,11 +246,11 @@ def _placed(local: np.ndarray, demonstration: Motion, body: Any, lift: np.ndarra
     """Local-frame poses placed where the demonstrator's root is and turned as they face (a centred running median
     of the facing over one second, held where it cannot be found); their displacement from where they began scaled
     by the observer's standing root height over theirs, so that a smaller body takes smaller steps."""
-    from plugins.lib.root_frame import root_relative, smooth_heading
+    from plugins.lib.root_frame import RecordingFacing, root_relative
 
     window = max(1, int(round(demonstration.fps)))
     _, _, root_world, heading = root_relative(demonstration.positions, demonstration.visible, body,
-                                              lambda h: smooth_heading(h, window))
+                                              RecordingFacing(window))
     heading, root_world = _held(heading), _held(root_world)
     seen = np.where(demonstration.visible[..., None], demonstration.positions, np.nan)[..., 1]
     floor = float(np.nanmin(seen)) if np.isfinite(seen).any() else 0.0
@@ -280,11 +280,11 @@ def imitation_error(imitation: Motion, demonstration: Motion, body: Any, frames:
     aligned), in the observer's body sizes (:func:`plugins.lib.body_size.body_scale` of its first frame).
     ``frames``: a boolean mask of the frames measured (default every frame)."""
     from plugins.lib.body_size import body_scale
-    from plugins.lib.root_frame import root_relative, smooth_heading
+    from plugins.lib.root_frame import RecordingFacing, root_relative
 
     def rel(m: Motion) -> tuple[np.ndarray, np.ndarray]:
         window = max(1, int(round(m.fps)))
-        poses, seen, _, _ = root_relative(m.positions, m.visible, body, lambda h: smooth_heading(h, window))
+        poses, seen, _, _ = root_relative(m.positions, m.visible, body, RecordingFacing(window))
         return poses, seen
 
     a, seen_a = rel(imitation)

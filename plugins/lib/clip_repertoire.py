@@ -34,7 +34,7 @@ import numpy as np
 
 from plugins.lib.gaps import bridged
 from plugins.lib.pose_distance import pose_distance
-from plugins.lib.root_frame import root_relative, smooth_heading
+from plugins.lib.root_frame import RecordingFacing, root_relative
 from toolkit import Body, ConfigError, Motion, Parameter
 from toolkit.recordings.clips import ClipFolder, clip_files, example_name
 from toolkit.recordings.profile import BodyProfile, load_profile
@@ -92,7 +92,7 @@ def root_relative_motion(world: Motion, body: Body, facing_window: float = 1.0) 
     body travels: :mod:`plugins.lib.travel`)."""
     world = bridged(world)
     window = max(1, int(round(facing_window * world.fps)))
-    pose, mask, _, _ = root_relative(world.positions, world.visible, body, lambda h: smooth_heading(h, window))
+    pose, mask, _, _ = root_relative(world.positions, world.visible, body, RecordingFacing(window))
     return Motion(pose, world.fps, world.parts, mask, world.positions).filled()
 
 

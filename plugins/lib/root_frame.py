@@ -6,8 +6,11 @@ with the facing found from a forward marker (the nose, "always somewhat in front
 of the body") against the line through the knees. Only visible parts are used.
 
 :func:`root_relative` is the transform every perception and the clip repertoire use: the facing found from the
-visible parts, smoothed over time (a running median while frames stream in, a centred one over a whole recording),
-then root-relative coordinates. All functions are vectorised over leading frame axes.
+visible parts, smoothed over time (a running median while frames stream in, a centred one over a whole recording:
+:class:`HeadingFilter`, :class:`RecordingFacing`), then root-relative coordinates. Over the same window the forward
+marker's side is put to a vote (:func:`marker_behind`): a tracker's jitter moves a marker near the line across it
+in a frame here and there, and a vote of the window's frames, not each frame on its own, turns the facing round.
+All functions are vectorised over leading frame axes.
 
 The transform and the running median take quick paths in a watching loop (the rotation written out instead of an
 einsum, the middle of each window read off its sorted estimates, no masking where nothing is hidden); each gives the
@@ -18,12 +21,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from collections.abc import Callable
+from typing import Protocol
 
 from toolkit.body import Body
 from toolkit.motion import world_to_local
 
-__all__ = ["facing_heading", "to_root_relative", "root_relative", "HeadingFilter", "smooth_heading"]
+__all__ = ["facing_heading", "marker_behind", "to_root_relative", "root_relative", "FacingWindow", "HeadingFilter",
+           "RecordingFacing", "smooth_heading"]
 
 _UP = np.array([0.0, 1.0, 0.0])
 
@@ -34,7 +38,8 @@ mirrored recording puts it well behind; a marker the profile gives at the line (
 centimetres from it is within a tracker's jitter of both sides, and the body's left and right decide."""
 
 
-def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body) -> np.ndarray:
+def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body, behind: np.ndarray | None = None
+                   ) -> np.ndarray:
     """Heading (radians about +y) of a body from its visible parts; NaN where it cannot be found.
 
     Parameters
@@ -42,6 +47,10 @@ def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body) -> np.nda
     world : array, shape (..., P, 3)
     visible : array of bool, shape (..., P)
     body : Body
+    behind : array, shape (...), optional
+        The share of a window of frames in which the forward marker lay behind the line (:func:`marker_behind`, put
+        to a vote by :meth:`FacingWindow.votes`): the facing turns to the other side where it is above one half.
+        ``None``: each frame's own marker decides (a window of one frame).
 
     Notes
     -----
@@ -65,20 +74,10 @@ def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body) -> np.nda
     knees = visible[..., li] & visible[..., ri]
     heading = np.full(world.shape[:-2], np.nan)
     if body.facing.forward is not None:
-        fi = body.index(body.facing.forward)
-        # the side of the knee line the nose is on; measured from the root when it is seen (a sitting
-        # body has its knees in front of its nose), else from the middle of the knees
-        mid = 0.5 * (world[..., li, :] + world[..., ri, :])
-        base = np.where(visible[..., root, None], world[..., root, :], mid)
-        bi = root
-        if body.facing.behind is not None:  # the forward marker is seen from its own behind part (toes from ankle)
-            bi = body.index(body.facing.behind)
-            base = np.where(visible[..., bi, None], world[..., bi, :], base)
-        ahead = world[..., fi, :] - base
-        # the marker behind the line by more than MARKER_MARGIN of the facing parts' distance: the other side
-        # (perp's horizontal length is that distance); nearer the line it says nothing a tracker's jitter cannot flip
-        behind_line = np.einsum("...i,...i->...", ahead, perp) < -MARKER_MARGIN * np.einsum("...i,...i->...", perp, perp)
-        perp = perp * np.where(behind_line & visible[..., fi], -1.0, 1.0)[..., None]
+        fi, bi = body.index(body.facing.forward), _marker_base(body)
+        flip = _behind_line(world, visible, body, perp) & visible[..., fi] if behind is None else \
+            np.asarray(behind, dtype=float) > 0.5  # NaN (no vote): not turned
+        perp = perp * np.where(flip, -1.0, 1.0)[..., None]
         fallback = world[..., fi, :] - world[..., bi, :]
         fallback[..., 1] = 0.0
         use_fb = ~knees & visible[..., fi] & visible[..., bi]
@@ -88,6 +87,49 @@ def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body) -> np.nda
     ok = knees & (norm > 1e-9)
     heading[ok] = np.arctan2(perp[..., 0], perp[..., 2])[ok]
     return heading
+
+
+def marker_behind(world: np.ndarray, visible: np.ndarray, body: Body) -> np.ndarray:
+    """Whether the forward marker lies behind the line through the facing parts by more than
+    :data:`MARKER_MARGIN` of their distance, frame by frame (...): 1.0 where it does, 0.0 where it does not, NaN where
+    the marker or a facing part is not seen (or the body has no forward marker). A window's vote on it
+    (:meth:`FacingWindow.votes`) is the ``behind`` of :func:`facing_heading`."""
+    world = np.asarray(world, dtype=float)
+    visible = np.asarray(visible, dtype=bool)
+    out = np.full(world.shape[:-2], np.nan)
+    if body.facing.forward is None:
+        return out
+    li, ri, fi = body.index(body.facing.left), body.index(body.facing.right), body.index(body.facing.forward)
+    perp = _cross_up(world[..., li, :] - world[..., ri, :])
+    perp[..., 1] = 0.0
+    seen = visible[..., li] & visible[..., ri] & visible[..., fi]
+    out[seen] = _behind_line(world, visible, body, perp)[seen]
+    return out
+
+
+def _marker_base(body: Body) -> int:
+    """The part the forward marker is seen from when it is seen: its own behind part (toes from the ankle), else the
+    root."""
+    return body.root_index if body.facing.behind is None else body.index(body.facing.behind)
+
+
+def _behind_line(world: np.ndarray, visible: np.ndarray, body: Body, perp: np.ndarray) -> np.ndarray:
+    """Each frame's forward marker behind the facing parts' line by more than :data:`MARKER_MARGIN` of their
+    distance (``perp``: the line's horizontal perpendicular, as long as the parts are apart).
+
+    The side of the line the marker is on is measured from the root when it is seen (a sitting body has its knees in
+    front of its nose), else from the middle of the facing parts; from the marker's own behind part where the profile
+    gives one and it is seen (toes from the ankle). Nearer the line than the margin the marker says nothing a
+    tracker's jitter cannot flip."""
+    li, ri, root = body.index(body.facing.left), body.index(body.facing.right), body.root_index
+    fi = body.index(body.facing.forward)
+    mid = 0.5 * (world[..., li, :] + world[..., ri, :])
+    base = np.where(visible[..., root, None], world[..., root, :], mid)
+    if body.facing.behind is not None:
+        bi = body.index(body.facing.behind)
+        base = np.where(visible[..., bi, None], world[..., bi, :], base)
+    ahead = world[..., fi, :] - base
+    return np.einsum("...i,...i->...", ahead, perp) < -MARKER_MARGIN * np.einsum("...i,...i->...", perp, perp)
 
 
 def _cross_up(across: np.ndarray) -> np.ndarray:
@@ -320,9 +362,44 @@ class HeadingFilter:
     def __init__(self, window: int) -> None:
         self.window = max(1, int(window))
         self._recent: list[float] = []
+        self._flags: list[float] = []  # the forward marker's recent sides (:meth:`votes`)
 
     def reset(self) -> None:
         self._recent.clear()
+        self._flags.clear()
+
+    def headings(self, found: np.ndarray) -> np.ndarray:
+        """:class:`FacingWindow`: the filtered facing after each estimate of ``found`` (a frame's, shape (), or a
+        block's, (n,)), by :meth:`update` for one frame and :meth:`update_many` for more."""
+        found = np.asarray(found, dtype=float)
+        if found.ndim == 0:
+            return np.asarray(self.update(float(found)))
+        if len(found) == 1:
+            return np.array([self.update(float(found[0]))])
+        return self.update_many(found)
+
+    def votes(self, flags: np.ndarray) -> np.ndarray:
+        """:class:`FacingWindow`: after each frame's flag (:func:`marker_behind`; a frame's, shape (), or a
+        block's), the flags of 1.0 among the last ``window`` flags there were (NaN ones skipped) over ``window``:
+        a stream's first frames, with fewer flags, are not turned round before half a window says so (as the
+        median follows a turn after half a window). NaN before the first flag."""
+        flags = np.asarray(flags, dtype=float)
+        block = flags.reshape(-1)
+        if len(block) == 1:  # one frame (a world's step): the same numbers on floats (flags are 0 and 1: sums exact)
+            flag = float(block[0])
+            if np.isfinite(flag):
+                self._flags.append(flag)
+                if len(self._flags) > self.window:
+                    del self._flags[0]
+            return np.full(flags.shape, sum(self._flags) / self.window if self._flags else np.nan)
+        given = block[np.isfinite(block)]
+        history = np.concatenate([np.asarray(self._flags, dtype=float), given])
+        ends = len(self._flags) + np.cumsum(np.isfinite(block))  # flags there were after each frame
+        self._flags = history[-self.window :].tolist()
+        sums = np.concatenate([[0.0], np.cumsum(history)])
+        starts = np.maximum(ends - self.window, 0)
+        out = np.where(ends > 0, (sums[ends] - sums[starts]) / self.window, np.nan)
+        return out.reshape(flags.shape)
 
     def update(self, heading: float) -> float:
         """Add one estimate (NaN when there was none) and return the filtered facing (NaN if none yet).
@@ -375,6 +452,41 @@ def smooth_heading(heading: np.ndarray, window: int) -> np.ndarray:
         return heading.copy()
     padded = np.pad(heading, half, constant_values=np.nan)  # near the ends the window shrinks: the facing stays
     return _windowed_median(padded, 2 * half + 1, np.arange(n))  # continuous from frame to frame
+
+
+class FacingWindow(Protocol):
+    """How a facing is found over a window of frames (:func:`root_relative`): :class:`HeadingFilter` while frames
+    stream in (it can only look back), :class:`RecordingFacing` over a whole recording (centred)."""
+
+    def votes(self, flags: np.ndarray) -> np.ndarray:
+        """The share of the window's frames in which the forward marker lay behind the line (:func:`marker_behind`;
+        NaN flags skipped, NaN where the window has none), frame by frame."""
+
+    def headings(self, found: np.ndarray) -> np.ndarray:
+        """The facing from the frames' estimates (:func:`facing_heading`) over the window, frame by frame."""
+
+
+class RecordingFacing:
+    """The facing of a whole recording (:class:`FacingWindow`): the centred running circular median of the estimates
+    over ``window`` frames (:func:`smooth_heading`), the forward marker's side put to the vote of the same centred
+    window (cut short near the ends, as the median's is): its flags of 1.0 over the window's length, so that the
+    facing turns round where more than half a window's frames say so (all of a window cut short at the ends)."""
+
+    def __init__(self, window: int) -> None:
+        self.window = max(1, int(window))
+
+    def votes(self, flags: np.ndarray) -> np.ndarray:
+        flags = np.asarray(flags, dtype=float)
+        n, half = len(flags), self.window // 2  # smooth_heading's window: 2 half + 1 frames
+        given = np.isfinite(flags)
+        sums = np.concatenate([[0.0], np.cumsum(np.where(given, flags, 0.0))])
+        counts = np.concatenate([[0], np.cumsum(given)])
+        frames = np.arange(n)
+        lo, hi = np.maximum(frames - half, 0), np.minimum(frames + half + 1, n)
+        return np.where(counts[hi] > counts[lo], (sums[hi] - sums[lo]) / (2 * half + 1), np.nan)
+
+    def headings(self, found: np.ndarray) -> np.ndarray:
+        return smooth_heading(found, self.window)
 
 
 def to_root_relative(
@@ -468,14 +580,14 @@ def _to_root_relative(world: np.ndarray, visible: np.ndarray, safe_world: np.nda
     return pose, mask, np.where(ok[..., None], root, np.nan), heading
 
 
-def root_relative(world: np.ndarray, visible: np.ndarray | None, body: Body,
-                  smooth: Callable[[np.ndarray], np.ndarray] | None = None
+def root_relative(world: np.ndarray, visible: np.ndarray | None, body: Body, smooth: FacingWindow | None = None
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """§5.1 in one place: world positions of frames (n, P, 3) to root-relative positions in the body's own frame.
 
-    The facing is found from the visible parts of each frame (:func:`facing_heading`) and smoothed over the frames
-    by ``smooth`` (headings (n,) to headings (n,)): :meth:`HeadingFilter.update_many` while frames stream in,
-    :func:`smooth_heading` over a whole recording, ``None`` for none. Non-finite coordinates are never visible.
+    The facing is found from the visible parts of each frame (:func:`facing_heading`) over the window ``smooth``
+    (:class:`FacingWindow`): the forward marker's side put to the window's vote (:func:`marker_behind`), the
+    estimates then smoothed; a :class:`HeadingFilter` while frames stream in, a :class:`RecordingFacing` over a
+    whole recording, ``None`` for neither (each frame on its own). Non-finite coordinates are never visible.
 
     Returns what :func:`to_root_relative` returns: poses (n, P, 3) (NaN where hidden), visibility (n, P), the root's
     world position (n, 3) and the heading (n,).
@@ -484,6 +596,9 @@ def root_relative(world: np.ndarray, visible: np.ndarray | None, body: Body,
     seen = _finite_points(world)
     visible = seen if visible is None else seen & np.asarray(visible, dtype=bool)
     safe_world = _zero_hidden(world, visible)  # computed once: the facing and the transform share it
-    found = facing_heading(safe_world, visible, body)
-    heading = found if smooth is None else np.asarray(smooth(found), dtype=float)
+    if smooth is None:
+        heading = facing_heading(safe_world, visible, body)
+    else:
+        votes = smooth.votes(marker_behind(safe_world, visible, body)) if body.facing.forward is not None else None
+        heading = np.asarray(smooth.headings(facing_heading(safe_world, visible, body, votes)), dtype=float)
     return _to_root_relative(world, visible, safe_world, body, heading)

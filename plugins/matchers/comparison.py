@@ -51,7 +51,7 @@ import numpy as np
 
 from plugins.lib.body_size import body_scale
 from plugins.lib.compiled import kernel
-from plugins.lib.root_frame import root_relative, smooth_heading
+from plugins.lib.root_frame import RecordingFacing, root_relative
 from plugins.lib.travel import body_velocity, turned
 from plugins.lib.velocity import derivative
 
@@ -325,8 +325,7 @@ class Motion(Comparison):
         travel = heading = None
         if motion.world is not None and np.isfinite(motion.world).any():
             window = max(1, int(round(FACING_WINDOW * motion.fps)))
-            local, seen, _, _ = root_relative(motion.world, motion.visible, body,
-                                              lambda h: smooth_heading(h, window))
+            local, seen, _, _ = root_relative(motion.world, motion.visible, body, RecordingFacing(window))
             if seen.any():
                 positions, visible = local, seen
                 travel = body_velocity(motion.world, local, seen, body.root_index, motion.fps, frames=rows)

@@ -25,8 +25,8 @@ class MotionCapture(Perception):
     watches_recordings = True
     parameters = (
         Parameter("facing_window", float, 3.0, "Seconds over which the target's facing is a running median "
-                  "(steady through kicks and head turns; a real turn is followed after half of it; 0: every "
-                  "frame on its own).", minimum=0.0, maximum=60.0),
+                  "(steady through kicks and head turns; a real turn is followed after half of it), the forward "
+                  "marker's side the vote of its frames (0: every frame on its own).", minimum=0.0, maximum=60.0),
         *OBJECT_PARAMETERS,
     )
 
@@ -38,14 +38,14 @@ class MotionCapture(Perception):
         self._facing = HeadingFilter(round(self.params["facing_window"] * fps))
         self._objects = tracker_for(self.params, fps)
 
-    def _smooth(self, headings: np.ndarray) -> np.ndarray:
-        """The facing's running median over the frames so far (made by :meth:`reset`)."""
+    @property
+    def _window(self) -> HeadingFilter:
+        """The facing's running median (and the forward marker's vote) over the frames so far (made by
+        :meth:`reset`); a frame on its own (a world's step) takes :meth:`HeadingFilter.update`'s path."""
         facing = getattr(self, "_facing", None)
         if facing is None:
             raise RuntimeError("perceive before reset(fps): an observer resets its perception when it begins watching")
-        if len(headings) == 1:  # one frame (a world's step): the same value without the block machinery
-            return np.array([facing.update(float(headings[0]))])
-        return facing.update_many(headings)
+        return facing
 
     def perceive(self, observer, target, world) -> Percept:
         percept = self.perceive_pose(target.world_pose(), None, target.body, world.time)
@@ -64,13 +64,13 @@ class MotionCapture(Perception):
         """Root-relative percept of recorded world positions (P, 3); non-finite or masked parts are not seen."""
         positions = np.asarray(positions, dtype=float)
         pose, mask, root, heading = root_relative(positions[None], None if visible is None else np.asarray(visible)[None],
-                                                  body, self._smooth)
+                                                  body, self._window)
         world = np.where(mask[0, :, None], positions, np.nan)
         return Percept(time, pose[0], mask[0], world, root[0], float(heading[0]))
 
     def perceive_poses(self, positions, visible, body, times) -> tuple[np.ndarray, np.ndarray]:
         """A block of recorded frames (n, P, 3) at once: the same poses and masks as one perceive_pose per frame."""
-        pose, mask, _, _ = root_relative(positions, visible, body, self._smooth)
+        pose, mask, _, _ = root_relative(positions, visible, body, self._window)
         return pose, mask
 
 

@@ -86,8 +86,8 @@ class SyntheticVision(Perception):
         Parameter("buffer", float, 0.1, "Seconds the sensory buffer bridges a part's dropout (0: off).", minimum=0.0,
                   seconds=True),
         Parameter("facing_window", float, 3.0, "Seconds over which the target's facing is a running median "
-                  "(steady through kicks and head turns; a real turn is followed after half of it; 0: every "
-                  "frame on its own).", minimum=0.0, seconds=True),
+                  "(steady through kicks and head turns; a real turn is followed after half of it), the forward "
+                  "marker's side the vote of its frames (0: every frame on its own).", minimum=0.0, seconds=True),
         Parameter("seed", int, 0, "Seed of noise and dropouts."),
         *OBJECT_PARAMETERS,
     )
@@ -187,7 +187,7 @@ class SyntheticVision(Perception):
             self._buffer = SensoryBuffer(len(positions), int(round(p["buffer"] * self._fps)))
         positions, seen = self._buffer.update(positions, seen)
         # one frame (P, 3): the facing's running median takes this frame's estimate
-        pose, mask, root, heading = root_relative(positions, seen, target.body, lambda h: self._facing.update(float(h)))
+        pose, mask, root, heading = root_relative(positions, seen, target.body, self._facing)
         objects, kinds, sizes = self._objects.update(detections)
         return Percept(world.time, pose, mask, np.where(seen[:, None], positions, np.nan), root, float(heading), objects,
                        kinds, sizes)

@@ -60,10 +60,10 @@ def body_frame(motion: Any, body: Any) -> np.ndarray:
     """A recording's world positions (F, P, 3) turned, frame by frame, to face +z about its root (the facing found
     from the body's facing parts, smoothed over the recording, as perceptions find it), heights above the floor
     found in the recording (:func:`floor_height`); hidden parts NaN."""
-    from plugins.lib.root_frame import root_relative, smooth_heading
+    from plugins.lib.root_frame import RecordingFacing, root_relative
 
     window = max(1, int(round(motion.fps)))  # one second
-    poses, visible, root, _ = root_relative(motion.positions, motion.visible, body, lambda h: smooth_heading(h, window))
+    poses, visible, root, _ = root_relative(motion.positions, motion.visible, body, RecordingFacing(window))
     floor = floor_height(motion.positions, motion.visible)
     poses = poses + np.array([0.0, 1.0, 0.0]) * (root[:, None, 1:2] - floor)  # back to the root's height above it
     return np.where(visible[..., None], poses, np.nan)

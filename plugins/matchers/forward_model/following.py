@@ -16,7 +16,8 @@ the decision the matchers share:
   Motion` with its shape taken from the onset, K&G's prediction from the active node, rather than about the whole
   movement's mean posture, which is not known yet): where each part has gone since the movement began, how it
   moves, how the body carries it, in the demonstrator's own body sizes; the demonstration's frames are taken as they
-  arrive, the body's facing from a running median over the last :data:`FACING` seconds;
+  arrive, the body's facing from a running median over the last :data:`FACING` seconds (the forward marker's side
+  put to the same window's vote, :class:`plugins.lib.root_frame.HeadingFilter`);
 - **tempo**: each prediction is followed at whatever pace the demonstration goes, by time warping advanced sample by
   sample (:class:`plugins.matchers.warping.Warping`): K&G re-parameterise a command by the path length seen (§4.4),
   the warping finds for every sample the point of each prediction that fits best so far;
@@ -50,7 +51,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from plugins.lib.compiled import one_thread
-from plugins.lib.root_frame import HeadingFilter, facing_heading, to_root_relative
+from plugins.lib.root_frame import HeadingFilter, facing_heading, marker_behind, to_root_relative
 from plugins.lib.velocity import SMOOTHING, derivative
 from plugins.matchers.comparison import Frames, Motion, sequence_size
 from plugins.matchers.decision import Calibrated, Calibration, Decision, Stillness
@@ -221,7 +222,9 @@ class Watched:
         k = len(world)
         if not k:
             return
-        found = facing_heading(np.where(visible[..., None], world, 0.0), visible, self.body)
+        safe = np.where(visible[..., None], world, 0.0)
+        votes = self.filter.votes(marker_behind(safe, visible, self.body)) if self.body.facing.forward else None
+        found = facing_heading(safe, visible, self.body, votes)
         local, seen, root, heading = to_root_relative(world, visible, self.body, self.filter.update_many(found))
         held = np.empty_like(local)
         last = self.last

@@ -17,7 +17,8 @@ from hypothesis import strategies as st
 
 from plugins.lib import root_frame
 from plugins.lib.root_frame import (_UP, HeadingFilter, _circular_median, _cross_up, _finite_points, _to_local,
-                                    _zero_hidden, facing_heading, root_relative, smooth_heading, to_root_relative)
+                                    _zero_hidden, RecordingFacing, facing_heading, marker_behind, root_relative,
+                                    smooth_heading, to_root_relative)
 from plugins.perception.motion_capture import MotionCapture
 from tests.conftest import CHARACTERS, ROOT
 from toolkit import create_plugin_manager, load_character
@@ -54,11 +55,19 @@ class Before:
         return pose, mask, np.where(ok[..., None], root, np.nan), heading
 
     @staticmethod
-    def root_relative(world, visible, body, smooth=None):
+    def root_relative(world, visible, body, smooth=None, vote=None):
+        """``vote`` (window, centred): the forward marker's side put to a vote, as :func:`votes` writes it out; or
+        the votes themselves (an array)."""
         world = np.asarray(world, dtype=float)
         seen = np.isfinite(world).all(axis=-1)
         visible = seen if visible is None else seen & np.asarray(visible, dtype=bool)
-        found = facing_heading(np.where(visible[..., None], world, 0.0), visible, body)
+        safe = np.where(visible[..., None], world, 0.0)
+        behind = None
+        if isinstance(vote, np.ndarray):
+            behind = vote
+        elif vote is not None and body.facing.forward is not None:
+            behind = votes(marker_behind(safe, visible, body), *vote)
+        found = facing_heading(safe, visible, body, behind)
         return Before.to_root_relative(world, visible, body, found if smooth is None else smooth(found))
 
     @staticmethod
@@ -153,6 +162,25 @@ class Before:
             return heading.copy()
         padded = np.pad(heading, half, constant_values=np.nan)
         return Before.windowed_median(padded, 2 * half + 1, np.arange(n))
+
+
+def votes(flags, window, centred):
+    """The marker's vote written out frame by frame: the sum of the finite flags of the window ending at (stream)
+    or centred on (recording) each frame, over the window's length; a stream's window holds its last ``window``
+    finite flags."""
+    flags = np.asarray(flags, dtype=float).reshape(-1)
+    out = np.full(len(flags), np.nan)
+    for i in range(len(flags)):
+        if centred:
+            half = max(1, window) // 2
+            near = flags[max(0, i - half) : i + half + 1]
+            near = near[np.isfinite(near)]
+        else:
+            near = flags[: i + 1]
+            near = near[np.isfinite(near)][-max(1, window):]
+        if len(near):
+            out[i] = near.sum() / (2 * (max(1, window) // 2) + 1 if centred else max(1, window))
+    return out
 
 
 def same_bits(a, b) -> bool:
@@ -323,12 +351,12 @@ def test_root_relative_is_the_transform_before_bit_for_bit(seed, name, n, turn, 
     body = BODIES[name]
     world, visible = frames(name, rng, n, turn=turn, hidden=hidden, bad=bad, zeros=zeros)
     given_visible = None if rng.random() < 0.3 else visible
-    smoothers = {"stream": (HeadingFilter(window).update_many, Before.HeadingFilter(window).update_many),
-                 "recording": (lambda h: smooth_heading(h, window), lambda h: Before.smooth_heading(h, window)),
-                 "none": (None, None)}[smooth]
+    smoothers = {"stream": (HeadingFilter(window), Before.HeadingFilter(window).update_many, (window, False)),
+                 "recording": (RecordingFacing(window), lambda h: Before.smooth_heading(h, window), (window, True)),
+                 "none": (None, None, None)}[smooth]
     with np.errstate(all="ignore"):
         got = root_relative(world, given_visible, body, smoothers[0])
-        want = Before.root_relative(world, given_visible, body, smoothers[1])
+        want = Before.root_relative(world, given_visible, body, smoothers[1], smoothers[2])
         assert all(same_bits(g, e) for g, e in zip(got, want))
         one = rng.integers(n)  # one frame on its own, and the public to_root_relative with and without a heading
         for frame in (world[one], world[one : one + 1], world):
@@ -350,7 +378,10 @@ def test_motion_capture_percepts_are_the_ones_before_whatever_the_blocks(name):
     body, fps = BODIES[name], 30.0
     window = round(MotionCapture().params["facing_window"] * fps)
     want_pose, want_mask, _, want_heading = Before.root_relative(world, visible, body,
-                                                                 Before.HeadingFilter(window).update_many)
+                                                                 Before.HeadingFilter(window).update_many,
+                                                                 (window, False))
+    seen = visible & np.isfinite(world).all(axis=-1)
+    stream_votes = votes(marker_behind(np.where(seen[..., None], world, 0.0), seen, body), window, False)
     perception = MotionCapture()
     perception.reset(fps)
     got = [perception.perceive_poses(world[a:b], visible[a:b], body, None) for a, b in ((0, 1), (1, 95), (95, 400))]
@@ -361,6 +392,7 @@ def test_motion_capture_percepts_are_the_ones_before_whatever_the_blocks(name):
     for f in range(0, 120):  # one frame at a time: HeadingFilter.update, as a world's step perceives
         percept = perception.perceive_pose(world[f], visible[f], body, f / fps)
         old_pose, old_mask, old_root, old_heading = Before.root_relative(world[f][None], visible[f][None], body,
-                                                                         lambda h: np.array([before.update(h[0])]))
+                                                                         lambda h: np.array([before.update(h[0])]),
+                                                                         stream_votes[f : f + 1])
         assert same_bits(percept.pose, old_pose[0]) and same_bits(percept.visible, old_mask[0])
         assert same_bits(percept.root, old_root[0]) and same_bits(np.float64(percept.heading), old_heading[0])
