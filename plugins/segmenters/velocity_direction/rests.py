@@ -13,7 +13,9 @@ movement under way only where it is a hub of this demonstrator:
   was a new stance (movements leave it and come back to it), if they had held it a stance's time (``stance``; the
   segmenter's ``STANCE``, 0.2 s). The movement is cut where they first rested there, and the one from it back to it
   follows;
-- or they rest ``settle`` seconds in one place (a new stance they stay in): the movement ends where that rest began;
+- or they rest ``settle`` seconds in one place (a new stance they stay in): the movement ends where that rest began.
+  A rest stays in one place: a hold from which some part drifts farther than twice ``rest.radius`` was no rest (a
+  movement slower than a tracker's jitter lets the speed show) and a new hold begins where they are (``still``);
 - or they have rested a stance's time at a hold reached by a shift (below) from a hold before it that lasted as
   long and where the movement had come at least half-way back to its first pose: the movement ended at that hold (a
   take that ends in another stance than it began, then the shift to the next one's).
@@ -96,7 +98,7 @@ class Rests:
     keep: int = 8
     hubs: list[np.ndarray] = field(default_factory=list)
     holds: list[Hold] = field(default_factory=list)
-    _stacked: np.ndarray | None = field(default=None, repr=False)  # the hubs as one array (k, m, 3)
+    _stacked: np.ndarray | None = field(default=None, repr=False)  # the hubs (and the hold under way) (k, m, 3)
 
     def began(self, pose: np.ndarray, radius: float) -> None:
         """A movement begins from ``pose`` (3m,), where the demonstrator was: a hub."""
@@ -112,18 +114,35 @@ class Rests:
 
     def at_hub(self, pose: np.ndarray) -> bool:
         """Whether ``pose`` is near one of the hubs (nothing to compare with: the paper's rule, any rest)."""
-        if not self.hubs:
-            return True
-        if self._stacked is None or len(self._stacked) != len(self.hubs):
-            self._stacked = np.array(self.hubs).reshape(len(self.hubs), -1, 3)
+        return self.place(pose)[0]
+
+    def still(self, pose: np.ndarray) -> bool:
+        """Whether ``pose`` (3m,) is still where the hold under way began: no part farther than twice the radius
+        from where it was (what leaving is). A rest stays in one place; one that drifts farther is a movement too
+        slow for the speed to show (a tracker's jitter hides it), not a rest. True with no hold under way."""
+        return self.place(pose)[1]
+
+    def place(self, pose: np.ndarray) -> tuple[bool, bool]:
+        """:meth:`at_hub` and :meth:`still` of ``pose`` (3m,) at once: its distances to the hubs and to the hold
+        under way, one array (the segmenter asks both at every frame of a hold)."""
+        holding = bool(self.holds) and self.holds[-1].end is None
+        if not self.hubs and not holding:
+            return True, True
+        if self._stacked is None or len(self._stacked) != len(self.hubs) + holding:
+            rows = self.hubs + ([self.holds[-1].pose] if holding else [])
+            self._stacked = np.array(rows).reshape(len(rows), -1, 3)
         apart = self._stacked - np.asarray(pose).reshape(-1, 3)
-        d = np.sqrt((apart * apart).sum(axis=2))
-        if np.isfinite(d).all():
-            return float(d.mean(axis=1).min()) <= self.radius
+        d2 = np.einsum("kmj,kmj->km", apart, apart)  # (hubs [+ the hold], m); NaN: a part not seen in both
+        still = not holding or not bool((d2[-1] > 4.0 * self.radius * self.radius).any())  # NaN: not counted
+        if not self.hubs:
+            return True, still
+        d = np.sqrt(d2[: len(self.hubs)])
+        if np.isfinite(d).all():  # eq. 1: the mean over the parts (np.mean's sum and division, without its overhead)
+            return float(np.add.reduce(d, axis=1).min()) / d.shape[1] <= self.radius, still
         with np.errstate(all="ignore"):
             near = np.nanmean(np.where(np.isfinite(d), d, np.nan), axis=1)  # eq. 1 over the parts seen in both
         near = near[np.isfinite(near)]
-        return not near.size or float(near.min()) <= self.radius
+        return not near.size or float(near.min()) <= self.radius, still
 
     def returned(self, pose: np.ndarray, start: int, window: np.ndarray) -> int | None:
         """The index of the last finished hold near ``pose`` that the demonstrator held a stance's time, left (some
@@ -144,11 +163,13 @@ class Rests:
     def hold(self, frame: int, pose: np.ndarray) -> None:
         """A rest away from the hubs began at ``frame`` in ``pose``."""
         self.holds.append(Hold(frame, np.array(pose, dtype=float)))
+        self._stacked = None
 
     def left(self, frame: int) -> None:
         """The demonstrator moves again at ``frame``: the hold under way (if any) ends there."""
         if self.holds and self.holds[-1].end is None:
             self.holds[-1].end = frame
+            self._stacked = None
 
     def pieces(self, start: int, end: int, window: np.ndarray, upto: int | None = None,
                shifts: bool = True) -> list[tuple[int, int]]:

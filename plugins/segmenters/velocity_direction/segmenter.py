@@ -62,9 +62,11 @@ parameter, off by default (the paper); the observer template (``characters/obser
   distance over the chosen parts; poses at rest are compared as their mean over the sensory memory or the line
   fit's window, so the jitter is averaged out). A rest elsewhere is a *hold* (a bow, a pointing hand held half-way:
   one movement, not two) unless they leave it and come to rest there again (a new stance: the movement is cut where
-  they first rested there) or rest there ``settle`` seconds. A straight *shift* from one stance to another is no
-  movement and is dropped, and a piece that never leaves where it began (some part farther than twice
-  ``rest.radius``) is motion at rest (sway, fidgeting), dropped too. ``rest.radius = 0.1``: B&B's hub threshold
+  they first rested there) or rest there ``settle`` seconds, in one place: a hold from which some part drifts
+  farther than twice ``rest.radius`` was no rest (a movement slower than the tracker's jitter lets the speed show)
+  and the rest counts again from there. A straight *shift* from one stance to another is no movement and is
+  dropped, and a piece that never leaves where it began (some part farther than twice ``rest.radius``) is motion
+  at rest (sway, fidgeting), dropped too. ``rest.radius = 0.1``: B&B's hub threshold
   (0.02 m on Max, 0.20 m body size); ``settle = 2`` s: longer than a gesture holds a pose (about a second), as
   ``hub-threshold``'s ``settle``. The paper's ``"still"`` (any rest ends it) is the default.
 
@@ -232,6 +234,7 @@ class VelocityDirection(Segmenter):
             if self.params["end"] == "rest" else None
         # end = rest: the hubs and holds
         self._holding = False  # end = rest: the rest under way is a hold (away from the hubs)
+        self._drift = -(1 << 62)  # end = rest: the frame the rest under way counts from, if it drifted
         self._settle = max(1, int(round(self.params["rest"]["settle"] * self._fps)))
 
     @property
@@ -533,18 +536,24 @@ class VelocityDirection(Segmenter):
             self._resting += 1
             self._moving = 0
             if self._start is not None and self._resting >= max(self._memory, self._pause):
-                began = max(self._start + 1, self._frame - self._resting + 1 - self._memory // 2 - lag)
+                began = max(self._start + 1, self._frame - self._here() + 1 - self._memory // 2 - lag)
                 if self.params["end"] == "still":
                     return cut + self._close(began)
                 return cut + self._rested(began, self._held(1))
         return cut
+
+    def _here(self) -> int:
+        """The frames the demonstrator has rested in one place (``end = "rest"``): since they last moved, or since
+        the rest under way drifted away from where it began (:meth:`.rests.Rests.still`)."""
+        return min(self._resting, self._frame - self._drift)
 
     def _held(self, back: int) -> np.ndarray:
         """The mean of the ``_still`` rows of the sensory memory up to the ``back``-th last (1: this frame's): a
         pose at rest with the tracker's jitter averaged out (3m,)."""
         rows = list(self._history)
         end = max(1, len(rows) - back + 1)
-        return np.mean(rows[max(0, end - self._still) : end], axis=0)
+        rows = rows[max(0, end - self._still) : end]
+        return np.add.reduce(rows, axis=0) / len(rows)  # np.mean's sum and division, without its overhead
 
     def _began(self, pose: np.ndarray, points: np.ndarray) -> None:
         """With ``end = "rest"``: a movement begins where the chosen parts are ``points`` (3m,), a rest of the
@@ -564,12 +573,20 @@ class VelocityDirection(Segmenter):
         hold; else the rest is a hold and the movement goes on (:mod:`.rests`)."""
         rests = self._rests
         start = self._start
-        if self._holding and self._resting < self._settle and (
-                self._resting != max(self._memory, self._pause) + rests.stance or len(rests.holds) < 2):
-            if not rests.at_hub(points):  # a hold goes on (the working memory is not needed)
+        hub, still = rests.place(points)
+        if self._holding and not still:  # it drifted away: no rest, a new hold begins here
+            fresh = max(self._memory, self._pause)
+            began = max(start + 1, began + self._here() - fresh)
+            self._drift = self._frame - fresh
+            rests.left(began)
+            rests.hold(began, points)
+        resting = self._here()
+        if self._holding and resting < self._settle and (
+                resting != max(self._memory, self._pause) + rests.stance or len(rests.holds) < 2):
+            if not hub:  # a hold goes on (the working memory is not needed)
                 return []
         window = np.array(self._buffer)
-        if rests.at_hub(points):
+        if hub:
             return self._close_pieces(rests.pieces(start, began, window), began)
         back = None if self._holding else rests.returned(points, start, window)
         if back is not None:
@@ -579,14 +596,14 @@ class VelocityDirection(Segmenter):
             second = window[hold.end - start : began - start]
             pieces += [] if rests.shift(second) else [(hold.end, began)]
             return self._close_pieces(pieces, began)
-        if self._resting >= self._settle:  # a new stance they stay in: the movement ends where they came to it
+        if resting >= self._settle:  # a new stance they stay in: the movement ends where they came to it
             pieces = rests.pieces(start, began, window, shifts=False)
             rests.hub(points)
             return self._close_pieces(pieces, began)
         if not self._holding:
             rests.hold(began, points)
             self._holding = True
-        elif self._resting == max(self._memory, self._pause) + rests.stance and rests.ended_before(start, window):
+        elif resting == max(self._memory, self._pause) + rests.stance and rests.ended_before(start, window):
             # held a stance's time after a shift from a hold where the movement had come most of the way back
             before = rests.holds[-2]
             pieces = rests.pieces(start, before.start, window, upto=len(rests.holds) - 2)
