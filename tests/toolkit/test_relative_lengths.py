@@ -53,7 +53,7 @@ def test_length_parameters_scale_with_the_observers_height_and_nothing_else_does
             for k in path:
                 a, b = a[k], b[k]
             assert a == pytest.approx(2 * b), path
-        assert dict(after.declared) == dict(before.params)  # as written
+        assert dict(after.declared) == dict(before.declared)  # as written (the plain one scales by 1, up to rounding)
     assert dict(halved.motor.params) == dict(plain.motor.params)  # the motor system measures the body itself
     assert ("distance", "max_distance") in length_names(type(plain.matcher).parameters)
 
