@@ -38,7 +38,7 @@ mirrored recording puts it well behind; a marker the profile gives at the line (
 centimetres from it is within a tracker's jitter of both sides, and the body's left and right decide."""
 
 
-def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body, behind: np.ndarray | None = None
+def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body, window: FacingWindow | None = None
                    ) -> np.ndarray:
     """Heading (radians about +y) of a body from its visible parts; NaN where it cannot be found.
 
@@ -47,10 +47,10 @@ def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body, behind: n
     world : array, shape (..., P, 3)
     visible : array of bool, shape (..., P)
     body : Body
-    behind : array, shape (...), optional
-        The share of a window of frames in which the forward marker lay behind the line (:func:`marker_behind`, put
-        to a vote by :meth:`FacingWindow.votes`): the facing turns to the other side where it is above one half.
-        ``None``: each frame's own marker decides (a window of one frame).
+    window : FacingWindow, optional
+        The window the frames' flags (:func:`marker_behind`) are put to the vote of (:meth:`FacingWindow.votes`,
+        once for these frames): the facing turns to the other side where more than half the window says the marker
+        lies behind the line. ``None``: each frame's own marker decides (a window of one frame).
 
     Notes
     -----
@@ -67,16 +67,16 @@ def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body, behind: n
     """
     world = np.asarray(world, dtype=float)
     visible = np.asarray(visible, dtype=bool)
-    li, ri, root = body.index(body.facing.left), body.index(body.facing.right), body.root_index
-    across = world[..., li, :] - world[..., ri, :]
-    perp = _cross_up(across)  # +z when left is +x
-    perp[..., 1] = 0.0
+    li, ri = body.index(body.facing.left), body.index(body.facing.right)
+    perp = _perpendicular(world, body)  # +z when left is +x
     knees = visible[..., li] & visible[..., ri]
     heading = np.full(world.shape[:-2], np.nan)
     if body.facing.forward is not None:
         fi, bi = body.index(body.facing.forward), _marker_base(body)
-        flip = _behind_line(world, visible, body, perp) & visible[..., fi] if behind is None else \
-            np.asarray(behind, dtype=float) > 0.5  # NaN (no vote): not turned
+        if window is None:
+            flip = _behind_line(world, visible, body, perp) & visible[..., fi]
+        else:  # the frames' flags, from this perpendicular, put to the window's vote; NaN (no vote): not turned
+            flip = window.votes(_flags(world, visible, body, perp)) > 0.5
         perp = perp * np.where(flip, -1.0, 1.0)[..., None]
         fallback = world[..., fi, :] - world[..., bi, :]
         fallback[..., 1] = 0.0
@@ -92,19 +92,28 @@ def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body, behind: n
 def marker_behind(world: np.ndarray, visible: np.ndarray, body: Body) -> np.ndarray:
     """Whether the forward marker lies behind the line through the facing parts by more than
     :data:`MARKER_MARGIN` of their distance, frame by frame (...): 1.0 where it does, 0.0 where it does not, NaN where
-    the marker or a facing part is not seen (or the body has no forward marker). A window's vote on it
-    (:meth:`FacingWindow.votes`) is the ``behind`` of :func:`facing_heading`."""
+    the marker or a facing part is not seen (or the body has no forward marker): the flags a window votes on
+    (:meth:`FacingWindow.votes`; :func:`facing_heading` given a window)."""
     world = np.asarray(world, dtype=float)
     visible = np.asarray(visible, dtype=bool)
-    out = np.full(world.shape[:-2], np.nan)
     if body.facing.forward is None:
-        return out
-    li, ri, fi = body.index(body.facing.left), body.index(body.facing.right), body.index(body.facing.forward)
-    perp = _cross_up(world[..., li, :] - world[..., ri, :])
+        return np.full(world.shape[:-2], np.nan)
+    return _flags(world, visible, body, _perpendicular(world, body))
+
+
+def _perpendicular(world: np.ndarray, body: Body) -> np.ndarray:
+    """The horizontal perpendicular of the line from the right facing part to the left one (..., 3), as long as
+    they are apart."""
+    perp = _cross_up(world[..., body.index(body.facing.left), :] - world[..., body.index(body.facing.right), :])
     perp[..., 1] = 0.0
+    return perp
+
+
+def _flags(world: np.ndarray, visible: np.ndarray, body: Body, perp: np.ndarray) -> np.ndarray:
+    """:func:`marker_behind` from the facing parts' perpendicular ``perp``."""
+    li, ri, fi = body.index(body.facing.left), body.index(body.facing.right), body.index(body.facing.forward)
     seen = visible[..., li] & visible[..., ri] & visible[..., fi]
-    out[seen] = _behind_line(world, visible, body, perp)[seen]
-    return out
+    return np.where(seen, _behind_line(world, visible, body, perp), np.nan)
 
 
 def _marker_base(body: Body) -> int:
@@ -596,9 +605,6 @@ def root_relative(world: np.ndarray, visible: np.ndarray | None, body: Body, smo
     seen = _finite_points(world)
     visible = seen if visible is None else seen & np.asarray(visible, dtype=bool)
     safe_world = _zero_hidden(world, visible)  # computed once: the facing and the transform share it
-    if smooth is None:
-        heading = facing_heading(safe_world, visible, body)
-    else:
-        votes = smooth.votes(marker_behind(safe_world, visible, body)) if body.facing.forward is not None else None
-        heading = np.asarray(smooth.headings(facing_heading(safe_world, visible, body, votes)), dtype=float)
+    found = facing_heading(safe_world, visible, body, smooth)
+    heading = found if smooth is None else np.asarray(smooth.headings(found), dtype=float)
     return _to_root_relative(world, visible, safe_world, body, heading)

@@ -51,7 +51,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from plugins.lib.compiled import one_thread
-from plugins.lib.root_frame import HeadingFilter, facing_heading, marker_behind, to_root_relative
+from plugins.lib.root_frame import HeadingFilter, facing_heading, to_root_relative
 from plugins.lib.velocity import SMOOTHING, derivative
 from plugins.matchers.comparison import Frames, Motion, sequence_size
 from plugins.matchers.decision import Calibrated, Calibration, Decision, Stillness
@@ -222,9 +222,7 @@ class Watched:
         k = len(world)
         if not k:
             return
-        safe = np.where(visible[..., None], world, 0.0)
-        votes = self.filter.votes(marker_behind(safe, visible, self.body)) if self.body.facing.forward else None
-        found = facing_heading(safe, visible, self.body, votes)
+        found = facing_heading(np.where(visible[..., None], world, 0.0), visible, self.body, self.filter)
         local, seen, root, heading = to_root_relative(world, visible, self.body, self.filter.update_many(found))
         held = np.empty_like(local)
         last = self.last

@@ -67,7 +67,7 @@ class Before:
             behind = vote
         elif vote is not None and body.facing.forward is not None:
             behind = votes(marker_behind(safe, visible, body), *vote)
-        found = facing_heading(safe, visible, body, behind)
+        found = facing_heading(safe, visible, body, None if behind is None else Given(behind))
         return Before.to_root_relative(world, visible, body, found if smooth is None else smooth(found))
 
     @staticmethod
@@ -162,6 +162,16 @@ class Before:
             return heading.copy()
         padded = np.pad(heading, half, constant_values=np.nan)
         return Before.windowed_median(padded, 2 * half + 1, np.arange(n))
+
+
+class Given:
+    """A window whose vote is given (the reference's, :func:`votes`)."""
+
+    def __init__(self, shares):
+        self.shares = np.asarray(shares, dtype=float)
+
+    def votes(self, flags):
+        return self.shares.reshape(np.shape(flags))
 
 
 def votes(flags, window, centred):
