@@ -45,7 +45,7 @@ import warnings
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from functools import cached_property
-from typing import ClassVar
+from typing import ClassVar, NamedTuple
 
 import numpy as np
 
@@ -55,7 +55,8 @@ from plugins.lib.root_frame import RecordingFacing, root_relative
 from plugins.lib.travel import body_velocity, turned
 from plugins.lib.velocity import derivative
 
-__all__ = ["COMPARISONS", "Comparison", "Frames", "HORIZON", "Motion", "Poses", "comparison", "sequence_size"]
+__all__ = ["COMPARISONS", "Comparison", "Fixed", "Frames", "HORIZON", "Motion", "Paired", "Poses", "Split", "comparison",
+           "sequence_size"]
 
 HORIZON = 0.25
 """Seconds over which a velocity counts as a displacement (the motion and the travel of :class:`Motion`)."""
@@ -107,6 +108,21 @@ class Frames:
         carry[:, -1] = self.carried
         return np.ascontiguousarray(self.parts.reshape(len(self), -1), dtype=np.float32), carry
 
+    @cached_property
+    def split(self) -> Split:
+        """The features by how they scale with a performance's tempo (:class:`Split`), kept with the frames (a
+        repertoire's are computed once). Six features a part are its shape and its motion (:class:`Motion`), three
+        its motion alone (``shape = "none"``)."""
+        n, parts, dims = self.parts.shape
+        seen = self.seen.astype(float)
+        masked = self.parts * seen[..., None]
+        shape, motion = (masked[..., :3], masked[..., 3:]) if dims == 6 else (masked[..., :0], masked)
+        carry = np.where(self.carried[:, None], self.carry, 0.0)
+        travel, turn = carry[:, :3], carry[:, 3:]
+        return Split(shape.reshape(n, -1), motion.reshape(n, -1), travel, turn, seen,
+                     np.einsum("npd,npd->np", shape, shape), np.einsum("npd,npd->np", motion, motion),
+                     np.einsum("nc,nc->n", travel, travel), np.einsum("nc,nc->n", turn, turn))
+
     def take(self, rows: np.ndarray | slice) -> Frames:
         """The frames ``rows`` of this sequence."""
         return Frames(self.parts[rows], self.seen[rows], self.carry[rows], self.carried[rows])
@@ -116,6 +132,89 @@ class Frames:
         """Sequences one after another (each keeps the features it was given: a take's shape about its own mean)."""
         return Frames(*(np.concatenate([getattr(s, f) for s in sequences]) for f in
                         ("parts", "seen", "carry", "carried")))
+
+
+class Split(NamedTuple):
+    """A sequence's features by how they scale with its tempo (:attr:`Frames.split`), unseen parts and unknown
+    carries zeroed: the parts' shape (n, P * 3; none without it) and motion (n, P * 3), the body's travel (n, 3) and
+    turn (n, 2), the mask as numbers (n, P), and the squared norms of each: per part (n, P) for shape and motion, per
+    frame (n,) for travel and turn."""
+
+    shape: np.ndarray
+    motion: np.ndarray
+    travel: np.ndarray
+    turn: np.ndarray
+    seen: np.ndarray
+    shape2: np.ndarray
+    motion2: np.ndarray
+    travel2: np.ndarray
+    turn2: np.ndarray
+
+
+class Paired:
+    """Every frame of ``a`` against every frame of ``b``, ready to be costed with ``a`` played at other speeds
+    (:meth:`at`): the mean squares of :meth:`Motion.costs` split by how they scale, ``|s x - y|^2 = s^2 |x|^2 +
+    |y|^2 - 2 s x.y``, each a matrix product over the parts seen in both (sums over the frames' parts where every
+    part is seen in both), computed once."""
+
+    def __init__(self, a: Frames, b: Frames) -> None:
+        x, y = a.split, b.split
+        fixed = x.shape @ y.shape.T
+        moving = x.motion @ y.motion.T
+        if a.seen.all() and b.seen.all():  # every part in both: the sums over the parts are each frame's own
+            parts = max(a.seen.shape[1], 1)
+            fixed *= -2.0 / parts
+            fixed += (x.shape2.sum(axis=1) / parts)[:, None]
+            fixed += ((y.shape2.sum(axis=1) + y.motion2.sum(axis=1)) / parts)[None, :]
+            moving *= -2.0 / parts
+            moving2 = (x.motion2.sum(axis=1) / parts)[:, None]
+            carried = None
+        else:
+            count = x.seen @ y.seen.T
+            inverse = np.divide(1.0, count, out=np.zeros_like(count), where=count > 0)
+            fixed = (x.shape2 @ y.seen.T + x.seen @ (y.shape2 + y.motion2).T - 2.0 * fixed) * inverse
+            moving2 = (x.motion2 @ y.seen.T) * inverse
+            moving *= -2.0 * inverse
+            carried = count > 0
+        if a.carry.shape[1] and a.carried.any() and b.carried.any():  # per frame pair, added to every part's
+            both = np.outer(a.carried, b.carried)  # square: once to the mean over the parts
+            carried = both if carried is None else both & carried
+            turn = x.turn @ y.turn.T
+            turn *= -2.0
+            turn += x.turn2[:, None]
+            turn += (y.turn2 + y.travel2)[None, :]
+            travel = x.travel @ y.travel.T
+            travel *= -2.0
+            if carried.all():
+                fixed += turn
+                moving += travel
+                moving2 = moving2 + x.travel2[:, None]
+            else:
+                fixed += np.where(carried, turn, 0.0)
+                moving += np.where(carried, travel, 0.0)
+                moving2 = moving2 + np.where(carried, x.travel2[:, None], 0.0)
+        self.fixed, self.moving2, self.moving = fixed, moving2, moving
+
+    def at(self, speed: np.ndarray | float = 1.0) -> np.ndarray:
+        """The costs (len(a), len(b)) with ``a``'s motion and travel multiplied by ``speed`` (a number, or one for each
+        frame of ``b``): :meth:`Motion.costs` of ``a`` played ``speed`` times as fast (shape and turn do not change
+        with tempo)."""
+        s = np.asarray(speed, dtype=float)
+        square = self.moving * s
+        square += self.fixed
+        square += self.moving2 * (s * s)
+        np.maximum(square, 0.0, out=square)
+        return np.sqrt(square, out=square)
+
+
+class Fixed:
+    """Costs that do not change with tempo (positions, eq. 1): :meth:`at` gives them whatever the speed."""
+
+    def __init__(self, costs: np.ndarray) -> None:
+        self.costs = costs
+
+    def at(self, speed: np.ndarray | float = 1.0) -> np.ndarray:
+        return self.costs
 
 
 class Comparison(ABC):
@@ -149,6 +248,18 @@ class Comparison(ABC):
             The body size the lengths are measured in (:func:`plugins.lib.body_size.body_scale`); ``None``: from
             the sequence's own median pose.
         """
+
+    paced: ClassVar[bool] = False
+    """Whether the frames carry velocities, which scale with a performance's tempo (:meth:`paired`)."""
+
+    def paired(self, a: Frames, b: Frames) -> Paired | Fixed:
+        """Every frame of ``a`` against every frame of ``b``, to be costed with ``a`` at other speeds (``.at(speed)``,
+        :mod:`plugins.matchers.tempo`). Positions have no tempo: :meth:`costs` whatever the speed."""
+        return Fixed(self.costs(a, b))
+
+    def still_at(self, frames: Frames, speeds: np.ndarray) -> np.ndarray:
+        """:meth:`still` with the frames played at each of ``speeds`` (K,): (n, K). Positions have no tempo."""
+        return np.repeat(self.still(frames)[:, None], len(speeds), axis=1)
 
     def costs(self, a: Frames, b: Frames) -> np.ndarray:
         """Every frame of ``a`` against every frame of ``b``: eq. 1 over the parts seen in both, (len(a), len(b)).
@@ -263,6 +374,21 @@ class Motion(Comparison):
         return Frames(motion if self.shape == "none" else np.concatenate([shape, motion], axis=2), seen, carry,
                       carried)
 
+
+    paced = True
+
+    def paired(self, a: Frames, b: Frames) -> Paired:
+        return Paired(a, b)
+
+    def still_at(self, frames: Frames, speeds: np.ndarray) -> np.ndarray:
+        """:meth:`still` of the frames played ``speeds`` (K,) times as fast (their motion and travel multiplied by
+        it), (n, K)."""
+        s = np.asarray(speeds, dtype=float)[None, :]
+        x = frames.split
+        count = x.seen.sum(axis=1)
+        square = (x.shape2.sum(axis=1)[:, None] + s * s * x.motion2.sum(axis=1)[:, None]) \
+            / np.maximum(count, 1)[:, None] + (s * s * x.travel2[:, None] + x.turn2[:, None])
+        return np.where(count[:, None] > 0, np.sqrt(square), 0.0)
 
     def costs(self, a: Frames, b: Frames) -> np.ndarray:
         """Every frame of ``a`` against every frame of ``b``: the root mean square over the parts seen in both of

@@ -29,7 +29,8 @@ from plugins.lib.compiled import kernel
 from plugins.matchers.comparison import Comparison, Frames
 from plugins.matchers.decision import Calibration
 
-__all__ = ["Chains", "Warping", "chain_calibration", "chain_distances", "chain_path"]
+__all__ = ["Chains", "Warping", "chain_calibration", "chain_distances", "chain_path", "relative_distances",
+           "warp_chains"]
 
 
 @dataclass(frozen=True)
@@ -68,39 +69,45 @@ class Chains:
         return self.nodes[self.starts[c] : self.starts[c + 1]]
 
 
-def _warp(cost, starts, cyclic, best, end):
+def _warp(cost, starts, cyclic, best, end, advanced):
     """Subsequence dynamic time warping of the samples (rows of ``cost``, (n, M)) on every chain (columns
     ``starts[c]:starts[c + 1]``): for each chain, the least summed cost over the path's length of a path that
-    begins at any node with the first sample and ends at any node with the last (``best[c]``) and the column it
-    ends in (``end[c]``). Steps: (i-1, j-1), (i-1, j), (i, j-1); a cyclic chain's first node also follows its
-    last. Ties keep the diagonal, then the vertical step. Plain Python as written (the reference), compiled by
-    :func:`plugins.lib.compiled.kernel`."""
+    begins at any node with the first sample and ends at any node with the last (``best[c]``), the column it
+    ends in (``end[c]``) and how many frames of the chain the path advanced over (``advanced[c]``: its diagonal and
+    horizontal steps, a cyclic chain's last frame to its first one of them; over the ``n - 1`` steps from sample to
+    sample it is the pace, :mod:`plugins.matchers.tempo`). Steps: (i-1, j-1), (i-1, j), (i, j-1); a cyclic chain's
+    first node also follows its last. Ties keep the diagonal, then the vertical step. Plain Python as written (the
+    reference), compiled by :func:`plugins.lib.compiled.kernel`."""
     n = cost.shape[0]
     for c in range(len(starts) - 1):
         a = starts[c]
         m = starts[c + 1] - a
         before = np.empty(m)
         before_len = np.empty(m)
+        before_adv = np.empty(m)
         now = np.empty(m)
         now_len = np.empty(m)
+        now_adv = np.empty(m)
         for j in range(m):
             before[j] = cost[0, a + j]
             before_len[j] = 1.0
+            before_adv[j] = 0.0
         for i in range(1, n):
             for j in range(m):
                 if j > 0:
-                    d, dl = before[j - 1], before_len[j - 1]
+                    d, dl, da = before[j - 1], before_len[j - 1], before_adv[j - 1] + 1.0
                 elif cyclic[c] and m > 1:
-                    d, dl = before[m - 1], before_len[m - 1]
+                    d, dl, da = before[m - 1], before_len[m - 1], before_adv[m - 1] + 1.0
                 else:
-                    d, dl = np.inf, 0.0
+                    d, dl, da = np.inf, 0.0, 0.0
                 v, vl = before[j], before_len[j]
                 if v < d:
-                    d, dl = v, vl
+                    d, dl, da = v, vl, before_adv[j]
                 if j > 0 and now[j - 1] < d:
-                    d, dl = now[j - 1], now_len[j - 1]
+                    d, dl, da = now[j - 1], now_len[j - 1], now_adv[j - 1] + 1.0
                 now[j] = d + cost[i, a + j]
                 now_len[j] = dl + 1.0
+                now_adv[j] = da
             if cyclic[c] and m > 1:  # the same sample on from the last node to the first, then on along the chain
                 j = 0
                 while j < m:
@@ -109,12 +116,14 @@ def _warp(cost, starts, cyclic, best, end):
                     if value < now[j]:
                         now[j] = value
                         now_len[j] = now_len[left] + 1.0
+                        now_adv[j] = now_adv[left] + 1.0
                         j += 1
                     else:
                         break
             for j in range(m):
                 before[j] = now[j]
                 before_len[j] = now_len[j]
+                before_adv[j] = now_adv[j]
         chosen = -1
         value = np.inf
         for j in range(m):
@@ -124,6 +133,7 @@ def _warp(cost, starts, cyclic, best, end):
                 chosen = j
         best[c] = value
         end[c] = chosen
+        advanced[c] = before_adv[chosen] if chosen >= 0 else 0.0
 
 
 def chain_distances(comparison: Comparison, samples: Frames, nodes: Frames, chains: Chains,
@@ -145,12 +155,22 @@ def chain_distances(comparison: Comparison, samples: Frames, nodes: Frames, chai
         cost = comparison.costs(samples, nodes.take(columns))
         starts = np.concatenate([[0], np.cumsum(np.diff(chains.starts)[kept])]).astype(np.intp)
         cyclic = chains.cyclic[kept]
+    found, _, _ = warp_chains(cost, starts, cyclic)
+    best[keep] = found
+    return best, cost
+
+
+def warp_chains(cost: np.ndarray, starts: np.ndarray, cyclic: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_warp` of the frame distances ``cost`` (n, M) on the chains ``starts`` (C + 1,), compiled: each chain's
+    distance (C,), the column (within the chain) its best path ends in and the frames it advanced over."""
     cost = np.ascontiguousarray(cost, dtype=np.float64)
     found = np.empty(len(starts) - 1)
     end = np.empty(len(starts) - 1, dtype=np.intp)
-    kernel(_warp)(cost, starts, cyclic, found, end)
-    best[keep] = found
-    return best, cost
+    advanced = np.empty(len(starts) - 1)
+    kernel(_warp)(cost, np.ascontiguousarray(starts, dtype=np.intp), np.asarray(cyclic, dtype=bool), found, end,
+                  advanced)
+    return found, end, advanced
 
 
 def _warp_path(cost, cyclic, out):
@@ -216,22 +236,33 @@ def _warp_path(cost, cyclic, out):
             j = j - 1 if j > 0 else m - 1
 
 
-def chain_calibration(comparison: Comparison, takes: list[Frames], nodes: Frames, chains: Chains) -> Calibration:
+def relative_distances(comparison: Comparison, samples: Frames, nodes: Frames, chains: Chains,
+                       skip: np.ndarray | None = None) -> np.ndarray:
+    """Each chain's distance (:func:`chain_distances`) over the demonstration's distance to standing still (C,):
+    the relative score of :mod:`plugins.matchers.decision` (``inf`` for a chain left out, and for every chain when
+    the demonstration does not move at all: nothing to explain, nothing to calibrate on)."""
+    distances, _ = chain_distances(comparison, samples, nodes, chains, skip)
+    still = float(np.mean(comparison.still(samples)))
+    return distances / still if still > 0 else np.full(len(distances), np.inf)
+
+
+def chain_calibration(comparison: Comparison, takes: list[Frames], nodes: Frames, chains: Chains,
+                      scores=relative_distances) -> Calibration:
     """The calibrated decision's scores from the takes themselves (:class:`~plugins.matchers.decision.Calibration`):
-    each take (chain ``c`` is ``takes[c]``) warped against its movement's other takes (leave one take out) and
-    against the other movements (leave one movement out), each nearest distance over the take's distance to
-    standing still."""
+    each take (chain ``c`` is ``takes[c]``) against its movement's other takes (leave one take out) and against the
+    other movements (leave one movement out), each nearest by ``scores(comparison, take, nodes, chains, skip)``: the
+    chains' relative scores as the matcher's search gives them (:func:`relative_distances`; at each take's tempo,
+    :func:`plugins.matchers.tempo.paced_scores`)."""
     own, other = [], []
     movements = np.asarray(chains.movements, dtype=object)
     for c, take in enumerate(takes):
         skip = np.zeros(len(chains), dtype=bool)
         skip[c] = True
-        distances, _ = chain_distances(comparison, take, nodes, chains, skip)
-        still = float(np.mean(comparison.still(take)))
+        relative = scores(comparison, take, nodes, chains, skip)
         mine = movements == movements[c]
         for out, chosen in ((own, mine & ~skip), (other, ~mine)):
             if chosen.any():
-                out.append(float(distances[chosen].min()) / still if still > 0 else np.inf)
+                out.append(float(relative[chosen].min()))
     return Calibration.of(own, other)
 
 

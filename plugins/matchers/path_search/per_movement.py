@@ -10,8 +10,11 @@ that is nearest to the samples, exactly, and ranks the movements by it.
 A movement's nodes are the takes it was built from (:meth:`Posegraph.takes`: one chain of nodes per clip, hubs
 left out; a clip that loops, a walk's cycle, joins its last node to its first). The samples are warped against
 every chain at once (:mod:`plugins.matchers.warping`: dynamic time warping free to begin and end at any node, so a
-movement seen only in part still finds its part, §5.2.3; any tempo, no limit to set); a movement's distance is its
-nearest take's, and the movements are ranked by it.
+movement seen only in part still finds its part, §5.2.3), then again with the samples' motion at the pace the first
+warping found for the chain (:mod:`plugins.matchers.tempo`: a performance up to four times slower or faster than a
+take is compared at the take's tempo); a movement's score is its nearest take's, relative to the samples' distance
+to standing still at that take's tempo, and the movements are ranked by it. The decision is calibrated on the takes
+compared alike (:func:`plugins.matchers.warping.chain_calibration` with :func:`plugins.matchers.tempo.paced_scores`).
 """
 
 from __future__ import annotations
@@ -21,7 +24,8 @@ import numpy as np
 from plugins.matchers.comparison import Frames
 from plugins.matchers.decision import Calibration
 from plugins.matchers.path_search.search import Found, Search
-from plugins.matchers.warping import Chains, chain_calibration, chain_distances, chain_path
+from plugins.matchers.tempo import paced_distances, paced_scores
+from plugins.matchers.warping import Chains, chain_calibration, chain_path
 
 __all__ = ["EachMovement", "posegraph_chains"]
 
@@ -56,16 +60,23 @@ class EachMovement(Search):
         if self.nodes is None or not samples.seen.any():
             return None
         m = self.matcher
-        per_chain, cost = chain_distances(m.comparison, samples, self.nodes, self.chains)
-        distances: dict[str, float] = {}
-        for movement, d in zip(self.chains.movements, per_chain):
-            distances[movement] = min(distances.get(movement, np.inf), float(d))
-        ranked = tuple(sorted(((mv, d) for mv, d in distances.items() if np.isfinite(d)), key=lambda c: (c[1], c[0])))
-        if not ranked:
+        paced = paced_distances(m.comparison, samples, self.nodes, self.chains)
+        still = float(np.mean(m.comparison.still(samples)))
+        # what the decision divides by the samples' distance to standing still (the relative score), or a distance
+        relative = m.decision.relative and still > 0
+        values = paced.scores * still if relative else paced.distances
+        order = paced.scores if relative else paced.distances
+        best: dict[str, int] = {}
+        for c, movement in enumerate(self.chains.movements):
+            if np.isfinite(values[c]) and (movement not in best or order[c] < order[best[movement]]):
+                best[movement] = c
+        if not best:
             return None
-        best = int(np.argmin(per_chain))
-        path = chain_path(cost, self.chains, best)
-        return Found(ranked[0][0], path, 1.0, ranked, {"mean_distance": ranked[0][1], "samples": len(samples)})
+        ranked = tuple((mv, float(values[c])) for mv, c in sorted(best.items(), key=lambda kv: (order[kv[1]], kv[0])))
+        chosen = best[ranked[0][0]]
+        path = chain_path(paced.cost, self.chains, chosen)
+        return Found(ranked[0][0], path, 1.0, ranked, {"mean_distance": float(paced.distances[chosen]),
+                                                       "pace": float(paced.pace[chosen]), "samples": len(samples)})
 
     def calibration(self) -> Calibration:
-        return chain_calibration(self.matcher.comparison, self.takes, self.nodes, self.chains)
+        return chain_calibration(self.matcher.comparison, self.takes, self.nodes, self.chains, paced_scores)

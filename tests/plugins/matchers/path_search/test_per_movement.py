@@ -85,7 +85,7 @@ def test_each_chains_distance_is_its_least_mean_cost_path(case):
     cyc = np.array([cyclic] * len(sizes))
     best = np.empty(len(sizes))
     end = np.empty(len(sizes), dtype=np.intp)
-    _warp(cost, starts, cyc, best, end)
+    _warp(cost, starts, cyc, best, end, np.empty(len(sizes)))
     for c in range(len(sizes)):
         block = cost[:, starts[c] : starts[c + 1]]
         want = cyclic_reference(block) if cyclic else enumerated(block)
@@ -102,9 +102,10 @@ def test_the_compiled_warping_is_the_reference_and_its_path_ends_where_the_best_
     starts = np.array([0, cost.shape[1]], dtype=np.intp)
     got, want = np.empty(1), np.empty(1)
     end_got, end_want = np.empty(1, dtype=np.intp), np.empty(1, dtype=np.intp)
-    kernel(_warp)(cost, starts, np.array([cyclic]), got, end_got)
-    _warp(cost, starts, np.array([cyclic]), want, end_want)
-    assert got[0] == want[0] and end_got[0] == end_want[0]
+    adv_got, adv_want = np.empty(1), np.empty(1)
+    kernel(_warp)(cost, starts, np.array([cyclic]), got, end_got, adv_got)
+    _warp(cost, starts, np.array([cyclic]), want, end_want, adv_want)
+    assert got[0] == want[0] and end_got[0] == end_want[0] and adv_got[0] == adv_want[0]
     out, ref = np.empty(len(cost), dtype=np.intp), np.empty(len(cost), dtype=np.intp)
     kernel(_warp_path)(cost, cyclic, out)
     _warp_path(cost, cyclic, ref)
@@ -113,6 +114,8 @@ def test_the_compiled_warping_is_the_reference_and_its_path_ends_where_the_best_
     assert out[-1] == end_want[0]
     if not cyclic:
         assert (np.diff(out) >= 0).all()
+    # the frames the path advanced over (the pace's numerator): its steps along the chain, a loop's included
+    assert adv_want[0] == (np.diff(out) % cost.shape[1]).sum()
 
 
 @pytest.fixture

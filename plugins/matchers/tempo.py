@@ -1,0 +1,122 @@
+"""A demonstration compared at each take's tempo: its motion rescaled by the pace its warping found.
+
+Time warping (:mod:`plugins.matchers.warping`) lets a slower performance stay on a take's frames and a faster one pass
+several at a sample, so *when* each pose comes no longer matters. *How fast* each part moves still does: the motion
+comparison (:class:`plugins.matchers.comparison.Motion`) sees each part's velocity and the body's travel, and a walk
+performed at half the pace moves every part, and the body, at half the speed. Aligned frame by frame with the take,
+such a walk's velocities lie nearer to standing still than to the take's, and a held pose explains it better than
+the walk does. Styles change tempo by up to four times (a raise of a hand took 37 to 163 frames across the styles of
+one performer, issue 34; the Bandai-Namco styles walk at 0.4-1.4 m/s).
+
+So each chain (a take) is compared twice:
+
+1. the warping aligns the demonstration with the chain as it is, and counts the chain's frames its best path
+   advanced over from the first sample to the last: over the steps between samples this is the *pace*, 1 at the
+   take's own tempo, 0.5 for a performance half as fast (it stayed on each frame for two samples), 2 for one twice
+   as fast;
+2. the demonstration's motion and travel are multiplied by ``1 / pace`` (what they would be at the take's tempo;
+   the shape and the turn since the onset do not change with tempo) and the warping aligns it again.
+
+Each chain's *score* is its distance at its own tempo over the demonstration's distance to standing still at that
+tempo (the relative score of :mod:`plugins.matchers.decision`), so that chains compared at different paces rank
+alike. The pace is held within ``1 / TEMPO`` and ``TEMPO``: a path that stays on one frame of a held pose has pace 0,
+and a demonstration's motion multiplied without bound would make its own jitter a movement.
+
+Positions have no tempo (:class:`plugins.matchers.comparison.Poses`, the papers' eq. 1): for them the second pass is
+the first, and it is not made.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from plugins.matchers.comparison import Comparison, Frames
+from plugins.matchers.warping import Chains, warp_chains
+
+__all__ = ["Paced", "TEMPO", "paced_distances", "paced_scores", "paces"]
+
+TEMPO = 4.0
+"""How many times slower or faster than a take a performance may be and still be compared at the take's tempo
+(issue 34: tempo varies up to four times between styles). Beyond it the pace is held at the limit."""
+
+
+@dataclass(frozen=True)
+class Paced:
+    """Every chain compared with a demonstration at the chain's own tempo.
+
+    Attributes
+    ----------
+    scores : array, shape (C,)
+        Each chain's distance at its pace over the demonstration's distance to standing still at that pace
+        (``inf`` for a chain left out, and where the demonstration does not move at all).
+    distances : array, shape (C,)
+        Each chain's distance at its pace, in the comparison's unit (``inf`` for a chain left out).
+    pace : array, shape (C,)
+        Each chain's frames per sample of the demonstration, within ``1 / TEMPO`` and ``TEMPO`` (1 for a chain left
+        out, and for a demonstration of one sample).
+    cost : array, shape (n, M) or None
+        The frame distances at each chain's pace (every chain kept), what :func:`plugins.matchers.warping.chain_path`
+        follows back; ``None`` when nothing was compared.
+    """
+
+    scores: np.ndarray
+    distances: np.ndarray
+    pace: np.ndarray
+    cost: np.ndarray | None
+
+
+def paces(advanced: np.ndarray, samples: int) -> np.ndarray:
+    """Each chain's pace: the frames its best path advanced over (:func:`~plugins.matchers.warping.warp_chains`)
+    per step from sample to sample, within ``1 / TEMPO`` and ``TEMPO`` (1 for a single sample)."""
+    advanced = np.asarray(advanced, dtype=float)
+    if samples < 2:
+        return np.ones(len(advanced))
+    return np.clip(advanced / (samples - 1), 1.0 / TEMPO, TEMPO)
+
+
+def paced_distances(comparison: Comparison, samples: Frames, nodes: Frames, chains: Chains,
+                    skip: np.ndarray | None = None) -> Paced:
+    """Every chain against the demonstration ``samples`` at the chain's own tempo (see the module); ``nodes``: the
+    frames of every chain, chain after chain; ``skip`` (C,) bool: chains left out."""
+    keep = np.ones(len(chains), dtype=bool) if skip is None else ~np.asarray(skip, dtype=bool)
+    scores, distances = np.full(len(chains), np.inf), np.full(len(chains), np.inf)
+    pace = np.ones(len(chains))
+    if len(samples) == 0 or not keep.any():
+        return Paced(scores, distances, pace, None)
+    lengths = np.diff(chains.starts)
+    if keep.all():
+        columns = None
+        starts, cyclic, frames = chains.starts, chains.cyclic, nodes
+    else:
+        kept = np.flatnonzero(keep)
+        columns = np.concatenate([np.arange(chains.starts[c], chains.starts[c + 1]) for c in kept])
+        starts = np.concatenate([[0], np.cumsum(lengths[kept])]).astype(np.intp)
+        cyclic, frames = chains.cyclic[kept], nodes.take(columns)
+    paired = comparison.paired(samples, frames)
+    cost = paired.at(1.0)
+    found, _, advanced = warp_chains(cost, starts, cyclic)
+    if comparison.paced:
+        at = paces(advanced, len(samples))
+        cost = paired.at(np.repeat(1.0 / at, np.diff(starts)))
+        found, _, _ = warp_chains(cost, starts, cyclic)
+        moving = comparison.still_at(samples, 1.0 / at).mean(axis=0)
+        pace[keep] = at
+    else:
+        moving = np.full(len(found), float(np.mean(comparison.still(samples))))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        scores[keep] = np.where(moving > 0, found / moving, np.inf)
+    distances[keep] = found
+    if columns is not None:
+        full = np.zeros((len(samples), len(nodes)))
+        full[:, columns] = cost
+        cost = full
+    return Paced(scores, distances, pace, cost)
+
+
+def paced_scores(comparison: Comparison, samples: Frames, nodes: Frames, chains: Chains,
+                 skip: np.ndarray | None = None) -> np.ndarray:
+    """:attr:`Paced.scores` of :func:`paced_distances`: what a calibration of the decision measures
+    (:func:`plugins.matchers.warping.chain_calibration`)."""
+    return paced_distances(comparison, samples, nodes, chains, skip).scores
