@@ -67,16 +67,14 @@ def facing_heading(world: np.ndarray, visible: np.ndarray, body: Body, window: F
     """
     world = np.asarray(world, dtype=float)
     visible = np.asarray(visible, dtype=bool)
-    li, ri = body.index(body.facing.left), body.index(body.facing.right)
-    perp = _perpendicular(world, body)  # +z when left is +x
-    knees = visible[..., li] & visible[..., ri]
+    perp, knees = _perpendicular(world, visible, body)  # +z when left is +x
     heading = np.full(world.shape[:-2], np.nan)
     if body.facing.forward is not None:
         fi, bi = body.index(body.facing.forward), _marker_base(body)
         if window is None:
             flip = _behind_line(world, visible, body, perp) & visible[..., fi]
         else:  # the frames' flags, from this perpendicular, put to the window's vote; NaN (no vote): not turned
-            flip = window.votes(_flags(world, visible, body, perp)) > 0.5
+            flip = window.votes(_flags(world, visible, body, perp, knees)) > 0.5
         perp = perp * np.where(flip, -1.0, 1.0)[..., None]
         fallback = world[..., fi, :] - world[..., bi, :]
         fallback[..., 1] = 0.0
@@ -98,21 +96,63 @@ def marker_behind(world: np.ndarray, visible: np.ndarray, body: Body) -> np.ndar
     visible = np.asarray(visible, dtype=bool)
     if body.facing.forward is None:
         return np.full(world.shape[:-2], np.nan)
-    return _flags(world, visible, body, _perpendicular(world, body))
+    return _flags(world, visible, body, *_perpendicular(world, visible, body))
 
 
-def _perpendicular(world: np.ndarray, body: Body) -> np.ndarray:
-    """The horizontal perpendicular of the line from the right facing part to the left one (..., 3), as long as
-    they are apart."""
-    perp = _cross_up(world[..., body.index(body.facing.left), :] - world[..., body.index(body.facing.right), :])
+def _perpendicular(world: np.ndarray, visible: np.ndarray, body: Body) -> tuple[np.ndarray, np.ndarray]:
+    """The horizontal perpendicular of the line across the body from right to left (..., 3), as long as the facing
+    parts are apart (:func:`across`), and where it was found (...)."""
+    line, seen = across(world, visible, body)
+    perp = _cross_up(line)
     perp[..., 1] = 0.0
-    return perp
+    return perp, seen
 
 
-def _flags(world: np.ndarray, visible: np.ndarray, body: Body, perp: np.ndarray) -> np.ndarray:
-    """:func:`marker_behind` from the facing parts' perpendicular ``perp``."""
-    li, ri, fi = body.index(body.facing.left), body.index(body.facing.right), body.index(body.facing.forward)
-    seen = visible[..., li] & visible[..., ri] & visible[..., fi]
+def across(world: np.ndarray, visible: np.ndarray, body: Body) -> tuple[np.ndarray, np.ndarray]:
+    """The line across the body, from its right to its left (..., 3), and where it was found (...): where at least
+    one of the facing's left/right pairs is seen.
+
+    One pair (the paper's knees): its left part minus its right part. Several (``body.facing.pairs``: the hips and
+    the shoulders, say): each seen pair's horizontal across vector ``a_k`` counts by its own horizontal length,
+    ``c = sum_k |a_k| a_k / sum_k |a_k|``.
+
+    A tracker's jitter of ``s`` metres per coordinate turns a pair's direction by about ``sqrt(2) s / |a_k|``
+    radians (variance ``2 s^2 / |a_k|^2``). The sum weighs each pair's direction by ``|a_k|^2``, the inverse of
+    that variance, so the combined direction's variance is ``2 s^2 / sum_k |a_k|^2``: less than the longest pair's
+    alone, and a short pair (the hips, 13 cm apart in the Bandai-Namco skeleton) counts for little beside a long one
+    (the shoulders). A pair seen foreshortened (the shoulders of a body bent sideways) counts for less. ``c`` is as
+    long as a length-weighted mean of the pairs' widths: the distance :data:`MARKER_MARGIN` is a share of.
+    """
+    pairs = body.facing.pairs
+    if len(pairs) == 1:  # the paper's one pair: its difference as it is
+        li, ri = body.index(body.facing.left), body.index(body.facing.right)
+        return world[..., li, :] - world[..., ri, :], visible[..., li] & visible[..., ri]
+    lefts, rights = body.indices([a for a, _ in pairs]), body.indices([b for _, b in pairs])
+    vectors = world[..., lefts, :] - world[..., rights, :]  # (..., K, 3)
+    vectors[..., 1] = 0.0
+    pair_seen = visible[..., lefts] & visible[..., rights]
+    lengths = np.where(pair_seen, np.sqrt(vectors[..., 0] ** 2 + vectors[..., 2] ** 2), 0.0)
+    total = lengths.sum(axis=-1)
+    seen = total > 0.0
+    line = np.einsum("...k,...ki->...i", lengths, vectors) / np.where(seen, total, 1.0)[..., None]
+    return line, pair_seen.any(axis=-1)
+
+
+def _middle(world: np.ndarray, visible: np.ndarray, body: Body) -> np.ndarray:
+    """The middle of the facing parts (..., 3): of the one pair's, or the mean of the seen pairs' middles."""
+    pairs = body.facing.pairs
+    if len(pairs) == 1:
+        return 0.5 * (world[..., body.index(body.facing.left), :] + world[..., body.index(body.facing.right), :])
+    lefts, rights = body.indices([a for a, _ in pairs]), body.indices([b for _, b in pairs])
+    middles = 0.5 * (world[..., lefts, :] + world[..., rights, :])
+    weights = (visible[..., lefts] & visible[..., rights]).astype(float)
+    count = weights.sum(axis=-1)
+    return np.einsum("...k,...ki->...i", weights, middles) / np.where(count > 0, count, 1.0)[..., None]
+
+
+def _flags(world: np.ndarray, visible: np.ndarray, body: Body, perp: np.ndarray, knees: np.ndarray) -> np.ndarray:
+    """:func:`marker_behind` from the facing parts' perpendicular ``perp``, found where ``knees``."""
+    seen = knees & visible[..., body.index(body.facing.forward)]
     return np.where(seen, _behind_line(world, visible, body, perp), np.nan)
 
 
@@ -130,9 +170,8 @@ def _behind_line(world: np.ndarray, visible: np.ndarray, body: Body, perp: np.nd
     front of its nose), else from the middle of the facing parts; from the marker's own behind part where the profile
     gives one and it is seen (toes from the ankle). Nearer the line than the margin the marker says nothing a
     tracker's jitter cannot flip."""
-    li, ri, root = body.index(body.facing.left), body.index(body.facing.right), body.root_index
-    fi = body.index(body.facing.forward)
-    mid = 0.5 * (world[..., li, :] + world[..., ri, :])
+    root, fi = body.root_index, body.index(body.facing.forward)
+    mid = _middle(world, visible, body)
     base = np.where(visible[..., root, None], world[..., root, :], mid)
     if body.facing.behind is not None:
         bi = body.index(body.facing.behind)
