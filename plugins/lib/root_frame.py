@@ -164,7 +164,8 @@ def _marker_base(body: Body) -> int:
 
 def _behind_line(world: np.ndarray, visible: np.ndarray, body: Body, perp: np.ndarray) -> np.ndarray:
     """Each frame's forward marker behind the facing parts' line by more than :data:`MARKER_MARGIN` of their
-    distance (``perp``: the line's horizontal perpendicular, as long as the parts are apart).
+    distance (``perp``: the line's horizontal perpendicular, as long as the parts are apart; with several pairs, of
+    the first pair's distance).
 
     The side of the line the marker is on is measured from the root when it is seen (a sitting body has its knees in
     front of its nose), else from the middle of the facing parts; from the marker's own behind part where the profile
@@ -177,7 +178,16 @@ def _behind_line(world: np.ndarray, visible: np.ndarray, body: Body, perp: np.nd
         bi = body.index(body.facing.behind)
         base = np.where(visible[..., bi, None], world[..., bi, :], base)
     ahead = world[..., fi, :] - base
-    return np.einsum("...i,...i->...", ahead, perp) < -MARKER_MARGIN * np.einsum("...i,...i->...", perp, perp)
+    if not body.facing.also:
+        return np.einsum("...i,...i->...", ahead, perp) < -MARKER_MARGIN * np.einsum("...i,...i->...", perp, perp)
+    # several pairs: the combined line's direction, the margin a share of the first pair's width where it is seen
+    # (of the combined line's length where not), as with that pair alone: a pair added beside the paper's knees
+    # turns the line, not how far behind it the marker must lie
+    length = np.sqrt(np.einsum("...i,...i->...", perp, perp))
+    li, ri = body.index(body.facing.left), body.index(body.facing.right)
+    first = world[..., li, :] - world[..., ri, :]
+    width = np.where(visible[..., li] & visible[..., ri], np.hypot(first[..., 0], first[..., 2]), length)
+    return np.einsum("...i,...i->...", ahead, perp) < -MARKER_MARGIN * width * length
 
 
 def _cross_up(across: np.ndarray) -> np.ndarray:
