@@ -128,7 +128,7 @@ class Body:
             at = () if not self.facing.also else (i,)
             self.index(left, key=("facing", "left", *at))
             self.index(right, key=("facing", "right", *at))
-            if left == right:
+            if left == right and i:  # the first pair's is refused where a body is declared (check_body), as before
                 raise ConfigError(f"left and right are the same part {left!r}", key=("facing", "right", *at),
                                   expected="two parts across the body", available=[p for p in self.parts if p != left])
         if len(set(self.facing.pairs)) != len(self.facing.pairs):
