@@ -134,15 +134,20 @@ def across(world: np.ndarray, visible: np.ndarray, body: Body) -> tuple[np.ndarr
     if len(pairs) == 1:  # the paper's one pair: its difference as it is
         li, ri = body.index(body.facing.left), body.index(body.facing.right)
         return world[..., li, :] - world[..., ri, :], visible[..., li] & visible[..., ri]
-    lefts, rights = body.indices([a for a, _ in pairs]), body.indices([b for _, b in pairs])
-    vectors = world[..., lefts, :] - world[..., rights, :]  # (..., K, 3)
-    vectors[..., 1] = 0.0
-    pair_seen = visible[..., lefts] & visible[..., rights]
-    lengths = np.where(pair_seen, np.sqrt(vectors[..., 0] ** 2 + vectors[..., 2] ** 2), 0.0)
-    total = lengths.sum(axis=-1)
-    seen = total > 0.0
-    line = np.einsum("...k,...ki->...i", lengths, vectors) / np.where(seen, total, 1.0)[..., None]
-    return line, pair_seen.any(axis=-1)
+    line = np.zeros(world.shape[:-2] + (3,))
+    total = np.zeros(world.shape[:-2])
+    seen = np.zeros(world.shape[:-2], dtype=bool)
+    for left, right in pairs:  # a few pairs: each written out (an einsum over a pair axis costs more for a frame)
+        li, ri = body.index(left), body.index(right)
+        dx, dz = world[..., li, 0] - world[..., ri, 0], world[..., li, 2] - world[..., ri, 2]
+        pair_seen = visible[..., li] & visible[..., ri]
+        length = np.where(pair_seen, np.hypot(dx, dz), 0.0)
+        line[..., 0] += length * dx
+        line[..., 2] += length * dz
+        total += length
+        seen |= pair_seen
+    line /= np.where(total > 0.0, total, 1.0)[..., None]
+    return line, seen
 
 
 def _middle(world: np.ndarray, visible: np.ndarray, body: Body) -> np.ndarray:
@@ -150,11 +155,14 @@ def _middle(world: np.ndarray, visible: np.ndarray, body: Body) -> np.ndarray:
     pairs = body.facing.pairs
     if len(pairs) == 1:
         return 0.5 * (world[..., body.index(body.facing.left), :] + world[..., body.index(body.facing.right), :])
-    lefts, rights = body.indices([a for a, _ in pairs]), body.indices([b for _, b in pairs])
-    middles = 0.5 * (world[..., lefts, :] + world[..., rights, :])
-    weights = (visible[..., lefts] & visible[..., rights]).astype(float)
-    count = weights.sum(axis=-1)
-    return np.einsum("...k,...ki->...i", weights, middles) / np.where(count > 0, count, 1.0)[..., None]
+    middle = np.zeros(world.shape[:-2] + (3,))
+    count = np.zeros(world.shape[:-2])
+    for left, right in pairs:
+        li, ri = body.index(left), body.index(right)
+        pair_seen = (visible[..., li] & visible[..., ri]).astype(float)
+        middle += pair_seen[..., None] * 0.5 * (world[..., li, :] + world[..., ri, :])
+        count += pair_seen
+    return middle / np.where(count > 0, count, 1.0)[..., None]
 
 
 def _flags(world: np.ndarray, visible: np.ndarray, body: Body, perp: np.ndarray, knees: np.ndarray) -> np.ndarray:
