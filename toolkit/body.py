@@ -38,12 +38,38 @@ class Facing:
     default the root). A motion-capture skeleton without a nose can use the toes
     seen from the ankle: the foot always points forward, while the toes are
     behind the hips half of every walking step.
+
+    ``also`` gives further left/right pairs across the body (the shoulders beside the hips): the line across is
+    then the pairs' across vectors combined, each counting by its length (``plugins/lib/root_frame.py``), so that
+    a tracker's jitter turns it less than it turns one short pair. ``left`` and ``right`` are the first pair.
     """
 
     left: str
     right: str
     forward: str | None = None
     behind: str | None = None
+    also: tuple[tuple[str, str], ...] = ()
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "also", tuple((str(a), str(b)) for a, b in self.also))
+
+    @property
+    def pairs(self) -> tuple[tuple[str, str], ...]:
+        """Every (left, right) pair, the first one ``(left, right)``."""
+        return ((self.left, self.right), *self.also)
+
+    def table(self) -> dict[str, Any]:
+        """The ``[facing]`` table that declares this facing (:meth:`Body.from_config`): ``left`` and ``right`` a
+        part each for one pair, lists (one part per pair) for several."""
+        if self.also:
+            out: dict[str, Any] = {"left": [a for a, _ in self.pairs], "right": [b for _, b in self.pairs]}
+        else:
+            out = {"left": self.left, "right": self.right}
+        if self.forward is not None:
+            out["forward"] = self.forward
+        if self.behind is not None:
+            out["behind"] = self.behind
+        return out
 
 
 @dataclass(frozen=True)
@@ -98,8 +124,16 @@ class Body:
         if not self.parts:
             raise ConfigError("a body needs at least one part", key=("parts",), expected="a non-empty list")
         self.index(self.root, key=("root",))
-        self.index(self.facing.left, key=("facing", "left"))
-        self.index(self.facing.right, key=("facing", "right"))
+        for i, (left, right) in enumerate(self.facing.pairs):
+            at = () if not self.facing.also else (i,)
+            self.index(left, key=("facing", "left", *at))
+            self.index(right, key=("facing", "right", *at))
+            if left == right and i:  # the first pair's is refused where a body is declared (check_body), as before
+                raise ConfigError(f"left and right are the same part {left!r}", key=("facing", "right", *at),
+                                  expected="two parts across the body", available=[p for p in self.parts if p != left])
+        if len(set(self.facing.pairs)) != len(self.facing.pairs):
+            raise ConfigError("a left/right pair given twice", key=("facing", "left"),
+                              expected="different pairs across the body", available=self.facing.pairs)
         if self.facing.forward is not None:
             self.index(self.facing.forward, key=("facing", "forward"))
         if self.facing.behind is not None:
@@ -119,7 +153,7 @@ class Body:
                 raise ConfigError("a hand without fingers", key=("hands", name, "fingers"), expected="a non-empty list of parts")
             for finger in hand.fingers:
                 self.index(finger, key=("hands", name, "fingers"))
-                if finger in seen or finger in (self.root, self.facing.left, self.facing.right, hand.wrist):
+                if finger in seen or finger in (self.root, hand.wrist, *(p for pair in self.facing.pairs for p in pair)):
                     raise ConfigError(f"part {finger!r} cannot be a finger of {name!r}", key=("hands", name, "fingers"),
                                       expected="parts that belong to one hand only and are not the root, facing or wrist parts")
                 seen[finger] = name
@@ -204,9 +238,7 @@ class Body:
                     f"unknown key {key!r}", key=("facing", key), expected="a facing key",
                     available=("behind", "forward", "left", "right")
                 )
-        for key in ("left", "right"):
-            if not isinstance(facing.get(key), str):
-                raise ConfigError("missing or invalid", key=("facing", key), expected="a part name", available=parts)
+        lefts, rights = _facing_pairs(facing, parts)
         forward, behind = facing.get("forward"), facing.get("behind")
         for key, value in (("forward", forward), ("behind", behind)):
             if value is not None and not isinstance(value, str):
@@ -236,11 +268,35 @@ class Body:
         return cls(
             parts=tuple(parts),
             root=root,
-            facing=Facing(facing["left"], facing["right"], forward, behind),
+            facing=Facing(lefts[0], rights[0], forward, behind, tuple(zip(lefts[1:], rights[1:]))),
             bones=tuple((a, b) for a, b in bones),
             colours=dict(colours),
             hands=parsed,
         )
+
+
+def _facing_pairs(facing: Mapping[str, Any], parts: list[str]) -> tuple[list[str], list[str]]:
+    """The ``left`` and ``right`` parts of a ``[facing]`` table, one per pair: a part name each (one pair, the
+    paper's knees) or lists of as many part names (several pairs, the first pair first)."""
+    given = {key: facing.get(key) for key in ("left", "right")}
+    lists = [key for key, value in given.items() if isinstance(value, list)]
+    if not lists:
+        for key, value in given.items():
+            if not isinstance(value, str):
+                raise ConfigError("missing or invalid", key=("facing", key),
+                                  expected="a part name, or a list of part names (one per left/right pair)",
+                                  available=parts)
+        return [given["left"]], [given["right"]]
+    for key, value in given.items():
+        if not isinstance(value, list) or not value or not all(isinstance(p, str) for p in value):
+            raise ConfigError("missing" if value is None else "invalid", key=("facing", key),
+                              expected="a non-empty list of part names, one per pair, as "
+                                       + ("left" if key == "right" else "right") + " is", available=parts)
+    if len(given["left"]) != len(given["right"]):
+        raise ConfigError(f"{len(given['left'])} left parts and {len(given['right'])} right parts",
+                          key=("facing", "right"), expected="one right part for each left part (pairs by position)",
+                          available=parts)
+    return list(given["left"]), list(given["right"])
 
 
 def _is_hex_colour(value: object) -> bool:

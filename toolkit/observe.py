@@ -205,11 +205,7 @@ def compose_observer(pm: Any, profile: BodyProfile, repertoire: Any, *, segmente
     """
     head, tables = observer_tables(pm, segmenter=segmenter, matcher=matcher, settings=settings, motor=motor,
                                    correspondence=correspondence, template=template)
-    facing = {"left": profile.body.facing.left, "right": profile.body.facing.right}
-    if profile.body.facing.forward:
-        facing["forward"] = profile.body.facing.forward
-    if profile.body.facing.behind:
-        facing["behind"] = profile.body.facing.behind
+    facing = profile.body.facing.table()  # every left/right pair, the forward marker and its behind part
     character: dict[str, Any] = {"name": head.get("name", "observer"),
                                  "description": f"watches {profile.name} motion" + (f": {head['description']}"
                                                                                      if head.get("description") else "")}
