@@ -96,6 +96,7 @@ class Rests:
     stance: int = 0
     smooth: int = 1
     keep: int = 8
+    origin: np.ndarray | None = None
     hubs: list[np.ndarray] = field(default_factory=list)
     holds: list[Hold] = field(default_factory=list)
     _stacked: np.ndarray | None = field(default=None, repr=False)  # the hubs (and the hold under way) (k, m, 3)
@@ -104,6 +105,7 @@ class Rests:
         """A movement begins from ``pose`` (3m,), where the demonstrator was: a hub."""
         self.radius = radius
         self.holds = []
+        self.origin = None
         self.hub(pose)
 
     def hub(self, pose: np.ndarray) -> None:
@@ -112,17 +114,20 @@ class Rests:
         self.hubs = [pose] + [h for h in self.hubs if not _apart(h, pose) <= self.radius][: self.keep - 1]
         self._stacked = None
 
-    def at_hub(self, pose: np.ndarray) -> bool:
-        """Whether ``pose`` is near one of the hubs (nothing to compare with: the paper's rule, any rest)."""
-        return self.place(pose)[0]
+    def at_hub(self, pose: np.ndarray, near: float = 0.0) -> bool:
+        """Whether ``pose`` is at one of the hubs: within the radius of it (eq. 1's mean over the parts) and no part
+        having left it (farther than twice the radius, or than ``near`` where that is larger: how far the tracker's
+        jitter alone puts a part from where it rests). Nothing to compare with: the paper's rule, any rest."""
+        return self.place(pose, near)[0]
 
-    def still(self, pose: np.ndarray) -> bool:
-        """Whether ``pose`` (3m,) is still where the hold under way began: no part farther than twice the radius
-        from where it was (what leaving is). A rest stays in one place; one that drifts farther is a movement too
-        slow for the speed to show (a tracker's jitter hides it), not a rest. True with no hold under way."""
-        return self.place(pose)[1]
+    def still(self, pose: np.ndarray, near: float = 0.0) -> bool:
+        """Whether ``pose`` (3m,) is still where the hold under way began: no part farther than the radius from
+        where it was, or than ``near`` where that is larger (how far the tracker's jitter alone puts it). A rest
+        stays in one place; one that drifts farther is a movement too slow for the speed to show (a tracker's
+        jitter hides it), not a rest. True with no hold under way."""
+        return self.place(pose, near)[1]
 
-    def place(self, pose: np.ndarray) -> tuple[bool, bool]:
+    def place(self, pose: np.ndarray, near: float = 0.0) -> tuple[bool, bool]:
         """:meth:`at_hub` and :meth:`still` of ``pose`` (3m,) at once: its distances to the hubs and to the hold
         under way, one array (the segmenter asks both at every frame of a hold)."""
         holding = bool(self.holds) and self.holds[-1].end is None
@@ -133,16 +138,23 @@ class Rests:
             self._stacked = np.array(rows).reshape(len(rows), -1, 3)
         apart = self._stacked - np.asarray(pose).reshape(-1, 3)
         d2 = np.einsum("kmj,kmj->km", apart, apart)  # (hubs [+ the hold], m); NaN: a part not seen in both
-        still = not holding or not bool((d2[-1] > 4.0 * self.radius * self.radius).any())  # NaN: not counted
+        drift = max(self.radius, near)
+        still = not holding or not bool((d2[-1] > drift * drift).any())  # NaN: not counted
         if not self.hubs:
             return True, still
-        d = np.sqrt(d2[: len(self.hubs)])
-        if np.isfinite(d).all():  # eq. 1: the mean over the parts (np.mean's sum and division, without its overhead)
-            return float(np.add.reduce(d, axis=1).min()) / d.shape[1] <= self.radius, still
+        d2 = d2[: len(self.hubs)]
+        left = max(2.0 * self.radius, near)
+        if np.isfinite(d2).all():  # eq. 1: the mean over the parts (np.mean's sum and division, without its overhead)
+            at = (np.add.reduce(np.sqrt(d2), axis=1) / d2.shape[1] <= self.radius) & (d2.max(axis=1) <= left * left)
+            return bool(at.any()), still
         with np.errstate(all="ignore"):
-            near = np.nanmean(np.where(np.isfinite(d), d, np.nan), axis=1)  # eq. 1 over the parts seen in both
-        near = near[np.isfinite(near)]
-        return not near.size or float(near.min()) <= self.radius, still
+            seen = np.isfinite(d2)
+            mean = np.nanmean(np.where(seen, np.sqrt(d2), np.nan), axis=1)  # eq. 1 over the parts seen in both
+            farthest = np.where(seen, d2, -np.inf).max(axis=1)
+        compared = np.isfinite(mean)
+        if not compared.any():
+            return True, still
+        return bool(((mean <= self.radius) & (farthest <= left * left))[compared].any()), still
 
     def returned(self, pose: np.ndarray, start: int, window: np.ndarray) -> int | None:
         """The index of the last finished hold near ``pose`` that the demonstrator held a stance's time, left (some
@@ -181,7 +193,9 @@ class Rests:
         holds = [h for h in self.holds[:upto] if h.end is not None and start < h.start and h.end < end]
         if not self.leaves(window[: end - start]):  # motion at rest (sway, a hand fidgeting): no movement
             return []
-        if _apart(window[0], window[end - start - 1]) <= self.radius:  # back where it began: no shift
+        last = self.seen(window[: end - start])[-1]  # the jitter averaged out
+        first = self.origin if self.origin is not None else self.seen(window[:1])[0]
+        if _apart(first, last) <= self.radius:  # back where it began: no shift
             return [(start, end)]
         if shifts and self.shift(window[: end - start]):
             return []

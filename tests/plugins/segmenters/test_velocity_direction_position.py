@@ -1,0 +1,87 @@
+"""velocity-direction's onsets found by position (issue 36, K&G §4.1 on a noisy tracker), with the observer template's
+settings: a movement slower than a tracker's jitter lets a line fit show is found where some part leaves the pose the
+demonstrator rests in; a rest at a hub is one no part has left; a stance is held as long as the line fit sees it."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from plugins.segmenters.velocity_direction import VelocityDirection
+from tests.fixtures.gesture_streams import FPS, bowing, hold, point, stream
+from tests.plugins.segmenters.test_velocity_direction import _in_blocks, _Stepped
+from tests.plugins.segmenters.test_velocity_direction_streams import TEMPLATE, A, scores
+
+
+def slow_bow():
+    """A bow over 8 s (the head at about 0.2 m/s at most, the chest slower: below the speed a tracker's jitter of
+    1 cm makes a still part seem to move over a third of a second), held 0.5 s at the bottom; then a point."""
+    return [("rest", [hold(A, 1.0)]), ("movement", bowing(A, seconds=8.0, hold_s=0.5)), ("rest", [hold(A, 1.0)]),
+            ("movement", point(A)), ("rest", [hold(A, 1.0)])]
+
+
+@pytest.mark.parametrize("tracker", [0.01, 0.02])
+def test_a_bow_slower_than_the_jitter_lets_a_line_fit_show_is_found_by_position(tracker):
+    """The slow bow under 1 and 2 cm of jitter: the speed never rises above the jitter's floor for long, but the
+    head and chest leave the standing pose by tens of centimetres: both movements are found on every seed (the speed
+    alone lost the bow on half the seeds at 1 cm and on all at 2 cm), and the F1 over the seeds is at least 0.9."""
+    found = [scores(slow_bow(), tracker=tracker, seed=seed) for seed in range(8)]
+    assert all(s["recall"] == 1.0 for s in found), [s["recall"] for s in found]
+    assert np.mean([s["f1"] for s in found]) >= 0.9, [s["f1"] for s in found]
+    assert scores(slow_bow())["f1"] == 1.0  # clean, the speed finds it
+
+
+def test_without_the_rest_end_nothing_is_found_by_position():
+    """The onset by position needs the demonstrator's rest (``end = "rest"``): with the paper's end (any rest ends a
+    movement) the slow bow under 2 cm of jitter is lost to the jitter's floor, as it was before."""
+    found = [scores(slow_bow(), tracker=0.02, seed=seed, end="still")["recall"] for seed in range(4)]
+    assert max(found) < 1.0, found
+
+
+def test_an_onset_by_position_is_dated_back_to_where_the_part_left_the_jitters_margin():
+    """The slow bow under 1 cm of jitter begins no later than where its head has gone twice ``rest.radius`` (the
+    body's size times 0.2) from the standing pose, and no earlier than the bow itself."""
+    motion, truth = stream(slow_bow(), jitter=0.01, seed=3)
+    found = VelocityDirection(**TEMPLATE).segment(motion)
+    clean, _ = stream(slow_bow())
+    head = clean.positions[:, 2]
+    leaving = int(np.argmax(np.linalg.norm(head - head[0], axis=1) > 2 * 0.1 * 0.45))  # 2 rest.radius on this body
+    first = min(found, key=lambda s: abs(s.start - truth[0][0]))
+    assert truth[0][0] - 0.25 * FPS <= first.start <= leaving, (first.start, truth[0][0], leaving)
+
+
+@given(seed=st.integers(0, 10_000), cuts=st.lists(st.integers(1, 60), min_size=1, max_size=8),
+       tracker=st.sampled_from([0.01, 0.02]))
+@settings(max_examples=12, deadline=None)
+def test_onsets_by_position_walked_are_their_frames_stepped(seed, cuts, tracker):
+    """The slow bow under jitter, where movements begin by position: the block walked (only the frames where
+    something can happen stepped; the frames where a part leaves the rest pose found for the block at once) closes
+    the same segments at the same frames, reports the same onsets and leaves the same state as every frame stepped,
+    whatever the packet sizes."""
+    motion, _ = stream(slow_bow(), jitter=tracker, seed=seed)
+    visible = np.isfinite(motion.positions[..., 0])
+    results = []
+    for kind in (VelocityDirection, _Stepped):
+        seg = kind(**TEMPLATE)
+        seg.reset(motion.parts, FPS)
+        got, since = _in_blocks(seg, motion.positions, visible, cuts)
+        rest = None if seg._rest_pose is None else seg._rest_pose.tolist()
+        results.append((got, since, seg.flush(), seg._away, rest, seg._frame))
+    assert results[0] == results[1]
+
+
+def test_a_stance_is_held_as_long_as_the_lengthened_line_fit_sees_it():
+    """Where ``stretch`` lengthens the line fit (the jitter hides the rest speed), a hold must last a stance's time
+    (0.2 s) plus the fit's extra frames to be a stance the movement was cut at: the fit blurs a rest's edges over its
+    length. Clean, a stance is the 0.2 s."""
+    seg = VelocityDirection(**TEMPLATE)
+    motion, _ = stream(slow_bow(), jitter=0.02, seed=1)
+    seg.segment(motion)
+    stretched = int(round(TEMPLATE["stretch"] * FPS))
+    window = int(round(TEMPLATE["window"] * FPS))
+    assert seg._rests.stance == int(round(0.2 * FPS)) + 2 * ((stretched - 1) // 2 - (window - 1) // 2)
+    seg = VelocityDirection(**TEMPLATE)
+    seg.segment(stream(slow_bow())[0])
+    assert seg._rests.stance == int(round(0.2 * FPS))
