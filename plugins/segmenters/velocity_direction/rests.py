@@ -130,31 +130,41 @@ class Rests:
     def place(self, pose: np.ndarray, near: float = 0.0) -> tuple[bool, bool]:
         """:meth:`at_hub` and :meth:`still` of ``pose`` (3m,) at once: its distances to the hubs and to the hold
         under way, one array (the segmenter asks both at every frame of a hold)."""
+        hub, still = self.places(np.asarray(pose)[None], np.array([near], dtype=float))
+        return bool(hub[0]), bool(still[0])
+
+    def places(self, poses: np.ndarray, near: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`place` of each of ``poses`` (k, 3m) with its ``near`` (k,): (hub (k,), still (k,)), the same
+        arithmetic pose by pose (a hold's frames are asked at once)."""
+        k = len(poses)
         holding = bool(self.holds) and self.holds[-1].end is None
         if not self.hubs and not holding:
-            return True, True
+            return np.ones(k, bool), np.ones(k, bool)
         if self._stacked is None or len(self._stacked) != len(self.hubs) + holding:
             rows = self.hubs + ([self.holds[-1].pose] if holding else [])
             self._stacked = np.array(rows).reshape(len(rows), -1, 3)
-        apart = self._stacked - np.asarray(pose).reshape(-1, 3)
-        d2 = np.einsum("kmj,kmj->km", apart, apart)  # (hubs [+ the hold], m); NaN: a part not seen in both
-        drift = max(self.radius, near)
-        still = not holding or not bool((d2[-1] > drift * drift).any())  # NaN: not counted
+        apart = self._stacked[None] - np.asarray(poses).reshape(k, 1, -1, 3)
+        d2 = (apart * apart).sum(axis=3)  # (k, hubs [+ the hold], m); NaN: a part not seen in both
+        if holding:
+            drift = np.maximum(self.radius, near)
+            with np.errstate(invalid="ignore"):
+                still = ~(d2[:, -1] > (drift * drift)[:, None]).any(axis=1)  # NaN: not counted
+        else:
+            still = np.ones(k, bool)
         if not self.hubs:
-            return True, still
-        d2 = d2[: len(self.hubs)]
-        left = max(2.0 * self.radius, near)
+            return np.ones(k, bool), still
+        d2 = d2[:, : len(self.hubs)]
+        left = np.maximum(2.0 * self.radius, near)[:, None]
         if np.isfinite(d2).all():  # eq. 1: the mean over the parts (np.mean's sum and division, without its overhead)
-            at = (np.add.reduce(np.sqrt(d2), axis=1) / d2.shape[1] <= self.radius) & (d2.max(axis=1) <= left * left)
-            return bool(at.any()), still
+            at = (np.add.reduce(np.sqrt(d2), axis=2) / d2.shape[2] <= self.radius) & (d2.max(axis=2) <= left * left)
+            return at.any(axis=1), still
         with np.errstate(all="ignore"):
             seen = np.isfinite(d2)
-            mean = np.nanmean(np.where(seen, np.sqrt(d2), np.nan), axis=1)  # eq. 1 over the parts seen in both
-            farthest = np.where(seen, d2, -np.inf).max(axis=1)
-        compared = np.isfinite(mean)
-        if not compared.any():
-            return True, still
-        return bool(((mean <= self.radius) & (farthest <= left * left))[compared].any()), still
+            mean = np.nanmean(np.where(seen, np.sqrt(d2), np.nan), axis=2)  # eq. 1 over the parts seen in both
+            farthest = np.where(seen, d2, -np.inf).max(axis=2)
+            compared = np.isfinite(mean)
+            at = ((mean <= self.radius) & (farthest <= left * left) & compared).any(axis=1)
+        return at | ~compared.any(axis=1), still
 
     def returned(self, pose: np.ndarray, start: int, window: np.ndarray) -> int | None:
         """The index of the last finished hold near ``pose`` that the demonstrator held a stance's time, left (some

@@ -239,6 +239,7 @@ class VelocityDirection(Segmenter):
         self._rest_pose: np.ndarray | None = None  # end = rest: where the demonstrator rests between movements
         self._away = 0  # end = rest: frames the parts have been farther from it than the tracker's jitter allows
         self._recent = self._near = self._leave = np.zeros(0)  # end = rest: the block's poses and margins (_leaving)
+        self._whole = np.zeros(0, bool)
         self._settle = max(1, int(round(self.params["rest"]["settle"] * self._fps)))
 
     @property
@@ -404,10 +405,15 @@ class VelocityDirection(Segmenter):
                 if self._rests is not None:  # or where the parts leave the rest pose (_left_rest)
                     e = self._next_left(f, e)
             else:
-                e = min(int(rests[np.searchsorted(rests, f)]) if np.searchsorted(rests, f) < len(rests) else n,
-                        int(onsets[np.searchsorted(onsets, f)]) if self._holding and
+                i = np.searchsorted(rests, f)
+                e = min(int(onsets[np.searchsorted(onsets, f)]) if self._holding and
                         np.searchsorted(onsets, f) < len(onsets) else n,
                         max(f, self._start + longest - first) if longest else n)
+                if self._holding and i < len(rests) and rests[i] < e:  # a hold's frames where it just goes on
+                    j = i + int(np.searchsorted(rests[i:], e))
+                    e = min(e, self._holds_on(rests[i:j], resting, lags, first, e))
+                else:
+                    e = min(e, int(rests[i]) if i < len(rests) else n)
                 self._buffer.extend(flat[f:e])
                 since[f:e] = self._start
             if e >= n:
@@ -423,6 +429,28 @@ class VelocityDirection(Segmenter):
             f = e + 1
         upto(n)
         return closed, since
+
+    def _holds_on(self, frames: np.ndarray, resting: np.ndarray, lags: np.ndarray, first: int, e: int) -> int:
+        """The first of a hold's rest ``frames`` (block frames, before ``e``) where :meth:`_rested` does more than
+        let the hold go on (it drifts, is at a hub, has lasted ``rest.settle`` or a stance's time), or ``e``; the
+        rest speed's counts ``resting`` and the line fits' delays ``lags`` of the block's frames."""
+        if not len(frames):
+            return e
+        rests = self._rests
+        here = np.minimum(resting[frames], first + frames - self._drift)
+        stance = self._stance + 2 * (lags[frames] - self._lag)
+        if len(rests.holds) < 2:
+            pending = here >= self._settle
+        else:
+            pending = (here >= self._settle) | (here == max(self._memory, self._pause) + stance)
+        whole = self._whole[frames]
+        pending |= ~whole  # no mean of the block's rows yet: stepped
+        hub, still = rests.places(np.where(whole[:, None], self._recent[frames], 0.0), self._near[frames])
+        event = np.flatnonzero(pending | hub | ~still)
+        if len(event):
+            return int(frames[event[0]])
+        rests.stance = int(stance[-1])  # as the last frame stepped would have left it
+        return e
 
     @property
     def _displacement(self) -> np.ndarray:
@@ -549,7 +577,10 @@ class VelocityDirection(Segmenter):
                     return cut + self._close(began)
                 # a stance as the line fit sees it: one lengthened (stretch) blurs a rest's edges over its extra frames
                 self._rests.stance = self._stance + 2 * ((self._lag if fit_lag is None else fit_lag) - self._lag)
-                return cut + self._rested(began, self._held(1), float(self._near[at]) if at is not None else 0.0)
+                if at is not None:  # the pose at rest (_held(1)) as the block's means have it, as _walk reads it
+                    points = self._recent[at] if self._whole[at] else self._held(1)
+                    return cut + self._rested(began, points, float(self._near[at]))
+                return cut + self._rested(began, self._held(1))
         if self._rests is not None and at is not None:
             self._left_rest(pose, at)
         return cut
@@ -562,12 +593,12 @@ class VelocityDirection(Segmenter):
         the block's."""
         n, w = len(poses), self._still
         recent = np.full((n, rows.shape[1]), np.nan)
-        if len(rows) >= w:
+        at = np.arange(n) + before - (w - 1)
+        whole = at >= 0  # the frames with as many rows before them
+        if whole.any():
             means = np.lib.stride_tricks.sliding_window_view(rows, w, axis=0).mean(axis=-1)  # row j: rows j..j+w-1
-            at = np.arange(n) + before - (w - 1)
-            ok = at >= 0
-            recent[ok] = means[at[ok]]
-        self._recent = recent
+            recent[whole] = means[at[whole]]
+        self._recent, self._whole = recent, whole
         jitter = np.zeros(n) if sigma is None else np.asarray(sigma)
         self._near = self.params["jitter"] * jitter * np.sqrt(3.0 * 2.0 / w)
         scale = body_scale(poses, self._positions) if len(self._positions) == poses.shape[1] else body_scale(poses)
