@@ -285,14 +285,13 @@ class VelocityDirection(Segmenter):
         sigma = self._jitter.update(flat) if self._jitter is not None else None
         floors = (p["jitter"] * speed_noise(sigma, self._weights if self._weights is not None else self._displacement)
                   if sigma is not None else np.zeros(n))
-        if p["units"] == "body":  # every frame's size at once (the running mean takes some of them)
-            sizes = (body_scale(poses, self._positions) if len(self._positions) == poses.shape[1]
-                     else body_scale(poses)).tolist()
-        else:
-            sizes = [None] * n
+        scale = None  # every frame's body size at once (the running mean takes some of them; end = rest: leaving)
+        if p["units"] == "body" or self._rests is not None:
+            scale = body_scale(poses, self._positions) if len(self._positions) == poses.shape[1] else body_scale(poses)
+        sizes = scale.tolist() if p["units"] == "body" else [None] * n
         lags = np.full(n, self._lag)
         if self._rests is not None:
-            self._leaving(rows, before, poses, sigma)
+            self._leaving(rows, before, scale, sigma)
         walk = not self._pause and not p["noise"] > 0  # the rest speed known for the block at once
         own = self._own_rests(sizes) if walk or self._longer else None  # once for the block: stretch and _walk
         if self._longer:  # stretch: a longer line fit where the tracker's jitter hides the rest speed
@@ -585,13 +584,13 @@ class VelocityDirection(Segmenter):
             self._left_rest(pose, at)
         return cut
 
-    def _leaving(self, rows: np.ndarray, before: int, poses: np.ndarray, sigma: np.ndarray | None) -> None:
+    def _leaving(self, rows: np.ndarray, before: int, scale: np.ndarray, sigma: np.ndarray | None) -> None:
         """With ``end = "rest"``: each block frame's pose seen through the mean of its last ``_still`` frames (NaN
         before there are as many), how far a part of it may lie from the rest pose for the tracker's jitter alone
         (``jitter`` times the root-mean-square distance between two such means of a part standing still), and how
-        far leaving is (twice ``rest.radius`` body sizes); ``rows``: the ``before`` rows of the sensory memory, then
-        the block's."""
-        n, w = len(poses), self._still
+        far leaving is (twice ``rest.radius`` times the body's size in each frame, ``scale``); ``rows``: the ``before``
+        rows of the sensory memory, then the block's; ``sigma``: the measured jitter (None: not measured)."""
+        n, w = len(scale), self._still
         recent = np.full((n, rows.shape[1]), np.nan)
         at = np.arange(n) + before - (w - 1)
         whole = at >= 0  # the frames with as many rows before them
@@ -601,7 +600,6 @@ class VelocityDirection(Segmenter):
         self._recent, self._whole = recent, whole
         jitter = np.zeros(n) if sigma is None else np.asarray(sigma)
         self._near = self.params["jitter"] * jitter * np.sqrt(3.0 * 2.0 / w)
-        scale = body_scale(poses, self._positions) if len(self._positions) == poses.shape[1] else body_scale(poses)
         self._leave = 2.0 * self.params["rest"]["radius"] * np.asarray(scale, dtype=float)
 
     def _farthest(self, poses: np.ndarray) -> np.ndarray:
