@@ -442,12 +442,16 @@ class VelocityDirection(Segmenter):
             pending = here >= self._settle
         else:
             pending = (here >= self._settle) | (here == max(self._memory, self._pause) + stance)
-        whole = self._whole[frames]
-        pending |= ~whole  # no mean of the block's rows yet: stepped
-        hub, still = rests.places(np.where(whole[:, None], self._recent[frames], 0.0), self._near[frames])
-        event = np.flatnonzero(pending | hub | ~still)
-        if len(event):
-            return int(frames[event[0]])
+        pending |= ~self._whole[frames]  # no mean of the block's rows yet: stepped
+        a, size = 0, 8
+        while a < len(frames):  # in chunks of growing size: the hold is most often left or drifts soon
+            b = min(len(frames), a + size)
+            chunk = frames[a:b]
+            hub, still = rests.places(self._recent[chunk], self._near[chunk])
+            event = np.flatnonzero(pending[a:b] | hub | ~still)
+            if len(event):
+                return int(chunk[event[0]])
+            a, size = b, 2 * size
         rests.stance = int(stance[-1])  # as the last frame stepped would have left it
         return e
 
