@@ -230,8 +230,7 @@ class VelocityDirection(Segmenter):
             if self.params["jitter"] > 0 else None  # measured again every second
         self._positions = ~np.array([p in angles for p in parts]) if parts else np.zeros(0, bool)
         self._size_sum, self._size_n = 0.0, 0
-        self._stance = int(round(STANCE * self._fps))
-        self._rests = Rests(stance=self._stance, smooth=self._still) \
+        self._rests = Rests(stance=int(round(STANCE * self._fps)), smooth=self._still) \
             if self.params["end"] == "rest" else None
         # end = rest: the hubs and holds
         self._holding = False  # end = rest: the rest under way is a hold (away from the hubs)
@@ -410,7 +409,7 @@ class VelocityDirection(Segmenter):
                         max(f, self._start + longest - first) if longest else n)
                 if self._holding and i < len(rests) and rests[i] < e:  # a hold's frames where it just goes on
                     j = i + int(np.searchsorted(rests[i:], e))
-                    e = min(e, self._holds_on(rests[i:j], resting, lags, first, e))
+                    e = min(e, self._holds_on(rests[i:j], resting, first, e))
                 else:
                     e = min(e, int(rests[i]) if i < len(rests) else n)
                 self._buffer.extend(flat[f:e])
@@ -429,19 +428,18 @@ class VelocityDirection(Segmenter):
         upto(n)
         return closed, since
 
-    def _holds_on(self, frames: np.ndarray, resting: np.ndarray, lags: np.ndarray, first: int, e: int) -> int:
+    def _holds_on(self, frames: np.ndarray, resting: np.ndarray, first: int, e: int) -> int:
         """The first of a hold's rest ``frames`` (block frames, before ``e``) where :meth:`_rested` does more than
-        let the hold go on (it drifts, is at a hub, has lasted ``rest.settle`` or a stance's time), or ``e``; the
-        rest speed's counts ``resting`` and the line fits' delays ``lags`` of the block's frames."""
+        let the hold go on (it drifts, is at a hub, has lasted ``rest.settle`` or a stance's time), or ``e``;
+        ``resting``: the counts of frames at the rest speed of the block's frames."""
         if not len(frames):
             return e
         rests = self._rests
         here = np.minimum(resting[frames], first + frames - self._drift)
-        stance = self._stance + 2 * (lags[frames] - self._lag)
         if len(rests.holds) < 2:
             pending = here >= self._settle
         else:
-            pending = (here >= self._settle) | (here == max(self._memory, self._pause) + stance)
+            pending = (here >= self._settle) | (here == max(self._memory, self._pause) + rests.stance)
         pending |= ~self._whole[frames]  # no mean of the block's rows yet: stepped
         a, size = 0, 8
         while a < len(frames):  # in chunks of growing size: the hold is most often left or drifts soon
@@ -452,7 +450,6 @@ class VelocityDirection(Segmenter):
             if len(event):
                 return int(chunk[event[0]])
             a, size = b, 2 * size
-        rests.stance = int(stance[-1])  # as the last frame stepped would have left it
         return e
 
     @property
@@ -578,8 +575,6 @@ class VelocityDirection(Segmenter):
                 began = max(self._start + 1, self._frame - self._here() + 1 - self._memory // 2 - lag)
                 if self.params["end"] == "still":
                     return cut + self._close(began)
-                # a stance as the line fit sees it: one lengthened (stretch) blurs a rest's edges over its extra frames
-                self._rests.stance = self._stance + 2 * ((self._lag if fit_lag is None else fit_lag) - self._lag)
                 if at is not None:  # the pose at rest (_held(1)) as the block's means have it, as _walk reads it
                     points = self._recent[at] if self._whole[at] else self._held(1)
                     return cut + self._rested(began, points, float(self._near[at]))
