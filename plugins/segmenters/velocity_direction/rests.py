@@ -7,14 +7,15 @@ changes it between gestures, and holds poses half-way through a gesture (a bow, 
 movement under way only where it is a hub of this demonstrator:
 
 - near the pose the movement began from, or near any rest they have been seen in (``rest.radius`` body sizes, eq. 1's
-  mean distance over the chosen parts): a rest there ends it where the rest began;
+  mean distance over the chosen parts, and no part farther than twice that: none has left it): a rest there ends it
+  where the rest began;
 - elsewhere the rest is a *hold* and the movement goes on, unless they leave it (some part farther than twice
   ``rest.radius``: a movement from it, not a hand fidgeting there) and come to rest near it again later: then it
   was a new stance (movements leave it and come back to it), if they had held it a stance's time (``stance``; the
   segmenter's ``STANCE``, 0.2 s). The movement is cut where they first rested there, and the one from it back to it
   follows;
 - or they rest ``settle`` seconds in one place (a new stance they stay in): the movement ends where that rest began.
-  A rest stays in one place: a hold from which some part drifts farther than twice ``rest.radius`` was no rest (a
+  A rest stays in one place: a hold from which some part drifts farther than ``rest.radius`` was no rest (a
   movement slower than a tracker's jitter lets the speed show) and a new hold begins where they are (``still``);
 - or they have rested a stance's time at a hold reached by a shift (below) from a hold before it that lasted as
   long and where the movement had come at least half-way back to its first pose: the movement ended at that hold (a
@@ -27,8 +28,14 @@ ends at the hold. A piece that never leaves where it began (no part farther than
 rest (sway, fidgeting) and is dropped too. So two takes joined through a transition between their stances give the
 two takes, and a stance change between two gestures gives the two gestures.
 
+On a noisy tracker each of these distances is at least what the jitter alone puts between two poses at rest (the
+segmenter's ``near``, from the measured jitter): the radius and twice it are the demonstrator's own, the jitter's
+margin where that is larger. A movement the segmenter found by position (it left its rest slower than the speed
+shows) comes back where it began when it is back at the rest pose it left (``origin``): its first frame already lies
+beyond the jitter's margin from there.
+
 Everything here is bookkeeping on frame numbers and the working memory's poses, called by the segmenter only on the
-frames where the demonstrator comes to rest or leaves it.
+frames where the demonstrator comes to rest or leaves it (:meth:`Rests.places` asks a hold's frames at once).
 """
 
 from __future__ import annotations
@@ -89,7 +96,8 @@ class Rests:
     ``rest.radius`` times the body's size when a movement begins. ``stance``: the frames a hold must last to be a
     stance that movements leave and come back to (shorter: a pause in a gesture, a hand fidgeting). ``smooth``: the
     frames of the moving average the working memory is seen through (the tracker's jitter averaged out) when it is
-    asked whether a piece leaves where it began, is a shift, or comes back to a hold.
+    asked whether a piece leaves where it began, is a shift, or comes back to a hold. ``origin``: the rest pose a
+    movement found by position left (the segmenter sets it; None: the movement's first frame is where it began).
     """
 
     radius: float = 0.0

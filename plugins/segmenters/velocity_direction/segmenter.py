@@ -59,16 +59,24 @@ parameter, off by default (the paper); the observer template (``characters/obser
 - ``end = "rest"``: a rest ends the movement under way only where it is a *hub* of this demonstrator's
   (:mod:`.rests`; K&G §4.2's hub nodes, "typical start states ... in which a complete movement normally starts and
   ends"): near the pose it began from or another rest they were seen in (``rest.radius`` body sizes, eq. 1's mean
-  distance over the chosen parts; poses at rest are compared as their mean over the sensory memory or the line
-  fit's window, so the jitter is averaged out). A rest elsewhere is a *hold* (a bow, a pointing hand held half-way:
-  one movement, not two) unless they leave it and come to rest there again (a new stance: the movement is cut where
-  they first rested there) or rest there ``settle`` seconds, in one place: a hold from which some part drifts
-  farther than twice ``rest.radius`` was no rest (a movement slower than the tracker's jitter lets the speed show)
-  and the rest counts again from there. A straight *shift* from one stance to another is no movement and is
-  dropped, and a piece that never leaves where it began (some part farther than twice ``rest.radius``) is motion
-  at rest (sway, fidgeting), dropped too. ``rest.radius = 0.1``: B&B's hub threshold
-  (0.02 m on Max, 0.20 m body size); ``settle = 2`` s: longer than a gesture holds a pose (about a second), as
-  ``hub-threshold``'s ``settle``. The paper's ``"still"`` (any rest ends it) is the default.
+  distance over the chosen parts, and no part farther than twice that: no part has left it; poses at rest are
+  compared as their mean over the sensory memory or the line fit's window, so the jitter is averaged out). A rest
+  elsewhere is a *hold* (a bow, a pointing hand held half-way: one movement, not two) unless they leave it and come
+  to rest there again (a new stance: the movement is cut where they first rested there) or rest there ``settle``
+  seconds, in one place: a hold from which some part drifts farther than ``rest.radius`` was no rest (a movement
+  slower than the tracker's jitter lets the speed show) and the rest counts again from there. A straight *shift*
+  from one stance to another is no movement and is dropped, and a piece that never leaves where it began (some part
+  farther than twice ``rest.radius``) is motion at rest (sway, fidgeting), dropped too. ``rest.radius = 0.1``:
+  B&B's hub threshold (0.02 m on Max, 0.20 m body size); ``settle = 2`` s: longer than a gesture holds a pose (about
+  a second), as ``hub-threshold``'s ``settle``. The paper's ``"still"`` (any rest ends it) is the default.
+- the onset *by position* (``end = "rest"``): a movement also begins where some part leaves the pose the
+  demonstrator rests in (the mean over the sensory memory, farther than twice ``rest.radius`` from the mean of the
+  same frames where they came to rest), dated back to the first frame it lay farther than the tracker's jitter
+  allows. A line fit's noise grows as its window shortens, a position's does not: a bow slower than a centimetre
+  of jitter lets a third-of-a-second fit tell from rest is found by where the head goes, not by how fast. Every
+  distance here is at least what the jitter alone gives (``jitter`` times the root-mean-square distance between two
+  such means of a part standing still, :meth:`_leaving`): the radius and twice it are the demonstrator's own, the
+  jitter's margin where that is larger.
 
 On locomotion, which never rests, the template's movement level finds no boundary inside a walk: a walk of several
 takes is one movement (closed after ``max_movement`` seconds if it goes on), not one a stride.
@@ -154,7 +162,8 @@ class VelocityDirection(Segmenter):
         Parameter("end", str, "still", "Where a movement ends: at any rest (`still`, the paper) or only at one of "
                   "the demonstrator's own rests (`rest`): near where it began or another rest they were seen in, a "
                   "stance they left and came back to, or after `rest.settle` seconds; a rest elsewhere is a hold, and a "
-                  "straight shift of stance is no movement.", choices=("still", "rest")),
+                  "straight shift of stance is no movement; and a movement also begins where some part leaves their "
+                  "rest (twice `rest.radius`), however slowly.", choices=("still", "rest")),
         Parameter("rest", doc="With end = rest: where the demonstrator's own rests are.", parameters=(
             Parameter("radius", float, 0.1, "How near (eq. 1's mean distance of the chosen parts, in the "
                       "demonstrator's body sizes) a pose at rest must be to one of their rests to be there; twice it, "
