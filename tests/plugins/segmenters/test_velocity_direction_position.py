@@ -10,9 +10,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from plugins.segmenters.velocity_direction import VelocityDirection
-from tests.fixtures.gesture_streams import FPS, bowing, hold, point, stream
-from tests.plugins.segmenters.test_velocity_direction import _in_blocks, _Stepped
-from tests.plugins.segmenters.test_velocity_direction_streams import TEMPLATE, A, scores
+from tests.fixtures.gesture_streams import bowing, hold, point, stream
+from tests.plugins.segmenters.test_velocity_direction_streams import A, scores, walked_and_stepped
 
 
 def slow_bow():
@@ -49,13 +48,7 @@ def test_onsets_by_position_walked_are_their_frames_stepped(seed, cuts, tracker)
     something can happen stepped; the frames where a part leaves the rest pose found for the block at once) closes
     the same segments at the same frames, reports the same onsets and leaves the same state as every frame stepped,
     whatever the packet sizes."""
-    motion, _ = stream(slow_bow(), jitter=tracker, seed=seed)
-    visible = np.isfinite(motion.positions[..., 0])
-    results = []
-    for kind in (VelocityDirection, _Stepped):
-        seg = kind(**TEMPLATE)
-        seg.reset(motion.parts, FPS)
-        got, since = _in_blocks(seg, motion.positions, visible, cuts)
-        rest = None if seg._rest_pose is None else seg._rest_pose.tolist()
-        results.append((got, since, seg.flush(), seg._away, rest, seg._frame))
-    assert results[0] == results[1]
+    walked, stepped = walked_and_stepped(
+        stream(slow_bow(), jitter=tracker, seed=seed)[0], cuts,
+        lambda seg: (seg._away, None if seg._rest_pose is None else seg._rest_pose.tolist(), seg._frame))
+    assert walked == stepped
