@@ -60,12 +60,15 @@ class ClipRepertoire:
     """Clips by movement, the hub poses found from them, and the profile they were read with.
 
     ``folder`` is where the clips were read from (``None``: built in memory); ``hub_radius`` and ``hub_share``
-    the settings the hubs were found with.
+    the settings the hubs were found with; ``worlds`` the clips' world positions as they were given (read from the
+    files, nothing bridged or filtered), one for each clip, which a repertoire with other hub settings is built
+    from again.
     """
 
     profile: BodyProfile
     clips: tuple[Clip, ...]
     hubs: np.ndarray  # (H, P, 3), local frame
+    worlds: tuple[Motion, ...]
     folder: Path | None
     hub_radius: float = 0.06
     hub_share: float = 0.2
@@ -75,12 +78,11 @@ class ClipRepertoire:
         return sorted({c.movement for c in self.clips})
 
     def with_hubs(self, hub_radius: float, hub_share: float) -> ClipRepertoire:
-        """This repertoire with hubs found with other settings (itself when they are its own): the same clips'
-        world positions built again."""
+        """This repertoire with hubs found with other settings (itself when they are its own): built again from the
+        clips' world positions as they were given (:attr:`worlds`)."""
         if (hub_radius, hub_share) == (self.hub_radius, self.hub_share):
             return self
-        worlds = [Motion(c.motion.world, c.motion.fps, c.motion.parts, c.motion.visible) for c in self.clips]
-        return clip_repertoire(worlds, [c.movement for c in self.clips], self.profile,
+        return clip_repertoire(self.worlds, [c.movement for c in self.clips], self.profile,
                                sources=[c.source for c in self.clips], hub_radius=hub_radius, hub_share=hub_share,
                                folder=self.folder)
 
@@ -90,13 +92,15 @@ def root_relative_motion(world: Motion, body: Body, facing_window: float = 1.0) 
     root-relative positions in the body's frame (§5.1): a tracker's short gaps bridged first
     (:func:`plugins.lib.gaps.bridged`) and its jitter filtered out (:func:`plugins.lib.lowpass.low_passed`), the
     facing a centred running median over ``facing_window`` seconds, parts hidden longer held (docs/conventions.md);
-    the world positions as seen (gaps bridged, not filtered: a repertoire rebuilt from them is the same) kept
-    beside them (:attr:`Motion.world`, where the body travels: :mod:`plugins.lib.travel`)."""
+    the world positions the pose was found from (bridged and filtered) kept beside them (:attr:`Motion.world`: where
+    the body travels and how it turns, :mod:`plugins.lib.travel`, read from the same filtered root as the pose).
+    Read the motion as given again, not this one's world positions, to build it once more: they are filtered
+    already."""
     world = bridged(world)
     smooth = low_passed(world, keep=body.angle_mask)
     window = max(1, int(round(facing_window * world.fps)))
     pose, mask, _, _ = root_relative(smooth.positions, smooth.visible, body, RecordingFacing(window))
-    return Motion(pose, world.fps, world.parts, mask, world.positions).filled()
+    return Motion(pose, world.fps, world.parts, mask, smooth.positions).filled()
 
 
 PAIR_BLOCK = 2**22
@@ -192,7 +196,7 @@ def clip_repertoire(motions: Sequence[Motion], labels: Sequence[str], profile: s
     height = _root_height(rel)
     lift = np.array([0.0, height, 0.0])
     clips = tuple(Clip(mv, src, Motion(m.positions + lift, m.fps, m.parts, m.visible, m.world)) for mv, src, m in rel)
-    return ClipRepertoire(profile, clips, hubs_rel + lift, folder, hub_radius, hub_share)
+    return ClipRepertoire(profile, clips, hubs_rel + lift, tuple(motions), folder, hub_radius, hub_share)
 
 
 def _filled(motion: Motion, frame: int) -> np.ndarray:

@@ -62,3 +62,42 @@ def test_the_filter_never_makes_a_frame_seen_nor_moves_a_part_beyond_its_reach(n
     assert np.array_equal(out.visible, motion.visible)
     assert np.isfinite(out.positions[out.visible]).all()
     assert np.abs(out.positions[out.visible]).max() <= 2.0  # a Butterworth's overshoot stays within its ringing
+
+
+PROFILE = """
+[profile]
+name = "person"
+units = "metre"
+up = "+y"
+
+[parts]
+{parts}
+
+[facing]
+root = "hips"
+left = "l_hip"
+right = "r_hip"
+"""
+
+
+def test_a_repertoire_keeps_the_filtered_world_beside_each_clip_and_rebuilds_from_the_motions_as_given(tmp_path):
+    """A clip's world positions are those its pose was found from (bridged, low-passed), so its travel and turning
+    carry no more of a tracker's jitter than its pose; a repertoire built again with other hub settings starts from
+    the motions as they were given, not from the filtered ones (filtered twice, a clip would change)."""
+    from plugins.lib.clip_repertoire import clip_repertoire
+    from tests.fixtures.skeletons import NAMES, human
+    from toolkit.recordings.profile import load_profile
+
+    (tmp_path / "person.toml").write_text(PROFILE.format(parts="\n".join(f'{n} = "{n}"' for n in NAMES)))
+    profile = load_profile(tmp_path / "person.toml")
+    rng = np.random.default_rng(1)
+    given = [Motion(human(m, 90) + rng.normal(0.0, 0.01, (90, len(NAMES), 3)), 30.0, NAMES) for m in ("bow", "wave")]
+    repertoire = clip_repertoire(given, ["bow", "wave"], profile)
+    for clip, motion in zip(repertoire.clips, given):
+        np.testing.assert_array_equal(clip.motion.world, low_passed(motion).positions)
+    assert all(a is b for a, b in zip(repertoire.worlds, given))
+    there_and_back = repertoire.with_hubs(0.2, 0.5).with_hubs(repertoire.hub_radius, 0.3)
+    assert there_and_back.hub_share == 0.3
+    for a, b in zip(repertoire.clips, there_and_back.clips):
+        np.testing.assert_array_equal(a.motion.positions, b.motion.positions)
+        np.testing.assert_array_equal(a.motion.world, b.motion.world)
