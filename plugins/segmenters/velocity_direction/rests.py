@@ -7,14 +7,15 @@ changes it between gestures, and holds poses half-way through a gesture (a bow, 
 movement under way only where it is a hub of this demonstrator:
 
 - near the pose the movement began from, or near any rest they have been seen in (``rest.radius`` body sizes, eq. 1's
-  mean distance over the chosen parts): a rest there ends it where the rest began;
+  mean distance over the chosen parts, and no part farther than twice that: none has left it): a rest there ends it
+  where the rest began;
 - elsewhere the rest is a *hold* and the movement goes on, unless they leave it (some part farther than twice
   ``rest.radius``: a movement from it, not a hand fidgeting there) and come to rest near it again later: then it
   was a new stance (movements leave it and come back to it), if they had held it a stance's time (``stance``; the
   segmenter's ``STANCE``, 0.2 s). The movement is cut where they first rested there, and the one from it back to it
   follows;
 - or they rest ``settle`` seconds in one place (a new stance they stay in): the movement ends where that rest began.
-  A rest stays in one place: a hold from which some part drifts farther than twice ``rest.radius`` was no rest (a
+  A rest stays in one place: a hold from which some part drifts farther than ``rest.radius`` was no rest (a
   movement slower than a tracker's jitter lets the speed show) and a new hold begins where they are (``still``);
 - or they have rested a stance's time at a hold reached by a shift (below) from a hold before it that lasted as
   long and where the movement had come at least half-way back to its first pose: the movement ended at that hold (a
@@ -27,8 +28,14 @@ ends at the hold. A piece that never leaves where it began (no part farther than
 rest (sway, fidgeting) and is dropped too. So two takes joined through a transition between their stances give the
 two takes, and a stance change between two gestures gives the two gestures.
 
+On a noisy tracker each of these distances is at least what the jitter alone puts between two poses at rest (the
+segmenter's ``near``, from the measured jitter): the radius and twice it are the demonstrator's own, the jitter's
+margin where that is larger. A movement the segmenter found by position (it left its rest slower than the speed
+shows) comes back where it began when it is back at the rest pose it left (``origin``): its first frame already lies
+beyond the jitter's margin from there.
+
 Everything here is bookkeeping on frame numbers and the working memory's poses, called by the segmenter only on the
-frames where the demonstrator comes to rest or leaves it.
+frames where the demonstrator comes to rest or leaves it (:meth:`Rests.places` asks a hold's frames at once).
 """
 
 from __future__ import annotations
@@ -89,13 +96,15 @@ class Rests:
     ``rest.radius`` times the body's size when a movement begins. ``stance``: the frames a hold must last to be a
     stance that movements leave and come back to (shorter: a pause in a gesture, a hand fidgeting). ``smooth``: the
     frames of the moving average the working memory is seen through (the tracker's jitter averaged out) when it is
-    asked whether a piece leaves where it began, is a shift, or comes back to a hold.
+    asked whether a piece leaves where it began, is a shift, or comes back to a hold. ``origin``: the rest pose a
+    movement found by position left (the segmenter sets it; None: the movement's first frame is where it began).
     """
 
     radius: float = 0.0
     stance: int = 0
     smooth: int = 1
     keep: int = 8
+    origin: np.ndarray | None = None
     hubs: list[np.ndarray] = field(default_factory=list)
     holds: list[Hold] = field(default_factory=list)
     _stacked: np.ndarray | None = field(default=None, repr=False)  # the hubs (and the hold under way) (k, m, 3)
@@ -104,6 +113,7 @@ class Rests:
         """A movement begins from ``pose`` (3m,), where the demonstrator was: a hub."""
         self.radius = radius
         self.holds = []
+        self.origin = None
         self.hub(pose)
 
     def hub(self, pose: np.ndarray) -> None:
@@ -112,37 +122,57 @@ class Rests:
         self.hubs = [pose] + [h for h in self.hubs if not _apart(h, pose) <= self.radius][: self.keep - 1]
         self._stacked = None
 
-    def at_hub(self, pose: np.ndarray) -> bool:
-        """Whether ``pose`` is near one of the hubs (nothing to compare with: the paper's rule, any rest)."""
-        return self.place(pose)[0]
+    def at_hub(self, pose: np.ndarray, near: float = 0.0) -> bool:
+        """Whether ``pose`` is at one of the hubs: within the radius of it (eq. 1's mean over the parts) and no part
+        having left it (farther than twice the radius, or than ``near`` where that is larger: how far the tracker's
+        jitter alone puts a part from where it rests). Nothing to compare with: the paper's rule, any rest."""
+        return self.place(pose, near)[0]
 
-    def still(self, pose: np.ndarray) -> bool:
-        """Whether ``pose`` (3m,) is still where the hold under way began: no part farther than twice the radius
-        from where it was (what leaving is). A rest stays in one place; one that drifts farther is a movement too
-        slow for the speed to show (a tracker's jitter hides it), not a rest. True with no hold under way."""
-        return self.place(pose)[1]
+    def still(self, pose: np.ndarray, near: float = 0.0) -> bool:
+        """Whether ``pose`` (3m,) is still where the hold under way began: no part farther than the radius from
+        where it was, or than ``near`` where that is larger (how far the tracker's jitter alone puts it). A rest
+        stays in one place; one that drifts farther is a movement too slow for the speed to show (a tracker's
+        jitter hides it), not a rest. True with no hold under way."""
+        return self.place(pose, near)[1]
 
-    def place(self, pose: np.ndarray) -> tuple[bool, bool]:
+    def place(self, pose: np.ndarray, near: float = 0.0) -> tuple[bool, bool]:
         """:meth:`at_hub` and :meth:`still` of ``pose`` (3m,) at once: its distances to the hubs and to the hold
         under way, one array (the segmenter asks both at every frame of a hold)."""
+        hub, still = self.places(np.asarray(pose)[None], np.array([near], dtype=float))
+        return bool(hub[0]), bool(still[0])
+
+    def places(self, poses: np.ndarray, near: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`place` of each of ``poses`` (k, 3m) with its ``near`` (k,): (hub (k,), still (k,)), the same
+        arithmetic pose by pose (a hold's frames are asked at once)."""
+        k = len(poses)
         holding = bool(self.holds) and self.holds[-1].end is None
         if not self.hubs and not holding:
-            return True, True
+            return np.ones(k, bool), np.ones(k, bool)
         if self._stacked is None or len(self._stacked) != len(self.hubs) + holding:
             rows = self.hubs + ([self.holds[-1].pose] if holding else [])
             self._stacked = np.array(rows).reshape(len(rows), -1, 3)
-        apart = self._stacked - np.asarray(pose).reshape(-1, 3)
-        d2 = np.einsum("kmj,kmj->km", apart, apart)  # (hubs [+ the hold], m); NaN: a part not seen in both
-        still = not holding or not bool((d2[-1] > 4.0 * self.radius * self.radius).any())  # NaN: not counted
+        apart = self._stacked[None] - np.asarray(poses).reshape(k, 1, -1, 3)
+        d2 = (apart * apart).sum(axis=3)  # (k, hubs [+ the hold], m); NaN: a part not seen in both
+        if holding:
+            drift = np.maximum(self.radius, near)
+            with np.errstate(invalid="ignore"):
+                still = ~(d2[:, -1] > (drift * drift)[:, None]).any(axis=1)  # NaN: not counted
+        else:
+            still = np.ones(k, bool)
         if not self.hubs:
-            return True, still
-        d = np.sqrt(d2[: len(self.hubs)])
-        if np.isfinite(d).all():  # eq. 1: the mean over the parts (np.mean's sum and division, without its overhead)
-            return float(np.add.reduce(d, axis=1).min()) / d.shape[1] <= self.radius, still
+            return np.ones(k, bool), still
+        d2 = d2[:, : len(self.hubs)]
+        left = np.maximum(2.0 * self.radius, near)[:, None]
+        if np.isfinite(d2).all():  # eq. 1: the mean over the parts (np.mean's sum and division, without its overhead)
+            at = (np.add.reduce(np.sqrt(d2), axis=2) / d2.shape[2] <= self.radius) & (d2.max(axis=2) <= left * left)
+            return at.any(axis=1), still
         with np.errstate(all="ignore"):
-            near = np.nanmean(np.where(np.isfinite(d), d, np.nan), axis=1)  # eq. 1 over the parts seen in both
-        near = near[np.isfinite(near)]
-        return not near.size or float(near.min()) <= self.radius, still
+            seen = np.isfinite(d2)
+            mean = np.nanmean(np.where(seen, np.sqrt(d2), np.nan), axis=2)  # eq. 1 over the parts seen in both
+            farthest = np.where(seen, d2, -np.inf).max(axis=2)
+            compared = np.isfinite(mean)
+            at = ((mean <= self.radius) & (farthest <= left * left) & compared).any(axis=1)
+        return at | ~compared.any(axis=1), still
 
     def returned(self, pose: np.ndarray, start: int, window: np.ndarray) -> int | None:
         """The index of the last finished hold near ``pose`` that the demonstrator held a stance's time, left (some
@@ -181,7 +211,9 @@ class Rests:
         holds = [h for h in self.holds[:upto] if h.end is not None and start < h.start and h.end < end]
         if not self.leaves(window[: end - start]):  # motion at rest (sway, a hand fidgeting): no movement
             return []
-        if _apart(window[0], window[end - start - 1]) <= self.radius:  # back where it began: no shift
+        last = self.seen(window[: end - start])[-1]  # the jitter averaged out
+        first = self.origin if self.origin is not None else self.seen(window[:1])[0]
+        if _apart(first, last) <= self.radius:  # back where it began: no shift
             return [(start, end)]
         if shifts and self.shift(window[: end - start]):
             return []

@@ -59,16 +59,24 @@ parameter, off by default (the paper); the observer template (``characters/obser
 - ``end = "rest"``: a rest ends the movement under way only where it is a *hub* of this demonstrator's
   (:mod:`.rests`; K&G §4.2's hub nodes, "typical start states ... in which a complete movement normally starts and
   ends"): near the pose it began from or another rest they were seen in (``rest.radius`` body sizes, eq. 1's mean
-  distance over the chosen parts; poses at rest are compared as their mean over the sensory memory or the line
-  fit's window, so the jitter is averaged out). A rest elsewhere is a *hold* (a bow, a pointing hand held half-way:
-  one movement, not two) unless they leave it and come to rest there again (a new stance: the movement is cut where
-  they first rested there) or rest there ``settle`` seconds, in one place: a hold from which some part drifts
-  farther than twice ``rest.radius`` was no rest (a movement slower than the tracker's jitter lets the speed show)
-  and the rest counts again from there. A straight *shift* from one stance to another is no movement and is
-  dropped, and a piece that never leaves where it began (some part farther than twice ``rest.radius``) is motion
-  at rest (sway, fidgeting), dropped too. ``rest.radius = 0.1``: B&B's hub threshold
-  (0.02 m on Max, 0.20 m body size); ``settle = 2`` s: longer than a gesture holds a pose (about a second), as
-  ``hub-threshold``'s ``settle``. The paper's ``"still"`` (any rest ends it) is the default.
+  distance over the chosen parts, and no part farther than twice that: no part has left it; poses at rest are
+  compared as their mean over the sensory memory or the line fit's window, so the jitter is averaged out). A rest
+  elsewhere is a *hold* (a bow, a pointing hand held half-way: one movement, not two) unless they leave it and come
+  to rest there again (a new stance: the movement is cut where they first rested there) or rest there ``settle``
+  seconds, in one place: a hold from which some part drifts farther than ``rest.radius`` was no rest (a movement
+  slower than the tracker's jitter lets the speed show) and the rest counts again from there. A straight *shift*
+  from one stance to another is no movement and is dropped, and a piece that never leaves where it began (some part
+  farther than twice ``rest.radius``) is motion at rest (sway, fidgeting), dropped too. ``rest.radius = 0.1``:
+  B&B's hub threshold (0.02 m on Max, 0.20 m body size); ``settle = 2`` s: longer than a gesture holds a pose (about
+  a second), as ``hub-threshold``'s ``settle``. The paper's ``"still"`` (any rest ends it) is the default.
+- the onset *by position* (``end = "rest"``): a movement also begins where some part leaves the pose the
+  demonstrator rests in (the mean over the sensory memory, farther than twice ``rest.radius`` from the mean of the
+  same frames where they came to rest), dated back to the first frame it lay farther than the tracker's jitter
+  allows. A line fit's noise grows as its window shortens, a position's does not: a bow slower than a centimetre
+  of jitter lets a third-of-a-second fit tell from rest is found by where the head goes, not by how fast. Every
+  distance here is at least what the jitter alone gives (``jitter`` times the root-mean-square distance between two
+  such means of a part standing still, :meth:`_leaving`): the radius and twice it are the demonstrator's own, the
+  jitter's margin where that is larger.
 
 On locomotion, which never rests, the template's movement level finds no boundary inside a walk: a walk of several
 takes is one movement (closed after ``max_movement`` seconds if it goes on), not one a stride.
@@ -154,7 +162,8 @@ class VelocityDirection(Segmenter):
         Parameter("end", str, "still", "Where a movement ends: at any rest (`still`, the paper) or only at one of "
                   "the demonstrator's own rests (`rest`): near where it began or another rest they were seen in, a "
                   "stance they left and came back to, or after `rest.settle` seconds; a rest elsewhere is a hold, and a "
-                  "straight shift of stance is no movement.", choices=("still", "rest")),
+                  "straight shift of stance is no movement; and a movement also begins where some part leaves their "
+                  "rest (twice `rest.radius`), however slowly.", choices=("still", "rest")),
         Parameter("rest", doc="With end = rest: where the demonstrator's own rests are.", parameters=(
             Parameter("radius", float, 0.1, "How near (eq. 1's mean distance of the chosen parts, in the "
                       "demonstrator's body sizes) a pose at rest must be to one of their rests to be there; twice it, "
@@ -217,8 +226,8 @@ class VelocityDirection(Segmenter):
         self._still = max(self._memory, window)  # end = rest: poses are compared as the mean of this many frames
         pause = int(round(self.params["pause"] * self._fps))
         self._history: deque[np.ndarray] = deque(maxlen=max(2 * self._memory + 2, widest) + (widest - 1) // 2
-                                                 + pause // 2 + self._still)  # the sensory memory (and what an
-        # onset goes back to)
+                                                 + pause // 2 + self._still + int(round(self._fps)))  # the sensory
+        # memory, and what an onset goes back to (one by position: up to a second)
         self._last: tuple[int, int, np.ndarray] | None = None  # the last movement closed: start, end, working memory
         self._done = 0  # the end of the last movement reported: a movement begins no earlier
         self._analysis: StrokeAnalysis | None = None
@@ -235,6 +244,10 @@ class VelocityDirection(Segmenter):
         # end = rest: the hubs and holds
         self._holding = False  # end = rest: the rest under way is a hold (away from the hubs)
         self._drift = -(1 << 62)  # end = rest: the frame the rest under way counts from, if it drifted
+        self._rest_pose: np.ndarray | None = None  # end = rest: where the demonstrator rests between movements
+        self._away = 0  # end = rest: frames the parts have been farther from it than the tracker's jitter allows
+        self._recent = self._near = self._leave = np.zeros(0)  # end = rest: the block's poses and margins (_leaving)
+        self._whole = np.zeros(0, bool)
         self._settle = max(1, int(round(self.params["rest"]["settle"] * self._fps)))
 
     @property
@@ -280,12 +293,13 @@ class VelocityDirection(Segmenter):
         sigma = self._jitter.update(flat) if self._jitter is not None else None
         floors = (p["jitter"] * speed_noise(sigma, self._weights if self._weights is not None else self._displacement)
                   if sigma is not None else np.zeros(n))
-        if p["units"] == "body":  # every frame's size at once (the running mean takes some of them)
-            sizes = (body_scale(poses, self._positions) if len(self._positions) == poses.shape[1]
-                     else body_scale(poses)).tolist()
-        else:
-            sizes = [None] * n
+        scale = None  # every frame's body size at once (the running mean takes some of them; end = rest: leaving)
+        if p["units"] == "body" or self._rests is not None:
+            scale = body_scale(poses, self._positions) if len(self._positions) == poses.shape[1] else body_scale(poses)
+        sizes = scale.tolist() if p["units"] == "body" else [None] * n
         lags = np.full(n, self._lag)
+        if self._rests is not None:
+            self._leaving(rows, before, scale, sigma)
         walk = not self._pause and not p["noise"] > 0  # the rest speed known for the block at once
         own = self._own_rests(sizes) if walk or self._longer else None  # once for the block: stretch and _walk
         if self._longer:  # stretch: a longer line fit where the tracker's jitter hides the rest speed
@@ -343,7 +357,7 @@ class VelocityDirection(Segmenter):
             self._frame += 1
             self._history.append(flat[f])
             closed.extend((f, s) for s in self._step(poses[f], flat[f], float(speeds[f]), floor, sizes[f],
-                                                     int(lags[f])))
+                                                     int(lags[f]), f))
             if self._start is not None:
                 since[f] = self._start
         return closed, since
@@ -395,11 +409,18 @@ class VelocityDirection(Segmenter):
         while f < n:
             if self._start is None:
                 e = int(onsets[np.searchsorted(onsets, f)]) if np.searchsorted(onsets, f) < len(onsets) else n
+                if self._rests is not None:  # or where the parts leave the rest pose (_left_rest)
+                    e = self._next_left(f, e)
             else:
-                e = min(int(rests[np.searchsorted(rests, f)]) if np.searchsorted(rests, f) < len(rests) else n,
-                        int(onsets[np.searchsorted(onsets, f)]) if self._holding and
+                i = np.searchsorted(rests, f)
+                e = min(int(onsets[np.searchsorted(onsets, f)]) if self._holding and
                         np.searchsorted(onsets, f) < len(onsets) else n,
                         max(f, self._start + longest - first) if longest else n)
+                if self._holding and i < len(rests) and rests[i] < e:  # a hold's frames where it just goes on
+                    j = i + int(np.searchsorted(rests[i:], e))
+                    e = min(e, self._holds_on(rests[i:j], resting, first, e))
+                else:
+                    e = min(e, int(rests[i]) if i < len(rests) else n)
                 self._buffer.extend(flat[f:e])
                 since[f:e] = self._start
             if e >= n:
@@ -409,12 +430,36 @@ class VelocityDirection(Segmenter):
             self._history.append(flat[e])
             pushed = e + 1
             closed.extend((e, s) for s in self._step(poses[e], flat[e], float(speeds[e]), float(floors[e]), sizes[e],
-                                                     int(lags[e])))
+                                                     int(lags[e]), e))
             if self._start is not None:
                 since[e] = self._start
             f = e + 1
         upto(n)
         return closed, since
+
+    def _holds_on(self, frames: np.ndarray, resting: np.ndarray, first: int, e: int) -> int:
+        """The first of a hold's rest ``frames`` (block frames, before ``e``) where :meth:`_rested` does more than
+        let the hold go on (it drifts, is at a hub, has lasted ``rest.settle`` or a stance's time), or ``e``;
+        ``resting``: the counts of frames at the rest speed of the block's frames."""
+        if not len(frames):
+            return e
+        rests = self._rests
+        here = np.minimum(resting[frames], first + frames - self._drift)
+        if len(rests.holds) < 2:
+            pending = here >= self._settle
+        else:
+            pending = (here >= self._settle) | (here == max(self._memory, self._pause) + rests.stance)
+        pending |= ~self._whole[frames]  # no mean of the block's rows yet: stepped
+        a, size = 0, 8
+        while a < len(frames):  # in chunks of growing size: the hold is most often left or drifts soon
+            b = min(len(frames), a + size)
+            chunk = frames[a:b]
+            hub, still = rests.places(self._recent[chunk], self._near[chunk])
+            event = np.flatnonzero(pending[a:b] | hub | ~still)
+            if len(event):
+                return int(chunk[event[0]])
+            a, size = b, 2 * size
+        return e
 
     @property
     def _displacement(self) -> np.ndarray:
@@ -499,7 +544,7 @@ class VelocityDirection(Segmenter):
         return closed, since
 
     def _step(self, pose: np.ndarray, points: np.ndarray, speed: float, floor: float = 0.0,
-              size: float | None = None, fit_lag: int | None = None) -> list[Segment]:
+              size: float | None = None, fit_lag: int | None = None, at: int | None = None) -> list[Segment]:
         """One frame after its sensory memory was updated: ``points`` are the chosen parts (3m,), ``speed`` the
         fastest one's over the sensory memory (NaN: none seen, or not enough frames yet), ``floor`` the least rest
         speed the tracker's jitter allows (``jitter``), ``fit_lag`` the delay of the line fit that measured the
@@ -539,8 +584,86 @@ class VelocityDirection(Segmenter):
                 began = max(self._start + 1, self._frame - self._here() + 1 - self._memory // 2 - lag)
                 if self.params["end"] == "still":
                     return cut + self._close(began)
+                if at is not None:  # the pose at rest (_held(1)) as the block's means have it, as _walk reads it
+                    points = self._recent[at] if self._whole[at] else self._held(1)
+                    return cut + self._rested(began, points, float(self._near[at]))
                 return cut + self._rested(began, self._held(1))
+        if self._rests is not None and at is not None:
+            self._left_rest(pose, at)
         return cut
+
+    def _leaving(self, rows: np.ndarray, before: int, scale: np.ndarray, sigma: np.ndarray | None) -> None:
+        """With ``end = "rest"``: each block frame's pose seen through the mean of its last ``_still`` frames (NaN
+        before there are as many), how far a part of it may lie from the rest pose for the tracker's jitter alone
+        (``jitter`` times the root-mean-square distance between two such means of a part standing still), and how
+        far leaving is (twice ``rest.radius`` times the body's size in each frame, ``scale``); ``rows``: the ``before``
+        rows of the sensory memory, then the block's; ``sigma``: the measured jitter (None: not measured)."""
+        n, w = len(scale), self._still
+        recent = np.full((n, rows.shape[1]), np.nan)
+        at = np.arange(n) + before - (w - 1)
+        whole = at >= 0  # the frames with as many rows before them
+        if whole.any():
+            means = np.lib.stride_tricks.sliding_window_view(rows, w, axis=0).mean(axis=-1)  # row j: rows j..j+w-1
+            recent[whole] = means[at[whole]]
+        self._recent, self._whole = recent, whole
+        jitter = np.zeros(n) if sigma is None else np.asarray(sigma)
+        self._near = self.params["jitter"] * jitter * np.sqrt(3.0 * 2.0 / w)
+        self._leave = 2.0 * self.params["rest"]["radius"] * np.asarray(scale, dtype=float)
+
+    def _farthest(self, poses: np.ndarray) -> np.ndarray:
+        """The farthest any chosen part of each pose (N, 3m) lies from the rest pose (N,); NaN: none seen in both."""
+        apart = (poses.reshape(len(poses), -1, 3) - self._rest_pose.reshape(-1, 3))
+        d = np.sqrt((apart * apart).sum(axis=2))
+        finite = np.isfinite(d)
+        return np.where(finite.any(axis=1), np.where(finite, d, -np.inf).max(axis=1), np.nan)
+
+    def _left_rest(self, pose: np.ndarray, at: int) -> None:
+        """With ``end = "rest"`` and no movement under way, after block frame ``at`` was stepped: the onset by
+        position. A movement begins where some part has left the pose the demonstrator rests in (farther than
+        twice ``rest.radius`` and than the tracker's jitter allows, ``_near``), dated back to the first of the frames
+        it has lain beyond the jitter's margin since. The speed misses a movement slower than the jitter lets a line
+        fit show; the position does not (its noise does not grow as the fit shortens)."""
+        if self._start is not None:
+            self._away = 0
+            return
+        recent = self._recent[at]
+        if self._rest_pose is None:
+            if np.isfinite(recent).any():
+                self._rest_pose, self._away = recent.copy(), 0
+            return
+        d = float(self._farthest(recent[None])[0])
+        if not d > self._near[at]:
+            self._away = 0
+            return
+        self._away += 1
+        if d > self._leave[at]:
+            start = max(self._done, self._frame - min(self._away, len(self._history)) + 1)
+            self._start = start
+            self._buffer = list(self._history)[-(self._frame - start + 1):]
+            self._began(pose, self._rest_pose)
+            self._rests.origin = self._rest_pose  # its first frame lies beyond the jitter's margin from there already
+            self._drift = self._frame  # a rest under way before the onset is not the movement's end
+            self._away = 0
+
+    def _next_left(self, f: int, e: int) -> int:
+        """With ``end = "rest"`` and no movement under way from block frame ``f``: the first frame before ``e`` where
+        :meth:`_left_rest` can begin a movement or sets the rest pose (``e`` if none), ``_away`` as the frames before
+        it left it."""
+        if e <= f:
+            return e
+        recent = self._recent[f:e]
+        if self._rest_pose is None:
+            seen = np.flatnonzero(np.isfinite(recent).any(axis=1))
+            return f + int(seen[0]) if len(seen) else e
+        d = self._farthest(recent)
+        over = d > self._near[f:e]
+        leaves = np.flatnonzero(over & (d > self._leave[f:e]))
+        g = f + int(leaves[0]) if len(leaves) else e
+        k = g - f  # the frames before g
+        if k:
+            below = np.flatnonzero(~over[:k])
+            self._away = k - 1 - int(below[-1]) if len(below) else self._away + k
+        return g
 
     def _here(self) -> int:
         """The frames the demonstrator has rested in one place (``end = "rest"``): since they last moved, or since
@@ -565,7 +688,7 @@ class VelocityDirection(Segmenter):
         self._rests.began(points, self.params["rest"]["radius"] * float(size))
         self._holding = False
 
-    def _rested(self, began: int, points: np.ndarray) -> list[Segment]:
+    def _rested(self, began: int, points: np.ndarray, near: float = 0.0) -> list[Segment]:
         """With ``end = "rest"``: the demonstrator has rested since ``began`` with the chosen parts at ``points``
         (3m,) while a movement is under way. Near a hub, or after ``settle`` seconds, it ends there; back at a hold
         of the movement's, the movement is cut where that hold began and the one from it back to it follows; held a
@@ -573,7 +696,7 @@ class VelocityDirection(Segmenter):
         hold; else the rest is a hold and the movement goes on (:mod:`.rests`)."""
         rests = self._rests
         start = self._start
-        hub, still = rests.place(points)
+        hub, still = rests.place(points, near)
         if self._holding and not still:  # it drifted away: no rest, a new hold begins here
             fresh = max(self._memory, self._pause)
             began = max(start + 1, began + self._here() - fresh)
@@ -669,6 +792,8 @@ class VelocityDirection(Segmenter):
                                else reason) for u, v in zip(edges, edges[1:]) if v > u)
         if end - start >= 2:
             self._done = end
+        if self._rests is not None:
+            self._rest_pose, self._away = self._held(1), 0
         return out
 
     def analyse(self, window: np.ndarray) -> StrokeAnalysis:

@@ -242,17 +242,36 @@ def test_a_slow_rise_under_two_centimetres_of_jitter_is_no_rest():
 
 
 def test_a_hold_that_drifts_is_still_no_longer():
-    """``Rests.still``: a pose is still where the hold under way began until some part is farther than twice the
-    radius from where it was there; with no hold under way (none, or the last one left) every pose is."""
+    """``Rests.still``: a pose is still where the hold under way began until some part is farther than the radius
+    from where it was there, or than the tracker's jitter allows (``near``) where that is larger; with no hold under
+    way (none, or the last one left) every pose is."""
     rests = Rests(radius=0.05)
     pose = np.zeros(6)
     assert rests.still(pose + 1.0)  # no hold
     rests.hold(10, pose)
-    assert rests.still(pose + np.array([0.0, 0.0, 0.0, 0.09, 0.0, 0.0]))  # one part 9 cm away: still there
-    assert not rests.still(pose + np.array([0.0, 0.0, 0.0, 0.11, 0.0, 0.0]))  # 11 cm: drifted
+    assert rests.still(pose + np.array([0.0, 0.0, 0.0, 0.045, 0.0, 0.0]))  # one part 4.5 cm away: still there
+    assert not rests.still(pose + np.array([0.0, 0.0, 0.0, 0.06, 0.0, 0.0]))  # 6 cm: drifted
+    assert rests.still(pose + np.array([0.0, 0.0, 0.0, 0.06, 0.0, 0.0]), near=0.08)  # within the jitter's margin
+    assert not rests.still(pose + np.array([0.0, 0.0, 0.0, 0.09, 0.0, 0.0]), near=0.08)
     assert rests.still(pose + np.array([np.nan, 0.0, 0.0, 0.01, 0.0, 0.0]))  # a part not seen is not counted
     rests.left(20)
     assert rests.still(pose + 1.0)  # the hold was left: nothing to drift from
+
+
+def test_at_a_hub_no_part_has_left_it():
+    """``Rests.at_hub``: near a hub on average (eq. 1's mean within the radius) and no part farther than twice the
+    radius (or the jitter's margin, if larger): a hand 12 cm out with the other parts home has left the rest, though
+    the mean over the parts is within the radius."""
+    rests = Rests(radius=0.05)
+    rests.began(np.zeros(12), 0.05)
+    hand_out = np.zeros(12)
+    hand_out[9] = 0.12  # one part of four 12 cm away: mean 3 cm
+    assert rests.at_hub(np.full(12, 0.01))
+    assert not rests.at_hub(hand_out)
+    assert rests.at_hub(hand_out, near=0.15)  # a tracker that jitters that much cannot tell
+    hidden = hand_out.copy()
+    hidden[:3] = np.nan  # a part not seen is not counted
+    assert not rests.at_hub(hidden)
 
 
 @given(seed=st.integers(0, 1000), cuts=st.lists(st.integers(1, 60), min_size=1, max_size=8))
@@ -261,13 +280,21 @@ def test_a_drifting_hold_walked_is_its_frames_stepped(seed, cuts):
     """The slow rise under 2 cm of jitter, where holds drift and count again: the block walked (only the frames
     where something can happen stepped) closes the same segments at the same frames as every frame stepped,
     whatever the packet sizes."""
-    motion, _ = stream(slow_rise(), jitter=0.02, seed=seed)
+    walked, stepped = walked_and_stepped(stream(slow_rise(), jitter=0.02, seed=seed)[0], cuts,
+                                         lambda seg: (seg._drift, seg._frame))
+    assert walked == stepped
+    assert walked[-1][0] > 0  # a hold drifted
+
+
+def walked_and_stepped(motion, cuts, state):
+    """The template on ``motion`` pushed in blocks of ``cuts`` frames, walked (:class:`VelocityDirection`) and with
+    every frame stepped (:class:`_Stepped`): for each, the segments closed (with the frame that closed them), the
+    onsets, what ``flush`` closes and ``state(segmenter)`` after it."""
     visible = np.isfinite(motion.positions[..., 0])
     results = []
     for kind in (VelocityDirection, _Stepped):
         seg = kind(**TEMPLATE)
         seg.reset(motion.parts, FPS)
         got, since = _in_blocks(seg, motion.positions, visible, cuts)
-        results.append((got, since, seg.flush(), seg._drift, seg._frame))
-    assert results[0] == results[1]
-    assert results[0][3] > 0  # a hold drifted
+        results.append((got, since, seg.flush(), state(seg)))
+    return results
