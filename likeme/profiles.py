@@ -520,7 +520,11 @@ def propose_profile(names: Sequence[str], positions: np.ndarray, *, parents: Seq
     candidates = [("nose", None)] if "nose" in mapping else []
     facing = _choose_facing(parts, pair, candidates, world, seen)
     chosen, flips = facing
-    body_facing = Facing(pair[0], pair[1], *chosen)
+    # the shoulders beside the hips, where both are seen in most frames: the line across the body from the two, each
+    # counting by its length, turns less with a tracker's jitter than the hips alone (docs/formats.md)
+    trunk = [TRUNK_PAIR] if pair == ("left_hip", "right_hip") and TRUNK_PAIR in pairs \
+        and both[pairs.index(TRUNK_PAIR)] >= 0.5 else []
+    body_facing = Facing(pair[0], pair[1], *chosen, also=tuple(trunk))
     if flips > FLIP_RATE * max(len(world) - 1, 1):
         todo.append(f"the facing flips in {flips} of {len(world)} frames with every marker tried")
         facing_note = f"TODO: {todo[-1]}"
@@ -557,6 +561,8 @@ PERSON_HEIGHT = (1.0, 2.3)
 no known scheme when another unit would make it one (a proposal cannot tell an inch file of a person from a small
 body in centimetres)."""
 _PERSON_UNITS = ((1.0, "metre"), (0.01, "centimetre"), (0.001, "millimetre"), (0.0254, "inch"))
+TRUNK_PAIR = ("left_shoulder", "right_shoulder")
+"""The pair a proposal adds beside the hips for the line across the body (:class:`toolkit.body.Facing` ``also``)."""
 FLOOR_OFFSET = 0.1
 """A floor further than this (m) from ``y = 0`` is proposed as the profile's ``floor``."""
 
@@ -677,7 +683,12 @@ def _format(name: str, source: str, scheme: str | None, units: str, units_note: 
               "[facing]"]
     if facing_note:
         lines.append(f"# {facing_note}")
-    lines += [f"left = {q(facing.left)}", f"right = {q(facing.right)}"]
+    if facing.also:
+        lines.append("# the hips and the shoulders: the line across the body from both turns less with a tracker's jitter")
+        lines += [f"left = [{', '.join(q(a) for a, _ in facing.pairs)}]",
+                  f"right = [{', '.join(q(b) for _, b in facing.pairs)}]"]
+    else:
+        lines += [f"left = {q(facing.left)}", f"right = {q(facing.right)}"]
     if facing.forward:
         lines.append(f"forward = {q(facing.forward)}")
     if facing.behind:

@@ -144,9 +144,9 @@ def test_validate_warns_for_a_profile_with_the_wrong_up_axis(tmp_path, capsys, b
 
 def test_validate_names_the_frames_where_the_facing_flips(tmp_path, capsys):
     clip = write_skeleton_bvh(tmp_path / "swing.bvh", BANDAI_SKELETON, human("rest", 240, swing=True), scale=100.0)
-    profile = proposed(tmp_path, capsys, clip)  # the proposal's facing (the hips) stays steady
+    profile = proposed(tmp_path, capsys, clip)  # the proposal's facing (the hips and the shoulders) stays steady
     text = profile.read_text()
-    assert 'left = "left_hip"' in text
+    assert 'left = ["left_hip", "left_shoulder"]' in text and 'right = ["right_hip", "right_shoulder"]' in text
     wrong = tmp_path / "wrong.toml"  # the left hand swings in front of the body and behind it: a bad forward marker
     assert "\nforward =" not in text
     wrong.write_text(text + 'forward = "left_wrist"\n')

@@ -86,6 +86,8 @@ def test_the_proposal_names_the_schemes_root_units_and_parts(tmp_path, capsys, c
         assert parts[part] == joint, part
     for part in ("head" if "head" in parts else "nose", "left_hip", "right_hip", "left_shoulder", "right_shoulder"):
         assert part in parts  # the head and both hips kept, not dropped for a root
+    # the line across the body from the hips and the shoulders (every scheme here has both, seen in every frame)
+    assert profile.body.facing.pairs == (("left_hip", "right_hip"), ("left_shoulder", "right_shoulder"))
     assert profile.floor == pytest.approx(expected.get("floor", 0.0), abs=0.02)
     assert not [line for line in err if line.startswith("likeme: warning")], err
     # read through it, the body stands on the floor, upright, a person's height
@@ -172,3 +174,14 @@ def test_an_upright_body_of_no_known_scheme_names_the_unit_that_makes_it_a_perso
     assert "if it is a person: inch would make it 1.58 m" in units_line  # head to toes: 1.6 - 0.02
     metres = propose_profile(names, positions, parents=parents).text
     assert "if it is a person" not in metres
+
+
+def test_shoulders_seen_in_few_frames_leave_the_line_across_to_the_hips(tmp_path, capsys):
+    """The shoulders join the hips only where both are seen together in most frames."""
+    pose = performance(["wave", "bow"])
+    for point in ("l_shoulder", "r_shoulder"):
+        pose[: int(0.7 * len(pose)), NAMES.index(point)] = np.nan  # lost for 70% of the frames
+    take = write_skeleton_csv(tmp_path / "take.csv", fixture.KINECT_V2, pose, up="+y")
+    profile, text, _ = _propose(capsys, tmp_path, take)
+    assert profile.body.facing.pairs == (("left_hip", "right_hip"),)
+    assert 'left = "left_hip"' in text
