@@ -685,12 +685,5 @@ def _format(name: str, source: str, scheme: str | None, units: str, units_note: 
         lines.append(f"# {facing_note}")
     if facing.also:
         lines.append("# the hips and the shoulders: the line across the body from both turns less with a tracker's jitter")
-        lines += [f"left = [{', '.join(q(a) for a, _ in facing.pairs)}]",
-                  f"right = [{', '.join(q(b) for _, b in facing.pairs)}]"]
-    else:
-        lines += [f"left = {q(facing.left)}", f"right = {q(facing.right)}"]
-    if facing.forward:
-        lines.append(f"forward = {q(facing.forward)}")
-    if facing.behind:
-        lines.append(f"behind = {q(facing.behind)}")
+    lines += [f"{key} = {q(value)}" for key, value in facing.table().items()]
     return "\n".join(lines) + "\n"

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from plugins.matchers.comparison import Comparison, Frames
-from plugins.matchers.warping import Chains, warp_chains
+from plugins.matchers.warping import Chains, kept, kept_chains, warp_chains
 
 __all__ = ["Paced", "TEMPO", "paced_distances", "paced_scores", "paces"]
 
@@ -80,20 +80,12 @@ def paced_distances(comparison: Comparison, samples: Frames, nodes: Frames, chai
                     skip: np.ndarray | None = None) -> Paced:
     """Every chain against the demonstration ``samples`` at the chain's own tempo (see the module); ``nodes``: the
     frames of every chain, chain after chain; ``skip`` (C,) bool: chains left out."""
-    keep = np.ones(len(chains), dtype=bool) if skip is None else ~np.asarray(skip, dtype=bool)
+    keep = kept(chains, skip)
     scores, distances = np.full(len(chains), np.inf), np.full(len(chains), np.inf)
     pace = np.ones(len(chains))
     if len(samples) == 0 or not keep.any():
         return Paced(scores, distances, pace, None)
-    lengths = np.diff(chains.starts)
-    if keep.all():
-        columns = None
-        starts, cyclic, frames = chains.starts, chains.cyclic, nodes
-    else:
-        kept = np.flatnonzero(keep)
-        columns = np.concatenate([np.arange(chains.starts[c], chains.starts[c + 1]) for c in kept])
-        starts = np.concatenate([[0], np.cumsum(lengths[kept])]).astype(np.intp)
-        cyclic, frames = chains.cyclic[kept], nodes.take(columns)
+    frames, starts, cyclic, columns = kept_chains(nodes, chains, keep)
     paired = comparison.paired(samples, frames)
     cost = paired.at(1.0)
     found, _, advanced = warp_chains(cost, starts, cyclic)

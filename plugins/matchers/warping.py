@@ -29,8 +29,8 @@ from plugins.lib.compiled import kernel
 from plugins.matchers.comparison import Comparison, Frames
 from plugins.matchers.decision import Calibration
 
-__all__ = ["Chains", "Warping", "chain_calibration", "chain_distances", "chain_path", "relative_distances",
-           "warp_chains"]
+__all__ = ["Chains", "Warping", "chain_calibration", "chain_distances", "chain_path", "kept", "kept_chains",
+           "relative_distances", "warp_chains"]
 
 
 @dataclass(frozen=True)
@@ -143,21 +143,32 @@ def chain_distances(comparison: Comparison, samples: Frames, nodes: Frames, chai
 
     ``nodes``: the frames of every node of the chains, in chain order (``Frames.join`` of the takes'); ``skip``
     (C,) bool: chains left out (infinite)."""
-    keep = np.ones(len(chains), dtype=bool) if skip is None else ~np.asarray(skip, dtype=bool)
+    keep = kept(chains, skip)
     best = np.full(len(chains), np.inf)
     if len(samples) == 0 or not keep.any():
         return best, None
-    if keep.all():
-        cost, starts, cyclic = comparison.costs(samples, nodes), chains.starts, chains.cyclic
-    else:
-        kept = np.flatnonzero(keep)
-        columns = np.concatenate([np.arange(chains.starts[c], chains.starts[c + 1]) for c in kept])
-        cost = comparison.costs(samples, nodes.take(columns))
-        starts = np.concatenate([[0], np.cumsum(np.diff(chains.starts)[kept])]).astype(np.intp)
-        cyclic = chains.cyclic[kept]
+    frames, starts, cyclic, _ = kept_chains(nodes, chains, keep)
+    cost = comparison.costs(samples, frames)
     found, _, _ = warp_chains(cost, starts, cyclic)
     best[keep] = found
     return best, cost
+
+
+def kept(chains: Chains, skip: np.ndarray | None) -> np.ndarray:
+    """The chains not left out (C,) bool; ``skip`` (C,) bool: chains left out (``None``: none)."""
+    return np.ones(len(chains), dtype=bool) if skip is None else ~np.asarray(skip, dtype=bool)
+
+
+def kept_chains(nodes: Frames, chains: Chains, keep: np.ndarray
+                ) -> tuple[Frames, np.ndarray, np.ndarray, np.ndarray | None]:
+    """The chains ``keep`` (C,) bool as a warping takes them: their frames, their starts (K + 1,) and whether each
+    loops (K,), and the columns of ``nodes`` they are (``None``: every chain, ``nodes`` itself)."""
+    if keep.all():
+        return nodes, chains.starts, chains.cyclic, None
+    which = np.flatnonzero(keep)
+    columns = np.concatenate([np.arange(chains.starts[c], chains.starts[c + 1]) for c in which])
+    starts = np.concatenate([[0], np.cumsum(np.diff(chains.starts)[which])]).astype(np.intp)
+    return nodes.take(columns), starts, chains.cyclic[which], columns
 
 
 def warp_chains(cost: np.ndarray, starts: np.ndarray, cyclic: np.ndarray
