@@ -6,6 +6,8 @@
   make them seem to move;
 - :mod:`.rests`: where a movement ends when the demonstrator's rest is their own (``end = "rest"``): near where it
   began or another rest they were seen in, a hold half-way, a new stance and the shift into it.
+- :mod:`.departure`: where a movement begins by position (``end = "rest"``): where some part leaves the pose the
+  demonstrator rests in, however slowly.
 """
 
 from plugins.segmenters.velocity_direction.segmenter import VelocityDirection, likeme_register_segmenters

@@ -75,7 +75,7 @@ parameter, off by default (the paper); the observer template (``characters/obser
   allows. A line fit's noise grows as its window shortens, a position's does not: a bow slower than a centimetre
   of jitter lets a third-of-a-second fit tell from rest is found by where the head goes, not by how fast. Every
   distance here is at least what the jitter alone gives (``jitter`` times the root-mean-square distance between two
-  such means of a part standing still, :meth:`_leaving`): the radius and twice it are the demonstrator's own, the
+  such means of a part standing still, :mod:`.departure`): the radius and twice it are the demonstrator's own, the
   jitter's margin where that is larger.
 
 On locomotion, which never rests, the template's movement level finds no boundary inside a walk: a walk of several
@@ -105,6 +105,7 @@ import numpy as np
 
 from plugins.lib.body_size import body_scale
 from plugins.lib.strokes import StrokeAnalysis, StrokeCriteria, _round_kernels, analyse, breaks
+from plugins.segmenters.velocity_direction.departure import Departure
 from plugins.segmenters.velocity_direction.rests import Rests
 from plugins.segmenters.velocity_direction.speed import Jitter, line_speeds, line_weights, longer_fits, speed_noise
 from toolkit import ConfigError, Parameter, Segment, Segmenter, hookimpl
@@ -244,10 +245,8 @@ class VelocityDirection(Segmenter):
         # end = rest: the hubs and holds
         self._holding = False  # end = rest: the rest under way is a hold (away from the hubs)
         self._drift = -(1 << 62)  # end = rest: the frame the rest under way counts from, if it drifted
-        self._rest_pose: np.ndarray | None = None  # end = rest: where the demonstrator rests between movements
-        self._away = 0  # end = rest: frames the parts have been farther from it than the tracker's jitter allows
-        self._recent = self._near = self._leave = np.zeros(0)  # end = rest: the block's poses and margins (_leaving)
-        self._whole = np.zeros(0, bool)
+        self._departure = Departure(self.params["jitter"], self.params["rest"]["radius"], self._still)  # end = rest:
+        # the rest pose, and where the parts leave it
         self._settle = max(1, int(round(self.params["rest"]["settle"] * self._fps)))
 
     @property
@@ -299,7 +298,7 @@ class VelocityDirection(Segmenter):
         sizes = scale.tolist() if p["units"] == "body" else [None] * n
         lags = np.full(n, self._lag)
         if self._rests is not None:
-            self._leaving(rows, before, scale, sigma)
+            self._departure.block(rows, before, scale, sigma)
         walk = not self._pause and not p["noise"] > 0  # the rest speed known for the block at once
         own = self._own_rests(sizes) if walk or self._longer else None  # once for the block: stretch and _walk
         if self._longer:  # stretch: a longer line fit where the tracker's jitter hides the rest speed
@@ -410,7 +409,7 @@ class VelocityDirection(Segmenter):
             if self._start is None:
                 e = int(onsets[np.searchsorted(onsets, f)]) if np.searchsorted(onsets, f) < len(onsets) else n
                 if self._rests is not None:  # or where the parts leave the rest pose (_left_rest)
-                    e = self._next_left(f, e)
+                    e = self._departure.next_left(f, e)
             else:
                 i = np.searchsorted(rests, f)
                 e = min(int(onsets[np.searchsorted(onsets, f)]) if self._holding and
@@ -449,12 +448,13 @@ class VelocityDirection(Segmenter):
             pending = here >= self._settle
         else:
             pending = (here >= self._settle) | (here == max(self._memory, self._pause) + rests.stance)
-        pending |= ~self._whole[frames]  # no mean of the block's rows yet: stepped
+        departure = self._departure
+        pending |= ~departure.whole[frames]  # no mean of the block's rows yet: stepped
         a, size = 0, 8
         while a < len(frames):  # in chunks of growing size: the hold is most often left or drifts soon
             b = min(len(frames), a + size)
             chunk = frames[a:b]
-            hub, still = rests.places(self._recent[chunk], self._near[chunk])
+            hub, still = rests.places(departure.recent[chunk], departure.near[chunk])
             event = np.flatnonzero(pending[a:b] | hub | ~still)
             if len(event):
                 return int(chunk[event[0]])
@@ -585,85 +585,30 @@ class VelocityDirection(Segmenter):
                 if self.params["end"] == "still":
                     return cut + self._close(began)
                 if at is not None:  # the pose at rest (_held(1)) as the block's means have it, as _walk reads it
-                    points = self._recent[at] if self._whole[at] else self._held(1)
-                    return cut + self._rested(began, points, float(self._near[at]))
+                    departure = self._departure
+                    points = departure.recent[at] if departure.whole[at] else self._held(1)
+                    return cut + self._rested(began, points, float(departure.near[at]))
                 return cut + self._rested(began, self._held(1))
         if self._rests is not None and at is not None:
             self._left_rest(pose, at)
         return cut
 
-    def _leaving(self, rows: np.ndarray, before: int, scale: np.ndarray, sigma: np.ndarray | None) -> None:
-        """With ``end = "rest"``: each block frame's pose seen through the mean of its last ``_still`` frames (NaN
-        before there are as many), how far a part of it may lie from the rest pose for the tracker's jitter alone
-        (``jitter`` times the root-mean-square distance between two such means of a part standing still), and how
-        far leaving is (twice ``rest.radius`` times the body's size in each frame, ``scale``); ``rows``: the ``before``
-        rows of the sensory memory, then the block's; ``sigma``: the measured jitter (None: not measured)."""
-        n, w = len(scale), self._still
-        recent = np.full((n, rows.shape[1]), np.nan)
-        at = np.arange(n) + before - (w - 1)
-        whole = at >= 0  # the frames with as many rows before them
-        if whole.any():
-            means = np.lib.stride_tricks.sliding_window_view(rows, w, axis=0).mean(axis=-1)  # row j: rows j..j+w-1
-            recent[whole] = means[at[whole]]
-        self._recent, self._whole = recent, whole
-        jitter = np.zeros(n) if sigma is None else np.asarray(sigma)
-        self._near = self.params["jitter"] * jitter * np.sqrt(3.0 * 2.0 / w)
-        self._leave = 2.0 * self.params["rest"]["radius"] * np.asarray(scale, dtype=float)
-
-    def _farthest(self, poses: np.ndarray) -> np.ndarray:
-        """The farthest any chosen part of each pose (N, 3m) lies from the rest pose (N,); NaN: none seen in both."""
-        apart = (poses.reshape(len(poses), -1, 3) - self._rest_pose.reshape(-1, 3))
-        d = np.sqrt((apart * apart).sum(axis=2))
-        finite = np.isfinite(d)
-        return np.where(finite.any(axis=1), np.where(finite, d, -np.inf).max(axis=1), np.nan)
-
     def _left_rest(self, pose: np.ndarray, at: int) -> None:
-        """With ``end = "rest"`` and no movement under way, after block frame ``at`` was stepped: the onset by
-        position. A movement begins where some part has left the pose the demonstrator rests in (farther than
-        twice ``rest.radius`` and than the tracker's jitter allows, ``_near``), dated back to the first of the frames
-        it has lain beyond the jitter's margin since. The speed misses a movement slower than the jitter lets a line
-        fit show; the position does not (its noise does not grow as the fit shortens)."""
+        """With ``end = "rest"``, after block frame ``at`` was stepped: the onset by position (:mod:`.departure`). A
+        movement begins where some part has left the pose the demonstrator rests in, dated back to the first of the
+        frames it has lain beyond the jitter's margin since."""
         if self._start is not None:
-            self._away = 0
+            self._departure.moving()
             return
-        recent = self._recent[at]
-        if self._rest_pose is None:
-            if np.isfinite(recent).any():
-                self._rest_pose, self._away = recent.copy(), 0
-            return
-        d = float(self._farthest(recent[None])[0])
-        if not d > self._near[at]:
-            self._away = 0
-            return
-        self._away += 1
-        if d > self._leave[at]:
-            start = max(self._done, self._frame - min(self._away, len(self._history)) + 1)
+        away = self._departure.left(at)
+        if away is not None:
+            start = max(self._done, self._frame - min(away, len(self._history)) + 1)
             self._start = start
             self._buffer = list(self._history)[-(self._frame - start + 1):]
-            self._began(pose, self._rest_pose)
-            self._rests.origin = self._rest_pose  # its first frame lies beyond the jitter's margin from there already
+            rest = self._departure.pose
+            self._began(pose, rest)
+            self._rests.origin = rest  # its first frame lies beyond the jitter's margin from there already
             self._drift = self._frame  # a rest under way before the onset is not the movement's end
-            self._away = 0
-
-    def _next_left(self, f: int, e: int) -> int:
-        """With ``end = "rest"`` and no movement under way from block frame ``f``: the first frame before ``e`` where
-        :meth:`_left_rest` can begin a movement or sets the rest pose (``e`` if none), ``_away`` as the frames before
-        it left it."""
-        if e <= f:
-            return e
-        recent = self._recent[f:e]
-        if self._rest_pose is None:
-            seen = np.flatnonzero(np.isfinite(recent).any(axis=1))
-            return f + int(seen[0]) if len(seen) else e
-        d = self._farthest(recent)
-        over = d > self._near[f:e]
-        leaves = np.flatnonzero(over & (d > self._leave[f:e]))
-        g = f + int(leaves[0]) if len(leaves) else e
-        k = g - f  # the frames before g
-        if k:
-            below = np.flatnonzero(~over[:k])
-            self._away = k - 1 - int(below[-1]) if len(below) else self._away + k
-        return g
 
     def _here(self) -> int:
         """The frames the demonstrator has rested in one place (``end = "rest"``): since they last moved, or since
@@ -793,7 +738,7 @@ class VelocityDirection(Segmenter):
         if end - start >= 2:
             self._done = end
         if self._rests is not None:
-            self._rest_pose, self._away = self._held(1), 0
+            self._departure.rested(self._held(1))
         return out
 
     def analyse(self, window: np.ndarray) -> StrokeAnalysis:

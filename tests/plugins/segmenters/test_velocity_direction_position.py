@@ -50,5 +50,6 @@ def test_onsets_by_position_walked_are_their_frames_stepped(seed, cuts, tracker)
     whatever the packet sizes."""
     walked, stepped = walked_and_stepped(
         stream(slow_bow(), jitter=tracker, seed=seed)[0], cuts,
-        lambda seg: (seg._away, None if seg._rest_pose is None else seg._rest_pose.tolist(), seg._frame))
+        lambda seg: (seg._departure.away, None if seg._departure.pose is None else seg._departure.pose.tolist(),
+                     seg._frame))
     assert walked == stepped
