@@ -544,7 +544,8 @@ class Matcher(Component):
         return a match to commit now.
 
         After committing, a match whose ``stop`` is true tells the runtime that the demonstration deviates from
-        the committed movement: an imitation of it is stopped (its ``reason`` says why).
+        the committed movement: an imitation of it is stopped (its ``reason`` says why). After a deviation the
+        matcher may commit again (K&G 2006, Fig. 3: back to the last correct node, and predict again).
         """
         return None
 

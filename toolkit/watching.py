@@ -14,8 +14,8 @@ frames in. :class:`WatchingLoop` is that cycle, and the only copy of it:
       -> frame by frame, in order:
            a segment closed at this frame    matcher.conclude(its frames) -> the answer     [commit or not]
            a segment under way               a streaming matcher is fed the frame (from the onset when it begins):
-                                             matcher.observe(memory) may commit once (response facilitation),
-                                             and after that report a deviation (Match.stop)
+                                             matcher.observe(memory) may commit (response facilitation), after
+                                             that report a deviation (Match.stop), and after one commit again
 
 An :class:`~toolkit.runtime.Actor` in a world feeds it one frame a step from its perception and turns what it
 reports into run events, interpretation and imitation; an :class:`~toolkit.observe.Observer` feeds it packets of
@@ -415,6 +415,7 @@ class WatchingLoop:
         self._open: int | None = None  # start row of the segment the matcher follows
         self._view: WorkingMemory | None = None
         self._early: Match | None = None
+        self._stopped: Match | None = None  # the commitment a deviation stopped
         self._since = -1  # the onset of the segment under way, from the last cut (-1: none)
         self._floor = 0  # no segment is reported from before this row (the last cut)
         self._last_end = 0  # the end of the last segment the segmenter closed (they are ordered and disjoint)
@@ -598,7 +599,8 @@ class WatchingLoop:
         self._call("matcher", "begin", self._view)
 
     def _feed(self, row: int) -> None:
-        """Give the matcher row ``row``; it may commit (once per segment) or report a deviation."""
+        """Give the matcher row ``row``; it may commit, report a deviation of its commitment, and commit again after
+        one."""
         if self.character.matcher is None or self._view is None:
             return
         self._view.feed(row + 1)
@@ -615,7 +617,8 @@ class WatchingLoop:
         self._check_match(match, method)
         if match.stop:
             self.listener.deviated(match)
-        elif self._early is None:
+            self._stopped = self._early  # a movement that prevails after it may be committed to (Fig. 3)
+        elif self._early is None or self._early is self._stopped:
             self._early = match
             self.listener.recognised(None, match)
 

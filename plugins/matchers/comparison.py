@@ -99,16 +99,6 @@ class Frames:
                 np.einsum("nc,nc->n", carry, carry))
 
     @cached_property
-    def flat(self) -> tuple[np.ndarray, np.ndarray]:
-        """The parts' features a frame after another, contiguous (n, P * D), and the carry with the unknown ones
-        zeroed and a last column of 1 where it is known (n, C + 1), in single precision (a distance in body sizes
-        needs no more than seven digits, and half the numbers to read): what :func:`_rms_full` reads."""
-        carry = np.zeros((len(self), self.carry.shape[1] + 1), dtype=np.float32)
-        carry[:, :-1] = np.where(self.carried[:, None], self.carry, 0.0)
-        carry[:, -1] = self.carried
-        return np.ascontiguousarray(self.parts.reshape(len(self), -1), dtype=np.float32), carry
-
-    @cached_property
     def split(self) -> Split:
         """The features by how they scale with a performance's tempo (:class:`Split`), kept with the frames (a
         repertoire's are computed once). Six features a part are its shape and its motion (:class:`Motion`), three
@@ -122,6 +112,16 @@ class Frames:
         return Split(shape.reshape(n, -1), motion.reshape(n, -1), travel, turn, seen,
                      np.einsum("npd,npd->np", shape, shape), np.einsum("npd,npd->np", motion, motion),
                      np.einsum("nc,nc->n", travel, travel), np.einsum("nc,nc->n", turn, turn))
+
+    @cached_property
+    def single(self) -> tuple[np.ndarray, ...]:
+        """:attr:`split`'s shape, motion, travel and turn contiguous in single precision (a distance in body sizes needs
+        no more than seven digits, and half the numbers to read), and each frame's mean squared motion over its parts
+        (kept with the frames: a repertoire's are made once): what :func:`_split_full` reads."""
+        x = self.split
+        parts = max(self.seen.shape[1], 1)
+        return (*(np.ascontiguousarray(v, dtype=np.float32) for v in (x.shape, x.motion, x.travel, x.turn)),
+                x.motion2.sum(axis=1) / parts)
 
     def take(self, rows: np.ndarray | slice) -> Frames:
         """The frames ``rows`` of this sequence."""
@@ -154,10 +154,20 @@ class Split(NamedTuple):
 class Paired:
     """Every frame of ``a`` against every frame of ``b``, ready to be costed with ``a`` played at other speeds
     (:meth:`at`): the mean squares of :meth:`Motion.costs` split by how they scale, ``|s x - y|^2 = s^2 |x|^2 +
-    |y|^2 - 2 s x.y``, each a matrix product over the parts seen in both (sums over the frames' parts where every
-    part is seen in both), computed once."""
+    |y|^2 - 2 s x.y``, so that the squared cost at speed ``s`` is ``fixed + s * moving + s^2 * moving2`` (arrays
+    (len(a), len(b)); ``moving2`` may be (len(a), 1) where it does not depend on ``b``'s frame), computed once.
 
-    def __init__(self, a: Frames, b: Frames) -> None:
+    :meth:`between` computes them as matrix products (every pair at once); :meth:`pairwise` row by row, each row's
+    numbers the same whatever rows come with it (a matrix product's rounding depends on how many rows it
+    multiplies): for a forward model fed rows one by one or at once."""
+
+    def __init__(self, fixed: np.ndarray, moving: np.ndarray, moving2: np.ndarray) -> None:
+        self.fixed, self.moving, self.moving2 = fixed, moving, moving2
+
+    @classmethod
+    def between(cls, a: Frames, b: Frames) -> Paired:
+        """As matrix products over the parts seen in both (sums over the frames' parts where every part is seen
+        in both)."""
         x, y = a.split, b.split
         fixed = x.shape @ y.shape.T
         moving = x.motion @ y.motion.T
@@ -193,7 +203,27 @@ class Paired:
                 fixed += np.where(carried, turn, 0.0)
                 moving += np.where(carried, travel, 0.0)
                 moving2 = moving2 + np.where(carried, x.travel2[:, None], 0.0)
-        self.fixed, self.moving2, self.moving = fixed, moving2, moving
+        return cls(fixed, moving, moving2)
+
+    @classmethod
+    def pairwise(cls, a: Frames, b: Frames) -> Paired:
+        """:meth:`between` row by row, each row's numbers the same whatever rows come with it: a row with every part
+        seen, against frames with every part seen, in a compiled loop (:func:`_split_full`); any other row on its own
+        by :meth:`between`."""
+        n, m = len(a), len(b)
+        fixed, moving, moving2 = np.empty((n, m)), np.empty((n, m)), np.empty((n, m))
+        whole = a.seen.all(axis=1) & bool(b.seen.all()) if m else np.zeros(n, dtype=bool)
+        if whole.any():
+            x, y = (a if whole.all() else a.take(whole)).single, b.single
+            rows = np.flatnonzero(whole)
+            out = [np.empty((len(rows), m)) for _ in range(3)]
+            kernel(_split_full, reordered=True)(*x[:4], a.carried[whole], *y, b.carried,
+                                                1.0 / max(b.seen.shape[1], 1), *out)
+            fixed[rows], moving[rows], moving2[rows] = out
+        for i in np.flatnonzero(~whole):
+            one = cls.between(a.take([i]), b)
+            fixed[i], moving[i], moving2[i] = one.fixed[0], one.moving[0], one.moving2[0]
+        return cls(fixed, moving, moving2)
 
     def at(self, speed: np.ndarray | float = 1.0) -> np.ndarray:
         """The costs (len(a), len(b)) with ``a``'s motion and travel multiplied by ``speed`` (a number, or one for each
@@ -205,6 +235,49 @@ class Paired:
         square += self.moving2 * (s * s)
         np.maximum(square, 0.0, out=square)
         return np.sqrt(square, out=square)
+
+
+def _split_full(a_shape, a_motion, a_travel, a_turn, a_carried, b_shape, b_motion, b_travel, b_turn, b_motion2,
+                b_carried, inverse, fixed, moving, moving2):
+    """:class:`Paired` of every pair of frames with every part seen in both, pair by pair: the features a frame after
+    another in single precision (:attr:`Frames.single`: shape and motion (n, P * 3) each, travel, turn),
+    ``b_motion2`` each frame of ``b``'s mean squared motion over its parts and ``inverse`` one over the number of
+    parts; the sums over a frame's features in single precision, the rest in double. Plain Python, compiled by
+    :func:`~plugins.lib.compiled.kernel` (reordered sums: the same order at every call, so a row's numbers do not
+    depend on the rows beside it)."""
+    n = a_motion.shape[0]
+    m = b_motion.shape[0]
+    width_shape = a_shape.shape[1]
+    width = a_motion.shape[1]
+    for i in range(n):
+        square = np.float32(0.0)
+        for k in range(width):
+            square += a_motion[i, k] * a_motion[i, k]
+        travel2 = np.float64(0.0)
+        for k in range(3):
+            travel2 += np.float64(a_travel[i, k]) * a_travel[i, k]
+        for j in range(m):
+            fs = np.float32(0.0)
+            for k in range(width_shape):
+                d = a_shape[i, k] - b_shape[j, k]
+                fs += d * d
+            xs = np.float32(0.0)
+            for k in range(width):
+                xs += a_motion[i, k] * b_motion[j, k]
+            f = np.float64(fs) * inverse + b_motion2[j]
+            x = np.float64(xs) * inverse
+            q = np.float64(square) * inverse
+            if a_carried[i] and b_carried[j]:
+                for k in range(3):
+                    f += np.float64(b_travel[j, k]) * b_travel[j, k]
+                    x += np.float64(a_travel[i, k]) * b_travel[j, k]
+                for k in range(2):
+                    d2 = np.float64(a_turn[i, k]) - b_turn[j, k]
+                    f += d2 * d2
+                q += travel2
+            fixed[i, j] = f
+            moving[i, j] = -2.0 * x
+            moving2[i, j] = q
 
 
 class Fixed:
@@ -378,17 +451,26 @@ class Motion(Comparison):
     paced = True
 
     def paired(self, a: Frames, b: Frames) -> Paired:
-        return Paired(a, b)
+        return Paired.between(a, b)
 
     def still_at(self, frames: Frames, speeds: np.ndarray) -> np.ndarray:
         """:meth:`still` of the frames played ``speeds`` (K,) times as fast (their motion and travel multiplied by
         it), (n, K)."""
         s = np.asarray(speeds, dtype=float)[None, :]
+        fixed, moving2 = self.still_split(frames)
+        return np.sqrt(fixed[:, None] + s * s * moving2[:, None])
+
+    def still_split(self, frames: Frames) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`still` split by how it scales with tempo: each frame's distance to standing still played ``s``
+        times as fast is ``sqrt(fixed + s^2 * moving2)`` (the shape and the turn; the motion and the travel), (n,)
+        each; both 0 in a frame with no part seen."""
         x = frames.split
         count = x.seen.sum(axis=1)
-        square = (x.shape2.sum(axis=1)[:, None] + s * s * x.motion2.sum(axis=1)[:, None]) \
-            / np.maximum(count, 1)[:, None] + (s * s * x.travel2[:, None] + x.turn2[:, None])
-        return np.where(count[:, None] > 0, np.sqrt(square), 0.0)
+        some = count > 0
+        inverse = np.where(some, 1.0 / np.maximum(count, 1), 0.0)
+        fixed = x.shape2.sum(axis=1) * inverse + np.where(some, x.turn2, 0.0)
+        moving2 = x.motion2.sum(axis=1) * inverse + np.where(some, x.travel2, 0.0)
+        return fixed, moving2
 
     def costs(self, a: Frames, b: Frames) -> np.ndarray:
         """Every frame of ``a`` against every frame of ``b``: the root mean square over the parts seen in both of
@@ -405,28 +487,6 @@ class Motion(Comparison):
         with np.errstate(invalid="ignore", divide="ignore"):
             mean = np.where(count > 0, square / np.maximum(count, 1.0), 0.0)
         return np.sqrt(np.maximum(mean, 0.0))
-
-    def row_costs(self, a: Frames, b: Frames) -> np.ndarray:
-        """:meth:`costs` computed pair by pair in a compiled loop (:func:`_rms`): each row's numbers the same whatever
-        rows come with it (a matrix product's rounding depends on how many rows it multiplies), for a forward model
-        fed rows one by one or at once; slower than :meth:`costs` for many rows."""
-        out = np.empty((len(a), len(b)))
-        if not out.size:
-            return out
-        whole = a.seen.all(axis=1) if b.seen.all() else np.zeros(len(a), dtype=bool)
-        if whole.all():  # every part seen: one contiguous run of numbers a frame
-            flat_a, carry_a = a.flat
-            flat_b, carry_b = b.flat
-            kernel(_rms_full, reordered=True)(flat_a, carry_a, flat_b, carry_b, a.parts.shape[1], out)
-        elif whole.any():  # each row by the kernel its own parts call for, whatever rows come with it
-            out[whole] = self.row_costs(a.take(whole), b)
-            out[~whole] = self.row_costs(a.take(~whole), b)
-        else:
-            kernel(_rms)(np.ascontiguousarray(a.parts, dtype=np.float64), a.seen,
-                          np.ascontiguousarray(np.where(a.carried[:, None], a.carry, 0.0)), a.carried,
-                          np.ascontiguousarray(b.parts, dtype=np.float64), b.seen,
-                          np.ascontiguousarray(np.where(b.carried[:, None], b.carry, 0.0)), b.carried, out)
-        return out
 
     def still(self, frames: Frames) -> np.ndarray:
         """Each frame's distance to standing still, every feature zero (no excursion from the mean posture, no
@@ -480,56 +540,6 @@ def _held(positions: np.ndarray, seen: np.ndarray) -> np.ndarray:
         last = np.maximum.accumulate(np.where(seen[:, p], np.arange(len(seen)), -1))
         out[:, p] = positions[np.where(last >= 0, last, rows[0]), p]
     return out
-
-
-def _rms(a, a_seen, a_carry, a_carried, b, b_seen, b_carry, b_carried, out):
-    """:meth:`Motion.costs` of every frame pair, pair by pair: ``out[i, j]`` the root of the mean over the parts seen
-    in both of each part's squared difference plus the carries' (where both are known); 0 where no part is seen in
-    both. Plain Python as written (the reference), compiled by :func:`~plugins.lib.compiled.kernel`."""
-    n, parts, dims = a.shape
-    m = b.shape[0]
-    width = a_carry.shape[1]
-    for i in range(n):
-        for j in range(m):
-            carry = 0.0
-            if a_carried[i] and b_carried[j]:
-                for c in range(width):
-                    d = a_carry[i, c] - b_carry[j, c]
-                    carry += d * d
-            total = 0.0
-            count = 0
-            for p in range(parts):
-                if a_seen[i, p] and b_seen[j, p]:
-                    sq = carry
-                    for k in range(dims):
-                        d = a[i, p, k] - b[j, p, k]
-                        sq += d * d
-                    total += sq
-                    count += 1
-            out[i, j] = np.sqrt(total / count) if count else 0.0
-
-
-def _rms_full(a, a_carry, b, b_carry, parts, out):
-    """:func:`_rms` where every part is seen in both: ``a`` (n, P * D) and ``b`` (m, P * D) a frame's features in
-    one run, the carries with a last column of 1 where known (:attr:`Frames.flat`). The same numbers as
-    :func:`_rms` up to the order of the sums, which the compiled loop takes side by side (the same order at every
-    call: a row's numbers do not depend on the rows beside it). Plain Python, compiled by
-    :func:`~plugins.lib.compiled.kernel`."""
-    n, width = a.shape
-    m = b.shape[0]
-    c = a_carry.shape[1] - 1
-    for i in range(n):
-        for j in range(m):
-            sq = np.float32(0.0)
-            for k in range(width):
-                d = a[i, k] - b[j, k]
-                sq += d * d
-            carry = np.float32(0.0)
-            if a_carry[i, c] > 0 and b_carry[j, c] > 0:
-                for k in range(c):
-                    d = a_carry[i, k] - b_carry[j, k]
-                    carry += d * d
-            out[i, j] = np.sqrt(np.float64(sq) / parts + np.float64(carry))
 
 
 def sequence_size(poses: np.ndarray, seen: np.ndarray) -> float:

@@ -13,8 +13,8 @@ no limit is set on either.
 - :func:`chain_distances`: every chain against a whole demonstration at once (path search's per-movement search,
   :mod:`plugins.matchers.path_search.per_movement`; the calibration of a decision);
 - :func:`chain_path`: the frames of one chain's best path;
-- :class:`Warping`: the same warping advanced sample by sample as a demonstration comes in, each chain's distance
-  so far after every sample (the forward model following real people, K&G 2006 §4.4).
+- the same warping advanced sample by sample as a demonstration comes in, each chain at its own pace, is
+  :class:`plugins.matchers.pacing.PacedWarping` (the forward model following real people, K&G 2006 §4.4).
 
 The loops are plain Python, their own reference, compiled by :mod:`plugins.lib.compiled`.
 """
@@ -29,7 +29,7 @@ from plugins.lib.compiled import kernel
 from plugins.matchers.comparison import Comparison, Frames
 from plugins.matchers.decision import Calibration
 
-__all__ = ["Chains", "Warping", "chain_calibration", "chain_distances", "chain_path", "kept", "kept_chains",
+__all__ = ["Chains", "chain_calibration", "chain_distances", "chain_path", "kept", "kept_chains",
            "relative_distances", "warp_chains"]
 
 
@@ -285,95 +285,3 @@ def chain_path(cost: np.ndarray, chains: Chains, c: int) -> np.ndarray:
     out = np.empty(len(block), dtype=np.intp)
     kernel(_warp_path)(block, bool(chains.cyclic[c]), out)
     return chains.chain(c)[out]
-
-
-def _advance(cost, starts, cyclic, total, length, fresh, means, ends):
-    """The warping of :func:`_warp`, advanced by the samples of ``cost`` (r, M) from the state ``total`` and
-    ``length`` (M,) after the samples before them (``fresh``: none yet). After each sample, each chain's best
-    summed cost over its path's length so far, and the column it ends in, go into ``means`` and ``ends`` (r, C).
-    ``total`` and ``length`` are left as the state after the last sample. Plain Python, compiled by
-    :func:`plugins.lib.compiled.kernel`."""
-    rows = cost.shape[0]
-    width = total.shape[0]
-    now = np.empty(width)
-    now_len = np.empty(width)
-    for i in range(rows):
-        for c in range(len(starts) - 1):
-            a = starts[c]
-            m = starts[c + 1] - a
-            if fresh and i == 0:
-                for j in range(m):
-                    now[a + j] = cost[i, a + j]
-                    now_len[a + j] = 1.0
-            else:
-                for j in range(m):
-                    if j > 0:
-                        d, dl = total[a + j - 1], length[a + j - 1]
-                    elif cyclic[c] and m > 1:
-                        d, dl = total[a + m - 1], length[a + m - 1]
-                    else:
-                        d, dl = np.inf, 0.0
-                    if total[a + j] < d:
-                        d, dl = total[a + j], length[a + j]
-                    if j > 0 and now[a + j - 1] < d:
-                        d, dl = now[a + j - 1], now_len[a + j - 1]
-                    now[a + j] = d + cost[i, a + j]
-                    now_len[a + j] = dl + 1.0
-                if cyclic[c] and m > 1:
-                    j = 0
-                    while j < m:
-                        left = a + (m - 1 if j == 0 else j - 1)
-                        value = now[left] + cost[i, a + j]
-                        if value < now[a + j]:
-                            now[a + j] = value
-                            now_len[a + j] = now_len[left] + 1.0
-                            j += 1
-                        else:
-                            break
-            best = np.inf
-            at = -1
-            for j in range(m):
-                mean = now[a + j] / now_len[a + j]
-                if mean < best:
-                    best = mean
-                    at = j
-            means[i, c] = best
-            ends[i, c] = at
-        for k in range(width):
-            total[k] = now[k]
-            length[k] = now_len[k]
-
-
-class Warping:
-    """The warping of a demonstration against every chain, advanced sample by sample as the demonstration comes in
-    (:func:`chain_distances` of the samples so far, after each sample, without warping them again).
-
-    Parameters
-    ----------
-    comparison : Comparison
-    frames : Frames
-        The frames of every chain, chain after chain (``Frames.join`` of the takes').
-    chains : Chains
-    """
-
-    def __init__(self, comparison: Comparison, frames: Frames, chains: Chains) -> None:
-        self.comparison, self.frames, self.chains = comparison, frames, chains
-        self.total = np.zeros(len(frames))
-        self.length = np.zeros(len(frames))
-        self.samples = 0
-
-    def advance(self, samples: Frames) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Take the next samples; after each of them (arrays (len(samples), C)): each chain's distance so far, the
-        frame (the index within its chain) its best path ends on, and the sample's own distance to that frame."""
-        means = np.full((len(samples), len(self.chains)), np.inf)
-        ends = np.full((len(samples), len(self.chains)), -1, dtype=np.intp)
-        local = np.full((len(samples), len(self.chains)), np.inf)
-        if len(samples) and len(self.frames):
-            # pair by pair: the same numbers whatever the samples come in (row_costs)
-            cost = self.comparison.row_costs(samples, self.frames)
-            kernel(_advance)(cost, self.chains.starts, self.chains.cyclic, self.total, self.length,
-                              self.samples == 0, means, ends)
-            rows, chains = np.nonzero(ends >= 0)
-            local[rows, chains] = cost[rows, self.chains.starts[:-1][chains] + ends[rows, chains]]
-            self.samples += len(samples)
-        return means, ends, local

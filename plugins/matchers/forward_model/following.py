@@ -19,16 +19,23 @@ the decision the matchers share:
   arrive, the body's facing from a running median over the last :data:`FACING` seconds (the forward marker's side
   put to the same window's vote, :class:`plugins.lib.root_frame.HeadingFilter`);
 - **tempo**: each prediction is followed at whatever pace the demonstration goes, by time warping advanced sample by
-  sample (:class:`plugins.matchers.warping.Warping`): K&G re-parameterise a command by the path length seen (§4.4),
-  the warping finds for every sample the point of each prediction that fits best so far;
+  sample, each take at the pace its own best path has gone so far (:class:`plugins.matchers.pacing.PacedWarping`):
+  K&G re-parameterise a command by the path length seen (§4.4); here the warping finds for every sample the point
+  of each prediction that fits best so far, and the demonstration's motion is compared at the take's tempo (a walk
+  at half the pace is compared with the take's walk as if it went at the take's pace);
 - **drop-out and commitment**: each movement's score is its best take's distance so far over the demonstration's
-  own distance to standing still, held to the calibrated threshold (:class:`plugins.matchers.decision.Calibrated`,
-  calibrated on the predictions themselves, each take left out of its movement and each movement left out). A
-  movement is committed to when it is within the threshold, every other movement is :data:`LEAD` times as far off
-  and ``min_progress`` of its take has been followed (``Match.decided_at``: response facilitation). A committed
-  movement that goes beyond the threshold, or that another now leads as far, is a deviation (``stop``);
-- **the answer at the end**: when nothing was committed or the commitment did not hold, every movement's score over
-  the whole demonstration, decided as path search decides (:mod:`plugins.matchers.decision`);
+  own distance to standing still (at that take's pace), held to the calibrated threshold
+  (:class:`plugins.matchers.decision.Calibrated`, calibrated on the predictions themselves followed the same way,
+  each take left out of its movement and each movement left out). A movement *prevails* when it has been the
+  nearest within the threshold at every sample of the last :data:`RECENT` seconds; it is committed to once it
+  prevails and ``min_progress`` of its take has been followed (``Match.decided_at``: response facilitation). When
+  another movement prevails over a committed one, the demonstration has deviated from it (``stop``, Fig. 3's
+  "stop imitation") and the other is committed to (Fig. 3: back to the last correct node, predict again, and
+  imitate what prevails);
+- **the answer at the end**: every movement's score over the whole demonstration, decided as path search decides
+  (:mod:`plugins.matchers.decision`). A commitment stands when it is that answer (its ``decided_at`` is when it was
+  committed to); otherwise the answer at the end replaces it (K&G §4.4: the demonstration must end where the
+  committed movement does);
 - **standing still**: a movement whose commands predict no motion at all (a pose held) is never committed to early;
   when it comes nearest at the end, the demonstration is it if it moved at most half as much as the least moving
   other movement (:class:`plugins.matchers.decision.Stillness`), else unknown;
@@ -46,6 +53,7 @@ guiding strokes (``comparison = "strokes"``).
 
 from __future__ import annotations
 
+from functools import partial
 from typing import Any, Protocol
 
 import numpy as np
@@ -55,11 +63,12 @@ from plugins.lib.root_frame import HeadingFilter, facing_heading, to_root_relati
 from plugins.lib.velocity import SMOOTHING, derivative
 from plugins.matchers.comparison import Frames, Motion, sequence_size
 from plugins.matchers.decision import Calibrated, Calibration, Decision, Stillness
-from plugins.matchers.warping import Chains, Warping, chain_calibration
+from plugins.matchers.pacing import PacedWarping, followed_scores
+from plugins.matchers.warping import Chains, chain_calibration
 from toolkit import Match
 from toolkit import Motion as Recording
 
-__all__ = ["FACING", "Following", "LEAD", "RATE", "Streaming"]
+__all__ = ["FACING", "Following", "RATE", "RECENT", "Streaming"]
 
 RATE = 10.0
 """Samples a second at which predictions and demonstrations are compared: the posegraph's node rate (B&B §4.1),
@@ -79,12 +88,8 @@ BLOCK = 0.3
 decided at stays the sample's; it is reported up to this much later, for a tenth of the work per frame."""
 
 RECENT = 0.5
-"""Seconds over which a committed take's prediction is held to the threshold to tell a deviation."""
-
-LEAD = 1.5
-"""How far ahead the best movement must be to be committed to: every other movement's score at least this many
-times its own (half again as far off: a clear lead, not a matter of noise)."""
-
+"""Seconds over which a movement must have been the nearest within the threshold, sample after sample, to prevail
+(to be committed to, or to replace a commitment): a lead that lasts, not a sample's noise."""
 
 class Takes(Protocol):
     """What following real people needs of a motor system: a motor command graph that learned takes from clips."""
@@ -336,7 +341,7 @@ class Following:
         p = self.prediction
         if p.frames is None:
             return Calibration()
-        return chain_calibration(self.comparison, p.takes, p.frames, p.chains)
+        return chain_calibration(self.comparison, p.takes, p.frames, p.chains, partial(followed_scores, rate=RATE))
 
     # -- following a demonstration ------------------------------------------------------------
 
@@ -350,18 +355,21 @@ class Following:
             with one_thread():
                 self.rebuild()
         self.watched = Watched(self.body, fps, self.comparison)
-        self.warping = Warping(self.comparison, self.prediction.frames, self.prediction.chains) \
+        self.warping = PacedWarping(self.comparison, self.prediction.frames, self.prediction.chains, RATE) \
             if self.prediction.frames is not None else None
-        self._still = np.zeros(0)  # the demonstration's mean distance to standing still, after each sample
-        self._stills = np.zeros(0)
-        self._local = np.zeros((0, len(self.prediction.chains)))  # each sample's own distance to each take's frame
+        self._moved = 0.0  # the demonstration's summed distance to standing still (at its own tempo)
+        self._samples = 0
         self.committed: str | None = None
         self.commitment: Match | None = None
         self.deviated = False
-        self.means = np.full(len(self.prediction.chains), np.inf)
+        self.distances = np.full(len(self.prediction.chains), np.inf)  # each take's, after the last sample
+        self.moved = np.zeros(len(self.prediction.chains))
+        self.ends = np.full(len(self.prediction.chains), -1, dtype=np.intp)
         self.trace: list[tuple[int, np.ndarray]] = []  # each sample's frame and every movement's score then
-        self.committed_at: int | None = None  # frames seen when committed / when it deviated
+        self.committed_at: int | None = None  # frames seen when committed (the last time) / when it deviated
         self.deviated_at: int | None = None
+        self._leader, self._led = -1, 0
+        self._prevail = max(1, int(round(RECENT * RATE)))  # samples a movement must lead to prevail
 
     def add(self, world: np.ndarray, visible: np.ndarray, ended: bool = False) -> list[tuple[int, Match]]:
         """The next frames of the demonstration; what the forward models decide on the samples they complete, with
@@ -378,107 +386,94 @@ class Following:
             rows, samples = rows[evidence], samples.take(evidence)
             if not len(rows):
                 return []
-        before = self.warping.samples
-        means, ends, local = self.warping.advance(samples)
-        stills = np.concatenate([self._stills, self.comparison.still(samples)])  # each row on its own: the same
-        self._stills = stills  # numbers whatever the rows come in
-        self._still = np.cumsum(stills) / np.arange(1, len(stills) + 1)  # whatever the rows come in
+        followed = self.warping.advance(samples)
+        stills = self.comparison.still(samples)  # each row on its own: the same numbers whatever the rows come in
         events = []
-        self._local = np.concatenate([self._local, local]) if len(self._local) else local
         for i, row in enumerate(rows):
-            self.means, self.ends = means[i], ends[i]
-            match = self._decide(row + (watched.delay if not ended else 0), before + i)
-            if match is not None:
+            self.distances, self.moved, self.ends = followed.distance[i], followed.moved[i], followed.ends[i]
+            self._moved += float(stills[i])
+            self._samples += 1
+            for match in self._decide(row + (watched.delay if not ended else 0)):
                 events.append((row, match))
         return events
 
-    def _scores(self, upto: int) -> np.ndarray:
-        """Each movement's score so far (in :attr:`movements` order): its best take's distance over the
-        demonstration's distance to standing still."""
-        best = np.minimum.reduceat(self.means[self._order], self._heads)
+    @property
+    def moving(self) -> float:
+        """The demonstration's mean distance to standing still so far, at its own tempo (0 before a sample)."""
+        return self._moved / self._samples if self._samples else 0.0
+
+    def _chain_scores(self) -> np.ndarray:
+        """Each take's score after the last sample: its distance over the demonstration's distance to standing
+        still at its pace (its distance, for a decision that is not relative)."""
         if not self.decision.relative:
-            return best
-        still = self._still[upto] if len(self._still) else 0.0
+            return self.distances
         with np.errstate(divide="ignore", invalid="ignore"):
-            return np.where(still > 0, best / still, np.where(best <= 0, 0.0, np.inf))
+            return np.where(self.moved > 0, self.distances / self.moved,
+                            np.where(self.distances <= 0, 0.0, np.inf))
+
+    def _scores(self) -> np.ndarray:
+        """Each movement's score so far (in :attr:`movements` order): its best take's."""
+        return np.minimum.reduceat(self._chain_scores()[self._order], self._heads)
 
     def _take(self, movement: int) -> int:
         """The chain of a movement's best take so far."""
         a = self._heads[movement]
         b = self._heads[movement + 1] if movement + 1 < len(self._heads) else len(self._order)
-        return int(self._order[a + int(np.argmin(self.means[self._order[a:b]]))])
+        return int(self._order[a + int(np.argmin(self._chain_scores()[self._order[a:b]]))])
 
-    def _decide(self, frame: int, sample: int) -> Match | None:
+    def _progress(self, movement: int) -> float:
+        """The share of the movement's best take its path has followed."""
+        c = self._take(movement)
+        return float((self.ends[c] + 1) / (self.prediction.chains.starts[c + 1] - self.prediction.chains.starts[c]))
+
+    def _decide(self, frame: int) -> list[Match]:
+        """After a sample (at ``frame``): a commitment, a deviation, or a deviation and the commitment that replaces it
+        (see the module)."""
         limit = self.decision.threshold()
-        scores = self._scores(sample)
+        scores = self._scores()
         self.trace.append((frame, scores))
         order = np.argsort(scores, kind="stable")
-        if self.committed is not None:
-            if self.deviated:
-                return None
-            index = self._index[self.committed]
-            recent = self._recent(sample)  # each movement's prediction over the last while
-            mine = float(recent[index])
-            other = float(np.min(np.delete(recent, index))) if len(recent) > 1 else np.inf
-            if scores[index] > limit or mine > limit or mine >= LEAD * other:  # it fails, or another now leads
-                self.deviated = True  # it as far as it led when committed to
-                self.deviated_at = frame + 1
-                return Match(self.committed, 0.0, frame, stop=True, reason="deviation", score=mine,
-                             threshold=limit, measure=self.decision.measure)
-            return None
         first = int(order[0])
-        score = float(scores[first])
-        runner = float(scores[order[1]]) if len(order) > 1 else np.inf
-        if not (score <= limit and runner >= LEAD * score) or self.movements[first] in self.stillness.still:
-            return None  # a still movement is told by how little the whole demonstration moved (conclude)
-        c = self._take(first)
-        length = self.prediction.chains.starts[c + 1] - self.prediction.chains.starts[c]
-        progress = (self.ends[c] + 1) / length
-        if progress < self.min_progress:
-            return None
-        self.committed = movement = self.movements[first]
-        self.committed_at = frame + 1
-        ranked = tuple((self.movements[i], float(scores[i])) for i in order)
-        self.commitment = Match(movement, max(0.0, 1.0 - score / limit) if 0 < limit < np.inf else 1.0, frame,
-                                candidates=ranked, score=score, threshold=limit, measure=self.decision.measure,
-                                details={"progress": float(progress)})
-        return self.commitment
+        leader = first if scores[first] <= limit and self.movements[first] not in self.stillness.still else -1
+        self._led = (self._led + 1 if leader == self._leader else 1) if leader >= 0 else 0
+        self._leader = leader  # a still movement is told by how little the whole demonstration moved (conclude)
+        prevails = leader >= 0 and self._led >= self._prevail and self._progress(leader) >= self.min_progress
+        events = []
+        if self.committed is not None and prevails and self.movements[leader] != self.committed:
+            mine = self._index[self.committed]
+            events.append(Match(self.committed, 0.0, frame, stop=True, reason="deviation", score=float(scores[mine]),
+                                threshold=limit, measure=self.decision.measure))
+            self.committed, self.deviated, self.deviated_at = None, True, frame + 1
+        if self.committed is None and prevails:
+            score = float(scores[leader])
+            self.committed = movement = self.movements[leader]
+            self.committed_at = frame + 1
+            ranked = tuple((self.movements[i], float(scores[i])) for i in order)
+            self.commitment = Match(movement, max(0.0, 1.0 - score / limit) if 0 < limit < np.inf else 1.0, frame,
+                                    candidates=ranked, score=score, threshold=limit, measure=self.decision.measure,
+                                    details={"progress": self._progress(leader)})
+            events.append(self.commitment)
+        return events
 
-    def _recent(self, sample: int) -> np.ndarray:
-        """Each movement's prediction over the last :data:`RECENT` seconds (in :attr:`movements` order): its best
-        take's samples' own distances to the frames they were aligned with, over their distances to standing still
-        (K&G §4.4's deviation: the imitated command parting from the demonstration now, not its average since the
-        onset)."""
-        a = max(0, sample + 1 - max(1, int(round(RECENT * RATE))))
-        moving = float(self._stills[a : sample + 1].sum())
-        error = self._local[a : sample + 1].sum(axis=0)
-        if self.decision.relative:
-            with np.errstate(divide="ignore", invalid="ignore"):
-                per_take = error / moving if moving > 0 else np.where(error <= 0, 0.0, np.inf)
-        else:
-            per_take = error / (sample + 1 - a)
-        return np.minimum.reduceat(per_take[self._order], self._heads)
-
-    def conclude(self, frames: int) -> Match | None:
-        """The demonstration has ended (``frames`` long): the last samples, then the answer on all of it when
-        nothing was committed or the commitment did not hold (``None``: the commitment stands)."""
-        was = self.committed
+    def conclude(self, frames: int) -> Match:
+        """The demonstration has ended (``frames`` long): the last samples, then the answer on all of it. The
+        commitment (:attr:`commitment`, the same object) when it stands, the answer at the end when it does not."""
         self.add(np.zeros((0, len(self.body.parts), 3)), np.zeros((0, len(self.body.parts)), dtype=bool), ended=True)
-        if self.committed is not None and not self.deviated:
-            return self.commitment if was is None else None  # committed on the last samples: not reported yet
-        if not len(self._still):
+        if not self._samples:
             return Match.unknown("nothing seen", details={"reason": "nothing seen"})
-        scores = self._scores(len(self._still) - 1)
+        scores = self._scores()
         ranked = tuple(sorted(zip(self.movements, scores.tolist()), key=lambda kv: (kv[1], kv[0])))
         limit = self.decision.threshold()
         nearest, score = ranked[0] if ranked else (None, np.inf)
         if nearest in self.stillness.still:  # it scores 1 whatever is shown: how little was there to explain
-            score, limit, measure = float(self._still[-1]), self.stillness.limit, self.stillness.measure
+            score, limit, measure = self.moving, self.stillness.limit, self.stillness.measure
         else:
             measure = self.decision.measure
         if nearest is None or score > limit:
             return Match.unknown("no prediction fits", nearest=nearest, score=score, threshold=limit,
                                  measure=measure, candidates=ranked)
+        if nearest == self.committed:
+            return self.commitment
         confidence = max(0.0, 1.0 - score / limit) if limit > 0 and np.isfinite(limit) else 1.0
         return Match(nearest, confidence, None, candidates=ranked, score=score, threshold=limit, measure=measure)
 
@@ -491,14 +486,13 @@ class Following:
         world = motion.world if motion.world is not None else motion.positions
         self.begin(motion.fps)
         self.add(world, motion.visible)
-        final = self.conclude(motion.n_frames)
-        return self.learned(motion, final) if final is not None else self.commitment
+        return self.learned(motion, self.conclude(motion.n_frames))
 
     def learned(self, motion: Recording, answer: Match | None) -> Match | None:
         """``answer`` at the end of the demonstration ``motion``; an unknown one learned as a new movement when
         this forward model learns (:class:`~plugins.matchers.forward_model.learning.TakeLearning`)."""
         if self.learning is None or answer is None or answer.movement is not None or answer.stop \
-                or not len(self._still):
+                or not self._samples:
             return answer
         return self.learning.learn(motion, answer)
 
@@ -507,18 +501,27 @@ class Streaming:
     """:class:`Following` as the watching loop drives a streaming matcher (:class:`toolkit.components.Matcher`):
     ``begin`` at a segment's onset, ``observe`` after each frame, ``replay`` for rows given at once, ``conclude`` at
     its end; each commitment or deviation at the frame it was decided (``Match.decided_at``), reported when the
-    rows are taken in (every :data:`BLOCK` seconds)."""
+    rows are taken in (every :data:`BLOCK` seconds). ``observe`` returns one answer a frame: when a block decided
+    more (a deviation and the commitment that replaces it), the others follow at the next frames."""
 
     def __init__(self, following: Following) -> None:
         self.following = following
         self.memory = None
         self.given = 0
         self.block = 1
+        self.pending: list[tuple[int, Match]] = []  # decided, not told yet
+        self.told: Match | None = None  # the last commitment told
 
     def begin(self, memory) -> None:
-        self.memory, self.given = memory, 0
+        self.memory, self.given, self.pending, self.told = memory, 0, [], None
         self.following.begin(memory.fps)
         self.block = max(1, int(round(BLOCK * memory.fps)))
+
+    def _tell(self, events: list[tuple[int, Match]]) -> list[tuple[int, Match]]:
+        for _, match in events:
+            if not match.stop:
+                self.told = match
+        return events
 
     def _take(self, memory, every: bool = False) -> list[tuple[int, Match]]:
         """The rows of ``memory`` not given yet, once :data:`BLOCK` seconds of them have come (``every``: all of
@@ -535,14 +538,15 @@ class Streaming:
         return [(memory.start + min(frame, n - 1), match) for frame, match in events]
 
     def observe(self, memory) -> Match | None:
-        events = self._take(memory)
-        return events[-1][1] if events else None
+        self.pending += self._take(memory)
+        return self._tell([self.pending.pop(0)])[0][1] if self.pending else None
 
     def replay(self, memory, stop: int) -> list[tuple[int, Match]]:
         if memory is not self.memory:
             self.begin(memory)
         memory.feed(stop)
-        return self._take(memory)
+        events, self.pending = self.pending + self._take(memory), []
+        return self._tell(events)
 
     def settled(self) -> int | None:
         return None
@@ -551,14 +555,14 @@ class Streaming:
         if self.memory is None:  # concluded without having followed the segment: all of it now
             return self.following.match(motion)
         try:
-            late = self._take(self.memory, every=True)  # the rows not taken in yet
+            self._take(self.memory, every=True)  # the rows not taken in yet
             with one_thread():
                 final = self.following.conclude(motion.n_frames)
-            if final is None and any(m is self.following.commitment for _, m in late):
-                return self.following.commitment  # committed in the last rows: not reported yet
-            return self.following.learned(motion, final)
+            if final is self.told:
+                return None  # the commitment told stands
+            return self.following.learned(motion, final)  # the answer at the end, or a commitment not told yet
         finally:
-            self.memory = None
+            self.memory, self.pending = None, []
 
     def inspect(self, shown: int = 5) -> dict[str, Any]:
         """The segment followed last, as the forward model's views read it: each movement's score at every sample

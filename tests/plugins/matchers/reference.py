@@ -40,3 +40,55 @@ def _paced_score(comparison, take: Frames, frames: Frames, chains, k: int) -> fl
     only[k] = False
     distances, _ = chain_distances(comparison, scaled, frames, chains, only)
     return float(distances[k] / np.mean(comparison.still(scaled)))
+
+
+def followed_score(comparison, take: Frames, frames: Frames, chains, k: int, prior: float) -> float:
+    """Chain ``k`` following ``take`` sample by sample at the pace its best path has gone so far
+    (:mod:`plugins.matchers.pacing`), written out: each sample played at ``1 / pace`` and costed against the chain's
+    frames, the warping's steps, its best path's frames advanced over, the pace ``(advanced + prior) / (steps +
+    prior)``; the chain's mean cost over the played samples' mean distance to standing still."""
+    nodes = chains.chain(k)
+    m = len(nodes)
+    cyclic = bool(chains.cyclic[k])
+    pace, still = 1.0, 0.0
+    total = length = advanced = None
+    for i in range(len(take)):
+        sample = take.take([i])
+        parts, carry = sample.parts.copy(), sample.carry.copy()
+        parts[..., 3:] /= pace
+        carry[:, :3] /= pace
+        played = Frames(parts, sample.seen, carry, sample.carried)
+        still += float(comparison.still(played)[0])
+        cost = comparison.costs(played, frames.take(nodes))[0]
+        if total is None:
+            total, length, advanced = cost.copy(), np.ones(m), np.zeros(m)
+        else:
+            new, new_len, new_adv = np.empty(m), np.empty(m), np.empty(m)
+            for j in range(m):
+                options = []  # (total, length, advanced), in the kernel's order of preference
+                if j > 0 or (cyclic and m > 1):
+                    options.append((total[j - 1], length[j - 1], advanced[j - 1] + 1))
+                options.append((total[j], length[j], advanced[j]))
+                if j > 0:
+                    options.append((new[j - 1], new_len[j - 1], new_adv[j - 1] + 1))
+                best = options[0]
+                for option in options[1:]:
+                    if option[0] < best[0]:
+                        best = option
+                new[j], new_len[j], new_adv[j] = best[0] + cost[j], best[1] + 1, best[2]
+            if cyclic and m > 1:
+                j = 0
+                while j < m and new[j - 1] + cost[j] < new[j]:
+                    new[j], new_len[j], new_adv[j] = new[j - 1] + cost[j], new_len[j - 1] + 1, new_adv[j - 1] + 1
+                    j += 1
+            total, length, advanced = new, new_len, new_adv
+        end = int(np.argmin(total / length))
+        pace = float(np.clip((advanced[end] + prior) / (i + prior), 1 / TEMPO, TEMPO)) if i + prior > 0 else 1.0
+    return float((total / length).min() / (still / len(take)))
+
+
+def followed_left_out_scores(comparison, takes, frames, chains, prior: float) -> list[float]:
+    """Leave one movement out, each take followed as a forward model follows it (:func:`followed_score`)."""
+    return [min(followed_score(comparison, take, frames, chains, k, prior)
+                for k in range(len(chains)) if chains.movements[k] != chains.movements[c])
+            for c, take in enumerate(takes)]

@@ -16,11 +16,12 @@ import pytest
 
 from plugins.bench.data import make_data
 from plugins.bench.mocap import _streams
-from plugins.matchers.forward_model.following import RATE, Following
+from plugins.matchers.forward_model.following import RATE, RECENT, Following
 from toolkit import Matcher, Motion, create_plugin_manager
 from toolkit.observe import Observer, compose_observer
 from toolkit.recordings.profile import load_profile
-from tests.plugins.matchers.reference import left_out_scores
+from plugins.matchers.pacing import PRIOR
+from tests.plugins.matchers.reference import followed_left_out_scores
 
 
 @pytest.fixture(scope="module")
@@ -59,11 +60,12 @@ def test_every_take_is_predicted_by_its_commands_at_the_sample_rate(observer):
 
 
 def test_the_calibration_leaves_each_take_out(observer):
-    """One take of each movement: each take's prediction against the other movements' (leave one movement out),
-    over its distance to standing still; no take of its own movement to leave out."""
+    """One take of each movement: each take's prediction followed against the other movements' (leave one movement
+    out) as a demonstration is followed, at each take's pace, over its distance to standing still at that pace; no
+    take of its own movement to leave out."""
     f = following(observer)
     p = f.prediction
-    want = left_out_scores(f.comparison, p.takes, p.frames, p.chains)
+    want = followed_left_out_scores(f.comparison, p.takes, p.frames, p.chains, PRIOR * RATE)
     assert f.decision.calibration.own == ()
     assert f.decision.calibration.other == pytest.approx(want)
 
@@ -102,28 +104,49 @@ def test_rows_given_at_once_give_what_rows_fed_one_by_one_give(observer, generat
     assert runs[0] and runs[0] == runs[1]
 
 
-def test_a_movement_that_goes_on_as_another_is_a_deviation(observer, generated):
-    """The first half of a wave, then a jump from where it was: the forward model commits to the wave and, when the
-    jump's prediction fits the last while :data:`LEAD` times as well, reports the deviation (``stop``, K&G Fig. 3's
-    "stop imitation") at a later frame; at the end it answers on the whole demonstration."""
+def test_a_movement_that_goes_on_as_another_is_a_deviation_and_the_other_is_committed_to(observer, generated):
+    """The first two fifths of a wave, then a stretch from where it was: the forward model commits to the wave and,
+    when the stretch prevails (it has been the nearest for :data:`RECENT` seconds), reports the wave's deviation
+    (``stop``, K&G Fig. 3's "stop imitation") and commits to the stretch at that frame (Fig. 3: predict again, and
+    imitate what prevails); at the end the stretch is the answer and its commitment stands."""
     data, profile = generated
     f = following(observer)
     first = profile.read(data / "repertoire" / "wave" / "max.bvh", None)
-    second = profile.read(data / "repertoire" / "jump" / "max.bvh", None)
-    half = first.n_frames // 2
-    start = second.positions - second.positions[:1] + first.positions[half - 1 : half]
-    joined = np.concatenate([first.positions[:half], start])
-    visible = np.concatenate([first.visible[:half], second.visible])
+    second = profile.read(data / "repertoire" / "stretch" / "max.bvh", None)
+    cut = int(0.4 * first.n_frames)
+    start = second.positions - second.positions[:1] + first.positions[cut - 1 : cut]
+    joined = np.concatenate([first.positions[:cut], start])
+    visible = np.concatenate([first.visible[:cut], second.visible])
     motion = Motion(joined, first.fps, first.parts, visible, joined)
     f.begin(motion.fps)
     events = f.add(motion.world, motion.visible)
     final = f.conclude(motion.n_frames)
-    commits = [(frame, m) for frame, m in events if not m.stop]
-    stops = [(frame, m) for frame, m in events if m.stop]
-    assert commits and commits[0][1].movement == "wave" and commits[0][0] < half
-    assert stops and stops[0][1].movement == "wave" and stops[0][1].reason == "deviation"
-    assert stops[0][0] > commits[0][0] and stops[0][1].score > 0
-    assert final is not None and final.decided_at is None  # the answer on all of it, not a commitment
+    assert [(m.movement, m.stop) for _, m in events] == [("wave", False), ("wave", True), ("stretch", False)]
+    (commit, wave), (stop, stopped), (again, stretch) = events
+    assert commit < cut < stop == again and stopped.reason == "deviation" and stopped.score > 0
+    assert wave.decided_at < stretch.decided_at
+    assert final is stretch  # the commitment stands: the answer on all of it is the stretch
+
+
+def test_a_commitment_that_is_not_the_answer_at_the_end_is_replaced(observer, generated):
+    """Eleven twentieths of a wave, then the stretch: the wave prevails for most of the demonstration and is committed
+    to; the stretch comes nearest only on the last samples, too late to prevail, but the answer on all of it is the
+    stretch:
+    the commitment does not stand (the demonstration must end where the committed movement does, K&G §4.4), and the
+    answer is the one at the end."""
+    data, profile = generated
+    f = following(observer)
+    first = profile.read(data / "repertoire" / "wave" / "max.bvh", None)
+    second = profile.read(data / "repertoire" / "stretch" / "max.bvh", None)
+    cut = int(0.55 * first.n_frames)
+    start = second.positions - second.positions[:1] + first.positions[cut - 1 : cut]
+    joined = np.concatenate([first.positions[:cut], start])
+    motion = Motion(joined, first.fps, first.parts, np.concatenate([first.visible[:cut], second.visible]), joined)
+    f.begin(motion.fps)
+    events = f.add(motion.world, motion.visible)
+    final = f.conclude(motion.n_frames)
+    assert [(m.movement, m.stop) for _, m in events] == [("wave", False)]
+    assert f.committed == "wave" and final.movement == "stretch" and final.decided_at is None
 
 
 def test_every_take_of_the_repertoire_is_its_own_movement_standing_still_too(observer, generated):
@@ -152,8 +175,8 @@ def test_a_moving_demonstration_is_not_the_still_movement(observer, generated):
     f.begin(wave.fps)
     f.add(wave.world if wave.world is not None else wave.positions, wave.visible)
     f.conclude(wave.n_frames)
-    assert float(f._still[-1]) > f.stillness.limit
-    assert not f.stillness.holds("stand", float(f._still[-1]))
+    assert f.moving > f.stillness.limit
+    assert not f.stillness.holds("stand", f.moving)
     assert f.stillness.holds("stand", 0.0) and not f.stillness.holds("nod", 0.0)
 
 
