@@ -10,7 +10,8 @@ movement under way only where it is a hub of this demonstrator:
   mean distance over the chosen parts, and no part farther than twice that: none has left it): a rest there ends it
   where the rest began;
 - elsewhere the rest is a *hold* and the movement goes on, unless they leave it (some part farther than twice
-  ``rest.radius``: a movement from it, not a hand fidgeting there) and come to rest near it again later: then it
+  ``rest.radius``: a movement from it, not a hand fidgeting there) and come to rest there again later (near it, as
+  near a hub: the mean and every part; a head bowing past the pose it was held in is not back there): then it
   was a new stance (movements leave it and come back to it), if they had held it a stance's time (``stance``; the
   segmenter's ``STANCE``, 0.2 s). The movement is cut where they first rested there, and the one from it back to it
   follows;
@@ -24,9 +25,12 @@ movement under way only where it is a hub of this demonstrator:
 A *shift* of stance is not a movement: a piece that goes straight from one rest to another (no part farther from the
 straight line between its first and last positions than ``rest.radius`` body sizes plus a quarter of its way: an arc
 of up to about 100 degrees) is dropped, and one that ends away from where it began with such a shift after a hold
-ends at the hold. A piece that never leaves where it began (no part farther than twice ``rest.radius``) is motion at
-rest (sway, fidgeting) and is dropped too. So two takes joined through a transition between their stances give the
-two takes, and a stance change between two gestures gives the two gestures.
+ends at the hold (if it left where it began before that hold: a movement, then the shift). A piece that never leaves
+where it began (no part farther than twice ``rest.radius``) is motion at rest (sway, fidgeting) and is dropped too.
+So two takes joined through a transition between their stances give the two takes, and a stance change between two
+gestures gives the two gestures. "Where it began" and "elsewhere" are judged as a hub is (:func:`_there`): eq. 1's
+mean within ``rest.radius`` and no part farther than twice it. A step to another stance moves the feet alone, whose
+mean over the parts may stay within the radius; it is a shift all the same, not a movement back where it began.
 
 On a noisy tracker each of these distances is at least what the jitter alone puts between two poses at rest (the
 segmenter's ``near``, from the measured jitter): the radius and twice it are the demonstrator's own, the jitter's
@@ -55,6 +59,14 @@ def _apart(a: np.ndarray, b: np.ndarray) -> float:
     d = np.linalg.norm((np.asarray(a) - np.asarray(b)).reshape(-1, 3), axis=1)
     d = d[np.isfinite(d)]
     return float(d.mean()) if d.size else float("nan")
+
+
+def _there(a: np.ndarray, b: np.ndarray, radius: float) -> bool:
+    """Whether pose ``b`` (3m,) is where pose ``a`` is: eq. 1's mean distance over the parts seen in both within
+    ``radius`` and no part farther than twice it (none has left it; as :meth:`Rests.at_hub`)."""
+    d = np.linalg.norm((np.asarray(a) - np.asarray(b)).reshape(-1, 3), axis=1)
+    d = d[np.isfinite(d)]
+    return bool(d.size) and float(d.mean()) <= radius and float(d.max()) <= 2.0 * radius
 
 
 def straight(window: np.ndarray, radius: float) -> bool:
@@ -175,13 +187,13 @@ class Rests:
         return at | ~compared.any(axis=1), still
 
     def returned(self, pose: np.ndarray, start: int, window: np.ndarray) -> int | None:
-        """The index of the last finished hold near ``pose`` that the demonstrator held a stance's time, left (some
-        part farther than twice the radius from it since it ended: a movement from it and back, not a hand fidgeting
-        there) and came back to rest at, or None.
+        """The index of the last finished hold ``pose`` is at (:func:`_there`) that the demonstrator held a stance's
+        time, left (some part farther than twice the radius from it since it ended: a movement from it and back, not a
+        hand fidgeting there) and came back to rest at, or None.
         ``window``: the movement's poses from frame ``start`` on."""
         for i in range(len(self.holds) - 1, -1, -1):
             h = self.holds[i]
-            if h.end is None or h.end - h.start < self.stance or not _apart(h.pose, pose) <= self.radius:
+            if h.end is None or h.end - h.start < self.stance or not _there(h.pose, pose, self.radius):
                 continue
             since = self.seen(window[h.end - start :]).reshape(-1, len(h.pose) // 3, 3)
             with np.errstate(all="ignore"):
@@ -205,22 +217,22 @@ class Rests:
                shifts: bool = True) -> list[tuple[int, int]]:
         """The movements (start, end) in frames of the stretch from ``start`` to ``end`` (its poses ``window``, one a
         frame from ``start``) whose holds are ``self.holds[:upto]``: none if it never leaves where it began (motion at
-        rest); the stretch if it comes back there; dropped if it is a shift of stance (unless not ``shifts``: a reach
-        held for ``settle`` is as much a movement as a shift); or ended at its last hold if what follows that hold is
-        a shift."""
+        rest); the stretch if it comes back where it began; dropped if it is a shift of stance (unless not
+        ``shifts``: a reach held for ``settle`` is as much a movement as a shift); or ended at its last hold if what
+        follows that hold is a shift and it left where it began before the hold."""
         holds = [h for h in self.holds[:upto] if h.end is not None and start < h.start and h.end < end]
         if not self.leaves(window[: end - start]):  # motion at rest (sway, a hand fidgeting): no movement
             return []
         last = self.seen(window[: end - start])[-1]  # the jitter averaged out
         first = self.origin if self.origin is not None else self.seen(window[:1])[0]
-        if _apart(first, last) <= self.radius:  # back where it began: no shift
+        if _there(first, last, self.radius):  # back where it began: no shift
             return [(start, end)]
         if shifts and self.shift(window[: end - start]):
             return []
         if holds:
             last = holds[-1]
-            if self.shift(window[last.end - start : end - start]):
-                return [(start, last.start)]
+            if self.shift(window[last.end - start : end - start]) and self.leaves(window[: last.start - start]):
+                return [(start, last.start)]  # a movement to the hold, then a shift
         return [(start, end)]
 
     def ended_before(self, start: int, window: np.ndarray) -> bool:
@@ -263,4 +275,4 @@ class Rests:
         if len(window) < 2:
             return False
         window = self.seen(window)
-        return not _apart(window[0], window[-1]) <= self.radius and straight(window, self.radius)
+        return not _there(window[0], window[-1], self.radius) and straight(window, self.radius)

@@ -1,0 +1,42 @@
+"""velocity-direction under a tracker's jitter whatever the noise draw (issue 36), with the observer template's
+settings: hand-built streams whose rest-to-rest movements are known, each watched under many draws of the same
+jitter, so that no rule holds on a lucky draw alone (``rests.py``: where a movement is back where it began, a step to
+another stance)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from plugins.segmenters.velocity_direction.rests import Rests
+from tests.fixtures.gesture_streams import hold, move, point, stance, wave
+from tests.plugins.segmenters.test_velocity_direction_streams import A, scores
+
+SEEDS = range(10)
+
+
+def stepped():
+    """A wave, a step to a wider stance (the feet alone move, 30 cm: eq. 1's mean over the parts stays within
+    ``rest.radius``) held 0.5 s, then a point from there."""
+    wide = stance("down", wide=0.3)
+    return [("rest", [hold(A, 1.0)]), ("movement", wave(A)), ("rest", [hold(A, 0.5)]),
+            ("shift", [move(A, wide, 0.5)]), ("rest", [hold(wide, 0.5)]), ("movement", point(wide)),
+            ("rest", [hold(wide, 1.0)])]
+
+
+@pytest.mark.parametrize("tracker", [0.0, 0.01, 0.02])
+def test_a_step_to_another_stance_is_a_shift_not_a_movement(tracker):
+    """A step moves the feet far (some part beyond twice ``rest.radius``) while the mean over the parts stays near:
+    it is not back where it began, so it is judged as a shift and dropped, on every draw."""
+    found = [scores(stepped(), tracker=tracker, seed=seed) for seed in SEEDS]
+    assert all(s["f1"] == 1.0 for s in found), [(s["found"], s["f1"]) for s in found]
+
+
+def test_a_pose_a_step_away_is_not_where_it_began():
+    """The step's end pose is not "back where it began" although eq. 1's mean is within the radius: a part (a foot)
+    lies farther than twice it."""
+    wide = stance("down", wide=0.3)
+    d = np.linalg.norm(wide - A, axis=1)
+    rests = Rests(radius=0.1)
+    assert d.mean() <= 0.1 < d.max() / 2
+    assert rests.shift(np.concatenate([hold(A, 0.2), move(A, wide, 0.5)]).reshape(-1, A.size))
