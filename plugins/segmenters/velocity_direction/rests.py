@@ -17,7 +17,9 @@ movement under way only where it is a hub of this demonstrator:
   follows;
 - or they rest ``settle`` seconds in one place (a new stance they stay in): the movement ends where that rest began.
   A rest stays in one place: a hold from which some part drifts farther than ``rest.radius`` was no rest (a
-  movement slower than a tracker's jitter lets the speed show) and a new hold begins where they are (``still``);
+  movement slower than a tracker's jitter lets the speed show) and a new hold begins where they are (``still``).
+  If the next movement from that stance ends back at the pose the settled one began from (``back``), the stance
+  was a long hold of that one (a hand raised and held, then lowered) and its way back is no new movement;
 - or they have rested a stance's time at a hold reached by a shift (below) from a hold before it that lasted as
   long and where the movement had come at least half-way back to its first pose: the movement ended at that hold (a
   take that ends in another stance than it began, then the shift to the next one's).
@@ -108,8 +110,10 @@ class Rests:
     ``rest.radius`` times the body's size when a movement begins. ``stance``: the frames a hold must last to be a
     stance that movements leave and come back to (shorter: a pause in a gesture, a hand fidgeting). ``smooth``: the
     frames of the moving average the working memory is seen through (the tracker's jitter averaged out) when it is
-    asked whether a piece leaves where it began, is a shift, or comes back to a hold. ``origin``: the rest pose a
-    movement found by position left (the segmenter sets it; None: the movement's first frame is where it began).
+    asked whether a piece leaves where it began, is a shift, or comes back to a hold. ``origin``: the rest pose a movement found by position left (the segmenter
+    sets it; None: the movement's first frame is where it began). ``settled``: where the movement that last ended
+    by ``settle`` began and the stance it settled in (:meth:`settle`); ``back``: the same for the movement under
+    way, which began from that stance (None: the last one did not end so).
     """
 
     radius: float = 0.0
@@ -117,6 +121,8 @@ class Rests:
     smooth: int = 1
     keep: int = 8
     origin: np.ndarray | None = None
+    settled: tuple[np.ndarray, np.ndarray] | None = None
+    back: tuple[np.ndarray, np.ndarray] | None = None
     hubs: list[np.ndarray] = field(default_factory=list)
     holds: list[Hold] = field(default_factory=list)
     _stacked: np.ndarray | None = field(default=None, repr=False)  # the hubs (and the hold under way) (k, m, 3)
@@ -126,7 +132,14 @@ class Rests:
         self.radius = radius
         self.holds = []
         self.origin = None
+        self.back, self.settled = self.settled, None
         self.hub(pose)
+
+    def settle(self, first: np.ndarray, pose: np.ndarray) -> None:
+        """The movement under way, which began at ``first`` (3m,), ended by ``settle`` in ``pose``: a new stance (a
+        hub), unless the next movement from it goes back to ``first``."""
+        self.hub(pose)
+        self.settled = (np.asarray(first, dtype=float), np.asarray(pose, dtype=float))
 
     def hub(self, pose: np.ndarray) -> None:
         """``pose`` is a rest of this demonstrator's (the latest first; one near it replaced)."""
@@ -217,7 +230,8 @@ class Rests:
                shifts: bool = True) -> list[tuple[int, int]]:
         """The movements (start, end) in frames of the stretch from ``start`` to ``end`` (its poses ``window``, one a
         frame from ``start``) whose holds are ``self.holds[:upto]``: none if it never leaves where it began (motion at
-        rest); the stretch if it comes back where it began; dropped if it is a shift of stance (unless not
+        rest) or if it began from a settled stance and ends where the settled movement began (``back``: that one's
+        way back); the stretch if it comes back where it began; dropped if it is a shift of stance (unless not
         ``shifts``: a reach held for ``settle`` is as much a movement as a shift); or ended at its last hold if what
         follows that hold is a shift and it left where it began before the hold."""
         holds = [h for h in self.holds[:upto] if h.end is not None and start < h.start and h.end < end]
@@ -225,6 +239,10 @@ class Rests:
             return []
         last = self.seen(window[: end - start])[-1]  # the jitter averaged out
         first = self.origin if self.origin is not None else self.seen(window[:1])[0]
+        if self.back is not None and _there(self.back[0], last, self.radius):  # a settled movement's way back:
+            self.hubs = [h for h in self.hubs if not _there(self.back[1], h, self.radius)]  # that was no stance
+            self._stacked = None
+            return []
         if _there(first, last, self.radius):  # back where it began: no shift
             return [(start, end)]
         if shifts and self.shift(window[: end - start]):

@@ -64,7 +64,8 @@ parameter, off by default (the paper); the observer template (``characters/obser
   elsewhere is a *hold* (a bow, a pointing hand held half-way: one movement, not two) unless they leave it and come
   to rest there again (a new stance: the movement is cut where they first rested there) or rest there ``settle``
   seconds, in one place: a hold from which some part drifts farther than ``rest.radius`` was no rest (a movement
-  slower than the tracker's jitter lets the speed show) and the rest counts again from there. A straight *shift*
+  slower than the tracker's jitter lets the speed show) and the rest counts again from there; the way back from such
+  a stance to where the settled movement began is no movement of its own. A straight *shift*
   from one stance to another is no movement and is dropped, and a piece that never leaves where it began (some part
   farther than twice ``rest.radius``) is motion at rest (sway, fidgeting), dropped too. ``rest.radius = 0.1``:
   B&B's hub threshold (0.02 m on Max, 0.20 m body size); ``settle = 2`` s: longer than a gesture holds a pose (about
@@ -666,7 +667,7 @@ class VelocityDirection(Segmenter):
             return self._close_pieces(pieces, began)
         if resting >= self._settle:  # a new stance they stay in: the movement ends where they came to it
             pieces = rests.pieces(start, began, window, shifts=False)
-            rests.hub(points)
+            rests.settle(rests.origin if rests.origin is not None else rests.seen(window[:1])[0], points)
             return self._close_pieces(pieces, began)
         if not self._holding:
             rests.hold(began, points)
