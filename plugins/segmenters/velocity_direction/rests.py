@@ -36,9 +36,12 @@ mean over the parts may stay within the radius; it is a shift all the same, not 
 
 On a noisy tracker each of these distances is at least what the jitter alone puts between two poses at rest (the
 segmenter's ``near``, from the measured jitter): the radius and twice it are the demonstrator's own, the jitter's
-margin where that is larger. A movement the segmenter found by position (it left its rest slower than the speed
-shows) comes back where it began when it is back at the rest pose it left (``origin``): its first frame already lies
-beyond the jitter's margin from there.
+margin where that is larger. Eq. 1's mean distance to a hub is taken over what the jitter does not explain: two
+poses seen through means of the same frames lie apart by the jitter's root-mean-square distance ``near / jitter``
+even at rest, so each part's squared distance less that square counts (an unbiased estimate of the square of the
+distance between the poses themselves), else a tracker's jitter alone would use up much of the radius. A movement
+the segmenter found by position (it left its rest slower than the speed shows) comes back where it began when it is
+back at the rest pose it left (``origin``): its first frame already lies beyond the jitter's margin from there.
 
 Everything here is bookkeeping on frame numbers and the working memory's poses, called by the segmenter only on the
 frames where the demonstrator comes to rest or leaves it (:meth:`Rests.places` asks a hold's frames at once).
@@ -110,7 +113,9 @@ class Rests:
     ``rest.radius`` times the body's size when a movement begins. ``stance``: the frames a hold must last to be a
     stance that movements leave and come back to (shorter: a pause in a gesture, a hand fidgeting). ``smooth``: the
     frames of the moving average the working memory is seen through (the tracker's jitter averaged out) when it is
-    asked whether a piece leaves where it began, is a shift, or comes back to a hold. ``origin``: the rest pose a movement found by position left (the segmenter
+    asked whether a piece leaves where it began, is a shift, or comes back to a hold. ``jitter``: how many times
+    the jitter's root-mean-square distance between two poses at rest the margins ``near`` are (the segmenter's
+    ``jitter``; 0: no jitter measured). ``origin``: the rest pose a movement found by position left (the segmenter
     sets it; None: the movement's first frame is where it began). ``settled``: where the movement that last ended
     by ``settle`` began and the stance it settled in (:meth:`settle`); ``back``: the same for the movement under
     way, which began from that stance (None: the last one did not end so).
@@ -120,6 +125,7 @@ class Rests:
     stance: int = 0
     smooth: int = 1
     keep: int = 8
+    jitter: float = 0.0
     origin: np.ndarray | None = None
     settled: tuple[np.ndarray, np.ndarray] | None = None
     back: tuple[np.ndarray, np.ndarray] | None = None
@@ -188,12 +194,15 @@ class Rests:
             return np.ones(k, bool), still
         d2 = d2[:, : len(self.hubs)]
         left = np.maximum(2.0 * self.radius, near)[:, None]
+        # eq. 1 on the distances the poses' own jitter does not explain: each part's square less the jitter's
+        noise = np.asarray(near, dtype=float) / self.jitter if self.jitter > 0 else np.zeros(k)
+        real = np.maximum(d2 - (noise * noise)[:, None, None], 0.0)  # NaN stays NaN
         if np.isfinite(d2).all():  # eq. 1: the mean over the parts (np.mean's sum and division, without its overhead)
-            at = (np.add.reduce(np.sqrt(d2), axis=2) / d2.shape[2] <= self.radius) & (d2.max(axis=2) <= left * left)
+            at = (np.add.reduce(np.sqrt(real), axis=2) / d2.shape[2] <= self.radius) & (d2.max(axis=2) <= left * left)
             return at.any(axis=1), still
         with np.errstate(all="ignore"):
             seen = np.isfinite(d2)
-            mean = np.nanmean(np.where(seen, np.sqrt(d2), np.nan), axis=2)  # eq. 1 over the parts seen in both
+            mean = np.nanmean(np.where(seen, np.sqrt(real), np.nan), axis=2)  # eq. 1 over the parts seen in both
             farthest = np.where(seen, d2, -np.inf).max(axis=2)
             compared = np.isfinite(mean)
             at = ((mean <= self.radius) & (farthest <= left * left) & compared).any(axis=1)

@@ -77,7 +77,8 @@ parameter, off by default (the paper); the observer template (``characters/obser
   of jitter lets a third-of-a-second fit tell from rest is found by where the head goes, not by how fast. Every
   distance here is at least what the jitter alone gives (``jitter`` times the root-mean-square distance between two
   such means of a part standing still, :mod:`.departure`): the radius and twice it are the demonstrator's own, the
-  jitter's margin where that is larger.
+  jitter's margin where that is larger; eq. 1's mean distance to a hub counts only what that root-mean-square
+  distance does not explain (each part's square less its square, :mod:`.rests`).
 
 On locomotion, which never rests, the template's movement level finds no boundary inside a walk: a walk of several
 takes is one movement (closed after ``max_movement`` seconds if it goes on), not one a stride.
@@ -241,7 +242,7 @@ class VelocityDirection(Segmenter):
             if self.params["jitter"] > 0 else None  # measured again every second
         self._positions = ~np.array([p in angles for p in parts]) if parts else np.zeros(0, bool)
         self._size_sum, self._size_n = 0.0, 0
-        self._rests = Rests(stance=int(round(STANCE * self._fps)), smooth=self._still) \
+        self._rests = Rests(stance=int(round(STANCE * self._fps)), smooth=self._still, jitter=self.params["jitter"]) \
             if self.params["end"] == "rest" else None
         # end = rest: the hubs and holds
         self._holding = False  # end = rest: the rest under way is a hold (away from the hubs)

@@ -59,3 +59,21 @@ def test_a_pose_a_step_away_is_not_where_it_began():
     rests = Rests(radius=0.1)
     assert d.mean() <= 0.1 < d.max() / 2
     assert rests.shift(np.concatenate([hold(A, 0.2), move(A, wide, 0.5)]).reshape(-1, A.size))
+
+
+def test_a_hubs_mean_distance_is_what_the_jitter_does_not_explain():
+    """Two poses seen through means of the same frames lie apart by the jitter's root-mean-square distance even at
+    rest: eq. 1's mean distance to a hub counts each part's squared distance less that square. Every part 5.5 cm from
+    the hub, radius 5 cm: not there without jitter; there when the jitter alone puts 3 cm between two such poses
+    (``near`` 9 cm at ``jitter = 3``: sqrt(5.5^2 - 3^2) = 4.6 cm); and not when the pose is 7 cm away."""
+    hub = np.zeros(15 * 3)
+
+    def at(distance, near, jitter=3.0):
+        rests = Rests(radius=0.05, jitter=jitter)
+        rests.hub(hub)
+        pose = np.tile([distance, 0.0, 0.0], 15)
+        return bool(rests.places(pose[None], np.array([near]))[0][0])
+
+    assert not at(0.055, 0.0) and not at(0.055, 0.09, jitter=0.0)
+    assert at(0.055, 0.09)
+    assert not at(0.07, 0.09)
