@@ -238,12 +238,13 @@ class Rests:
     def pieces(self, start: int, end: int, window: np.ndarray, upto: int | None = None,
                shifts: bool = True) -> list[tuple[int, int]]:
         """The movements (start, end) in frames of the stretch from ``start`` to ``end`` (its poses ``window``, one a
-        frame from ``start``) whose holds are ``self.holds[:upto]``: none if it never leaves where it began (motion at
+        frame from ``start``) whose holds are ``self.holds[:upto]`` (those that lasted: a rest dated back to where the
+        motion resumed ends where it began and is no hold): none if it never leaves where it began (motion at
         rest) or if it began from a settled stance and ends where the settled movement began (``back``: that one's
         way back); the stretch if it comes back where it began; dropped if it is a shift of stance (unless not
         ``shifts``: a reach held for ``settle`` is as much a movement as a shift); or ended at its last hold if what
         follows that hold is a shift and it left where it began before the hold."""
-        holds = [h for h in self.holds[:upto] if h.end is not None and start < h.start and h.end < end]
+        holds = [h for h in self.holds[:upto] if h.end is not None and start < h.start < h.end < end]
         if not self.leaves(window[: end - start]):  # motion at rest (sway, a hand fidgeting): no movement
             return []
         last = self.seen(window[: end - start])[-1]  # the jitter averaged out

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from plugins.segmenters.velocity_direction.rests import Rests
+from plugins.segmenters.velocity_direction.rests import Hold, Rests
 from tests.fixtures.gesture_streams import hold, move, point, reach, stance, wave
 from tests.plugins.segmenters.test_velocity_direction_streams import A, scores
 
@@ -77,3 +77,19 @@ def test_a_hubs_mean_distance_is_what_the_jitter_does_not_explain():
     assert not at(0.055, 0.0) and not at(0.055, 0.09, jitter=0.0)
     assert at(0.055, 0.09)
     assert not at(0.07, 0.09)
+
+
+def test_a_hold_that_ended_where_it_began_is_no_hold():
+    """A rest dated back to where the motion resumed ends where it began (``Hold(30, pose, 30)``): no hold, so a
+    movement whose end after it goes straight is not cut there (the clean Bandai stream_09's "bye" was cut 79 frames
+    early at such a hold); a hold that lasted is, when what follows it is a shift."""
+    t = np.linspace(0.0, np.pi, 30)
+    out = np.stack([0.2 - 0.2 * np.cos(t), 0.4 * np.sin(t), 0 * t], axis=1)  # an arc out to (0.4, 0, 0)
+    on = np.linspace([0.4, 0.0, 0.0], [0.8, 0.0, 0.0], 31)[1:]  # then straight on to (0.8, 0, 0)
+    part = np.concatenate([out, on])
+    window = np.concatenate([part, np.zeros_like(part)], axis=1)  # a second part standing still
+    rests = Rests(radius=0.05)
+    rests.holds = [Hold(30, window[30], 30)]
+    assert rests.pieces(0, 60, window) == [(0, 60)]
+    rests.holds = [Hold(30, window[30], 34)]
+    assert rests.pieces(0, 60, window) == [(0, 30)]
