@@ -14,7 +14,8 @@ movement under way only where it is a hub of this demonstrator:
   near a hub: the mean and every part; a head bowing past the pose it was held in is not back there): then it
   was a new stance (movements leave it and come back to it), if they had held it a stance's time (``stance``; the
   segmenter's ``STANCE``, 0.2 s). The movement is cut where they first rested there, and the one from it back to it
-  follows;
+  follows; so too where the rest is at a hub as well (a new stance near an old one): what led to the new stance was
+  no part of the movement from it;
 - or they rest ``settle`` seconds in one place (a new stance they stay in): the movement ends where that rest began.
   A rest stays in one place: a hold from which some part drifts farther than ``rest.radius`` was no rest (a
   movement slower than a tracker's jitter lets the speed show) and a new hold begins where they are (``still``).

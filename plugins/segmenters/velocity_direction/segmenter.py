@@ -637,8 +637,9 @@ class VelocityDirection(Segmenter):
 
     def _rested(self, began: int, points: np.ndarray, near: float = 0.0) -> list[Segment]:
         """With ``end = "rest"``: the demonstrator has rested since ``began`` with the chosen parts at ``points``
-        (3m,) while a movement is under way. Near a hub, or after ``settle`` seconds, it ends there; back at a hold
-        of the movement's, the movement is cut where that hold began and the one from it back to it follows; held a
+        (3m,) while a movement is under way. Back at a hold of the movement's (near a hub or not), the movement is
+        cut where that hold began and the one from it back to it follows; near a hub, or after ``settle`` seconds,
+        it ends there; held a
         stance's time after a shift from a hold where the movement had come most of the way back, it ended at that
         hold; else the rest is a hold and the movement goes on (:mod:`.rests`)."""
         rests = self._rests
@@ -656,9 +657,9 @@ class VelocityDirection(Segmenter):
             if not hub:  # a hold goes on (the working memory is not needed)
                 return []
         window = np.array(self._buffer)
-        if hub:
-            return self._close_pieces(rests.pieces(start, began, window), began)
         back = None if self._holding else rests.returned(points, start, window)
+        if hub and back is None:
+            return self._close_pieces(rests.pieces(start, began, window), began)
         if back is not None:
             hold = rests.holds[back]
             pieces = rests.pieces(start, hold.start, window, upto=back)

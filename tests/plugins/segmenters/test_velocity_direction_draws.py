@@ -93,3 +93,24 @@ def test_a_hold_that_ended_where_it_began_is_no_hold():
     assert rests.pieces(0, 60, window) == [(0, 60)]
     rests.holds = [Hold(30, window[30], 34)]
     assert rests.pieces(0, 60, window) == [(0, 30)]
+
+
+def shifted_then_waved():
+    """A point from a stance, a shift leaning 0.2 rad forward (farther than ``rest.radius`` from it) held 0.5 s, then
+    a wave from there that ends half-way between the two (within the radius of both): back at the new stance's hold,
+    and at the first stance's hub too."""
+    first, leaning, between = stance("down"), stance("down", lean=0.2), stance("down", lean=0.1)
+    moves = wave(leaning)
+    moves[-1] = move(moves[-2][-1], between, 0.48)  # the wave's way down ends between the two stances
+    return [("rest", [hold(first, 1.0)]), ("movement", point(first)), ("rest", [hold(first, 1.0)]),
+            ("shift", [move(first, leaning, 0.6)]), ("rest", [hold(leaning, 0.5)]), ("movement", moves),
+            ("rest", [hold(between, 1.0)])]
+
+
+@pytest.mark.parametrize("tracker", [0.0, 0.01])
+def test_a_movement_back_at_the_stance_it_shifted_to_is_cut_there_even_at_a_hub(tracker):
+    """The wave comes back to the stance the shift led to (a hold of a stance's time, left and come back to) and to
+    the first stance's hub at once: the shift is cut off (no movement) and the wave begins where the hold ended,
+    within 0.25 s, on every draw (before, the hub ended the movement whole, the shift and the hold with it)."""
+    found = [scores(shifted_then_waved(), tracker=tracker, seed=seed) for seed in SEEDS]
+    assert all(s["f1"] == 1.0 and s["within"] == 1.0 for s in found), [(s["f1"], s["within"]) for s in found]
