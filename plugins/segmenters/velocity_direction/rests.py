@@ -10,13 +10,17 @@ movement under way only where it is a hub of this demonstrator:
   mean distance over the chosen parts, and no part farther than twice that: none has left it): a rest there ends it
   where the rest began;
 - elsewhere the rest is a *hold* and the movement goes on, unless they leave it (some part farther than twice
-  ``rest.radius``: a movement from it, not a hand fidgeting there) and come to rest near it again later: then it
+  ``rest.radius``: a movement from it, not a hand fidgeting there) and come to rest there again later (near it, as
+  near a hub: the mean and every part; a head bowing past the pose it was held in is not back there): then it
   was a new stance (movements leave it and come back to it), if they had held it a stance's time (``stance``; the
   segmenter's ``STANCE``, 0.2 s). The movement is cut where they first rested there, and the one from it back to it
-  follows;
+  follows; so too where the rest is at a hub as well (a new stance near an old one): what led to the new stance was
+  no part of the movement from it;
 - or they rest ``settle`` seconds in one place (a new stance they stay in): the movement ends where that rest began.
   A rest stays in one place: a hold from which some part drifts farther than ``rest.radius`` was no rest (a
-  movement slower than a tracker's jitter lets the speed show) and a new hold begins where they are (``still``);
+  movement slower than a tracker's jitter lets the speed show) and a new hold begins where they are (``still``).
+  If the next movement from that stance ends back at the pose the settled one began from (``back``), the stance
+  was a long hold of that one (a hand raised and held, then lowered) and its way back is no new movement;
 - or they have rested a stance's time at a hold reached by a shift (below) from a hold before it that lasted as
   long and where the movement had come at least half-way back to its first pose: the movement ended at that hold (a
   take that ends in another stance than it began, then the shift to the next one's).
@@ -24,15 +28,21 @@ movement under way only where it is a hub of this demonstrator:
 A *shift* of stance is not a movement: a piece that goes straight from one rest to another (no part farther from the
 straight line between its first and last positions than ``rest.radius`` body sizes plus a quarter of its way: an arc
 of up to about 100 degrees) is dropped, and one that ends away from where it began with such a shift after a hold
-ends at the hold. A piece that never leaves where it began (no part farther than twice ``rest.radius``) is motion at
-rest (sway, fidgeting) and is dropped too. So two takes joined through a transition between their stances give the
-two takes, and a stance change between two gestures gives the two gestures.
+ends at the hold (if it left where it began before that hold: a movement, then the shift). A piece that never leaves
+where it began (no part farther than twice ``rest.radius``) is motion at rest (sway, fidgeting) and is dropped too.
+So two takes joined through a transition between their stances give the two takes, and a stance change between two
+gestures gives the two gestures. "Where it began" and "elsewhere" are judged as a hub is (:func:`_there`): eq. 1's
+mean within ``rest.radius`` and no part farther than twice it. A step to another stance moves the feet alone, whose
+mean over the parts may stay within the radius; it is a shift all the same, not a movement back where it began.
 
 On a noisy tracker each of these distances is at least what the jitter alone puts between two poses at rest (the
 segmenter's ``near``, from the measured jitter): the radius and twice it are the demonstrator's own, the jitter's
-margin where that is larger. A movement the segmenter found by position (it left its rest slower than the speed
-shows) comes back where it began when it is back at the rest pose it left (``origin``): its first frame already lies
-beyond the jitter's margin from there.
+margin where that is larger. Eq. 1's mean distance to a hub is taken over what the jitter does not explain: two
+poses seen through means of the same frames lie apart by the jitter's root-mean-square distance ``near / jitter``
+even at rest, so each part's squared distance less that square counts (an unbiased estimate of the square of the
+distance between the poses themselves), else a tracker's jitter alone would use up much of the radius. A movement
+the segmenter found by position (it left its rest slower than the speed shows) comes back where it began when it is
+back at the rest pose it left (``origin``): its first frame already lies beyond the jitter's margin from there.
 
 Everything here is bookkeeping on frame numbers and the working memory's poses, called by the segmenter only on the
 frames where the demonstrator comes to rest or leaves it (:meth:`Rests.places` asks a hold's frames at once).
@@ -55,6 +65,14 @@ def _apart(a: np.ndarray, b: np.ndarray) -> float:
     d = np.linalg.norm((np.asarray(a) - np.asarray(b)).reshape(-1, 3), axis=1)
     d = d[np.isfinite(d)]
     return float(d.mean()) if d.size else float("nan")
+
+
+def _there(a: np.ndarray, b: np.ndarray, radius: float) -> bool:
+    """Whether pose ``b`` (3m,) is where pose ``a`` is: eq. 1's mean distance over the parts seen in both within
+    ``radius`` and no part farther than twice it (none has left it; as :meth:`Rests.at_hub`)."""
+    d = np.linalg.norm((np.asarray(a) - np.asarray(b)).reshape(-1, 3), axis=1)
+    d = d[np.isfinite(d)]
+    return bool(d.size) and float(d.mean()) <= radius and float(d.max()) <= 2.0 * radius
 
 
 def straight(window: np.ndarray, radius: float) -> bool:
@@ -96,15 +114,22 @@ class Rests:
     ``rest.radius`` times the body's size when a movement begins. ``stance``: the frames a hold must last to be a
     stance that movements leave and come back to (shorter: a pause in a gesture, a hand fidgeting). ``smooth``: the
     frames of the moving average the working memory is seen through (the tracker's jitter averaged out) when it is
-    asked whether a piece leaves where it began, is a shift, or comes back to a hold. ``origin``: the rest pose a
-    movement found by position left (the segmenter sets it; None: the movement's first frame is where it began).
+    asked whether a piece leaves where it began, is a shift, or comes back to a hold. ``jitter``: how many times
+    the jitter's root-mean-square distance between two poses at rest the margins ``near`` are (the segmenter's
+    ``jitter``; 0: no jitter measured). ``origin``: the rest pose a movement found by position left (the segmenter
+    sets it; None: the movement's first frame is where it began). ``settled``: where the movement that last ended
+    by ``settle`` began and the stance it settled in (:meth:`settle`); ``back``: the same for the movement under
+    way, which began from that stance (None: the last one did not end so).
     """
 
     radius: float = 0.0
     stance: int = 0
     smooth: int = 1
     keep: int = 8
+    jitter: float = 0.0
     origin: np.ndarray | None = None
+    settled: tuple[np.ndarray, np.ndarray] | None = None
+    back: tuple[np.ndarray, np.ndarray] | None = None
     hubs: list[np.ndarray] = field(default_factory=list)
     holds: list[Hold] = field(default_factory=list)
     _stacked: np.ndarray | None = field(default=None, repr=False)  # the hubs (and the hold under way) (k, m, 3)
@@ -114,7 +139,14 @@ class Rests:
         self.radius = radius
         self.holds = []
         self.origin = None
+        self.back, self.settled = self.settled, None
         self.hub(pose)
+
+    def settle(self, first: np.ndarray, pose: np.ndarray) -> None:
+        """The movement under way, which began at ``first`` (3m,), ended by ``settle`` in ``pose``: a new stance (a
+        hub), unless the next movement from it goes back to ``first``."""
+        self.hub(pose)
+        self.settled = (np.asarray(first, dtype=float), np.asarray(pose, dtype=float))
 
     def hub(self, pose: np.ndarray) -> None:
         """``pose`` is a rest of this demonstrator's (the latest first; one near it replaced)."""
@@ -163,25 +195,28 @@ class Rests:
             return np.ones(k, bool), still
         d2 = d2[:, : len(self.hubs)]
         left = np.maximum(2.0 * self.radius, near)[:, None]
+        # eq. 1 on the distances the poses' own jitter does not explain: each part's square less the jitter's
+        noise = np.asarray(near, dtype=float) / self.jitter if self.jitter > 0 else np.zeros(k)
+        real = np.maximum(d2 - (noise * noise)[:, None, None], 0.0)  # NaN stays NaN
         if np.isfinite(d2).all():  # eq. 1: the mean over the parts (np.mean's sum and division, without its overhead)
-            at = (np.add.reduce(np.sqrt(d2), axis=2) / d2.shape[2] <= self.radius) & (d2.max(axis=2) <= left * left)
+            at = (np.add.reduce(np.sqrt(real), axis=2) / d2.shape[2] <= self.radius) & (d2.max(axis=2) <= left * left)
             return at.any(axis=1), still
         with np.errstate(all="ignore"):
             seen = np.isfinite(d2)
-            mean = np.nanmean(np.where(seen, np.sqrt(d2), np.nan), axis=2)  # eq. 1 over the parts seen in both
+            mean = np.nanmean(np.where(seen, np.sqrt(real), np.nan), axis=2)  # eq. 1 over the parts seen in both
             farthest = np.where(seen, d2, -np.inf).max(axis=2)
             compared = np.isfinite(mean)
             at = ((mean <= self.radius) & (farthest <= left * left) & compared).any(axis=1)
         return at | ~compared.any(axis=1), still
 
     def returned(self, pose: np.ndarray, start: int, window: np.ndarray) -> int | None:
-        """The index of the last finished hold near ``pose`` that the demonstrator held a stance's time, left (some
-        part farther than twice the radius from it since it ended: a movement from it and back, not a hand fidgeting
-        there) and came back to rest at, or None.
+        """The index of the last finished hold ``pose`` is at (:func:`_there`) that the demonstrator held a stance's
+        time, left (some part farther than twice the radius from it since it ended: a movement from it and back, not a
+        hand fidgeting there) and came back to rest at, or None.
         ``window``: the movement's poses from frame ``start`` on."""
         for i in range(len(self.holds) - 1, -1, -1):
             h = self.holds[i]
-            if h.end is None or h.end - h.start < self.stance or not _apart(h.pose, pose) <= self.radius:
+            if h.end is None or h.end - h.start < self.stance or not _there(h.pose, pose, self.radius):
                 continue
             since = self.seen(window[h.end - start :]).reshape(-1, len(h.pose) // 3, 3)
             with np.errstate(all="ignore"):
@@ -204,23 +239,29 @@ class Rests:
     def pieces(self, start: int, end: int, window: np.ndarray, upto: int | None = None,
                shifts: bool = True) -> list[tuple[int, int]]:
         """The movements (start, end) in frames of the stretch from ``start`` to ``end`` (its poses ``window``, one a
-        frame from ``start``) whose holds are ``self.holds[:upto]``: none if it never leaves where it began (motion at
-        rest); the stretch if it comes back there; dropped if it is a shift of stance (unless not ``shifts``: a reach
-        held for ``settle`` is as much a movement as a shift); or ended at its last hold if what follows that hold is
-        a shift."""
-        holds = [h for h in self.holds[:upto] if h.end is not None and start < h.start and h.end < end]
+        frame from ``start``) whose holds are ``self.holds[:upto]`` (those that lasted: a rest dated back to where the
+        motion resumed ends where it began and is no hold): none if it never leaves where it began (motion at
+        rest) or if it began from a settled stance and ends where the settled movement began (``back``: that one's
+        way back); the stretch if it comes back where it began; dropped if it is a shift of stance (unless not
+        ``shifts``: a reach held for ``settle`` is as much a movement as a shift); or ended at its last hold if what
+        follows that hold is a shift and it left where it began before the hold."""
+        holds = [h for h in self.holds[:upto] if h.end is not None and start < h.start < h.end < end]
         if not self.leaves(window[: end - start]):  # motion at rest (sway, a hand fidgeting): no movement
             return []
         last = self.seen(window[: end - start])[-1]  # the jitter averaged out
         first = self.origin if self.origin is not None else self.seen(window[:1])[0]
-        if _apart(first, last) <= self.radius:  # back where it began: no shift
+        if self.back is not None and _there(self.back[0], last, self.radius):  # a settled movement's way back:
+            self.hubs = [h for h in self.hubs if not _there(self.back[1], h, self.radius)]  # that was no stance
+            self._stacked = None
+            return []
+        if _there(first, last, self.radius):  # back where it began: no shift
             return [(start, end)]
         if shifts and self.shift(window[: end - start]):
             return []
         if holds:
             last = holds[-1]
-            if self.shift(window[last.end - start : end - start]):
-                return [(start, last.start)]
+            if self.shift(window[last.end - start : end - start]) and self.leaves(window[: last.start - start]):
+                return [(start, last.start)]  # a movement to the hold, then a shift
         return [(start, end)]
 
     def ended_before(self, start: int, window: np.ndarray) -> bool:
@@ -263,4 +304,4 @@ class Rests:
         if len(window) < 2:
             return False
         window = self.seen(window)
-        return not _apart(window[0], window[-1]) <= self.radius and straight(window, self.radius)
+        return not _there(window[0], window[-1], self.radius) and straight(window, self.radius)

@@ -64,7 +64,8 @@ parameter, off by default (the paper); the observer template (``characters/obser
   elsewhere is a *hold* (a bow, a pointing hand held half-way: one movement, not two) unless they leave it and come
   to rest there again (a new stance: the movement is cut where they first rested there) or rest there ``settle``
   seconds, in one place: a hold from which some part drifts farther than ``rest.radius`` was no rest (a movement
-  slower than the tracker's jitter lets the speed show) and the rest counts again from there. A straight *shift*
+  slower than the tracker's jitter lets the speed show) and the rest counts again from there; the way back from such
+  a stance to where the settled movement began is no movement of its own. A straight *shift*
   from one stance to another is no movement and is dropped, and a piece that never leaves where it began (some part
   farther than twice ``rest.radius``) is motion at rest (sway, fidgeting), dropped too. ``rest.radius = 0.1``:
   B&B's hub threshold (0.02 m on Max, 0.20 m body size); ``settle = 2`` s: longer than a gesture holds a pose (about
@@ -76,7 +77,8 @@ parameter, off by default (the paper); the observer template (``characters/obser
   of jitter lets a third-of-a-second fit tell from rest is found by where the head goes, not by how fast. Every
   distance here is at least what the jitter alone gives (``jitter`` times the root-mean-square distance between two
   such means of a part standing still, :mod:`.departure`): the radius and twice it are the demonstrator's own, the
-  jitter's margin where that is larger.
+  jitter's margin where that is larger; eq. 1's mean distance to a hub counts only what that root-mean-square
+  distance does not explain (each part's square less its square, :mod:`.rests`).
 
 On locomotion, which never rests, the template's movement level finds no boundary inside a walk: a walk of several
 takes is one movement (closed after ``max_movement`` seconds if it goes on), not one a stride.
@@ -240,7 +242,7 @@ class VelocityDirection(Segmenter):
             if self.params["jitter"] > 0 else None  # measured again every second
         self._positions = ~np.array([p in angles for p in parts]) if parts else np.zeros(0, bool)
         self._size_sum, self._size_n = 0.0, 0
-        self._rests = Rests(stance=int(round(STANCE * self._fps)), smooth=self._still) \
+        self._rests = Rests(stance=int(round(STANCE * self._fps)), smooth=self._still, jitter=self.params["jitter"]) \
             if self.params["end"] == "rest" else None
         # end = rest: the hubs and holds
         self._holding = False  # end = rest: the rest under way is a hold (away from the hubs)
@@ -635,8 +637,9 @@ class VelocityDirection(Segmenter):
 
     def _rested(self, began: int, points: np.ndarray, near: float = 0.0) -> list[Segment]:
         """With ``end = "rest"``: the demonstrator has rested since ``began`` with the chosen parts at ``points``
-        (3m,) while a movement is under way. Near a hub, or after ``settle`` seconds, it ends there; back at a hold
-        of the movement's, the movement is cut where that hold began and the one from it back to it follows; held a
+        (3m,) while a movement is under way. Back at a hold of the movement's (near a hub or not), the movement is
+        cut where that hold began and the one from it back to it follows; near a hub, or after ``settle`` seconds,
+        it ends there; held a
         stance's time after a shift from a hold where the movement had come most of the way back, it ended at that
         hold; else the rest is a hold and the movement goes on (:mod:`.rests`)."""
         rests = self._rests
@@ -654,9 +657,9 @@ class VelocityDirection(Segmenter):
             if not hub:  # a hold goes on (the working memory is not needed)
                 return []
         window = np.array(self._buffer)
-        if hub:
-            return self._close_pieces(rests.pieces(start, began, window), began)
         back = None if self._holding else rests.returned(points, start, window)
+        if hub and back is None:
+            return self._close_pieces(rests.pieces(start, began, window), began)
         if back is not None:
             hold = rests.holds[back]
             pieces = rests.pieces(start, hold.start, window, upto=back)
@@ -666,7 +669,7 @@ class VelocityDirection(Segmenter):
             return self._close_pieces(pieces, began)
         if resting >= self._settle:  # a new stance they stay in: the movement ends where they came to it
             pieces = rests.pieces(start, began, window, shifts=False)
-            rests.hub(points)
+            rests.settle(rests.origin if rests.origin is not None else rests.seen(window[:1])[0], points)
             return self._close_pieces(pieces, began)
         if not self._holding:
             rests.hold(began, points)

@@ -204,10 +204,14 @@ def test_slow_gestures_under_a_centimetre_of_jitter_are_found_by_the_stretched_l
     assert scores(pieces, tracker=0.0, seed=seed, stretch=0.0)["f1"] == 1.0
 
 
-def test_without_the_stretch_slow_gestures_are_lost_to_a_centimetre_of_jitter():
-    """The same slow gestures with the 0.2 s line fit alone lose movements to the jitter's floor, over seeds."""
-    f1 = [scores(slow_gestures(), tracker=0.01, seed=seed, stretch=0.0)["f1"] for seed in range(4)]
-    assert np.mean(f1) < 0.9, f1
+def test_without_the_stretch_slow_gestures_are_cut_late_under_a_centimetre_of_jitter():
+    """The same slow gestures with the 0.2 s line fit alone: the onset by position still finds each one, but where
+    the jitter's floor hides their hands' speed, so their boundaries fall far from where they are (over eight seeds,
+    fewer than a third within 0.25 s, against more than half with the stretch)."""
+    def within(**params):
+        return np.mean([scores(slow_gestures(), tracker=0.01, seed=seed, **params)["within"] for seed in range(8)])
+
+    assert within(stretch=0.0) < 0.33 < 0.5 < within()
 
 
 def test_longer_fits_double_up_to_the_stretch_and_lower_the_jitters_speed():
