@@ -365,6 +365,7 @@ class Following:
         self.distances = np.full(len(self.prediction.chains), np.inf)  # each take's, after the last sample
         self.moved = np.zeros(len(self.prediction.chains))
         self.ends = np.full(len(self.prediction.chains), -1, dtype=np.intp)
+        self.chain_scores = np.full(len(self.prediction.chains), np.inf)  # each take's score after the last sample
         self.trace: list[tuple[int, np.ndarray]] = []  # each sample's frame and every movement's score then
         self.committed_at: int | None = None  # frames seen when committed (the last time) / when it deviated
         self.deviated_at: int | None = None
@@ -391,6 +392,7 @@ class Following:
         events = []
         for i, row in enumerate(rows):
             self.distances, self.moved, self.ends = followed.distance[i], followed.moved[i], followed.ends[i]
+            self.chain_scores = self._chain_scores()
             self._moved += float(stills[i])
             self._samples += 1
             for match in self._decide(row + (watched.delay if not ended else 0)):
@@ -413,13 +415,13 @@ class Following:
 
     def _scores(self) -> np.ndarray:
         """Each movement's score so far (in :attr:`movements` order): its best take's."""
-        return np.minimum.reduceat(self._chain_scores()[self._order], self._heads)
+        return np.minimum.reduceat(self.chain_scores[self._order], self._heads)
 
     def _take(self, movement: int) -> int:
         """The chain of a movement's best take so far."""
         a = self._heads[movement]
         b = self._heads[movement + 1] if movement + 1 < len(self._heads) else len(self._order)
-        return int(self._order[a + int(np.argmin(self._chain_scores()[self._order[a:b]]))])
+        return int(self._order[a + int(np.argmin(self.chain_scores[self._order[a:b]]))])
 
     def _progress(self, movement: int) -> float:
         """The share of the movement's best take its path has followed."""
