@@ -104,23 +104,29 @@ def test_rows_given_at_once_give_what_rows_fed_one_by_one_give(observer, generat
     assert runs[0] and runs[0] == runs[1]
 
 
-def test_a_movement_that_goes_on_as_another_is_a_deviation_and_the_other_is_committed_to(observer, generated):
-    """The first two fifths of a wave, then a stretch from where it was: the forward model commits to the wave and,
-    when the stretch prevails (it has been the nearest for :data:`RECENT` seconds), reports the wave's deviation
-    (``stop``, K&G Fig. 3's "stop imitation") and commits to the stretch at that frame (Fig. 3: predict again, and
-    imitate what prevails); at the end the stretch is the answer and its commitment stands."""
+def _wave_then_stretch(observer, generated, share: float):
+    """The first ``share`` of Max's wave, then his stretch from where the wave was, followed as one demonstration:
+    the forward model, what it decided while following (frame, match) and its answer at the end, and the cut."""
     data, profile = generated
     f = following(observer)
     first = profile.read(data / "repertoire" / "wave" / "max.bvh", None)
     second = profile.read(data / "repertoire" / "stretch" / "max.bvh", None)
-    cut = int(0.4 * first.n_frames)
+    cut = int(share * first.n_frames)
     start = second.positions - second.positions[:1] + first.positions[cut - 1 : cut]
     joined = np.concatenate([first.positions[:cut], start])
     visible = np.concatenate([first.visible[:cut], second.visible])
     motion = Motion(joined, first.fps, first.parts, visible, joined)
     f.begin(motion.fps)
     events = f.add(motion.world, motion.visible)
-    final = f.conclude(motion.n_frames)
+    return f, events, f.conclude(motion.n_frames), cut
+
+
+def test_a_movement_that_goes_on_as_another_is_a_deviation_and_the_other_is_committed_to(observer, generated):
+    """The first two fifths of a wave, then a stretch: the forward model commits to the wave and, when the stretch
+    prevails (it has been the nearest for :data:`RECENT` seconds), reports the wave's deviation (``stop``, K&G
+    Fig. 3's "stop imitation") and commits to the stretch at that frame (Fig. 3: predict again, and imitate what
+    prevails); at the end the stretch is the answer and its commitment stands."""
+    f, events, final, cut = _wave_then_stretch(observer, generated, 0.4)
     assert [(m.movement, m.stop) for _, m in events] == [("wave", False), ("wave", True), ("stretch", False)]
     (commit, wave), (stop, stopped), (again, stretch) = events
     assert commit < cut < stop == again and stopped.reason == "deviation" and stopped.score > 0
@@ -131,20 +137,9 @@ def test_a_movement_that_goes_on_as_another_is_a_deviation_and_the_other_is_comm
 def test_a_commitment_that_is_not_the_answer_at_the_end_is_replaced(observer, generated):
     """Eleven twentieths of a wave, then the stretch: the wave prevails for most of the demonstration and is committed
     to; the stretch comes nearest only on the last samples, too late to prevail, but the answer on all of it is the
-    stretch:
-    the commitment does not stand (the demonstration must end where the committed movement does, K&G §4.4), and the
-    answer is the one at the end."""
-    data, profile = generated
-    f = following(observer)
-    first = profile.read(data / "repertoire" / "wave" / "max.bvh", None)
-    second = profile.read(data / "repertoire" / "stretch" / "max.bvh", None)
-    cut = int(0.55 * first.n_frames)
-    start = second.positions - second.positions[:1] + first.positions[cut - 1 : cut]
-    joined = np.concatenate([first.positions[:cut], start])
-    motion = Motion(joined, first.fps, first.parts, np.concatenate([first.visible[:cut], second.visible]), joined)
-    f.begin(motion.fps)
-    events = f.add(motion.world, motion.visible)
-    final = f.conclude(motion.n_frames)
+    stretch: the commitment does not stand (the demonstration must end where the committed movement does, K&G
+    §4.4), and the answer is the one at the end."""
+    f, events, final, _ = _wave_then_stretch(observer, generated, 0.55)
     assert [(m.movement, m.stop) for _, m in events] == [("wave", False)]
     assert f.committed == "wave" and final.movement == "stretch" and final.decided_at is None
 
