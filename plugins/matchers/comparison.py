@@ -118,10 +118,13 @@ class Frames:
         """:attr:`split`'s shape, motion, travel and turn contiguous in single precision (a distance in body sizes needs
         no more than seven digits, and half the numbers to read), and each frame's mean squared motion over its parts
         (kept with the frames: a repertoire's are made once): what :func:`_split_full` reads."""
-        x = self.split
-        parts = max(self.seen.shape[1], 1)
-        return (*(np.ascontiguousarray(v, dtype=np.float32) for v in (x.shape, x.motion, x.travel, x.turn)),
-                x.motion2.sum(axis=1) / parts)
+        n, parts, dims = self.parts.shape
+        masked = self.parts if self.seen.all() else self.parts * self.seen[..., None]
+        shape = (masked[..., :3] if dims == 6 else masked[..., :0]).reshape(n, -1)
+        motion = masked[..., dims - 3 :].reshape(n, -1)
+        carry = self.carry if self.carried.all() else np.where(self.carried[:, None], self.carry, 0.0)
+        return (*(np.ascontiguousarray(v, dtype=np.float32) for v in (shape, motion, carry[:, :3], carry[:, 3:])),
+                np.einsum("nk,nk->n", motion, motion) / max(parts, 1))
 
     def take(self, rows: np.ndarray | slice) -> Frames:
         """The frames ``rows`` of this sequence."""
@@ -213,11 +216,14 @@ class Paired:
         n, m = len(a), len(b)
         fixed, moving, moving2 = np.empty((n, m)), np.empty((n, m)), np.empty((n, m))
         whole = a.seen.all(axis=1) & bool(b.seen.all()) if m else np.zeros(n, dtype=bool)
+        if whole.all() and n:
+            kernel(_split_full, reordered=True)(*a.single[:4], a.carried, *b.single, b.carried,
+                                                1.0 / max(b.seen.shape[1], 1), fixed, moving, moving2)
+            return cls(fixed, moving, moving2)
         if whole.any():
-            x, y = (a if whole.all() else a.take(whole)).single, b.single
             rows = np.flatnonzero(whole)
             out = [np.empty((len(rows), m)) for _ in range(3)]
-            kernel(_split_full, reordered=True)(*x[:4], a.carried[whole], *y, b.carried,
+            kernel(_split_full, reordered=True)(*a.take(whole).single[:4], a.carried[whole], *b.single, b.carried,
                                                 1.0 / max(b.seen.shape[1], 1), *out)
             fixed[rows], moving[rows], moving2[rows] = out
         for i in np.flatnonzero(~whole):
@@ -250,20 +256,24 @@ def _split_full(a_shape, a_motion, a_travel, a_turn, a_carried, b_shape, b_motio
     width_shape = a_shape.shape[1]
     width = a_motion.shape[1]
     for i in range(n):
+        shape_a = a_shape[i]
+        motion_a = a_motion[i]
         square = np.float32(0.0)
         for k in range(width):
-            square += a_motion[i, k] * a_motion[i, k]
+            square += motion_a[k] * motion_a[k]
         travel2 = np.float64(0.0)
         for k in range(3):
             travel2 += np.float64(a_travel[i, k]) * a_travel[i, k]
         for j in range(m):
+            shape_b = b_shape[j]
+            motion_b = b_motion[j]
             fs = np.float32(0.0)
             for k in range(width_shape):
-                d = a_shape[i, k] - b_shape[j, k]
+                d = shape_a[k] - shape_b[k]
                 fs += d * d
             xs = np.float32(0.0)
             for k in range(width):
-                xs += a_motion[i, k] * b_motion[j, k]
+                xs += motion_a[k] * motion_b[k]
             f = np.float64(fs) * inverse + b_motion2[j]
             x = np.float64(xs) * inverse
             q = np.float64(square) * inverse
