@@ -474,6 +474,13 @@ class Motion(Comparison):
         """:meth:`still` split by how it scales with tempo: each frame's distance to standing still played ``s``
         times as fast is ``sqrt(fixed + s^2 * moving2)`` (the shape and the turn; the motion and the travel), (n,)
         each; both 0 in a frame with no part seen."""
+        n, parts, dims = frames.parts.shape
+        if frames.seen.all():  # the sums over every part at once (a block of a forward model's samples)
+            square = np.einsum("npd,npd->nd", frames.parts, frames.parts) / max(parts, 1)
+            carry = frames.carry * frames.carried[:, None] if frames.carry.shape[1] else np.zeros((n, 5))
+            carry *= carry
+            return (square[:, : dims - 3].sum(axis=1) + carry[:, 3:].sum(axis=1),
+                    square[:, dims - 3 :].sum(axis=1) + carry[:, :3].sum(axis=1))
         x = frames.split
         count = x.seen.sum(axis=1)
         some = count > 0

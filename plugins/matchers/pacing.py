@@ -42,18 +42,21 @@ PRIOR = 0.5
 demonstration at half the tempo the pace is 0.75, after two seconds 0.6."""
 
 
-def _follow(fixed, moving, moving2, still_fixed, still_moving2, starts, cyclic, total, length, advanced, pace,
-            still, first, prior, tempo, distance, moved, ends):
+def _follow(fixed, moving, moving2, still_parts, starts, cyclic, state, chain_state, first, prior, tempo, out, ends):
     """The warping of :func:`plugins.matchers.warping._warp` advanced by the samples whose costs against every
     column are split in ``fixed``, ``moving``, ``moving2`` (r, M) (:class:`Paired`), each chain ``c`` costed at
-    speed ``1 / pace[c]``, from the state ``total``, ``length``, ``advanced`` (M,) after the ``first`` samples
-    before them (none: a fresh start). After each sample: each chain's best mean cost so far (``distance``, (r, C)),
-    its mean distance to standing still at its paces (``moved``: ``still[c]``, the sum, over the samples so far;
-    a sample's is ``sqrt(still_fixed + s^2 still_moving2)``), the column its best path ends in (``ends``); then the
-    chain's pace from that path, ``(advanced + prior) / (steps + prior)`` within ``1 / tempo`` and ``tempo``. The
-    state is left as after the last sample. Plain Python as written (the reference), compiled by
-    :func:`plugins.lib.compiled.kernel`."""
+    speed ``1 / pace``, from the state after the ``first`` samples before them (none: a fresh start): ``state``
+    (3, M), each column's best path's summed cost, length and frames advanced over; ``chain_state`` (2, C), each
+    chain's pace and the samples' summed distance to standing still at its paces (a sample's is ``sqrt(fixed +
+    s^2 moving2)`` of its ``still_parts`` (2, r)). After each sample: each chain's best mean cost so far
+    (``out[0]``, (r, C)), its mean distance to standing still at its paces so far (``out[1]``), the column its best
+    path ends in (``ends``); then the chain's pace from that path, ``(advanced + prior) / (steps + prior)`` within
+    ``1 / tempo`` and ``tempo``. The states are left as after the last sample. Plain Python as written (the
+    reference), compiled by :func:`plugins.lib.compiled.kernel`."""
     rows = fixed.shape[0]
+    total, length, advanced = state[0], state[1], state[2]
+    pace, still = chain_state[0], chain_state[1]
+    distance, moved = out[0], out[1]
     width = total.shape[0]
     now = np.empty(width)
     now_len = np.empty(width)
@@ -65,7 +68,7 @@ def _follow(fixed, moving, moving2, still_fixed, still_moving2, starts, cyclic, 
             a = starts[c]
             m = starts[c + 1] - a
             s = 1.0 / pace[c]
-            still[c] += np.sqrt(still_fixed[i] + s * s * still_moving2[i])
+            still[c] += np.sqrt(still_parts[0, i] + s * s * still_parts[1, i])
             for j in range(m):
                 square = fixed[i, a + j] + s * moving[i, a + j] + s * s * moving2[i, a + j]
                 cost[a + j] = np.sqrt(square) if square > 0.0 else 0.0
@@ -150,28 +153,30 @@ class PacedWarping:
                              f"{type(comparison).__name__}")
         self.comparison, self.frames, self.chains = comparison, frames, chains
         self.prior = PRIOR * float(rate)
-        self.total = np.zeros(len(frames))
-        self.length = np.zeros(len(frames))
-        self.advanced = np.zeros(len(frames))
-        self.pace = np.ones(len(chains))
-        self.still = np.zeros(len(chains))
+        self.state = np.zeros((3, len(frames)))  # each column's best path: summed cost, length, frames advanced
+        self.chain_state = np.zeros((2, len(chains)))  # each chain's pace and summed distance to standing still
+        self.chain_state[0] = 1.0
         self.samples = 0
+
+    @property
+    def pace(self) -> np.ndarray:
+        """Each chain's pace after the samples taken so far (C,)."""
+        return self.chain_state[0]
 
     def advance(self, samples: Frames) -> Followed:
         """Take the next samples; what each chain made of them (:class:`Followed`). :attr:`pace` is each chain's
         pace after the last of them."""
         r, chains = len(samples), len(self.chains)
-        distance = np.full((r, chains), np.inf)
-        moved = np.zeros((r, chains))
+        out = np.empty((2, r, chains))
+        out[0], out[1] = np.inf, 0.0
         ends = np.full((r, chains), -1, dtype=np.intp)
         if r and len(self.frames):
             paired = Paired.pairwise(samples, self.frames)
-            still_fixed, still_moving2 = self.comparison.still_split(samples)
-            kernel(_follow)(paired.fixed, paired.moving, np.ascontiguousarray(np.broadcast_to(
-                paired.moving2, paired.fixed.shape)), still_fixed, still_moving2, self.chains.starts,
-                self.chains.cyclic, self.total, self.length, self.advanced, self.pace, self.still, self.samples,
-                self.prior, TEMPO, distance, moved, ends)
+            kernel(_follow)(paired.fixed, paired.moving, paired.moving2, np.stack(self.comparison.still_split(samples)),
+                            self.chains.starts, self.chains.cyclic, self.state, self.chain_state, self.samples,
+                            self.prior, TEMPO, out, ends)
             self.samples += r
+        distance, moved = out
         return Followed(distance, moved, ends)
 
 

@@ -389,13 +389,15 @@ class Following:
                 return []
         followed = self.warping.advance(samples)
         stills = self.comparison.still(samples)  # each row on its own: the same numbers whatever the rows come in
+        chain_scores = self._chain_scores(followed.distance, followed.moved)
+        scores = np.minimum.reduceat(chain_scores[:, self._order], self._heads, axis=1)
         events = []
         for i, row in enumerate(rows):
             self.distances, self.moved, self.ends = followed.distance[i], followed.moved[i], followed.ends[i]
-            self.chain_scores = self._chain_scores()
+            self.chain_scores = chain_scores[i]
             self._moved += float(stills[i])
             self._samples += 1
-            for match in self._decide(row + (watched.delay if not ended else 0)):
+            for match in self._decide(row + (watched.delay if not ended else 0), scores[i]):
                 events.append((row, match))
         return events
 
@@ -404,14 +406,13 @@ class Following:
         """The demonstration's mean distance to standing still so far, at its own tempo (0 before a sample)."""
         return self._moved / self._samples if self._samples else 0.0
 
-    def _chain_scores(self) -> np.ndarray:
-        """Each take's score after the last sample: its distance over the demonstration's distance to standing
-        still at its pace (its distance, for a decision that is not relative)."""
+    def _chain_scores(self, distances: np.ndarray, moved: np.ndarray) -> np.ndarray:
+        """Each take's score: its distance over the demonstration's distance to standing still at its pace (its
+        distance, for a decision that is not relative)."""
         if not self.decision.relative:
-            return self.distances
+            return distances
         with np.errstate(divide="ignore", invalid="ignore"):
-            return np.where(self.moved > 0, self.distances / self.moved,
-                            np.where(self.distances <= 0, 0.0, np.inf))
+            return np.where(moved > 0, distances / moved, np.where(distances <= 0, 0.0, np.inf))
 
     def _scores(self) -> np.ndarray:
         """Each movement's score so far (in :attr:`movements` order): its best take's."""
@@ -428,33 +429,33 @@ class Following:
         c = self._take(movement)
         return float((self.ends[c] + 1) / (self.prediction.chains.starts[c + 1] - self.prediction.chains.starts[c]))
 
-    def _decide(self, frame: int) -> list[Match]:
-        """After a sample (at ``frame``): a commitment, a deviation, or a deviation and the commitment that replaces it
-        (see the module)."""
+    def _decide(self, frame: int, scores: np.ndarray) -> list[Match]:
+        """After a sample (at ``frame``), with each movement's ``scores`` then: a commitment, a deviation, or a
+        deviation and the commitment that replaces it (see the module)."""
         limit = self.decision.threshold()
-        scores = self._scores()
         self.trace.append((frame, scores))
-        order = np.argsort(scores, kind="stable")
-        first = int(order[0])
+        first = int(np.argmin(scores))
         leader = first if scores[first] <= limit and self.movements[first] not in self.stillness.still else -1
         self._led = (self._led + 1 if leader == self._leader else 1) if leader >= 0 else 0
         self._leader = leader  # a still movement is told by how little the whole demonstration moved (conclude)
         prevails = leader >= 0 and self._led >= self._prevail and self._progress(leader) >= self.min_progress
+        if not prevails or self.movements[leader] == self.committed:
+            return []
+        order = np.argsort(scores, kind="stable")
         events = []
-        if self.committed is not None and prevails and self.movements[leader] != self.committed:
+        if self.committed is not None:  # another prevails over it
             mine = self._index[self.committed]
             events.append(Match(self.committed, 0.0, frame, stop=True, reason="deviation", score=float(scores[mine]),
                                 threshold=limit, measure=self.decision.measure))
             self.committed, self.deviated, self.deviated_at = None, True, frame + 1
-        if self.committed is None and prevails:
-            score = float(scores[leader])
-            self.committed = movement = self.movements[leader]
-            self.committed_at = frame + 1
-            ranked = tuple((self.movements[i], float(scores[i])) for i in order)
-            self.commitment = Match(movement, max(0.0, 1.0 - score / limit) if 0 < limit < np.inf else 1.0, frame,
-                                    candidates=ranked, score=score, threshold=limit, measure=self.decision.measure,
-                                    details={"progress": self._progress(leader)})
-            events.append(self.commitment)
+        score = float(scores[leader])
+        self.committed = movement = self.movements[leader]
+        self.committed_at = frame + 1
+        ranked = tuple((self.movements[i], float(scores[i])) for i in order)
+        self.commitment = Match(movement, max(0.0, 1.0 - score / limit) if 0 < limit < np.inf else 1.0, frame,
+                                candidates=ranked, score=score, threshold=limit, measure=self.decision.measure,
+                                details={"progress": self._progress(leader)})
+        events.append(self.commitment)
         return events
 
     def conclude(self, frames: int) -> Match:
