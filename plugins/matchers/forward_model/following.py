@@ -460,7 +460,8 @@ class Following:
 
     def conclude(self, frames: int) -> Match:
         """The demonstration has ended (``frames`` long): the last samples, then the answer on all of it. The
-        commitment (:attr:`commitment`, the same object) when it stands, the answer at the end when it does not."""
+        commitment (:attr:`commitment`, the same object) when it stands; the answer at the end when it does not (the
+        commitment is then a deviation at the end: :attr:`committed` is cleared, :attr:`deviated_at` is ``frames``)."""
         self.add(np.zeros((0, len(self.body.parts), 3)), np.zeros((0, len(self.body.parts)), dtype=bool), ended=True)
         if not self._samples:
             return Match.unknown("nothing seen", details={"reason": "nothing seen"})
@@ -472,11 +473,13 @@ class Following:
             score, limit, measure = self.moving, self.stillness.limit, self.stillness.measure
         else:
             measure = self.decision.measure
+        if nearest == self.committed and score <= limit:
+            return self.commitment
+        if self.committed is not None:  # it does not stand: the demonstration did not end where it does
+            self.committed, self.deviated, self.deviated_at = None, True, frames
         if nearest is None or score > limit:
             return Match.unknown("no prediction fits", nearest=nearest, score=score, threshold=limit,
                                  measure=measure, candidates=ranked)
-        if nearest == self.committed:
-            return self.commitment
         confidence = max(0.0, 1.0 - score / limit) if limit > 0 and np.isfinite(limit) else 1.0
         return Match(nearest, confidence, None, candidates=ranked, score=score, threshold=limit, measure=measure)
 
@@ -577,7 +580,7 @@ class Streaming:
         kept = sorted({int(i) for _, s in trace for i in np.argsort(s, kind="stable")[:shown] if np.isfinite(s[i])})
         limit = f.decision.threshold()
         return {"committed": f.committed, "committed_path": (f.committed,) if f.committed else (),
-                "deviated": f.deviated, "committed_at": getattr(f, "committed_at", None),
+                "deviated": f.deviated, "committed_at": getattr(f, "committed_at", None) if f.committed else None,
                 "deviated_at": getattr(f, "deviated_at", None), "scores": dict(zip(f.movements, scores.tolist())),
                 "trace": tuple((frame, {(f.movements[i],): float(s[i]) for i in kept if np.isfinite(s[i])})
                                for frame, s in trace),

@@ -138,10 +138,11 @@ def test_a_commitment_that_is_not_the_answer_at_the_end_is_replaced(observer, ge
     """Eleven twentieths of a wave, then the stretch: the wave prevails for most of the demonstration and is committed
     to; the stretch comes nearest only on the last samples, too late to prevail, but the answer on all of it is the
     stretch: the commitment does not stand (the demonstration must end where the committed movement does, K&G
-    §4.4), and the answer is the one at the end."""
+    §4.4): it is a deviation at the end, and the answer is the one at the end."""
     f, events, final, _ = _wave_then_stretch(observer, generated, 0.55)
     assert [(m.movement, m.stop) for _, m in events] == [("wave", False)]
-    assert f.committed == "wave" and final.movement == "stretch" and final.decided_at is None
+    assert final.movement == "stretch" and final.decided_at is None
+    assert f.committed is None and f.deviated and f.deviated_at == f.watched.n  # stopped at the end
 
 
 def test_every_take_of_the_repertoire_is_its_own_movement_standing_still_too(observer, generated):
