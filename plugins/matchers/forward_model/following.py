@@ -272,10 +272,11 @@ class Watched:
             starts = np.clip(rows - self.half, 0, n - taps)
             windows = relative[starts[:, None] + np.arange(taps)]  # (r, taps, P, 3)
             velocity = np.einsum("t,rtpd->rpd", self.coeffs, windows)
-            edge = starts != rows - self.half
-            if edge.any():  # near an end: the window's own fit at the row
-                whole = derivative(relative[: n], self.fps)
-                velocity[edge] = whole[rows[edge]]
+            early, late = rows - self.half < 0, rows - self.half > n - taps
+            if early.any():  # near an end: the window's own fit at the row (the first or last window's frames)
+                velocity[early] = derivative(relative[:taps], self.fps)[rows[early]]
+            if late.any():
+                velocity[late] = derivative(relative[n - taps : n], self.fps)[rows[late] - (n - taps)]
         else:
             velocity = derivative(relative, self.fps)[rows]
         a = np.maximum(rows - self.reach, 0)
