@@ -103,13 +103,9 @@ class Frames:
         """The features by how they scale with a performance's tempo (:class:`Split`), kept with the frames (a
         repertoire's are computed once). Six features a part are its shape and its motion (:class:`Motion`), three
         its motion alone (``shape = "none"``)."""
-        n, parts, dims = self.parts.shape
-        seen = self.seen.astype(float)
-        masked = self.parts * seen[..., None]
-        shape, motion = (masked[..., :3], masked[..., 3:]) if dims == 6 else (masked[..., :0], masked)
-        carry = np.where(self.carried[:, None], self.carry, 0.0)
-        travel, turn = carry[:, :3], carry[:, 3:]
-        return Split(shape.reshape(n, -1), motion.reshape(n, -1), travel, turn, seen,
+        n = len(self)
+        shape, motion, travel, turn = self._by_tempo()
+        return Split(shape.reshape(n, -1), motion.reshape(n, -1), travel, turn, self.seen.astype(float),
                      np.einsum("npd,npd->np", shape, shape), np.einsum("npd,npd->np", motion, motion),
                      np.einsum("nc,nc->n", travel, travel), np.einsum("nc,nc->n", turn, turn))
 
@@ -118,13 +114,19 @@ class Frames:
         """:attr:`split`'s shape, motion, travel and turn contiguous in single precision (a distance in body sizes needs
         no more than seven digits, and half the numbers to read), and each frame's mean squared motion over its parts
         (kept with the frames: a repertoire's are made once): what :func:`_split_full` reads."""
-        n, parts, dims = self.parts.shape
-        masked = self.parts if self.seen.all() else self.parts * self.seen[..., None]
-        shape = (masked[..., :3] if dims == 6 else masked[..., :0]).reshape(n, -1)
-        motion = masked[..., dims - 3 :].reshape(n, -1)
-        carry = self.carry if self.carried.all() else np.where(self.carried[:, None], self.carry, 0.0)
-        return (*(np.ascontiguousarray(v, dtype=np.float32) for v in (shape, motion, carry[:, :3], carry[:, 3:])),
+        n, parts = self.seen.shape
+        shape, motion, travel, turn = self._by_tempo()
+        shape, motion = shape.reshape(n, -1), motion.reshape(n, -1)
+        return (*(np.ascontiguousarray(v, dtype=np.float32) for v in (shape, motion, travel, turn)),
                 np.einsum("nk,nk->n", motion, motion) / max(parts, 1))
+
+    def _by_tempo(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The parts' shape (n, P, 3; none without it) and motion (n, P, 3), the unseen ones zeroed, and the body's
+        travel (n, 3) and turn (n, 2), the unknown ones zeroed: the features by how they scale with tempo."""
+        dims = self.parts.shape[2]
+        masked = self.parts if self.seen.all() else self.parts * self.seen[..., None]
+        carry = self.carry if self.carried.all() else np.where(self.carried[:, None], self.carry, 0.0)
+        return (masked[..., :3] if dims == 6 else masked[..., :0]), masked[..., dims - 3 :], carry[:, :3], carry[:, 3:]
 
     def take(self, rows: np.ndarray | slice) -> Frames:
         """The frames ``rows`` of this sequence."""
@@ -339,10 +341,6 @@ class Comparison(ABC):
         """Every frame of ``a`` against every frame of ``b``, to be costed with ``a`` at other speeds (``.at(speed)``,
         :mod:`plugins.matchers.tempo`). Positions have no tempo: :meth:`costs` whatever the speed."""
         return Fixed(self.costs(a, b))
-
-    def still_at(self, frames: Frames, speeds: np.ndarray) -> np.ndarray:
-        """:meth:`still` with the frames played at each of ``speeds`` (K,): (n, K). Positions have no tempo."""
-        return np.repeat(self.still(frames)[:, None], len(speeds), axis=1)
 
     def costs(self, a: Frames, b: Frames) -> np.ndarray:
         """Every frame of ``a`` against every frame of ``b``: eq. 1 over the parts seen in both, (len(a), len(b)).

@@ -363,10 +363,9 @@ class Following:
         self.committed: str | None = None
         self.commitment: Match | None = None
         self.deviated = False
-        self.distances = np.full(len(self.prediction.chains), np.inf)  # each take's, after the last sample
-        self.moved = np.zeros(len(self.prediction.chains))
-        self.ends = np.full(len(self.prediction.chains), -1, dtype=np.intp)
-        self.chain_scores = np.full(len(self.prediction.chains), np.inf)  # each take's score after the last sample
+        self.ends = np.full(len(self.prediction.chains), -1, dtype=np.intp)  # after the last sample: each take's
+        self.chain_scores = np.full(len(self.prediction.chains), np.inf)  # end frame and score, each movement's score
+        self.scores = np.full(len(self.movements), np.inf)
         self.trace: list[tuple[int, np.ndarray]] = []  # each sample's frame and every movement's score then
         self.committed_at: int | None = None  # frames seen when committed (the last time) / when it deviated
         self.deviated_at: int | None = None
@@ -391,14 +390,13 @@ class Following:
         followed = self.warping.advance(samples)
         stills = self.comparison.still(samples)  # each row on its own: the same numbers whatever the rows come in
         chain_scores = self._chain_scores(followed.distance, followed.moved)
-        scores = np.minimum.reduceat(chain_scores[:, self._order], self._heads, axis=1)
+        scores = np.minimum.reduceat(chain_scores[:, self._order], self._heads, axis=1)  # each movement's best take
         events = []
         for i, row in enumerate(rows):
-            self.distances, self.moved, self.ends = followed.distance[i], followed.moved[i], followed.ends[i]
-            self.chain_scores = chain_scores[i]
+            self.ends, self.chain_scores, self.scores = followed.ends[i], chain_scores[i], scores[i]
             self._moved += float(stills[i])
             self._samples += 1
-            for match in self._decide(row + (watched.delay if not ended else 0), scores[i]):
+            for match in self._decide(row + (watched.delay if not ended else 0)):
                 events.append((row, match))
         return events
 
@@ -415,10 +413,6 @@ class Following:
         with np.errstate(divide="ignore", invalid="ignore"):
             return np.where(moved > 0, distances / moved, np.where(distances <= 0, 0.0, np.inf))
 
-    def _scores(self) -> np.ndarray:
-        """Each movement's score so far (in :attr:`movements` order): its best take's."""
-        return np.minimum.reduceat(self.chain_scores[self._order], self._heads)
-
     def _take(self, movement: int) -> int:
         """The chain of a movement's best take so far."""
         a = self._heads[movement]
@@ -430,10 +424,10 @@ class Following:
         c = self._take(movement)
         return float((self.ends[c] + 1) / (self.prediction.chains.starts[c + 1] - self.prediction.chains.starts[c]))
 
-    def _decide(self, frame: int, scores: np.ndarray) -> list[Match]:
-        """After a sample (at ``frame``), with each movement's ``scores`` then: a commitment, a deviation, or a
-        deviation and the commitment that replaces it (see the module)."""
-        limit = self.decision.threshold()
+    def _decide(self, frame: int) -> list[Match]:
+        """After a sample (at ``frame``), on each movement's score then (:attr:`scores`, in :attr:`movements`
+        order): a commitment, a deviation, or a deviation and the commitment that replaces it (see the module)."""
+        limit, scores = self.decision.threshold(), self.scores
         self.trace.append((frame, scores))
         first = int(np.argmin(scores))
         leader = first if scores[first] <= limit and self.movements[first] not in self.stillness.still else -1
@@ -466,8 +460,7 @@ class Following:
         self.add(np.zeros((0, len(self.body.parts), 3)), np.zeros((0, len(self.body.parts)), dtype=bool), ended=True)
         if not self._samples:
             return Match.unknown("nothing seen", details={"reason": "nothing seen"})
-        scores = self._scores()
-        ranked = tuple(sorted(zip(self.movements, scores.tolist()), key=lambda kv: (kv[1], kv[0])))
+        ranked = tuple(sorted(zip(self.movements, self.scores.tolist()), key=lambda kv: (kv[1], kv[0])))
         limit = self.decision.threshold()
         nearest, score = ranked[0] if ranked else (None, np.inf)
         if nearest in self.stillness.still:  # it scores 1 whatever is shown: how little was there to explain
