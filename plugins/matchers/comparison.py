@@ -559,10 +559,15 @@ def _held(positions: np.ndarray, seen: np.ndarray) -> np.ndarray:
 
 def sequence_size(poses: np.ndarray, seen: np.ndarray) -> float:
     """A sequence's body size: :func:`plugins.lib.body_size.body_scale` of each part's median position over the
-    frames it is seen (0 when fewer than two parts are ever seen)."""
+    frames it is seen (0 when fewer than two parts are ever seen). Every part seen in every frame (a forward model's
+    onset, mostly): the plain median, which is what ``nanmedian`` computes when nothing is masked, without its
+    masking."""
     with np.errstate(invalid="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # a part never seen: its median is NaN, and left out
-        median = np.nanmedian(np.where(seen[..., None], poses, np.nan), axis=0)
+        if len(poses) and seen.all() and np.isfinite(poses).all():
+            median = np.median(poses, axis=0)
+        else:
+            median = np.nanmedian(np.where(seen[..., None], poses, np.nan), axis=0)
     return float(body_scale(median))
 
 

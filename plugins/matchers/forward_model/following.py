@@ -53,7 +53,7 @@ guiding strokes (``comparison = "strokes"``).
 
 from __future__ import annotations
 
-from functools import partial
+from functools import lru_cache, partial
 from typing import Any, Protocol
 
 import numpy as np
@@ -172,6 +172,19 @@ def _size(poses: np.ndarray) -> float:
     return float(body_scale(np.median(poses, axis=0)))
 
 
+@lru_cache(maxsize=16)
+def _window_fits(taps: int, fps: float) -> np.ndarray:
+    """The Savitzky-Golay derivative of :func:`plugins.lib.velocity.derivative` (second order, ``taps`` frames) at
+    each position of its window, as weights of the window's frames (taps, taps): row ``k`` the parabola through the
+    window differentiated at its ``k``-th frame, row ``taps // 2`` the centred filter, the others the window's own fit
+    near an end (scipy's ``mode = "interp"``). Made once for a frame rate, not at every segment."""
+    from scipy.signal import savgol_coeffs
+
+    fits = np.stack([savgol_coeffs(taps, 2, deriv=1, delta=1.0 / fps, pos=k, use="dot") for k in range(taps)])
+    fits.setflags(write=False)
+    return fits
+
+
 class Watched:
     """A demonstration as it comes in: its frames at :data:`RATE` once everything they need has been seen.
 
@@ -184,14 +197,13 @@ class Watched:
     """
 
     def __init__(self, body: Any, fps: float, comparison: Motion) -> None:
-        from scipy.signal import savgol_coeffs
-
         self.body, self.fps, self.comparison = body, float(fps), comparison
         self.root = body.root_index
         self.filter = HeadingFilter(max(1, int(round(FACING * fps))))
         taps = max(5, int(round(SMOOTHING * fps)) | 1)
         self.half = taps // 2
-        self.coeffs = savgol_coeffs(taps, 2, deriv=1, delta=1.0 / fps, use="dot")
+        self.fits = _window_fits(taps, self.fps)
+        self.coeffs = self.fits[self.half]
         self.reach = max(1, int(round(TRAVEL * fps / 2)))
         self.delay = max(self.half, self.reach)
         parts = len(body.parts)
@@ -229,12 +241,12 @@ class Watched:
             return
         found = facing_heading(np.where(visible[..., None], world, 0.0), visible, self.body, self.filter)
         local, seen, root, heading = to_root_relative(world, visible, self.body, self.filter.update_many(found))
-        held = np.empty_like(local)
-        last = self.last
-        for i in range(k):  # each part held where it was last seen (not seen yet: 0, and not compared)
-            last = np.where(seen[i][:, None], local[i], last)
-            held[i] = last
-        self.last = last
+        if seen.all():  # each part held where it was last seen (not seen yet: 0, and not compared)
+            held = local
+        else:  # the frame each part was last seen in by each frame of the block (-1: before it, self.last)
+            at = np.maximum.accumulate(np.where(seen, np.arange(k)[:, None], -1), axis=0)
+            held = np.where((at >= 0)[..., None], local[np.maximum(at, 0), np.arange(local.shape[1])], self.last)
+        self.last = held[-1]
         held = np.nan_to_num(held)
         self._grow(k)
         rows = slice(self.n, self.n + k)
@@ -274,9 +286,9 @@ class Watched:
             velocity = np.einsum("t,rtpd->rpd", self.coeffs, windows)
             early, late = rows - self.half < 0, rows - self.half > n - taps
             if early.any():  # near an end: the window's own fit at the row (the first or last window's frames)
-                velocity[early] = derivative(relative[:taps], self.fps)[rows[early]]
+                velocity[early] = np.einsum("rt,tpd->rpd", self.fits[rows[early]], relative[:taps])
             if late.any():
-                velocity[late] = derivative(relative[n - taps : n], self.fps)[rows[late] - (n - taps)]
+                velocity[late] = np.einsum("rt,tpd->rpd", self.fits[rows[late] - (n - taps)], relative[n - taps : n])
         else:
             velocity = derivative(relative, self.fps)[rows]
         a = np.maximum(rows - self.reach, 0)

@@ -174,3 +174,19 @@ def test_hidden_parts_take_no_part_and_a_frame_with_nothing_seen_costs_nothing()
     costs = Motion().costs(frames, other)
     assert costs[3] == pytest.approx(np.zeros(8))
     assert np.isfinite(costs).all()
+
+
+@settings(max_examples=60)
+@given(n=st.integers(1, 12), parts=st.integers(1, 6), seed=st.integers(0, 2**16), hide=st.booleans())
+def test_a_sequence_seen_throughout_has_the_size_of_its_masked_median(n, parts, seed, hide):
+    """:func:`sequence_size` takes the plain median where every part is seen in every frame; the same number as the
+    median over the frames each part is seen in (odd and even counts alike), and where parts are hidden the
+    median is over the frames they are seen in."""
+    from plugins.lib.body_size import body_scale
+
+    rng = np.random.default_rng(seed)
+    poses = rng.normal(size=(n, parts, 3))
+    visible = rng.random((n, parts)) > 0.4 if hide else np.ones((n, parts), dtype=bool)
+    expected = np.array([np.median(poses[visible[:, p], p], axis=0) if visible[:, p].any() else np.full(3, np.nan)
+                         for p in range(parts)])
+    assert sequence_size(poses, visible) == float(body_scale(expected))

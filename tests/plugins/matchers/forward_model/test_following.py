@@ -13,6 +13,8 @@ import types
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from plugins.bench.data import make_data
 from plugins.bench.mocap import _streams
@@ -201,3 +203,49 @@ def test_a_part_hidden_at_the_onset_is_measured_from_where_it_was_first_seen(obs
     since = (whole.relative[7, hand] - whole.relative[0, hand]) / whole.size
     np.testing.assert_allclose(frames.parts[seen, hand, :3] * watched.size / whole.size,
                                later.parts[seen, hand, :3] - since, atol=1e-9)
+
+
+def test_the_window_fits_are_the_derivative_of_the_window():
+    """The weights a live demonstration's velocities are taken with near its ends (``_window_fits``) give what the
+    Savitzky-Golay derivative of the first or last window's frames gives there (scipy's own edge fit, to rounding),
+    and their middle row is the centred filter itself."""
+    from scipy.signal import savgol_coeffs
+
+    from plugins.lib.velocity import derivative
+    from plugins.matchers.forward_model.following import _window_fits
+
+    rng = np.random.default_rng(3)
+    for fps in (24.0, 30.0, 60.0, 120.0):
+        fits = _window_fits(max(5, int(round(0.2 * fps)) | 1), fps)
+        taps = len(fits)
+        window = rng.normal(size=(taps, 4, 3)) + np.linspace(0.0, 1.0, taps)[:, None, None] ** 2
+        expected = derivative(window, fps)
+        np.testing.assert_allclose(np.einsum("kt,tpd->kpd", fits, window), expected, rtol=1e-10,
+                                   atol=1e-10 * np.abs(expected).max())
+        np.testing.assert_array_equal(fits[taps // 2], savgol_coeffs(taps, 2, deriv=1, delta=1.0 / fps, use="dot"))
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**16), cut=st.integers(1, 60))
+def test_parts_hidden_in_a_block_are_held_as_frame_by_frame(observer, generated, seed, cut):
+    """Each part hidden by a tracker is held where it was last seen whether the frames come in one block, in two,
+    or one by one (the block's holding is vectorised; frame by frame it is one frame's)."""
+    from plugins.matchers.comparison import Motion as Comparison
+    from plugins.matchers.forward_model.following import Watched
+
+    data, profile = generated
+    motion = profile.read(data / "demos" / "wave" / "morris_1.0.bvh")
+    rng = np.random.default_rng(seed)
+    visible = rng.random(motion.visible.shape) > 0.3
+    visible[:, profile.body.root_index] = rng.random(len(visible)) > 0.1
+    world = np.where(visible[..., None], motion.positions, np.nan)
+    blocks, halves, single = (Watched(observer.body, motion.fps, Comparison(shape="onset")) for _ in range(3))
+    blocks.add(world, visible)
+    halves.add(world[:cut], visible[:cut])
+    halves.add(world[cut:], visible[cut:])
+    for i in range(len(world)):
+        single.add(world[i : i + 1], visible[i : i + 1])
+    for other in (halves, single):
+        np.testing.assert_array_equal(blocks.seen[: blocks.n], other.seen[: other.n])
+        np.testing.assert_allclose(blocks.relative[: blocks.n], other.relative[: other.n], rtol=0, atol=1e-12)
+        np.testing.assert_array_equal(blocks.origin, other.origin)
