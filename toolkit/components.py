@@ -465,6 +465,10 @@ class Segmenter(Component):
 
     kind = "segmenter"
 
+    none_found: ClassVar[str] = ""
+    """What to tell a user whose whole recording gave no segment: how this segmenter begins a movement, and what
+    to try where that never happens (``likeme observe`` prints it under such a file); empty: nothing to add."""
+
     @abstractmethod
     def reset(self, parts: Sequence[str], fps: float) -> None:
         """Start a new stream of poses of ``parts`` at ``fps``; frame numbering restarts at 0."""

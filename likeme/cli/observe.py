@@ -102,6 +102,8 @@ def handle(args: argparse.Namespace, pm: PluginManager) -> int:
         print(f"{entry['file']}: {entry['frames']} frames at {entry['fps']:g} fps, {n} segment{'' if n == 1 else 's'}")
         for seg in entry["segments"]:
             print(_segment_text(seg))
+        if not n and entry["frames"] and character.segmenter.none_found:
+            print(f"  no movement: {character.segmenter.none_found}")
     if args.json:
         print(json.dumps(report, indent=1))
     return 1 if failed else 0

@@ -84,6 +84,10 @@ class HubThreshold(Segmenter):
     """Segments where the distance from the observer's own hub pose crosses a threshold (§5.1)."""
 
     name = "hub-threshold"
+    none_found = ("hub-threshold begins a movement where the body leaves its rest (the distance from the hub pose "
+                  "rising above its running minimum): a recording that begins in motion, or never rests, shows no "
+                  "beginning; --segmenter velocity-direction cuts at the demonstrator's own rests and takes a "
+                  "recording that never rests whole")
     parameters = (
         Parameter("threshold", float, 0.02, "Filtered eq. 1 distance (m) from the hub above which a movement has begun. "
                   "Lower finds subtler movements and more noise; higher misses small movements.", minimum=0.0, length=True),

@@ -281,6 +281,19 @@ def test_observe_prints_segments_and_json(data, capsys):
     ends = [s["ends"] for s in report[0]["segments"]]
     assert ends and set(ends) <= {"back near a hub pose", "came to rest", "the stream ended"}
     assert text.count("\n    ends: ") == len(ends)
+    assert "no movement:" not in text
+
+
+def test_observe_says_how_the_segmenter_begins_a_movement_where_a_recording_gave_none(data, capsys):
+    """A demonstrator who never leaves the rest (Morris standing) gives hub-threshold no segment: the file's line
+    says 0 segments, and what the segmenter waits for and what to try instead follow it."""
+    stand = sorted((data / "demos" / "stand").glob("*.bvh"))[0]
+    assert main(["observe", "--body", str(data / "profile.toml"), "--repertoire", str(data / "repertoire"),
+                 str(stand)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].endswith(", 0 segments")
+    assert lines[1].startswith("  no movement: hub-threshold begins a movement where the body leaves its rest")
+    assert "--segmenter velocity-direction" in lines[1]
 
 
 @pytest.mark.parametrize(

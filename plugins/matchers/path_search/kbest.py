@@ -249,7 +249,8 @@ class Beam(Search):
                                         / max(other_evidence, 1))))
             exclude = exclude | (m.labels == other)
         ranked = (found[0], *sorted(found[1:], key=lambda c: c[1]))
-        return Found(movement, path, counts[best] / voting.size, ranked, details)
+        still = float(np.mean(m.comparison.still(samples))) if m.decision.relative else 1.0
+        return Found(movement, path, counts[best] / voting.size, ranked, details, still)
 
     def calibration(self):
         m = self.matcher

@@ -119,9 +119,10 @@ class PathSearch(Matcher):
                       "called unknown, as far as the repertoire's takes of one movement show how they vary.",
                       minimum=0.0, maximum=1.0),
         )),
-        Parameter("candidates", int, 0, "Ranked candidates to report besides the best (B&B Fig. 13), each with its "
-                  "mean eq. 3 distance: with 'k-best' each is the best path through the other movements' nodes (one "
-                  "more search each); with 'per-movement' the next nearest movements. 0: the best only.",
+        Parameter("candidates", int, 0, "Ranked candidates to report besides the best (B&B Fig. 13): with 'k-best' "
+                  "each is the best path through the other movements' nodes (one more search each), with its mean "
+                  "eq. 3 distance; with 'per-movement' the next nearest movements, each with the decision's score "
+                  "(relative to standing still with the calibrated decision). 0: the best only.",
                   minimum=0, maximum=10),
         Parameter("learn", bool, False, "Add an unknown movement's path to the posegraph as a new movement."),
         Parameter("learn_prefix", str, "learned", "Name prefix of learned movements (learned-1, learned-2...)."),
@@ -213,8 +214,7 @@ class PathSearch(Matcher):
             return Match.unknown("nothing visible", details={"reason": "nothing visible"})
         node_path = tuple(self.node_names[i] for i in found.path)
         details = dict(found.details)
-        still = float(np.mean(self.comparison.still(samples))) if self.decision.relative else 1.0
-        verdict = self.decision.decide(found.movement, found.distance, still)
+        verdict = self.decision.decide(found.movement, found.distance, found.still)
         measure = self.decision.measure
         if found.movement is None:
             return Match.unknown("only hub poses", score=details.get("mean_distance"), measure=measure, details={

@@ -61,22 +61,25 @@ class EachMovement(Search):
             return None
         m = self.matcher
         paced = paced_distances(m.comparison, samples, self.nodes, self.chains)
-        still = float(np.mean(m.comparison.still(samples)))
-        # what the decision divides by the samples' distance to standing still (the relative score), or a distance
-        relative = m.decision.relative and still > 0
-        values = paced.scores * still if relative else paced.distances
-        order = paced.scores if relative else paced.distances
+        # ranked by the relative score itself (each chain's distance over the demonstration's distance to standing
+        # still at its pace), which the decision then takes as it is; a demonstration that does not move at all has
+        # none (inf): its distances, over a distance to standing still of 0 (the decision's score is 0 for a
+        # distance of 0, else inf); a decision that is not relative takes the distances
+        relative = m.decision.relative and bool(np.isfinite(paced.scores).any())
+        values = paced.scores if relative else paced.distances
+        still = 0.0 if m.decision.relative and not relative else 1.0
         best: dict[str, int] = {}
         for c, movement in enumerate(self.chains.movements):
-            if np.isfinite(values[c]) and (movement not in best or order[c] < order[best[movement]]):
+            if np.isfinite(values[c]) and (movement not in best or values[c] < values[best[movement]]):
                 best[movement] = c
         if not best:
             return None
-        ranked = tuple((mv, float(values[c])) for mv, c in sorted(best.items(), key=lambda kv: (order[kv[1]], kv[0])))
+        ranked = tuple((mv, float(values[c])) for mv, c in sorted(best.items(), key=lambda kv: (values[kv[1]], kv[0])))
         chosen = best[ranked[0][0]]
         path = chain_path(paced.cost, self.chains, chosen)
         return Found(ranked[0][0], path, 1.0, ranked, {"mean_distance": float(paced.distances[chosen]),
-                                                       "pace": float(paced.pace[chosen]), "samples": len(samples)})
+                                                       "pace": float(paced.pace[chosen]), "samples": len(samples)},
+                     still)
 
     def calibration(self) -> Calibration:
         return chain_calibration(self.matcher.comparison, self.takes, self.nodes, self.chains, paced_scores)

@@ -27,14 +27,18 @@ __all__ = ["Found", "Search"]
 @dataclass
 class Found:
     """What a search found for a demonstration: its answer (``None``: the best path holds only hubs), the node path
-    of the answer, the share of that path's nodes that belong to it (hubs do not vote), and the ranked movements
-    with their distances, the answer first."""
+    of the answer, the share of that path's nodes that belong to it (hubs do not vote), the ranked movements with
+    their distances, the answer first, and ``still``: what the decision divides those distances by
+    (:meth:`plugins.matchers.decision.Decision.decide`): the demonstration's distance to standing still where they
+    are distances and the decision is relative, 1 where the search ranked by the relative score itself or the
+    decision is a distance."""
 
     movement: str | None
     path: np.ndarray
     share: float = 1.0
     ranked: tuple[tuple[str, float], ...] = ()
     details: dict[str, Any] = field(default_factory=dict)
+    still: float = 1.0
 
     @property
     def distance(self) -> float:
