@@ -13,7 +13,7 @@ import contextlib
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from plugins.bench.data import make_data
@@ -143,6 +143,8 @@ def observers(data, profile, pm_):
 @settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(pairing=st.integers(0, len(PAIRINGS) - 1), start=st.integers(0, 600), length=st.integers(300, 1200),
        keep=st.sampled_from([0.5, 1.0, 3.0]), seed=st.integers(0, 2**16), hidden=st.booleans())
+@example(pairing=2, start=128, length=300, keep=0.5, seed=1, hidden=False)  # velocity-direction back-dating an
+# onset 16 frames, past what half a second kept, before it said so (holds_since)
 def test_a_bounded_working_memory_gives_the_observations_an_unbounded_one_gives(observers, profile, stream, pairing,
                                                                                  start, length, keep, seed, hidden):
     """On generated streams (Morris's random movements with noise, a part lost for a while), in random packets:

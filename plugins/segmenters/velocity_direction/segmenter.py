@@ -255,6 +255,18 @@ class VelocityDirection(Segmenter):
     def active_since(self) -> int | None:
         return self._start
 
+    @property
+    def holds_since(self) -> int | None:
+        """The first frame a segment still to be reported may begin at: the onset of the movement under way, else
+        the oldest frame of the sensory memory a movement's onset is back-dated into (never before the last movement
+        reported), so a bounded working memory keeps those rows (:mod:`toolkit.watching`); ``None`` before any
+        frame."""
+        if self._start is not None:
+            return self._start
+        if not self._history:
+            return None
+        return max(self._done, self._frame + 1 - len(self._history))
+
     def push(self, pose: np.ndarray, visible: np.ndarray) -> list[Segment]:
         closed, _ = self.push_block(np.asarray(pose)[None], np.asarray(visible)[None])
         return [segment for _, segment in closed]
