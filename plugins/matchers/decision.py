@@ -35,13 +35,15 @@ chosen once when a matcher is attached (``decision = "distance"`` or ``"calibrat
       as the repertoire shows; the threshold is the gap's far side (the ``known_rejected`` quantile of the other
       scores), because takes recorded one after another lie nearer each other than performances in other styles
       or by other people do;
-    - *no gap* (one take of each movement, or takes that lie as far apart as movements do): the larger of the
-      ``1 - known_rejected`` quantiles of the own and the other scores. One take shows nothing of how far a
-      performance may lie, so the repertoire's movements stand for it: a performance of a movement is taken to
-      lie no farther from it than the repertoire's movements lie from their nearest neighbours, all but
-      ``known_rejected`` of them. A movement the repertoire does not hold is unknown where it lies farther than
-      that; one as near to a known movement as the repertoire's own movements are to each other cannot be told from
-      a performance of it.
+    - *no gap, several takes* (takes that lie as far apart as movements do: performed by different people, or
+      in different styles): the ``1 - known_rejected`` quantile of the own scores, split-conformal: all but that
+      share of a known movement's performances score below it, as far as its takes show how they vary;
+    - *one take of each movement* (no own scores): the ``1 - known_rejected`` quantile of the other scores. One take
+      shows nothing of how far a performance may lie, so the repertoire's movements stand for it: a performance of
+      a movement is taken to lie no farther from it than the repertoire's movements lie from their nearest
+      neighbours, all but ``known_rejected`` of them. A movement the repertoire does not hold is unknown where it
+      lies farther than that; one as near to a known movement as the repertoire's own movements are to each other
+      cannot be told from a performance of it.
 
     The same setting holds with one take of each movement, two, or fourteen (``docs/matchers.md`` has the figures).
 
@@ -180,15 +182,18 @@ class Calibrated(Decision):
         - where the repertoire shows a gap (the ``1 - known_rejected`` quantile of the own scores at most the
           ``known_rejected`` quantile of the other scores), the gap's far side, the ``known_rejected`` quantile of
           the other scores;
-        - else the larger of the ``1 - known_rejected`` quantiles of the own and of the other scores."""
+        - else, with own scores, their ``1 - known_rejected`` quantile;
+        - else (one take of each movement) the ``1 - known_rejected`` quantile of the other scores."""
         rate = self.known_rejected
         own, other = np.asarray(self.calibration.own), np.asarray(self.calibration.other)
         if len(own) and len(other):
             unknown = float(np.quantile(other, rate))
             if float(np.quantile(own, 1.0 - rate)) <= unknown:
                 return min(unknown, STILL)
-        limits = [float(np.quantile(s, 1.0 - rate)) for s in (own, other) if len(s)]
-        return min(max(limits), STILL) if limits else STILL
+        for scores in (own, other):
+            if len(scores):
+                return min(float(np.quantile(scores, 1.0 - rate)), STILL)
+        return STILL
 
 
 @dataclass(frozen=True)

@@ -28,14 +28,16 @@ def test_distance_is_the_papers_limit_and_zero_is_none():
 
 
 @given(scores, scores, st.floats(0.0, 1.0))
-def test_the_calibrated_threshold_is_the_gaps_far_side_else_the_larger_quantile_at_most_one(own, other, rate):
+def test_the_calibrated_threshold_is_the_gaps_far_side_else_the_own_else_the_others_quantile_at_most_one(own, other,
+                                                                                                         rate):
     decision = Calibrated(rate)
     decision.calibrate(Calibration.of(own, other))
-    limits = [np.quantile(scores, 1.0 - rate) for scores in (own, other) if scores]
     if own and other and np.quantile(own, 1.0 - rate) <= np.quantile(other, rate):
         assert decision.threshold() == min(np.quantile(other, rate), 1.0)
+    elif own:
+        assert decision.threshold() == min(np.quantile(own, 1.0 - rate), 1.0)
     else:
-        assert decision.threshold() == (min(max(limits), 1.0) if limits else 1.0)
+        assert decision.threshold() == (min(np.quantile(other, 1.0 - rate), 1.0) if other else 1.0)
 
 
 def test_a_gap_between_own_takes_and_other_movements_puts_unknown_at_its_far_side():
@@ -47,7 +49,20 @@ def test_a_gap_between_own_takes_and_other_movements_puts_unknown_at_its_far_sid
     assert decision.decide("walk", 0.6, 1.0).movement == "walk"  # a styled walk between the two
     assert decision.decide("walk", 0.7, 1.0).movement is None  # as far as the repertoire's other movements lie
     decision.calibrate(Calibration.of([0.17, 0.70], [0.66, 0.69, 0.70, 0.73, 0.76]))  # overlap: no gap
-    assert decision.threshold() == pytest.approx(np.quantile([0.66, 0.69, 0.70, 0.73, 0.76], 0.95))
+    assert decision.threshold() == pytest.approx(np.quantile([0.17, 0.70], 0.95))  # the own takes'
+
+
+def test_without_a_gap_the_own_takes_set_unknown_not_the_farthest_other_movement():
+    """Takes by two people that lie as far apart as some movements do (no gap): all but 5% of a known movement's
+    performances are taken for it as far as its takes show (the own scores' 95th percentile, split-conformal); a new
+    movement beyond that is unknown although another movement of the repertoire lies as far from its neighbours."""
+    own, other = [0.30, 0.35, 0.42, 0.48, 0.55, 0.60], [0.40, 0.52, 0.70, 0.85, 0.95, 0.98]
+    decision = Calibrated(0.05)
+    decision.calibrate(Calibration.of(own, other))
+    assert decision.threshold() == pytest.approx(np.quantile(own, 0.95))
+    assert decision.decide("walk", 0.58, 1.0).movement == "walk"  # a performance as far as the two people's
+    assert decision.decide("walk", 0.80, 1.0).movement is None  # a new movement: once accepted below 0.98
+    assert decision.threshold() < np.quantile(other, 0.95)
 
 
 def test_the_calibrated_score_is_the_share_left_unexplained():
