@@ -60,18 +60,22 @@ SHIFT_BOW = 0.25
 """How far (a share of its length) a shift of stance may bow out of a straight line."""
 
 
+def _part_distances(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Each chosen part's distance between two poses (3m,), over the parts seen in both."""
+    d = np.linalg.norm((np.asarray(a) - np.asarray(b)).reshape(-1, 3), axis=1)
+    return d[np.isfinite(d)]
+
+
 def _apart(a: np.ndarray, b: np.ndarray) -> float:
     """Eq. 1's mean distance between two poses of the chosen parts (3m,), over the parts seen in both (NaN: none)."""
-    d = np.linalg.norm((np.asarray(a) - np.asarray(b)).reshape(-1, 3), axis=1)
-    d = d[np.isfinite(d)]
+    d = _part_distances(a, b)
     return float(d.mean()) if d.size else float("nan")
 
 
 def _there(a: np.ndarray, b: np.ndarray, radius: float) -> bool:
     """Whether pose ``b`` (3m,) is where pose ``a`` is: eq. 1's mean distance over the parts seen in both within
     ``radius`` and no part farther than twice it (none has left it; as :meth:`Rests.at_hub`)."""
-    d = np.linalg.norm((np.asarray(a) - np.asarray(b)).reshape(-1, 3), axis=1)
-    d = d[np.isfinite(d)]
+    d = _part_distances(a, b)
     return bool(d.size) and float(d.mean()) <= radius and float(d.max()) <= 2.0 * radius
 
 
@@ -249,7 +253,7 @@ class Rests:
         if not self.leaves(window[: end - start]):  # motion at rest (sway, a hand fidgeting): no movement
             return []
         last = self.seen(window[: end - start])[-1]  # the jitter averaged out
-        first = self.origin if self.origin is not None else self.seen(window[:1])[0]
+        first = self.start_pose(window)
         if self.back is not None and _there(self.back[0], last, self.radius):  # a settled movement's way back:
             self.hubs = [h for h in self.hubs if not _there(self.back[1], h, self.radius)]  # that was no stance
             self._stacked = None
@@ -280,6 +284,11 @@ class Rests:
         if not way.size or not _apart(window[0], before.pose) <= 0.5 * float(way.max()):
             return False
         return self.shift(window[before.end - start : now.start - start])
+
+    def start_pose(self, window: np.ndarray) -> np.ndarray:
+        """Where the movement under way (its poses ``window`` from its first frame) began: the rest pose it left
+        (:attr:`origin`), else its first pose seen through the moving average."""
+        return self.origin if self.origin is not None else self.seen(window[:1])[0]
 
     def seen(self, window: np.ndarray) -> np.ndarray:
         """Poses ``window`` (N, 3m) through a centred moving average of ``smooth`` frames (the ends held)."""

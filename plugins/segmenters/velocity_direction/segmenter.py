@@ -681,7 +681,7 @@ class VelocityDirection(Segmenter):
             return self._close_pieces(pieces, began)
         if resting >= self._settle:  # a new stance they stay in: the movement ends where they came to it
             pieces = rests.pieces(start, began, window, shifts=False)
-            rests.settle(rests.origin if rests.origin is not None else rests.seen(window[:1])[0], points)
+            rests.settle(rests.start_pose(window), points)
             return self._close_pieces(pieces, began)
         if not self._holding:
             rests.hold(began, points)
