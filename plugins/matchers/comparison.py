@@ -505,12 +505,10 @@ class Motion(Comparison):
 
     def still(self, frames: Frames) -> np.ndarray:
         """Each frame's distance to standing still, every feature zero (no excursion from the mean posture, no
-        motion, no carry): the root mean square of its parts' norms with the carry's, (n,)."""
-        norm2 = np.einsum("npd,npd->np", frames.parts, frames.parts)
-        if frames.carry.shape[1]:
-            norm2 = norm2 + np.where(frames.carried, np.einsum("nc,nc->n", frames.carry, frames.carry), 0.0)[:, None]
-        count = frames.seen.sum(axis=1)
-        return np.sqrt(np.where(count > 0, (norm2 * frames.seen).sum(axis=1) / np.maximum(count, 1), 0.0))
+        motion, no carry): the root mean square of its parts' norms with the carry's, (n,) (:meth:`still_split` at
+        the frames' own tempo)."""
+        fixed, moving2 = self.still_split(frames)
+        return np.sqrt(fixed + moving2)
 
     def of_motion(self, motion, body, rows: np.ndarray, fps: float) -> Frames:
         """The frames of a whole observed motion (a segment in working memory, with its world positions) at its

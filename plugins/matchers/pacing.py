@@ -126,11 +126,14 @@ def _follow(fixed, moving, moving2, still_parts, starts, cyclic, state, chain_st
 class Followed(NamedTuple):
     """What each chain made of the samples a :class:`PacedWarping` took, after each sample (arrays (r, C)): its best
     path's mean cost so far (``distance``), the demonstration's mean distance to standing still so far at the
-    chain's paces (``moved``) and the frame (the index within the chain) its best path ends on (``ends``)."""
+    chain's paces (``moved``) and the frame (the index within the chain) its best path ends on (``ends``); and each
+    sample's own distance to standing still at its own tempo (``still``, (r,): :meth:`Motion.still`, from the same
+    sums)."""
 
     distance: np.ndarray
     moved: np.ndarray
     ends: np.ndarray
+    still: np.ndarray
 
 
 class PacedWarping:
@@ -170,14 +173,15 @@ class PacedWarping:
         out = np.empty((2, r, chains))
         out[0], out[1] = np.inf, 0.0
         ends = np.full((r, chains), -1, dtype=np.intp)
+        still_parts = np.stack(self.comparison.still_split(samples)) if r else np.zeros((2, 0))
         if r and len(self.frames):
             paired = Paired.pairwise(samples, self.frames)
-            kernel(_follow)(paired.fixed, paired.moving, paired.moving2, np.stack(self.comparison.still_split(samples)),
-                            self.chains.starts, self.chains.cyclic, self.state, self.chain_state, self.samples,
-                            self.prior, TEMPO, out, ends)
+            kernel(_follow)(paired.fixed, paired.moving, paired.moving2, still_parts, self.chains.starts,
+                            self.chains.cyclic, self.state, self.chain_state, self.samples, self.prior, TEMPO, out,
+                            ends)
             self.samples += r
         distance, moved = out
-        return Followed(distance, moved, ends)
+        return Followed(distance, moved, ends, np.sqrt(still_parts[0] + still_parts[1]))
 
 
 def followed_scores(comparison: Motion, samples: Frames, nodes: Frames, chains: Chains,

@@ -400,7 +400,7 @@ class Following:
             if not len(rows):
                 return []
         followed = self.warping.advance(samples)
-        stills = self.comparison.still(samples)  # each row on its own: the same numbers whatever the rows come in
+        stills = followed.still  # each row on its own: the same numbers whatever the rows come in
         chain_scores = self._chain_scores(followed.distance, followed.moved)
         scores = np.minimum.reduceat(chain_scores[:, self._order], self._heads, axis=1)  # each movement's best take
         events = []
