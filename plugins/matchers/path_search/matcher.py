@@ -219,19 +219,19 @@ class PathSearch(Matcher):
         if found.movement is None:
             return Match.unknown("only hub poses", score=details.get("mean_distance"), measure=measure, details={
                 "reason": "only hub poses", "path": node_path, **details})
+        candidates = found.ranked[: self.params["candidates"] + 1] if self.params["candidates"] else ()
         if verdict.movement is None:
             if self.params["learn"]:
                 return self._learn(*raw, details)
             return Match(None, 0.0, None, node_path, {"reason": "too far from every path", "nearest": verdict.nearest,
                                                       "max_distance": verdict.threshold, **details},
-                         reason="too far from every path", nearest=verdict.nearest, score=verdict.score,
-                         threshold=verdict.threshold, measure=measure)
+                         candidates=candidates, reason="too far from every path", nearest=verdict.nearest,
+                         score=verdict.score, threshold=verdict.threshold, measure=measure)
         if isinstance(self.decision, Distance):
             confidence = float(np.exp(-verdict.score / self.params["distance"]["scale"]) * found.share)
         else:
             confidence = float(max(0.0, 1.0 - verdict.score / verdict.threshold) * found.share) \
                 if np.isfinite(verdict.threshold) and verdict.threshold > 0 else found.share
-        candidates = found.ranked[: self.params["candidates"] + 1] if self.params["candidates"] else ()
         return Match(verdict.movement, confidence, None, node_path, details, candidates=candidates,
                      score=verdict.score, threshold=verdict.threshold, measure=measure)
 

@@ -156,6 +156,19 @@ def test_a_performance_four_times_slower_or_faster_than_ones_own_is_found(stick,
     assert first == "raise" and second == "reach" and near < 0.25 * far
 
 
+def test_an_unknown_answer_still_ranks_the_candidates(stick):
+    """What ``likeme observe`` explains an "unknown" with: the movements ranked by the score the decision read, the
+    nearest first, as a known answer ranks them."""
+    from plugins.matchers.decision import Distance
+
+    stick.matcher.params = {**stick.matcher.params, "candidates": 1}
+    known = stick.matcher.match(observed(stick, "raise"))
+    stick.matcher.decision = Distance(1e-12)  # nothing is near enough
+    match = stick.matcher.match(observed(stick, "raise"))
+    assert match.movement is None and match.nearest == "raise"
+    assert [name for name, _ in match.candidates] == [name for name, _ in known.candidates] == ["raise", "reach"]
+
+
 def test_the_paths_nodes_follow_the_movement_in_order(stick):
     match = stick.matcher.match(observed(stick, "reach", speed=0.5))
     path = match.path
