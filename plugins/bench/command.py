@@ -182,6 +182,22 @@ def _motion_capture_commands(sub: Any) -> None:
                    help="the recordings' format: BVH, CSV joint positions, .npy arrays or C3D markers (default: bvh)")
     p.set_defaults(handler=_handler("data", "cmd_make_data"))
 
+    p = sub.add_parser("make-gestures", help="write hand gestures (waves and raises of the left, right and both "
+                       "hands) of several performers in seven styles as a Kinect's tracker records them: "
+                       "repertoire, demos and a profile")
+    p.add_argument("dest", metavar="DIR")
+    _jobs_options(p, "the CSV files, each take drawn here and written by a worker; the same files whatever N")
+    p.add_argument("--seed", type=seed_type, default=0)
+    p.add_argument("--performers", type=count_type(1, 100), default=4, help="performers (default: 4); the first "
+                   "one's normal style is the repertoire")
+    p.add_argument("--takes", type=count_type(1, 100), default=4, help="takes of the repertoire's movements "
+                   "(default: 4)")
+    p.add_argument("--jitter", type=number_type(0.0, 1.0, "metres"), default=0.01, metavar="M", help="the tracker's "
+                   "jitter, twice this at the wrists and hands (default: 0.01)")
+    p.add_argument("--lost", type=number_type(0.0, 0.5, "share of joint positions"), default=0.02, metavar="S",
+                   help="the share of joint positions lost, in runs of one to four frames (default: 0.02)")
+    p.set_defaults(handler=_handler("gestures", "cmd_make_gestures"))
+
     p = sub.add_parser("bandai", help="build benchmark folders from the Bandai-Namco clips (links; nothing copied): "
                        "streams/ (takes at rest joined through a rest), cropped/ (takes joined end to end), and with "
                        "--locomotion locomotion/")

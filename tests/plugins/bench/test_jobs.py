@@ -19,8 +19,9 @@ from plugins.bench.jobs import run_with_pm
 from likeme.cli import main
 from toolkit.manager import create_plugin_manager
 
-SUB_COMMANDS = ("recognition", "segmentation", "stream", "sweep", "make-data", "bandai", "watch", "facilitation",
-                "memory", "posegraph", "startup", "vision", "fuzz", "scaling", "behaviour", "learning", "latency")
+SUB_COMMANDS = ("recognition", "segmentation", "stream", "sweep", "make-data", "make-gestures", "bandai", "watch",
+                "facilitation", "memory", "posegraph", "startup", "vision", "fuzz", "scaling", "behaviour", "learning",
+                "latency")
 """Every ``likeme bench`` sub-command (a test checks the list against the command's own)."""
 TIMED = ("memory", "posegraph", "startup", "vision", "scaling", "latency")
 """The sub-commands whose figures are timings or memory."""
