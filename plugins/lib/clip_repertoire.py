@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from plugins.lib.gaps import bridged
+from plugins.lib.jitter import jitter_variance
 from plugins.lib.lowpass import low_passed
 from plugins.lib.pose_distance import pose_distance
 from plugins.lib.root_frame import RecordingFacing, root_relative
@@ -48,11 +49,14 @@ __all__ = ["Clip", "ClipRepertoire", "load_clip_repertoire", "clip_repertoire", 
 @dataclass(frozen=True)
 class Clip:
     """One example of a movement: its label, file (or name, built in memory) and local-frame motion (root at hub
-    height; its world positions in :attr:`Motion.world`)."""
+    height; its world positions in :attr:`Motion.world`); ``jitter``: each part's jitter about the root as the file
+    gave it, before the low-pass, as a variance per axis (m^2, (P,); :func:`plugins.lib.jitter.jitter_variance`),
+    ``None`` where not measured."""
 
     movement: str
     source: Path | str
     motion: Motion
+    jitter: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -101,6 +105,20 @@ def root_relative_motion(world: Motion, body: Body, facing_window: float = 1.0) 
     window = max(1, int(round(facing_window * world.fps)))
     pose, mask, _, _ = root_relative(smooth.positions, smooth.visible, body, RecordingFacing(window))
     return Motion(pose, world.fps, world.parts, mask, smooth.positions).filled()
+
+
+def clip_jitter(world: Motion, body: Body) -> np.ndarray:
+    """Each part's jitter about the root in a clip's world positions as given (:func:`plugins.lib.jitter.
+    jitter_variance`: variance per axis, m^2, (P,)): the tracker's, which the low-pass of
+    :func:`root_relative_motion` then reduces (:func:`plugins.lib.jitter.feature_noise`). Turning the positions
+    into the body's frame does not change a variance, and the facing turns slowly. A joint angle (a finger's) is not
+    a position: 0."""
+    root = body.root_index
+    positions = np.asarray(world.positions, dtype=float)
+    seen = np.asarray(world.visible, dtype=bool) & np.isfinite(positions).all(axis=-1)
+    jitter = jitter_variance(positions - positions[:, root : root + 1], seen & seen[:, root : root + 1], world.fps)
+    jitter[np.asarray(body.angle_mask, dtype=bool)] = 0.0
+    return jitter
 
 
 PAIR_BLOCK = 2**22
@@ -182,6 +200,7 @@ def clip_repertoire(motions: Sequence[Motion], labels: Sequence[str], profile: s
             sources.append(example_name(label, counts.get(label, 0)))
             counts[label] = counts.get(label, 0) + 1
     rel: list[tuple[str, Path | str, Motion]] = []
+    jitters = [clip_jitter(world, profile.body) for world in motions]
     for movement, source, world in zip(labels, sources, motions):
         where = {"file": source} if isinstance(source, Path) else {"key": ("clips", str(source))}
         if tuple(world.parts) != tuple(profile.body.parts):
@@ -195,7 +214,8 @@ def clip_repertoire(motions: Sequence[Motion], labels: Sequence[str], profile: s
     hubs_rel = find_hubs(ends, hub_radius, hub_share)
     height = _root_height(rel)
     lift = np.array([0.0, height, 0.0])
-    clips = tuple(Clip(mv, src, Motion(m.positions + lift, m.fps, m.parts, m.visible, m.world)) for mv, src, m in rel)
+    clips = tuple(Clip(mv, src, Motion(m.positions + lift, m.fps, m.parts, m.visible, m.world), jitter)
+                  for (mv, src, m), jitter in zip(rel, jitters))
     return ClipRepertoire(profile, clips, hubs_rel + lift, tuple(motions), folder, hub_radius, hub_share)
 
 

@@ -51,6 +51,7 @@ import numpy as np
 
 from plugins.lib.body_size import body_scale
 from plugins.lib.compiled import kernel
+from plugins.lib.jitter import feature_noise, jitter_variance
 from plugins.lib.root_frame import RecordingFacing, root_relative
 from plugins.lib.travel import body_velocity, turned
 from plugins.lib.velocity import derivative
@@ -77,12 +78,19 @@ class Frames:
         :class:`Poses`).
     carried : array of bool, shape (n,)
         Whether the carry is known (where the body goes needs its world positions).
+    noise : array, shape (n, 2), or None
+        The tracker's jitter in each frame's features, squared, as it adds to the squared distance of two frames
+        (:mod:`plugins.lib.jitter`): the mean over the frame's parts seen of the part's squared shape noise and of its
+        squared motion noise (the second scales with a performance's tempo as the motion does); the search takes it
+        out of its distances (:func:`plugins.matchers.tempo.less_jitter`). ``None``: none known, 0 (the papers'
+        characters, a motion authored as key poses).
     """
 
     parts: np.ndarray
     seen: np.ndarray
     carry: np.ndarray
     carried: np.ndarray
+    noise: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.parts)
@@ -128,15 +136,22 @@ class Frames:
         carry = self.carry if self.carried.all() else np.where(self.carried[:, None], self.carry, 0.0)
         return (masked[..., :3] if dims == 6 else masked[..., :0]), masked[..., dims - 3 :], carry[:, :3], carry[:, 3:]
 
+    @property
+    def floor(self) -> np.ndarray:
+        """:attr:`noise`, zeros where none is known, (n, 2)."""
+        return self.noise if self.noise is not None else np.zeros((len(self), 2))
+
     def take(self, rows: np.ndarray | slice) -> Frames:
         """The frames ``rows`` of this sequence."""
-        return Frames(self.parts[rows], self.seen[rows], self.carry[rows], self.carried[rows])
+        return Frames(self.parts[rows], self.seen[rows], self.carry[rows], self.carried[rows],
+                      None if self.noise is None else self.noise[rows])
 
     @staticmethod
     def join(sequences: list[Frames]) -> Frames:
         """Sequences one after another (each keeps the features it was given: a take's shape about its own mean)."""
+        noise = None if all(s.noise is None for s in sequences) else np.concatenate([s.floor for s in sequences])
         return Frames(*(np.concatenate([getattr(s, f) for s in sequences]) for f in
-                        ("parts", "seen", "carry", "carried")))
+                        ("parts", "seen", "carry", "carried")), noise)
 
 
 class Split(NamedTuple):
@@ -312,7 +327,7 @@ class Comparison(ABC):
     @abstractmethod
     def frames(self, poses: np.ndarray, visible: np.ndarray, fps: float, *, velocity: np.ndarray | None = None,
                travel: np.ndarray | None = None, heading: np.ndarray | None = None,
-               size: float | None = None) -> Frames:
+               size: float | None = None, noise: np.ndarray | None = None) -> Frames:
         """The frames of a sequence of root-relative poses.
 
         Parameters
@@ -332,6 +347,10 @@ class Comparison(ABC):
         size : float, optional
             The body size the lengths are measured in (:func:`plugins.lib.body_size.body_scale`); ``None``: from
             the sequence's own median pose.
+        noise : array, shape (P, 2), (n, P, 2) or (n, 1, 2), optional
+            Each part's squared jitter in its position (m^2) and its velocity ((m/s)^2), three axes together
+            (:func:`plugins.lib.jitter.feature_noise`; one for every part: their mean), which a comparison that sees
+            it keeps as :attr:`Frames.noise`; ``None``: none known.
         """
 
     paced: ClassVar[bool] = False
@@ -393,7 +412,9 @@ class Poses(Comparison):
     name = "poses"
     unit = "m"
 
-    def frames(self, poses, visible, fps, *, velocity=None, travel=None, heading=None, size=None) -> Frames:
+    def frames(self, poses, visible, fps, *, velocity=None, travel=None, heading=None, size=None,
+               noise=None) -> Frames:
+        """:meth:`Comparison.frames`: eq. 1 as the paper has it, the jitter in it (``noise`` is not used)."""
         poses = np.asarray(poses, dtype=float)
         seen = np.asarray(visible, dtype=bool) & np.isfinite(poses).all(axis=-1)
         n = len(poses)
@@ -422,10 +443,12 @@ class Motion(Comparison):
             raise ValueError(f"shape must be 'mean', 'onset' or 'none', not {shape!r}")
         self.shape = shape
 
-    def frames(self, poses, visible, fps, *, velocity=None, travel=None, heading=None, size=None,
+    def frames(self, poses, visible, fps, *, velocity=None, travel=None, heading=None, size=None, noise=None,
                origin=None) -> Frames:
         """:meth:`Comparison.frames`; ``origin`` (P, 3): with ``shape = "onset"``, the pose the shape is measured
-        from (default: the first frame's)."""
+        from (default: the first frame's). ``noise``: kept in body sizes as :attr:`Frames.noise`, each frame's mean
+        over its parts seen (the shape's about the mean pose as the position's; the motion's times
+        :data:`HORIZON` squared)."""
         poses = np.asarray(poses, dtype=float)
         seen = np.asarray(visible, dtype=bool) & np.isfinite(poses).all(axis=-1)
         n = len(poses)
@@ -452,8 +475,13 @@ class Motion(Comparison):
             turn = np.where(carried, heading, 0.0)
             carry[:, 3] = np.cos(turn) - 1.0
             carry[:, 4] = np.sin(turn)
+        floor = None
+        if noise is not None:
+            per_part = np.broadcast_to(np.asarray(noise, dtype=float), (n, seen.shape[1], 2)) * seen[..., None]
+            floor = per_part.sum(axis=1) / np.maximum(seen.sum(axis=1), 1)[:, None] * \
+                np.array([0.0 if self.shape == "none" else scale * scale, (HORIZON * scale) ** 2])
         return Frames(motion if self.shape == "none" else np.concatenate([shape, motion], axis=2), seen, carry,
-                      carried)
+                      carried, floor)
 
 
     paced = True
@@ -533,9 +561,12 @@ class Motion(Comparison):
         relative = np.where(seen[..., None], positions, 0.0)
         root = body.root_index
         held = _held(relative, seen)
-        velocity = derivative(held - held[:, root : root + 1], motion.fps)[rows]
+        about_root = held - held[:, root : root + 1]
+        velocity = derivative(about_root, motion.fps)[rows]
+        noise = feature_noise(jitter_variance(about_root, seen & seen[:, root : root + 1], motion.fps), motion.fps,
+                              motion.n_frames)
         return self.frames(held[rows], seen[rows], fps, velocity=velocity, travel=travel, heading=heading,
-                           size=sequence_size(relative, seen))
+                           size=sequence_size(relative, seen), noise=noise)
 
 
 FACING_WINDOW = 1.0

@@ -24,6 +24,13 @@ and a demonstration's motion multiplied without bound would make its own jitter 
 
 Positions have no tempo (:class:`plugins.matchers.comparison.Poses`, the papers' eq. 1): for them the second pass is
 the first, and it is not made.
+
+A tracker's jitter adds to both distances (:mod:`plugins.lib.jitter`): where the frames know it
+(:attr:`plugins.matchers.comparison.Frames.noise`: a demonstration seen whole, a take from a recording), it is taken
+out of both before the one is divided by the other (:func:`less_jitter`), so that a score says more of how far the
+movements lie apart and less of how noisy the trackers were: the hand gestures of ``likeme bench make-gestures``,
+recorded with 1 cm of jitter (2 cm at the hands), score a median 0.34 from their movements in the normal style with
+it and 0.23 without it, against 0.15 recorded clean.
 """
 
 from __future__ import annotations
@@ -35,7 +42,7 @@ import numpy as np
 from plugins.matchers.comparison import Comparison, Frames
 from plugins.matchers.warping import Chains, kept, kept_chains, warp_chains
 
-__all__ = ["Paced", "TEMPO", "paced_distances", "paced_scores", "paces"]
+__all__ = ["Paced", "TEMPO", "less_jitter", "paced_distances", "paced_scores", "paces"]
 
 TEMPO = 4.0
 """How many times slower or faster than a take a performance may be and still be compared at the take's tempo
@@ -97,6 +104,8 @@ def paced_distances(comparison: Comparison, samples: Frames, nodes: Frames, chai
         pace[keep] = at
     else:
         moving = np.full(len(found), float(np.mean(comparison.still(samples))))
+    if samples.noise is not None or frames.noise is not None:
+        found, moving = less_jitter(found, moving, samples, frames, starts, pace[keep])
     with np.errstate(divide="ignore", invalid="ignore"):
         scores[keep] = np.where(moving > 0, found / moving, np.inf)
     distances[keep] = found
@@ -105,6 +114,25 @@ def paced_distances(comparison: Comparison, samples: Frames, nodes: Frames, chai
         full[:, columns] = cost
         cost = full
     return Paced(scores, distances, pace, cost)
+
+
+def less_jitter(found: np.ndarray, moving: np.ndarray, samples: Frames, frames: Frames, starts: np.ndarray,
+                pace: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each chain's distance ``found`` (K,) and the demonstration's distance to standing still at the chain's
+    ``pace`` (K,) less the tracker's jitter (:attr:`Frames.noise`, :mod:`plugins.lib.jitter`): squared, the
+    demonstration's mean squared noise at that pace (its motion's noise times ``1 / pace`` squared, as its motion)
+    and the chain's own (the mean over its frames, ``frames`` chain after chain from ``starts``) subtracted, at least
+    0. What is left lies far nearer the distance of the movements themselves, but keeps some of the noise: a chain's
+    distance is a mean of frame distances, and the square of a mean is not the mean of the squares the noise adds
+    to (at 1.5 cm of jitter, 3 cm at the hands, about a third of the rise in the scores remains,
+    ``tests/plugins/matchers/path_search/test_jitter_scores.py``).
+
+    A demonstration that moves no more than its jitter moves by its jitter: its distance to standing still is held
+    at its noise, not brought to 0, so that its scores stay finite and rank its movements as before."""
+    noise = samples.floor
+    own = (noise[:, :1] + noise[:, 1:] / (pace[None, :] ** 2)).mean(axis=0)
+    take = np.add.reduceat(frames.floor.sum(axis=1), starts[:-1]) / np.diff(starts)
+    return np.sqrt(np.maximum(found ** 2 - own - take, 0.0)), np.sqrt(np.maximum(moving ** 2 - own, own))
 
 
 def paced_scores(comparison: Comparison, samples: Frames, nodes: Frames, chains: Chains,

@@ -22,6 +22,9 @@ relative to the root, m/s, measured at the clip's own frame rate) and
 ``node_heading`` (N,) how far the body had turned since its movement began
 (radians; NaN where not known): what a comparison that sees motion compares
 (:mod:`plugins.matchers.comparison`), which the poses alone do not show.
+``node_noise`` (N, 2) holds the tracker's jitter a clip's nodes keep (the mean over
+the parts of the squared noise of a position, m^2, and of a velocity, (m/s)^2;
+:mod:`plugins.lib.jitter`; 0 for key poses and what was learned by watching).
 
 Learning (§5.2.3, §7.3): :meth:`Posegraph.learn` adds an observed path as a new
 movement (new nodes from the observed poses, entered from and returning to the
@@ -50,6 +53,7 @@ import numpy as np
 
 from plugins.lib.clip_repertoire import CLIP_PARAMETERS, example_name, repertoire_for
 from plugins.lib.compiled import one_thread
+from plugins.lib.jitter import feature_noise
 from plugins.lib.pose_distance import pose_distance
 from plugins.lib.travel import body_velocity, turned
 from plugins.lib.velocity import derivative
@@ -115,14 +119,14 @@ class Posegraph(MotorSystem):
                            np.zeros(len(sampled) - 2))
         clips = self.clips.clips if self.clips is not None else ()
         for clip in clips:
-            self._add_clip(clip.movement, clip.motion, rows)
+            self._add_clip(clip.movement, clip.motion, rows, clip.jitter)
         self._add_learned(getattr(self, "learned", {}), rows)  # what it learned by watching, again
         self._set_rows(rows)
 
     def _set_rows(self, rows: _NodeRows) -> None:
         """The node arrays from ``rows`` (one row per node, in node order)."""
         root = self.body.root_index
-        self.node_poses, self.node_travel, self.node_motion, self.node_heading = rows.arrays()
+        self.node_poses, self.node_travel, self.node_motion, self.node_heading, self.node_noise = rows.arrays()
         self.node_root_relative = self.node_poses - self.node_poses[:, root : root + 1]
 
     def _sampled(self, motion: Motion, rate: float | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -165,9 +169,11 @@ class Posegraph(MotorSystem):
                         out[name] = (sampled[:, j], np.nan_to_num(travel), motion[:, j])
         return out
 
-    def _add_clip(self, movement: str, motion: Motion, rows: _NodeRows) -> None:
+    def _add_clip(self, movement: str, motion: Motion, rows: _NodeRows, jitter: np.ndarray | None = None) -> None:
         """One example clip as a path between the hubs nearest its ends, sampled at ``node_rate``; its travel and
-        turn from its world positions (none known: at rest, turn unknown), its parts' motion from its frames."""
+        turn from its world positions (none known: at rest, turn unknown), its parts' motion from its frames; the
+        jitter its nodes keep from the tracker, through the clip's low-pass (:func:`plugins.lib.jitter.
+        feature_noise`), from the clip's ``jitter`` (none given: none)."""
         keep, filled = self._sampled(motion)  # hidden parts held (docs/conventions.md)
         sampled = filled[keep]
         hub_rel = self.key_poses.array - self.key_poses.array[:, self.body.root_index : self.body.root_index + 1]
@@ -184,8 +190,9 @@ class Posegraph(MotorSystem):
             heading = turned(motion.world, motion.positions, motion.visible, root)[keep]
         parts = derivative(filled - filled[:, root : root + 1], motion.fps)[keep]
         name = example_name(movement, n)
+        noise = None if jitter is None else feature_noise(jitter, motion.fps, motion.n_frames, low_passed=True)
         self._add_path(name, ends[0], sampled[1:-1], ends[1], rows, velocity[1:-1], parts[1:-1], heading[1:-1],
-                       label=movement)
+                       label=movement, noise=noise)
         whole = filled[[0, -1]] - filled[[0, -1], root : root + 1]
         cycle = float(pose_distance(whole[0], whole[1], True))  # its very first and last frames
         radius = self.params["hub_radius"]
@@ -195,7 +202,8 @@ class Posegraph(MotorSystem):
             self.graph.add_edge(path[-2], path[1], movement=movement, cycle=True)
 
     def _add_path(self, name: str, start: str, interior: np.ndarray, end: str, rows: _NodeRows,
-                  travel: np.ndarray, motion: np.ndarray, heading: np.ndarray, *, label: str | None = None) -> None:
+                  travel: np.ndarray, motion: np.ndarray, heading: np.ndarray, *, label: str | None = None,
+                  noise: np.ndarray | None = None) -> None:
         import networkx as nx
 
         label = label or name
@@ -205,7 +213,7 @@ class Posegraph(MotorSystem):
             node = f"{name}/{j}"
             self.graph.add_node(node, index=first + j - 1, movement=label, hub=False)
             path.append(node)
-        rows.add(interior, travel, motion, heading)
+        rows.add(interior, travel, motion, heading, noise)
         path.append(end)
         nx.add_path(self.graph, path, movement=label)
         self.paths[name] = path
@@ -471,18 +479,24 @@ class Posegraph(MotorSystem):
 
 
 class _NodeRows:
-    """The posegraph's per-node arrays while it is built: poses, travel, motion and heading, a block per path."""
+    """The posegraph's per-node arrays while it is built: poses, travel, motion, heading and the jitter (the mean over
+    the parts of the squared noise of their positions and velocities, two numbers a node,
+    :func:`plugins.lib.jitter.feature_noise`; 0 where none is known), a block per path."""
 
     def __init__(self) -> None:
-        self.blocks: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
+        self.blocks: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
         self.count = 0
 
-    def add(self, poses: np.ndarray, travel: np.ndarray, motion: np.ndarray, heading: np.ndarray) -> None:
-        self.blocks.append((np.asarray(poses, dtype=float), np.asarray(travel, dtype=float),
-                            np.asarray(motion, dtype=float), np.asarray(heading, dtype=float)))
+    def add(self, poses: np.ndarray, travel: np.ndarray, motion: np.ndarray, heading: np.ndarray,
+            noise: np.ndarray | None = None) -> None:
+        """A path's rows; ``noise`` (P, 2): its parts' squared jitter, kept as their mean over the parts."""
+        poses = np.asarray(poses, dtype=float)
+        mean = np.zeros(2) if noise is None else np.asarray(noise, dtype=float).mean(axis=0)
+        self.blocks.append((poses, np.asarray(travel, dtype=float), np.asarray(motion, dtype=float),
+                            np.asarray(heading, dtype=float), np.broadcast_to(mean, (len(poses), 2))))
         self.count += len(poses)
 
-    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         return tuple(np.concatenate(column) for column in zip(*self.blocks))  # type: ignore[return-value]
 
 

@@ -70,6 +70,9 @@ class Takes(Protocol):
     """The root's velocity in the body's frame at each node (m/s), (N, 3)."""
     node_heading: np.ndarray
     """How far the body had turned at each node since its take began (radians; NaN: not known), (N,)."""
+    node_noise: np.ndarray
+    """The tracker's jitter each node keeps from its clip: the mean over the parts of the squared noise of a position
+    (m^2) and of a velocity ((m/s)^2) (:func:`plugins.lib.jitter.feature_noise`; 0 where none is known), (N, 2)."""
 
     def takes(self) -> dict[str, list[list[str]]]:
         """Movement -> the node names of each of its takes (hubs left out)."""
@@ -176,14 +179,16 @@ class PathSearch(Matcher):
 
     def take_frames(self, nodes: np.ndarray) -> Frames:
         """The frames of one take's nodes (in their order): as the comparison sees a demonstration, about the take's
-        own mean and in its own body size, with its parts' motion, travel and turn as the posegraph keeps them."""
+        own mean and in its own body size, with its parts' motion, travel, turn and jitter as the posegraph keeps
+        them."""
         motor = self.motor
         poses = motor.node_root_relative[nodes]
         heading = motor.node_heading[nodes]
         first = heading[np.isfinite(heading)][:1]
         return self.comparison.frames(poses, np.ones(poses.shape[:2], dtype=bool), motor.node_rate,
                                       velocity=motor.node_motion[nodes], travel=motor.node_travel[nodes],
-                                      heading=heading - (first[0] if len(first) else 0.0))
+                                      heading=heading - (first[0] if len(first) else 0.0),
+                                      noise=motor.node_noise[nodes][:, None, :])
 
     def samples(self, motion: Motion) -> tuple[Frames, tuple[np.ndarray, np.ndarray]]:
         """The observed motion (in the observer's own parts) at the posegraph's node rate: its frames as the

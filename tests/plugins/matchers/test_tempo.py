@@ -98,3 +98,23 @@ def test_at_its_own_tempo_a_take_is_itself_and_a_left_out_chain_is_infinitely_fa
     assert paced.scores[0] == pytest.approx(0.0, abs=1e-6) and paced.pace[0] == pytest.approx(1.0)  # sqrt of rounding
     assert np.isinf(paced.scores[1]) and np.isinf(paced.distances[1]) and paced.pace[1] == 1.0
     assert paced.cost.shape == (len(take), len(nodes)) and (paced.cost[:, len(take):] == 0).all()
+
+
+def test_the_jitter_is_taken_out_of_both_distances_squared():
+    """plugins.matchers.tempo.less_jitter by hand: the demonstration's noise at each chain's pace (its motion's
+    noise over the pace squared) and the chain's own, squared, out of the distance; the demonstration's alone out of
+    its distance to standing still, which never falls below its noise."""
+    from plugins.matchers.tempo import less_jitter
+
+    def frames(noise):
+        n = len(noise)
+        return Frames(np.zeros((n, 1, 6)), np.ones((n, 1), dtype=bool), np.zeros((n, 5)), np.zeros(n, dtype=bool),
+                      np.asarray(noise, dtype=float))
+
+    samples = frames([[0.01, 0.04], [0.01, 0.04]])
+    chains = frames([[0.01, 0.01], [0.01, 0.01], [0.0, 0.0]])  # chain 0: frames 0-1; chain 1: frame 2
+    found, moving = less_jitter(np.array([0.5, 0.3]), np.array([1.0, 0.1]), samples, chains,
+                                np.array([0, 2, 3]), np.array([1.0, 2.0]))
+    own = np.array([0.01 + 0.04, 0.01 + 0.04 / 4])
+    assert found == pytest.approx(np.sqrt([0.25 - own[0] - 0.02, 0.09 - own[1] - 0.0]))
+    assert moving == pytest.approx(np.sqrt([1.0 - own[0], own[1]]))  # 0.1 moves less than its noise
