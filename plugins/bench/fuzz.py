@@ -337,6 +337,7 @@ OUTPUTS = (
     ["run", "learn_windmill", "--duration", "0.2", "--save", "out/s.json"],
     ["run", "learn_windmill", "--duration", "0.2", "--load", "{state}", "--save", "out/s.json"],
     ["bench", "make-data", "out/gen"],
+    ["bench", "make-gestures", "out/ges", "--performers", "1", "--takes", "1"],
     ["show", "max", "--view", "posegraph", "--out", "out/g.png"],
     ["show", "max", "--view", "posegraph"],  # into the working folder
 )

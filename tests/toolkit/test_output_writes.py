@@ -126,6 +126,8 @@ WRITERS = [
     ("run --render", ["run", "demo", "--duration", "0.2", "--render", "OUT/r", "--set", 'formats=["png", "gif"]'],
      "OUT/r: cannot write the render"),
     ("bench make-data", ["bench", "make-data", "OUT/gen"], "OUT/gen: cannot write the benchmark data"),
+    ("bench make-gestures", ["bench", "make-gestures", "OUT/ges", "--performers", "1", "--takes", "1"],
+     "OUT/ges: cannot write the benchmark data"),
     ("bench posegraph --json", ["bench", "posegraph", "--nodes", "1000", "--json", "OUT/p.json"],
      "OUT/p.json: cannot write the output"),
     ("bench fuzz --out", ["bench", "fuzz", "--n", "1", "--out", "OUT/f"], "cannot write the work files"),
