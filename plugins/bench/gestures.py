@@ -157,6 +157,16 @@ def _reach(shoulder: np.ndarray, wrist: np.ndarray, upper: float, fore: float, s
     return elbow, shoulder + dist * u
 
 
+def _arm(shoulder: np.ndarray, wrist: np.ndarray, p: Performer, sign: float) -> tuple:
+    """The elbow, wrist and hand (each (n, 3)) of an arm of ``p`` reaching from ``shoulder`` for ``wrist``: the hand
+    on from the wrist along the forearm."""
+    s = p.size
+    elbow, wrist = _reach(shoulder, wrist, p.upper_arm * s, p.forearm * s, sign)
+    forearm = wrist - elbow
+    return elbow, wrist, wrist + 0.045 * s * forearm / np.maximum(np.linalg.norm(forearm, axis=-1, keepdims=True),
+                                                                   1e-9)
+
+
 def gesture(movement: str, style: Style, p: Performer, rng: np.random.Generator, *, vary: float = 0.04) -> np.ndarray:
     """One take (frames, 20, 3), in the body's frame: ``movement`` of :data:`MOVEMENTS` in ``style`` by ``p``; every
     duration, place and swing varied by about ``vary`` (a take recorded after another differs by a few percent)."""
@@ -210,18 +220,14 @@ def gesture(movement: str, style: Style, p: Performer, rng: np.random.Generator,
         else:
             path[:, 1] += 0.02 * s * np.sin(np.pi * reversals * phase) * during
         path += 0.003 * s * np.sin(2 * np.pi * jitter(0.7) * t + rng.uniform(0, 2 * np.pi))[:, None]
-        elbow, wrist = _reach(shoulder, shoulder + path, p.upper_arm * s, p.forearm * s, sign)
-        hand = wrist + 0.045 * s * (wrist - elbow) / np.maximum(np.linalg.norm(wrist - elbow, axis=-1,
-                                                                               keepdims=True), 1e-9)
-        q[:, _J[f"Elbow{name}"]], q[:, _J[f"Wrist{name}"]], q[:, _J[f"Hand{name}"]] = elbow, wrist, hand
+        q[:, [_J[f"Elbow{name}"], _J[f"Wrist{name}"], _J[f"Hand{name}"]]] = np.stack(
+            _arm(shoulder, shoulder + path, p, sign), axis=1)
     for side, sign in (("Left", 1.0), ("Right", -1.0)):
-        if side.lower() not in sides:
+        if side.lower() not in sides:  # the other arm hangs at rest
             rest = np.array([sign * (_REST[0] + p.rest_out), _REST[1], _REST[2]]) * reach
             shoulder = q[:, _J[f"Shoulder{side}"]]
-            elbow, wrist = _reach(shoulder, shoulder + rest, p.upper_arm * s, p.forearm * s, sign)
-            q[:, _J[f"Elbow{side}"]], q[:, _J[f"Wrist{side}"]] = elbow, wrist
-            q[:, _J[f"Hand{side}"]] = wrist + 0.045 * s * (wrist - elbow) / np.linalg.norm(wrist - elbow, axis=-1,
-                                                                                         keepdims=True)
+            q[:, [_J[f"Elbow{side}"], _J[f"Wrist{side}"], _J[f"Hand{side}"]]] = np.stack(
+                _arm(shoulder, shoulder + rest, p, sign), axis=1)
     upper = [_J[n] for n in _UPPER]
     q[:, upper, 0] += rock[:, None] * (q[:, upper, 1] - q[:, _J["HipCenter"], 1][:, None]) / (0.4 * s)
     return q

@@ -6,10 +6,10 @@ recordings of the same movement then differ by the noise of both, and a recordin
 its own: squared, ``E|x + n - y - m|^2 = |x - y|^2 + E|n|^2 + E|m|^2``. A comparison that sees motion
 (:mod:`plugins.matchers.comparison`) compares velocities too, which a derivative makes noisier still, so on a
 tracker's recordings every distance grows by a floor that says nothing of the movements, the more the noisier the
-tracker: with 1-2 cm of jitter, performances of one hand gesture lie twice as far apart as recorded clean. The comparison keeps that floor with each sequence's frames
-(:attr:`plugins.matchers.comparison.Frames.noise`), and path search subtracts it from its squared distances
-(:func:`plugins.matchers.tempo.less_jitter`), which leaves an estimate of the squared distance of the movements
-themselves.
+tracker: with 1-2 cm of jitter, performances of one hand gesture lie twice as far apart as recorded clean. The
+comparison keeps that floor with each sequence's frames (:attr:`plugins.matchers.comparison.Frames.noise`), and path
+search subtracts it from its squared distances (:func:`plugins.matchers.tempo.less_jitter`), which leaves an
+estimate of the squared distance of the movements themselves.
 
 :func:`jitter_variance` measures each part's noise on the recording: the residual of a quadratic Savitzky-Golay
 smoothing over :data:`plugins.lib.velocity.SMOOTHING` seconds, which a person's movement (below a few hertz) passes
