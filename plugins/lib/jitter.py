@@ -41,9 +41,9 @@ def _residual_weights(fps: float) -> np.ndarray:
     least 5 frames, :data:`plugins.lib.velocity.SMOOTHING` seconds): one at the middle frame less the smoothing's."""
     from scipy.signal import savgol_coeffs
 
-    from plugins.lib.velocity import SMOOTHING
+    from plugins.lib.velocity import window_frames
 
-    taps = max(5, int(round(SMOOTHING * fps)) | 1)
+    taps = window_frames(fps)
     weights = -savgol_coeffs(taps, 2)
     weights[taps // 2] += 1.0
     return weights
@@ -57,9 +57,8 @@ def jitter_variance(positions: np.ndarray, seen: np.ndarray, fps: float) -> np.n
     white noise of variance ``s^2`` per axis, Gaussian with variance ``s^2 (1 - w)``, ``w`` the fit's weight on its
     middle frame (the sum of the residual weights' squares); its squared length over three axes is that times a
     chi-square of three degrees of freedom, whose median is :data:`_CHI2_3_MEDIAN`. Only frames whose whole window
-    the part is seen in count, away from the ends (hidden frames are bridged by straight lines for the fit, and a
-    bridge is no noise). A part with fewer such frames than one window, or a recording shorter than two windows: 0
-    (nothing to measure).
+    the part is seen in count, away from the ends (what stands in a hidden frame takes no part in them). A part with
+    fewer such frames than one window, or a recording shorter than two windows: 0 (nothing to measure).
     """
     from scipy.ndimage import correlate1d
 
@@ -77,18 +76,12 @@ def jitter_variance(positions: np.ndarray, seen: np.ndarray, fps: float) -> np.n
     if not len(measured):
         return out
     filled = positions[:, measured]
-    gaps = [j for j, part in enumerate(measured) if not seen[:, part].all()]
-    if gaps:
-        filled = filled.copy()
-        frames = np.arange(n)
-        for j in gaps:
-            at = frames[seen[:, measured[j]]]
-            for k in range(3):
-                filled[:, j, k] = np.interp(frames, at, filled[at, j, k])
+    if not seen[:, measured].all():  # a hidden frame's residuals are never counted: any finite number will do
+        filled = np.where(seen[:, measured, None], filled, 0.0)
     residual = correlate1d(filled, weights, axis=0, mode="nearest")[half : n - half]
     square = np.einsum("npk,npk->np", residual, residual)
     scale = _CHI2_3_MEDIAN * float(weights @ weights)
-    if not gaps and whole[:, measured].all():
+    if whole[:, measured].all():
         out[measured] = np.median(square, axis=0) / scale
         return out
     for j, part in enumerate(measured):

@@ -12,11 +12,16 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["SMOOTHING", "derivative"]
+__all__ = ["SMOOTHING", "derivative", "window_frames"]
 
 SMOOTHING = 0.2
 """Seconds of the Savitzky-Golay window (at least 5 frames): a fifth of a second, shorter than any stroke of a
 human movement (K&G §4.3's strokes last a quarter of a second and more)."""
+
+
+def window_frames(fps: float, window: float = SMOOTHING) -> int:
+    """The frames of a Savitzky-Golay window of ``window`` seconds at ``fps``: odd, at least 5."""
+    return max(5, int(round(window * fps)) | 1)
 
 
 def derivative(values: np.ndarray, fps: float, window: float = SMOOTHING) -> np.ndarray:
@@ -31,7 +36,7 @@ def derivative(values: np.ndarray, fps: float, window: float = SMOOTHING) -> np.
     n = len(values)
     if n < 2:
         return np.zeros_like(values)
-    taps = max(5, int(round(window * fps)) | 1)
+    taps = window_frames(fps, window)
     if n >= taps:
         return savgol_filter(values, taps, 2, deriv=1, delta=1.0 / fps, axis=0, mode="interp")
     return np.gradient(values, 1.0 / fps, axis=0)

@@ -60,7 +60,7 @@ import numpy as np
 
 from plugins.lib.compiled import one_thread
 from plugins.lib.root_frame import HeadingFilter, facing_heading, to_root_relative
-from plugins.lib.velocity import SMOOTHING, derivative
+from plugins.lib.velocity import derivative, window_frames
 from plugins.matchers.comparison import Frames, Motion, sequence_size
 from plugins.matchers.decision import Calibrated, Calibration, Decision, Stillness
 from plugins.matchers.pacing import PacedWarping, followed_scores
@@ -200,7 +200,7 @@ class Watched:
         self.body, self.fps, self.comparison = body, float(fps), comparison
         self.root = body.root_index
         self.filter = HeadingFilter(max(1, int(round(FACING * fps))))
-        taps = max(5, int(round(SMOOTHING * fps)) | 1)
+        taps = window_frames(fps)
         self.half = taps // 2
         self.fits = _window_fits(taps, self.fps)
         self.coeffs = self.fits[self.half]
