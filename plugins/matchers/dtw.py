@@ -24,6 +24,18 @@ the segment's own distance to standing still (the root-mean-square distance of
 its frames from their mean pose). Every movement is a ranked candidate
 (``Match.candidates``), by the distance of its nearest example.
 
+What is warped (``features``, a strategy chosen once at ``attach``, :data:`FEATURES`): ``positions`` (the
+default, :class:`Positions`), every part's root-relative position in metres, what most users compare against; or
+the stronger baselines issue 34 measured on real people, :class:`BodyMotion` over the parts named in ``parts``
+(every part: ``[]``), each sequence in its own body size (:func:`plugins.matchers.comparison.sequence_size`):
+``motion``, the parts' root-relative positions and their velocities (a DTW 1-NN "on hip-centred, size-normalised
+positions and velocities of the moving parts", 0.905 on the Kinect actions there); ``velocity``, the velocities
+alone, blind to where a part is held ("on the hands' velocities in the body frame, scaled by body size", 0.97 on
+the hand gestures there, with ``parts = ["left_hand", "right_hand"]``). A velocity is a Savitzky-Golay derivative
+(:func:`plugins.lib.velocity.derivative`) times :data:`plugins.matchers.comparison.HORIZON` seconds, so that it
+counts as a displacement, as in path search's motion comparison. These measure in body sizes, and ``decision =
+"distance"`` takes only ``max_distance = 0`` with them (always the nearest); ``"calibrated"`` any.
+
 Speed (issue 22): with numba installed and no band, :func:`warp_all` warps the
 segment against every template in one compiled call, with dtaidistance's
 arithmetic in dtaidistance's order (the same bits; ``tests/test_dtw_kernel.py``
@@ -38,10 +50,53 @@ from typing import Any
 import numpy as np
 
 from plugins.lib.compiled import compiled
+from plugins.lib.velocity import derivative
+from plugins.matchers.comparison import HORIZON, sequence_size
 from plugins.matchers.decision import Calibrated, Calibration, Decision, Distance
-from toolkit import Match, Matcher, Motion, Parameter, hookimpl
+from toolkit import ConfigError, Match, Matcher, Motion, Parameter, hookimpl
 
-__all__ = ["DTW", "frame_distance", "warp_all"]
+__all__ = ["DTW", "FEATURES", "BodyMotion", "Positions", "frame_distance", "warp_all"]
+
+
+class Positions:
+    """Every part's root-relative position (m), every ``stride``-th frame, flat: what most users compare against."""
+
+    measure = "root-mean-square distance per frame after warping (m)"
+
+    def __init__(self, stride: int) -> None:
+        self.stride = stride
+
+    def series(self, rel: np.ndarray, fps: float) -> np.ndarray:
+        """The series (n', P * 3) of root-relative positions ``rel`` (n, P, 3)."""
+        series = rel[:: self.stride].reshape(-1, rel.shape[1] * 3)
+        if not np.isfinite(series).all():  # nan_to_num changes nothing in a finite series (and costs more than this)
+            series = np.nan_to_num(series)
+        return np.ascontiguousarray(series, dtype=np.double)
+
+
+class BodyMotion(Positions):
+    """The chosen parts' root-relative positions and (or) velocities (times :data:`HORIZON`), over the sequence's
+    body size (see the module): issue 34's baselines on real people."""
+
+    measure = "root-mean-square distance per frame after warping (body sizes)"
+
+    def __init__(self, stride: int, parts: np.ndarray, root: int, *, positions: bool) -> None:
+        super().__init__(stride)
+        self.parts, self.root, self.positions = parts, root, positions
+
+    def series(self, rel: np.ndarray, fps: float) -> np.ndarray:
+        rel = np.nan_to_num(np.asarray(rel, dtype=float))
+        rel = rel - rel[:, self.root : self.root + 1]
+        size = sequence_size(rel, np.ones(rel.shape[:2], dtype=bool))
+        scale = 1.0 / size if size > 0 else 0.0
+        features = [derivative(rel[:, self.parts], fps) * (HORIZON * scale)]
+        if self.positions:
+            features.insert(0, rel[:, self.parts] * scale)
+        return super().series(np.concatenate(features, axis=1), fps)
+
+
+FEATURES = ("positions", "motion", "velocity")
+"""What ``dtw`` may warp (its ``features`` parameter)."""
 
 
 def frame_distance(series: np.ndarray, template: np.ndarray, window: float = 0.0) -> float:
@@ -165,10 +220,6 @@ def _kernel():
     return kernel
 
 
-MEASURE = "root-mean-square distance per frame after warping (m)"
-"""What a match's ``score`` and ``threshold`` are."""
-
-
 class DTW(Matcher):
     """Nearest example by multivariate dynamic time warping (dtaidistance); decides at the segment's end."""
 
@@ -178,6 +229,10 @@ class DTW(Matcher):
                   minimum=1),
         Parameter("window", float, 0.0, "Sakoe-Chiba band as a share of the longer series (0: no band).",
                   minimum=0.0, maximum=1.0),
+        Parameter("features", str, "positions", "What is warped: 'positions', every part's root-relative position (m); "
+                  "'motion', the parts' positions and velocities over body size; 'velocity', their velocities alone "
+                  "(issue 34's baselines on real people).", choices=FEATURES),
+        Parameter("parts", list, [], "The parts 'motion' and 'velocity' compare (empty: every part).", items=str),
         Parameter("decision", str, "distance", "When the nearest template is 'unknown' (plugins.matchers.decision): "
                   "'distance', beyond [matcher.distance] max_distance; 'calibrated', beyond a threshold calibrated on "
                   "the templates themselves ([matcher.calibrated]).", choices=("distance", "calibrated")),
@@ -195,12 +250,22 @@ class DTW(Matcher):
     def attach(self, owner: Any) -> None:
         super().attach(owner)
         root = owner.body.root_index
+        if self.params["features"] != "positions":
+            names = self.params["parts"] or list(owner.body.parts)
+            parts = np.array([owner.body.index(p, key=("parts", i)) for i, p in enumerate(names)], dtype=np.intp)
+            self.features = BodyMotion(self.params["stride"], parts, root,
+                                       positions=self.params["features"] == "motion")
+            if self.params["decision"] == "distance" and self.params["distance"]["max_distance"] > 0:
+                raise ConfigError(f"features = '{self.params['features']}' measures in body sizes, and "
+                                  "max_distance is metres", key=("distance", "max_distance"),
+                                  expected="max_distance = 0 (always the nearest), decision = 'calibrated', or "
+                                           "features = 'positions'")
         examples = owner.motor.examples(fps=30.0)  # the clips of a clip repertoire, else one performance of each
         self.labels = [label for label, _ in examples]
         self.templates = []
         for _, motion in examples:
             positions = motion.filled().positions  # hidden parts held (docs/conventions.md); never seen: 0
-            self.templates.append(self._series(positions - positions[:, root : root + 1]))
+            self.templates.append(self._series(positions - positions[:, root : root + 1], motion.fps))
         seen: set[str] = set()  # each movement's first example is warped in full; its further ones (extras) are
         self._firsts, self._extras = [], []  # abandoned once sure to be farther than the movement's nearest so far
         for i, label in enumerate(self.labels):
@@ -213,7 +278,7 @@ class DTW(Matcher):
             self.decision: Decision = Calibrated(self.params["calibrated"]["known_rejected"])
             self.decision.calibrate(self._calibration())
         else:
-            self.decision = Distance(self.params["distance"]["max_distance"], MEASURE)
+            self.decision = Distance(self.params["distance"]["max_distance"], self.features.measure)
 
     def _calibration(self) -> Calibration:
         """Each template as a segment: against its movement's other templates (leave one take out) and against the
@@ -252,11 +317,13 @@ class DTW(Matcher):
             self._warp_one_by_one(series, templates, prep, lengths, summed)
         return np.sqrt(summed * summed / lengths)  # frame_distance of each template, element by element
 
-    def _series(self, rel: np.ndarray) -> np.ndarray:
-        series = rel[:: self.params["stride"]].reshape(-1, rel.shape[1] * 3)
-        if not np.isfinite(series).all():  # nan_to_num changes nothing in a finite series (and costs more than this)
-            series = np.nan_to_num(series)
-        return np.ascontiguousarray(series, dtype=np.double)
+    @functools.cached_property
+    def features(self) -> Positions:
+        """What is warped (:data:`FEATURES`): set by :meth:`attach`; every part's positions until then."""
+        return Positions(self.params["stride"])
+
+    def _series(self, rel: np.ndarray, fps: float = 30.0) -> np.ndarray:
+        return self.features.series(rel, fps)
 
     def _prepared(self) -> _Prepared:
         """What :meth:`match` needs of the templates, computed once per list of templates (set by :meth:`attach`)."""
@@ -292,7 +359,7 @@ class DTW(Matcher):
         prep = self._prepared()
         # every part seen in every frame: nothing to fill (fill_hidden would copy the same coordinates)
         positions = np.asarray(motion.positions, dtype=float) if motion.visible.all() else motion.filled().positions
-        series = self._series(positions)
+        series = self._series(positions, motion.fps)
         distances = self._distances(series)
         best = int(np.argmin(distances))
         per_frame = float(distances[best])

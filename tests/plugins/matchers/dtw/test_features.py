@@ -1,0 +1,134 @@
+"""What dtw warps (its ``features``): every part's positions, or issue 34's baselines on real people, the parts'
+positions and velocities over body size, or their velocities alone."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+from plugins.matchers.comparison import HORIZON, sequence_size
+from plugins.matchers.dtw import BodyMotion, Positions
+from plugins.lib.velocity import derivative
+from toolkit import ConfigError, load_character
+
+FPS = 30.0
+
+HANDS = """
+[character]
+name = "Hands"
+
+[body]
+parts = ["root", "head", "lk", "rk", "hand"]
+root = "root"
+facing = { left = "lk", right = "rk", forward = "head" }
+
+[motor]
+plugin = "posegraph"
+node_rate = 10.0
+
+[motor.poses.stand]
+root = [0.0, 1.0, 0.0]
+head = [0.0, 1.6, 0.1]
+lk = [0.1, 0.5, 0.0]
+rk = [-0.1, 0.5, 0.0]
+hand = [0.3, 1.0, 0.0]
+
+[motor.poses.out]
+base = "stand"
+hand = [0.45, 1.4, 0.2]
+
+[motor.poses.in]
+base = "stand"
+hand = [0.15, 1.4, 0.2]
+
+[motor.poses.held]
+base = "stand"
+hand = [0.3, 1.4, 0.2]
+
+[motor.poses.up]
+base = "stand"
+hand = [0.3, 1.8, 0.1]
+
+[motor.movements.wave]
+keys = [{ pose = "stand", at = 0.0 }, { pose = "held", at = 0.5 }, { pose = "out", at = 0.7 },
+        { pose = "in", at = 0.95 }, { pose = "out", at = 1.2 }, { pose = "in", at = 1.45 },
+        { pose = "held", at = 1.6 }, { pose = "stand", at = 2.1 }]
+
+[motor.movements.raise]
+keys = [{ pose = "stand", at = 0.0 }, { pose = "up", at = 0.6 }, { pose = "up", at = 1.5 },
+        { pose = "stand", at = 2.1 }]
+"""
+
+LOW_RAISE = """
+[motor.movements.low_raise]
+keys = [{ pose = "stand", at = 0.0 }, { pose = "held", at = 0.5 }, { pose = "held", at = 1.6 },
+        { pose = "stand", at = 2.1 }]
+"""
+
+
+def _observer(write, pm, **params):
+    table = "".join(f"{k} = {v!r}\n".replace("'", '"') for k, v in params.items())
+    return load_character(write("hands.toml", HANDS + f'\n[matcher]\nplugin = "dtw"\nstride = 1\n{table}'), pm)
+
+
+def _low_raise(write, pm):
+    """A raise held where the observer's wave is held (issue 34's low style): the demonstrator's own movement."""
+    demonstrator = load_character(write("demonstrator.toml", HANDS + LOW_RAISE), pm)
+    return demonstrator.motor.perform("low_raise", fps=FPS).root_relative(demonstrator.body.root)
+
+
+@pytest.mark.parametrize(("features", "answer"), [("positions", "wave"), ("velocity", "raise")])
+def test_a_raise_held_where_a_wave_is_held_is_a_raise_only_to_the_velocities(write, pm, features, answer):
+    """Positions see where the hand is held, the wave's place; velocities see the hand lift and stay, a raise."""
+    observer = _observer(write, pm, features=features)
+    assert observer.matcher.match(_low_raise(write, pm)).movement == answer
+
+
+def test_the_parts_compared_are_named_and_an_unknown_one_is_a_clear_error(write, pm):
+    observer = _observer(write, pm, features="velocity", parts=["hand"])
+    assert observer.matcher.features.parts.tolist() == [observer.body.index("hand")]
+    assert observer.matcher.match(_low_raise(write, pm)).movement == "raise"
+    with pytest.raises(ConfigError, match="unknown body part 'wrist'") as error:
+        _observer(write, pm, features="velocity", parts=["hand", "wrist"])
+    assert "hand" in str(error.value)
+
+
+def test_a_distance_in_metres_is_refused_for_features_in_body_sizes(write, pm):
+    with pytest.raises(ConfigError, match="max_distance"):
+        load_character(write("hands.toml", HANDS + '\n[matcher]\nplugin = "dtw"\nfeatures = "motion"\n'
+                                                   "[matcher.distance]\nmax_distance = 0.2\n"), pm)
+
+
+poses = arrays(np.float64, (12, 4, 3), elements=st.floats(-1.0, 1.0))
+
+
+@settings(max_examples=50, deadline=None)
+@given(poses, st.floats(0.3, 3.0), arrays(np.float64, (3,), elements=st.floats(-1.0, 1.0)))
+def test_motion_is_in_body_sizes_and_velocity_blind_to_where_a_part_is_held(rel, scale, offset):
+    """A body ``scale`` times as big moving alike has the same series; a part held elsewhere throughout changes
+    its positions, never its velocities."""
+    rel = rel - rel[:, :1]
+    parts = np.arange(4)
+    motion, velocity = (BodyMotion(1, parts, 0, positions=p) for p in (True, False))
+    np.testing.assert_allclose(motion.series(rel * scale, FPS), motion.series(rel, FPS), atol=1e-9)
+    moved = rel.copy()
+    moved[:, 2] += offset
+    size, moved_size = (sequence_size(x, np.ones(x.shape[:2], dtype=bool)) for x in (rel, moved))
+    if size > 1e-6 and moved_size > 1e-6:
+        np.testing.assert_allclose(velocity.series(moved, FPS) * moved_size, velocity.series(rel, FPS) * size,
+                                   atol=1e-9)
+
+
+def test_each_frame_is_the_positions_then_the_velocities_times_the_horizon_over_the_body_size():
+    rng = np.random.default_rng(3)
+    rel = rng.normal(size=(20, 4, 3))
+    rel[:, 0] = 0.0
+    size = sequence_size(rel, np.ones((20, 4), dtype=bool))
+    parts = np.array([1, 3])
+    got = BodyMotion(2, parts, 0, positions=True).series(rel, FPS)
+    expected = np.concatenate([rel[:, parts] / size, derivative(rel, FPS)[:, parts] * HORIZON / size], axis=1)
+    np.testing.assert_allclose(got, expected[::2].reshape(10, -1))
+    assert Positions(2).series(rel, FPS).tolist() == rel[::2].reshape(10, -1).tolist()
