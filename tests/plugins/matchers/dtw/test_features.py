@@ -12,45 +12,17 @@ from hypothesis.extra.numpy import arrays
 from plugins.matchers.comparison import HORIZON, sequence_size
 from plugins.matchers.dtw import BodyMotion, Positions
 from plugins.lib.velocity import derivative
+from tests.plugins.matchers.path_search.stick import STICK
 from toolkit import ConfigError, load_character
 
 FPS = 30.0
 
-HANDS = """
-[character]
-name = "Hands"
-
-[body]
-parts = ["root", "head", "lk", "rk", "hand"]
-root = "root"
-facing = { left = "lk", right = "rk", forward = "head" }
-
-[motor]
-plugin = "posegraph"
-node_rate = 10.0
-
-[motor.poses.stand]
-root = [0.0, 1.0, 0.0]
-head = [0.0, 1.6, 0.1]
-lk = [0.1, 0.5, 0.0]
-rk = [-0.1, 0.5, 0.0]
-hand = [0.3, 1.0, 0.0]
-
-[motor.poses.out]
-base = "stand"
-hand = [0.45, 1.4, 0.2]
-
-[motor.poses.in]
-base = "stand"
-hand = [0.15, 1.4, 0.2]
-
-[motor.poses.held]
-base = "stand"
-hand = [0.3, 1.4, 0.2]
-
-[motor.poses.up]
-base = "stand"
-hand = [0.3, 1.8, 0.1]
+HANDS = STICK[: STICK.index("[motor.poses.up]")].replace("Stick", "Hands") + """
+[motor.poses]
+out = { base = "stand", hand = [0.45, 1.4, 0.2] }
+in = { base = "stand", hand = [0.15, 1.4, 0.2] }
+held = { base = "stand", hand = [0.3, 1.4, 0.2] }
+up = { base = "stand", hand = [0.3, 1.8, 0.1] }
 
 [motor.movements.wave]
 keys = [{ pose = "stand", at = 0.0 }, { pose = "held", at = 0.5 }, { pose = "out", at = 0.7 },
