@@ -75,19 +75,20 @@ class Positions:
 
 
 class BodyMotion(Positions):
-    """The chosen parts' root-relative positions and (or) velocities (times :data:`HORIZON`), over the sequence's
-    body size (see the module): issue 34's baselines on real people."""
+    """The chosen ``parts``' root-relative positions and (or) velocities (times :data:`HORIZON`), over the sequence's
+    body size, the size of its ``sized`` parts (the position parts; see the module): issue 34's baselines on real
+    people."""
 
     measure = "root-mean-square distance per frame after warping (body sizes)"
 
-    def __init__(self, stride: int, parts: np.ndarray, root: int, *, positions: bool) -> None:
+    def __init__(self, stride: int, parts: np.ndarray, root: int, sized: np.ndarray, *, positions: bool) -> None:
         super().__init__(stride)
-        self.parts, self.root, self.positions = parts, root, positions
+        self.parts, self.root, self.sized, self.positions = parts, root, sized, positions
 
     def series(self, rel: np.ndarray, fps: float) -> np.ndarray:
         rel = np.nan_to_num(np.asarray(rel, dtype=float))
-        rel = rel - rel[:, self.root : self.root + 1]
-        size = sequence_size(rel, np.ones(rel.shape[:2], dtype=bool))
+        rel[:, self.sized] = rel[:, self.sized] - rel[:, self.root : self.root + 1]
+        size = sequence_size(rel[:, self.sized], np.ones((len(rel), len(self.sized)), dtype=bool))
         scale = 1.0 / size if size > 0 else 0.0
         features = [derivative(rel[:, self.parts], fps) * (HORIZON * scale)]
         if self.positions:
@@ -251,9 +252,15 @@ class DTW(Matcher):
         super().attach(owner)
         root = owner.body.root_index
         if self.params["features"] != "positions":
-            names = self.params["parts"] or list(owner.body.parts)
-            parts = np.array([owner.body.index(p, key=("parts", i)) for i, p in enumerate(names)], dtype=np.intp)
-            self.features = BodyMotion(self.params["stride"], parts, root,
+            body = owner.body
+            positional = [p for p, angle in zip(body.parts, body.angle_mask) if not angle]
+            names = self.params["parts"] or positional
+            parts = np.array([body.index(p, key=("parts", i)) for i, p in enumerate(names)], dtype=np.intp)
+            if body.angle_mask[parts].any():
+                raise ConfigError(f"{names[int(np.argmax(body.angle_mask[parts]))]!r} is a finger's joint "
+                                  "angle, not a position", key=("parts",), expected="position parts",
+                                  available=positional)
+            self.features = BodyMotion(self.params["stride"], parts, root, body.indices(positional),
                                        positions=self.params["features"] == "motion")
             if self.params["decision"] == "distance" and self.params["distance"]["max_distance"] > 0:
                 raise ConfigError(f"features = '{self.params['features']}' measures in body sizes, and "

@@ -84,7 +84,7 @@ def test_motion_is_in_body_sizes_and_velocity_blind_to_where_a_part_is_held(rel,
     its positions, never its velocities."""
     rel = rel - rel[:, :1]
     parts = np.arange(4)
-    motion, velocity = (BodyMotion(1, parts, 0, positions=p) for p in (True, False))
+    motion, velocity = (BodyMotion(1, parts, 0, parts, positions=p) for p in (True, False))
     np.testing.assert_allclose(motion.series(rel * scale, FPS), motion.series(rel, FPS), atol=1e-9)
     moved = rel.copy()
     moved[:, 2] += offset
@@ -100,7 +100,26 @@ def test_each_frame_is_the_positions_then_the_velocities_times_the_horizon_over_
     rel[:, 0] = 0.0
     size = sequence_size(rel, np.ones((20, 4), dtype=bool))
     parts = np.array([1, 3])
-    got = BodyMotion(2, parts, 0, positions=True).series(rel, FPS)
+    got = BodyMotion(2, parts, 0, np.arange(4), positions=True).series(rel, FPS)
     expected = np.concatenate([rel[:, parts] / size, derivative(rel, FPS)[:, parts] * HORIZON / size], axis=1)
     np.testing.assert_allclose(got, expected[::2].reshape(10, -1))
     assert Positions(2).series(rel, FPS).tolist() == rel[::2].reshape(10, -1).tolist()
+
+
+def test_a_fingers_joint_angle_is_neither_compared_nor_sized_as_a_position(write, pm):
+    """A finger is a joint angle (docs/formats.md): not among the parts compared by default, an error when named,
+    and left out of the body size and of the root's subtraction."""
+    fingered = HANDS.replace('"hand"]', '"hand", "index"]')
+    fingered = fingered.replace("[motor]", '[body.hands.right]\nwrist = "hand"\nfingers = ["index"]\n\n[motor]')
+    fingered = fingered.replace('hand = [0.3, 1.0, 0.0]', 'hand = [0.3, 1.0, 0.0]\nindex = [0.2, 0.0, 0.0]')
+    table = '\n[matcher]\nplugin = "dtw"\nfeatures = "motion"\n'
+    observer = load_character(write("fingered.toml", fingered + table), pm)
+    features = observer.matcher.features
+    assert features.parts.tolist() == features.sized.tolist() == [0, 1, 2, 3, 4]
+    rel = np.random.default_rng(1).normal(size=(8, 6, 3))
+    bent = rel.copy()
+    bent[:, 5] *= 3.0  # the finger bent further: nothing compared changes
+    assert features.series(bent, FPS).tolist() == features.series(rel, FPS).tolist()
+    with pytest.raises(ConfigError, match="'index' is a finger's joint angle") as error:
+        load_character(write("fingered.toml", fingered + table + 'parts = ["hand", "index"]\n'), pm)
+    assert "available" in str(error.value) and "index" not in str(error.value).split("available")[1]
