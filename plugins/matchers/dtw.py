@@ -251,22 +251,7 @@ class DTW(Matcher):
     def attach(self, owner: Any) -> None:
         super().attach(owner)
         root = owner.body.root_index
-        if self.params["features"] != "positions":
-            body = owner.body
-            positional = [p for p, angle in zip(body.parts, body.angle_mask) if not angle]
-            names = self.params["parts"] or positional
-            parts = np.array([body.index(p, key=("parts", i)) for i, p in enumerate(names)], dtype=np.intp)
-            if body.angle_mask[parts].any():
-                raise ConfigError(f"{names[int(np.argmax(body.angle_mask[parts]))]!r} is a finger's joint "
-                                  "angle, not a position", key=("parts",), expected="position parts",
-                                  available=positional)
-            self.features = BodyMotion(self.params["stride"], parts, root, body.indices(positional),
-                                       positions=self.params["features"] == "motion")
-            if self.params["decision"] == "distance" and self.params["distance"]["max_distance"] > 0:
-                raise ConfigError(f"features = '{self.params['features']}' measures in body sizes, and "
-                                  "max_distance is metres", key=("distance", "max_distance"),
-                                  expected="max_distance = 0 (always the nearest), decision = 'calibrated', or "
-                                           "features = 'positions'")
+        self.features = self._chosen_features(owner.body)
         examples = owner.motor.examples(fps=30.0)  # the clips of a clip repertoire, else one performance of each
         self.labels = [label for label, _ in examples]
         self.templates = []
@@ -286,6 +271,24 @@ class DTW(Matcher):
             self.decision.calibrate(self._calibration())
         else:
             self.decision = Distance(self.params["distance"]["max_distance"], self.features.measure)
+
+    def _chosen_features(self, body: Any) -> Positions:
+        """The strategy ``features`` names (:data:`FEATURES`) for ``body``, its ``parts`` and decision checked."""
+        if self.params["features"] == "positions":
+            return Positions(self.params["stride"])
+        positional = [p for p, angle in zip(body.parts, body.angle_mask) if not angle]
+        names = self.params["parts"] or positional
+        parts = np.array([body.index(p, key=("parts", i)) for i, p in enumerate(names)], dtype=np.intp)
+        if body.angle_mask[parts].any():
+            raise ConfigError(f"{names[int(np.argmax(body.angle_mask[parts]))]!r} is a finger's joint angle, not a "
+                              "position", key=("parts",), expected="position parts", available=positional)
+        if self.params["decision"] == "distance" and self.params["distance"]["max_distance"] > 0:
+            raise ConfigError(f"features = '{self.params['features']}' measures in body sizes, and max_distance is "
+                              "metres", key=("distance", "max_distance"),
+                              expected="max_distance = 0 (always the nearest), decision = 'calibrated', or "
+                                       "features = 'positions'")
+        return BodyMotion(self.params["stride"], parts, body.root_index, body.indices(positional),
+                          positions=self.params["features"] == "motion")
 
     def _calibration(self) -> Calibration:
         """Each template as a segment: against its movement's other templates (leave one take out) and against the
