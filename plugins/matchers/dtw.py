@@ -27,7 +27,7 @@ its frames from their mean pose). Every movement is a ranked candidate
 What is warped (``features``, a strategy chosen once at ``attach``, :data:`FEATURES`): ``positions`` (the
 default, :class:`Positions`), every part's root-relative position in metres, what most users compare against; or
 the stronger baselines issue 34 measured on real people, :class:`BodyMotion` over the parts named in ``parts``
-(every part: ``[]``), each sequence in its own body size (:func:`plugins.matchers.comparison.sequence_size`):
+(every position part: ``[]``), each sequence in its own body size (:func:`plugins.matchers.comparison.sequence_size`):
 ``motion``, the parts' root-relative positions and their velocities (a DTW 1-NN "on hip-centred, size-normalised
 positions and velocities of the moving parts", 0.905 on the Kinect actions there); ``velocity``, the velocities
 alone, blind to where a part is held ("on the hands' velocities in the body frame, scaled by body size", 0.97 on
@@ -233,7 +233,8 @@ class DTW(Matcher):
         Parameter("features", str, "positions", "What is warped: 'positions', every part's root-relative position (m); "
                   "'motion', the parts' positions and velocities over body size; 'velocity', their velocities alone "
                   "(issue 34's baselines on real people).", choices=FEATURES),
-        Parameter("parts", list, [], "The parts 'motion' and 'velocity' compare (empty: every part).", items=str),
+        Parameter("parts", list, [], "The parts 'motion' and 'velocity' compare (empty: every position part; a "
+                  "finger's joint angle is not one).", items=str),
         Parameter("decision", str, "distance", "When the nearest template is 'unknown' (plugins.matchers.decision): "
                   "'distance', beyond [matcher.distance] max_distance; 'calibrated', beyond a threshold calibrated on "
                   "the templates themselves ([matcher.calibrated]).", choices=("distance", "calibrated")),
