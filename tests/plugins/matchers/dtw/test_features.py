@@ -85,13 +85,13 @@ def test_motion_is_in_body_sizes_and_velocity_blind_to_where_a_part_is_held(rel,
     rel = rel - rel[:, :1]
     parts = np.arange(4)
     motion, velocity = (BodyMotion(1, parts, 0, parts, positions=p) for p in (True, False))
-    np.testing.assert_allclose(motion.series(rel * scale, FPS), motion.series(rel, FPS), atol=1e-9)
+    np.testing.assert_allclose(motion.series(rel * scale, FPS), motion.series(rel, FPS), rtol=1e-7, atol=1e-9)
     moved = rel.copy()
     moved[:, 2] += offset
     size, moved_size = (sequence_size(x, np.ones(x.shape[:2], dtype=bool)) for x in (rel, moved))
     if size > 1e-6 and moved_size > 1e-6:
         np.testing.assert_allclose(velocity.series(moved, FPS) * moved_size, velocity.series(rel, FPS) * size,
-                                   atol=1e-9)
+                                   rtol=1e-7, atol=1e-9)
 
 
 def test_each_frame_is_the_positions_then_the_velocities_times_the_horizon_over_the_body_size():
