@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from plugins.lib.gaps import bridged
-from plugins.lib.jitter import jitter_variance
+from plugins.lib.jitter import jitter_about_root
 from plugins.lib.lowpass import low_passed
 from plugins.lib.pose_distance import pose_distance
 from plugins.lib.root_frame import RecordingFacing, root_relative
@@ -50,7 +50,7 @@ __all__ = ["Clip", "ClipRepertoire", "load_clip_repertoire", "clip_repertoire", 
 class Clip:
     """One example of a movement: its label, file (or name, built in memory) and local-frame motion (root at hub
     height; its world positions in :attr:`Motion.world`); ``jitter``: each part's jitter about the root as the file
-    gave it, before the low-pass, as a variance per axis (m^2, (P,); :func:`plugins.lib.jitter.jitter_variance`),
+    gave it, before the low-pass, as a variance per axis (m^2, (P,); :func:`plugins.lib.jitter.jitter_about_root`),
     ``None`` where not measured."""
 
     movement: str
@@ -105,20 +105,6 @@ def root_relative_motion(world: Motion, body: Body, facing_window: float = 1.0) 
     window = max(1, int(round(facing_window * world.fps)))
     pose, mask, _, _ = root_relative(smooth.positions, smooth.visible, body, RecordingFacing(window))
     return Motion(pose, world.fps, world.parts, mask, smooth.positions).filled()
-
-
-def clip_jitter(world: Motion, body: Body) -> np.ndarray:
-    """Each part's jitter about the root in a clip's world positions as given (:func:`plugins.lib.jitter.
-    jitter_variance`: variance per axis, m^2, (P,)): the tracker's, which the low-pass of
-    :func:`root_relative_motion` then reduces (:func:`plugins.lib.jitter.feature_noise`). Turning the positions
-    into the body's frame does not change a variance, and the facing turns slowly. A joint angle (a finger's) is not
-    a position: 0."""
-    root = body.root_index
-    positions = np.asarray(world.positions, dtype=float)
-    seen = np.asarray(world.visible, dtype=bool) & np.isfinite(positions).all(axis=-1)
-    jitter = jitter_variance(positions - positions[:, root : root + 1], seen & seen[:, root : root + 1], world.fps)
-    jitter[np.asarray(body.angle_mask, dtype=bool)] = 0.0
-    return jitter
 
 
 PAIR_BLOCK = 2**22
@@ -200,7 +186,7 @@ def clip_repertoire(motions: Sequence[Motion], labels: Sequence[str], profile: s
             sources.append(example_name(label, counts.get(label, 0)))
             counts[label] = counts.get(label, 0) + 1
     rel: list[tuple[str, Path | str, Motion]] = []
-    jitters = [clip_jitter(world, profile.body) for world in motions]
+    jitters = [jitter_about_root(world.positions, world.visible, world.fps, profile.body) for world in motions]
     for movement, source, world in zip(labels, sources, motions):
         where = {"file": source} if isinstance(source, Path) else {"key": ("clips", str(source))}
         if tuple(world.parts) != tuple(profile.body.parts):

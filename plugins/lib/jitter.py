@@ -28,7 +28,7 @@ import numpy as np
 
 from toolkit import Motion
 
-__all__ = ["feature_noise", "jitter_variance"]
+__all__ = ["feature_noise", "jitter_about_root", "jitter_variance"]
 
 _CHI2_3_MEDIAN = 2.3660
 """The median of a chi-square variable with three degrees of freedom (its mean is 3): a Gaussian jitter's squared
@@ -87,6 +87,19 @@ def jitter_variance(positions: np.ndarray, seen: np.ndarray, fps: float) -> np.n
     for j, part in enumerate(measured):
         out[part] = np.median(square[whole[:, part], j]) / scale
     return out
+
+
+def jitter_about_root(positions: np.ndarray, visible: np.ndarray, fps: float, body) -> np.ndarray:
+    """Each part's jitter about the ``body``'s root (:func:`jitter_variance`: variance per axis, m^2, (P,)) in
+    ``positions`` (n, P, 3) seen where ``visible`` (n, P) and finite: what a clip's file or a watched segment gives,
+    before anything smooths it. Turning the positions into the body's frame does not change a variance, and the
+    facing turns slowly. A joint angle (a finger's) is not a position: 0."""
+    positions = np.asarray(positions, dtype=float)
+    seen = np.asarray(visible, dtype=bool) & np.isfinite(positions).all(axis=-1)
+    root = body.root_index
+    jitter = jitter_variance(positions - positions[:, root : root + 1], seen & seen[:, root : root + 1], fps)
+    jitter[np.asarray(body.angle_mask, dtype=bool)] = 0.0
+    return jitter
 
 
 def feature_noise(variance: np.ndarray, fps: float, frames: int, low_passed: bool = False) -> np.ndarray:

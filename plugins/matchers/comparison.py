@@ -51,7 +51,7 @@ import numpy as np
 
 from plugins.lib.body_size import body_scale
 from plugins.lib.compiled import kernel
-from plugins.lib.jitter import feature_noise, jitter_variance
+from plugins.lib.jitter import feature_noise, jitter_about_root
 from plugins.lib.root_frame import RecordingFacing, root_relative
 from plugins.lib.travel import body_velocity, turned
 from plugins.lib.velocity import derivative
@@ -561,10 +561,8 @@ class Motion(Comparison):
         relative = np.where(seen[..., None], positions, 0.0)
         root = body.root_index
         held = _held(relative, seen)
-        about_root = held - held[:, root : root + 1]
-        velocity = derivative(about_root, motion.fps)[rows]
-        noise = feature_noise(jitter_variance(about_root, seen & seen[:, root : root + 1], motion.fps), motion.fps,
-                              motion.n_frames)
+        velocity = derivative(held - held[:, root : root + 1], motion.fps)[rows]
+        noise = feature_noise(jitter_about_root(relative, seen, motion.fps, body), motion.fps, motion.n_frames)
         return self.frames(held[rows], seen[rows], fps, velocity=velocity, travel=travel, heading=heading,
                            size=sequence_size(relative, seen), noise=noise)
 
