@@ -167,6 +167,11 @@ def _arm(shoulder: np.ndarray, wrist: np.ndarray, p: Performer, sign: float) -> 
                                                                    1e-9)
 
 
+def _rest(p: Performer, sign: float) -> np.ndarray:
+    """Where ``p``'s wrist hangs at rest relative to its shoulder (m), on the arm's own side (``sign``)."""
+    return np.array([sign * (_REST[0] + p.rest_out), _REST[1], _REST[2]]) * ((p.upper_arm + p.forearm) * p.size)
+
+
 def gesture(movement: str, style: Style, p: Performer, rng: np.random.Generator, *, vary: float = 0.04) -> np.ndarray:
     """One take (frames, 20, 3), in the body's frame: ``movement`` of :data:`MOVEMENTS` in ``style`` by ``p``; every
     duration, place and swing varied by about ``vary`` (a take recorded after another differs by a few percent)."""
@@ -206,7 +211,7 @@ def gesture(movement: str, style: Style, p: Performer, rng: np.random.Generator,
         # the shoulder rises a little as the hand goes above it
         shoulder[:, 1] += 0.015 * s * level * (held_place[1] > 0.3)
         q[:, _J[f"Shoulder{name}"]] = shoulder
-        rest = np.array([sign * (_REST[0] + p.rest_out), _REST[1], _REST[2]]) * reach
+        rest = _rest(p, sign)
         held = np.array([sign * held_place[0], held_place[1], held_place[2]]) * reach * jitter(1.0)
         path = rest + level[:, None] * (held - rest)
         path[:, 2] += 0.2 * reach * np.sin(np.pi * np.clip(level, 0, 1))  # the hand passes in front of the body
@@ -224,10 +229,9 @@ def gesture(movement: str, style: Style, p: Performer, rng: np.random.Generator,
             _arm(shoulder, shoulder + path, p, sign), axis=1)
     for side, sign in (("Left", 1.0), ("Right", -1.0)):
         if side.lower() not in sides:  # the other arm hangs at rest
-            rest = np.array([sign * (_REST[0] + p.rest_out), _REST[1], _REST[2]]) * reach
             shoulder = q[:, _J[f"Shoulder{side}"]]
             q[:, [_J[f"Elbow{side}"], _J[f"Wrist{side}"], _J[f"Hand{side}"]]] = np.stack(
-                _arm(shoulder, shoulder + rest, p, sign), axis=1)
+                _arm(shoulder, shoulder + _rest(p, sign), p, sign), axis=1)
     upper = [_J[n] for n in _UPPER]
     q[:, upper, 0] += rock[:, None] * (q[:, upper, 1] - q[:, _J["HipCenter"], 1][:, None]) / (0.4 * s)
     return q
