@@ -55,7 +55,7 @@ from plugins.matchers.comparison import HORIZON, sequence_size
 from plugins.matchers.decision import Calibrated, Calibration, Decision, Distance
 from toolkit import ConfigError, Match, Matcher, Motion, Parameter, hookimpl
 
-__all__ = ["DTW", "FEATURES", "BodyMotion", "Positions", "frame_distance", "warp_all"]
+__all__ = ["DTW", "FEATURES", "BodyMotion", "Grouped", "Positions", "frame_distance", "position_parts", "warp_all"]
 
 
 class Positions:
@@ -94,6 +94,19 @@ class BodyMotion(Positions):
         if self.positions:
             features.insert(0, rel[:, self.parts] * scale)
         return super().series(np.concatenate(features, axis=1), fps)
+
+
+def position_parts(body: Any, names: list[str]) -> tuple[np.ndarray, np.ndarray]:
+    """The indices of the parts ``names`` (a matcher's ``parts`` parameter; empty: every position part) and of every
+    position part of ``body`` (what a body size is measured on). A finger's joint angle is not a position: naming one
+    is a :class:`~toolkit.ConfigError` that lists the position parts, as is naming a part the body lacks."""
+    positional = [p for p, angle in zip(body.parts, body.angle_mask) if not angle]
+    names = names or positional
+    parts = np.array([body.index(p, key=("parts", i)) for i, p in enumerate(names)], dtype=np.intp)
+    if body.angle_mask[parts].any():
+        raise ConfigError(f"{names[int(np.argmax(body.angle_mask[parts]))]!r} is a finger's joint angle, not a "
+                          "position", key=("parts",), expected="position parts", available=positional)
+    return parts, body.indices(positional)
 
 
 FEATURES = ("positions", "motion", "velocity")
@@ -264,31 +277,34 @@ class DTW(Matcher):
         for i, label in enumerate(self.labels):
             (self._extras if label in seen else self._firsts).append(i)
             seen.add(label)
-        import dtaidistance.dtw_ndim  # noqa: F401  loaded when the observer is composed, not at the first match
+        self._compile()
+        self.decision = self._chosen_decision()
+
+    def _compile(self) -> None:
+        """Load and compile what :meth:`match` calls, when the observer is composed rather than at the first match."""
+        import dtaidistance.dtw_ndim  # noqa: F401
 
         _kernel()
+
+    def _chosen_decision(self) -> Decision:
+        """The decision ``decision`` names, calibrated on the templates where it is ``calibrated``."""
         if self.params["decision"] == "calibrated":
-            self.decision: Decision = Calibrated(self.params["calibrated"]["known_rejected"])
-            self.decision.calibrate(self._calibration())
-        else:
-            self.decision = Distance(self.params["distance"]["max_distance"], self.features.measure)
+            decision = Calibrated(self.params["calibrated"]["known_rejected"])
+            decision.calibrate(self._calibration())
+            return decision
+        return Distance(self.params["distance"]["max_distance"], self.features.measure)
 
     def _chosen_features(self, body: Any) -> Positions:
         """The strategy ``features`` names (:data:`FEATURES`) for ``body``, its ``parts`` and decision checked."""
         if self.params["features"] == "positions":
             return Positions(self.params["stride"])
-        positional = [p for p, angle in zip(body.parts, body.angle_mask) if not angle]
-        names = self.params["parts"] or positional
-        parts = np.array([body.index(p, key=("parts", i)) for i, p in enumerate(names)], dtype=np.intp)
-        if body.angle_mask[parts].any():
-            raise ConfigError(f"{names[int(np.argmax(body.angle_mask[parts]))]!r} is a finger's joint angle, not a "
-                              "position", key=("parts",), expected="position parts", available=positional)
+        parts, sized = position_parts(body, self.params["parts"])
         if self.params["decision"] == "distance" and self.params["distance"]["max_distance"] > 0:
             raise ConfigError(f"features = '{self.params['features']}' measures in body sizes, and max_distance is "
                               "metres", key=("distance", "max_distance"),
                               expected="max_distance = 0 (always the nearest), decision = 'calibrated', or "
                                        "features = 'positions'")
-        return BodyMotion(self.params["stride"], parts, body.root_index, body.indices(positional),
+        return BodyMotion(self.params["stride"], parts, body.root_index, sized,
                           positions=self.params["features"] == "motion")
 
     def _calibration(self) -> Calibration:
@@ -298,7 +314,7 @@ class DTW(Matcher):
         labels = np.array(self.labels, dtype=object)
         for i, series in enumerate(self.templates):
             distances = self._distances(series)
-            still = _still(series)
+            still = self._still(series)
             mine = labels == labels[i]
             mine_others = mine.copy()
             mine_others[i] = False
@@ -340,8 +356,17 @@ class DTW(Matcher):
         """What :meth:`match` needs of the templates, computed once per list of templates (set by :meth:`attach`)."""
         prepared = getattr(self, "_prep", None)
         if prepared is None or prepared.templates is not self.templates or prepared.labels is not self.labels:
-            prepared = self._prep = _Prepared(self.templates, self.labels, self._firsts, self._extras)
+            prepared = self._prep = self._prepare()
         return prepared
+
+    def _prepare(self) -> _Prepared:
+        """The templates prepared for :meth:`match` (:meth:`_prepared` keeps them until the templates change)."""
+        return _Prepared(self.templates, self.labels, self._firsts, self._extras)
+
+    def _still(self, series: np.ndarray) -> float:
+        """A series' distance to standing still, in the unit of :meth:`_distances` (what a relative decision
+        divides by)."""
+        return _still(series)
 
     def _warp_one_by_one(self, series: np.ndarray, templates: list[np.ndarray], prep: _Prepared,
                          lengths: np.ndarray, summed: np.ndarray) -> None:
@@ -375,7 +400,7 @@ class DTW(Matcher):
         best = int(np.argmin(distances))
         per_frame = float(distances[best])
         label = prep.labels[best]
-        verdict = self.decision.decide(label, per_frame, _still(series) if self.decision.relative else 1.0)
+        verdict = self.decision.decide(label, per_frame, self._still(series) if self.decision.relative else 1.0)
         measure = self.decision.measure
         if verdict.movement is None:
             return Match.unknown("too far from every example", nearest=label, score=verdict.score,
@@ -398,26 +423,35 @@ def _still(series: np.ndarray) -> float:
     return float(np.sqrt(((series - series.mean(axis=0)) ** 2).sum(axis=1).mean())) if len(series) else 0.0
 
 
-class _Prepared:
-    """The templates as :meth:`DTW.match` uses them, computed once: their sizes, the coordinates that are 0 in all
-    of them (``dropped``; ``None`` if none) with the templates without them (``reduced``), and the examples
-    grouped by movement (``order``, ``starts``, ``names``: the movements sorted by name, for
-    :func:`numpy.minimum.reduceat`)."""
+class Grouped:
+    """Templates grouped by movement, for :meth:`DTW.match`'s ranking: the movements sorted by name (``names``), the
+    templates in that order (``order``) and where each movement's begin (``starts``), for
+    :func:`numpy.minimum.reduceat`; ``slot`` the place of each movement among ``names``."""
 
-    def __init__(self, templates: list[np.ndarray], labels: list[str], firsts: list[int], extras: list[int]):
-        self.templates, self.labels, self.firsts, self.extras = templates, labels, list(firsts), list(extras)
-        self.sizes = np.array([len(t) for t in templates], dtype=float)
-        self.no_band = [None] * len(templates)
-        zero = np.logical_and.reduce([~t.any(axis=0) for t in templates]) if templates else np.zeros(0, bool)
-        self.dropped = np.flatnonzero(zero) if zero.any() and not zero.all() else None
-        self.kept = np.flatnonzero(~zero)
-        self.reduced = [np.ascontiguousarray(t[:, self.kept]) for t in templates]
+    def __init__(self, templates: list, labels: list[str]):
+        self.templates, self.labels = templates, labels
         names = np.array(labels, dtype=object)
         self.order = np.argsort(names, kind="stable")
         sorted_names = names[self.order]
         self.starts = np.flatnonzero(np.r_[True, sorted_names[1:] != sorted_names[:-1]])
         self.names = sorted_names[self.starts]
         self.slot = {name: i for i, name in enumerate(self.names.tolist())}
+
+
+class _Prepared(Grouped):
+    """The templates as :meth:`DTW.match` uses them, computed once: their sizes, the coordinates that are 0 in all
+    of them (``dropped``; ``None`` if none) with the templates without them (``reduced``), and the examples
+    grouped by movement (:class:`Grouped`)."""
+
+    def __init__(self, templates: list[np.ndarray], labels: list[str], firsts: list[int], extras: list[int]):
+        super().__init__(templates, labels)
+        self.firsts, self.extras = list(firsts), list(extras)
+        self.sizes = np.array([len(t) for t in templates], dtype=float)
+        self.no_band = [None] * len(templates)
+        zero = np.logical_and.reduce([~t.any(axis=0) for t in templates]) if templates else np.zeros(0, bool)
+        self.dropped = np.flatnonzero(zero) if zero.any() and not zero.all() else None
+        self.kept = np.flatnonzero(~zero)
+        self.reduced = [np.ascontiguousarray(t[:, self.kept]) for t in templates]
         self._columns: dict[bool, tuple[np.ndarray, np.ndarray]] = {}
 
     def columns(self, reduced: bool) -> tuple[np.ndarray, np.ndarray]:
