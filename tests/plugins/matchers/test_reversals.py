@@ -1,4 +1,4 @@
-"""A part's path cut into strokes where it turns back (plugins.lib.reversals)."""
+"""A part's path cut into strokes where it turns back (plugins.matchers.reversals)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from plugins.lib.reversals import _zigzag, reversal_strokes
+from plugins.matchers.reversals import _zigzag, reversal_strokes
 
 FPS = 30.0
 

@@ -1,0 +1,209 @@
+"""Matcher ``stroke-warping``: the nearest example by warping each part's sequence of strokes (issue 34, real people).
+
+Kopp & Graeser 2006 (§4.1, §4.3) represent a movement as guiding strokes, not as the frames that trace them; a
+wave of the hand is a stroke up to where the hand is held, the swings, and a stroke down. This matcher compares
+movements so: each part's root-relative path, in the sequence's own body size
+(:func:`plugins.matchers.comparison.sequence_size`), is cut into strokes where it turns back
+(:func:`plugins.matchers.reversals.reversal_strokes`), and the demonstration's strokes are warped onto each example's,
+part by part (:func:`warp_strokes`). What that sees, and what it does not:
+
+- *how a part moves*: the swings of a wave against the single stroke up and down of a raise, which positions (eq. 1)
+  barely tell apart where the hand is held at the same height;
+- *not the tempo*: strokes have no duration, so a performance four times slower or faster than every example is
+  the same strokes;
+- *not the number of swings*: a stroke of one sequence may stand for several like it in the other (time warping's
+  repeated steps), so seven swings match four;
+- *not a stroke cut in two*: up to ``merge`` successive strokes of one sequence may stand for one of the other, at
+  the length the path lost by the merge (two strokes in one direction merge for free, a swing and its return
+  do not: they cost what they lose).
+
+The distance of two sequences is, summed over the parts, the length of stroke left unexplained along the best
+alignment (:func:`warp_strokes`), in body sizes; a part with no strokes in one sequence leaves all the other's
+unexplained. Its distance to standing still is the total length of its strokes (:meth:`StrokeWarping._still`).
+The decision is the matchers' shared one (:mod:`plugins.matchers.decision`): ``calibrated`` (the default) on the
+examples themselves, its score the share of the demonstration's stroke length the nearest example leaves
+unexplained; ``nearest`` never says "unknown" (a 1-NN classifier).
+
+Everything else is :class:`plugins.matchers.dtw.DTW`'s: every example of every movement is a template, each
+movement a ranked candidate by its nearest example, the decision at the segment's end.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from plugins.lib.compiled import kernel
+from plugins.matchers.reversals import reversal_strokes
+from plugins.matchers.comparison import sequence_size
+from plugins.matchers.decision import Calibrated, Decision, Distance
+from plugins.matchers.dtw import DTW, Grouped, position_parts
+from toolkit import Parameter, hookimpl
+
+__all__ = ["PartStrokes", "StrokeWarping", "Strokes", "warp_strokes"]
+
+Strokes = list[np.ndarray]
+"""A sequence as this matcher sees it: one array of strokes (k, 3) per compared part, in body sizes."""
+
+
+class PartStrokes:
+    """The strokes of the chosen ``parts`` (indices) of root-relative positions, in the sequence's body size (the
+    size of its ``sized`` parts, the position parts), cut where a part turns back by ``reversal`` body sizes after
+    ``smooth`` seconds of smoothing."""
+
+    measure = "stroke length left unexplained (body sizes)"
+
+    def __init__(self, parts: np.ndarray, root: int, sized: np.ndarray, reversal: float, smooth: float) -> None:
+        self.parts, self.root, self.sized, self.reversal, self.smooth = parts, root, sized, reversal, smooth
+
+    def series(self, rel: np.ndarray, fps: float) -> Strokes:
+        """The strokes of each chosen part of the poses ``rel`` (n, P, 3) sampled ``fps`` times a second."""
+        rel = np.nan_to_num(np.asarray(rel, dtype=float))
+        rel = rel - rel[:, self.root : self.root + 1]
+        size = sequence_size(rel[:, self.sized], np.ones((len(rel), len(self.sized)), dtype=bool))
+        if not size > 0:
+            return [np.zeros((0, 3)) for _ in self.parts]
+        return [reversal_strokes(rel[:, p] / size, fps, self.reversal, self.smooth) for p in self.parts]
+
+
+class StrokeWarping(DTW):
+    """Nearest example by warping the parts' strokes (see the module); decides at the segment's end."""
+
+    name = "stroke-warping"
+    parameters = (
+        Parameter("parts", list, [], "The parts compared (empty: every position part; a finger's joint angle is not "
+                  "one).", items=str),
+        Parameter("reversal", float, 0.1, "How far (body sizes) a part must come back from the farthest it went for "
+                  "its stroke to end: smaller excursions, and a tracker's jitter, are no strokes.",
+                  check=lambda v: None if v > 0 else "must be above 0"),
+        Parameter("smooth", float, 1 / 3, "Seconds of Savitzky-Golay smoothing of each path before it is cut "
+                  "(0: none).", minimum=0.0, seconds=True),
+        Parameter("merge", int, 3, "The most successive strokes of one sequence that may stand for one stroke of "
+                  "the other (1: none).", minimum=1),
+        Parameter("decision", str, "calibrated", "When the nearest example is 'unknown' (plugins.matchers.decision): "
+                  "'calibrated', beyond a threshold calibrated on the examples themselves ([matcher.calibrated]); "
+                  "'nearest', never.", choices=("calibrated", "nearest")),
+        Parameter("calibrated", doc="The calibration of decision = 'calibrated'.", parameters=(
+            Parameter("known_rejected", float, 0.05, "The share of a known movement's performances that may be "
+                      "called unknown, as far as the repertoire's takes of one movement show how they vary.",
+                      minimum=0.0, maximum=1.0),
+        )),
+    )
+
+    def _chosen_features(self, body: Any) -> PartStrokes:
+        parts, sized = position_parts(body, self.params["parts"])
+        return PartStrokes(parts, body.root_index, sized, self.params["reversal"], self.params["smooth"])
+
+    def _compile(self) -> None:
+        warp_strokes(np.zeros((1, 3)), np.zeros((1, 3)))
+
+    def _chosen_decision(self) -> Decision:
+        if self.params["decision"] == "calibrated":
+            decision = Calibrated(self.params["calibrated"]["known_rejected"])
+            decision.calibrate(self._calibration())
+            return decision
+        return Distance(0.0, self.features.measure)
+
+    def _prepare(self) -> Grouped:
+        return Grouped(self.templates, self.labels)
+
+    def _distances(self, series: Strokes) -> np.ndarray:
+        flat, starts = _flat([series])
+        templates, template_starts = self._flat_templates()
+        out = np.empty(len(self.templates))
+        kernel(_warp_all)(flat, starts, templates, template_starts, len(series), self.params["merge"], out)
+        return out
+
+    def _flat_templates(self) -> tuple[np.ndarray, np.ndarray]:
+        """The templates' strokes one after another (:func:`_flat`), kept until the templates change."""
+        kept = getattr(self, "_flat_kept", None)
+        if kept is None or kept[0] is not self.templates:
+            kept = self._flat_kept = (self.templates, *_flat(self.templates))
+        return kept[1], kept[2]
+
+    def _still(self, series: Strokes) -> float:
+        return float(sum(np.linalg.norm(strokes, axis=1).sum() for strokes in series))
+
+
+def warp_strokes(a: np.ndarray, b: np.ndarray, merge: int = 3) -> float:
+    """The stroke length left unexplained when the strokes ``a`` (n, 3) and ``b`` (m, 3) are warped onto each other.
+
+    Dynamic programming over the two sequences, each step aligning a run of strokes of one with a run of the other
+    (one of the two runs a single stroke, the other up to ``merge`` strokes) at the cost ``|Σa - Σb| + (Σ|a| - |Σa|)
+    + (Σ|b| - |Σb|)``: the difference of the runs' displacements, and the length each run loses by being taken as
+    one stroke. A stroke may also stand for several strokes of the other sequence, one after another (time
+    warping's repeated steps). An empty sequence leaves all the other's length unexplained."""
+    a, b = np.asarray(a, dtype=float).reshape(-1, 3), np.asarray(b, dtype=float).reshape(-1, 3)
+    out = np.empty(1)
+    kernel(_warp_all)(a, np.array([0, len(a)]), b, np.array([0, len(b)]), 1, int(merge), out)
+    return float(out[0])
+
+
+def _flat(sequences: list[Strokes]) -> tuple[np.ndarray, np.ndarray]:
+    """The strokes of every part of every sequence one after another (N, 3), and where each sequence's part begins
+    (S * P + 1,): sequence ``s``'s part ``p`` is ``flat[starts[s * P + p] : starts[s * P + p + 1]]``."""
+    pieces = [strokes for sequence in sequences for strokes in sequence]
+    counts = np.array([len(strokes) for strokes in pieces], dtype=np.int64)
+    flat = np.concatenate(pieces) if pieces else np.zeros((0, 3))
+    return np.ascontiguousarray(flat, dtype=float), np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+
+
+def _warp_all(a: np.ndarray, a_starts: np.ndarray, b: np.ndarray, b_starts: np.ndarray, parts: int, merge: int,
+              out: np.ndarray) -> None:
+    """:func:`warp_strokes` of the sequence ``a`` against each sequence of ``b``, summed over their ``parts`` parts,
+    into ``out``; both flat as :func:`_flat` lays them out. The reference loop, compiled where numba is installed
+    (:func:`plugins.lib.compiled.kernel`): a run's displacement and length are differences of running sums (the
+    length a run loses never below 0, which rounding could make it)."""
+    longest_a = 0
+    for p in range(parts):
+        longest_a = max(longest_a, a_starts[p + 1] - a_starts[p])
+    longest_b = 0
+    for k in range(len(b_starts) - 1):
+        longest_b = max(longest_b, b_starts[k + 1] - b_starts[k])
+    sum_a, sum_b = np.zeros((longest_a + 1, 3)), np.zeros((longest_b + 1, 3))
+    len_a, len_b = np.zeros(longest_a + 1), np.zeros(longest_b + 1)
+    cost = np.empty((longest_a + 1, longest_b + 1))
+    for t in range(len(out)):
+        total = 0.0
+        for p in range(parts):
+            a0, b0 = a_starts[p], b_starts[t * parts + p]
+            n, m = a_starts[p + 1] - a0, b_starts[t * parts + p + 1] - b0
+            for i in range(n):
+                sum_a[i + 1] = sum_a[i] + a[a0 + i]
+                len_a[i + 1] = len_a[i] + np.sqrt(a[a0 + i, 0] ** 2 + a[a0 + i, 1] ** 2 + a[a0 + i, 2] ** 2)
+            for j in range(m):
+                sum_b[j + 1] = sum_b[j] + b[b0 + j]
+                len_b[j + 1] = len_b[j] + np.sqrt(b[b0 + j, 0] ** 2 + b[b0 + j, 1] ** 2 + b[b0 + j, 2] ** 2)
+            if n == 0 or m == 0:  # nothing explains the other's strokes
+                total += len_a[n] + len_b[m]
+                continue
+            cost[0, 0] = 0.0
+            for j in range(1, m + 1):
+                cost[0, j] = np.inf
+            for i in range(1, n + 1):
+                cost[i, 0] = np.inf
+                for j in range(1, m + 1):
+                    best = np.inf
+                    for ki in range(1, min(merge, i) + 1):
+                        for kj in range(1, min(merge, j) + 1):
+                            if ki > 1 and kj > 1:
+                                break
+                            ax, ay, az = (sum_a[i, 0] - sum_a[i - ki, 0], sum_a[i, 1] - sum_a[i - ki, 1],
+                                          sum_a[i, 2] - sum_a[i - ki, 2])
+                            bx, by, bz = (sum_b[j, 0] - sum_b[j - kj, 0], sum_b[j, 1] - sum_b[j - kj, 1],
+                                          sum_b[j, 2] - sum_b[j - kj, 2])
+                            step = (np.sqrt((ax - bx) ** 2 + (ay - by) ** 2 + (az - bz) ** 2)
+                                    + max(0.0, len_a[i] - len_a[i - ki] - np.sqrt(ax * ax + ay * ay + az * az))
+                                    + max(0.0, len_b[j] - len_b[j - kj] - np.sqrt(bx * bx + by * by + bz * bz)))
+                            best = min(best, cost[i - ki, j - kj] + step)
+                            if ki == 1 and kj == 1:  # one stroke standing for several of the other
+                                best = min(best, cost[i - 1, j] + step, cost[i, j - 1] + step)
+                    cost[i, j] = best
+            total += cost[n, m]
+        out[t] = total
+
+
+@hookimpl
+def likeme_register_matchers():
+    return [StrokeWarping]
