@@ -75,12 +75,12 @@ class StrokeWarping(DTW):
         Parameter("parts", list, [], "The parts compared (empty: every position part; a finger's joint angle is not "
                   "one).", items=str),
         Parameter("reversal", float, 0.1, "How far (body sizes) a part must come back from the farthest it went for "
-                  "its stroke to end: smaller excursions, and a tracker's jitter, are no strokes.",
+                  "its stroke to end: smaller excursions, and a tracker's jitter, are no strokes.", minimum=0.0,
                   check=lambda v: None if v > 0 else "must be above 0"),
-        Parameter("smooth", float, 1 / 3, "Seconds of Savitzky-Golay smoothing of each path before it is cut "
+        Parameter("smooth", float, 0.33, "Seconds of Savitzky-Golay smoothing of each path before it is cut "
                   "(0: none).", minimum=0.0, seconds=True),
         Parameter("merge", int, 3, "The most successive strokes of one sequence that may stand for one stroke of "
-                  "the other (1: none).", minimum=1),
+                  "the other (1: none).", minimum=1, maximum=10),
         Parameter("decision", str, "calibrated", "When the nearest example is 'unknown' (plugins.matchers.decision): "
                   "'calibrated', beyond a threshold calibrated on the examples themselves ([matcher.calibrated]); "
                   "'nearest', never.", choices=("calibrated", "nearest")),
