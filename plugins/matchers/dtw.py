@@ -55,7 +55,8 @@ from plugins.matchers.comparison import HORIZON, sequence_size
 from plugins.matchers.decision import Calibrated, Calibration, Decision, Distance
 from toolkit import ConfigError, Match, Matcher, Motion, Parameter, hookimpl
 
-__all__ = ["DTW", "FEATURES", "BodyMotion", "Grouped", "Positions", "frame_distance", "position_parts", "warp_all"]
+__all__ = ["DTW", "FEATURES", "BodyMotion", "Grouped", "Positions", "body_sized", "frame_distance", "position_parts",
+           "warp_all"]
 
 
 class Positions:
@@ -86,14 +87,20 @@ class BodyMotion(Positions):
         self.parts, self.root, self.sized, self.positions = parts, root, sized, positions
 
     def series(self, rel: np.ndarray, fps: float) -> np.ndarray:
-        rel = np.nan_to_num(np.asarray(rel, dtype=float))
-        rel[:, self.sized] = rel[:, self.sized] - rel[:, self.root : self.root + 1]
-        size = sequence_size(rel[:, self.sized], np.ones((len(rel), len(self.sized)), dtype=bool))
-        scale = 1.0 / size if size > 0 else 0.0
+        rel, scale = body_sized(rel, self.root, self.sized)
         features = [derivative(rel[:, self.parts], fps) * (HORIZON * scale)]
         if self.positions:
             features.insert(0, rel[:, self.parts] * scale)
         return super().series(np.concatenate(features, axis=1), fps)
+
+
+def body_sized(rel: np.ndarray, root: int, sized: np.ndarray) -> tuple[np.ndarray, float]:
+    """Poses ``rel`` (n, P, 3), NaN as 0, their position parts ``sized`` relative to the ``root`` part, and one over the
+    sequence's body size (:func:`~plugins.matchers.comparison.sequence_size` of those parts; 0 where it has none)."""
+    rel = np.nan_to_num(np.asarray(rel, dtype=float))
+    rel[:, sized] = rel[:, sized] - rel[:, root : root + 1]
+    size = sequence_size(rel[:, sized], np.ones((len(rel), len(sized)), dtype=bool))
+    return rel, (1.0 / size if size > 0 else 0.0)
 
 
 def position_parts(body: Any, names: list[str]) -> tuple[np.ndarray, np.ndarray]:
@@ -289,10 +296,14 @@ class DTW(Matcher):
     def _chosen_decision(self) -> Decision:
         """The decision ``decision`` names, calibrated on the templates where it is ``calibrated``."""
         if self.params["decision"] == "calibrated":
-            decision = Calibrated(self.params["calibrated"]["known_rejected"])
-            decision.calibrate(self._calibration())
-            return decision
+            return self._calibrated()
         return Distance(self.params["distance"]["max_distance"], self.features.measure)
+
+    def _calibrated(self) -> Calibrated:
+        """The ``calibrated`` decision at ``[calibrated] known_rejected``, calibrated on the templates."""
+        decision = Calibrated(self.params["calibrated"]["known_rejected"])
+        decision.calibrate(self._calibration())
+        return decision
 
     def _chosen_features(self, body: Any) -> Positions:
         """The strategy ``features`` names (:data:`FEATURES`) for ``body``, its ``parts`` and decision checked."""

@@ -36,9 +36,8 @@ import numpy as np
 
 from plugins.lib.compiled import kernel
 from plugins.matchers.reversals import reversal_strokes
-from plugins.matchers.comparison import sequence_size
-from plugins.matchers.decision import Calibrated, Decision, Distance
-from plugins.matchers.dtw import DTW, Grouped, position_parts
+from plugins.matchers.decision import Decision, Distance
+from plugins.matchers.dtw import DTW, Grouped, body_sized, position_parts
 from toolkit import Parameter, hookimpl
 
 __all__ = ["PartStrokes", "StrokeWarping", "Strokes", "warp_strokes"]
@@ -59,12 +58,10 @@ class PartStrokes:
 
     def series(self, rel: np.ndarray, fps: float) -> Strokes:
         """The strokes of each chosen part of the poses ``rel`` (n, P, 3) sampled ``fps`` times a second."""
-        rel = np.nan_to_num(np.asarray(rel, dtype=float))
-        rel = rel - rel[:, self.root : self.root + 1]
-        size = sequence_size(rel[:, self.sized], np.ones((len(rel), len(self.sized)), dtype=bool))
-        if not size > 0:
+        rel, scale = body_sized(rel, self.root, self.sized)
+        if not scale > 0:
             return [np.zeros((0, 3)) for _ in self.parts]
-        return [reversal_strokes(rel[:, p] / size, fps, self.reversal, self.smooth) for p in self.parts]
+        return [reversal_strokes(rel[:, p] * scale, fps, self.reversal, self.smooth) for p in self.parts]
 
 
 class StrokeWarping(DTW):
@@ -100,9 +97,7 @@ class StrokeWarping(DTW):
 
     def _chosen_decision(self) -> Decision:
         if self.params["decision"] == "calibrated":
-            decision = Calibrated(self.params["calibrated"]["known_rejected"])
-            decision.calibrate(self._calibration())
-            return decision
+            return self._calibrated()
         return Distance(0.0, self.features.measure)
 
     def _prepare(self) -> Grouped:
