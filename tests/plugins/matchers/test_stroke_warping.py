@@ -9,25 +9,11 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from plugins.matchers.stroke_warping import _flat, _warp_all, warp_strokes
-from tests.plugins.matchers.hands import HANDS, LOW_RAISE
+from tests.plugins.matchers.hands import HANDS, LOW_RAISE, holding, waving
 from toolkit import ConfigError, load_character
 
 FPS = 30.0
 X, Y = np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
-
-REACH = """
-[motor.movements.reach]
-keys = [{ pose = "stand", at = 0.0 }, { pose = "ahead", at = 0.6 }, { pose = "ahead", at = 1.5 },
-        { pose = "stand", at = 2.1 }]
-"""
-
-SEVEN_SWINGS = """
-[motor.movements.long_wave]
-keys = [{ pose = "stand", at = 0.0 }, { pose = "held", at = 0.5 }, { pose = "out", at = 0.7 },
-        { pose = "in", at = 0.95 }, { pose = "out", at = 1.2 }, { pose = "in", at = 1.45 }, { pose = "out", at = 1.7 },
-        { pose = "in", at = 1.95 }, { pose = "out", at = 2.2 }, { pose = "held", at = 2.35 },
-        { pose = "stand", at = 2.85 }]
-"""
 
 
 def _observer(write, pm, table: str = "", known: str = ""):
@@ -37,7 +23,8 @@ def _observer(write, pm, table: str = "", known: str = ""):
 def _performed(write, pm, movement: str, speed: float = 1.0):
     """``movement`` as the demonstrator performs it (it knows the observer's movements and a few more)."""
     poses = '\n[motor.poses.ahead]\nbase = "stand"\nhand = [0.3, 1.0, 0.6]\n'
-    demonstrator = load_character(write("demonstrator.toml", HANDS + LOW_RAISE + REACH + SEVEN_SWINGS + poses), pm)
+    known = LOW_RAISE + holding("reach", "ahead") + waving("long_wave", 7)
+    demonstrator = load_character(write("demonstrator.toml", HANDS + known + poses), pm)
     return demonstrator.motor.perform(movement, fps=FPS, speed=speed).root_relative(demonstrator.body.root)
 
 
