@@ -64,6 +64,15 @@ class PartStrokes:
         return [reversal_strokes(rel[:, p] * scale, fps, self.reversal, self.smooth) for p in self.parts]
 
 
+class FlatTemplates(Grouped):
+    """The templates grouped by movement (:class:`~plugins.matchers.dtw.Grouped`) and their strokes one after another
+    for the compiled pass (:func:`_flat`: ``flat``, ``flat_starts``), made once per list of templates."""
+
+    def __init__(self, templates: list[Strokes], labels: list[str]):
+        super().__init__(templates, labels)
+        self.flat, self.flat_starts = _flat(templates)
+
+
 class StrokeWarping(DTW):
     """Nearest example by warping the parts' strokes (see the module); decides at the segment's end."""
 
@@ -100,22 +109,15 @@ class StrokeWarping(DTW):
             return self._calibrated()
         return Distance(0.0, self.features.measure)
 
-    def _prepare(self) -> Grouped:
-        return Grouped(self.templates, self.labels)
+    def _prepare(self) -> FlatTemplates:
+        return FlatTemplates(self.templates, self.labels)
 
     def _distances(self, series: Strokes) -> np.ndarray:
         flat, starts = _flat([series])
-        templates, template_starts = self._flat_templates()
+        prep = self._prepared()
         out = np.empty(len(self.templates))
-        kernel(_warp_all)(flat, starts, templates, template_starts, len(series), self.params["merge"], out)
+        kernel(_warp_all)(flat, starts, prep.flat, prep.flat_starts, len(series), self.params["merge"], out)
         return out
-
-    def _flat_templates(self) -> tuple[np.ndarray, np.ndarray]:
-        """The templates' strokes one after another (:func:`_flat`), kept until the templates change."""
-        kept = getattr(self, "_flat_kept", None)
-        if kept is None or kept[0] is not self.templates:
-            kept = self._flat_kept = (self.templates, *_flat(self.templates))
-        return kept[1], kept[2]
 
     def _still(self, series: Strokes) -> float:
         return float(sum(np.linalg.norm(strokes, axis=1).sum() for strokes in series))
