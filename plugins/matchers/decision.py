@@ -88,6 +88,22 @@ class Calibration:
         """The finite scores of ``own`` and ``other``."""
         return cls(tuple(float(x) for x in own if np.isfinite(x)), tuple(float(x) for x in other if np.isfinite(x)))
 
+    @classmethod
+    def of_rows(cls, rows: np.ndarray, movements: Sequence[str]) -> Calibration:
+        """From every take's scores against every take, ``rows[c, d]`` (C, C), take ``c`` itself left out (its own
+        column ignored), and each take's movement: own, the nearest of a take's movement's other takes; other, the
+        nearest take of another movement."""
+        movements = np.asarray(movements, dtype=object)
+        own, other = [], []
+        for c, row in enumerate(np.asarray(rows, dtype=float)):
+            mine = movements == movements[c]
+            others = mine.copy()
+            others[c] = False
+            for out, chosen in ((own, others), (other, ~mine)):
+                if chosen.any():
+                    out.append(float(row[chosen].min()))
+        return cls.of(own, other)
+
 
 @dataclass(frozen=True)
 class Verdict:

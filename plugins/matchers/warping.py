@@ -29,7 +29,7 @@ from plugins.lib.compiled import kernel
 from plugins.matchers.comparison import Comparison, Frames
 from plugins.matchers.decision import Calibration
 
-__all__ = ["Chains", "chain_calibration", "chain_distances", "chain_path", "kept", "kept_chains",
+__all__ = ["Chains", "chain_calibration", "chain_distances", "chain_path", "chain_rows", "kept", "kept_chains",
            "relative_distances", "warp_chains"]
 
 
@@ -260,21 +260,23 @@ def relative_distances(comparison: Comparison, samples: Frames, nodes: Frames, c
 def chain_calibration(comparison: Comparison, takes: list[Frames], nodes: Frames, chains: Chains,
                       scores=relative_distances) -> Calibration:
     """The calibrated decision's scores from the takes themselves (:class:`~plugins.matchers.decision.Calibration`):
-    each take (chain ``c`` is ``takes[c]``) against its movement's other takes (leave one take out) and against the
-    other movements (leave one movement out), each nearest by ``scores(comparison, take, nodes, chains, skip)``: the
-    chains' relative scores as the matcher's search gives them (:func:`relative_distances`; at each take's tempo,
-    :func:`plugins.matchers.tempo.paced_scores`)."""
-    own, other = [], []
-    movements = np.asarray(chains.movements, dtype=object)
+    each take against its movement's other takes (leave one take out) and against the other movements (leave one
+    movement out), each nearest by the scores of :func:`chain_rows`."""
+    return Calibration.of_rows(chain_rows(comparison, takes, nodes, chains, scores), chains.movements)
+
+
+def chain_rows(comparison: Comparison, takes: list[Frames], nodes: Frames, chains: Chains,
+               scores=relative_distances) -> np.ndarray:
+    """Each take (chain ``c`` is ``takes[c]``) against every chain but itself (``inf``), (C, C), by
+    ``scores(comparison, take, nodes, chains, skip)``: the chains' relative scores as the matcher's search gives
+    them (:func:`relative_distances`; at each take's tempo, :func:`plugins.matchers.tempo.paced_scores`)."""
+    rows = np.full((len(takes), len(chains)), np.inf)
     for c, take in enumerate(takes):
         skip = np.zeros(len(chains), dtype=bool)
         skip[c] = True
-        relative = scores(comparison, take, nodes, chains, skip)
-        mine = movements == movements[c]
-        for out, chosen in ((own, mine & ~skip), (other, ~mine)):
-            if chosen.any():
-                out.append(float(relative[chosen].min()))
-    return Calibration.of(own, other)
+        rows[c] = scores(comparison, take, nodes, chains, skip)
+        rows[c, c] = np.inf
+    return rows
 
 
 def chain_path(cost: np.ndarray, chains: Chains, c: int) -> np.ndarray:
