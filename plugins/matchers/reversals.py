@@ -21,7 +21,7 @@ import numpy as np
 
 from plugins.lib.compiled import kernel
 
-__all__ = ["reversal_strokes"]
+__all__ = ["parts_strokes", "reversal_strokes"]
 
 
 def reversal_strokes(path: np.ndarray, fps: float, reversal: float, smooth: float = 0.0) -> np.ndarray:
@@ -30,17 +30,26 @@ def reversal_strokes(path: np.ndarray, fps: float, reversal: float, smooth: floa
     start (see the module). ``smooth``: seconds of Savitzky-Golay smoothing first (0: none; a window of at least 5
     frames, odd, used only where the path is longer). The last excursion counts where it went at least ``reversal``
     from its start; a path that never goes that far has no stroke."""
-    path = np.asarray(path, dtype=float)
-    if len(path) < 2:
-        return np.zeros((0, 3))
+    return parts_strokes(np.asarray(path, dtype=float)[:, None], fps, reversal, smooth)[0]
+
+
+def parts_strokes(paths: np.ndarray, fps: float, reversal: float, smooth: float = 0.0) -> list[np.ndarray]:
+    """:func:`reversal_strokes` of each part's path in ``paths`` (n, P, 3), the smoothing done for every part at
+    once: one array of strokes (k, 3) per part."""
+    paths = np.asarray(paths, dtype=float)
+    if len(paths) < 2:
+        return [np.zeros((0, 3)) for _ in range(paths.shape[1])]
     width = int(round(smooth * fps)) | 1
-    if smooth > 0 and width >= 5 and len(path) > width:
+    if smooth > 0 and width >= 5 and len(paths) > width:
         from scipy.signal import savgol_filter
 
-        path = savgol_filter(path, width, 2, axis=0)
-    out = np.empty((len(path), 3))
-    count = kernel(_zigzag)(np.ascontiguousarray(path), float(reversal), out)
-    return out[:count].copy()
+        paths = savgol_filter(paths, width, 2, axis=0)
+    out = np.empty((len(paths), 3))
+    strokes = []
+    for p in range(paths.shape[1]):
+        count = kernel(_zigzag)(np.ascontiguousarray(paths[:, p]), float(reversal), out)
+        strokes.append(out[:count].copy())
+    return strokes
 
 
 def _zigzag(path: np.ndarray, reversal: float, out: np.ndarray) -> int:

@@ -35,12 +35,21 @@ from typing import Any
 import numpy as np
 
 from plugins.lib.compiled import kernel
-from plugins.matchers.reversals import reversal_strokes
+from plugins.matchers.reversals import parts_strokes
 from plugins.matchers.decision import Decision, Distance
 from plugins.matchers.dtw import DTW, Grouped, body_sized, position_parts
 from toolkit import Parameter, hookimpl
 
-__all__ = ["PartStrokes", "StrokeWarping", "Strokes", "warp_strokes"]
+__all__ = ["MERGE", "PartStrokes", "REVERSAL", "SMOOTH", "StrokeWarping", "Strokes", "flat_strokes",
+           "stroke_distances", "strokes_still", "warp_strokes"]
+
+REVERSAL = 0.1
+"""How far (body sizes) a part comes back from the farthest it went before its stroke ends: the default of
+``reversal``, chosen on the generated gestures (``docs/matchers.md``)."""
+SMOOTH = 0.33
+"""Seconds of smoothing of each part's path before it is cut: the default of ``smooth``."""
+MERGE = 3
+"""The most successive strokes that may stand for one stroke of the other sequence: the default of ``merge``."""
 
 Strokes = list[np.ndarray]
 """A sequence as this matcher sees it: one array of strokes (k, 3) per compared part, in body sizes."""
@@ -61,16 +70,16 @@ class PartStrokes:
         rel, scale = body_sized(rel, self.root, self.sized)
         if not scale > 0:
             return [np.zeros((0, 3)) for _ in self.parts]
-        return [reversal_strokes(rel[:, p] * scale, fps, self.reversal, self.smooth) for p in self.parts]
+        return parts_strokes(rel[:, self.parts] * scale, fps, self.reversal, self.smooth)
 
 
 class FlatTemplates(Grouped):
     """The templates grouped by movement (:class:`~plugins.matchers.dtw.Grouped`) and their strokes one after another
-    for the compiled pass (:func:`_flat`: ``flat``, ``flat_starts``), made once per list of templates."""
+    for the compiled pass (:func:`flat_strokes`: ``flat``, ``flat_starts``), made once per list of templates."""
 
     def __init__(self, templates: list[Strokes], labels: list[str]):
         super().__init__(templates, labels)
-        self.flat, self.flat_starts = _flat(templates)
+        self.flat, self.flat_starts = flat_strokes(templates)
 
 
 class StrokeWarping(DTW):
@@ -80,12 +89,12 @@ class StrokeWarping(DTW):
     parameters = (
         Parameter("parts", list, [], "The parts compared (empty: every position part; a finger's joint angle is not "
                   "one).", items=str),
-        Parameter("reversal", float, 0.1, "How far (body sizes) a part must come back from the farthest it went for "
-                  "its stroke to end: smaller excursions, and a tracker's jitter, are no strokes.", minimum=0.0,
+        Parameter("reversal", float, REVERSAL, "How far (body sizes) a part must come back from the farthest it went "
+                  "for its stroke to end: smaller excursions, and a tracker's jitter, are no strokes.", minimum=0.0,
                   check=lambda v: None if v > 0 else "must be above 0"),
-        Parameter("smooth", float, 0.33, "Seconds of Savitzky-Golay smoothing of each path before it is cut "
+        Parameter("smooth", float, SMOOTH, "Seconds of Savitzky-Golay smoothing of each path before it is cut "
                   "(0: none).", minimum=0.0, seconds=True),
-        Parameter("merge", int, 3, "The most successive strokes of one sequence that may stand for one stroke of "
+        Parameter("merge", int, MERGE, "The most successive strokes of one sequence that may stand for one stroke of "
                   "the other (1: none).", minimum=1, maximum=10),
         Parameter("decision", str, "calibrated", "When the nearest example is 'unknown' (plugins.matchers.decision): "
                   "'calibrated', beyond a threshold calibrated on the examples themselves ([matcher.calibrated]); "
@@ -113,17 +122,19 @@ class StrokeWarping(DTW):
         return FlatTemplates(self.templates, self.labels)
 
     def _distances(self, series: Strokes) -> np.ndarray:
-        flat, starts = _flat([series])
         prep = self._prepared()
-        out = np.empty(len(self.templates))
-        kernel(_warp_all)(flat, starts, prep.flat, prep.flat_starts, len(series), self.params["merge"], out)
-        return out
+        return stroke_distances(series, prep.flat, prep.flat_starts, self.params["merge"])
 
     def _still(self, series: Strokes) -> float:
-        return float(sum(np.linalg.norm(strokes, axis=1).sum() for strokes in series))
+        return strokes_still(series)
 
 
-def warp_strokes(a: np.ndarray, b: np.ndarray, merge: int = 3) -> float:
+def strokes_still(series: Strokes) -> float:
+    """A sequence's distance to standing still: the total length of its parts' strokes (body sizes)."""
+    return float(sum(np.linalg.norm(strokes, axis=1).sum() for strokes in series))
+
+
+def warp_strokes(a: np.ndarray, b: np.ndarray, merge: int = MERGE) -> float:
     """The stroke length left unexplained when the strokes ``a`` (n, 3) and ``b`` (m, 3) are warped onto each other.
 
     Dynamic programming over the two sequences, each step aligning a run of strokes of one with a run of the other
@@ -137,7 +148,16 @@ def warp_strokes(a: np.ndarray, b: np.ndarray, merge: int = 3) -> float:
     return float(out[0])
 
 
-def _flat(sequences: list[Strokes]) -> tuple[np.ndarray, np.ndarray]:
+def stroke_distances(series: Strokes, flat: np.ndarray, flat_starts: np.ndarray, merge: int = MERGE) -> np.ndarray:
+    """:func:`warp_strokes` of ``series`` against every sequence laid out flat by :func:`flat_strokes`, summed over
+    the parts, in one compiled pass: (S,)."""
+    a, a_starts = flat_strokes([series])
+    out = np.empty((len(flat_starts) - 1) // max(1, len(series)))
+    kernel(_warp_all)(a, a_starts, flat, flat_starts, len(series), int(merge), out)
+    return out
+
+
+def flat_strokes(sequences: list[Strokes]) -> tuple[np.ndarray, np.ndarray]:
     """The strokes of every part of every sequence one after another (N, 3), and where each sequence's part begins
     (S * P + 1,): sequence ``s``'s part ``p`` is ``flat[starts[s * P + p] : starts[s * P + p + 1]]``."""
     pieces = [strokes for sequence in sequences for strokes in sequence]
@@ -149,8 +169,8 @@ def _flat(sequences: list[Strokes]) -> tuple[np.ndarray, np.ndarray]:
 def _warp_all(a: np.ndarray, a_starts: np.ndarray, b: np.ndarray, b_starts: np.ndarray, parts: int, merge: int,
               out: np.ndarray) -> None:
     """:func:`warp_strokes` of the sequence ``a`` against each sequence of ``b``, summed over their ``parts`` parts,
-    into ``out``; both flat as :func:`_flat` lays them out. The reference loop, compiled where numba is installed
-    (:func:`plugins.lib.compiled.kernel`): a run's displacement and length are differences of running sums (the
+    into ``out``; both flat as :func:`flat_strokes` lays them out. The reference loop, compiled where numba is
+    installed (:func:`plugins.lib.compiled.kernel`): a run's displacement and length are differences of running sums (the
     length a run loses never below 0, which rounding could make it)."""
     longest_a = 0
     for p in range(parts):

@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from plugins.matchers.reversals import _zigzag, reversal_strokes
+from plugins.matchers.reversals import _zigzag, parts_strokes, reversal_strokes
 
 FPS = 30.0
 
@@ -65,3 +65,16 @@ def test_the_compiled_loop_gives_the_reference_loops_strokes():
     count = _zigzag(path, 0.5, out)
     np.testing.assert_array_equal(reversal_strokes(path, FPS, reversal=0.5), out[:count])
     assert reversal_strokes(path[:1], FPS, reversal=0.5).shape == (0, 3)
+
+
+@settings(max_examples=50, deadline=None)
+@given(arrays(np.float64, st.tuples(st.integers(2, 40), st.integers(1, 4), st.just(3)), elements=st.floats(-1.0, 1.0)),
+       st.sampled_from([0.0, 0.2, 0.5]))
+def test_every_part_at_once_gives_each_parts_own_strokes(paths, smooth):
+    """The parts smoothed together (one Savitzky-Golay pass over every part) and cut one by one: each part's
+    strokes are those of its path alone."""
+    together = parts_strokes(paths, 30.0, 0.1, smooth)
+    assert len(together) == paths.shape[1]
+    for p, strokes in enumerate(together):
+        alone = reversal_strokes(paths[:, p], 30.0, 0.1, smooth)
+        assert strokes.shape == alone.shape and np.allclose(strokes, alone, atol=1e-12)

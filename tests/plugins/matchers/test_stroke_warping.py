@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from plugins.matchers.stroke_warping import _flat, _warp_all, warp_strokes
+from plugins.matchers.stroke_warping import _warp_all, flat_strokes, warp_strokes
 from tests.plugins.matchers.hands import HANDS, LOW_RAISE, holding, waving
 from toolkit import ConfigError, load_character
 
@@ -89,15 +89,15 @@ def test_warping_is_symmetric_zero_on_itself_and_scales(a, b, merge, scale):
 
 
 def test_every_template_at_once_is_each_part_warped_on_its_own():
-    """The compiled pass against every template (the layout of :func:`_flat`, a part with no strokes among them)
+    """The compiled pass against every template (the layout of :func:`flat_strokes`, a part with no strokes among them)
     gives, for each template, the sum over the parts of each part's warping."""
     rng = np.random.default_rng(4)
 
     def sequence():
         return [rng.normal(size=(int(rng.integers(0, 6)), 3)) for _ in range(3)]
     demo, templates = sequence(), [sequence() for _ in range(5)]
-    flat, starts = _flat([demo])
-    all_flat, all_starts = _flat(templates)
+    flat, starts = flat_strokes([demo])
+    all_flat, all_starts = flat_strokes(templates)
     out = np.empty(5)
     _warp_all(flat, starts, all_flat, all_starts, 3, 2, out)
     expected = [sum(warp_strokes(a, b, 2) for a, b in zip(demo, template)) for template in templates]
