@@ -112,6 +112,7 @@ class Posegraph(MotorSystem):
             self.graph.add_node(hub, index=i, movement=None, hub=True)
         self.paths: dict[str, list[str]] = {}
         self.paths_label: dict[str, str] = {}  # path name -> movement (several clips of one movement)
+        self.path_clips: dict[str, Motion] = {}  # path name -> the clip it was built from (take_motions)
         played = self._played()
         for name, m in self.repertoire.items():
             sampled, travel, motion = played[name]
@@ -193,6 +194,7 @@ class Posegraph(MotorSystem):
         noise = None if jitter is None else feature_noise(jitter, motion.fps, motion.n_frames, low_passed=True)
         self._add_path(name, ends[0], sampled[1:-1], ends[1], rows, velocity[1:-1], parts[1:-1], heading[1:-1],
                        label=movement, noise=noise)
+        self.path_clips[name] = motion
         whole = filled[[0, -1]] - filled[[0, -1], root : root + 1]
         cycle = float(pose_distance(whole[0], whole[1], True))  # its very first and last frames
         radius = self.params["hub_radius"]
@@ -247,6 +249,18 @@ class Posegraph(MotorSystem):
         out: dict[str, list[list[str]]] = {}
         for name, path in self.paths.items():
             out.setdefault(self.paths_label[name], []).append([n for n in path if not self.graph.nodes[n]["hub"]])
+        return out
+
+    def take_motions(self, fps: float = 30.0) -> dict[str, list[Motion | None]]:
+        """Movement -> each of its takes (in the order of :meth:`takes`) as a motion: the clip it was built from,
+        else its nodes played at ``fps`` (:meth:`play_path`; ``None`` for a take of one node, which does not move)."""
+        out: dict[str, list[Motion | None]] = {}
+        for name, path in self.paths.items():
+            nodes = [n for n in path if not self.graph.nodes[n]["hub"]]
+            clip = self.path_clips.get(name)
+            if clip is None and len(nodes) > 1:
+                clip = self.play_path(nodes, fps=fps)
+            out.setdefault(self.paths_label[name], []).append(clip)
         return out
 
     def rest_pose(self) -> np.ndarray:
