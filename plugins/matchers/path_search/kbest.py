@@ -215,7 +215,7 @@ class Beam(Search):
         self.kbest = KBest(m.motor.graph, m.node_names, m.motor.node_root_relative, options["k"],
                            options["max_skip"], m.index_min_nodes)
 
-    def find(self, samples):
+    def find(self, samples, motion):
         m = self.matcher
         obs, vis = samples.parts, samples.seen
         path, _, evidence = self.kbest.search(obs, vis)

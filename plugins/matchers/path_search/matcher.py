@@ -22,13 +22,14 @@ from plugins.lib.learned_names import learned_name
 from plugins.matchers.comparison import Comparison, Frames, comparison
 from plugins.matchers.comparison import Motion as MotionComparison
 from plugins.matchers.decision import Calibrated, Decision, Distance
+from plugins.matchers.path_search.evidence import Evidence, MotionAlone, MotionAndStrokes
 from plugins.matchers.path_search.kbest import INDEX_MIN_NODES, Beam
 from plugins.matchers.path_search.per_movement import EachMovement
 from plugins.matchers.path_search.search import Search
 from toolkit import ConfigError, Match, Matcher, Motion, Parameter
 from toolkit.components import provides
 
-__all__ = ["PathSearch", "PoseGraph", "Takes"]
+__all__ = ["PathSearch", "Played", "PoseGraph", "Takes"]
 
 
 class PoseGraph(Protocol):
@@ -78,6 +79,14 @@ class Takes(Protocol):
         """Movement -> the node names of each of its takes (hubs left out)."""
 
 
+class Played(Protocol):
+    """A posegraph that gives each of its takes as a motion: what ``comparison = "motion+strokes"`` cuts into
+    strokes (:mod:`plugins.matchers.path_search.evidence`)."""
+
+    def take_motions(self, fps: float = 30.0) -> dict[str, list[Motion | None]]:
+        """Movement -> each take (in the order of ``takes()``) as a motion, ``None`` for one that does not move."""
+
+
 SEARCHES: dict[str, type[Search]] = {"k-best": Beam, "per-movement": EachMovement}
 """The search strategies by the name the ``search`` parameter takes."""
 
@@ -94,8 +103,10 @@ class PathSearch(Matcher):
     parameters = (
         Parameter("comparison", str, "poses", "What a sample is compared by (plugins.matchers.comparison): 'poses', "
                   "eq. 1 on root-relative positions in metres (the paper); 'motion', each part's shape, motion and "
-                  "carry in body sizes, for real people (needs search = 'per-movement').",
-                  choices=("poses", "motion")),
+                  "carry in body sizes, for real people (needs search = 'per-movement'); 'motion+strokes', that and "
+                  "each take's strokes (K&G §4.1), each weighed by how well the takes show it separates the "
+                  "movements (plugins.matchers.path_search.evidence).",
+                  choices=("poses", "motion", "motion+strokes")),
         Parameter("search", str, "k-best", "How the nearest path is found: 'k-best', the k best paths from the poses "
                   "nearest the middle frame (§5.2, the paper); 'per-movement', every movement's own best path, "
                   "exactly, by dynamic time warping (it cannot lose the true movement).",
@@ -136,11 +147,16 @@ class PathSearch(Matcher):
         provides(owner.motor, PoseGraph, needed_by="path-search", what="a posegraph motor system",
                  expected=" or ".join(f'[motor] plugin = "{name}"' for name in self.motor_systems))
         self.motor = owner.motor
-        for key, value in (("search", "per-movement"), ("comparison", "motion"), ("decision", "calibrated")):
+        for key, value in (("search", "per-movement"), ("comparison", "motion"), ("comparison", "motion+strokes"),
+                           ("decision", "calibrated")):
             if self.params[key] == value:
                 provides(owner.motor, Takes, needed_by=f"path-search's {key} = '{value}'",
                          what="a posegraph that knows its takes and how its nodes move", key=(key,),
                          expected="a motor system with takes(), node_motion, node_travel and node_heading (posegraph)")
+        if self.params["comparison"] == "motion+strokes":
+            provides(owner.motor, Played, needed_by="path-search's comparison = 'motion+strokes'",
+                     what="a posegraph that plays each of its takes", key=("comparison",),
+                     expected="a motor system with take_motions() (posegraph)")
         if self.params["comparison"] != "poses" and self.params["search"] == "k-best":
             raise ConfigError("search = 'k-best' compares poses (eq. 1)", key=("search",),
                               expected="search = 'per-movement' with comparison = 'motion', or comparison = 'poses'")
@@ -148,7 +164,9 @@ class PathSearch(Matcher):
             raise ConfigError("decision = 'distance' holds eq. 1 to max_distance in metres, and comparison = "
                               f"'{self.params['comparison']}' measures in body sizes", key=("decision",),
                               expected="decision = 'calibrated' with comparison = 'motion', or comparison = 'poses'")
-        self.comparison: Comparison = comparison(self.params["comparison"])
+        self.comparison: Comparison = comparison("poses" if self.params["comparison"] == "poses" else "motion")
+        self.evidence: Evidence = MotionAndStrokes(owner.body) if self.params["comparison"] == "motion+strokes" \
+            else MotionAlone()
         self.searcher: Search = SEARCHES[self.params["search"]](self)
         if self.params["decision"] == "calibrated":
             self.decision: Decision = Calibrated(self.params["calibrated"]["known_rejected"])
@@ -214,7 +232,7 @@ class PathSearch(Matcher):
         evidence = samples.seen.any(axis=1)
         if not evidence.all():  # a sample with no part seen (its root hidden, say) carries no evidence: left out,
             samples = samples.take(evidence)  # not a free step the warping could stretch along a long take
-        found = self.searcher.find(samples)
+        found = self.searcher.find(samples, motion)
         if found is None:
             return Match.unknown("nothing visible", details={"reason": "nothing visible"})
         node_path = tuple(self.node_names[i] for i in found.path)

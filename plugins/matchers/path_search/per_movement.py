@@ -13,8 +13,9 @@ every chain at once (:mod:`plugins.matchers.warping`: dynamic time warping free 
 movement seen only in part still finds its part, §5.2.3), then again with the samples' motion at the pace the first
 warping found for the chain (:mod:`plugins.matchers.tempo`: a performance up to four times slower or faster than a
 take is compared at the take's tempo); a movement's score is its nearest take's, relative to the samples' distance
-to standing still at that take's tempo, and the movements are ranked by it. The decision is calibrated on the takes
-compared alike (:func:`plugins.matchers.warping.chain_calibration` with :func:`plugins.matchers.tempo.paced_scores`).
+to standing still at that take's tempo, and the movements are ranked by it (``comparison = "motion+strokes"`` mixes
+in the takes' strokes: :mod:`plugins.matchers.path_search.evidence`). The decision is calibrated on the takes
+compared alike (:meth:`plugins.matchers.path_search.evidence.Evidence.calibration`).
 """
 
 from __future__ import annotations
@@ -24,8 +25,8 @@ import numpy as np
 from plugins.matchers.comparison import Frames
 from plugins.matchers.decision import Calibration
 from plugins.matchers.path_search.search import Found, Search
-from plugins.matchers.tempo import paced_distances, paced_scores
-from plugins.matchers.warping import Chains, chain_calibration, chain_path
+from plugins.matchers.tempo import paced_distances
+from plugins.matchers.warping import Chains, chain_path
 
 __all__ = ["EachMovement", "posegraph_chains"]
 
@@ -55,8 +56,10 @@ class EachMovement(Search):
         self.chains = posegraph_chains(m.motor)
         self.takes = [m.take_frames(self.chains.chain(c)) for c in range(len(self.chains))]
         self.nodes = Frames.join(self.takes) if self.takes else None
+        if self.takes:
+            m.evidence.rebuild(self)
 
-    def find(self, samples):
+    def find(self, samples, motion):
         if self.nodes is None or not samples.seen.any():
             return None
         m = self.matcher
@@ -66,7 +69,7 @@ class EachMovement(Search):
         # none (inf): its distances, over a distance to standing still of 0 (the decision's score is 0 for a
         # distance of 0, else inf); a decision that is not relative takes the distances
         relative = m.decision.relative and bool(np.isfinite(paced.scores).any())
-        values = paced.scores if relative else paced.distances
+        values = m.evidence.scores(paced, motion) if relative else paced.distances
         still = 0.0 if m.decision.relative and not relative else 1.0
         best: dict[str, int] = {}
         for c, movement in enumerate(self.chains.movements):
@@ -82,4 +85,6 @@ class EachMovement(Search):
                      still)
 
     def calibration(self) -> Calibration:
-        return chain_calibration(self.matcher.comparison, self.takes, self.nodes, self.chains, paced_scores)
+        if not self.takes:
+            return Calibration()
+        return self.matcher.evidence.calibration(self)

@@ -17,6 +17,7 @@ import numpy as np
 
 from plugins.matchers.comparison import Frames
 from plugins.matchers.decision import Calibration
+from toolkit import Motion
 
 if TYPE_CHECKING:
     from plugins.matchers.path_search.matcher import PathSearch
@@ -56,8 +57,10 @@ class Search(ABC):
         """Build what the search needs of the posegraph as it is now (at attach and after learning)."""
 
     @abstractmethod
-    def find(self, samples: Frames) -> Found | None:
-        """The nearest path to the demonstration's ``samples`` (``None`` when nothing was seen)."""
+    def find(self, samples: Frames, motion: Motion) -> Found | None:
+        """The nearest path to the demonstration's ``samples`` (``None`` when nothing was seen); ``motion``: the
+        demonstration as observed, for what is compared beyond the samples (:mod:`plugins.matchers.path_search.
+        evidence`)."""
 
     @abstractmethod
     def calibration(self) -> Calibration:

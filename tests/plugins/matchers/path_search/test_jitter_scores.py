@@ -21,10 +21,11 @@ def recorded(tmp_path_factory):
             for name, jitter in (("clean", 0.0), ("noisy", 0.015))}
 
 
-def _scores(folder) -> np.ndarray:
+def _scores(folder, comparison: str = "motion") -> np.ndarray:
     pm = create_plugin_manager(autoload=False, trace=False)
     profile = load_profile(folder / "profile.toml")
-    observer = compose_observer(pm, profile, folder / "repertoire", matcher="path-search")
+    observer = compose_observer(pm, profile, folder / "repertoire", matcher="path-search",
+                                settings={"matcher": {"comparison": comparison}})
     scores = []
     for clip in sorted(folder.glob("demos/*/*_p2_001.csv")):
         if any(f"_{style}_" in clip.name for style in ("normal", "big", "slow")):
