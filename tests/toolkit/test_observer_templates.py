@@ -110,7 +110,7 @@ def test_papers_is_the_template_with_the_papers_comparisons_and_decisions(data, 
     assert observer.segmenter.declared["units"] == template["segmenter"]["units"]
     real = compose_observer(pm, profile, data / "repertoire")
     assert {k: real.matcher.params[k] for k in ("comparison", "search", "decision")} == \
-        {"comparison": "motion", "search": "per-movement", "decision": "calibrated"}
+        {"comparison": "motion+strokes", "search": "per-movement", "decision": "calibrated"}
 
 
 def test_observe_and_bench_watch_with_the_template_named(data, write, capsys):
