@@ -320,19 +320,14 @@ class DTW(Matcher):
 
     def _calibration(self) -> Calibration:
         """Each template as a segment: against its movement's other templates (leave one take out) and against the
-        other movements' (leave one movement out), each over its distance to standing still."""
-        own, other = [], []
-        labels = np.array(self.labels, dtype=object)
+        other movements' (leave one movement out), each over its distance to standing still
+        (:meth:`Calibration.of_rows`)."""
+        rows = np.full((len(self.templates), len(self.templates)), np.inf)
         for i, series in enumerate(self.templates):
-            distances = self._distances(series)
             still = self._still(series)
-            mine = labels == labels[i]
-            mine_others = mine.copy()
-            mine_others[i] = False
-            for out, chosen in ((own, mine_others), (other, ~mine)):
-                if chosen.any():
-                    out.append(float(distances[chosen].min()) / still if still > 0 else np.inf)
-        return Calibration.of(own, other)
+            if still > 0:
+                rows[i] = self._distances(series) / still
+        return Calibration.of_rows(rows, self.labels)
 
     def _distances(self, series: np.ndarray) -> np.ndarray:
         """The root-mean-square distance per frame of ``series`` to every template after warping."""
