@@ -69,8 +69,12 @@ class PartStrokes:
         """The strokes of each chosen part of the poses ``rel`` (n, P, 3) sampled ``fps`` times a second."""
         rel, scale = body_sized(rel, self.root, self.sized)
         if not scale > 0:
-            return [np.zeros((0, 3)) for _ in self.parts]
+            return self.none()
         return parts_strokes(rel[:, self.parts] * scale, fps, self.reversal, self.smooth)
+
+    def none(self) -> Strokes:
+        """A sequence with no stroke: what standing still gives."""
+        return [np.zeros((0, 3)) for _ in self.parts]
 
 
 class FlatTemplates(Grouped):

@@ -145,17 +145,14 @@ class TakeStrokes:
         for movement, takes in motor.takes().items():
             for nodes, motion in zip(takes, played[movement]):
                 if nodes:
-                    self.templates.append(self.series(motion) if motion is not None else self._none())
+                    self.templates.append(self.series(motion) if motion is not None else self.features.none())
         self.flat, self.starts = flat_strokes(self.templates)
         self.still = np.array([strokes_still(t) for t in self.templates])
-
-    def _none(self) -> Strokes:
-        return [np.zeros((0, 3)) for _ in self.features.parts]
 
     def series(self, motion: Motion) -> Strokes:
         """A motion's strokes (hidden parts held where last seen, :meth:`toolkit.Motion.filled`)."""
         if motion.n_frames < 2 or not motion.visible.any():
-            return self._none()
+            return self.features.none()
         positions = np.asarray(motion.positions, dtype=float) if motion.visible.all() else motion.filled().positions
         return self.features.series(positions, motion.fps)
 
