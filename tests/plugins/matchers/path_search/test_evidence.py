@@ -15,13 +15,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from plugins.bench.gestures import MOVEMENTS, make_gestures
+from plugins.bench.gestures import MOVEMENTS
 from plugins.matchers.decision import Calibration
-from plugins.matchers.path_search.evidence import MOST_SEPARATION, evidence_weights
+from plugins.matchers.strokes_evidence import MOST_SEPARATION, evidence_weights
 from tests.plugins.matchers.hands import HANDS, LOW_RAISE, holding, waving
 from toolkit import ConfigError, load_character
 from toolkit.observe import Observer, compose_observer
-from toolkit.recordings.profile import load_profile
 
 STROKES = {"matcher": {"comparison": "motion+strokes"}}
 
@@ -81,14 +80,6 @@ def test_the_calibration_of_rows_is_each_takes_nearest_own_and_other(case):
     other = [min(rows[c, d] for d in range(len(labels)) if labels[d] != labels[c]) for c in range(len(labels))
              if len(set(labels)) > 1]
     assert got == Calibration.of(own, other)
-
-
-@pytest.fixture(scope="module")
-def gestures(tmp_path_factory):
-    folder = make_gestures(tmp_path_factory.mktemp("gestures"), seed=5, performers=2, takes=2)
-    profile = load_profile(folder / "profile.toml")
-    demos = [(clip.parent.name, profile.read(clip)) for clip in sorted((folder / "demos").glob("*/*.csv"))]
-    return folder, profile, demos
 
 
 def _answers(pm, folder, profile, demos, settings=None):
