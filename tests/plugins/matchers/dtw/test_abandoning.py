@@ -69,3 +69,32 @@ def test_dtw_answers_as_if_every_example_were_warped_in_full(seed, templates, mo
     assert got.candidates == tuple(nearest.items())
     confidence = float(1.0 - distances[best] / runner_up) if np.isfinite(runner_up) and runner_up > 0 else 1.0
     assert got.confidence == max(0.0, confidence)
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(2, 8), st.integers(1, 3), st.sampled_from([0.0, 0.5]))
+def test_the_calibration_warped_one_by_one_scores_every_example_against_every_other(seed, templates, movements,
+                                                                                    window):
+    """Warped one by one (a ``window``, or no compiled kernel), the calibration is that of the full distances: a
+    template scored against the others meets itself at distance 0, and a bound of 0 abandons none of its movement's
+    other examples (every example has its own score)."""
+    from unittest import mock
+
+    from plugins.matchers import dtw
+    from plugins.matchers.decision import Calibration
+
+    rng = np.random.default_rng(seed)
+    labels = [f"m{i}" for i in rng.integers(0, movements, templates)]
+    series = [rng.normal(size=(int(rng.integers(2, 12)), 9)) for _ in labels]
+    matcher = _dtw_matcher(labels, series, stride=1, window=window)
+    rows = np.full((templates, templates), np.inf)
+    for i, a in enumerate(matcher.templates):
+        band = [None if not window else dtw._band(window, len(a), len(b)) for b in matcher.templates]
+        full = [dtw._dtw(a, b, band[j]) for j, b in enumerate(matcher.templates)]
+        lengths = len(a) + np.array([len(b) for b in matcher.templates])
+        rows[i] = np.sqrt(np.square(full) / lengths) / dtw._still(a)
+    with mock.patch.object(dtw, "_kernel", lambda: None):
+        got = matcher._calibration()
+    want = Calibration.of_rows(rows, labels)
+    assert np.allclose(got.own, want.own) and np.allclose(got.other, want.other)
+    assert len(got.own) == sum(labels.count(label) > 1 for label in labels)
