@@ -264,6 +264,34 @@ class MotorCommandGraph(MotorSystem):
             return [(c.movement, c.motion) for c in self.clips.clips]
         return super().examples(fps)
 
+    def play_take(self, edges: tuple[str, ...], subsystem: str, fps: float = 30.0) -> list[np.ndarray]:
+        """A take's edges played by their commands (each from its start to its duration, at ``fps``), the subsystem's
+        parts where the commands put them and the other parts at rest: one array of frames (n, P, 3) per edge."""
+        idx, pieces = self.subsystems[subsystem], []
+        for name in edges:
+            edge = self.edge(name)
+            t = np.arange(0.0, edge.duration + 0.5 / fps, 1.0 / fps)
+            frames = np.repeat(self.rest[None], len(t), axis=0)
+            frames[:, idx] = np.stack([c.position(t) for c in edge.commands], axis=1)
+            pieces.append(frames)
+        return pieces
+
+    def take_motions(self, fps: float = 30.0) -> dict[str, list[Motion | None]]:
+        """Movement -> each of its takes (in the order of :meth:`takes`) as a motion: the positions the inverse model
+        was given (its subsystem's parts, the others at rest), else (a take restored from a saved state) its commands
+        played at ``fps`` (:meth:`play_take`); ``None`` for a take with no frame."""
+        out: dict[str, list[Motion | None]] = {}
+        for movement, takes in self._takes.items():
+            for edges, subsystem, observed, rate in takes:
+                if observed is not None:
+                    frames = np.repeat(self.rest[None], len(observed), axis=0)
+                    frames[:, self.subsystems[subsystem]] = observed
+                else:
+                    pieces = self.play_take(edges, subsystem, fps)
+                    frames, rate = (np.concatenate(pieces) if pieces else np.zeros((0, len(self.body.parts), 3))), fps
+                out.setdefault(movement, []).append(Motion(frames, rate, self.body.parts) if len(frames) else None)
+        return out
+
     # -- the graph ------------------------------------------------------------------------------
 
     def edges(self, subsystem: str) -> list[Edge]:

@@ -63,8 +63,9 @@ from plugins.lib.root_frame import HeadingFilter, facing_heading, to_root_relati
 from plugins.lib.velocity import derivative, window_frames
 from plugins.matchers.comparison import Frames, Motion, sequence_size
 from plugins.matchers.decision import Calibrated, Calibration, Decision, Stillness
+from plugins.matchers.forward_model.answer import Answer, FollowedScores
 from plugins.matchers.pacing import PacedWarping, followed_scores
-from plugins.matchers.warping import Chains, chain_calibration
+from plugins.matchers.warping import Chains, chain_rows
 from toolkit import Match
 from toolkit import Motion as Recording
 
@@ -103,8 +104,11 @@ class Takes(Protocol):
     def edge(self, movement: str) -> Any:
         """The edge record of a movement (edge) name: its commands, travel and turn."""
 
-    def rest_pose(self) -> np.ndarray:
-        """The body's rest pose, local frame (P, 3)."""
+    def play_take(self, edges: tuple[str, ...], subsystem: str, fps: float = 30.0) -> list[np.ndarray]:
+        """A take's edges played by their commands, the other parts at rest: frames (n, P, 3) per edge."""
+
+    def take_motions(self, fps: float = 30.0) -> dict[str, list[Any]]:
+        """Movement -> each take (in the order of ``takes()``) as a motion (``None``: one with no frame)."""
 
 
 class Prediction:
@@ -112,32 +116,36 @@ class Prediction:
 
     def __init__(self, motor: Any, comparison: Motion) -> None:
         root = motor.body.root_index
-        rest = np.asarray(motor.rest_pose(), dtype=float)
-        takes, movements, lengths = [], [], []
+        takes, movements, lengths, sources = [], [], [], []
         for movement, chains in motor.takes().items():
-            for edges, subsystem, _, _ in chains:
-                frames = self._take(motor, edges, subsystem, rest, root, comparison)
+            for k, (edges, subsystem, _, _) in enumerate(chains):
+                frames = self._take(motor, edges, subsystem, root, comparison)
                 if frames is not None and len(frames):
                     takes.append(frames)
                     movements.append(movement)
                     lengths.append(len(frames))
+                    sources.append((movement, k))
         self.takes = takes
         self.chains = Chains.of_lengths(lengths, movements)
         self.frames = Frames.join(takes) if takes else None
+        self.sources = sources  # each chain's movement and the take's place among the movement's takes
+
+    def motions(self, motor: Any) -> list[Recording | None]:
+        """Each chain's take as a motion (:meth:`MotorCommandGraph.take_motions`), in the chains' order."""
+        played = motor.take_motions(fps=PLAY_FPS)
+        return [played[movement][k] for movement, k in self.sources]
 
     @staticmethod
-    def _take(motor, edges, subsystem, rest, root, comparison) -> Frames | None:
-        """One take's commands played: the parts' positions predicted by their commands (the others held at rest),
-        their velocities, the travel and the turn shown with each command, sampled at :data:`RATE`."""
+    def _take(motor, edges, subsystem, root, comparison) -> Frames | None:
+        """One take's commands played (:meth:`MotorCommandGraph.play_take`: the parts' positions predicted by their
+        commands, the others held at rest), their velocities, the travel and the turn shown with each command,
+        sampled at :data:`RATE`."""
         idx = motor.subsystems[subsystem]
-        pieces, travel, turn, shown, turned = [], [], [], [], 0.0
-        for name in edges:
+        pieces = motor.play_take(edges, subsystem, PLAY_FPS)
+        travel, turn, shown, turned = [], [], [], 0.0
+        for name, frames in zip(edges, pieces):
             edge = motor.edge(name)
-            t = np.arange(0.0, edge.duration + 0.5 / PLAY_FPS, 1.0 / PLAY_FPS)
-            frames = np.repeat(rest[None], len(t), axis=0)
-            frames[:, idx] = np.stack([c.position(t) for c in edge.commands], axis=1)
-            pieces.append(frames)
-            at = np.linspace(0.0, 1.0, len(t))
+            at = np.linspace(0.0, 1.0, len(frames))
             travel.append(_along(edge.travel, at, 3))
             turn.append(turned + _along(edge.turn, at, 1)[:, 0])
             turned = turn[-1][-1]
@@ -265,6 +273,11 @@ class Watched:
         if self.size <= 0 and self.n > self.delay:  # from the frames the first sample needs, however they come
             self.size = sequence_size(self.relative[: self.delay + 1], self.seen[: self.delay + 1])
 
+    def motion(self) -> Recording:
+        """The demonstration so far as a motion: root-relative in the body's frame, each part held where it was last
+        seen (0 before it was first seen, where it is not visible), at its own frame rate."""
+        return Recording(self.relative[: self.n].copy(), self.fps, self.body.parts, visible=self.seen[: self.n].copy())
+
     def due(self, ended: bool) -> np.ndarray:
         """The frames of the samples not given yet whose frames are all there (``ended``: every sample left)."""
         last = self.n - 1 if ended else self.n - 1 - self.delay
@@ -320,12 +333,16 @@ class Following:
     learning : TakeLearning, optional
         Learns a demonstration no take predicts as a new movement's take (K&G §4.3, true imitation), a candidate
         from the next demonstration on; ``None``: nothing is learned.
+    answer : Answer, optional
+        What the whole demonstration is scored by and decided on at its end
+        (:mod:`plugins.matchers.forward_model.answer`); ``None``: the followed scores, by ``decision``.
     """
 
     def __init__(self, motor: Any, body: Any, decision: Decision, min_progress: float,
-                 learning: Any | None = None) -> None:
+                 learning: Any | None = None, answer: Answer | None = None) -> None:
         self.motor, self.body, self.decision, self.min_progress = motor, body, decision, float(min_progress)
         self.learning = learning
+        self.answer = answer if answer is not None else FollowedScores(decision)
         self.comparison = Motion(shape="onset")
         with one_thread():
             self.rebuild()
@@ -340,8 +357,10 @@ class Following:
         self._heads = np.flatnonzero(np.r_[True, ordered[1:] != ordered[:-1]]) if len(ordered) else np.zeros(0, int)
         self.movements = [str(m) for m in ordered[self._heads]]
         self._index = {m: i for i, m in enumerate(self.movements)}
+        rows = self.rows()
         if isinstance(self.decision, Calibrated):
-            self.decision.calibrate(self.calibration())
+            self.decision.calibrate(Calibration.of_rows(rows, self.prediction.chains.movements))
+        self.answer.rebuild(rows, self.prediction.chains.movements, partial(self.prediction.motions, self.motor))
         motion: dict[str, float] = {}
         for take, movement in zip(self.prediction.takes, self.prediction.chains.movements):
             moved = float(self.comparison.still(take).mean()) if len(take) else 0.0
@@ -349,12 +368,14 @@ class Following:
         self.stillness = Stillness.of(motion) if self.decision.relative else Stillness()
         self.watched: Watched | None = None
 
-    def calibration(self) -> Calibration:
-        """Each take's prediction as a demonstration: against its movement's other takes and without its movement."""
+    def rows(self) -> np.ndarray:
+        """Each take's prediction followed as a demonstration against every other take (:func:`plugins.matchers.
+        warping.chain_rows`), (C, C): the calibration's own and other scores (leave one take out, leave one movement
+        out)."""
         p = self.prediction
         if p.frames is None:
-            return Calibration()
-        return chain_calibration(self.comparison, p.takes, p.frames, p.chains, partial(followed_scores, rate=RATE))
+            return np.zeros((0, 0))
+        return chain_rows(self.comparison, p.takes, p.frames, p.chains, partial(followed_scores, rate=RATE))
 
     # -- following a demonstration ------------------------------------------------------------
 
@@ -472,13 +493,17 @@ class Following:
         self.add(np.zeros((0, len(self.body.parts), 3)), np.zeros((0, len(self.body.parts)), dtype=bool), ended=True)
         if not self._samples:
             return Match.unknown("nothing seen", details={"reason": "nothing seen"})
+        scores = self.answer.scores(self.chain_scores, self.watched.motion)
+        if scores is not self.chain_scores:  # each movement's best take on the whole demonstration
+            self.chain_scores = scores
+            self.scores = np.minimum.reduceat(scores[self._order], self._heads)
         ranked = tuple(sorted(zip(self.movements, self.scores.tolist()), key=lambda kv: (kv[1], kv[0])))
-        limit = self.decision.threshold()
+        limit = self.answer.decision.threshold()
         nearest, score = ranked[0] if ranked else (None, np.inf)
         if nearest in self.stillness.still:  # it scores 1 whatever is shown: how little was there to explain
             score, limit, measure = self.moving, self.stillness.limit, self.stillness.measure
         else:
-            measure = self.decision.measure
+            measure = self.answer.decision.measure
         if nearest == self.committed and score <= limit:
             return self.commitment
         if self.committed is not None:  # it does not stand: the demonstration did not end where it does

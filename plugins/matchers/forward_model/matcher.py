@@ -19,6 +19,7 @@ import numpy as np
 
 from plugins.lib.strokes import STROKE_PARAMETERS, StrokeCriteria
 from plugins.matchers.forward_model.anchors import Anchors
+from plugins.matchers.forward_model.answer import FollowedAndStrokes
 from plugins.matchers.forward_model.command_graphs import CommandGraphs
 from plugins.matchers.decision import Calibrated
 from plugins.matchers.forward_model.commitment import Commitment
@@ -48,7 +49,10 @@ class ForwardModel(Matcher):
                   "guiding strokes at the path length seen, the largest part's error in metres, dropped beyond "
                   "threshold (the paper); 'motion', every take learned from clips played by its commands and "
                   "followed by time warping with the comparison and the calibrated decision the matchers share "
-                  "(plugins.matchers.forward_model.following; real people).", choices=("strokes", "motion")),
+                  "(plugins.matchers.forward_model.following; real people); 'motion+strokes', the same, and the "
+                  "answer at the end mixes in the takes' strokes over the whole demonstration, weighed by how well "
+                  "the takes show they separate the movements (plugins.matchers.forward_model.answer).",
+                  choices=("strokes", "motion", "motion+strokes")),
         Parameter("calibrated", doc="The calibration of comparison = 'motion' (plugins.matchers.decision).",
                   parameters=(
                       Parameter("known_rejected", float, 0.05, "The share of a known movement's performances that "
@@ -91,14 +95,16 @@ class ForwardModel(Matcher):
         provides(motor, CommandGraphs, needed_by="forward-model", what="a motor command graph",
                  expected=" or ".join(f'[motor] plugin = "{name}"' for name in self.motor_systems))
         self.motor = motor
-        if self.params["comparison"] == "motion":  # the real people's forward model, chosen once: it answers the
+        if self.params["comparison"] != "strokes":  # the real people's forward model, chosen once: it answers the
             # watching loop's calls in place of the paper's mechanism below (K&G §4.4 with the shared comparison)
             provides(motor, Takes, needed_by="forward-model's comparison = 'motion'", what="a motor command graph "
                      "that knows the takes it learned from clips", key=("comparison",),
                      expected="a motor system with takes(), subsystems and body (motor-command-graph with clips)")
-            following = Following(motor, owner.body, Calibrated(self.params["calibrated"]["known_rejected"]),
-                                  self.params["min_progress"],
-                                  TakeLearning(motor, owner.body) if self.params["learn"] else None)
+            known_rejected = self.params["calibrated"]["known_rejected"]
+            answer = FollowedAndStrokes(owner.body, known_rejected) \
+                if self.params["comparison"] == "motion+strokes" else None
+            following = Following(motor, owner.body, Calibrated(known_rejected), self.params["min_progress"],
+                                  TakeLearning(motor, owner.body) if self.params["learn"] else None, answer)
             stream = Streaming(following)
             for name in ("begin", "observe", "replay", "settled", "conclude", "inspect"):
                 setattr(self, name, getattr(stream, name))
