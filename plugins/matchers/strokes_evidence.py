@@ -13,11 +13,14 @@ search, :mod:`plugins.matchers.path_search.evidence`; the forward model's answer
   against every take's at once (:func:`plugins.matchers.stroke_warping.stroke_distances`): the share of the
   demonstration's stroke length a take leaves unexplained, a relative score like the motion comparison's;
 - :func:`evidence_weights`: the two scores mixed per take, each evidence weighed by how well the repertoire's own
-  takes show it separates the movements: by the log of how much farther the nearest other movement lies than
-  the movement's own other takes (medians over the takes), over that distance to the nearest other movement, so a
-  score is first measured in the evidence's own spacing of movements. An evidence whose takes of one movement lie
-  as far apart as movements do counts for nothing. A repertoire of one take per movement shows nothing of how far
-  performances of one movement lie: there the motion comparison decides alone (and no stroke is computed);
+  takes show it separates the movements *where the decision draws its line*: by the log of how much farther the
+  nearest other movement lies than the movement's own other takes, each taken at the quantile the calibrated
+  decision reads (``known_rejected``: the nearest of the other movements but that share, the farthest of the own
+  takes but that share), over that distance to the nearest other movement, so a score is first measured in the
+  evidence's own spacing of movements. An evidence whose takes of one movement lie, at the tails, as far apart as
+  movements do counts for nothing, however well it separates them on the whole: the decision would still call the
+  one a performance of the other. A repertoire of one take per movement shows nothing of how far performances of
+  one movement lie: there the motion comparison decides alone (and no stroke is computed);
 - :class:`StrokesEvidence`: the mix, and the takes scored alike against each other, on which the calibrated
   decision (:mod:`plugins.matchers.decision`) is calibrated. A demonstration with no stroke at all (it moves less
   than a stroke's ``reversal``) is scored by the motion alone, and so is a take with none: the strokes say nothing
@@ -103,8 +106,9 @@ class StrokesEvidence:
     :attr:`weights` are the two evidences' (motion, strokes); :attr:`rows` every take scored alike against every
     other take (:func:`plugins.matchers.warping.chain_rows`' shape), for :meth:`calibration`."""
 
-    def __init__(self, body: Any) -> None:
+    def __init__(self, body: Any, known_rejected: float) -> None:
         self.strokes = TakeStrokes(body)
+        self.known_rejected = float(known_rejected)
         self.weights = np.array([1.0, 0.0])
         self.rows = np.zeros((0, 0))
 
@@ -118,7 +122,7 @@ class StrokesEvidence:
             return
         self.strokes.rebuild(motions())
         stroke_rows = self.strokes.rows()
-        self.weights = evidence_weights([motion_rows, stroke_rows], movements)
+        self.weights = evidence_weights([motion_rows, stroke_rows], movements, self.known_rejected)
         self.rows = np.where(self.strokes.still[:, None] > 0, self._mixed(motion_rows, stroke_rows), motion_rows)
 
     def _mixed(self, motion: np.ndarray, strokes: np.ndarray) -> np.ndarray:
@@ -146,14 +150,16 @@ class StrokesEvidence:
         return Calibration.of_rows(self.rows, movements)
 
 
-def evidence_weights(rows: Sequence[np.ndarray], movements: Sequence[str]) -> np.ndarray:
+def evidence_weights(rows: Sequence[np.ndarray], movements: Sequence[str], known_rejected: float) -> np.ndarray:
     """Each evidence's weight (E,), summing to 1, from its scores of every take against every other (``rows``, each
     (C, C) as :func:`plugins.matchers.warping.chain_rows` gives them) and the takes' ``movements``.
 
-    An evidence's separation is ``log(other / own)``, ``other`` the median score of a take's nearest other movement
-    and ``own`` that of its movement's nearest other take (:meth:`Calibration.of_rows`), at least 0; its weight is
-    its separation over ``other``. Where some evidence shows no separation to weigh (no movement with two takes, no
-    second movement, or every separation 0), the first evidence alone (weight 1)."""
+    An evidence's separation is ``log(other / own)``, at least 0, where the calibrated decision reads the scores
+    (:class:`plugins.matchers.decision.Calibrated`): ``other`` the ``known_rejected`` quantile of the scores of each
+    take's nearest other movement, ``own`` the ``1 - known_rejected`` quantile of those of its movement's nearest
+    other take (:meth:`Calibration.of_rows`); its weight is its separation over ``other``. Where some evidence shows
+    no separation to weigh (no movement with two takes, no second movement, or every separation 0), the first
+    evidence alone (weight 1)."""
     weights = np.zeros(len(rows))
     weights[0] = 1.0
     measured = []
@@ -161,7 +167,8 @@ def evidence_weights(rows: Sequence[np.ndarray], movements: Sequence[str]) -> np
         calibration = Calibration.of_rows(row, movements)
         if not calibration.own or not calibration.other:
             return weights
-        own, other = float(np.median(calibration.own)), float(np.median(calibration.other))
+        own = float(np.quantile(calibration.own, 1.0 - known_rejected))
+        other = float(np.quantile(calibration.other, known_rejected))
         if not other > 0 or not np.isfinite(other):
             return weights
         separation = np.log(other / own) if own > 0 else np.inf

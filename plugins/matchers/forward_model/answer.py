@@ -69,7 +69,7 @@ class FollowedAndStrokes(Answer):
     (``comparison = "motion+strokes"``)."""
 
     def __init__(self, body: Any, known_rejected: float) -> None:
-        self.mix = StrokesEvidence(body)
+        self.mix = StrokesEvidence(body, known_rejected)
         self.decision = Calibrated(known_rejected)
 
     @property

@@ -61,8 +61,8 @@ class MotionAndStrokes(Evidence):
     """The motion comparison's scores and the takes' strokes', weighed as
     :class:`plugins.matchers.strokes_evidence.StrokesEvidence` weighs them."""
 
-    def __init__(self, body: Any) -> None:
-        self.mix = StrokesEvidence(body)
+    def __init__(self, body: Any, known_rejected: float) -> None:
+        self.mix = StrokesEvidence(body, known_rejected)
 
     @property
     def weights(self) -> np.ndarray:

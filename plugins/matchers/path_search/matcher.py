@@ -165,8 +165,8 @@ class PathSearch(Matcher):
                               f"'{self.params['comparison']}' measures in body sizes", key=("decision",),
                               expected="decision = 'calibrated' with comparison = 'motion', or comparison = 'poses'")
         self.comparison: Comparison = comparison("poses" if self.params["comparison"] == "poses" else "motion")
-        self.evidence: Evidence = MotionAndStrokes(owner.body) if self.params["comparison"] == "motion+strokes" \
-            else MotionAlone()
+        self.evidence: Evidence = MotionAndStrokes(owner.body, self.params["calibrated"]["known_rejected"]) \
+            if self.params["comparison"] == "motion+strokes" else MotionAlone()
         self.searcher: Search = SEARCHES[self.params["search"]](self)
         if self.params["decision"] == "calibrated":
             self.decision: Decision = Calibrated(self.params["calibrated"]["known_rejected"])

@@ -2,84 +2,22 @@
 alone, or with the takes' strokes, each evidence weighed by how well the repertoire's takes show it separates the
 movements.
 
-The weights and the calibration are pinned to their formulas on hand-written scores; on generated hand gestures
-(two takes of each movement, other people and styles as demos) the strokes tell waves from raises that the motion
-alone does not; with one take of each movement the strokes weigh nothing and the answers are the motion's.
+On generated hand gestures (two takes of each movement, other people and styles as demos) the strokes tell waves
+from raises that the motion alone does not; with one take of each movement the strokes weigh nothing and the answers
+are the motion's (the weights' formula: ``tests/plugins/matchers/test_strokes_evidence.py``).
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
-from hypothesis import strategies as st
-from hypothesis.extra.numpy import arrays
 
 from plugins.bench.gestures import MOVEMENTS
-from plugins.matchers.decision import Calibration
-from plugins.matchers.strokes_evidence import MOST_SEPARATION, evidence_weights
 from tests.plugins.matchers.hands import HANDS, LOW_RAISE, holding, waving
 from toolkit import ConfigError, load_character
 from toolkit.observe import Observer, compose_observer
 
 STROKES = {"matcher": {"comparison": "motion+strokes"}}
-
-
-def _rows(own: float, other: float, takes: int = 2, movements: int = 2) -> tuple[np.ndarray, list[str]]:
-    """Scores of ``takes`` takes of each of ``movements`` movements against each other: ``own`` between two takes
-    of one movement, ``other`` between movements, ``inf`` on the diagonal."""
-    labels = [f"m{i}" for i in range(movements) for _ in range(takes)]
-    same = np.equal.outer(labels, labels)
-    rows = np.where(same, own, other).astype(float)
-    np.fill_diagonal(rows, np.inf)
-    return rows, labels
-
-
-def test_each_evidence_weighs_its_separation_over_its_spacing():
-    """Motion: own 0.5, other 0.6; strokes: own 0.1, other 0.8: weights in the ratio log(1.2) / 0.6 to
-    log(8) / 0.8, summing to 1."""
-    motion, labels = _rows(0.5, 0.6)
-    strokes, _ = _rows(0.1, 0.8)
-    expected = np.array([np.log(1.2) / 0.6, np.log(8.0) / 0.8])
-    assert evidence_weights([motion, strokes], labels) == pytest.approx(expected / expected.sum())
-
-
-@pytest.mark.parametrize(("own", "other", "expected"), [
-    (0.9, 0.6, [1.0, 0.0]),     # the strokes' takes lie as far apart as movements: they weigh nothing
-    (0.0, 0.8, None),           # two copies of one clip: the most separation counts, not an infinite one
-])
-def test_an_evidence_that_separates_nothing_weighs_nothing_and_copies_do_not_weigh_everything(own, other, expected):
-    motion, labels = _rows(0.3, 0.6)
-    strokes, _ = _rows(own, other)
-    weights = evidence_weights([motion, strokes], labels)
-    if expected is None:
-        expected = np.array([np.log(2.0) / 0.6, MOST_SEPARATION / 0.8])
-        expected = expected / expected.sum()
-    assert weights == pytest.approx(expected)
-
-
-@pytest.mark.parametrize("case", ["one take of each", "one movement", "nothing separates"])
-def test_where_the_takes_show_no_separation_the_motion_decides_alone(case):
-    rows = {"one take of each": _rows(0.2, 0.6, takes=1), "one movement": _rows(0.2, 0.6, movements=1),
-            "nothing separates": _rows(0.7, 0.6)}[case]
-    assert evidence_weights([rows[0], rows[0]], rows[1]).tolist() == [1.0, 0.0]
-
-
-@settings(max_examples=100, deadline=None)
-@given(st.lists(st.sampled_from("abc"), min_size=1, max_size=7).flatmap(lambda labels: st.tuples(
-    st.just(labels), arrays(np.float64, (len(labels), len(labels)), elements=st.floats(0.0, 2.0)))))
-def test_the_calibration_of_rows_is_each_takes_nearest_own_and_other(case):
-    """Each take's row, itself left out: own is the least of its movement's other takes, other the least of every
-    other movement's takes; takes with neither give nothing."""
-    labels, rows = case
-    rows = rows.copy()
-    np.fill_diagonal(rows, 5.0)  # never read
-    got = Calibration.of_rows(rows, labels)
-    own = [min(rows[c, d] for d in range(len(labels)) if d != c and labels[d] == labels[c]) for c in range(len(labels))
-           if labels.count(labels[c]) > 1]
-    other = [min(rows[c, d] for d in range(len(labels)) if labels[d] != labels[c]) for c in range(len(labels))
-             if len(set(labels)) > 1]
-    assert got == Calibration.of(own, other)
 
 
 def _answers(pm, folder, profile, demos, settings=None):
