@@ -33,7 +33,8 @@ the decision the matchers share:
   "stop imitation") and the other is committed to (Fig. 3: back to the last correct node, predict again, and
   imitate what prevails);
 - **the answer at the end**: every movement's score over the whole demonstration, decided as path search decides
-  (:mod:`plugins.matchers.decision`). A commitment stands when it is that answer (its ``decided_at`` is when it was
+  (:mod:`plugins.matchers.decision`); with ``comparison = "motion+strokes"`` the takes' strokes mixed in, on a
+  calibration of their own (:mod:`plugins.matchers.forward_model.answer`). A commitment stands when it is that answer (its ``decided_at`` is when it was
   committed to); otherwise the answer at the end replaces it (K&G §4.4: the demonstration must end where the
   committed movement does);
 - **standing still**: a movement whose commands predict no motion at all (a pose held) is never committed to early;

@@ -41,7 +41,7 @@ def generated(tmp_path_factory, pm):
 def observer(generated, pm):
     data, profile = generated
     character = compose_observer(pm, profile, data / "repertoire", matcher="forward-model")
-    assert character.matcher.params["comparison"] == "motion"  # the observer template's
+    assert character.matcher.params["comparison"] == "motion+strokes"  # the observer template's
     return character
 
 

@@ -35,7 +35,7 @@ def watcher(pm, generated, learn):
     data, known, profile = generated
     settings = {"matcher": {"learn": True}} if learn else {}
     character = compose_observer(pm, profile, known, matcher="forward-model", settings=settings)
-    assert character.matcher.params["comparison"] == "motion"
+    assert character.matcher.params["comparison"] == "motion+strokes"
     return character, Observer(character, profile.body, 30.0)
 
 
