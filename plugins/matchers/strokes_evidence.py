@@ -13,14 +13,15 @@ search, :mod:`plugins.matchers.path_search.evidence`; the forward model's answer
   against every take's at once (:func:`plugins.matchers.stroke_warping.stroke_distances`): the share of the
   demonstration's stroke length a take leaves unexplained, a relative score like the motion comparison's;
 - :func:`evidence_weights`: the two scores mixed per take, each evidence weighed by how well the repertoire's own
-  takes show it separates the movements *where the decision draws its line*: by the log of how much farther the
-  nearest other movement lies than the movement's own other takes, each taken at the quantile the calibrated
-  decision reads (``known_rejected``: the nearest of the other movements but that share, the farthest of the own
-  takes but that share), over that distance to the nearest other movement, so a score is first measured in the
-  evidence's own spacing of movements. An evidence whose takes of one movement lie, at the tails, as far apart as
-  movements do counts for nothing, however well it separates them on the whole: the decision would still call the
-  one a performance of the other. A repertoire of one take per movement shows nothing of how far performances of
-  one movement lie: there the motion comparison decides alone (and no stroke is computed);
+  takes show it separates the movements: by the log of how much farther the nearest other movement lies than the
+  movement's own other takes (medians over the takes), over that distance to the nearest other movement, so a score
+  is first measured in the evidence's own spacing of movements. The strokes, an evidence added to the matcher's own
+  comparison, count only where they separate the movements *where the decision draws its line*: where the nearest
+  of the other movements but ``known_rejected`` of them lies farther than the farthest of the own takes but that
+  share (the quantiles the calibrated decision reads). Strokes whose takes of one movement lie, at those tails, as
+  far apart as movements do count for nothing, however well they separate them on the whole: the decision would
+  still call the one a performance of the other. A repertoire of one take per movement shows nothing of how far
+  performances of one movement lie: there the motion comparison decides alone (and no stroke is computed);
 - :class:`StrokesEvidence`: the mix, and the takes scored alike against each other, on which the calibrated
   decision (:mod:`plugins.matchers.decision`) is calibrated. A demonstration with no stroke at all (it moves less
   than a stroke's ``reversal``) is scored by the motion alone, and so is a take with none: the strokes say nothing
@@ -152,26 +153,31 @@ class StrokesEvidence:
 
 def evidence_weights(rows: Sequence[np.ndarray], movements: Sequence[str], known_rejected: float) -> np.ndarray:
     """Each evidence's weight (E,), summing to 1, from its scores of every take against every other (``rows``, each
-    (C, C) as :func:`plugins.matchers.warping.chain_rows` gives them) and the takes' ``movements``.
+    (C, C) as :func:`plugins.matchers.warping.chain_rows` gives them; the first the matcher's own comparison's) and
+    the takes' ``movements``.
 
-    An evidence's separation is ``log(other / own)``, at least 0, where the calibrated decision reads the scores
-    (:class:`plugins.matchers.decision.Calibrated`): ``other`` the ``known_rejected`` quantile of the scores of each
-    take's nearest other movement, ``own`` the ``1 - known_rejected`` quantile of those of its movement's nearest
-    other take (:meth:`Calibration.of_rows`); its weight is its separation over ``other``. Where some evidence shows
-    no separation to weigh (no movement with two takes, no second movement, or every separation 0), the first
-    evidence alone (weight 1)."""
+    An evidence's separation is ``log(other / own)``, at least 0, ``other`` the median score of each take's nearest
+    other movement and ``own`` that of its movement's nearest other take (:meth:`Calibration.of_rows`); its weight is
+    its separation over ``other``. An evidence beside the first counts only where it separates the movements where
+    the calibrated decision draws its line (:class:`plugins.matchers.decision.Calibrated`): where the
+    ``known_rejected`` quantile of the other scores lies beyond the ``1 - known_rejected`` quantile of the own ones;
+    else it weighs nothing. Where no evidence shows a separation to weigh (no movement with two takes, no second
+    movement, or every separation 0), the first evidence alone (weight 1)."""
     weights = np.zeros(len(rows))
     weights[0] = 1.0
     measured = []
-    for row in rows:
+    for k, row in enumerate(rows):
         calibration = Calibration.of_rows(row, movements)
         if not calibration.own or not calibration.other:
             return weights
-        own = float(np.quantile(calibration.own, 1.0 - known_rejected))
-        other = float(np.quantile(calibration.other, known_rejected))
+        own, other = float(np.median(calibration.own)), float(np.median(calibration.other))
         if not other > 0 or not np.isfinite(other):
             return weights
         separation = np.log(other / own) if own > 0 else np.inf
+        if k and not np.quantile(calibration.other, known_rejected) > np.quantile(calibration.own, 1 - known_rejected):
+            separation = 0.0  # an added evidence that does not separate the movements where "unknown" is decided
         measured.append(min(max(separation, 0.0), MOST_SEPARATION) / other)
     total = float(np.sum(measured))
     return np.asarray(measured) / total if total > 0 else weights
+
+

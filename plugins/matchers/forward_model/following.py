@@ -34,9 +34,9 @@ the decision the matchers share:
   imitate what prevails);
 - **the answer at the end**: every movement's score over the whole demonstration, decided as path search decides
   (:mod:`plugins.matchers.decision`); with ``comparison = "motion+strokes"`` the takes' strokes mixed in, on a
-  calibration of their own (:mod:`plugins.matchers.forward_model.answer`). A commitment stands when it is that answer (its ``decided_at`` is when it was
-  committed to); otherwise the answer at the end replaces it (K&G §4.4: the demonstration must end where the
-  committed movement does);
+  calibration of their own (:mod:`plugins.matchers.forward_model.answer`). A commitment stands when it is that
+  answer (its ``decided_at`` is when it was committed to); otherwise the answer at the end replaces it (K&G §4.4:
+  the demonstration must end where the committed movement does);
 - **standing still**: a movement whose commands predict no motion at all (a pose held) is never committed to early;
   when it comes nearest at the end, the demonstration is it if it moved at most half as much as the least moving
   other movement (:class:`plugins.matchers.decision.Stillness`), else unknown;

@@ -1,7 +1,8 @@
 """The takes' strokes as a second evidence beside a motion comparison (plugins.matchers.strokes_evidence): each
-evidence weighed by how well the repertoire's takes show it separates the movements where the calibrated decision
-draws its line, pinned to the formula on hand-written scores. Path search's use of it is tested in
-``path_search/test_evidence.py``, the forward model's in ``forward_model/test_answer.py``."""
+evidence weighed by how well the repertoire's takes show it separates the movements, the strokes only where they
+separate them where the calibrated decision draws its line, pinned to the formula on hand-written scores. Path
+search's use of it is tested in ``path_search/test_evidence.py``, the forward model's in
+``forward_model/test_answer.py``."""
 
 from __future__ import annotations
 
@@ -75,7 +76,7 @@ def test_the_calibration_of_rows_is_each_takes_nearest_own_and_other(case):
     assert got == Calibration.of(own, other)
 
 
-def test_an_evidence_is_weighed_where_the_decision_reads_it_not_by_its_medians():
+def test_the_strokes_count_only_where_they_separate_the_movements_where_the_decision_reads_them():
     """Strokes whose takes lie far nearer each other than movements on the whole (own 0.1, other 0.8), but one of
     ten movements' takes as far apart as movements come (0.9): at the quantiles the decision reads
     (``known_rejected``) they separate nothing and weigh nothing; read at the medians (0.5) they weigh most."""
@@ -84,3 +85,14 @@ def test_an_evidence_is_weighed_where_the_decision_reads_it_not_by_its_medians()
     strokes[0, 1] = strokes[1, 0] = 0.9
     assert evidence_weights([motion, strokes], labels, RATE).tolist() == [1.0, 0.0]
     assert evidence_weights([motion, strokes], labels, 0.5)[1] > 0.5
+
+
+def test_the_matchers_own_comparison_counts_by_its_medians_even_where_its_tails_overlap():
+    """Takes of two performers: the motion's own takes lie as far apart at the tails as movements (one pair at 0.9),
+    and nearer on the whole (0.3 against 0.6); the strokes separate at the tails too. The motion, the matcher's own
+    comparison, still weighs its median separation: the strokes do not decide alone."""
+    motion, labels = _rows(0.3, 0.6, movements=10)
+    motion[0, 1] = motion[1, 0] = 0.9
+    strokes, _ = _rows(0.1, 0.8, movements=10)
+    expected = np.array([np.log(2.0) / 0.6, np.log(8.0) / 0.8])
+    assert evidence_weights([motion, strokes], labels, RATE) == pytest.approx(expected / expected.sum())
