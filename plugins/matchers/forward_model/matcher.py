@@ -97,9 +97,10 @@ class ForwardModel(Matcher):
         self.motor = motor
         if self.params["comparison"] != "strokes":  # the real people's forward model, chosen once: it answers the
             # watching loop's calls in place of the paper's mechanism below (K&G §4.4 with the shared comparison)
-            provides(motor, Takes, needed_by="forward-model's comparison = 'motion'", what="a motor command graph "
-                     "that knows the takes it learned from clips", key=("comparison",),
-                     expected="a motor system with takes(), subsystems and body (motor-command-graph with clips)")
+            provides(motor, Takes, needed_by=f"forward-model's comparison = '{self.params['comparison']}'",
+                     what="a motor command graph that knows the takes it learned from clips", key=("comparison",),
+                     expected="a motor system with takes(), play_take(), take_motions(), subsystems and body "
+                              "(motor-command-graph with clips)")
             known_rejected = self.params["calibrated"]["known_rejected"]
             answer = FollowedAndStrokes(owner.body, known_rejected) \
                 if self.params["comparison"] == "motion+strokes" else None
