@@ -494,10 +494,8 @@ class Following:
         self.add(np.zeros((0, len(self.body.parts), 3)), np.zeros((0, len(self.body.parts)), dtype=bool), ended=True)
         if not self._samples:
             return Match.unknown("nothing seen", details={"reason": "nothing seen"})
-        scores = self.answer.scores(self.chain_scores, self.watched.motion)
-        if scores is not self.chain_scores:  # each movement's best take on the whole demonstration
-            self.chain_scores = scores
-            self.scores = np.minimum.reduceat(scores[self._order], self._heads)
+        self.chain_scores = self.answer.scores(self.chain_scores, self.watched.motion)
+        self.scores = np.minimum.reduceat(self.chain_scores[self._order], self._heads)  # each movement's best take
         ranked = tuple(sorted(zip(self.movements, self.scores.tolist()), key=lambda kv: (kv[1], kv[0])))
         limit = self.answer.decision.threshold()
         nearest, score = ranked[0] if ranked else (None, np.inf)
