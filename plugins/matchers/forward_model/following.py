@@ -66,6 +66,7 @@ from plugins.matchers.comparison import Frames, Motion, sequence_size
 from plugins.matchers.decision import Calibrated, Calibration, Decision, Stillness
 from plugins.matchers.forward_model.answer import Answer, FollowedScores
 from plugins.matchers.pacing import PacedWarping, followed_scores
+from plugins.matchers.strokes_evidence import PLAYED_FPS
 from plugins.matchers.warping import Chains, chain_rows
 from toolkit import Match
 from toolkit import Motion as Recording
@@ -133,7 +134,7 @@ class Prediction:
 
     def motions(self, motor: Any) -> list[Recording | None]:
         """Each chain's take as a motion (:meth:`MotorCommandGraph.take_motions`), in the chains' order."""
-        played = motor.take_motions(fps=PLAY_FPS)
+        played = motor.take_motions(fps=PLAYED_FPS)
         return [played[movement][k] for movement, k in self.sources]
 
     @staticmethod
