@@ -15,11 +15,18 @@ part by part (:func:`warp_strokes`). What that sees, and what it does not:
   repeated steps), so seven swings match four;
 - *not a stroke cut in two*: up to ``merge`` successive strokes of one sequence may stand for one of the other, at
   the length the path lost by the merge (two strokes in one direction merge for free, a swing and its return
-  do not: they cost what they lose).
+  do not: they cost what they lose);
+- *not the size*: the strokes are cut in body sizes, then every part's scaled together to a total length of 1
+  (:func:`shares`), each stroke its share of what the sequence does. A wave held low with smaller swings is the
+  same strokes as a wave held high with wide ones; what is left is the shape: which parts move, in which
+  directions, in which proportions (the lift against the swings). Where a hand is held and how far it goes is the
+  motion comparison's to see (path search's and the forward model's, beside which these strokes are an evidence:
+  :mod:`plugins.matchers.strokes_evidence`).
 
-The distance of two sequences is, summed over the parts, the length of stroke left unexplained along the best
-alignment (:func:`warp_strokes`), in body sizes; a part with no strokes in one sequence leaves all the other's
-unexplained. Its distance to standing still is the total length of its strokes (:meth:`StrokeWarping._still`).
+The distance of two sequences is, summed over the parts, the share of stroke left unexplained along the best
+alignment (:func:`warp_strokes`); a part with no strokes in one sequence leaves all the other's unexplained. A
+sequence's distance to standing still is the total share of its strokes, 1 (:meth:`StrokeWarping._still`; 0 with
+no stroke at all).
 The decision is the matchers' shared one (:mod:`plugins.matchers.decision`): ``calibrated`` (the default) on the
 examples themselves, its score the share of the demonstration's stroke length the nearest example leaves
 unexplained; ``nearest`` never says "unknown" (a 1-NN classifier).
@@ -40,7 +47,7 @@ from plugins.matchers.decision import Decision, Distance
 from plugins.matchers.dtw import DTW, Grouped, body_sized, position_parts
 from toolkit import Parameter, hookimpl
 
-__all__ = ["MERGE", "PartStrokes", "REVERSAL", "SMOOTH", "StrokeWarping", "Strokes", "flat_strokes",
+__all__ = ["MERGE", "PartStrokes", "REVERSAL", "SMOOTH", "StrokeWarping", "Strokes", "flat_strokes", "shares",
            "stroke_distances", "strokes_still", "warp_strokes"]
 
 REVERSAL = 0.1
@@ -52,25 +59,27 @@ MERGE = 3
 """The most successive strokes that may stand for one stroke of the other sequence: the default of ``merge``."""
 
 Strokes = list[np.ndarray]
-"""A sequence as this matcher sees it: one array of strokes (k, 3) per compared part, in body sizes."""
+"""A sequence as this matcher sees it: one array of strokes (k, 3) per compared part, in shares of the sequence's
+stroke length (:func:`shares`)."""
 
 
 class PartStrokes:
     """The strokes of the chosen ``parts`` (indices) of root-relative positions, in the sequence's body size (the
     size of its ``sized`` parts, the position parts), cut where a part turns back by ``reversal`` body sizes after
-    ``smooth`` seconds of smoothing."""
+    ``smooth`` seconds of smoothing, and scaled to shares of their total length (:func:`shares`)."""
 
-    measure = "stroke length left unexplained (body sizes)"
+    measure = "share of the stroke length left unexplained"
 
     def __init__(self, parts: np.ndarray, root: int, sized: np.ndarray, reversal: float, smooth: float) -> None:
         self.parts, self.root, self.sized, self.reversal, self.smooth = parts, root, sized, reversal, smooth
 
     def series(self, rel: np.ndarray, fps: float) -> Strokes:
-        """The strokes of each chosen part of the poses ``rel`` (n, P, 3) sampled ``fps`` times a second."""
+        """The strokes of each chosen part of the poses ``rel`` (n, P, 3) sampled ``fps`` times a second, cut in body
+        sizes and scaled together to a total length of 1 (:func:`shares`)."""
         rel, scale = body_sized(rel, self.root, self.sized)
         if not scale > 0:
             return self.none()
-        return parts_strokes(rel[:, self.parts] * scale, fps, self.reversal, self.smooth)
+        return shares(parts_strokes(rel[:, self.parts] * scale, fps, self.reversal, self.smooth))
 
     def none(self) -> Strokes:
         """A sequence with no stroke: what standing still gives."""
@@ -131,6 +140,13 @@ class StrokeWarping(DTW):
 
     def _still(self, series: Strokes) -> float:
         return strokes_still(series)
+
+
+def shares(series: Strokes) -> Strokes:
+    """The strokes of every part scaled together to a total length of 1, each stroke its share of the sequence's
+    stroke length (a sequence with no stroke as it is): what the parts do, whatever the size they do it at."""
+    total = strokes_still(series)
+    return [strokes / total for strokes in series] if total > 0 else series
 
 
 def strokes_still(series: Strokes) -> float:

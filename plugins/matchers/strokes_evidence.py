@@ -9,7 +9,8 @@ search, :mod:`plugins.matchers.path_search.evidence`; the forward model's answer
 :mod:`plugins.matchers.forward_model.answer`):
 
 - :class:`TakeStrokes`: each take's strokes, from the clip it was learned from (else its movement played), cut
-  where a part turns back (:class:`plugins.matchers.stroke_warping.PartStrokes`), and a demonstration's warped
+  where a part turns back and scaled to shares of their total length, so that they show what the parts do and not
+  at what size (:class:`plugins.matchers.stroke_warping.PartStrokes`), and a demonstration's warped
   against every take's at once (:func:`plugins.matchers.stroke_warping.stroke_distances`): the share of the
   demonstration's stroke length a take leaves unexplained, a relative score like the motion comparison's;
 - :func:`evidence_weights`: the two scores mixed per take, each evidence weighed by how well the repertoire's own

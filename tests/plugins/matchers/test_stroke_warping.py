@@ -8,7 +8,15 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from plugins.matchers.stroke_warping import _warp_all, flat_strokes, warp_strokes
+from plugins.matchers.reversals import parts_strokes
+from plugins.matchers.stroke_warping import (
+    PartStrokes,
+    _warp_all,
+    flat_strokes,
+    shares,
+    strokes_still,
+    warp_strokes,
+)
 from tests.plugins.matchers.hands import HANDS, LOW_RAISE, holding, waving
 from toolkit import ConfigError, load_character
 
@@ -41,11 +49,12 @@ def test_tempo_swings_and_the_held_place_do_not_decide_how_a_hand_moves(write, p
 
 def test_a_new_movement_is_unknown_and_a_slow_known_one_is_not(write, pm):
     """Calibrated on one example of each of three movements (leave one movement out): a reach forward at the hip's
-    height, which the observer does not know, is unknown, with its nearest movement and the threshold, below 1 (its
-    score is not beyond standing still); the wave four times slower is known."""
+    height, which the observer does not know, is unknown, with its nearest movement and the threshold, below 1 (a
+    movement that explains a demonstration no better than standing still is never known); the wave four times slower
+    is known."""
     matcher = _observer(write, pm, known=LOW_RAISE).matcher
     reach = matcher.match(_performed(write, pm, "reach"))
-    assert reach.movement is None and reach.threshold < reach.score < 1.0 and reach.nearest == "low_raise"
+    assert reach.movement is None and reach.threshold < min(reach.score, 1.0) and reach.nearest == "low_raise"
     slow = matcher.match(_performed(write, pm, "wave", 0.25))
     assert slow.movement == "wave" and slow.score <= slow.threshold
 
@@ -61,6 +70,25 @@ def test_bad_settings_are_clear_errors(write, pm):
         _observer(write, pm, 'parts = ["wrist"]\n')
     with pytest.raises(ConfigError, match="decision"):
         _observer(write, pm, 'decision = "distance"\n')
+
+
+def test_a_wave_half_the_size_makes_the_same_strokes():
+    """The strokes are shares of the sequence's stroke length: a hand lifted half as high that swings half as wide
+    makes the same strokes as the full wave, summing to a length of 1; a raise (up and down) is far from both."""
+    t = np.arange(0.0, 3.0, 1.0 / FPS)
+    lift = np.clip(t / 0.5, 0.0, 1.0) * np.clip((3.0 - t) / 0.5, 0.0, 1.0)
+    swing = np.where((t > 0.7) & (t < 2.2), 0.3 * np.sin(2.0 * np.pi * 2.0 * (t - 0.7)), 0.0)
+    wave = np.stack([swing, lift, np.zeros_like(t)], axis=1)
+    features = PartStrokes(np.array([2]), 0, np.array([1, 2]), 0.05, 0.0)  # the hand; sized by the head and hand
+
+    def body(k):  # the root at the origin, the head still, the hand's path k times as large
+        return np.stack([0 * wave, 0 * wave + [0.0, 1.6, 0.0], [0.2, 0.8, 0.0] + k * wave], axis=1)
+    full, half = (features.series(body(k), FPS) for k in (1.0, 0.5))
+    assert len(full[0]) == len(half[0]) > 4 and strokes_still(full) == pytest.approx(1.0)
+    np.testing.assert_allclose(half[0], full[0], atol=1e-12)
+    raise_ = shares(parts_strokes(np.stack([0 * t, lift, 0 * t], axis=1)[:, None], FPS, 0.05))
+    assert warp_strokes(full[0], half[0]) < 1e-12 and warp_strokes(full[0], raise_[0]) > 0.5
+    assert shares([np.zeros((0, 3))])[0].shape == (0, 3)  # no stroke: nothing to share
 
 
 def test_warping_by_hand():
