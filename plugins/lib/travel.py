@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["frame_rotation", "body_velocity", "travel_part", "turned"]
+__all__ = ["frame_rotation", "body_velocity", "travel_part", "travelled", "turned"]
 
 
 def frame_rotation(world: np.ndarray, local: np.ndarray, visible: np.ndarray, root: int) -> np.ndarray:
@@ -58,6 +58,24 @@ def turned(world: np.ndarray, local: np.ndarray, visible: np.ndarray, root: int)
     if known.any():
         unwrapped = np.unwrap(angle[known])
         out[known] = unwrapped[0] - unwrapped  # the body's heading turns opposite to the frame rotation
+    return out
+
+
+def travelled(world: np.ndarray, local: np.ndarray, visible: np.ndarray, root: int) -> np.ndarray:
+    """Where the root has gone since the first frame whose facing is known, in the body's frame at that frame (F,
+    3), metres: a walk forwards goes along +z whichever way the body faced in the world, a walk backwards along -z, a
+    turning walk curves to the side it turns to. NaN where the root is not seen, and everywhere when no facing is
+    ever known (:func:`frame_rotation`)."""
+    world = np.asarray(world, dtype=float)
+    angle = frame_rotation(world, local, visible, root)
+    out = np.full((len(world), 3), np.nan)
+    known = np.flatnonzero(np.isfinite(angle))
+    if not len(known):
+        return out
+    offset = world[:, root] - world[known[0], root]
+    horizontal = (offset[:, 0] + 1j * offset[:, 2]) * np.exp(1j * angle[known[0]])
+    out[:, 0], out[:, 1], out[:, 2] = horizontal.real, offset[:, 1], horizontal.imag
+    out[~(np.asarray(visible, dtype=bool)[:, root] & np.isfinite(offset).all(axis=1))] = np.nan
     return out
 
 

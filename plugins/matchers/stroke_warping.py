@@ -73,17 +73,27 @@ class PartStrokes:
     def __init__(self, parts: np.ndarray, root: int, sized: np.ndarray, reversal: float, smooth: float) -> None:
         self.parts, self.root, self.sized, self.reversal, self.smooth = parts, root, sized, reversal, smooth
 
-    def series(self, rel: np.ndarray, fps: float) -> Strokes:
+    def series(self, rel: np.ndarray, fps: float, track: np.ndarray | None = None) -> Strokes:
         """The strokes of each chosen part of the poses ``rel`` (n, P, 3) sampled ``fps`` times a second, cut in body
-        sizes and scaled together to a total length of 1 (:func:`shares`)."""
+        sizes and scaled together to a total length of 1 (:func:`shares`); ``track``: where the root went (n, 3),
+        for strokes that see it (:meth:`paths`)."""
         rel, scale = body_sized(rel, self.root, self.sized)
         if not scale > 0:
             return self.none()
-        return shares(parts_strokes(rel[:, self.parts] * scale, fps, self.reversal, self.smooth))
+        return shares(parts_strokes(self.paths(rel, track) * scale, fps, self.reversal, self.smooth))
+
+    def paths(self, rel: np.ndarray, track: np.ndarray | None) -> np.ndarray:
+        """The paths cut into strokes (n, K, 3), metres: the chosen parts' root-relative ones."""
+        return rel[:, self.parts]
+
+    @property
+    def count(self) -> int:
+        """How many paths a sequence's strokes have (K)."""
+        return len(self.parts)
 
     def none(self) -> Strokes:
         """A sequence with no stroke: what standing still gives."""
-        return [np.zeros((0, 3)) for _ in self.parts]
+        return [np.zeros((0, 3)) for _ in range(self.count)]
 
 
 class FlatTemplates(Grouped):

@@ -10,7 +10,9 @@ search, :mod:`plugins.matchers.path_search.evidence`; the forward model's answer
 
 - :class:`TakeStrokes`: each take's strokes, from the clip it was learned from (else its movement played), cut
   where a part turns back and scaled to shares of their total length, so that they show what the parts do and not
-  at what size (:class:`plugins.matchers.stroke_warping.PartStrokes`), and a demonstration's warped
+  at what size (:class:`plugins.matchers.stroke_warping.PartStrokes`), the root's travel among them
+  (:class:`TravelStrokes`: a walk backwards is not a walk forwards, a turn to the right not one to the left, where
+  the motions carry their world positions), and a demonstration's warped
   against every take's at once (:func:`plugins.matchers.stroke_warping.stroke_distances`): the share of the
   demonstration's stroke length a take leaves unexplained, a relative score like the motion comparison's;
 - :func:`evidence_weights`: the two scores mixed per take, each evidence weighed by how well the repertoire's own
@@ -39,6 +41,7 @@ from typing import Any
 
 import numpy as np
 
+from plugins.lib.travel import travelled
 from plugins.matchers.decision import Calibration
 from plugins.matchers.dtw import position_parts
 from plugins.matchers.stroke_warping import (
@@ -52,7 +55,7 @@ from plugins.matchers.stroke_warping import (
 )
 from toolkit import Motion
 
-__all__ = ["MOST_SEPARATION", "PLAYED_FPS", "StrokesEvidence", "TakeStrokes", "evidence_weights"]
+__all__ = ["MOST_SEPARATION", "PLAYED_FPS", "StrokesEvidence", "TakeStrokes", "TravelStrokes", "evidence_weights"]
 
 PLAYED_FPS = 30.0
 """Frames per second at which a take with no clip of its own (a learned movement, key poses, a take restored from
@@ -63,13 +66,29 @@ MOST_SEPARATION = float(np.log(1000.0))
 copies of one clip are infinitely near, and would leave the other evidence nothing)."""
 
 
+class TravelStrokes(PartStrokes):
+    """Every position part's strokes and the root's travel's, as one more path: where the root went since the
+    first frame, in the body's frame at that frame (:func:`plugins.lib.travel.travelled`), cut like a part's. A walk
+    forwards and one backwards make the same strokes of the limbs, root-relative, and opposite strokes of the root;
+    a turn to the left and one to the right, strokes of the root that curve to either side."""
+
+    def paths(self, rel: np.ndarray, track: np.ndarray | None) -> np.ndarray:
+        """The chosen parts' root-relative paths and ``track`` (none known: the root held where it is)."""
+        track = np.zeros((len(rel), 3)) if track is None else track
+        return np.concatenate([rel[:, self.parts], track[:, None]], axis=1)
+
+    @property
+    def count(self) -> int:
+        return len(self.parts) + 1
+
+
 class TakeStrokes:
-    """Every take's strokes, with the defaults of :mod:`plugins.matchers.stroke_warping`, and a demonstration's
-    relative score against each."""
+    """Every take's strokes, with the defaults of :mod:`plugins.matchers.stroke_warping` and the root's travel
+    (:class:`TravelStrokes`), and a demonstration's relative score against each."""
 
     def __init__(self, body: Any) -> None:
         parts, sized = position_parts(body, [])
-        self.features = PartStrokes(parts, body.root_index, sized, REVERSAL, SMOOTH)
+        self.features = TravelStrokes(parts, body.root_index, sized, REVERSAL, SMOOTH)
         self.templates: list[Strokes] = []
         self.flat, self.starts = flat_strokes([])
         self.still = np.zeros(0)
@@ -82,11 +101,12 @@ class TakeStrokes:
         self.still = np.array([strokes_still(t) for t in self.templates])
 
     def series(self, motion: Motion) -> Strokes:
-        """A motion's strokes (hidden parts held where last seen, :meth:`toolkit.Motion.filled`)."""
+        """A motion's strokes (hidden parts held where last seen, :meth:`toolkit.Motion.filled`; the root's travel
+        from its world positions, :attr:`toolkit.Motion.world`, bridged where it is not seen; none known: none)."""
         if motion.n_frames < 2 or not motion.visible.any():
             return self.features.none()
         positions = np.asarray(motion.positions, dtype=float) if motion.visible.all() else motion.filled().positions
-        return self.features.series(positions, motion.fps)
+        return self.features.series(positions, motion.fps, _track(motion, self.features.root))
 
     def scores(self, series: Strokes, still: float) -> np.ndarray:
         """Each take's stroke length left unexplained by ``series`` over its own (``still`` > 0), (C,)."""
@@ -150,6 +170,22 @@ class StrokesEvidence:
     def calibration(self, movements: Sequence[str]) -> Calibration:
         """Leave one take out and leave one movement out, on the takes scored alike (:attr:`rows`)."""
         return Calibration.of_rows(self.rows, movements)
+
+
+def _track(motion: Motion, root: int) -> np.ndarray | None:
+    """Where ``motion``'s root went (:func:`plugins.lib.travel.travelled`), linearly bridged over the frames it was
+    not seen in and held beyond them; ``None`` where the motion has no world positions or its facing is never
+    known."""
+    if motion.world is None:
+        return None
+    track = travelled(motion.world, motion.positions, motion.visible, root)
+    seen = np.isfinite(track).all(axis=1)
+    if not seen.any():
+        return None
+    if seen.all():
+        return track
+    steps = np.arange(len(track))
+    return np.stack([np.interp(steps, steps[seen], track[seen, k]) for k in range(3)], axis=1)
 
 
 def evidence_weights(rows: Sequence[np.ndarray], movements: Sequence[str], known_rejected: float) -> np.ndarray:

@@ -15,7 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from plugins.lib.root_frame import root_relative
-from plugins.lib.travel import body_velocity, frame_rotation, travel_part
+from plugins.lib.travel import body_velocity, frame_rotation, travel_part, travelled
 from tests.conftest import STICK, STICK_PARTS, write_stick_clip, write_stick_profile
 from toolkit import Motion, create_plugin_manager, load_character
 from toolkit.motion import local_to_world
@@ -70,6 +70,29 @@ def test_hidden_roots_and_frames_without_a_facing_have_no_velocity():
     assert np.isnan(velocity[[4, 6]]).all()
     assert np.allclose(np.delete(velocity, [4, 6], axis=0), [0.0, 0.0, 1.2])
     assert np.isnan(body_velocity(world[:1], local[:1], visible[:1], 0, 30.0)).all()  # one frame: no velocity
+
+
+@settings(max_examples=40, deadline=None)
+@given(heading=st.floats(-np.pi, np.pi), vx=st.floats(-2, 2), vz=st.floats(-4, 4))
+def test_where_the_root_went_is_in_the_bodys_first_frame_whatever_its_heading(heading, vx, vz):
+    world, local = walking(heading, np.array([vx, 0.0, vz]))
+    went = travelled(world, local, np.ones(world.shape[:2], dtype=bool), 0)
+    assert np.allclose(went, np.arange(len(world))[:, None] / 30.0 * [vx, 0.0, vz], atol=1e-9)
+
+
+def test_a_walk_that_turns_left_goes_off_to_the_left_of_where_it_began_facing():
+    """A quarter turn to the heading's positive side (the body's left, +x) while walking along the facing: the path,
+    in the body's first frame, ends ahead and to the left; a root never seen or a facing never known: NaN."""
+    t = np.arange(61) / 30.0
+    heading = np.pi / 2 * t / t[-1]
+    roots = np.cumsum(np.stack([np.sin(heading), 0 * t, np.cos(heading)], axis=1) * 1.2 / 30.0, axis=0)
+    world = np.stack([local_to_world(STAND - STAND[0], r, h) for r, h in zip(roots, heading)])
+    local = np.repeat((STAND - STAND[0])[None], len(t), axis=0)
+    visible = np.ones(world.shape[:2], dtype=bool)
+    visible[10, 0] = False
+    went = travelled(world, local, visible, 0)
+    assert went[-1, 0] > 0.5 and went[-1, 2] > 0.5 and np.isnan(went[10]).all()
+    assert np.isnan(travelled(world, local, visible & False, 0)).all()
 
 
 def test_travel_is_the_displacement_over_the_horizon():
@@ -163,10 +186,11 @@ def test_a_clip_that_is_one_cycle_away_from_every_hub_loops_and_a_gesture_does_n
 def test_travel_tells_forwards_from_backwards_where_the_poses_are_the_same(clips):
     """Three cycles of the walk and of the walk backwards, watched from the same point of the cycle: their
     root-relative poses are the same, all the paper's eq. 1 sees; the motion comparison carries every part along
-    where the body goes, and each is itself."""
+    where the body goes, and each is itself (the comparison alone: the takes' strokes, beside it in the template,
+    are :func:`test_the_takes_strokes_see_where_the_root_went`'s)."""
     from toolkit.observe import Observer
 
-    profile, observer = _observer(clips)
+    profile, observer = _observer(clips, comparison="motion")
     watch = Observer(observer, profile.body, 30.0)
     answers, poses = {}, {}
     for movement, speed in (("walk", 1.2), ("back", -1.2)):
@@ -176,6 +200,23 @@ def test_travel_tells_forwards_from_backwards_where_the_poses_are_the_same(clips
     assert np.allclose(poses["walk"], poses["back"])
     assert answers["walk"].movement == "walk" and answers["back"].movement == "back"
     assert {observer.motor.movement_of(n) for n in answers["walk"].path} == {"walk"}
+
+
+def test_the_takes_strokes_see_where_the_root_went(clips):
+    """The strokes beside the motion comparison cut the root's travel as one more path
+    (plugins.matchers.strokes_evidence.TravelStrokes): a walk forwards and one backwards from the same point of the
+    cycle make the same strokes of the feet, and opposite strokes of the root, along the facing."""
+    from plugins.lib.clip_repertoire import root_relative_motion
+    from plugins.matchers.strokes_evidence import TakeStrokes
+
+    body = load_profile(clips / "profile.toml").body
+    strokes = TakeStrokes(body)
+    walk, back = (strokes.series(root_relative_motion(Motion(_step_cycle(30, speed, cycles=3), 30.0, PARTS), body))
+                  for speed in (1.2, -1.2))
+    for feet, other in zip(walk[:-1], back[:-1]):
+        np.testing.assert_allclose(feet, other, atol=1e-9)
+    assert len(walk[-1]) == len(back[-1]) == 1 and walk[-1][0, 2] > 0.2
+    np.testing.assert_allclose(back[-1], -walk[-1], atol=1e-9)
 
 
 def test_a_key_posed_bob_travels_down_then_up(pm, write):
