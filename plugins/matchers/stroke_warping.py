@@ -160,7 +160,8 @@ def shares(series: Strokes) -> Strokes:
 
 
 def strokes_still(series: Strokes) -> float:
-    """A sequence's distance to standing still: the total length of its parts' strokes (body sizes)."""
+    """A sequence's distance to standing still: the total length of its parts' strokes (1 once in shares,
+    :func:`shares`; 0 with no stroke)."""
     return float(sum(np.linalg.norm(strokes, axis=1).sum() for strokes in series))
 
 
