@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["frame_rotation", "body_velocity", "travel_part", "travelled", "turned"]
+__all__ = ["frame_rotation", "body_velocity", "bridged_rows", "travel_part", "travelled", "turned"]
 
 
 def frame_rotation(world: np.ndarray, local: np.ndarray, visible: np.ndarray, root: int) -> np.ndarray:
@@ -79,6 +79,15 @@ def travelled(world: np.ndarray, local: np.ndarray, visible: np.ndarray, root: i
     return out
 
 
+def bridged_rows(values: np.ndarray, seen: np.ndarray) -> np.ndarray:
+    """``values`` (n, k) with the rows not ``seen`` (n,) filled in: on a straight line between the seen rows around
+    them, held beyond the first and the last. At least one row must be seen."""
+    if seen.all():  # np.interp at its own sample points gives those samples back: no call needed
+        return values
+    steps = np.arange(len(values))
+    return np.stack([np.interp(steps, steps[seen], values[seen, k]) for k in range(values.shape[1])], axis=1)
+
+
 def body_velocity(world: np.ndarray, local: np.ndarray, visible: np.ndarray, root: int, fps: float,
                   window: float = 0.25, frames: np.ndarray | None = None) -> np.ndarray:
     """The root's velocity in the body's own frame (F, 3), m/s; NaN where the root or the facing is not known.
@@ -99,11 +108,7 @@ def body_velocity(world: np.ndarray, local: np.ndarray, visible: np.ndarray, roo
     root_seen = np.asarray(visible, dtype=bool)[:, root] & np.isfinite(world[:, root]).all(axis=1)
     if root_seen.sum() < 2:
         return out
-    if root_seen.all():  # np.interp at its own sample points gives those samples back: no call needed
-        track = world[:, root]
-    else:
-        steps = np.arange(n)
-        track = np.stack([np.interp(steps, steps[root_seen], world[root_seen, root, k]) for k in range(3)], axis=1)
+    track = bridged_rows(world[:, root], root_seen)
     velocity = np.empty((n, 3))  # np.gradient(track, axis=0) (unit spacing, first-order edges), the same numbers
     velocity[1:-1] = (track[2:] - track[:-2]) / 2.0
     velocity[0] = track[1] - track[0]

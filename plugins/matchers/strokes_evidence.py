@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from plugins.lib.travel import travelled
+from plugins.lib.travel import bridged_rows, travelled
 from plugins.matchers.decision import Calibration
 from plugins.matchers.dtw import position_parts
 from plugins.matchers.stroke_warping import (
@@ -180,12 +180,7 @@ def _track(motion: Motion, root: int) -> np.ndarray | None:
         return None
     track = travelled(motion.world, motion.positions, motion.visible, root)
     seen = np.isfinite(track).all(axis=1)
-    if not seen.any():
-        return None
-    if seen.all():
-        return track
-    steps = np.arange(len(track))
-    return np.stack([np.interp(steps, steps[seen], track[seen, k]) for k in range(3)], axis=1)
+    return bridged_rows(track, seen) if seen.any() else None
 
 
 def evidence_weights(rows: Sequence[np.ndarray], movements: Sequence[str], known_rejected: float) -> np.ndarray:

@@ -15,7 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from plugins.lib.root_frame import root_relative
-from plugins.lib.travel import body_velocity, frame_rotation, travel_part, travelled
+from plugins.lib.travel import body_velocity, bridged_rows, frame_rotation, travel_part, travelled
 from tests.conftest import STICK, STICK_PARTS, write_stick_clip, write_stick_profile
 from toolkit import Motion, create_plugin_manager, load_character
 from toolkit.motion import local_to_world
@@ -93,6 +93,13 @@ def test_a_walk_that_turns_left_goes_off_to_the_left_of_where_it_began_facing():
     went = travelled(world, local, visible, 0)
     assert went[-1, 0] > 0.5 and went[-1, 2] > 0.5 and np.isnan(went[10]).all()
     assert np.isnan(travelled(world, local, visible & False, 0)).all()
+
+
+def test_rows_not_seen_are_bridged_on_a_line_and_held_beyond_the_ends():
+    values = np.array([[9.0, 9.0], [0.0, 2.0], [9.0, 9.0], [4.0, 6.0], [9.0, 9.0]])
+    seen = np.array([False, True, False, True, False])
+    assert np.array_equal(bridged_rows(values, seen), [[0, 2], [0, 2], [2, 4], [4, 6], [4, 6]])
+    assert bridged_rows(values, np.ones(5, dtype=bool)) is values
 
 
 def test_travel_is_the_displacement_over_the_horizon():
