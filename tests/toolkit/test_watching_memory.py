@@ -145,6 +145,7 @@ def observers(data, profile, pm_):
        keep=st.sampled_from([0.5, 1.0, 3.0]), seed=st.integers(0, 2**16), hidden=st.booleans())
 @example(pairing=2, start=128, length=300, keep=0.5, seed=1, hidden=False)  # velocity-direction back-dating an
 # onset 16 frames, past what half a second kept, before it said so (holds_since)
+@example(pairing=1, start=600, length=1185, keep=0.5, seed=547, hidden=True)  # CI, 3030ef8
 def test_a_bounded_working_memory_gives_the_observations_an_unbounded_one_gives(observers, profile, stream, pairing,
                                                                                  start, length, keep, seed, hidden):
     """On generated streams (Morris's random movements with noise, a part lost for a while), in random packets:

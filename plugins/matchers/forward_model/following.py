@@ -226,6 +226,7 @@ class Watched:
         self.origin = np.zeros((parts, 3))  # where each part was first seen (root-relative): its onset
         self.found = np.zeros(parts, dtype=bool)
         self.size = 0.0
+        self.first = max(self.delay, taps - 1)  # the frame the first sample can be given at (:meth:`due`)
         self.sampled = 0  # samples given so far
 
     def __len__(self) -> int:
@@ -272,8 +273,19 @@ class Watched:
         unwrapped = np.unwrap(np.concatenate([[previous], heading])) [1:] if previous is not None else np.unwrap(heading)
         self.headings[rows] = unwrapped
         self.n += k
-        if self.size <= 0 and self.n > self.delay:  # from the frames the first sample needs, however they come
-            self.size = sequence_size(self.relative[: self.delay + 1], self.seen[: self.delay + 1])
+        if self.size <= 0:
+            self._measure()
+
+    def _measure(self) -> None:
+        """The body size, once the frames it is measured on are all there, however they come: the frames the first
+        sample needs (:attr:`delay` + 1), from the first frame with two parts seen (the root lost at the onset:
+        nothing is root-relative before it is found)."""
+        two = np.flatnonzero(self.seen[: self.n].sum(axis=1) >= 2)
+        if not len(two) or self.n <= two[0] + self.delay:
+            return
+        onset = slice(two[0], two[0] + self.delay + 1)
+        self.size = sequence_size(self.relative[onset], self.seen[onset])
+        self.first = max(self.first, two[0] + self.delay)
 
     def motion(self) -> Recording:
         """The demonstration so far as a motion: root-relative in the body's frame, each part held where it was last
@@ -281,7 +293,12 @@ class Watched:
         return Recording(self.relative[: self.n].copy(), self.fps, self.body.parts, visible=self.seen[: self.n].copy())
 
     def due(self, ended: bool) -> np.ndarray:
-        """The frames of the samples not given yet whose frames are all there (``ended``: every sample left)."""
+        """The frames of the samples not given yet whose frames are all there (``ended``: every sample left).
+
+        Not before :attr:`first`: the first window of velocities and the body size are then there, and a sample is
+        the same whatever blocks its frames came in (a bounded working memory gives them in small ones)."""
+        if not ended and (self.size <= 0 or self.n <= self.first):
+            return np.zeros(0, dtype=np.intp)
         last = self.n - 1 if ended else self.n - 1 - self.delay
         step = self.fps / RATE
         count = int(np.floor(last / step + 0.5 + 1e-9)) + 1 if last >= 0 else 0
@@ -292,7 +309,7 @@ class Watched:
         """The frames of the samples at ``rows`` (frames of the demonstration), given in order."""
         n, rows = self.n, np.asarray(rows, dtype=np.intp)
         relative, headings, roots = self.relative[:n], self.headings[:n], self.roots[:n]
-        if self.size <= 0:  # a segment shorter than the first sample needs: what there is of it
+        if self.size <= 0:  # a segment that ended before its size was known: what there is of it
             self.size = sequence_size(relative, self.seen[:n])
         taps = len(self.coeffs)
         if n >= taps:
@@ -431,7 +448,7 @@ class Following:
             self.ends, self.chain_scores, self.scores = followed.ends[i], chain_scores[i], scores[i]
             self._moved += float(stills[i])
             self._samples += 1
-            for match in self._decide(row + (watched.delay if not ended else 0)):
+            for match in self._decide(row if ended else max(row + watched.delay, watched.first)):
                 events.append((row, match))
         return events
 

@@ -205,6 +205,32 @@ def test_a_part_hidden_at_the_onset_is_measured_from_where_it_was_first_seen(obs
                                later.parts[seen, hand, :3] - since, atol=1e-9)
 
 
+@settings(max_examples=15, deadline=None)
+@given(hidden=st.integers(0, 40), seed=st.integers(0, 2**16))
+def test_the_root_lost_at_the_onset_gives_the_same_answers_however_the_frames_come(observer, generated, hidden, seed):
+    """The root hidden for the first frames, nothing is root-relative, and the body's size waits for the first
+    frames with two parts seen: fed at once or in random blocks (as a bounded working memory gives them), the same
+    decisions at the same frames and the same answer (before: a size measured on whatever block came first)."""
+    data, profile = generated
+    motion = profile.read(data / "demos" / "wave" / "morris_1.0.bvh")
+    world = motion.positions.copy()
+    world[:hidden, profile.body.root_index] = np.nan
+    visible = np.isfinite(world).all(axis=-1)
+    rng = np.random.default_rng(seed)
+    cuts = np.sort(rng.choice(np.arange(1, len(world)), size=6, replace=False)).tolist()
+    f = following(observer)
+    runs = []
+    for blocks in ([0, len(world)], [0, *cuts, len(world)]):
+        f.begin(motion.fps)
+        events = []
+        for a, b in zip(blocks[:-1], blocks[1:]):
+            events += [(frame, repr(match)) for frame, match in f.add(world[a:b], visible[a:b])]
+        runs.append((events, repr(f.conclude(motion.n_frames)), f.watched.size, f.watched.first))
+    assert runs[0] == runs[1]
+    assert runs[0][2] > 0 and runs[0][3] >= hidden + f.watched.delay  # measured once the root was found
+    assert all(frame + f.watched.delay >= hidden for frame, _ in runs[0][0])
+
+
 def test_the_window_fits_are_the_derivative_of_the_window():
     """The weights a live demonstration's velocities are taken with near its ends (``_window_fits``) give what the
     Savitzky-Golay derivative of the first or last window's frames gives there (scipy's own edge fit, to rounding),
