@@ -14,9 +14,10 @@ chosen once when a matcher is attached (``decision = "distance"`` or ``"calibrat
 
 :class:`Calibrated` (real people, the observer template's)
     Calibrated from the repertoire itself, so the same setting holds for one take of each movement, two, or
-    fourteen, on any skeleton. The score is unit-free: the distance to the nearest movement over the
-    demonstration's distance to standing still (:meth:`plugins.matchers.comparison.Comparison.still`), the share of
-    the demonstration its nearest movement leaves unexplained. The matcher measures, with its own comparison and
+    fourteen, on any skeleton. The score is unit-free (:func:`relative_scores`): the distance to the nearest
+    movement over the larger of the demonstration's distance to standing still
+    (:meth:`plugins.matchers.comparison.Comparison.still`) and that movement's take's, the share of the larger of
+    the two motions the pair leaves unexplained. The matcher measures, with its own comparison and
     search, two sets of scores on its repertoire (:class:`Calibration`):
 
     - *own*: each take of a movement of several takes, against the movement's other takes (leave one take out):
@@ -64,7 +65,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Calibrated", "Calibration", "DECISIONS", "Decision", "Distance", "Stillness", "Verdict"]
+__all__ = ["Calibrated", "Calibration", "DECISIONS", "Decision", "Distance", "Stillness", "Verdict", "relative_scores"]
 
 
 @dataclass(frozen=True)
@@ -251,9 +252,29 @@ class Stillness:
         return nearest in self.still and moved <= self.limit
 
 
+def relative_scores(distances: np.ndarray, moving: np.ndarray, takes: np.ndarray) -> np.ndarray:
+    """The calibrated decision's unit-free scores (..., C): each chain's ``distances`` over how much there is to
+    explain, the larger of the demonstration's distance to standing still (``moving``, each chain's at its pace)
+    and the nearest chain's take's own (``takes``, (C,)), one denominator for every chain of a row, so they rank as
+    their distances over ``moving`` do; ``inf`` where the demonstration does not move.
+
+    Over the demonstration's motion alone, a performance with less motion than the take (a wave held low, with a
+    smaller lift and smaller swings: half the take's motion) lay twice as far as the same difference in a larger
+    one, and a style that moves little read as unknown. Over the larger of the two, the share left unexplained is
+    the same whichever of the pair moves more. A take that holds still (no motion) changes nothing."""
+    distances = np.asarray(distances, dtype=float)
+    moving = np.broadcast_to(np.asarray(moving, dtype=float), distances.shape)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(moving > 0, distances / moving, np.inf)
+        best = np.argmin(ratio, axis=-1)[..., None]
+        own = np.take_along_axis(moving, best, axis=-1)
+        larger = np.where(own > 0, np.maximum(1.0, np.asarray(takes, dtype=float)[best] / own), 1.0)
+        return np.where(moving > 0, ratio / larger, np.inf)
+
+
 STILL = 1.0
 """The largest calibrated threshold: a score of 1 is a demonstration its nearest movement explains no better than
-standing still would."""
+standing still would (the larger of the pair's motions left unexplained)."""
 
 DECISIONS = {"distance": Distance, "calibrated": Calibrated}
 """The decisions by the name a matcher's ``decision`` parameter takes."""

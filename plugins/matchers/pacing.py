@@ -15,8 +15,8 @@ for the end, so here each take (a chain) is followed at the pace its own best pa
   (:class:`plugins.matchers.comparison.Paired`: what it would be at the take's tempo), and the warping steps on
   (the steps and the free beginning and end of :mod:`plugins.matchers.warping`);
 - its distance to standing still is taken at the same pace, so each chain's *score* is its best path's mean cost over
-  the demonstration's mean distance to standing still as that chain has paced it (the relative score of
-  :mod:`plugins.matchers.decision`).
+  the demonstration's mean distance to standing still as that chain has paced it, or the nearest take's own where it
+  moves more (the relative score, :func:`plugins.matchers.decision.relative_scores`).
 
 A demonstration at the take's own tempo is followed as the unpaced warping follows it. The numbers after a sample do
 not depend on how the samples before it came in (one by one or at once): the costs are computed pair by pair
@@ -33,7 +33,8 @@ import numpy as np
 from plugins.lib.compiled import kernel
 from plugins.matchers.comparison import Frames, Motion, Paired
 from plugins.matchers.tempo import TEMPO
-from plugins.matchers.warping import Chains, kept, kept_chains
+from plugins.matchers.decision import relative_scores
+from plugins.matchers.warping import Chains, chain_stills, kept, kept_chains
 
 __all__ = ["Followed", "PRIOR", "PacedWarping", "followed_scores"]
 
@@ -199,6 +200,5 @@ def followed_scores(comparison: Motion, samples: Frames, nodes: Frames, chains: 
     warping = PacedWarping(comparison, frames, Chains(np.arange(len(frames), dtype=np.intp), starts, movements,
                                                       cyclic), rate)
     followed = warping.advance(samples)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        scores[keep] = np.where(followed.moved[-1] > 0, followed.distance[-1] / followed.moved[-1], np.inf)
+    scores[keep] = relative_scores(followed.distance[-1], followed.moved[-1], chain_stills(comparison, frames, starts))
     return scores

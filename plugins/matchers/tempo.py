@@ -18,8 +18,8 @@ So each chain (a take) is compared twice:
    the shape and the turn since the onset do not change with tempo) and the warping aligns it again.
 
 Each chain's *score* is its distance at its own tempo over the demonstration's distance to standing still at that
-tempo (the relative score of :mod:`plugins.matchers.decision`), so that chains compared at different paces rank
-alike. The pace is held within ``1 / TEMPO`` and ``TEMPO``: a path that stays on one frame of a held pose has pace 0,
+tempo (the relative score of :func:`plugins.matchers.decision.relative_scores`, which takes the nearest take's own
+motion where it moves more), so that chains compared at different paces rank alike. The pace is held within ``1 / TEMPO`` and ``TEMPO``: a path that stays on one frame of a held pose has pace 0,
 and a demonstration's motion multiplied without bound would make its own jitter a movement.
 
 Positions have no tempo (:class:`plugins.matchers.comparison.Poses`, the papers' eq. 1): for them the second pass is
@@ -40,7 +40,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from plugins.matchers.comparison import Comparison, Frames
-from plugins.matchers.warping import Chains, kept, kept_chains, warp_chains
+from plugins.matchers.decision import relative_scores
+from plugins.matchers.warping import Chains, chain_stills, kept, kept_chains, warp_chains
 
 __all__ = ["Paced", "TEMPO", "less_jitter", "paced_distances", "paced_scores", "paces"]
 
@@ -56,8 +57,9 @@ class Paced:
     Attributes
     ----------
     scores : array, shape (C,)
-        Each chain's distance at its pace over the demonstration's distance to standing still at that pace
-        (``inf`` for a chain left out, and where the demonstration does not move at all).
+        Each chain's distance at its pace over the demonstration's distance to standing still at that pace, or
+        over the nearest take's own where that take moves more (:func:`~plugins.matchers.decision.relative_scores`;
+        ``inf`` for a chain left out, and where the demonstration does not move at all).
     distances : array, shape (C,)
         Each chain's distance at its pace, in the comparison's unit (``inf`` for a chain left out).
     pace : array, shape (C,)
@@ -106,8 +108,7 @@ def paced_distances(comparison: Comparison, samples: Frames, nodes: Frames, chai
         moving = np.full(len(found), float(np.mean(comparison.still(samples))))
     if samples.noise is not None or frames.noise is not None:
         found, moving = less_jitter(found, moving, samples, frames, starts, pace[keep])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        scores[keep] = np.where(moving > 0, found / moving, np.inf)
+    scores[keep] = relative_scores(found, moving, chain_stills(comparison, frames, starts))
     distances[keep] = found
     if columns is not None:
         full = np.zeros((len(samples), len(nodes)))

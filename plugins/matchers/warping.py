@@ -27,10 +27,10 @@ import numpy as np
 
 from plugins.lib.compiled import kernel
 from plugins.matchers.comparison import Comparison, Frames
-from plugins.matchers.decision import Calibration
+from plugins.matchers.decision import Calibration, relative_scores
 
-__all__ = ["Chains", "chain_calibration", "chain_distances", "chain_path", "chain_rows", "kept", "kept_chains",
-           "relative_distances", "warp_chains"]
+__all__ = ["Chains", "chain_calibration", "chain_distances", "chain_path", "chain_rows", "chain_stills", "kept",
+           "kept_chains", "relative_distances", "warp_chains"]
 
 
 @dataclass(frozen=True)
@@ -254,7 +254,18 @@ def relative_distances(comparison: Comparison, samples: Frames, nodes: Frames, c
     the demonstration does not move at all: nothing to explain, nothing to calibrate on)."""
     distances, _ = chain_distances(comparison, samples, nodes, chains, skip)
     still = float(np.mean(comparison.still(samples)))
-    return distances / still if still > 0 else np.full(len(distances), np.inf)
+    return relative_scores(distances, np.full(len(distances), still), chain_stills(comparison, nodes, chains.starts))
+
+
+def chain_stills(comparison: Comparison, nodes: Frames, starts: np.ndarray) -> np.ndarray:
+    """Each chain's take's own distance to standing still (C,): the mean over its frames ``nodes[starts[c] :
+    starts[c + 1]]`` of :meth:`~plugins.matchers.comparison.Comparison.still`, what
+    :func:`~plugins.matchers.decision.relative_scores` weighs the demonstration's against."""
+    still = comparison.still(nodes)
+    starts = np.asarray(starts, dtype=np.intp)
+    if len(still) == 0:
+        return np.zeros(len(starts) - 1)
+    return np.add.reduceat(still, np.minimum(starts[:-1], len(still) - 1)) / np.maximum(np.diff(starts), 1)
 
 
 def chain_calibration(comparison: Comparison, takes: list[Frames], nodes: Frames, chains: Chains,

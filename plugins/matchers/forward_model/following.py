@@ -63,11 +63,11 @@ from plugins.lib.compiled import one_thread
 from plugins.lib.root_frame import HeadingFilter, facing_heading, to_root_relative
 from plugins.lib.velocity import derivative, window_frames
 from plugins.matchers.comparison import Frames, Motion, sequence_size
-from plugins.matchers.decision import Calibrated, Calibration, Decision, Stillness
+from plugins.matchers.decision import Calibrated, Calibration, Decision, Stillness, relative_scores
 from plugins.matchers.forward_model.answer import Answer, FollowedScores
 from plugins.matchers.pacing import PacedWarping, followed_scores
 from plugins.matchers.strokes_evidence import PLAYED_FPS
-from plugins.matchers.warping import Chains, chain_rows
+from plugins.matchers.warping import Chains, chain_rows, chain_stills
 from toolkit import Match
 from toolkit import Motion as Recording
 
@@ -376,14 +376,16 @@ class Following:
         self._heads = np.flatnonzero(np.r_[True, ordered[1:] != ordered[:-1]]) if len(ordered) else np.zeros(0, int)
         self.movements = [str(m) for m in ordered[self._heads]]
         self._index = {m: i for i, m in enumerate(self.movements)}
+        p = self.prediction
+        self._takes_moved = chain_stills(self.comparison, p.frames, p.chains.starts) if p.frames is not None \
+            else np.zeros(0)  # each take's own distance to standing still (relative_scores)
         rows = self.rows()
         if isinstance(self.decision, Calibrated):
             self.decision.calibrate(Calibration.of_rows(rows, self.prediction.chains.movements))
         self.answer.rebuild(rows, self.prediction.chains.movements, partial(self.prediction.motions, self.motor))
         motion: dict[str, float] = {}
-        for take, movement in zip(self.prediction.takes, self.prediction.chains.movements):
-            moved = float(self.comparison.still(take).mean()) if len(take) else 0.0
-            motion[movement] = max(motion.get(movement, 0.0), moved)
+        for moved, movement in zip(self._takes_moved, self.prediction.chains.movements):
+            motion[movement] = max(motion.get(movement, 0.0), float(moved))
         self.stillness = Stillness.of(motion) if self.decision.relative else Stillness()
         self.watched: Watched | None = None
 
@@ -458,12 +460,13 @@ class Following:
         return self._moved / self._samples if self._samples else 0.0
 
     def _chain_scores(self, distances: np.ndarray, moved: np.ndarray) -> np.ndarray:
-        """Each take's score: its distance over the demonstration's distance to standing still at its pace (its
-        distance, for a decision that is not relative)."""
+        """Each take's score: its distance over the demonstration's distance to standing still at its pace, or the
+        nearest take's own where it moves more (:func:`~plugins.matchers.decision.relative_scores`; its distance, for
+        a decision that is not relative)."""
         if not self.decision.relative:
             return distances
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return np.where(moved > 0, distances / moved, np.where(distances <= 0, 0.0, np.inf))
+        scores = relative_scores(distances, moved, self._takes_moved)
+        return np.where(moved > 0, scores, np.where(distances <= 0, 0.0, np.inf))
 
     def _take(self, movement: int) -> int:
         """The chain of a movement's best take so far."""

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from plugins.matchers.decision import Calibrated, Calibration, Distance, Stillness
+from plugins.matchers.decision import Calibrated, Calibration, Distance, Stillness, relative_scores
 from toolkit import load_character
 from toolkit.observe import Observer, compose_observer
 from toolkit.recordings.profile import load_profile
@@ -78,6 +78,25 @@ def test_the_calibrated_score_is_the_share_left_unexplained():
     assert decision.decide("wave", 0.1, 0.0).movement is None
 
 
+@given(st.lists(st.tuples(*(st.floats(low, 5.0, allow_subnormal=False) for low in (0.0, 0.01, 0.0))), min_size=1,
+                max_size=8))
+def test_relative_scores_rank_as_the_share_of_the_demonstrations_motion_over_the_larger_of_the_nearest_pair(rows):
+    """Each chain's (distance, the demonstration's motion at its pace, the take's motion): the scores rank as
+    distance over the demonstration's motion, and the nearest's is its distance over the larger of the pair's
+    motions (a half-size performance leaves the same share of the take unexplained as the take would of it)."""
+    distances, moving, takes = (np.array(column) for column in zip(*rows))
+    got = relative_scores(distances, moving, takes)
+    ratio = distances / moving
+    k = int(np.argmin(ratio))
+    assert got[k] == pytest.approx(distances[k] / max(moving[k], takes[k]))
+    np.testing.assert_allclose(got, ratio / max(1.0, takes[k] / moving[k]))
+    assert int(np.argmin(got)) == k
+    half = relative_scores(np.array([0.5]), np.array([0.5]), np.array([1.0]))  # half the take's motion, half missing
+    assert half[0] == pytest.approx(0.5) and relative_scores(np.array([0.5]), np.array([1.0]), np.array([0.5]))[0] \
+        == pytest.approx(0.5)
+    assert relative_scores(np.array([0.0, 1.0]), np.array([0.0, 0.0]), np.array([1.0, 1.0])).tolist() == [np.inf] * 2
+
+
 def test_calibration_keeps_finite_scores_only():
     assert Calibration.of([0.1, np.inf, np.nan], [np.inf, 0.5]) == Calibration((0.1,), (0.5,))
 
@@ -136,6 +155,24 @@ def test_a_known_movement_performed_otherwise_is_taken_for_it_and_a_new_one_is_u
     unknown = stick.matcher.match(type(new)(positions, new.fps, new.parts, new.visible))
     assert unknown.movement is None and unknown.reason == "too far from every path"
     assert unknown.score > unknown.threshold and unknown.nearest in ("raise", "reach", "kick")
+
+
+def test_a_wave_with_half_the_takes_motion_leaves_half_of_it_unexplained():
+    """A wave with half the take's reach and travel (a style that moves less): over its own motion alone the wave
+    explained it hardly better than standing still (score above 0.9); over the larger of the pair's
+    motions half of the take is left unexplained, as a wave twice the take's size leaves half of itself."""
+    from plugins.matchers.comparison import Frames, Motion
+    from plugins.matchers.tempo import paced_distances
+    from plugins.matchers.warping import Chains
+    from tests.plugins.matchers.test_tempo import _waving
+
+    take, still = _waving(3.0), _waving(3.0, travel=0.0, reach=0.0)
+    nodes, chains = Frames.join([take, still]), Chains.of_lengths([len(take), len(still)], ["wave", "still"])
+    half, double = _waving(3.0, travel=0.6, reach=0.15), _waving(3.0, travel=2.4, reach=0.6)
+    small, large = (paced_distances(Motion(), d, nodes, chains) for d in (half, double))
+    assert small.scores[0] == pytest.approx(0.5, abs=0.05) and large.scores[0] == pytest.approx(0.5, abs=0.05)
+    assert small.distances[0] / np.mean(Motion().still(half)) > 0.9  # over its own motion: near standing still
+    assert small.scores[0] < small.scores[1] and large.scores[0] < large.scores[1]  # the wave, not standing still
 
 
 @pytest.fixture(scope="module")

@@ -11,7 +11,8 @@ from hypothesis import strategies as st
 
 from plugins.matchers.comparison import Frames, Motion
 from plugins.matchers.pacing import PRIOR, PacedWarping, followed_scores
-from plugins.matchers.warping import Chains, relative_distances
+from plugins.matchers.decision import relative_scores
+from plugins.matchers.warping import Chains, chain_stills, relative_distances
 from tests.plugins.matchers.reference import followed_score
 from tests.plugins.matchers.test_tempo import RATE, _frames, _waving
 
@@ -76,7 +77,9 @@ def test_a_performance_slower_than_its_take_is_followed_at_the_takes_tempo(slowe
     assert scores[0] < 0.3 < 0.99 < scores[1]
     plain = relative_distances(Motion(), demonstration, nodes, chains)
     assert scores[0] < 0.5 * plain[0]
-    np.testing.assert_allclose(followed_scores(Motion(), demonstration, nodes, chains, rate=RATE), scores)
+    takes = chain_stills(Motion(), nodes, chains.starts)  # the calibration's scores: relative to the larger motion
+    np.testing.assert_allclose(followed_scores(Motion(), demonstration, nodes, chains, rate=RATE),
+                               relative_scores(followed.distance[-1], followed.moved[-1], takes))
 
 
 def test_a_chain_left_out_is_infinitely_far_and_positions_cannot_be_paced():
