@@ -182,7 +182,7 @@ class Calibrated(Decision):
 
     @property
     def measure(self) -> str:
-        return "distance to the nearest movement over the distance to standing still"
+        return "distance to the nearest movement over the larger motion, its or the demonstration's"
 
     def calibrate(self, calibration: Calibration) -> None:
         """Take the scores measured on the repertoire (:class:`Calibration`)."""

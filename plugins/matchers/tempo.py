@@ -19,8 +19,9 @@ So each chain (a take) is compared twice:
 
 Each chain's *score* is its distance at its own tempo over the demonstration's distance to standing still at that
 tempo (the relative score of :func:`plugins.matchers.decision.relative_scores`, which takes the nearest take's own
-motion where it moves more), so that chains compared at different paces rank alike. The pace is held within ``1 / TEMPO`` and ``TEMPO``: a path that stays on one frame of a held pose has pace 0,
-and a demonstration's motion multiplied without bound would make its own jitter a movement.
+motion where it moves more), so that chains compared at different paces rank alike. The pace is held within
+``1 / TEMPO`` and ``TEMPO``: a path that stays on one frame of a held pose has pace 0, and a demonstration's motion
+multiplied without bound would make its own jitter a movement.
 
 Positions have no tempo (:class:`plugins.matchers.comparison.Poses`, the papers' eq. 1): for them the second pass is
 the first, and it is not made.
